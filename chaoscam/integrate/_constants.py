@@ -1,0 +1,59 @@
+"""Assemble the kernel's constants vector from a :class:`~chaoscam.model.Params`.
+
+This is the only bridge between the documented parameter set and the compiled kernels: every
+number a kernel uses is put here, by name.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..model import Params
+from . import _kernel as k
+
+__all__ = ["kernel_constants"]
+
+
+def kernel_constants(p: Params, *, t_record: float = 0.0, stride: int = 0) -> np.ndarray:
+    """The float64 constants vector indexed by ``_kernel.C_*``.
+
+    Parameters
+    ----------
+    p : Params
+        The model.
+    t_record : float
+        Outputs (series, section, impacts, contact fraction) are kept from this time [s].
+    stride : int
+        Keep a series sample every ``stride`` grid steps; 0 keeps none.
+    """
+    c = np.zeros(k.N_CONSTANTS)
+    xo, yo = p.pivot
+    c[k.C_OMEGA] = p.omega
+    c[k.C_THETA_C0] = p.theta_c0
+    c[k.C_E] = p.e
+    c[k.C_XO] = xo
+    c[k.C_YO] = yo
+    c[k.C_RSUM] = p.R + p.r
+    c[k.C_RCAM] = p.R
+    c[k.C_RROD] = p.r
+    c[k.C_GRAV] = 0.5 * p.m * p.g * p.l
+    c[k.C_INV_J] = 1.0 / p.inertia
+    c[k.C_HERTZ] = 0.25 * math.pi * p.E
+    c[k.C_K_FIXED] = p.stiffness_at(0.0) if p.stiffness == "fractal" else 0.0
+    c[k.C_DAMP_SIGN] = 1.0 if p.damping == "hunt_crossley" else -1.0
+    c[k.C_BETA] = p.beta
+    c[k.C_MU_ARM] = p.mu_f * p.arm
+    c[k.C_VEPS] = p.v_eps
+    c[k.C_VMIN] = p.v_min
+    c[k.C_XI] = p.xi
+    c[k.C_ROD_L] = p.l
+    c[k.C_DT] = p.dt
+    c[k.C_EVENT_TOL] = p.event_tol
+    c[k.C_PERIOD] = p.cam_period
+    c[k.C_T_RECORD] = t_record
+    c[k.C_RESAMPLE_DT] = p.resample_dt if p.resample == "interval" else 0.0
+    c[k.C_MAX_EVENTS] = p.max_events_per_step
+    c[k.C_STRIDE] = stride
+    return c

@@ -1,0 +1,85 @@
+"""Geometry of the cam and the follower rod (shared/MODEL.md, "Geometry"; paper eqs. (5), (6)).
+
+Plain numpy functions of time and the follower state; they accept scalars or arrays. The
+compiled kernels carry their own scalar copy of these formulas, and the tests check the two
+against each other.
+
+Frame: cam rotation centre O' at the origin, pivot O = (x_O, y_O), cam phase
+``theta_c = omega t + theta_c0``, cam centre ``C = e (cos theta_c, sin theta_c)``. Rod axis
+direction ``u = (cos theta_f, sin theta_f)``, upward normal ``n = (-sin theta_f, cos theta_f)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._params import Params
+
+__all__ = [
+    "cam_centre",
+    "gap",
+    "lever_arm",
+    "gap_rate",
+    "normal_cam_speed",
+    "contact_angle",
+    "contact_angle_rate",
+    "slip_speed",
+]
+
+
+def cam_centre(p: Params, t):
+    """Cam centre C(t) and its velocity dC/dt, each as an (x, y) pair of arrays [m, m/s]."""
+    th = p.omega * np.asarray(t, dtype=float) + p.theta_c0
+    c, s = np.cos(th), np.sin(th)
+    return (p.e * c, p.e * s), (-p.e * p.omega * s, p.e * p.omega * c)
+
+
+def gap(p: Params, t, theta_f):
+    """Signed gap delta = (O - C).n - (R + r) [m]; > 0 separated, <= 0 in contact."""
+    (cx, cy), _ = cam_centre(p, t)
+    xo, yo = p.pivot
+    return (xo - cx) * -np.sin(theta_f) + (yo - cy) * np.cos(theta_f) - (p.R + p.r)
+
+
+def lever_arm(p: Params, t, theta_f):
+    """Lever arm l_1 = (C - O).u [m], the distance from the pivot to the contact point."""
+    (cx, cy), _ = cam_centre(p, t)
+    xo, yo = p.pivot
+    return (cx - xo) * np.cos(theta_f) + (cy - yo) * np.sin(theta_f)
+
+
+def normal_cam_speed(p: Params, t, theta_f):
+    """Cam-centre velocity along the rod normal, dC/dt . n [m/s] (paper (5): v_Bc . n)."""
+    _, (vx, vy) = cam_centre(p, t)
+    return -vx * np.sin(theta_f) + vy * np.cos(theta_f)
+
+
+def gap_rate(p: Params, t, theta_f, omega_f):
+    """Gap rate d(delta)/dt = l_1 dtheta_f/dt - dC/dt . n [m/s]."""
+    return lever_arm(p, t, theta_f) * omega_f - normal_cam_speed(p, t, theta_f)
+
+
+def contact_angle(p: Params, t):
+    """Persistent-contact angle theta_fc(t) [rad], the root of delta = 0 (closed form).
+
+    With ``O - C = rho (cos phi, sin phi)``: ``theta_fc = phi - pi + arcsin((R + r)/rho)``.
+    """
+    (cx, cy), _ = cam_centre(p, t)
+    xo, yo = p.pivot
+    dx, dy = xo - cx, yo - cy
+    rho = np.hypot(dx, dy)
+    return np.arctan2(dy, dx) - np.pi + np.arcsin((p.R + p.r) / rho)
+
+
+def contact_angle_rate(p: Params, t):
+    """d(theta_fc)/dt = (dC/dt . n) / l_1 at theta_f = theta_fc [rad/s]."""
+    th = contact_angle(p, t)
+    return normal_cam_speed(p, t, th) / lever_arm(p, t, th)
+
+
+def slip_speed(p: Params, t, theta_f, omega_f):
+    """Slip speed v_r = r dtheta_f/dt - (omega z x B_c).u at B_c = C - R n [m/s]."""
+    (cx, cy), _ = cam_centre(p, t)
+    nx, ny = -np.sin(theta_f), np.cos(theta_f)
+    bx, by = cx - p.R * nx, cy - p.R * ny
+    return p.r * omega_f - p.omega * (-by * np.cos(theta_f) + bx * np.sin(theta_f))

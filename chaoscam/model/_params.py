@@ -1,0 +1,363 @@
+"""The parameter set: Table 1 of the paper plus every decision of shared/MODEL.md.
+
+This module is the single home of physics choices. A kernel never holds a constant of its
+own; it receives the numbers assembled here (see :meth:`Params.kernel_constants`).
+
+Reference: "Effect of Surface Morphology on Dynamic Characteristics of Cam-Follower Oblique
+Impact System", Table 1 (SI units throughout).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+__all__ = ["Params", "ParameterError", "FIELD_DOCS"]
+
+
+class ParameterError(ValueError):
+    """A parameter is missing, of the wrong type or outside its allowed range.
+
+    The message always names the field and the allowed range.
+    """
+
+
+STIFFNESS_MODELS = ("hertz", "fractal")
+DAMPING_FORMS = ("hunt_crossley", "paper_literal")
+RESAMPLE_MODES = ("impact", "interval")
+
+# (lower, upper, lower_inclusive, upper_inclusive); None = unbounded.
+_POS = (0.0, None, False, None)
+_NONNEG = (0.0, None, True, None)
+
+
+def _meta(doc: str, unit: str, rng: tuple | None = _POS, choices: tuple | None = None) -> dict:
+    return {"doc": doc, "unit": unit, "range": rng, "choices": choices}
+
+
+@dataclass(frozen=True, slots=True)
+class Params:
+    """Frozen, validated parameters of the cam-follower oblique impact model.
+
+    Every field is overridable by keyword (``Params(omega=30.0)``), by :meth:`replace`, or on
+    the command line as ``--set NAME=VALUE``; the field names are the CLI names. Defaults are
+    Table 1 of the paper; fields marked *decision* are ours where the paper is silent or
+    inconsistent (shared/MODEL.md), each with its reason in ``FIELD_DOCS``.
+
+    Derived quantities (``J``, ``y_O``, the composite modulus, the stiffness) are computed by
+    properties so that a value left as ``None`` always means "the documented default rule".
+    """
+
+    # --- Table 1 -------------------------------------------------------------------------
+    l: float = field(default=0.6, metadata=_meta("follower (rod) length", "m"))
+    r: float = field(default=0.005, metadata=_meta("follower radius", "m"))
+    m: float = field(default=0.3676, metadata=_meta("follower mass", "kg"))
+    R: float = field(default=0.09, metadata=_meta("cam radius", "m"))
+    e: float = field(default=0.04, metadata=_meta("cam eccentricity", "m", _NONNEG))
+    nu_f: float = field(
+        default=0.3, metadata=_meta("Poisson's ratio of the follower", "-", (0.0, 0.5, True, False))
+    )
+    nu_c: float = field(
+        default=0.3, metadata=_meta("Poisson's ratio of the cam", "-", (0.0, 0.5, True, False))
+    )
+    Y_f: float = field(default=2.07e11, metadata=_meta("Young's modulus of the follower", "Pa"))
+    Y_c: float = field(default=2.07e11, metadata=_meta("Young's modulus of the cam", "Pa"))
+    g: float = field(default=9.81, metadata=_meta("gravity", "m/s^2", _NONNEG))
+    mu_f: float = field(default=0.3, metadata=_meta("friction coefficient", "-", _NONNEG))
+    beta: float = field(default=3.25, metadata=_meta("impact damping factor", "s/m", _NONNEG))
+    xi: float = field(
+        default=0.42,
+        metadata=_meta("coefficient of restitution, eq. (4)", "-", (0.0, 1.0, True, True)),
+    )
+    omega: float = field(default=28.7, metadata=_meta("cam speed", "rad/s"))
+    l_lambda: float = field(
+        default=0.008,
+        metadata=_meta("contact line length l_lambda, the mean mu when random, eq. (18)", "m"),
+    )
+    D: float = field(
+        default=1.45,
+        metadata=_meta("fractal dimension, eq. (15)", "-", (1.0, 2.0, False, False)),
+    )
+    G: float = field(default=1e-10, metadata=_meta("fractal roughness, eq. (15)", "m"))
+    k: float = field(default=2.8, metadata=_meta("hardness/yield-strength ratio", "-"))
+    phi: float = field(default=0.01, metadata=_meta("yield-strength/modulus ratio", "-"))
+    A_r: float = field(default=1e-5, metadata=_meta("real contact area", "m^2"))
+
+    # --- Decisions: geometry and inertia -------------------------------------------------
+    J: float | None = field(
+        default=None,
+        metadata=_meta(
+            "follower moment of inertia about the pivot; None = m (l^2/3 + r^2/4), a solid "
+            "rod about a transverse axis through its end (decision)",
+            "kg m^2",
+        ),
+    )
+    x_O: float = field(
+        default=-0.5,
+        metadata=_meta("pivot x, cam rotation centre at the origin (decision)", "m", None),
+    )
+    y_O: float | None = field(
+        default=None,
+        metadata=_meta(
+            "pivot y; None = R + r, so the rod is horizontal when touching the cam with the "
+            "cam centre on the x axis (decision)",
+            "m",
+            None,
+        ),
+    )
+    theta_c0: float = field(
+        default=0.0, metadata=_meta("cam phase at t = 0 (decision)", "rad", None)
+    )
+    theta_f0: float | None = field(
+        default=None,
+        metadata=_meta(
+            "initial follower angle; None = theta_fc(0), in contact (decision, paper sec. 2)",
+            "rad",
+            None,
+        ),
+    )
+    omega_f0: float | None = field(
+        default=None,
+        metadata=_meta(
+            "initial follower angular velocity; None = d(theta_fc)/dt at t = 0 (decision)",
+            "rad/s",
+            None,
+        ),
+    )
+
+    # --- Decisions: contact force, friction, impacts -------------------------------------
+    stiffness: str = field(
+        default="hertz",
+        metadata=_meta(
+            "contact stiffness model: 'hertz' line contact (18) or 'fractal' joint (15)/(17)",
+            "-",
+            None,
+            STIFFNESS_MODELS,
+        ),
+    )
+    damping: str = field(
+        default="hunt_crossley",
+        metadata=_meta(
+            "contact damping: 'hunt_crossley' F = K p (1 + beta dp/dt) (default), or "
+            "'paper_literal' F = -K d - beta K d dd/dt, whose damping feeds energy in on "
+            "restitution; kept for reproduction only (decision)",
+            "-",
+            None,
+            DAMPING_FORMS,
+        ),
+    )
+    friction_arm: float | None = field(
+        default=None,
+        metadata=_meta(
+            "arm of the friction force about the pivot; None = r, the rod radius "
+            "(decision: (1) writes a force where a torque belongs)",
+            "m",
+            _NONNEG,
+        ),
+    )
+    v_eps: float = field(
+        default=1e-4,
+        metadata=_meta(
+            "slip-speed scale of the regularised sign, sgn(v) ~ tanh(v / v_eps); 0 = exact "
+            "sign. Decision: keeps the right-hand side smooth for RK4; slips are ~1 m/s",
+            "m/s",
+            _NONNEG,
+        ),
+    )
+    v_min: float = field(
+        default=1e-3,
+        metadata=_meta(
+            "least approach speed -d(delta)/dt for which the restitution jump (4) is applied; "
+            "slower closings belong to the compliant contact (decision: micro-impacts)",
+            "m/s",
+            _NONNEG,
+        ),
+    )
+
+    # --- Decisions: random contact-line length (section 2.5) -----------------------------
+    l_lambda_sigma: float = field(
+        default=0.0,
+        metadata=_meta(
+            "standard deviation sigma of the contact-line length; 0 = deterministic", "m", _NONNEG
+        ),
+    )
+    l_min: float = field(
+        default=1e-4,
+        metadata=_meta(
+            "lower truncation of the line-length normal, which must stay positive (decision)",
+            "m",
+        ),
+    )
+    resample: str = field(
+        default="impact",
+        metadata=_meta(
+            "when a new line length is drawn: at each applied 'impact' (default: each contact "
+            "has its own line) or every resample_dt ('interval', the paper's Fig. 3)",
+            "-",
+            None,
+            RESAMPLE_MODES,
+        ),
+    )
+    resample_dt: float = field(
+        default=0.01,
+        metadata=_meta("interval between draws when resample = 'interval'", "s"),
+    )
+
+    # --- Numerics ------------------------------------------------------------------------
+    dt: float = field(
+        default=2e-6,
+        metadata=_meta(
+            "RK4 step; resolves the Hertz contact oscillation (period ~9e-5 s) with ~45 steps",
+            "s",
+        ),
+    )
+    event_tol: float = field(
+        default=1e-12,
+        metadata=_meta("tolerance on the located impact time", "s"),
+    )
+    max_events_per_step: int = field(
+        default=8,
+        metadata=_meta(
+            "chattering guard: impacts handled inside one step before the rest of the step is "
+            "left to the compliant contact",
+            "-",
+            (1, None, True, None),
+        ),
+    )
+
+    # ------------------------------------------------------------------------------------
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            _validate_field(f, getattr(self, f.name))
+        if self.stiffness == "fractal":
+            # Raises a ParameterError naming D or G when (15)/(17) do not apply.
+            from ._stiffness import fractal_stiffness
+
+            fractal_stiffness(self.E, self.D, self.G, self.k, self.phi, self.A_r)
+
+    # --- derived quantities --------------------------------------------------------------
+    @property
+    def inertia(self) -> float:
+        """Moment of inertia J about the pivot [kg m^2]."""
+        return self.m * (self.l**2 / 3.0 + self.r**2 / 4.0) if self.J is None else self.J
+
+    @property
+    def pivot(self) -> tuple[float, float]:
+        """Pivot O = (x_O, y_O) [m], the cam rotation centre O' at the origin."""
+        return (self.x_O, self.R + self.r if self.y_O is None else self.y_O)
+
+    @property
+    def arm(self) -> float:
+        """Friction arm about the pivot [m]."""
+        return self.r if self.friction_arm is None else self.friction_arm
+
+    @property
+    def E(self) -> float:
+        """Composite modulus, eq. (7) [Pa]."""
+        from ._stiffness import composite_modulus
+
+        return composite_modulus(self.nu_f, self.Y_f, self.nu_c, self.Y_c)
+
+    def stiffness_at(self, l_lambda: float) -> float:
+        """Contact stiffness K_n [N/m] for a contact-line length ``l_lambda`` [m]."""
+        from ._stiffness import fractal_stiffness, hertz_line_stiffness
+
+        if self.stiffness == "hertz":
+            return hertz_line_stiffness(self.E, l_lambda)
+        return fractal_stiffness(self.E, self.D, self.G, self.k, self.phi, self.A_r)
+
+    @property
+    def cam_period(self) -> float:
+        """Forcing period 2 pi / omega [s]: the stroboscopic section's interval."""
+        return 2.0 * math.pi / self.omega
+
+    # --- conveniences --------------------------------------------------------------------
+    def replace(self, **changes: Any) -> Params:
+        """A copy with ``changes`` applied and validated."""
+        unknown = set(changes) - set(field_names())
+        if unknown:
+            raise ParameterError(_unknown_message(sorted(unknown)[0]))
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The fields as given (``None`` kept), for provenance records."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @classmethod
+    def from_strings(cls, assignments: dict[str, str], base: Params | None = None) -> Params:
+        """Build from ``NAME=VALUE`` strings as given on the command line."""
+        base = cls() if base is None else base
+        return base.replace(**{k: parse_value(k, v) for k, v in assignments.items()})
+
+
+def field_names() -> tuple[str, ...]:
+    return tuple(f.name for f in fields(Params))
+
+
+FIELD_DOCS: dict[str, dict] = {f.name: dict(f.metadata) for f in fields(Params)}
+
+
+def _unknown_message(name: str) -> str:
+    import difflib
+
+    close = difflib.get_close_matches(name, field_names(), n=3)
+    hint = f" Did you mean {', '.join(close)}?" if close else ""
+    return f"unknown parameter {name!r}.{hint} Known: {', '.join(field_names())}"
+
+
+def parse_value(name: str, text: str) -> Any:
+    """Convert the string ``text`` to the type of field ``name``."""
+    if name not in FIELD_DOCS:
+        raise ParameterError(_unknown_message(name))
+    f = next(f for f in fields(Params) if f.name == name)
+    if text.strip().lower() == "none":
+        if f.default is not None:
+            raise ParameterError(f"{name} cannot be None")
+        return None
+    if FIELD_DOCS[name]["choices"] is not None:
+        return text.strip()
+    try:
+        return int(text) if f.type == "int" else float(text)
+    except ValueError:
+        raise ParameterError(f"{name} = {text!r} is not a number") from None
+
+
+def _describe_range(rng: tuple) -> str:
+    lo, hi, lo_inc, hi_inc = rng
+    left = "(-inf" if lo is None else ("[" if lo_inc else "(") + repr(lo)
+    right = "inf)" if hi is None else repr(hi) + ("]" if hi_inc else ")")
+    return f"{left}, {right}"
+
+
+def _validate_field(f: dataclasses.Field, value: Any) -> None:
+    meta = f.metadata
+    name = f.name
+    if value is None:
+        if f.default is None:
+            return
+        raise ParameterError(f"{name} must be given (None is not allowed)")
+    if meta["choices"] is not None:
+        if value not in meta["choices"]:
+            raise ParameterError(
+                f"{name} = {value!r} is not one of {', '.join(map(repr, meta['choices']))}"
+            )
+        return
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ParameterError(f"{name} = {value!r} must be a number [{meta['unit']}]")
+    if f.type == "int" and not float(value).is_integer():
+        raise ParameterError(f"{name} = {value!r} must be an integer")
+    if not math.isfinite(value):
+        raise ParameterError(f"{name} = {value!r} must be finite [{meta['unit']}]")
+    rng = meta["range"]
+    if rng is None:
+        return
+    lo, hi, lo_inc, hi_inc = rng
+    bad_lo = lo is not None and (value < lo or (value == lo and not lo_inc))
+    bad_hi = hi is not None and (value > hi or (value == hi and not hi_inc))
+    if bad_lo or bad_hi:
+        raise ParameterError(
+            f"{name} = {value!r} [{meta['unit']}] is outside the allowed range "
+            f"{_describe_range(rng)}: {meta['doc']}"
+        )
