@@ -1,0 +1,83 @@
+"""The ``chaoscam`` command: a thin layer over the API.
+
+Each subcommand lives with the layer it drives; this module only wires them. A command module
+exposes ``register(subparsers)``, which adds its parsers and sets ``func`` on them; ``func``
+takes the parsed arguments and returns an exit code. Bad input exits with code 2 and a message
+naming the field.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from .model import ParameterError, Params
+
+__all__ = ["main", "parse_assignments", "UsageError"]
+
+# Modules that add subcommands, in the order they are listed by --help.
+_COMMAND_MODULES = (
+    "chaoscam._cli_simulate",
+    "chaoscam._cli_classify",
+    "chaoscam.sweep._cli",
+    "chaoscam.report._cli",
+)
+
+
+class UsageError(Exception):
+    """Bad command-line input: printed as ``chaoscam: error: ...`` with exit code 2."""
+
+
+def parse_assignments(items: list[str] | None, base: Params | None = None) -> Params:
+    """Params from ``--set NAME=VALUE`` items."""
+    pairs: dict[str, str] = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise UsageError(f"--set expects NAME=VALUE, got {item!r}")
+        pairs[name.strip()] = value
+    return Params.from_strings(pairs, base=base)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="chaoscam",
+        description="Stochastic dynamics of a cam-follower oblique impact system.",
+    )
+    from ._version import __version__
+
+    parser.add_argument("--version", action="version", version=f"chaoscam {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in _COMMAND_MODULES:
+        try:
+            module = importlib.import_module(name)
+        except ModuleNotFoundError as err:
+            if err.name != name:
+                raise
+            continue  # that layer is not installed in this build
+        module.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args.func(args) or 0)
+    except (ParameterError, UsageError) as err:
+        print(f"chaoscam: error: {err}", file=sys.stderr)
+        return 2
+    except FileExistsError as err:
+        print(f"chaoscam: error: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("chaoscam: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
