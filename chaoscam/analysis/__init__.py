@@ -1,0 +1,62 @@
+"""Analysis of simulated motion: sections, spectrum, Lyapunov exponents, 0–1 test, verdict.
+
+Everything here takes numpy arrays (or, for the Lyapunov routines, a user callable that
+advances a state); nothing imports the model or the integrators.
+"""
+
+from ._classify import classify_section, classify_signal
+from ._lyapunov import (
+    LyapunovResult,
+    LyapunovSpectrum,
+    lyapunov_benettin,
+    lyapunov_benettin_map,
+    lyapunov_spectrum_map,
+)
+from ._lyapunov_series import DoubtfulEstimateWarning, SeriesLyapunovResult, lyapunov_from_series
+from ._periodicity import (
+    PeriodResult,
+    RotationResult,
+    correlation_dimension,
+    embed_angles,
+    neighbour_expansion,
+    rotation_order,
+    section_period,
+    stationarity_ratio,
+)
+from ._sections import crossing_section, local_maxima
+from ._spectrum import SpectrumResult, power_spectrum, spectrum_analysis
+from ._verdict import LABELS, VOTES, Evidence, Verdict, combine
+from ._zero_one import ZeroOneResult, zero_one_test
+
+__all__ = [
+    "LABELS",
+    "VOTES",
+    "DoubtfulEstimateWarning",
+    "Evidence",
+    "LyapunovResult",
+    "LyapunovSpectrum",
+    "PeriodResult",
+    "RotationResult",
+    "SeriesLyapunovResult",
+    "SpectrumResult",
+    "Verdict",
+    "ZeroOneResult",
+    "classify_section",
+    "classify_signal",
+    "combine",
+    "correlation_dimension",
+    "crossing_section",
+    "embed_angles",
+    "local_maxima",
+    "lyapunov_benettin",
+    "lyapunov_benettin_map",
+    "lyapunov_from_series",
+    "lyapunov_spectrum_map",
+    "neighbour_expansion",
+    "power_spectrum",
+    "rotation_order",
+    "section_period",
+    "spectrum_analysis",
+    "stationarity_ratio",
+    "zero_one_test",
+]

@@ -1,0 +1,440 @@
+"""Entry points: classify section points or a sampled signal into a `Verdict`."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from ._evidence import (
+    D2_CHAOTIC,
+    EXPANSION_CHAOTIC,
+    K_CHAOTIC,
+    K_REGULAR,
+    ROTATION_QUASI,
+    STATIONARY,
+    lyapunov_evidence,
+    safe,
+    section_evidence,
+    zero_one_evidence,
+)
+from ._lyapunov_series import lyapunov_from_series
+from ._sections import local_maxima
+from ._spectrum import spectrum_analysis
+from ._validate import as_points, as_series
+from ._verdict import Evidence, Verdict, combine
+
+__all__ = ["classify_section", "classify_signal"]
+
+
+def classify_section(
+    points,
+    *,
+    lyapunov: float | None = None,
+    lyapunov_tol: float = 0.02,
+    angle_periods: Sequence[float | None] | None = None,
+    rtol: float = 1e-3,
+    atol=None,
+    max_period: int | None = None,
+    min_points_aperiodic: int = 100,
+    zero_one: bool = True,
+    seed: int = 0,
+) -> Verdict:
+    """Classify map iterates or Poincaré-section points as periodic, quasiperiodic or chaotic.
+
+    Evidence gathered (each an `Evidence` in the verdict):
+
+    * ``section_period`` — recurrence at a fixed lag (`section_period`): periodic with the
+      smallest lag n at which every point returns within ``rtol`` of the set's extent;
+      otherwise "not_periodic" (no period up to N / 2), unless the points have not settled
+      (spread of the second half over the first outside [0.5, 2]: abstains).
+    * ``section_rotation`` — rank-shift consistency R (`rotation_order`): R >= 0.9 votes
+      quasiperiodic (the points advance along a closed curve like a rotation).
+    * ``section_expansion`` — mean one-step log growth of nearest-neighbour distances
+      (`neighbour_expansion`): > 0.1 per iterate votes chaotic.
+    * ``section_dimension`` — correlation dimension (d >= 2 and N >= 500): >= 1.3 votes
+      chaotic (not a curve).
+    * ``section_zero_one`` — 0–1 test on the first coordinate (N >= 100): K >= 0.8 chaotic,
+      K <= 0.2 not chaotic.
+    * ``lyapunov`` — a largest exponent per iterate computed elsewhere (e.g. by
+      `lyapunov_benettin_map`): > `lyapunov_tol` chaotic, else not chaotic.
+
+    With fewer than `min_points_aperiodic` points, rotation and expansion are reported but
+    do not vote: 40–90 points show a period up to N / 2 reliably, but a
+    quasiperiodic/chaotic call from so few points is weak; pass `lyapunov` (or use
+    `classify_signal` with the sampled signal) to decide. The votes are combined by
+    `combine`: a label only when all votes admit it and one names it, else "undetermined".
+
+    Parameters
+    ----------
+    points : array_like, shape (N,) or (N, d)
+        Section points in time order, after the transient. N >= 8.
+    lyapunov : float, optional
+        Largest Lyapunov exponent per iterate of the section map.
+    lyapunov_tol : float
+        |λ₁| below this counts as zero.
+    angle_periods : sequence of float or None, optional
+        Period of each angular coordinate (None for ordinary ones), see `embed_angles`.
+    rtol, atol, max_period
+        Passed to `section_period`.
+    min_points_aperiodic : int
+        Fewest points for the rotation and expansion votes.
+    zero_one : bool
+        Run the 0–1 test when N >= 100.
+    seed : int
+        Seed of the 0–1 test's c values.
+
+    Returns
+    -------
+    Verdict
+        Period in iterates of the section map (forcing periods for a stroboscopic section).
+
+    Raises
+    ------
+    ValueError
+        NaN or infinite points, or points of the wrong shape.
+
+    Notes
+    -----
+    Choice for degenerate input: a set of identical points is a fixed point of the section
+    map and is labelled periodic with period 1 (for a stroboscopic section, a response
+    with the forcing's period). Fewer than 8 points: "undetermined".
+    """
+    x = as_points(points)
+    settings = dict(
+        rtol=rtol,
+        atol=atol,
+        max_period=max_period,
+        lyapunov_tol=lyapunov_tol,
+        angle_periods=None if angle_periods is None else list(angle_periods),
+        min_points_aperiodic=min_points_aperiodic,
+        zero_one=zero_one,
+        seed=seed,
+        thresholds=dict(
+            k_chaotic=K_CHAOTIC,
+            k_regular=K_REGULAR,
+            rotation=ROTATION_QUASI,
+            expansion=EXPANSION_CHAOTIC,
+            dimension=D2_CHAOTIC,
+            stationary=STATIONARY,
+        ),
+    )
+    ev, periods, reasons = section_evidence(
+        x,
+        prefix="section_",
+        angle_periods=angle_periods,
+        rtol=rtol,
+        atol=atol,
+        max_period=max_period,
+        min_points_aperiodic=min_points_aperiodic,
+        zero_one=zero_one,
+        seed=seed,
+    )
+    if lyapunov is not None:
+        ev.append(lyapunov_evidence(lyapunov, lyapunov_tol, "per iterate"))
+    return combine(ev, periods, reasons, settings)
+
+
+def _zero_one_signal(x, dt, forcing_period, seed, per_period, line_freq):
+    """0–1 test on a map-like sequence derived from the signal (see classify_signal)."""
+    if forcing_period is not None:
+        t = np.arange(x.size) * dt
+        step = forcing_period / per_period
+        tk = np.arange(0.0, t[-1] + 1e-12 * step, step)
+        n_per = tk.size // per_period
+        if n_per < 2:
+            return Evidence("zero_one", None, None, "fewer than 2 forcing periods")
+        y = np.interp(tk[: n_per * per_period], t, x).reshape(n_per, per_period)
+        seq = (y - y.mean(axis=0)).ravel()
+        rate = per_period / forcing_period
+        what = (
+            f"0-1 test on the signal sampled {per_period} times per forcing period, "
+            "minus its forcing-synchronous mean"
+        )
+        if np.std(seq) <= 1e-3 * np.std(y):
+            return Evidence(
+                "zero_one",
+                0.0,
+                "not_chaotic",
+                what + ": nothing left (the signal repeats every forcing period), K = 0",
+            )
+    else:
+        _, seq = local_maxima(x, dt)
+        rate = seq.size / (x.size * dt)
+        what = "0-1 test on the successive local maxima"
+        if seq.size >= 8 and np.ptp(seq) <= 1e-3 * np.ptp(x):
+            return Evidence(
+                "zero_one",
+                0.0,
+                "not_chaotic",
+                what + ": all maxima equal (a period-1 oscillation), K = 0",
+            )
+    e = zero_one_evidence("zero_one", seq, what, seed)
+    if e.vote == "chaotic" and line_freq:
+        period = rate / line_freq  # samples per period of the slowest line base
+        n_cut = seq.size // 10
+        if n_cut < 5.0 * period:
+            return Evidence(
+                "zero_one",
+                e.value,
+                None,
+                e.detail + f"; not used: the spectrum is a line spectrum whose slowest base "
+                f"spans {period:.1f} samples, and lags up to {n_cut} cover fewer than 5 of "
+                "its periods (a long period then mimics diffusion)",
+            )
+    return e
+
+
+def classify_signal(
+    x,
+    dt: float,
+    forcing_period: float | None = None,
+    section=None,
+    lyapunov: float | None = None,
+    *,
+    lyapunov_tol: float | None = None,
+    angle_periods: Sequence[float | None] | None = None,
+    rtol: float = 1e-3,
+    atol=None,
+    max_period: int | None = None,
+    min_points_aperiodic: int = 100,
+    series_lyapunov: bool = False,
+    zero_one_per_period: int = 4,
+    spectrum_options: dict | None = None,
+    seed: int = 0,
+) -> Verdict:
+    """Classify a uniformly sampled signal of a flow (with optional section points).
+
+    Evidence gathered:
+
+    * ``spectrum`` (`spectrum_analysis`, forcing frequency 1 / `forcing_period`): a harmonic
+      comb votes periodic (with the period in forcing periods when forced), two
+      incommensurate bases quasiperiodic, a broadband fraction >= 1 % chaotic, and a
+      smaller unexplained remainder "not_periodic".
+    * ``zero_one`` (`zero_one_test`) on a map-like sequence, never on the oversampled
+      signal: for a forced system, the signal sampled `zero_one_per_period` times per
+      forcing period (linear interpolation) minus its forcing-synchronous mean (which is
+      periodic and only slows the test's convergence); without forcing, the successive
+      local maxima (`local_maxima`). K >= 0.8 votes chaotic, K <= 0.2 not chaotic. A
+      sequence with nothing left (all maxima equal, or a signal that repeats every forcing
+      period) is K = 0. A chaotic K is not used when the spectrum is a line spectrum whose
+      slowest base period is longer than a fifth of the largest lag (N / 10): a periodic
+      sequence with a long period makes the displacement grow over every lag the test sees
+      (for a period-8 cam response sampled 4 times per forcing period over 20 s, K ≈ 0.9).
+    * the section evidence of `classify_section`, when `section` is given (names prefixed
+      ``section_``).
+    * ``lyapunov``: an externally computed largest exponent per unit time (e.g.
+      `lyapunov_benettin` on the equations): > `lyapunov_tol` chaotic, else not chaotic.
+    * ``lyapunov_series`` (when `series_lyapunov`): Rosenstein's estimate from the signal
+      (`lyapunov_from_series`); it votes only when not doubtful, chaotic when
+      λ T > 0.05 and not chaotic when |λ T| < 0.01 (T the characteristic period).
+
+    Votes are combined by `combine`; when they disagree the label is "undetermined" and
+    `reasons` lists the votes. The period comes from the section when given, else from the
+    spectrum for a forced signal; an unforced periodic signal without section gets period
+    1 (one period of its own fundamental), with a note in `reasons`.
+
+    Parameters
+    ----------
+    x : array_like, shape (N,)
+        Uniformly sampled signal after the transient (e.g. θ_f(t)).
+    dt : float
+        Sampling interval (s).
+    forcing_period : float, optional
+        Period of the forcing (s), e.g. 2π / ω of the cam.
+    section : array_like, shape (M,) or (M, d), optional
+        Section points (e.g. stroboscopic (θ, θ̇) once per forcing period).
+    lyapunov : float, optional
+        Largest Lyapunov exponent (1/s) computed elsewhere.
+    lyapunov_tol : float, optional
+        |λ₁| below this counts as zero; default 0.02 / T with T the forcing period, else
+        the fundamental period of the spectrum.
+    angle_periods, rtol, atol, max_period, min_points_aperiodic
+        Passed to the section analysis (see `classify_section`).
+    series_lyapunov : bool
+        Also estimate λ₁ from the signal with nolds (slower: ~0.2–0.5 s).
+    zero_one_per_period : int
+        Samples per forcing period fed to the 0–1 test of a forced signal.
+    spectrum_options : dict, optional
+        Extra keyword arguments of `spectrum_analysis`.
+    seed : int
+        Seed of the 0–1 test's c values.
+
+    Returns
+    -------
+    Verdict
+
+    Raises
+    ------
+    ValueError
+        NaN or infinite samples, a non-positive `dt` or `forcing_period`.
+
+    Notes
+    -----
+    Choice for degenerate input: a constant signal is an equilibrium, not an oscillation,
+    and is labelled "undetermined" (even if constant section points would say period 1).
+    With ~20 s of a cam signal (~90 forcing periods), the 0–1 test runs on ~360 samples
+    and the spectrum resolves subharmonics up to order 9: a periodic call is solid, a
+    quasiperiodic versus chaotic call rests on the spectrum and the 0–1 test agreeing.
+    """
+    x = as_series(x)
+    if not dt > 0:
+        raise ValueError(f"dt must be positive, got {dt}")
+    if forcing_period is not None and not forcing_period > 0:
+        raise ValueError(f"forcing_period must be positive, got {forcing_period}")
+    if section is not None:
+        section = as_points(section, "section")
+    settings = dict(
+        dt=dt,
+        forcing_period=forcing_period,
+        lyapunov_tol=lyapunov_tol,
+        rtol=rtol,
+        atol=atol,
+        max_period=max_period,
+        angle_periods=None if angle_periods is None else list(angle_periods),
+        min_points_aperiodic=min_points_aperiodic,
+        series_lyapunov=series_lyapunov,
+        zero_one_per_period=zero_one_per_period,
+        spectrum_options=dict(spectrum_options or {}),
+        seed=seed,
+        thresholds=dict(
+            k_chaotic=K_CHAOTIC,
+            k_regular=K_REGULAR,
+            rotation=ROTATION_QUASI,
+            expansion=EXPANSION_CHAOTIC,
+            dimension=D2_CHAOTIC,
+            stationary=STATIONARY,
+            broadband=None,
+        ),
+    )
+    if x.size < 2 or np.ptp(x) <= 1e-12 * max(1.0, float(np.max(np.abs(x)))):
+        return Verdict(
+            "undetermined",
+            None,
+            (),
+            ("constant signal: an equilibrium, not an oscillation",),
+            settings,
+        )
+    ev: list[Evidence] = []
+    periods: dict[str, int] = {}
+    reasons: list[str] = []
+
+    # --- spectrum
+    f_force = None if forcing_period is None else 1.0 / forcing_period
+    spec, failed = safe(
+        "spectrum", spectrum_analysis, x, dt, forcing_frequency=f_force, **(spectrum_options or {})
+    )
+    t_char = forcing_period
+    if failed:
+        ev.append(failed)
+    else:
+        settings["thresholds"]["broadband"] = spec.settings["broadband_tol"]
+        bases = ", ".join(f"{f:.5g}" for f in spec.base_frequencies)
+        txt = (
+            f"{spec.model}: line model holds {spec.line_fraction:.6f} of the power "
+            f"(bases {bases} Hz; spectral entropy {spec.spectral_entropy:.3f})"
+        )
+        resid = spec.residual_fraction
+        if spec.model == "periodic":
+            ev.append(Evidence("spectrum", resid, "periodic", txt))
+            if spec.period is not None:
+                periods["spectrum"] = spec.period
+        elif spec.model == "quasiperiodic":
+            ev.append(Evidence("spectrum", resid, "quasiperiodic", txt))
+        elif spec.model == "broadband":
+            ev.append(Evidence("spectrum", resid, "chaotic", txt))
+        elif spec.model == "aperiodic":
+            ev.append(Evidence("spectrum", resid, "not_periodic", txt))
+        else:
+            ev.append(Evidence("spectrum", None, None, spec.message))
+            reasons.append(f"spectrum: {spec.message}")
+        if t_char is None and spec.base_frequencies and spec.base_frequencies[0] > 0:
+            t_char = 1.0 / spec.base_frequencies[0]
+    line_freq = None
+    if not failed and spec.model in ("periodic", "quasiperiodic"):
+        line_freq = min(spec.base_frequencies)
+
+    # --- 0-1 test
+    e01, failed = safe(
+        "zero_one",
+        _zero_one_signal,
+        x,
+        dt,
+        forcing_period,
+        seed,
+        int(zero_one_per_period),
+        line_freq,
+    )
+    ev.append(failed or e01)
+
+    # --- section
+    if section is not None:
+        sev, speriods, sreasons = section_evidence(
+            section,
+            prefix="section_",
+            angle_periods=angle_periods,
+            rtol=rtol,
+            atol=atol,
+            max_period=max_period,
+            min_points_aperiodic=min_points_aperiodic,
+            zero_one=True,
+            seed=seed,
+        )
+        ev.extend(sev)
+        periods.update(speriods)
+        reasons.extend(sreasons)
+
+    # --- Lyapunov exponents
+    tol = lyapunov_tol
+    if tol is None and t_char is not None:
+        tol = 0.02 / t_char
+    if lyapunov is not None:
+        if tol is None:
+            ev.append(
+                Evidence(
+                    "lyapunov",
+                    float(lyapunov),
+                    None,
+                    "no time scale to judge λ₁ against: pass lyapunov_tol",
+                )
+            )
+        else:
+            ev.append(lyapunov_evidence(lyapunov, tol, "per unit time"))
+    if series_lyapunov:
+        res, failed = safe("lyapunov_series", lyapunov_from_series, x, dt, warn=False)
+        if failed:
+            ev.append(failed)
+        elif res.doubtful or t_char is None:
+            why = "; ".join(res.reasons) or "no time scale"
+            ev.append(
+                Evidence(
+                    "lyapunov_series",
+                    res.exponent,
+                    None,
+                    f"Rosenstein λ₁ = {res.exponent:.4g}, doubtful: {why}",
+                )
+            )
+        else:
+            lt = res.exponent * t_char
+            txt = f"Rosenstein λ₁ = {res.exponent:.4g} (λ₁ T = {lt:.3f})"
+            if lt > 0.05:
+                ev.append(Evidence("lyapunov_series", res.exponent, "chaotic", txt))
+            elif abs(lt) < 0.01:
+                ev.append(Evidence("lyapunov_series", res.exponent, "not_chaotic", txt))
+            else:
+                ev.append(Evidence("lyapunov_series", res.exponent, None, txt + ": inconclusive"))
+    settings["lyapunov_tol_used"] = tol
+    verdict = combine(ev, periods, reasons, settings)
+    if verdict.label == "periodic" and forcing_period is None and section is None:
+        verdict = Verdict(
+            verdict.label,
+            1,
+            verdict.evidence,
+            verdict.reasons
+            + (
+                "no forcing period and no section: the period is counted in periods of the "
+                "signal's own fundamental (1)",
+            ),
+            verdict.settings,
+        )
+    return verdict

@@ -1,0 +1,120 @@
+"""Sections of sampled signals: local maxima and plane crossings."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._validate import as_points, as_series
+
+__all__ = ["crossing_section", "local_maxima"]
+
+
+def local_maxima(x, dt: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """Local maxima of a sampled signal, refined by a parabola through three samples.
+
+    A strict interior maximum x_{i-1} < x_i >= x_{i+1} is moved to the vertex of the
+    parabola through the three samples: ``δ = (x_{i-1} - x_{i+1}) / (2 (x_{i-1} - 2 x_i +
+    x_{i+1}))``, value ``x_i - (x_{i-1} - x_{i+1}) δ / 4``. The successive maxima form a
+    one-dimensional map of the flow (the Lorenz map; Lorenz 1963, J. Atmos. Sci. 20, 130).
+
+    Parameters
+    ----------
+    x : array_like, shape (N,)
+        Signal.
+    dt : float
+        Sampling interval; the times returned are in its units.
+
+    Returns
+    -------
+    times, values : ndarray
+        Refined times and values of the maxima. For a smooth signal the value error is
+        O(dt³) per maximum (O(dt²) in time); at a kink (an impact) it is O(dt).
+    """
+    x = as_series(x)
+    if x.size < 3:
+        return np.array([]), np.array([])
+    i = np.nonzero((x[1:-1] > x[:-2]) & (x[1:-1] >= x[2:]))[0] + 1
+    a, b, c = x[i - 1], x[i], x[i + 1]
+    den = a - 2.0 * b + c
+    with np.errstate(invalid="ignore", divide="ignore"):
+        delta = np.where(den < 0, 0.5 * (a - c) / den, 0.0)
+    delta = np.clip(delta, -0.5, 0.5)
+    return (i + delta) * dt, b - 0.25 * (a - c) * delta
+
+
+def crossing_section(
+    t, states, *, index: int, level: float = 0.0, direction: int = 1
+) -> tuple[np.ndarray, np.ndarray]:
+    """Poincaré section of a sampled trajectory at ``states[:, index] = level``.
+
+    Crossings in the given direction (+1 upwards, -1 downwards, 0 both) are located by
+    the cubic through the four samples around each sign change (Lagrange interpolation,
+    error O(dt⁴) for smooth trajectories) and every state component is interpolated there.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+        Sample times.
+    states : array_like, shape (N, d)
+        Sampled states.
+    index : int
+        Component that defines the section.
+    level : float
+        Section level.
+    direction : int
+        +1, -1 or 0.
+
+    Returns
+    -------
+    times : ndarray, shape (M,)
+    points : ndarray, shape (M, d)
+        States on the section (the `index` component equals `level` up to round-off).
+
+    Notes
+    -----
+    Crossings in the first and last sample intervals are skipped (four samples are
+    needed). Sampling must resolve each crossing: two crossings within one sample step
+    are missed. For a stroboscopic section of a simulation, prefer the states the
+    integrator produces at the exact instants.
+    """
+    t = as_series(t, "t")
+    y = as_points(states, "states")
+    g = y[:, index] - level
+    s = np.sign(g)
+    idx = np.nonzero(s[:-1] * s[1:] < 0)[0]
+    if direction > 0:
+        idx = idx[g[idx] < 0]
+    elif direction < 0:
+        idx = idx[g[idx] > 0]
+    idx = idx[(idx >= 1) & (idx + 2 < t.size)]
+    if idx.size == 0:
+        return np.empty(0), np.empty((0, y.shape[1]))
+    win = idx[:, None] + np.arange(-1, 3)[None, :]  # four samples around each crossing
+    tt = t[win]
+    yy = y[win]  # (M, 4, d)
+    h = tt[:, 2] - tt[:, 1]
+    nodes = (tt - tt[:, 1:2]) / h[:, None]  # u of the samples; crossing in u ∈ (0, 1)
+
+    def weights(u):
+        """Lagrange weights of the four nodes at u, shape (M, 4)."""
+        w = np.ones((u.size, 4))
+        for a in range(4):
+            for b in range(4):
+                if a != b:
+                    w[:, a] *= (u - nodes[:, b]) / (nodes[:, a] - nodes[:, b])
+        return w
+
+    lo = np.zeros(idx.size)
+    hi = np.ones(idx.size)
+    g_lo = yy[:, 1, index] - level
+    for _ in range(60):  # bisection on the cubic, all crossings at once
+        mid = 0.5 * (lo + hi)
+        g_mid = np.einsum("ma,ma->m", weights(mid), yy[:, :, index]) - level
+        same = np.sign(g_mid) == np.sign(g_lo)
+        lo = np.where(same, mid, lo)
+        g_lo = np.where(same, g_mid, g_lo)
+        hi = np.where(same, hi, mid)
+    u = 0.5 * (lo + hi)
+    times = tt[:, 1] + u * h
+    points = np.einsum("ma,mad->md", weights(u), yy)
+    return times, points

@@ -1,0 +1,177 @@
+"""The verdict: evidence from several methods combined into one label, never a guess."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["LABELS", "VOTES", "Evidence", "Verdict", "combine"]
+
+LABELS = ("periodic", "quasiperiodic", "chaotic", "undetermined")
+"""The labels a verdict can carry."""
+
+VOTES: dict[str | None, frozenset[str]] = {
+    "periodic": frozenset({"periodic"}),
+    "quasiperiodic": frozenset({"quasiperiodic"}),
+    "chaotic": frozenset({"chaotic"}),
+    "not_chaotic": frozenset({"periodic", "quasiperiodic"}),
+    "not_periodic": frozenset({"quasiperiodic", "chaotic"}),
+    None: frozenset({"periodic", "quasiperiodic", "chaotic"}),
+}
+"""The labels each vote admits. None abstains (the method could not decide)."""
+
+
+def _json_value(v):
+    """A JSON-safe copy of an evidence value (NaN and inf become None)."""
+    if v is None or isinstance(v, bool | str):
+        return v
+    if isinstance(v, int | np.integer):
+        return int(v)
+    if isinstance(v, float | np.floating):
+        f = float(v)
+        return f if math.isfinite(f) else None
+    if isinstance(v, tuple | list | np.ndarray):
+        return [_json_value(u) for u in v]
+    return str(v)
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """One method's finding.
+
+    Attributes
+    ----------
+    name : str
+        The method ("section_period", "spectrum", "zero_one", "lyapunov", ...).
+    value : float, int or None
+        Its headline number (the period, K, λ₁, the broadband fraction, ...).
+    vote : str or None
+        "periodic", "quasiperiodic", "chaotic", "not_chaotic", "not_periodic", or None
+        when the method abstains (see `VOTES`).
+    detail : str
+        What was measured and why it votes as it does (or why it abstains).
+    """
+
+    name: str
+    value: float | int | None
+    vote: str | None
+    detail: str
+
+    def __post_init__(self):
+        if self.vote not in VOTES:
+            raise ValueError(f"unknown vote {self.vote!r}; expected one of {list(VOTES)}")
+
+    def to_dict(self) -> dict:
+        """JSON-serialisable form."""
+        return dict(
+            name=self.name, value=_json_value(self.value), vote=self.vote, detail=self.detail
+        )
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """A classification of the dynamics, traceable to its evidence and settings.
+
+    Attributes
+    ----------
+    label : str
+        "periodic", "quasiperiodic", "chaotic" or "undetermined".
+    period : int or None
+        For "periodic": the period in iterates of the section map (in forcing periods for a
+        stroboscopic section); None otherwise.
+    evidence : tuple of Evidence
+        Every method's finding, including those that abstained.
+    reasons : tuple of str
+        Why the label is "undetermined" (disagreement, too little data), or what limits it.
+    settings : dict
+        The settings used by each method.
+    """
+
+    label: str
+    period: int | None
+    evidence: tuple[Evidence, ...]
+    reasons: tuple[str, ...] = ()
+    settings: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if self.label not in LABELS:
+            raise ValueError(f"unknown label {self.label!r}; expected one of {LABELS}")
+
+    def to_dict(self) -> dict:
+        """JSON-serialisable dict with keys label, period, evidence, reasons."""
+        return dict(
+            label=self.label,
+            period=None if self.period is None else int(self.period),
+            evidence=[e.to_dict() for e in self.evidence],
+            reasons=list(self.reasons),
+        )
+
+
+def combine(
+    evidence: tuple[Evidence, ...] | list[Evidence],
+    periods: dict[str, int] | None = None,
+    reasons: tuple[str, ...] | list[str] = (),
+    settings: dict | None = None,
+) -> Verdict:
+    """Combine votes into a verdict: the one label every vote admits, with direct support.
+
+    Rules: (1) each vote admits a set of labels (`VOTES`); the verdict's label must lie in
+    the intersection of the sets of all votes cast; (2) it must be named by at least one
+    vote (an exclusion such as "not_chaotic" and "not_periodic" alone does not make a
+    "quasiperiodic"); (3) otherwise — no vote, disagreement, or more than one label left —
+    the label is "undetermined" and `reasons` says why. For "periodic", the periods the
+    methods report (`periods`, by evidence name) must agree: a section's period is taken
+    as exact and a spectral period must divide it (weak subharmonics may be missed by the
+    spectrum); any other disagreement makes the verdict undetermined.
+    """
+    evidence = tuple(evidence)
+    reasons = list(reasons)
+    settings = dict(settings or {})
+    cast = [e for e in evidence if e.vote is not None]
+    if not cast:
+        reasons.append("no method could decide (see the evidence for why each abstained)")
+        return Verdict("undetermined", None, evidence, tuple(reasons), settings)
+    admitted = frozenset({"periodic", "quasiperiodic", "chaotic"})
+    for e in cast:
+        admitted = admitted & VOTES[e.vote]
+    votes_txt = ", ".join(f"{e.name}: {e.vote}" for e in cast)
+    if not admitted:
+        reasons.append(f"the evidence disagrees ({votes_txt})")
+        return Verdict("undetermined", None, evidence, tuple(reasons), settings)
+    if len(admitted) > 1:
+        reasons.append(
+            f"the evidence does not separate {' / '.join(sorted(admitted))} ({votes_txt})"
+        )
+        return Verdict("undetermined", None, evidence, tuple(reasons), settings)
+    (label,) = admitted
+    if not any(e.vote == label for e in cast):
+        reasons.append(
+            f"only exclusions point to {label} ({votes_txt}); no method supports it directly"
+        )
+        return Verdict("undetermined", None, evidence, tuple(reasons), settings)
+    period = None
+    if label == "periodic":
+        periods = {k: int(v) for k, v in (periods or {}).items() if v is not None}
+        exact = {k: v for k, v in periods.items() if k.startswith("section")}
+        spectral = {k: v for k, v in periods.items() if not k.startswith("section")}
+        if len(set(exact.values())) > 1:
+            reasons.append(f"the section periods disagree: {exact}")
+            return Verdict("undetermined", None, evidence, tuple(reasons), settings)
+        if exact:
+            period = next(iter(exact.values()))
+            bad = {k: v for k, v in spectral.items() if period % v != 0}
+            if bad:
+                reasons.append(
+                    f"the spectral period {bad} does not divide the section period {period}"
+                )
+                return Verdict("undetermined", None, evidence, tuple(reasons), settings)
+        elif spectral:
+            if len(set(spectral.values())) > 1:
+                reasons.append(f"the periods disagree: {spectral}")
+                return Verdict("undetermined", None, evidence, tuple(reasons), settings)
+            period = next(iter(spectral.values()))
+        else:
+            period = 1
+    return Verdict(label, period, evidence, tuple(reasons), settings)

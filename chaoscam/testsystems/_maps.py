@@ -1,0 +1,182 @@
+"""Discrete-time test systems: logistic map, Hénon map, sine circle map.
+
+Each system comes as a one-step function, its Jacobian (where it is smooth) and an orbit
+generator that discards a transient. They exist to validate the analysis layer against
+values known from the literature; they never depend on the cam-follower model.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = [
+    "circle_map_orbit",
+    "circle_map_rotation_number",
+    "henon_jacobian",
+    "henon_orbit",
+    "henon_step",
+    "logistic_jacobian",
+    "logistic_orbit",
+    "logistic_step",
+]
+
+
+def logistic_step(x: np.ndarray, r: float) -> np.ndarray:
+    """One step of the logistic map ``x -> r x (1 - x)``.
+
+    Parameters
+    ----------
+    x : ndarray, shape (1,)
+        State in [0, 1].
+    r : float
+        Growth parameter in (0, 4].
+
+    Returns
+    -------
+    ndarray, shape (1,)
+        The image of `x`.
+    """
+    x = np.asarray(x, dtype=float)
+    return r * x * (1.0 - x)
+
+
+def logistic_jacobian(x: np.ndarray, r: float) -> np.ndarray:
+    """Jacobian of the logistic map, ``[[r (1 - 2 x)]]`` (shape (1, 1))."""
+    x = np.asarray(x, dtype=float).reshape(-1)
+    return np.array([[r * (1.0 - 2.0 * x[0])]])
+
+
+def logistic_orbit(r: float, n: int, *, x0: float = 0.1234, transient: int = 1000) -> np.ndarray:
+    """Orbit of the logistic map ``x_{k+1} = r x_k (1 - x_k)`` after a transient.
+
+    Parameters
+    ----------
+    r : float
+        Growth parameter in (0, 4].
+    n : int
+        Number of iterates returned.
+    x0 : float
+        Initial condition in (0, 1).
+    transient : int
+        Iterates discarded first.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        ``x_{transient}, ..., x_{transient + n - 1}``.
+
+    Notes
+    -----
+    Known values (May 1976, Nature 261, 459): period 2 for 3 < r < 1 + sqrt(6), period 4 up
+    to r ≈ 3.5441, the period-3 window opens at r = 1 + sqrt(8) ≈ 3.8284, and at r = 4 the
+    map is conjugate to the tent map with Lyapunov exponent ln 2.
+    """
+    x = float(x0)
+    for _ in range(int(transient)):
+        x = r * x * (1.0 - x)
+    out = np.empty(int(n))
+    for k in range(int(n)):
+        out[k] = x
+        x = r * x * (1.0 - x)
+    return out
+
+
+def henon_step(x: np.ndarray, a: float = 1.4, b: float = 0.3) -> np.ndarray:
+    """One step of the Hénon map ``(x, y) -> (1 - a x² + y, b x)``."""
+    return np.array([1.0 - a * x[0] * x[0] + x[1], b * x[0]])
+
+
+def henon_jacobian(x: np.ndarray, a: float = 1.4, b: float = 0.3) -> np.ndarray:
+    """Jacobian of the Hénon map, ``[[-2 a x, 1], [b, 0]]``; its determinant is ``-b``."""
+    return np.array([[-2.0 * a * x[0], 1.0], [b, 0.0]])
+
+
+def henon_orbit(
+    n: int,
+    *,
+    a: float = 1.4,
+    b: float = 0.3,
+    x0: tuple[float, float] = (0.1, 0.1),
+    transient: int = 1000,
+) -> np.ndarray:
+    """Orbit of the Hénon map (Hénon 1976, Commun. Math. Phys. 50, 69) after a transient.
+
+    Returns
+    -------
+    ndarray, shape (n, 2)
+        Iterates ``(x_k, y_k)``. For a = 1.4, b = 0.3 the largest Lyapunov exponent is
+        ≈ 0.419 per iterate and the exponents sum to ln b.
+    """
+    x, y = float(x0[0]), float(x0[1])
+    for _ in range(int(transient)):
+        x, y = 1.0 - a * x * x + y, b * x
+    out = np.empty((int(n), 2))
+    for k in range(int(n)):
+        out[k, 0] = x
+        out[k, 1] = y
+        x, y = 1.0 - a * x * x + y, b * x
+    return out
+
+
+def circle_map_orbit(
+    n: int,
+    *,
+    omega: float = (math.sqrt(5.0) - 1.0) / 2.0,
+    k: float = 0.5,
+    x0: float = 0.0,
+    transient: int = 1000,
+    lift: bool = False,
+) -> np.ndarray:
+    """Orbit of the sine circle map ``θ_{j+1} = θ_j + Ω - (K / 2π) sin(2π θ_j)``.
+
+    Parameters
+    ----------
+    n : int
+        Number of iterates returned.
+    omega : float
+        Bare rotation Ω; the default is the golden mean (sqrt(5) - 1) / 2.
+    k : float
+        Nonlinearity K. For 0 <= K < 1 the map is an analytic circle diffeomorphism; outside
+        the Arnold tongues (a set of positive measure in Ω for K < 1) its rotation number is
+        irrational and the orbit is quasiperiodic, dense on the circle.
+    x0 : float
+        Initial angle (in turns).
+    transient : int
+        Iterates discarded first.
+    lift : bool
+        Return the lift (not reduced mod 1), from which the rotation number is computed.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Angles in turns, in [0, 1) unless `lift`.
+
+    Notes
+    -----
+    Reference: Arnold (1965); Jensen, Bak & Bohr (1984), Phys. Rev. A 30, 1960. Whether a
+    given (Ω, K) lies outside every tongue cannot be proven numerically: finite orbits only
+    bound the denominators of a possible locking (see `circle_map_rotation_number`).
+    """
+    two_pi = 2.0 * math.pi
+    x = float(x0)
+    for _ in range(int(transient)):
+        x = x + omega - k / two_pi * math.sin(two_pi * x)
+    x -= math.floor(x)
+    out = np.empty(int(n))
+    for j in range(int(n)):
+        out[j] = x
+        x = x + omega - k / two_pi * math.sin(two_pi * x)
+    return out if lift else out - np.floor(out)
+
+
+def circle_map_rotation_number(
+    *, omega: float = (math.sqrt(5.0) - 1.0) / 2.0, k: float = 0.5, n: int = 100_000
+) -> float:
+    """Rotation number ``ρ = lim (θ_n - θ_0) / n`` of the sine circle map from its lift.
+
+    The error after `n` iterates is below 1/n for a circle homeomorphism (K <= 1).
+    """
+    lifted = circle_map_orbit(n + 1, omega=omega, k=k, lift=True)
+    return float((lifted[-1] - lifted[0]) / n)

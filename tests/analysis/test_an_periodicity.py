@@ -1,0 +1,97 @@
+"""Tests of the section-point evidence: period, rotation order, expansion, dimension."""
+
+import math
+
+import numpy as np
+
+from chaoscam.analysis import (
+    correlation_dimension,
+    embed_angles,
+    neighbour_expansion,
+    rotation_order,
+    section_period,
+    stationarity_ratio,
+)
+from chaoscam.testsystems import circle_map_orbit, logistic_orbit, torus_section
+
+RNG = np.random.default_rng(np.random.SeedSequence(11))
+
+
+def test_period_of_a_cycle_with_noise_below_tolerance():
+    """A period-5 cycle with noise at 1e-5 of its extent is found to have period 5."""
+    cycle = RNG.uniform(-1, 1, size=(5, 2))
+    pts = np.tile(cycle, (12, 1)) + 1e-5 * RNG.standard_normal((60, 2))
+    res = section_period(pts)
+    assert res.period == 5 and res.transient == 0
+
+
+def test_noise_above_tolerance_hides_the_period():
+    """The same cycle with noise at 1e-2 of its extent has no period at rtol 1e-3."""
+    cycle = RNG.uniform(-1, 1, size=(5, 2))
+    pts = np.tile(cycle, (12, 1)) + 1e-2 * RNG.standard_normal((60, 2))
+    assert section_period(pts).period is None
+
+
+def test_smallest_period_is_returned():
+    """A period-2 cycle is period 2, not 4 or 6."""
+    pts = np.tile([[0.0], [1.0]], (20, 1))
+    assert section_period(pts).period == 2
+
+
+def test_fixed_point_is_period_one_even_with_round_off():
+    """Points equal up to round-off (no extent to speak of) are a fixed point: period 1."""
+    pts = np.array([[0.1, 2.0]]) + 1e-13 * RNG.standard_normal((40, 2))
+    res = section_period(pts)
+    assert res.period == 1 and res.coincident
+
+
+def test_converging_transient_is_left_out():
+    """A geometric approach to a period-3 cycle is period 3 once the transient is left out."""
+    cycle = np.array([[0.0, 1.0], [1.0, 0.0], [0.5, 0.5]])
+    k = np.arange(90)
+    pts = cycle[k % 3] + 0.1 * (0.5**k)[:, None]
+    res = section_period(pts)
+    assert res.period == 3 and res.transient > 0
+
+
+def test_too_few_points_give_a_message():
+    """Fewer than 8 points: no period test, and the result says why."""
+    res = section_period(np.zeros((5, 2)))
+    assert res.period is None and "needs" in res.message
+
+
+def test_rotation_order_of_a_rotation_and_of_chaos():
+    """A circle rotation has R ≈ 1 and ρ = its rotation; a chaotic orbit has R well below."""
+    rot = rotation_order(torus_section(500))
+    assert rot.consistency > 0.99
+    assert math.isclose(
+        min(rot.rotation_number, 1 - rot.rotation_number), 1 - (math.sqrt(5) - 1) / 2, abs_tol=0.01
+    )
+    assert rotation_order(logistic_orbit(3.9, 500)).consistency < 0.7
+
+
+def test_embedding_removes_the_wrap_of_angles():
+    """One angle written as 0.25, 1.25 and -0.75 turns is one point after embedding."""
+    pts = np.array([0.25, 1.25, -0.75] * 10)
+    assert section_period(pts).period == 3
+    assert section_period(embed_angles(pts, [1.0])).period == 1
+
+
+def test_expansion_sign():
+    """Nearest neighbours separate on a chaotic orbit and keep their distance on a rotation."""
+    assert neighbour_expansion(logistic_orbit(4.0, 1000)) > 0.5
+    assert abs(neighbour_expansion(torus_section(1000))) < 0.05
+
+
+def test_correlation_dimension_of_a_curve():
+    """Points on a closed curve (quasiperiodic circle map) have D₂ ≈ 1."""
+    z = embed_angles(circle_map_orbit(1000), [1.0])
+    assert abs(correlation_dimension(z) - 1.0) < 0.1
+
+
+def test_stationarity_ratio_detects_a_shrinking_transient():
+    """A spiral converging to a point has a second-half spread far below the first half's."""
+    k = np.arange(200)
+    pts = np.column_stack([np.cos(k), np.sin(k)]) * (0.98**k)[:, None]
+    assert stationarity_ratio(pts) < 0.5
+    assert 0.5 < stationarity_ratio(torus_section(200)) < 2.0
