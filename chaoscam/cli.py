@@ -53,8 +53,8 @@ def build_parser() -> argparse.ArgumentParser:
         try:
             module = importlib.import_module(name)
         except ModuleNotFoundError as err:
-            if err.name != name:
-                raise
+            if err.name is None or not (name == err.name or name.startswith(err.name + ".")):
+                raise  # a missing dependency inside the module, not a missing module
             continue  # that layer is not installed in this build
         module.register(sub)
     return parser
