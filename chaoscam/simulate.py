@@ -198,7 +198,7 @@ def simulate(
         )
 
     # Buffers hold at least a few steps' worth of the most a step can produce.
-    per_step = p.max_events_per_step + 2
+    per_step = p.max_events_per_step + p.flight_merge + 2
     if p.resample == "interval":
         per_step += int(p.dt / p.resample_dt) + 2
     block = max(_BLOCK, 4 * per_step, 4 * (int(p.dt / p.cam_period) + 2))

@@ -56,4 +56,5 @@ def kernel_constants(p: Params, *, t_record: float = 0.0, stride: int = 0) -> np
     c[k.C_RESAMPLE_DT] = p.resample_dt if p.resample == "interval" else 0.0
     c[k.C_MAX_EVENTS] = p.max_events_per_step
     c[k.C_STRIDE] = stride
+    c[k.C_FLIGHT_MERGE] = p.flight_merge
     return c

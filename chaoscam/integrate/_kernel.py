@@ -56,7 +56,8 @@ C_T_RECORD = 22  # outputs are kept from this time on (transient) [s]
 C_RESAMPLE_DT = 23  # interval between line-length draws [s]; 0 = draw at each impact
 C_MAX_EVENTS = 24  # impacts handled in one step before chattering hand-over
 C_STRIDE = 25  # series sample every C_STRIDE steps; 0 = no series
-N_CONSTANTS = 26
+C_FLIGHT_MERGE = 26  # most grid steps taken as one RK4 step where the gap provably stays open
+N_CONSTANTS = 27
 
 # --- indices into the integer counters ---------------------------------------------------
 I_STEP = 0  # grid step n of the current time n dt
@@ -288,6 +289,8 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     """
     h = c[C_DT]
     stride = np.int64(c[C_STRIDE])
+    merge = np.int64(c[C_FLIGHT_MERGE])
+    samples_per_block = merge // stride + 1 if stride > 0 else 0
     max_events = np.int64(c[C_MAX_EVENTS])
     resample_on_impact = c[C_RESAMPLE_DT] <= 0.0
     th = y[0]
@@ -304,7 +307,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     while cnt[I_STEP] < n_stop:
         # Room for one more step's worth of outputs and draws, else hand back to Python.
         if (
-            cnt[I_N_SERIES] >= series.shape[0]
+            cnt[I_N_SERIES] + samples_per_block > series.shape[0]
             or cnt[I_N_SECTION] + sections_per_step > section.shape[0]
             or cnt[I_N_IMPACT] + max_events > impacts.shape[0]
             or cnt[I_LAM_POS] + draws_per_step >= lam.shape[0]
@@ -315,6 +318,43 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
 
         n = cnt[I_STEP]
         t = n * h
+        # Proven flight over several grid steps: one RK4 step of the free pendulum across
+        # them, ending on the grid and before any scheduled time or series sample.
+        m = min(np.int64((t_safe - t) / h), merge, n_stop - n)
+        if m >= 2:
+            m = min(m, np.int64((cnt[I_SECTION_K] * c[C_PERIOD] - t) / h))
+            if not resample_on_impact:
+                m = min(m, np.int64((cnt[I_RESAMPLE_J] * c[C_RESAMPLE_DT] - t) / h))
+            if m >= 2 and (n + m) * h >= c[C_T_RECORD] > t:
+                m = 0  # do not merge across the start of the recording
+        if m >= 2:
+            th0 = th
+            om0 = om
+            th, om = rk4_flight(th0, om0, m * h, c)
+            stale = True
+            cnt[I_STEP] = n + m
+            if not (math.isfinite(th) and math.isfinite(om)):
+                y[0] = th
+                y[1] = om
+                return NON_FINITE
+            if (n + m) * h >= c[C_T_RECORD]:
+                cnt[I_COUNTED_STEPS] += m
+                # Series samples inside the block come from a substep off its start, so that
+                # sampling never changes the trajectory.
+                j = n + stride - n % stride if stride > 0 else n + m + 1
+                while j <= n + m:
+                    if j == n + m:
+                        th_j, om_j = th, om
+                    else:
+                        th_j, om_j = rk4_flight(th0, om0, (j - n) * h, c)
+                    i = cnt[I_N_SERIES]
+                    series[i, 0] = j * h
+                    series[i, 1] = th_j
+                    series[i, 2] = om_j
+                    series[i, 3] = lam[cnt[I_LAM_POS]]
+                    cnt[I_N_SERIES] += 1
+                    j += stride
+            continue
         t_end = (n + 1) * h
         events = 0
         while t < t_end:

@@ -227,6 +227,19 @@ class Params:
         ),
     )
 
+    flight_merge: int = field(
+        default=16,
+        metadata=_meta(
+            "most grid steps taken as one RK4 step where a bound on the gap's curvature proves "
+            "no contact can occur (free pendulum, truncation error ~1e-19 rad per merged "
+            "step); the step still ends on the grid. 1 = plain fixed-step RK4 everywhere. "
+            "Default 16: 6x faster, and equal to plain RK4 within 5e-9 s / 1e-8 rad on the "
+            "first ten impacts and on 20 s sections of periodic responses (tests)",
+            "-",
+            (1, None, True, None),
+        ),
+    )
+
     # ------------------------------------------------------------------------------------
     def __post_init__(self) -> None:
         for f in fields(self):

@@ -50,3 +50,27 @@ def test_reference_and_kernel_sections_agree(reference):
     n = min(len(ours), len(reference.section))
     assert n >= 3
     assert np.max(np.abs(ours.theta_f.values[:n] - reference.section.theta_f.values[:n])) < 1e-6
+
+
+def fast_impacts(p, n=10):
+    imp = simulate(p, duration=20.0, series=False).impacts
+    return imp[-imp.gap_rate_before > 0.01].iloc[:n]
+
+
+def test_flight_merging_agrees_with_plain_fixed_step_on_impacts():
+    """Merged flight steps (default) match plain RK4 on the first ten impacts to 1e-6 s, rad."""
+    a = fast_impacts(Params(flight_merge=1))
+    b = fast_impacts(Params())
+    assert Params().flight_merge > 1 and len(a) == len(b) == 10
+    assert np.max(np.abs(a.t.values - b.t.values)) < 1e-6
+    assert np.max(np.abs(a.theta_f.values - b.theta_f.values)) < 1e-6
+
+
+@pytest.mark.parametrize("changes", [{"xi": 0.2}, {"omega": 45.0}], ids=["xi0.2", "omega45"])
+def test_flight_merging_agrees_on_periodic_sections(changes):
+    """On periodic responses the 20 s stroboscopic sections agree to 1e-6 rad."""
+    a = simulate(Params(flight_merge=1, **changes), duration=20.0, series=False).section
+    b = simulate(Params(**changes), duration=20.0, series=False).section
+    assert len(a) == len(b) > 90
+    assert np.max(np.abs(a.theta_f.values - b.theta_f.values)) < 1e-6
+    assert np.max(np.abs(a.omega_f.values - b.omega_f.values)) < 1e-5
