@@ -117,8 +117,9 @@ class Trajectory:
         table = pa.Table.from_pandas(frame, preserve_index=False)
         meta = dict(table.schema.metadata or {})
         meta[b"chaoscam.trajectory"] = json.dumps(self.provenance()).encode()
-        meta[b"chaoscam.section"] = self.section.to_json(orient="split").encode()
-        meta[b"chaoscam.impacts"] = self.impacts.to_json(orient="split").encode()
+        for name in ("section", "impacts"):
+            frame_json = getattr(self, name).to_json(orient="split", double_precision=15)
+            meta[f"chaoscam.{name}".encode()] = frame_json.encode()
         pq.write_table(table.replace_schema_metadata(meta), path)
 
 

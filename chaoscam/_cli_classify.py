@@ -1,0 +1,139 @@
+"""``chaoscam classify`` and ``chaoscam classify-series``: a verdict as JSON on stdout."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+__all__ = ["register"]
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "classify",
+        help="classify a simulated trajectory (Parquet) as periodic/quasiperiodic/chaotic",
+        description="Classify a trajectory written by `chaoscam simulate --out FILE.parquet`: "
+        "evidence from its stroboscopic section and theta_f(t) series, printed as JSON "
+        "(label, period, evidence, reasons).",
+    )
+    p.add_argument("trajectory", type=Path, metavar="TRAJ.parquet")
+    p.add_argument(
+        "--lyapunov",
+        action="store_true",
+        help="add the model's largest Lyapunov exponent (about twice the run's cost)",
+    )
+    p.add_argument(
+        "--check-step",
+        action="store_true",
+        help="re-simulate with dt/2 and report undetermined if the verdict changes",
+    )
+    p.set_defaults(func=run_classify)
+
+    q = sub.add_parser(
+        "classify-series",
+        help="classify one column of a CSV file (a sampled signal or section points)",
+        description="Classify a column of a CSV file, printed as JSON (label, period, "
+        "evidence, reasons). With --dt the rows are a uniformly sampled signal of a flow; "
+        "with --section they are already Poincaré-section points (map iterates).",
+    )
+    q.add_argument("file", type=Path, metavar="FILE.csv")
+    q.add_argument(
+        "--column",
+        action="append",
+        required=True,
+        metavar="NAME",
+        help="the column to classify; with --section it may be repeated for points with "
+        "several coordinates",
+    )
+    mode = q.add_mutually_exclusive_group()
+    mode.add_argument("--dt", type=float, metavar="SECONDS", help="sampling interval [s]")
+    mode.add_argument(
+        "--section", action="store_true", help="rows are section points / map iterates"
+    )
+    q.add_argument(
+        "--forcing-period",
+        type=float,
+        metavar="S",
+        help="period of the forcing [s] (with --dt): e.g. 2 pi / omega for the cam",
+    )
+    q.set_defaults(func=run_classify_series)
+
+
+def _print(verdict) -> None:
+    print(json.dumps(verdict.to_dict(), indent=2, ensure_ascii=False))
+
+
+def run_classify(args: argparse.Namespace) -> int:
+    from .classify import classify_trajectory, load_trajectory
+    from .cli import UsageError
+
+    try:
+        traj = load_trajectory(args.trajectory)
+    except (OSError, ValueError) as err:
+        raise UsageError(str(err)) from None
+    _print(classify_trajectory(traj, lyapunov=args.lyapunov, check_step=args.check_step))
+    return 0
+
+
+def run_classify_series(args: argparse.Namespace) -> int:
+    import numpy as np
+    import pandas as pd
+
+    from .analysis import classify_section, classify_signal
+    from .cli import UsageError
+
+    if args.dt is None and not args.section:
+        raise UsageError(
+            "say what the rows are: --dt SECONDS (a uniformly sampled signal) or --section "
+            "(section points / map iterates)"
+        )
+    if args.dt is not None and not (math.isfinite(args.dt) and args.dt > 0):
+        raise UsageError(f"--dt {args.dt}: the sampling interval must be > 0")
+    if args.forcing_period is not None:
+        if args.section:
+            raise UsageError(
+                "--forcing-period applies to a sampled signal (--dt); section points are "
+                "already one per forcing period"
+            )
+        if not (math.isfinite(args.forcing_period) and args.forcing_period > 0):
+            raise UsageError(f"--forcing-period {args.forcing_period}: must be > 0")
+    if args.dt is not None and len(args.column) != 1:
+        raise UsageError("--dt takes one --column (a scalar signal)")
+    path = args.file
+    if not path.is_file():
+        raise UsageError(f"{path}: no such file")
+    try:
+        frame = pd.read_csv(path)
+    except (ValueError, OSError, UnicodeDecodeError) as err:
+        raise UsageError(f"{path}: not a readable CSV file ({err})") from None
+    missing = [c for c in args.column if c not in frame.columns]
+    if missing:
+        raise UsageError(
+            f"{path}: no column {', '.join(repr(c) for c in missing)}; the columns are "
+            f"{', '.join(repr(str(c)) for c in frame.columns)}"
+        )
+    try:
+        data = frame[args.column].apply(pd.to_numeric, errors="raise").to_numpy(dtype=float)
+    except (ValueError, TypeError):
+        raise UsageError(
+            f"{path}: column(s) {', '.join(args.column)} hold values that are not numbers"
+        ) from None
+    bad = ~np.isfinite(data).all(axis=1)
+    if bad.any():
+        rows = np.flatnonzero(bad)
+        raise UsageError(
+            f"{path}: {rows.size} row(s) with NaN or infinite values in "
+            f"{', '.join(args.column)} (first at data row {int(rows[0]) + 1}); remove them"
+        )
+    try:
+        if args.section:
+            points = data[:, 0] if data.shape[1] == 1 else data
+            verdict = classify_section(points)
+        else:
+            verdict = classify_signal(data[:, 0], args.dt, args.forcing_period)
+    except ValueError as err:
+        raise UsageError(f"{path}: {err}") from None
+    _print(verdict)
+    return 0

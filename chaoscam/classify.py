@@ -1,0 +1,349 @@
+"""classify_trajectory(traj) -> Verdict: periodic, quasiperiodic or chaotic, for the model.
+
+The glue between a simulated :class:`~chaoscam.simulate.Trajectory` and the array-only
+analysis layer (:mod:`chaoscam.analysis`): it picks the observables (the stroboscopic
+section (θ_f, θ̇_f) once per cam period and the sampled θ_f(t)), the forcing period
+T = 2 pi / omega, and optionally adds the model's own Lyapunov exponent
+(:func:`chaoscam.lyapunov.lyapunov_model`) and a step-halving check.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import re
+from io import StringIO
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .analysis import Evidence, Verdict, classify_section, classify_signal
+from .integrate import Status
+from .model import Params
+from .simulate import SECTION_COLUMNS, SERIES_COLUMNS, Trajectory, simulate
+
+__all__ = ["classify_trajectory", "classify_file", "load_trajectory"]
+
+_SECTION_COORDS = ["theta_f", "omega_f"]
+
+
+def _with_settings(v: Verdict, **extra: Any) -> Verdict:
+    return dataclasses.replace(v, settings={**v.settings, **extra})
+
+
+def _rename_lyapunov(v: Verdict, detail_prefix: str, exponent: float) -> Verdict:
+    """Call the analysis layer's "lyapunov" evidence "lyapunov_model" (its source).
+
+    Its value is the exponent in 1/s in both modes (the section-only classifier was given
+    it per iterate, λ₁ T; its detail says so).
+    """
+    ev = tuple(
+        dataclasses.replace(
+            e,
+            name="lyapunov_model",
+            value=exponent if e.value is not None else None,
+            detail=detail_prefix + e.detail,
+        )
+        if e.name == "lyapunov"
+        else e
+        for e in v.evidence
+    )
+    reasons = tuple(re.sub(r"(?<![\w])lyapunov: ", "lyapunov_model: ", r) for r in v.reasons)
+    return dataclasses.replace(v, evidence=ev, reasons=reasons)
+
+
+def _status_verdict(traj: Trajectory, settings: dict) -> Verdict:
+    st = traj.status
+    label = st.label or st.name.lower()
+    t_end = traj.final_state[0]
+    e = Evidence(
+        "status",
+        int(st),
+        None,
+        f"the run ended with status {st.name} at t = {t_end:.6g} s: {st.message}",
+    )
+    return Verdict(
+        "undetermined",
+        None,
+        (e,),
+        (
+            f"the run did not end normally ({label}, t = {t_end:.6g} s): the motion is not "
+            "described by the model after that, so it is not classified",
+        ),
+        settings,
+    )
+
+
+def _evidence_verdict(
+    traj: Trajectory, discard: float, lyap: float | None, options: dict
+) -> Verdict:
+    """The analysis-layer verdict from the section (and the series when kept)."""
+    period = traj.params.cam_period
+    t0 = traj.settings["transient"] + discard
+    sec = traj.section
+    points = sec.loc[sec["t"] >= t0 - 1e-9 * period, _SECTION_COORDS].to_numpy(dtype=float)
+    opts = dict(options)
+    if traj.series is None:
+        tol = opts.pop("lyapunov_tol", None)
+        if tol is not None:
+            opts["lyapunov_tol"] = tol * period  # 1/s -> per iterate
+        per_iter = None if lyap is None else lyap * period
+        return classify_section(points, lyapunov=per_iter, **opts)
+    ser = traj.series
+    x = ser.loc[ser["t"] >= t0 - 1e-9 * period, "theta_f"].to_numpy(dtype=float)
+    dt = float(traj.settings["output_dt"])
+    return classify_signal(x, dt, period, section=points, lyapunov=lyap, **opts)
+
+
+def classify_trajectory(
+    traj: Trajectory,
+    *,
+    lyapunov: bool = False,
+    check_step: bool = False,
+    discard: float = 0.0,
+    **options: Any,
+) -> Verdict:
+    """Classify a simulated trajectory from its stroboscopic section and its θ_f(t) series.
+
+    The evidence is that of :func:`chaoscam.analysis.classify_signal` applied to the
+    sampled θ_f(t) (``traj.series``), with the stroboscopic section (θ_f, θ̇_f) at
+    t = k 2 pi / omega as section points and the cam period T = 2 pi / omega as forcing
+    period (MODEL.md, "Poincaré sections"). A trajectory simulated without series
+    (``series=False``) is classified from its section alone
+    (:func:`chaoscam.analysis.classify_section`); with the ~90 points of a 20 s run that
+    calls a period reliably, but a quasiperiodic versus chaotic call then needs
+    ``lyapunov=True``.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The run, after its transient (``simulate(..., transient=...)``).
+    lyapunov : bool
+        Also compute the model's largest Lyapunov exponent through the impacts
+        (:func:`chaoscam.lyapunov.lyapunov_model`, same params, duration, transient, seed,
+        index; about twice the cost of the simulation) and add it as evidence
+        ``lyapunov_model``: λ₁ > `lyapunov_tol` (default 0.02 / T) votes chaotic, else not
+        chaotic. A NaN exponent (a companion that failed) abstains with its reason.
+        Weak for contact-dominated responses, where the estimate depends on the separation
+        d0 (see its Limits): a period-1 orbit that chatters onto the cam every period
+        (omega = 22 rad/s) gets λ₁ ≈ +0.4 1/s, and the verdict is then "undetermined".
+    check_step : bool
+        Re-simulate the same realization (params, duration, transient, seed, index, output
+        step) with dt / 2 and classify it the same way (Lyapunov included when asked); if
+        the label or the period changes, the verdict becomes "undetermined" with that reason
+        (MODEL.md: a result must not change when the step is halved). Evidence
+        ``step_check`` (value 1 unchanged, 0 changed; the half-step verdict in its detail)
+        does not vote.
+    discard : float
+        Extra time after the run's transient left out of the classification [s].
+    **options
+        Passed to the analysis classifier (``rtol``, ``lyapunov_tol`` [1/s], ``seed``, ...).
+
+    Returns
+    -------
+    Verdict
+        Period in cam periods for "periodic". A run whose status is not OK (left the cam's
+        reach, diverged) is "undetermined" with a ``status`` evidence item (value: the
+        integer status code) and the reason; it is not classified. ``settings`` records the
+        trajectory's provenance and these options.
+    """
+    if discard < 0 or not math.isfinite(discard):
+        raise ValueError(f"discard = {discard!r} s must be >= 0")
+    settings = {
+        "classify": dict(lyapunov=lyapunov, check_step=check_step, discard=discard, **options),
+        "trajectory": {
+            "params": traj.params.to_dict(),
+            "settings": dict(traj.settings),
+            "status": traj.status.name,
+        },
+    }
+    if traj.status is not Status.OK:
+        return _status_verdict(traj, settings)
+
+    verdict, extra = _verdict_of(traj, lyapunov, discard, options)
+    verdict = _with_settings(verdict, **settings, **extra)
+    if not check_step:
+        return verdict
+
+    half = _resimulate_half_step(traj)
+    hv, _ = (
+        (_status_verdict(half, {}), {})
+        if half.status is not Status.OK
+        else _verdict_of(half, lyapunov, discard, options)
+    )
+    dt = traj.params.dt
+    same = hv.label == verdict.label and hv.period == verdict.period
+    what = f"dt = {dt:g} s: {_describe(verdict)}; dt / 2 = {dt / 2:g} s: {_describe(hv)}"
+    check = Evidence(
+        "step_check",
+        int(same),
+        None,
+        ("unchanged when the step is halved (" if same else "changed when the step is halved (")
+        + what
+        + ")",
+    )
+    settings_h = {
+        **verdict.settings,
+        "step_check": {
+            "dt_half": dt / 2,
+            "label": hv.label,
+            "period": hv.period,
+            "reasons": list(hv.reasons),
+        },
+    }
+    if same:
+        return dataclasses.replace(
+            verdict, evidence=verdict.evidence + (check,), settings=settings_h
+        )
+    return Verdict(
+        "undetermined",
+        None,
+        verdict.evidence + (check,),
+        verdict.reasons + (f"halving the step changes the verdict ({what})",),
+        settings_h,
+    )
+
+
+def _describe(v: Verdict) -> str:
+    return f"{v.label}" + (f" (period {v.period})" if v.period is not None else "")
+
+
+def _verdict_of(
+    traj: Trajectory, lyapunov: bool, discard: float, options: dict
+) -> tuple[Verdict, dict]:
+    if not lyapunov:
+        return _evidence_verdict(traj, discard, None, options), {}
+    from .lyapunov import lyapunov_model
+
+    s = traj.settings
+    res = lyapunov_model(
+        traj.params,
+        duration=s["duration"],
+        transient=s["transient"] + discard,
+        seed=s["seed"],
+        index=s["index"],
+    )
+    extra = {
+        "lyapunov_model": dict(
+            res.settings,
+            exponent=res.exponent,
+            stderr=res.stderr,
+            n_intervals=res.n_intervals,
+            message=res.message,
+        )
+    }
+    if not res.ok:
+        v = _evidence_verdict(traj, discard, None, options)
+        e = Evidence("lyapunov_model", None, None, f"not computed: {res.message}")
+        return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
+    prefix = (
+        f"model equations (two-trajectory Benettin through the impacts, "
+        f"{res.n_intervals} intervals): λ₁ = {res.exponent:.4g} ± {res.stderr:.2g} 1/s"
+        + (f" ({res.message})" if res.message else "")
+        + "; "
+    )
+    v = _evidence_verdict(traj, discard, res.exponent, options)
+    return _rename_lyapunov(v, prefix, res.exponent), extra
+
+
+def _resimulate_half_step(traj: Trajectory) -> Trajectory:
+    s = traj.settings
+    keep_series = traj.series is not None
+    return simulate(
+        traj.params.replace(dt=traj.params.dt / 2),
+        duration=s["duration"],
+        transient=s["transient"],
+        seed=s["seed"],
+        index=s["index"],
+        series=keep_series,
+        output_dt=s["output_dt"] if keep_series else 1e-3,
+    )
+
+
+def load_trajectory(path) -> Trajectory:
+    """Rebuild a :class:`Trajectory` from a Parquet file written by ``Trajectory.to_parquet``.
+
+    The table holds the series (or, for a run without one, the section); the metadata keys
+    ``chaoscam.trajectory`` (params, settings, status, stats), ``chaoscam.section`` and
+    ``chaoscam.impacts`` (JSON, pandas "split" orientation, 10 decimals) hold the rest.
+    ``final_state`` is not stored: it is taken from the last row of the table.
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    ValueError
+        Not a Parquet file, or not one written by chaoscam (the message names the file).
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    try:
+        table = pq.read_table(path)
+    except (pa.ArrowException, OSError) as err:
+        raise ValueError(f"{path}: not a Parquet file ({err})") from err
+    meta = table.schema.metadata or {}
+    missing = [
+        key
+        for key in (b"chaoscam.trajectory", b"chaoscam.section", b"chaoscam.impacts")
+        if key not in meta
+    ]
+    if missing:
+        raise ValueError(
+            f"{path}: not a chaoscam trajectory file (metadata "
+            f"{', '.join(m.decode() for m in missing)} missing; write one with "
+            "`chaoscam simulate --out FILE.parquet` or Trajectory.to_parquet)"
+        )
+    try:
+        prov = json.loads(meta[b"chaoscam.trajectory"])
+        params = Params(**prov["params"])
+        status = Status[prov["status"]]
+        section = pd.read_json(StringIO(meta[b"chaoscam.section"].decode()), orient="split")
+        impacts = pd.read_json(StringIO(meta[b"chaoscam.impacts"].decode()), orient="split")
+        settings = dict(prov["settings"])
+        stats = dict(prov.get("stats", {}))
+    except (KeyError, TypeError, ValueError) as err:
+        raise ValueError(f"{path}: unreadable chaoscam metadata ({err!r})") from err
+    frame = table.to_pandas()
+    cols = tuple(frame.columns)
+    if cols == SERIES_COLUMNS:
+        series = frame
+    elif cols == SECTION_COLUMNS:
+        series = None
+    else:
+        raise ValueError(f"{path}: unexpected columns {list(cols)} for a chaoscam trajectory")
+    section = section.reindex(columns=list(SECTION_COLUMNS))
+    if len(section):
+        section["k"] = section["k"].astype(np.int64)
+    last = frame.iloc[-1] if len(frame) else None
+    final = (
+        (float(last["t"]), float(last["theta_f"]), float(last["omega_f"]))
+        if last is not None
+        else (math.nan, math.nan, math.nan)
+    )
+    return Trajectory(
+        params=params,
+        settings=settings,
+        status=status,
+        series=series,
+        section=section,
+        impacts=impacts,
+        stats=stats,
+        final_state=final,
+    )
+
+
+def classify_file(
+    path, *, lyapunov: bool = False, check_step: bool = False, **options: Any
+) -> Verdict:
+    """Classify a trajectory Parquet file (``Trajectory.to_parquet``): see
+    :func:`load_trajectory` and :func:`classify_trajectory`."""
+    return classify_trajectory(
+        load_trajectory(path), lyapunov=lyapunov, check_step=check_step, **options
+    )

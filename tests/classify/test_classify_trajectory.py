@@ -1,0 +1,138 @@
+"""classify_trajectory / classify_file: the verdict of a simulated run of the model."""
+
+import json
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+import chaoscam
+import chaoscam.classify as cl
+from chaoscam import Params, Status
+from chaoscam.classify import classify_file, classify_trajectory, load_trajectory
+
+PERIODIC = Params(e=0.02)  # a period-1 response after ~2 s
+
+
+@pytest.fixture(scope="module")
+def periodic():
+    return chaoscam.simulate(PERIODIC, duration=4.0, transient=2.0)
+
+
+@pytest.fixture(scope="module")
+def default3():
+    return chaoscam.simulate(duration=3.0)
+
+
+def test_periodic_run_is_period_1(periodic):
+    """A period-1 response: label periodic, period 1 cam period, settings traceable."""
+    v = classify_trajectory(periodic)
+    assert (v.label, v.period) == ("periodic", 1)
+    assert v.settings["trajectory"]["params"]["e"] == 0.02
+    assert v.settings["forcing_period"] == pytest.approx(PERIODIC.cam_period)
+    json.dumps(v.to_dict())
+
+
+def test_section_only_run_is_classified_from_the_section():
+    """series=False: the section alone decides; still period 1."""
+    tr = chaoscam.simulate(PERIODIC, duration=4.0, transient=2.0, series=False)
+    v = classify_trajectory(tr)
+    assert (v.label, v.period) == ("periodic", 1)
+    assert all(e.name.startswith("section_") for e in v.evidence)
+
+
+def test_lyapunov_evidence_is_named_lyapunov_model(default3):
+    """lyapunov=True adds the model's λ₁ [1/s] as evidence 'lyapunov_model', chaotic here."""
+    v = classify_trajectory(default3, lyapunov=True)
+    names = [e.name for e in v.evidence]
+    assert "lyapunov_model" in names and "lyapunov" not in names
+    e = v.evidence[names.index("lyapunov_model")]
+    assert e.vote == "chaotic" and e.value > 0 and "Benettin" in e.detail
+    assert v.settings["lyapunov_model"]["exponent"] == e.value
+
+
+def test_section_only_lyapunov_value_is_per_second():
+    """Section-only mode gets λ₁ T per iterate, but the evidence value stays in 1/s."""
+    tr = chaoscam.simulate(duration=3.0, series=False)
+    v = classify_trajectory(tr, lyapunov=True)
+    e = next(e for e in v.evidence if e.name == "lyapunov_model")
+    assert e.value == pytest.approx(v.settings["lyapunov_model"]["exponent"])
+    assert "per iterate" in e.detail
+
+
+def test_failed_run_is_undetermined_with_status():
+    """A run that left the cam's reach is not classified: undetermined, status evidence."""
+    tr = chaoscam.simulate(Params(x_O=-0.58), duration=1.0)
+    assert tr.status is Status.LEFT_REACH
+    v = classify_trajectory(tr, lyapunov=True, check_step=True)
+    assert v.label == "undetermined" and v.period is None
+    assert [e.name for e in v.evidence] == ["status"]
+    assert v.evidence[0].value == int(Status.LEFT_REACH)
+    assert "left_reach" in v.reasons[0]
+
+
+def test_step_check_passes_when_the_label_holds(default3):
+    """Halving dt keeps the label of a 3 s default run: step_check evidence 1 (unchanged)."""
+    v = classify_trajectory(default3, check_step=True)
+    e = v.evidence[-1]
+    assert e.name == "step_check" and e.value == 1 and e.vote is None
+    assert v.label == classify_trajectory(default3).label
+    assert v.settings["step_check"]["dt_half"] == Params().dt / 2
+
+
+def test_step_check_failure_makes_the_verdict_undetermined(periodic, default3, monkeypatch):
+    """If the half-step run gives another label, the verdict is undetermined with the reason."""
+    seen = {}
+
+    def fake_half(traj):
+        seen["dt"] = traj.params.dt
+        return default3  # stands in for a half-step run that came out irregular
+
+    monkeypatch.setattr(cl, "_resimulate_half_step", fake_half)
+    v = classify_trajectory(periodic, check_step=True)
+    assert v.label == "undetermined" and v.period is None
+    assert any("halving the step" in r for r in v.reasons)
+    assert v.evidence[-1].name == "step_check" and v.evidence[-1].value == 0
+
+
+def test_half_step_run_is_the_same_realization(periodic):
+    """The re-simulation keeps params, duration, transient, seed, index; only dt halves."""
+    half = cl._resimulate_half_step(periodic)
+    assert half.params == PERIODIC.replace(dt=PERIODIC.dt / 2)
+    for key in ("duration", "transient", "seed", "index", "output_dt"):
+        assert half.settings[key] == pytest.approx(periodic.settings[key])
+
+
+def test_parquet_round_trip_gives_the_same_verdict(tmp_path, periodic, default3):
+    """classify_file on Trajectory.to_parquet output equals classify_trajectory in memory."""
+    for tr, name in ((periodic, "p.parquet"), (default3, "d.parquet")):
+        tr.to_parquet(tmp_path / name)
+        a, b = classify_trajectory(tr), classify_file(tmp_path / name)
+        assert (a.label, a.period) == (b.label, b.period)
+        assert [e.name for e in a.evidence] == [e.name for e in b.evidence]
+        back = load_trajectory(tmp_path / name)
+        assert back.params == tr.params and back.status is tr.status
+        assert len(back.section) == len(tr.section) and len(back.impacts) == len(tr.impacts)
+
+
+def test_section_only_parquet_loads_without_series(tmp_path):
+    """A file written without a series rebuilds a section-only trajectory."""
+    tr = chaoscam.simulate(PERIODIC, duration=4.0, transient=2.0, series=False)
+    tr.to_parquet(tmp_path / "s.parquet")
+    back = load_trajectory(tmp_path / "s.parquet")
+    assert back.series is None
+    assert classify_file(tmp_path / "s.parquet").label == classify_trajectory(tr).label
+
+
+def test_wrong_files_raise_errors_naming_them(tmp_path):
+    """Missing file, non-Parquet and foreign Parquet files: errors that name the file."""
+    with pytest.raises(FileNotFoundError, match="nope.parquet"):
+        load_trajectory(tmp_path / "nope.parquet")
+    bad = tmp_path / "bad.parquet"
+    bad.write_text("t,theta_f\n0,1\n")
+    with pytest.raises(ValueError, match="bad.parquet.*not a Parquet"):
+        load_trajectory(bad)
+    foreign = tmp_path / "foreign.parquet"
+    pq.write_table(pa.table({"x": [1.0, 2.0]}), foreign)
+    with pytest.raises(ValueError, match="foreign.parquet.*not a chaoscam trajectory"):
+        load_trajectory(foreign)

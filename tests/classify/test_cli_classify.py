@@ -1,0 +1,109 @@
+"""The `chaoscam classify` and `chaoscam classify-series` commands."""
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import chaoscam
+from chaoscam.cli import main
+
+
+@pytest.fixture(scope="module")
+def traj_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("cli") / "t.parquet"
+    chaoscam.simulate(duration=3.0).to_parquet(path)
+    return path
+
+
+def _json(capsys):
+    out = json.loads(capsys.readouterr().out)
+    assert set(out) == {"label", "period", "evidence", "reasons"}
+    return out
+
+
+def test_classify_prints_the_verdict_as_json(traj_file, capsys):
+    """classify TRAJ.parquet: JSON verdict on stdout, exit 0."""
+    assert main(["classify", str(traj_file)]) == 0
+    out = _json(capsys)
+    assert out["label"] in ("periodic", "quasiperiodic", "chaotic", "undetermined")
+    assert {e["name"] for e in out["evidence"]} >= {"spectrum", "section_period"}
+
+
+def test_classify_with_lyapunov_adds_model_evidence(traj_file, capsys):
+    """--lyapunov adds the lyapunov_model evidence item."""
+    assert main(["classify", str(traj_file), "--lyapunov"]) == 0
+    assert "lyapunov_model" in {e["name"] for e in _json(capsys)["evidence"]}
+
+
+def test_classify_bad_files_exit_2(tmp_path, capsys):
+    """A missing file or a file of the wrong kind: exit 2 with a message naming it."""
+    assert main(["classify", str(tmp_path / "none.parquet")]) == 2
+    assert "none.parquet" in capsys.readouterr().err
+    csv = tmp_path / "x.csv"
+    csv.write_text("a\n1\n")
+    assert main(["classify", str(csv)]) == 2
+    assert "x.csv" in capsys.readouterr().err
+
+
+def test_series_with_dt_and_forcing_period(tmp_path, capsys):
+    """--dt: a forced period-2 signal is periodic with period 2 forcing periods."""
+    t = np.arange(20_000) * 0.01
+    x = np.cos(2 * math.pi * t) + 0.3 * np.cos(math.pi * t + 0.4)
+    pd.DataFrame({"t": t, "x": x}).to_csv(tmp_path / "s.csv", index=False)
+    argv = [
+        "classify-series",
+        str(tmp_path / "s.csv"),
+        "--column",
+        "x",
+        "--dt",
+        "0.01",
+        "--forcing-period",
+        "1.0",
+    ]
+    assert main(argv) == 0
+    out = _json(capsys)
+    assert (out["label"], out["period"]) == ("periodic", 2)
+
+
+def test_series_with_section_points(tmp_path, capsys):
+    """--section: period-3 points in two columns are periodic with period 3."""
+    k = np.arange(60)
+    pts = pd.DataFrame({"a": np.cos(2 * math.pi * k / 3), "b": np.sin(2 * math.pi * k / 3)})
+    pts.to_csv(tmp_path / "p.csv", index=False)
+    argv = [
+        "classify-series",
+        str(tmp_path / "p.csv"),
+        "--column",
+        "a",
+        "--column",
+        "b",
+        "--section",
+    ]
+    assert main(argv) == 0
+    out = _json(capsys)
+    assert (out["label"], out["period"]) == ("periodic", 3)
+
+
+@pytest.mark.parametrize(
+    "extra, content, message",
+    [
+        (["--column", "x", "--dt", "0.01"], None, "no such file"),
+        (["--column", "y", "--dt", "0.01"], "x\n1\n2\n", "no column 'y'"),
+        (["--column", "x", "--section"], "x\n1\n\n2\nnan\n", "NaN"),
+        (["--column", "x"], "x\n1\n2\n", "--dt SECONDS"),
+        (["--column", "x", "--dt", "0"], "x\n1\n2\n", "--dt"),
+        (["--column", "x", "--section", "--forcing-period", "1"], "x\n1\n2\n", "forcing"),
+        (["--column", "x", "--dt", "0.1"], "x\n1\nfoo\n", "not numbers"),
+    ],
+    ids=["missing-file", "missing-column", "nan", "no-mode", "bad-dt", "section-forcing", "text"],
+)
+def test_series_bad_input_exits_2(tmp_path, capsys, extra, content, message):
+    """Bad input to classify-series: a clear message on stderr and exit code 2."""
+    path = tmp_path / "d.csv"
+    if content is not None:
+        path.write_text(content)
+    assert main(["classify-series", str(path), *extra]) == 2
+    assert message in capsys.readouterr().err

@@ -1,0 +1,98 @@
+"""The model's largest Lyapunov exponent (chaoscam.lyapunov), two trajectories via the kernel."""
+
+import math
+
+import numpy as np
+import pytest
+
+import chaoscam
+from chaoscam import Params, Status
+from chaoscam.analysis import lyapunov_benettin
+from chaoscam.lyapunov import lyapunov_model
+from chaoscam.model import ParameterError, contact_angle, contact_angle_rate
+
+PERIODIC = Params(e=0.02)  # period-1 response (section period 1, spectrum and 0-1 test agree)
+
+
+def _via_simulate(p: Params, duration: float, n_align: int):
+    """lyapunov_benettin driven by simulate() restarts: state (theta_f, omega_f / omega, t).
+
+    Restarting at time t0 with theta_c0 shifted by omega t0 is the same forced system; the
+    scaled state makes the analysis layer's Euclidean norm the model's scaled norm, and the
+    same seed gives the same initial direction.
+    """
+    w = p.omega
+
+    def advance(x, d):
+        q = p.replace(
+            theta_f0=float(x[0]), omega_f0=float(x[1] * w), theta_c0=p.theta_c0 + w * float(x[2])
+        )
+        tr = chaoscam.simulate(q, duration=d, series=False)
+        assert tr.ok
+        return np.array([tr.final_state[1], tr.final_state[2] / w, x[2] + tr.final_state[0]])
+
+    x0 = [float(contact_angle(p, 0.0)), float(contact_angle_rate(p, 0.0)) / w, 0.0]
+    n = int(round(duration / p.cam_period)) - n_align
+    return lyapunov_benettin(
+        advance, x0, renorm_time=p.cam_period, n_renorm=n, n_align=n_align, components=(0, 1)
+    )
+
+
+def test_periodic_response_has_negative_exponent():
+    """A period-1 response (e = 0.02 m) contracts: λ₁ < 0, clearly below the zero band."""
+    r = lyapunov_model(PERIODIC, duration=3.0)
+    assert r.ok and r.status is Status.OK and r.message == ""
+    assert r.exponent < -1.0  # 1/s; the classifier's zero band is |λ| < 0.02 / T ≈ 0.09
+    assert r.per_period == pytest.approx(r.exponent * PERIODIC.cam_period)
+
+
+def test_default_response_has_positive_exponent():
+    """The default model (l_lambda = 8 mm) is irregular: λ₁ > 0 beyond 2 standard errors."""
+    r = lyapunov_model(duration=6.0)
+    assert r.ok and r.n_intervals >= 20
+    assert r.exponent > 0.02 / Params().cam_period
+    assert r.exponent > 2.0 * r.stderr
+
+
+@pytest.mark.parametrize("p", [PERIODIC, Params()], ids=["periodic", "default"])
+def test_agrees_with_the_analysis_layer_on_simulate_restarts(p):
+    """Kernel-driven pair and analysis.lyapunov_benettin over simulate() agree (rtol 0.1)."""
+    n_align, periods = 3, 14
+    ref = _via_simulate(p, periods * p.cam_period, n_align)
+    r = lyapunov_model(p, duration=periods * p.cam_period, n_align=n_align)
+    assert r.n_intervals == periods - n_align
+    assert r.exponent == pytest.approx(ref.exponent, rel=0.1)
+
+
+def test_failed_run_gives_nan_with_reason():
+    """A reference run that leaves the cam's reach gives NaN, its status and the reason."""
+    r = lyapunov_model(Params(x_O=-0.58), duration=1.0)
+    assert math.isnan(r.exponent) and not r.ok
+    assert r.status is Status.LEFT_REACH and "LEFT_REACH" in r.message
+
+
+def test_realization_is_a_pure_function_of_seed_and_index():
+    """With a random line length the estimate repeats for (seed, index) and changes with index."""
+    p = Params(l_lambda_sigma=0.002)
+    a = lyapunov_model(p, duration=2.0, seed=3, index=1)
+    b = lyapunov_model(p, duration=2.0, seed=3, index=1)
+    c = lyapunov_model(p, duration=2.0, seed=3, index=2)
+    assert a.exponent == b.exponent and np.array_equal(a.running, b.running)
+    assert c.exponent != a.exponent
+    assert a.settings["seed"] == 3 and a.settings["index"] == 1
+
+
+def test_bad_settings_raise_parameter_errors():
+    """Non-positive d0, a fractional renorm_periods or a too-long transient name the field."""
+    with pytest.raises(ParameterError, match="d0"):
+        lyapunov_model(duration=1.0, d0=0.0)
+    with pytest.raises(ParameterError, match="renorm_periods"):
+        lyapunov_model(duration=1.0, renorm_periods=1.5)
+    with pytest.raises(ParameterError, match="transient"):
+        lyapunov_model(duration=1.0, transient=2.0)
+
+
+def test_too_short_run_says_so():
+    """Fewer intervals than the alignment discards: NaN and a message to lengthen the run."""
+    r = lyapunov_model(duration=0.5)
+    assert math.isnan(r.exponent) and "lengthen" in r.message
