@@ -1,0 +1,109 @@
+"""``chaoscam report`` and ``chaoscam paper``: thin layers over the report API."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+from pathlib import Path
+
+__all__ = ["register"]
+
+
+def register(sub) -> None:
+    r = sub.add_parser(
+        "report",
+        help="one self-contained HTML report from trajectories, bifurcations, regime maps",
+        description="Read chaoscam outputs (simulate --out, bifurcation --out, regime-map "
+        "--out; .parquet) and write one HTML file with every figure inline: it opens from "
+        "disk and refers to no network address.",
+    )
+    r.add_argument("inputs", nargs="+", metavar="INPUT", help="chaoscam .parquet outputs")
+    r.add_argument("--out", type=Path, required=True, help="the report, FILE.html")
+    r.add_argument("--title", default="chaoscam report", help="the report's title")
+    r.set_defaults(func=run_report)
+
+    p = sub.add_parser(
+        "paper",
+        help="reproduce the paper's Figs. 3-10 and write the comparison report",
+        description="Run the figure scripts (chaoscam.report._paper: Figs. 3-10), write each "
+        "figure's data and PNG next to the report (DIR/paper-data/), and build the HTML "
+        "report comparing the paper's statements with what this run finds.",
+    )
+    p.add_argument(
+        "--quick",
+        action="store_true",
+        help="small grids and short runs (minutes on 2 cores); say so in the report",
+    )
+    p.add_argument(
+        "--out",
+        type=Path,
+        default=Path("reports/paper.html"),
+        help="the report (default reports/paper.html)",
+    )
+    p.add_argument(
+        "--figures",
+        default=None,
+        metavar="LIST",
+        help="only these figures, e.g. 3,5,7 (default: all)",
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="worker processes for the sweeps (default: every core)",
+    )
+    p.set_defaults(func=run_paper)
+
+
+def _check_out(out: Path) -> None:
+    from ..cli import UsageError
+
+    if out.suffix.lower() != ".html":
+        raise UsageError(f"--out {out}: the report must end in .html")
+
+
+def run_report(args: argparse.Namespace) -> int:
+    from ..cli import UsageError
+    from ._html import build_report, write_report
+    from ._inputs import InputError, load_inputs
+
+    _check_out(args.out)
+    try:
+        inputs = load_inputs(args.inputs)
+    except InputError as err:
+        raise UsageError(str(err)) from None
+    parts = build_report(inputs)
+    command = shlex.join(
+        ["chaoscam", "report", *map(str, args.inputs), "--out", str(args.out)]
+        + (["--title", args.title] if args.title != "chaoscam report" else [])
+    )
+    write_report(parts, args.out, title=args.title, command=command)
+    print(f"report: {args.out}")
+    return 0
+
+
+def run_paper(args: argparse.Namespace) -> int:
+    from ..cli import UsageError
+    from ._paper import FIGURES
+    from ._paper import run_paper as _run
+
+    _check_out(args.out)
+    figures = None
+    if args.figures:
+        try:
+            figures = [int(x) for x in args.figures.split(",")]
+        except ValueError:
+            raise UsageError(f"--figures {args.figures}: expected numbers like 3,5,7") from None
+        bad = [f for f in figures if f not in FIGURES]
+        if bad:
+            raise UsageError(f"--figures: no figure {bad}; choose from {sorted(FIGURES)}")
+    command = shlex.join(
+        ["chaoscam", "paper"]
+        + (["--quick"] if args.quick else [])
+        + (["--figures", args.figures] if args.figures else [])
+        + (["--workers", str(args.workers)] if args.workers else [])
+        + ["--out", str(args.out)]
+    )
+    _run(quick=args.quick, out=args.out, figures=figures, workers=args.workers, command=command)
+    print(f"report: {args.out}")
+    return 0

@@ -1,0 +1,88 @@
+"""Figures of single trajectories (paper Figs. 7-10) and the PNG data URIs the HTML embeds.
+
+Built with matplotlib's object API (no pyplot: nothing opens a window, the Agg canvas
+renders), scatter layers rasterised so that thousands of points stay light.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+
+import numpy as np
+
+__all__ = ["png_data_uri", "png_bytes", "response_figure"]
+
+
+def png_bytes(fig, dpi: int = 96) -> bytes:
+    """The figure rendered to PNG bytes with the Agg canvas."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(fig)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    return buf.getvalue()
+
+
+def png_data_uri(fig, dpi: int = 96) -> str:
+    """``data:image/png;base64,...`` of a figure, for an ``<img src>`` that needs no network."""
+    return "data:image/png;base64," + base64.b64encode(png_bytes(fig, dpi)).decode("ascii")
+
+
+def response_figure(traj, title: str = ""):
+    """Four panels of one run: θ_f and θ_fc over time, phase portrait, section, spectrum.
+
+    The time panel shows the last 2 s of the kept series; the phase portrait the whole kept
+    series; the Poincaré panel the stroboscopic section at t = k 2π/ω; the spectrum the
+    periodogram of θ_f (:func:`chaoscam.analysis.power_spectrum`) with the cam frequency
+    ω/2π marked.
+    """
+    from matplotlib.figure import Figure
+
+    from ..analysis import power_spectrum
+
+    fig = Figure(figsize=(11, 7.5), layout="constrained")
+    (a, b), (c, d) = fig.subplots(2, 2)
+    s = traj.series
+    sec = traj.section
+    f_cam = traj.params.omega / (2 * np.pi)
+    if s is not None and len(s) > 2:
+        last = s[s["t"] >= s["t"].iloc[-1] - 2.0]
+        a.plot(last["t"], last["theta_f"], lw=0.8, color="#0072B2", label="θ_f (follower)")
+        a.plot(
+            last["t"],
+            last["theta_fc"],
+            lw=0.8,
+            ls="--",
+            color="#D55E00",
+            label="θ_fc (persistent contact)",
+        )
+        a.legend(frameon=False, fontsize="small", loc="upper right")
+        b.plot(s["theta_f"], s["omega_f"], lw=0.3, color="#555555", rasterized=True)
+        dt = float(s["t"].diff().median())
+        f, pw = power_spectrum(s["theta_f"].to_numpy(), dt)
+        keep = (f > 0) & (f <= 10 * f_cam)
+        d.semilogy(f[keep], pw[keep] + 1e-300, lw=0.7, color="#0072B2")
+        d.axvline(f_cam, color="#D55E00", lw=0.8, ls=":", label=f"cam ω/2π = {f_cam:.3g} Hz")
+        d.legend(frameon=False, fontsize="small")
+    else:
+        for ax in (a, b, d):
+            ax.text(
+                0.5, 0.5, "no time series kept", ha="center", va="center", transform=ax.transAxes
+            )
+    c.scatter(sec["theta_f"], sec["omega_f"], s=6, color="#000000", linewidths=0, rasterized=True)
+    a.set(xlabel="time t [s]", ylabel="angle [rad]", title="θ_f and θ_fc, last 2 s")
+    b.set(xlabel="θ_f [rad]", ylabel="θ̇_f [rad/s]", title="phase portrait")
+    c.set(
+        xlabel="θ_f [rad]",
+        ylabel="θ̇_f [rad/s]",
+        title=f"Poincaré section at t = k·2π/ω ({len(sec)} points)",
+    )
+    d.set(
+        xlabel="frequency [Hz]",
+        ylabel="power of θ_f [rad²·s, arbitrary scale]",
+        title="spectrum of θ_f",
+    )
+    if title:
+        fig.suptitle(title)
+    return fig

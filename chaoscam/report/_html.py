@@ -1,0 +1,351 @@
+"""The self-contained HTML report: inputs read, figures drawn, a Jinja2 template rendered.
+
+Figures are inline PNG data URIs; the template holds its own CSS; nothing in the file refers
+to the network, so it opens from disk anywhere. A report built from a partial set of inputs
+says what is missing instead of failing.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ._figures import png_data_uri, response_figure
+
+__all__ = ["Comparison", "FigureItem", "build_report", "git_commit", "render", "write_report"]
+
+SECTIONS = (
+    ("summary", "Summary of findings"),
+    ("provenance", "Parameters and provenance"),
+    ("paper-figures", "Paper figures reproduced"),
+    ("regime-maps", "Regime maps"),
+    ("bifurcations", "Bifurcation diagrams"),
+    ("responses", "Representative responses"),
+    ("evidence", "Classifier evidence"),
+    ("comparison", "The paper against this run"),
+    ("missing", "What is missing"),
+)
+
+
+@dataclass
+class FigureItem:
+    """One embedded figure: anchor id, title, data URI, alt text, caption."""
+
+    id: str
+    title: str
+    uri: str
+    alt: str
+    caption: str
+
+
+@dataclass
+class Comparison:
+    """One row of the paper-vs-run table; ``verdict`` is agrees / differs / not comparable."""
+
+    figure: str
+    paper: str
+    found: str
+    verdict: str
+    reason: str
+    anchor: str = ""
+
+    def __post_init__(self):
+        if self.verdict not in ("agrees", "differs", "not comparable"):
+            raise ValueError(f"verdict {self.verdict!r}: agrees, differs or not comparable")
+
+
+@dataclass
+class ReportParts:
+    """Everything the template shows, gathered before rendering."""
+
+    summary: list[str] = field(default_factory=list)
+    provenance: list[dict[str, Any]] = field(default_factory=list)
+    paper_figures: list[FigureItem] = field(default_factory=list)
+    regime_maps: list[dict[str, Any]] = field(default_factory=list)
+    bifurcations: list[dict[str, Any]] = field(default_factory=list)
+    responses: list[FigureItem] = field(default_factory=list)
+    evidence: list[dict[str, Any]] = field(default_factory=list)
+    comparison: list[Comparison] = field(default_factory=list)
+    missing: list[str] = field(default_factory=list)
+
+
+def git_commit(start: Path | None = None) -> str | None:
+    """The commit checked out around ``start`` (read from ``.git``, no git process), or None."""
+    here = Path(start or Path(__file__)).resolve()
+    for d in [here, *here.parents]:
+        g = d / ".git"
+        if g.is_file():  # a worktree: "gitdir: PATH"
+            text = g.read_text().strip()
+            if text.startswith("gitdir:"):
+                g = (d / text.split(":", 1)[1].strip()).resolve()
+        if not g.is_dir():
+            continue
+        try:
+            head = (g / "HEAD").read_text().strip()
+            if not head.startswith("ref:"):
+                return head
+            ref = head.split(":", 1)[1].strip()
+            common = g
+            if (g / "commondir").exists():
+                common = (g / (g / "commondir").read_text().strip()).resolve()
+            for base in (g, common):
+                if (base / ref).exists():
+                    return (base / ref).read_text().strip()
+            packed = common / "packed-refs"
+            if packed.exists():
+                for line in packed.read_text().splitlines():
+                    if line.endswith(" " + ref):
+                        return line.split()[0]
+        except OSError:
+            return None
+        return None
+    return None
+
+
+def _counts(counts: dict) -> str:
+    return ", ".join(f"{k} {v}" for k, v in counts.items()) or "none"
+
+
+def _fmt(v: Any) -> str:
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else f"{v:.6g}"
+    return "" if v is None else str(v)
+
+
+def _provenance_rows(source: str, kind: str, rows: dict[str, Any]) -> dict[str, Any]:
+    return {"source": source, "kind": kind, "rows": [(k, _fmt(v)) for k, v in rows.items()]}
+
+
+def add_trajectory(parts: ReportParts, path: str, traj, *, caption: str = "") -> None:
+    """A trajectory's response figure, its classification and its provenance."""
+    from ._classify import classifier_name, classify
+
+    name = Path(path).name
+    p = traj.params
+    verdict = classify(traj)
+    s = traj.settings
+    parts.provenance.append(
+        _provenance_rows(
+            path,
+            "trajectory",
+            {
+                "status": traj.status.name,
+                "seed": s.get("seed"),
+                "realization index": s.get("index"),
+                "solver": s.get("solver"),
+                "step dt [s]": p.dt,
+                "duration [s]": s.get("duration"),
+                "transient [s]": s.get("transient"),
+                "package version": s.get("version"),
+                "stiffness": p.stiffness,
+                "l_lambda (mean) [m]": p.l_lambda,
+                "l_lambda_sigma [m]": p.l_lambda_sigma,
+                "resample": p.resample,
+                "impacts applied": traj.stats.get("n_impacts"),
+                "contact fraction": traj.stats.get("contact_fraction"),
+            },
+        )
+    )
+    label = verdict.label + (f" (period {verdict.period})" if verdict.period else "")
+    fig = response_figure(traj, title=f"{name}: {label}")
+    fid = f"resp-{len(parts.responses) + 1}"
+    parts.responses.append(
+        FigureItem(
+            fid,
+            f"Response of {name}",
+            png_data_uri(fig),
+            f"Four panels for {name}: follower angle and persistent-contact angle over the "
+            f"last 2 s, phase portrait, stroboscopic Poincaré section and spectrum of theta_f; "
+            f"classified {label}.",
+            caption
+            or f"μ = l_lambda = {p.l_lambda:g} m, σ = {p.l_lambda_sigma:g} m, "
+            f"stiffness {p.stiffness}; classified {label}.",
+        )
+    )
+    parts.evidence.append(
+        {
+            "run": name,
+            "label": verdict.label,
+            "period": verdict.period,
+            "reasons": list(verdict.reasons),
+            "classifier": classifier_name(),
+            "rows": [
+                (e.name, _fmt(e.value), e.vote or "abstains", e.detail) for e in verdict.evidence
+            ],
+        }
+    )
+    parts.summary.append(f"{name}: {label} ({traj.status.name}).")
+
+
+def add_bifurcation(parts: ReportParts, path: str, bif, *, caption: str = "") -> None:
+    """A bifurcation diagram, its verdicts per value and its provenance."""
+    from ._sweep_fallback import bifurcation_figure
+
+    name = Path(path).name
+    cfg = bif.config or {}
+    param = cfg.get("axis", {}).get("name", "value")
+    v = bif.verdicts
+    counts = v["label"].value_counts().to_dict() if len(v) else {}
+    fig = bifurcation_figure(bif.points)
+    ev_cols = [c for c in v.columns if c.startswith("ev_")]
+    parts.bifurcations.append(
+        {
+            "figure": FigureItem(
+                f"bif-{len(parts.bifurcations) + 1}",
+                f"Bifurcation diagram over {param} ({name})",
+                png_data_uri(fig),
+                f"Stroboscopic section theta_f in rad against {param}, coloured by the "
+                f"classifier's label; label counts {_counts(counts)}.",
+                caption
+                or f"{len(v)} runs, {len(bif.points)} section points; labels {_counts(counts)}.",
+            ),
+            "header": [param, "initial condition", "label", "period", "status"]
+            + [c[3:] for c in ev_cols],
+            "rows": [
+                (
+                    _fmt(r["value"]),
+                    int(r["ic"]),
+                    r["label"],
+                    _fmt(r["period"]),
+                    r["status"],
+                    *(_fmt(float(r[c])) for c in ev_cols),
+                )
+                for r in v.sort_values(["value", "ic"]).to_dict("records")
+            ][:300],
+        }
+    )
+    parts.provenance.append(_provenance_rows(path, "bifurcation", _sweep_settings(cfg)))
+    parts.summary.append(f"{name}: bifurcation over {param}, labels {_counts(counts)}.")
+
+
+def add_regime_map(parts: ReportParts, path: str, rm, *, caption: str = "") -> None:
+    """A regime map's figure, its cell table and its provenance."""
+    from ._sweep_fallback import regime_map_figure
+
+    name = Path(path).name
+    cfg = rm.config or {}
+    x, y = cfg.get("x", {}).get("name", "x"), cfg.get("y", {}).get("name", "y")
+    c = rm.cells
+    fig = regime_map_figure(c, x=x, y=y)
+    rows = []
+    for r in c.sort_values([x, y]).to_dict("records"):
+        rows.append(
+            (
+                _fmt(r[x]),
+                _fmt(r[y]),
+                int(r.get("n", 0)),
+                r.get("dominant", ""),
+                f"{r.get('p_chaotic', float('nan')):.2f} "
+                f"[{r.get('p_chaotic_lo', float('nan')):.2f}, "
+                f"{r.get('p_chaotic_hi', float('nan')):.2f}]",
+                f"{r.get('p_quasiperiodic', float('nan')):.2f}",
+                f"{r.get('p_periodic', float('nan')):.2f}",
+            )
+        )
+    parts.regime_maps.append(
+        {
+            "figure": FigureItem(
+                f"map-{len(parts.regime_maps) + 1}",
+                f"Regime map {x} × {y} ({name})",
+                png_data_uri(fig),
+                f"Heatmaps over {x} and {y}: dominant label per cell, probability of chaos "
+                "with its 95% Wilson interval, and the interval width.",
+                caption or f"{len(rm.realizations)} realizations in {len(c)} cells.",
+            ),
+            "x": x,
+            "y": y,
+            "rows": rows,
+        }
+    )
+    parts.provenance.append(_provenance_rows(path, "regime map", _sweep_settings(cfg)))
+    dom = c["dominant"].value_counts().to_dict() if len(c) else {}
+    parts.summary.append(f"{name}: regime map {x} × {y}, dominant labels {_counts(dom)}.")
+
+
+def _sweep_settings(cfg: dict[str, Any]) -> dict[str, Any]:
+    names = {
+        "kind": "kind",
+        "version": "package version",
+        "seed": "seed",
+        "duration": "duration [s]",
+        "transient": "transient [s]",
+        "realizations": "realizations per cell",
+        "classifier": "classifier",
+        "continuation": "continuation",
+    }
+    rows = {label: cfg.get(k) for k, label in names.items() if k in cfg}
+    for axis, label in (("axis", "swept parameter"), ("x", "x axis"), ("y", "y axis")):
+        if axis in cfg:
+            a = cfg[axis]
+            vals = a.get("values", [])
+            rows[label] = (
+                f"{a.get('name')}: {len(vals)} values in [{min(vals):g}, {max(vals):g}]"
+                if vals
+                else a.get("name")
+            )
+    base = cfg.get("base", {})
+    units = {"dt": "s", "l_lambda": "m", "l_lambda_sigma": "m", "G": "m", "D": "-"}
+    for k in ("stiffness", "dt", "l_lambda", "l_lambda_sigma", "D", "G", "resample"):
+        if k in base:
+            rows[f"base {k}" + (f" [{units[k]}]" if k in units else "")] = base[k]
+    return rows
+
+
+def render(parts: ReportParts, *, title: str, command: str | None = None) -> str:
+    """The report's HTML text."""
+    import jinja2
+
+    from .._version import __version__
+    from ._classify import classifier_fingerprint
+
+    env = jinja2.Environment(
+        loader=jinja2.PackageLoader("chaoscam.report", "templates"),
+        autoescape=jinja2.select_autoescape(["html"]),
+        undefined=jinja2.StrictUndefined,
+    )
+    commit = git_commit()
+    return env.get_template("report.html").render(
+        title=title,
+        sections=SECTIONS,
+        parts=parts,
+        version=__version__,
+        commit=commit or "not available (not run from a git checkout)",
+        date=_dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),
+        command=command or " ".join(["chaoscam", *sys.argv[1:]]),
+        python=sys.version.split()[0],
+        classifier=classifier_fingerprint(),
+    )
+
+
+def build_report(inputs, parts: ReportParts | None = None) -> ReportParts:
+    """Add every input (an :class:`~chaoscam.report._inputs.Inputs`) to the report parts."""
+    parts = parts or ReportParts()
+    for path, rm in inputs.regime_maps:
+        add_regime_map(parts, path, rm)
+    for path, bif in inputs.bifurcations:
+        add_bifurcation(parts, path, bif)
+    for path, traj in inputs.trajectories:
+        add_trajectory(parts, path, traj)
+    for kind, items, what in (
+        ("regime map", inputs.regime_maps, "regime-map"),
+        ("bifurcation diagram", inputs.bifurcations, "bifurcation"),
+        ("trajectory", inputs.trajectories, "simulate --out"),
+    ):
+        if not items:
+            parts.missing.append(
+                f"No {kind} among the inputs: its section is empty (make one with "
+                f"`chaoscam {what}`)."
+            )
+    return parts
+
+
+def write_report(parts: ReportParts, out: str | Path, *, title: str, command=None) -> Path:
+    """Render and write the report; returns the path."""
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(render(parts, title=title, command=command), encoding="utf-8")
+    return out

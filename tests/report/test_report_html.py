@@ -1,0 +1,154 @@
+"""The HTML report: every section, decodable inline PNGs, no network reference, clear errors."""
+
+from __future__ import annotations
+
+import base64
+import io
+import re
+from html.parser import HTMLParser
+
+import pytest
+
+import chaoscam
+from chaoscam.cli import main
+from chaoscam.report._html import SECTIONS
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+class _Collect(HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.ids, self.imgs, self.tables, self.open = set(), [], 0, []
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if "id" in a:
+            self.ids.add(a["id"])
+        if tag == "img":
+            self.imgs.append(a)
+        if tag == "table":
+            self.tables += 1
+
+
+def _parse(text: str) -> _Collect:
+    p = _Collect()
+    p.feed(text)
+    p.close()
+    return p
+
+
+@pytest.fixture(scope="module")
+def outputs(tmp_path_factory):
+    """A tiny trajectory, bifurcation diagram and regime map, written as chaoscam writes them."""
+    from chaoscam.report._classify import ReportClassifier
+    from chaoscam.sweep import Axis, bifurcation, regime_map
+
+    d = tmp_path_factory.mktemp("inputs")
+    traj = chaoscam.simulate(duration=3.0, transient=1.0)
+    traj.to_parquet(d / "traj.parquet")
+    bif = bifurcation(
+        "l_lambda",
+        "0.006:0.010:2",
+        duration=3.0,
+        transient=1.5,
+        classify=ReportClassifier(),
+        workers=1,
+    )
+    bif.to_parquet(d / "bif.parquet")
+    rm = regime_map(
+        Axis("l_lambda", (0.008,)),
+        Axis("l_lambda_sigma", (0.0, 0.001)),
+        realizations=2,
+        duration=2.5,
+        transient=1.0,
+        classify=ReportClassifier(),
+        workers=1,
+    )
+    rm.to_parquet(d / "map.parquet")
+    return d
+
+
+def _report(args, tmp_path, capsys) -> tuple[int, str, str]:
+    out = tmp_path / "r.html"
+    code = main(["report", *map(str, args), "--out", str(out)])
+    err = capsys.readouterr().err
+    return code, (out.read_text() if out.exists() else ""), err
+
+
+def test_full_report_has_every_section_and_valid_images(outputs, tmp_path, capsys):
+    """A report of all three kinds parses, has each section, and every image is a real PNG."""
+    import matplotlib.image as mpimg
+
+    code, text, err = _report(
+        [outputs / "traj.parquet", outputs / "bif.parquet", outputs / "map.parquet"],
+        tmp_path,
+        capsys,
+    )
+    assert code == 0, err
+    doc = _parse(text)
+    assert {sid for sid, _ in SECTIONS} <= doc.ids
+    assert len(doc.imgs) >= 3 and doc.tables >= 4
+    for img in doc.imgs:
+        assert img.get("alt"), "every figure has alt text"
+        head, _, data = img["src"].partition(",")
+        assert head == "data:image/png;base64"
+        raw = base64.b64decode(data, validate=True)
+        assert raw.startswith(PNG_SIGNATURE)
+        assert mpimg.imread(io.BytesIO(raw), format="png").shape[0] > 50
+    assert not re.search(r"https?:", text, re.IGNORECASE), "no network reference"
+    assert "Nothing: every part of the report has its inputs." in text
+    assert "chaoscam report " in text and "package version" in text and "git commit" in text
+
+
+def test_partial_inputs_say_what_is_missing(outputs, tmp_path, capsys):
+    """A trajectory alone still gives a report, which names the missing sweeps."""
+    code, text, _ = _report([outputs / "traj.parquet"], tmp_path, capsys)
+    assert code == 0
+    assert "No regime map among the inputs" in text
+    assert "No bifurcation diagram among the inputs" in text
+
+
+def test_companion_file_reads_its_sweep(outputs, tmp_path, capsys):
+    """Naming a sweep by its companion (.verdicts / .cells) reads the whole sweep."""
+    code, text, _ = _report(
+        [outputs / "bif.verdicts.parquet", outputs / "map.cells.parquet"], tmp_path, capsys
+    )
+    assert code == 0
+    assert "Bifurcation diagram over l_lambda" in text and "Regime map l_lambda" in text
+
+
+@pytest.mark.parametrize("kind", ["missing", "not_parquet", "foreign_parquet", "suffix"])
+def test_bad_input_is_a_usage_error_naming_the_file(kind, tmp_path, capsys):
+    """Missing, unreadable or foreign input exits 2 with the file's name in the message."""
+    import pandas as pd
+
+    path = tmp_path / f"{kind}.parquet"
+    if kind == "not_parquet":
+        path.write_text("t,theta\n0,1\n")
+    elif kind == "foreign_parquet":
+        pd.DataFrame({"a": [1, 2]}).to_parquet(path)
+    elif kind == "suffix":
+        path = tmp_path / "run.csv"
+        path.write_text("x\n")
+    code, _, err = _report([path], tmp_path, capsys)
+    assert code == 2
+    assert str(path) in err
+
+
+def test_out_must_be_html(outputs, tmp_path, capsys):
+    """The report's name must end in .html."""
+    code = main(["report", str(outputs / "traj.parquet"), "--out", str(tmp_path / "r.txt")])
+    assert code == 2 and "html" in capsys.readouterr().err
+
+
+def test_fallback_classifier_labels_a_run(monkeypatch):
+    """Without chaoscam.classify the report's fallback still returns a verdict with evidence."""
+    from chaoscam.analysis import LABELS
+    from chaoscam.report import _classify
+
+    monkeypatch.setattr(_classify, "package_classifier", lambda: None)
+    traj = chaoscam.simulate(duration=4.0, transient=1.0)
+    v = _classify.classify(traj)
+    assert v.label in LABELS and len(v.evidence) > 0
+    assert "fallback" in _classify.classifier_name()
