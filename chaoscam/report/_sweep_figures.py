@@ -1,0 +1,242 @@
+"""Figures of sweeps: regime-map heatmaps (seaborn) and bifurcation diagrams.
+
+Every function takes the tidy tables of :mod:`chaoscam.sweep` and returns a matplotlib
+``Figure`` (built without pyplot, so nothing opens a window); ``fig.savefig(path)`` writes
+it. seaborn and matplotlib are imported inside the functions.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+__all__ = [
+    "LABEL_COLORS",
+    "axis_label",
+    "plot_dominant",
+    "plot_probability",
+    "plot_bifurcation",
+    "regime_map_figure",
+    "bifurcation_figure",
+]
+
+# Okabe-Ito colours: distinguishable with the common colour-vision deficiencies.
+LABEL_COLORS = {
+    "periodic": "#0072B2",
+    "quasiperiodic": "#009E73",
+    "chaotic": "#D55E00",
+    "undetermined": "#BBBBBB",
+    "left_reach": "#CC79A7",
+    "diverged": "#000000",
+}
+_OTHER = "#E69F00"
+
+_SYMBOLS = {
+    "l_lambda": "l_λ",
+    "l_lambda_sigma": "σ of l_λ",
+    "omega": "ω",
+    "xi": "ξ",
+    "beta": "β",
+    "mu_f": "μ_f",
+    "theta_f": "θ_f",
+    "omega_f": "θ̇_f",
+}
+
+
+def axis_label(name: str, *, role: str | None = None) -> str:
+    """``"symbol (name) [unit]"`` for a parameter or a section coordinate.
+
+    ``role="mean"`` names l_lambda as the mean mu of the random line length.
+    """
+    from ..model import FIELD_DOCS
+
+    units = {"theta_f": "rad", "omega_f": "rad/s", "t": "s", "l_lambda_used": "m"}
+    unit = FIELD_DOCS[name]["unit"] if name in FIELD_DOCS else units.get(name, "")
+    if name == "l_lambda" and role == "mean":
+        text = "mean line length μ (l_lambda)"
+    elif name == "l_lambda_sigma":
+        text = "line-length spread σ (l_lambda_sigma)"
+    else:
+        sym = _SYMBOLS.get(name)
+        text = f"{sym} ({name})" if sym and sym != name else name
+    return f"{text} [{unit}]" if unit and unit != "-" else text
+
+
+def _grid(cells: pd.DataFrame, x: str, y: str, column: str) -> pd.DataFrame:
+    """Cells as a matrix: rows = y values, top row the largest, columns = x values."""
+    m = cells.pivot(index=y, columns=x, values=column)
+    return m.sort_index(ascending=False).sort_index(axis=1)
+
+
+def _ticks(ax, m: pd.DataFrame, x: str, y: str, role: str | None) -> None:
+    nx, ny = m.shape[1], m.shape[0]
+    sx, sy = max(1, nx // 10), max(1, ny // 10)
+    ax.set_xticks(np.arange(0, nx, sx) + 0.5)
+    ax.set_xticklabels([f"{v:.4g}" for v in m.columns[::sx]], rotation=45, ha="right")
+    ax.set_yticks(np.arange(0, ny, sy) + 0.5)
+    ax.set_yticklabels([f"{v:.4g}" for v in m.index[::sy]], rotation=0)
+    ax.set_xlabel(axis_label(x, role=role))
+    ax.set_ylabel(axis_label(y))
+
+
+def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
+    """Heatmap of each cell's dominant label, with a legend of the labels present."""
+    import seaborn as sns
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    present = [lab for lab in cells["dominant"].unique() if lab]
+    order = [lab for lab in LABEL_COLORS if lab in present] + sorted(
+        set(present) - set(LABEL_COLORS)
+    )
+    code = {lab: i for i, lab in enumerate(order)}
+    coded = cells.assign(_code=cells["dominant"].map(code).astype(float))
+    m = _grid(coded, x, y, "_code")
+    colors = [LABEL_COLORS.get(lab, _OTHER) for lab in order] or ["#FFFFFF"]
+    sns.heatmap(
+        m,
+        ax=ax,
+        cmap=ListedColormap(colors),
+        vmin=-0.5,
+        vmax=len(colors) - 0.5,
+        cbar=False,
+        linewidths=0.2 if m.size <= 400 else 0,
+        linecolor="white",
+        mask=m.isna(),
+    )
+    _ticks(ax, m, x, y, _role(x, y))
+    ax.set_title("dominant label")
+    ax.legend(
+        handles=[Patch(color=LABEL_COLORS.get(lab, _OTHER), label=lab) for lab in order],
+        loc="upper left",
+        bbox_to_anchor=(1.01, 1.0),
+        frameon=False,
+        fontsize="small",
+    )
+
+
+def _role(x: str, y: str) -> str | None:
+    return "mean" if x == "l_lambda" and y == "l_lambda_sigma" else None
+
+
+def plot_probability(
+    cells: pd.DataFrame, x: str, y: str, ax, *, label: str = "chaotic", annotate=None
+) -> None:
+    """Heatmap of P(label) per cell; small grids are annotated with the 95 % interval.
+
+    ``annotate`` None annotates grids of at most 64 cells with ``p`` and ``[lo, hi]``.
+    """
+    import seaborn as sns
+
+    m = _grid(cells, x, y, f"p_{label}")
+    if annotate is None:
+        annotate = m.size <= 64
+    annot = False
+    if annotate:
+        lo = _grid(cells, x, y, f"p_{label}_lo").to_numpy()
+        hi = _grid(cells, x, y, f"p_{label}_hi").to_numpy()
+        p = m.to_numpy()
+        annot = np.array(
+            [
+                [f"{a:.2f}\n[{b:.2f}, {c:.2f}]" for a, b, c in zip(ra, rb, rc, strict=True)]
+                for ra, rb, rc in zip(p, lo, hi, strict=True)
+            ]
+        )
+    sns.heatmap(
+        m,
+        ax=ax,
+        cmap="rocket_r",
+        vmin=0.0,
+        vmax=1.0,
+        annot=annot,
+        fmt="",
+        annot_kws={"fontsize": 6},
+        cbar_kws={"label": f"P({label})"},
+        mask=m.isna(),
+    )
+    _ticks(ax, m, x, y, _role(x, y))
+    ax.set_title(f"P({label})" + (" with 95% Wilson interval" if annotate else ""))
+
+
+def plot_interval_width(cells: pd.DataFrame, x: str, y: str, ax, *, label="chaotic") -> None:
+    """Heatmap of the width hi - lo of the 95 % Wilson interval of P(label)."""
+    import seaborn as sns
+
+    width = cells[f"p_{label}_hi"] - cells[f"p_{label}_lo"]
+    m = _grid(cells.assign(_w=width), x, y, "_w")
+    sns.heatmap(
+        m,
+        ax=ax,
+        cmap="mako_r",
+        vmin=0.0,
+        vmax=1.0,
+        cbar_kws={"label": "interval width"},
+        mask=m.isna(),
+    )
+    _ticks(ax, m, x, y, _role(x, y))
+    ax.set_title(f"95% interval width of P({label})")
+
+
+def regime_map_figure(cells: pd.DataFrame, *, x: str, y: str, label: str = "chaotic"):
+    """Three panels: dominant label, P(label) (annotated when small), interval width."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(17, 5), layout="constrained")
+    a, b, c = fig.subplots(1, 3)
+    plot_dominant(cells, x, y, a)
+    plot_probability(cells, x, y, b, label=label)
+    plot_interval_width(cells, x, y, c, label=label)
+    return fig
+
+
+def plot_bifurcation(
+    points: pd.DataFrame,
+    ax,
+    *,
+    coordinate: str = "theta_f",
+    color_by: str = "label",
+    size: float | None = None,
+) -> None:
+    """Section points over the swept value, rasterised (tens of thousands stay light).
+
+    ``color_by`` = "label" (the verdict), "ic" (the initial condition) or None.
+    """
+    param = str(points["param"].iloc[0]) if len(points) else "value"
+    groups = [(None, points)] if color_by is None else list(points.groupby(color_by, sort=True))
+    if size is None:  # dots that stay visible for a few points and do not merge for 1e5
+        size = float(np.clip(3e4 / max(len(points), 1), 0.3, 6.0))
+    for key, g in groups:
+        if color_by == "label":
+            color = LABEL_COLORS.get(key, _OTHER)
+        elif color_by is None:
+            color = "#000000"
+        else:
+            color = None
+        ax.scatter(
+            g["value"],
+            g[coordinate],
+            s=size,
+            c=color,
+            marker="o",
+            linewidths=0,
+            rasterized=True,
+            label=None if key is None else str(key),
+        )
+    ax.set_xlabel(axis_label(param) if len(points) else "value")
+    ax.set_ylabel(axis_label(coordinate))
+    if color_by is not None and groups:
+        ax.legend(markerscale=6, frameon=False, fontsize="small", title=color_by)
+
+
+def bifurcation_figure(
+    points: pd.DataFrame, *, coordinate: str = "theta_f", color_by: str = "label"
+):
+    """One panel: the bifurcation diagram of ``coordinate`` over the swept parameter."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9, 5), layout="constrained")
+    ax = fig.subplots()
+    plot_bifurcation(points, ax, coordinate=coordinate, color_by=color_by)
+    param = str(points["param"].iloc[0]) if len(points) else ""
+    ax.set_title(f"bifurcation diagram over {param}: stroboscopic section after the transient")
+    return fig

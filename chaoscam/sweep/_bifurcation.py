@@ -1,0 +1,330 @@
+"""Bifurcation diagrams: stroboscopic section points and the verdict over one parameter.
+
+Paper Figs. 4 and 6: for each value of a parameter (l_lambda over [0.001, 0.018] m in steps
+of 0.00025 m; D over [1.36, 1.56] with fractal stiffness for G = 1e-9 and 1e-10 m), the
+follower's angle at the cam period after the transient. Several initial conditions per
+value show coexisting attractors; continuation starts each value from the previous value's
+last section point, following one branch.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .._version import __version__
+from ..model import Params, contact_angle
+from ._checkpoint import read_sweep_metadata, write_parquet
+from ._common import (
+    backend_for,
+    companion,
+    evidence_columns,
+    open_store,
+    period_column,
+    reemit_warnings,
+    resolve_classifier,
+    run_settings,
+    unique_sorted,
+)
+from ._engine import execute
+from ._grid import Axis, SweepError, realization_index, validate_grid
+from ._tasks import BranchTask, needs_series
+
+__all__ = ["Bifurcation", "bifurcation", "read_bifurcation", "initial_offsets"]
+
+IC_BOX = (0.3, 3.0)
+"""Extra initial conditions lie in theta_f0 - theta_fc(0) in [0, 0.3] rad (lifted off the
+cam, never into it) and omega_f0 in [-3, 3] rad/s: the extent of the default model's
+stroboscopic section (theta_f in [0, 0.31] rad, omega_f within +-3.6 rad/s)."""
+
+POINT_COLUMNS = ("k", "t", "theta_f", "omega_f", "l_lambda")
+
+
+@dataclass(frozen=True)
+class Bifurcation:
+    """A bifurcation diagram: section points and verdicts, with the settings used.
+
+    Attributes
+    ----------
+    points : DataFrame
+        One row per stroboscopic section point after the transient, sorted by (value_index,
+        ic, k): ``param``, ``value``, ``value_index``, ``ic``, ``k``, ``t`` [s],
+        ``theta_f`` [rad], ``omega_f`` [rad/s], ``l_lambda`` (the line length in use [m]),
+        and the run's ``status``, ``label``, ``period``.
+    verdicts : DataFrame
+        One row per (value, initial condition): ``param``, ``value``, ``value_index``,
+        ``ic``, ``seed``, ``sim_index``, ``theta_f0``, ``omega_f0`` (NaN = in contact),
+        ``continued``, ``status``, ``label``, ``period``, ``n_points``, ``reasons``,
+        ``warnings`` and ``ev_<name>`` evidence values.
+    config : dict
+        The settings that fix the result.
+    """
+
+    points: pd.DataFrame
+    verdicts: pd.DataFrame
+    config: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def param(self) -> str:
+        return self.config["axis"]["name"]
+
+    def to_parquet(self, path: str | Path) -> None:
+        """Points to ``FILE.parquet``, verdicts to ``FILE.verdicts.parquet``."""
+        path = Path(path)
+        write_parquet(self.points, path, self.config)
+        write_parquet(self.verdicts, companion(path, "verdicts"), self.config)
+
+
+def read_bifurcation(path: str | Path) -> Bifurcation:
+    """Read a diagram written by :func:`bifurcation`."""
+    path = Path(path)
+    meta = read_sweep_metadata(path) or {}
+    return Bifurcation(
+        pd.read_parquet(path),
+        pd.read_parquet(companion(path, "verdicts")),
+        meta.get("config", {}),
+    )
+
+
+def initial_offsets(n: int) -> list[tuple[float, float]]:
+    """Offsets (d theta [rad], omega_f0 [rad/s]) of initial conditions 1 .. n-1.
+
+    The points of the unscrambled 2-D Halton sequence (bases 2 and 3), skipping its origin,
+    mapped onto `IC_BOX`: spread evenly, and the same for every value and every seed.
+    """
+    from scipy.stats import qmc
+
+    if n <= 1:
+        return []
+    u = qmc.Halton(d=2, scramble=False).random(n)[1:]
+    d_theta, omega = IC_BOX
+    return [(float(a * d_theta), float((2.0 * b - 1.0) * omega)) for a, b in u]
+
+
+class _BranchPlan:
+    """Every (value, initial condition); with continuation, one chain per condition."""
+
+    def __init__(self, make_task: Callable, nvalues: int, nics: int, continuation: bool):
+        self.make_task, self.nvalues, self.nics = make_task, nvalues, nics
+        self.continuation = continuation
+        self.finished: set[tuple[int, int]] = set()
+        self.last: dict[int, tuple[int, Any]] = {}  # chain -> (value index, next state)
+        self.total = nvalues * nics
+        self.done = 0
+
+    def restore(self, record: dict[str, Any]) -> bool:
+        key = (record["value_index"], record["ic"])
+        if key in self.finished:
+            return False
+        self.finished.add(key)
+        self.done += 1
+        v, j = key
+        if v >= self.last.get(j, (-1, None))[0]:
+            self.last[j] = (v, record["next_state"])
+        return True
+
+    def start(self) -> Iterator[BranchTask]:
+        if not self.continuation:
+            return (
+                self.make_task(v, j, None)
+                for v in range(self.nvalues)
+                for j in range(self.nics)
+                if (v, j) not in self.finished
+            )
+        tasks = []
+        for j in range(self.nics):
+            v, state = self.last.get(j, (-1, None))
+            if v + 1 < self.nvalues:
+                tasks.append(self.make_task(v + 1, j, state))
+        return iter(tasks)
+
+    def on_record(self, record: dict[str, Any]) -> list[BranchTask]:
+        if not self.restore(record):
+            return []
+        v, j = record["value_index"], record["ic"]
+        if self.continuation and v + 1 < self.nvalues:
+            return [self.make_task(v + 1, j, record["next_state"])]
+        return []
+
+
+def _tables(records: list[dict], axis: Axis) -> tuple[pd.DataFrame, pd.DataFrame]:
+    verdicts = pd.DataFrame(
+        {
+            "param": axis.name,
+            "value": np.array([r["value"] for r in records], dtype=float),
+            "value_index": np.array([r["value_index"] for r in records], dtype=np.int64),
+            "ic": np.array([r["ic"] for r in records], dtype=np.int64),
+            "seed": np.array([r["seed"] for r in records], dtype=np.int64),
+            "sim_index": np.array([r["sim_index"] for r in records], dtype=np.int64),
+            "theta_f0": np.array([r["theta_f0"] for r in records], dtype=float),
+            "omega_f0": np.array([r["omega_f0"] for r in records], dtype=float),
+            "continued": np.array([r["continued"] for r in records], dtype=bool),
+            "status": [r["status"] for r in records],
+            "label": [r["label"] for r in records],
+            "period": period_column(records),
+            "n_points": np.array([r["n_points"] for r in records], dtype=np.int64),
+            "reasons": [r["reasons"] for r in records],
+            "warnings": [r["warnings"] for r in records],
+        }
+    )
+    verdicts = pd.concat([verdicts, evidence_columns(records)], axis=1)
+    n = verdicts["n_points"].to_numpy()
+    rep = np.repeat(np.arange(len(records)), n)
+    cols = {
+        c: np.concatenate([[]] + [r["section"].get(c, []) for r in records]) for c in POINT_COLUMNS
+    }
+    points = pd.DataFrame(
+        {
+            "param": axis.name,
+            "value": verdicts["value"].to_numpy()[rep],
+            "value_index": verdicts["value_index"].to_numpy()[rep],
+            "ic": verdicts["ic"].to_numpy()[rep],
+            "k": cols["k"].astype(np.int64),
+            **{c: cols[c].astype(float) for c in POINT_COLUMNS[1:]},
+            "status": verdicts["status"].to_numpy()[rep],
+            "label": verdicts["label"].to_numpy()[rep],
+            "period": verdicts["period"].array[rep] if len(rep) else pd.array([], "Int64"),
+        }
+    )
+    return points, verdicts
+
+
+def bifurcation(
+    param: str | Axis,
+    values: Sequence[float] | str | None = None,
+    *,
+    base: Params | None = None,
+    duration: float = 20.0,
+    transient: float | None = None,
+    seed: int = 0,
+    initial_conditions: int | Sequence[tuple[float, float]] = 1,
+    continuation: bool = False,
+    classify: Callable | None = None,
+    lyapunov: bool = False,
+    check_step: bool = False,
+    workers: int | None = None,
+    scheduler: Any = None,
+    out: str | Path | None = None,
+    resume: bool = False,
+    progress: bool = False,
+    flush_interval: float = 1.0,
+) -> Bifurcation:
+    """Bifurcation diagram of the stroboscopic section over one parameter (paper Figs. 4, 6).
+
+    Parameters
+    ----------
+    param : str or Axis
+        The swept field (``l_lambda``, ``D``, ``G``, ``omega``, ``xi``, ``beta``, ...), or an
+        Axis holding the values too.
+    values : sequence of float or str
+        The values, or ``"START:STOP:NUM"`` (NUM points, ends included). Fig. 4:
+        ``bifurcation("l_lambda", "0.001:0.018:69")``.
+    base : Params, optional
+        Everything not swept; for Fig. 6 ``Params(stiffness="fractal", G=1e-9)`` (the
+        fractal stiffness needs a smaller ``dt``; simulate warns when it is too coarse).
+    duration, transient : float
+        Simulated time and the discarded start [s]; transient None = duration / 2.
+    seed : int
+        Seed of the line-length process (matters only when ``l_lambda_sigma`` > 0); value
+        ``v``, condition ``j`` uses index ``realization_index(v, j)``.
+    initial_conditions : int or sequence of (theta_f0, omega_f0)
+        An int n: condition 0 is the base's initial state (in contact by default) and
+        1 .. n-1 are spread over `IC_BOX` by :func:`initial_offsets`; or explicit states
+        [rad, rad/s].
+    continuation : bool
+        Start value v+1 of each condition from the last section point of value v (at cam
+        phase theta_c0, so the cam phase carries over); a run that did not end normally
+        hands over the condition's own initial state instead. Values run in order along
+        each chain, so only the conditions run in parallel.
+    classify, lyapunov, check_step, workers, scheduler, out, resume, progress, flush_interval
+        As for :func:`regime_map`; the verdicts go to ``FILE.verdicts.parquet``.
+
+    Returns
+    -------
+    Bifurcation
+    """
+    if isinstance(param, Axis):
+        axis = param
+    elif values is None:
+        raise SweepError(f"give the values of {param} to sweep (or an Axis)")
+    elif isinstance(values, str):
+        axis = Axis.parse(values, name=param)
+    else:
+        axis = Axis(param, tuple(values))
+    base = Params() if base is None else base
+    duration, transient = run_settings(duration, transient, seed)
+    validate_grid(base, [axis])
+    if isinstance(initial_conditions, int) and not isinstance(initial_conditions, bool):
+        if initial_conditions < 1:
+            raise SweepError(f"initial conditions = {initial_conditions} must be >= 1")
+        specs: list[tuple[str, float | None, float | None]] = [
+            ("base", base.theta_f0, base.omega_f0)
+        ] + [("offset", a, b) for a, b in initial_offsets(initial_conditions)]
+    else:
+        specs = [("absolute", float(a), float(b)) for a, b in initial_conditions]
+        if not specs:
+            raise SweepError("initial conditions: the list is empty")
+    classify, identity = resolve_classifier(classify, lyapunov, check_step)
+    config = {
+        "kind": "bifurcation",
+        "version": __version__,
+        "base": base.to_dict(),
+        "axis": axis.to_dict(),
+        "seed": int(seed),
+        "duration": duration,
+        "transient": transient,
+        "initial_conditions": [list(s) for s in specs],
+        "continuation": bool(continuation),
+        "classifier": identity,
+        "index_scheme": "cantor(value_index, ic)",
+    }
+    out = None if out is None else Path(out)
+    store, reuse = open_store(out, "verdicts", config, resume, flush_interval)
+    if reuse:
+        return read_bifurcation(out)
+
+    series = needs_series(classify)
+
+    def make_task(v: int, j: int, state) -> BranchTask:
+        value = axis.values[v]
+        p = base.replace(**{axis.name: value})
+        kind, a, b = specs[j]
+        if state is not None:
+            th, om = state
+        elif kind == "offset":
+            th, om = float(contact_angle(p, 0.0)) + a, b
+        else:
+            th, om = a, b
+        p = p.replace(theta_f0=th, omega_f0=om)
+        return BranchTask(
+            v,
+            j,
+            value,
+            int(seed),
+            realization_index(v, j),
+            p,
+            duration,
+            transient,
+            classify,
+            continued=state is not None,
+            series=series,
+        )
+
+    plan = _BranchPlan(make_task, len(axis), len(specs), bool(continuation))
+    backend = backend_for(workers, scheduler)
+    try:
+        execute(plan, backend, store, progress=progress, desc=f"bifurcation {axis.name}")
+    finally:
+        backend.close()
+    records = unique_sorted(store.records(), ("value_index", "ic"))
+    reemit_warnings(records)
+    result = Bifurcation(*_tables(records, axis), config)
+    if out is not None:
+        result.to_parquet(out)
+        store.remove()
+    return result

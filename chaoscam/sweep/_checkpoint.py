@@ -1,0 +1,240 @@
+"""Checkpoints: finished records written as they complete, so a killed run can resume.
+
+Layout, beside the output ``FILE.parquet``: a folder ``FILE.parquet.ckpt/`` holding
+``manifest.json`` (the run's configuration and its SHA-256) and append-only part files
+``part-NNNNNN.jsonl``, one JSON record per line. Every file is written to a temporary name,
+flushed to disk and moved into place with :func:`os.replace`, so a part is either whole or
+absent whatever moment the process is killed (SIGKILL included); a resumed run reads the
+parts, skips the records they hold and appends new parts. Floats are written with Python's
+shortest round-trip ``repr``, so a record read back is bit-identical to the one written.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from ._grid import SweepError
+
+__all__ = ["MemoryStore", "CheckpointStore", "config_hash", "checkpoint_dir", "write_parquet"]
+
+_META_KEY = b"chaoscam.sweep"
+
+
+def config_hash(config: dict[str, Any]) -> str:
+    """SHA-256 of the configuration's canonical JSON (sorted keys, exact floats)."""
+    text = json.dumps(config, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def checkpoint_dir(out: Path) -> Path:
+    """The checkpoint folder of output ``out``: ``out`` + ``.ckpt``."""
+    return out.with_name(out.name + ".ckpt")
+
+
+def _atomic_write(path: Path, data: bytes) -> None:
+    tmp = path.with_name(f".tmp-{os.getpid()}-{path.name}")
+    with open(tmp, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+class MemoryStore:
+    """Records kept in memory only (a run without an output file)."""
+
+    path: Path | None = None
+
+    def __init__(self) -> None:
+        self._records: list[dict[str, Any]] = []
+
+    def open(self) -> None:
+        pass
+
+    def restored(self) -> Iterator[dict[str, Any]]:
+        return iter(())
+
+    def add(self, record: dict[str, Any]) -> None:
+        self._records.append(record)
+
+    def maybe_flush(self) -> None:
+        pass
+
+    def flush(self) -> None:
+        pass
+
+    def records(self) -> Iterator[dict[str, Any]]:
+        return iter(self._records)
+
+    def remove(self) -> None:
+        self._records = []
+
+
+class CheckpointStore:
+    """Append-only part files under ``directory`` with a manifest of the configuration.
+
+    Parameters
+    ----------
+    directory : Path
+        The checkpoint folder (created if absent).
+    config : dict
+        The run's configuration; a folder made by another configuration is refused.
+    resume : bool
+        Continue the records already there. Without it an existing folder is refused, so
+        nothing is overwritten by accident.
+    flush_interval : float
+        Seconds between part files while records arrive [s]; 0 writes one part per record.
+        At most this much finished work is lost (and simply recomputed) when killed.
+    """
+
+    def __init__(
+        self,
+        directory: Path,
+        config: dict[str, Any],
+        *,
+        resume: bool,
+        flush_interval: float = 1.0,
+    ) -> None:
+        self.path = Path(directory)
+        self.hash = config_hash(config)
+        self.flush_interval = float(flush_interval)
+        self._pending: list[dict[str, Any]] = []
+        self._last = time.monotonic()
+        if self.path.exists():
+            if not resume:
+                raise FileExistsError(
+                    f"{self.path} holds the checkpoint of an interrupted run: run the same "
+                    "command with --resume to finish it, or delete the folder to start over"
+                )
+            self._check_manifest()
+            for tmp in self.path.glob(".tmp-*"):
+                tmp.unlink(missing_ok=True)
+        self._config = config
+        self._seq = 1 + max((int(p.stem.split("-")[1]) for p in self._parts()), default=-1)
+
+    def open(self) -> None:
+        """Create the folder and its manifest if absent (when the run starts)."""
+        if not self.path.exists():
+            self._create(self._config)
+
+    def _create(self, config: dict[str, Any]) -> None:
+        tmp = self.path.with_name(f".tmp-{os.getpid()}-{self.path.name}")
+        shutil.rmtree(tmp, ignore_errors=True)
+        tmp.mkdir(parents=True)
+        manifest = {"hash": self.hash, "config": config}
+        _atomic_write(tmp / "manifest.json", json.dumps(manifest, indent=1).encode())
+        os.replace(tmp, self.path)
+
+    def _check_manifest(self) -> None:
+        try:
+            manifest = json.loads((self.path / "manifest.json").read_text())
+        except (OSError, ValueError) as err:
+            raise SweepError(
+                f"{self.path}: no readable manifest.json ({err}); not a chaoscam checkpoint"
+            ) from None
+        if manifest.get("hash") != self.hash:
+            raise SweepError(
+                f"{self.path} is the checkpoint of a different configuration (hash "
+                f"{str(manifest.get('hash'))[:12]}, this run {self.hash[:12]}); use the "
+                "original command to resume it, or delete the folder to start over"
+            )
+
+    def _parts(self) -> list[Path]:
+        return sorted(self.path.glob("part-*.jsonl")) if self.path.is_dir() else []
+
+    def restored(self) -> Iterator[dict[str, Any]]:
+        """The records already checkpointed, part by part (streamed, not all in memory)."""
+        for part in self._parts():
+            with open(part) as fh:
+                for line in fh:
+                    if line.strip():
+                        yield json.loads(line)
+
+    def add(self, record: dict[str, Any]) -> None:
+        self._pending.append(record)
+
+    def maybe_flush(self) -> None:
+        if self._pending and time.monotonic() - self._last >= self.flush_interval:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write the pending records as one new part file, atomically."""
+        self._last = time.monotonic()
+        if not self._pending:
+            return
+        self.open()
+        text = "".join(json.dumps(r, separators=(",", ":")) + "\n" for r in self._pending)
+        _atomic_write(self.path / f"part-{self._seq:06d}.jsonl", text.encode())
+        self._seq += 1
+        self._pending = []
+
+    def records(self) -> Iterator[dict[str, Any]]:
+        """Every record: the parts on disk and any not yet flushed."""
+        yield from self.restored()
+        yield from self._pending
+
+    def remove(self) -> None:
+        """Delete the folder (after the final table is safely written).
+
+        It is first renamed away in one step, so a kill during the deletion never leaves a
+        half-deleted checkpoint that a later --resume would trip over.
+        """
+        if not self.path.exists():
+            return
+        gone = self.path.with_name(f".tmp-{os.getpid()}-removed-{self.path.name}")
+        os.replace(self.path, gone)
+        shutil.rmtree(gone, ignore_errors=True)
+
+
+def write_parquet(frame: pd.DataFrame, path: Path, config: dict[str, Any]) -> None:
+    """Write ``frame`` atomically, with the configuration and its hash as file metadata."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    meta = dict(table.schema.metadata or {})
+    meta[_META_KEY] = json.dumps({"hash": config_hash(config), "config": config}).encode()
+    tmp = path.with_name(f".tmp-{os.getpid()}-{path.name}")
+    pq.write_table(table.replace_schema_metadata(meta), tmp)
+    os.replace(tmp, path)
+
+
+def read_sweep_metadata(path: Path) -> dict[str, Any] | None:
+    """The configuration record of a sweep output, or None if it has none."""
+    import pyarrow.parquet as pq
+
+    meta = pq.read_schema(path).metadata or {}
+    return json.loads(meta[_META_KEY]) if _META_KEY in meta else None
+
+
+def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> bool:
+    """Check the output files before any work; True when a finished run can be reused.
+
+    Without ``resume`` an existing output is refused (nothing is overwritten). With it, a
+    finished output of the same configuration is reused as is, one of another configuration
+    is refused.
+    """
+    existing = [p for p in outputs if p.exists()]
+    if not existing:
+        return False
+    if not resume:
+        raise FileExistsError(
+            f"{existing[0]} exists: pass --resume to finish or reuse that run, or choose "
+            "another --out (nothing was overwritten)"
+        )
+    meta = read_sweep_metadata(outputs[0]) if outputs[0].exists() else None
+    if meta is None or meta.get("hash") != config_hash(config):
+        raise SweepError(
+            f"{existing[0]} was made by a different configuration (or is not a chaoscam "
+            "sweep); --resume continues only the same command. Choose another --out"
+        )
+    return not checkpoint_dir(outputs[0]).exists() and all(p.exists() for p in outputs)

@@ -1,0 +1,272 @@
+"""``chaoscam bifurcation`` and ``chaoscam regime-map``: thin layers over the sweep API."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+__all__ = ["register"]
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--set",
+        action="append",
+        metavar="NAME=VALUE",
+        default=[],
+        help="override a model parameter (repeatable), e.g. --set omega=30",
+    )
+    p.add_argument("--duration", type=float, default=20.0, help="simulated time [s] (default 20)")
+    p.add_argument(
+        "--transient",
+        type=float,
+        default=None,
+        help="discarded start [s] (default: half the duration)",
+    )
+    p.add_argument("--seed", type=int, default=0, help="master seed of the line-length process")
+    p.add_argument(
+        "--lyapunov",
+        action="store_true",
+        help="also compute the model's largest Lyapunov exponent (slower)",
+    )
+    p.add_argument(
+        "--check-step",
+        action="store_true",
+        help="re-run each realization with dt/2; a changed verdict becomes undetermined",
+    )
+    p.add_argument(
+        "--classifier",
+        metavar="MODULE:NAME",
+        default=None,
+        help="a classifier other than chaoscam.classify.classify_trajectory: a function, or "
+        "a class instantiated without arguments, importable by the workers",
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="worker processes (default: every core; 1 = this process); with "
+        "--scheduler local, the local Dask cluster's workers",
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        default=None,
+        help="run on Dask: tcp://HOST:PORT of a running scheduler, or 'local' for a local "
+        "cluster on 127.0.0.1",
+    )
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="finish an interrupted run of the same command from its checkpoint",
+    )
+    p.add_argument(
+        "--checkpoint-interval",
+        type=float,
+        default=1.0,
+        metavar="S",
+        help="seconds between checkpoint writes (default 1; 0 = after every run)",
+    )
+    p.add_argument("--plot", type=Path, default=None, help="also draw the figure to FILE.png/pdf")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--out", type=Path, required=True, help="output FILE.parquet")
+
+
+def register(sub) -> None:
+    b = sub.add_parser(
+        "bifurcation",
+        help="bifurcation diagram over one parameter (stroboscopic section + verdict)",
+        description="For each value of a model parameter, simulate, keep the stroboscopic "
+        "section points after the transient and classify the motion. Writes the points to "
+        "FILE.parquet and one verdict per value and initial condition to "
+        "FILE.verdicts.parquet. Paper Fig. 4: --param l_lambda --values 0.001:0.018:69.",
+    )
+    b.add_argument("--param", required=True, metavar="NAME", help="the swept parameter")
+    b.add_argument(
+        "--values",
+        required=True,
+        metavar="START:STOP:NUM",
+        help="NUM values from START to STOP, both included",
+    )
+    b.add_argument(
+        "--initial-conditions",
+        type=int,
+        default=1,
+        metavar="N",
+        help="initial conditions per value: the default state plus N-1 spread ones",
+    )
+    b.add_argument(
+        "--continuation",
+        action="store_true",
+        help="start each value from the previous value's last section point",
+    )
+    _common(b)
+    b.set_defaults(func=run_bifurcation)
+
+    r = sub.add_parser(
+        "regime-map",
+        help="Monte Carlo regime map over (mu, sigma) or any two parameters",
+        description="In each cell of a grid, simulate and classify N realizations of the "
+        "random line length. Writes one row per realization to FILE.parquet and the "
+        "per-cell fractions with 95%% Wilson intervals to FILE.cells.parquet.",
+    )
+    r.add_argument("--mu", metavar="START:STOP:NUM", help="mean line length l_lambda [m]")
+    r.add_argument("--sigma", metavar="START:STOP:NUM", help="spread l_lambda_sigma [m]")
+    r.add_argument("--x", metavar="NAME=START:STOP:NUM", help="first axis (instead of --mu)")
+    r.add_argument("--y", metavar="NAME=START:STOP:NUM", help="second axis (instead of --sigma)")
+    r.add_argument(
+        "--realizations", type=int, default=1, metavar="N", help="realizations per cell (default 1)"
+    )
+    r.add_argument(
+        "--target-halfwidth",
+        type=float,
+        default=None,
+        metavar="W",
+        help="adaptive: add N more realizations to a cell while its widest 95%% interval "
+        "half-width exceeds W",
+    )
+    r.add_argument(
+        "--max-realizations",
+        type=int,
+        default=None,
+        metavar="M",
+        help="adaptive: at most M per cell (default 1000)",
+    )
+    _common(r)
+    r.set_defaults(func=run_regime_map)
+
+
+def _execution(args) -> dict:
+    from ..cli import UsageError
+    from ._tasks import load_classifier
+
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers {args.workers}: must be >= 1")
+    if args.scheduler not in (None, "local") and args.workers is not None:
+        raise UsageError("--workers applies to local runs and --scheduler local only")
+    if args.out.suffix != ".parquet":
+        raise UsageError(f"--out {args.out}: the output must end in .parquet")
+    if args.checkpoint_interval < 0:
+        raise UsageError("--checkpoint-interval must be >= 0")
+    classify = None
+    if args.classifier is not None:
+        try:
+            classify = load_classifier(args.classifier)
+        except (ValueError, ImportError, AttributeError) as err:
+            raise UsageError(f"--classifier {args.classifier}: {err}") from None
+    return dict(
+        duration=args.duration,
+        transient=args.transient,
+        seed=args.seed,
+        classify=classify,
+        lyapunov=args.lyapunov,
+        check_step=args.check_step,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        out=args.out,
+        resume=args.resume,
+        progress=not args.quiet,
+        flush_interval=args.checkpoint_interval,
+    )
+
+
+def _call(fn, **kwargs):
+    """Run a sweep; bad settings become usage errors (exit 2), Ctrl-C exit 130."""
+    from ..cli import UsageError
+    from ._engine import SweepInterrupted
+    from ._grid import SweepError
+
+    try:
+        return fn(**kwargs)
+    except SweepError as err:
+        raise UsageError(str(err)) from None
+    except SweepInterrupted as err:
+        print(f"chaoscam: {err.message}", file=sys.stderr)
+        return None
+
+
+def _counts(labels) -> str:
+    return ", ".join(f"{k} {v}" for k, v in labels.value_counts().sort_index().items())
+
+
+def run_bifurcation(args: argparse.Namespace) -> int:
+    from ..cli import parse_assignments
+    from ._bifurcation import bifurcation
+    from ._common import companion
+
+    base = parse_assignments(args.set)
+    if args.initial_conditions < 1:
+        from ..cli import UsageError
+
+        raise UsageError(f"--initial-conditions {args.initial_conditions}: must be >= 1")
+    res = _call(
+        bifurcation,
+        param=args.param,
+        values=args.values,
+        base=base,
+        initial_conditions=args.initial_conditions,
+        continuation=args.continuation,
+        **_execution(args),
+    )
+    if res is None:
+        return 130
+    v = res.verdicts
+    print(
+        f"bifurcation over {res.param}: {v['value_index'].nunique()} values x "
+        f"{v['ic'].nunique()} initial condition(s), {len(res.points)} section points\n"
+        f"verdicts: {_counts(v['label'])}\n"
+        f"points: {args.out}\nverdicts: {companion(args.out, 'verdicts')}"
+    )
+    if args.plot is not None:
+        from ..report._sweep_figures import bifurcation_figure
+
+        bifurcation_figure(res.points).savefig(args.plot, dpi=150)
+        print(f"figure: {args.plot}")
+    return 0
+
+
+def run_regime_map(args: argparse.Namespace) -> int:
+    from ..cli import UsageError, parse_assignments
+    from ._common import companion
+    from ._grid import Axis, SweepError
+    from ._regime import mu_sigma_axes, regime_map
+
+    try:
+        if (args.mu is None) == (args.x is None):
+            raise UsageError("give the first axis with --mu or --x (one of them)")
+        if (args.sigma is None) == (args.y is None):
+            raise UsageError("give the second axis with --sigma or --y (one of them)")
+        if args.mu is not None and args.sigma is not None:
+            x, y = mu_sigma_axes(args.mu, args.sigma)
+        else:
+            x = Axis.parse(args.mu, name="l_lambda") if args.mu else Axis.parse(args.x)
+            y = Axis.parse(args.sigma, name="l_lambda_sigma") if args.sigma else Axis.parse(args.y)
+    except SweepError as err:
+        raise UsageError(str(err)) from None
+    base = parse_assignments(args.set)
+    res = _call(
+        regime_map,
+        x=x,
+        y=y,
+        base=base,
+        realizations=args.realizations,
+        target_halfwidth=args.target_halfwidth,
+        max_realizations=args.max_realizations,
+        **_execution(args),
+    )
+    if res is None:
+        return 130
+    c = res.cells
+    print(
+        f"regime map {res.x} x {res.y}: {len(c)} cells, {len(res.realizations)} realizations\n"
+        f"labels: {_counts(res.realizations['label'])}\n"
+        f"dominant: {_counts(c['dominant'])}\n"
+        f"realizations: {args.out}\ncells: {companion(args.out, 'cells')}"
+    )
+    if args.plot is not None:
+        from ..report._sweep_figures import regime_map_figure
+
+        regime_map_figure(c, x=res.x, y=res.y).savefig(args.plot, dpi=150)
+        print(f"figure: {args.plot}")
+    return 0

@@ -1,0 +1,136 @@
+"""Pieces shared by the sweep drivers: run settings, the classifier, outputs, tables."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections import Counter
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from ..model import ParameterError
+from ._backends import make_backend
+from ._checkpoint import CheckpointStore, MemoryStore, checkpoint_dir, guard_outputs
+from ._grid import Axis, SweepError
+from ._tasks import DefaultClassifier, classifier_identity
+
+__all__ = ["run_settings", "resolve_classifier", "companion", "open_store", "evidence_columns"]
+
+
+def run_settings(duration: float, transient: float | None, seed: int) -> tuple[float, float]:
+    """Validated (duration, transient) [s]; transient None = half the duration."""
+    if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):
+        raise ParameterError(f"duration = {duration!r} s must be > 0")
+    transient = 0.5 * float(duration) if transient is None else transient
+    if not (isinstance(transient, int | float) and 0 <= transient < duration):
+        raise ParameterError(f"transient = {transient!r} s must be in [0, duration = {duration})")
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ParameterError(f"seed = {seed!r} must be an integer >= 0")
+    return float(duration), float(transient)
+
+
+def resolve_classifier(classify, lyapunov: bool, check_step: bool = False):
+    """The classifier to use and its identity; None = the package classifier."""
+    if classify is None:
+        if not DefaultClassifier.available():
+            raise SweepError(
+                "the default classifier (chaoscam.classify) is not in this build; pass "
+                "classify=... (command line: --classifier MODULE:NAME)"
+            )
+        classify = DefaultClassifier(lyapunov=bool(lyapunov), check_step=bool(check_step))
+    elif lyapunov or check_step:
+        raise SweepError("lyapunov and check_step apply to the default classifier only")
+    return classify, classifier_identity(classify)
+
+
+def as_axis(axis: Axis | str | tuple) -> Axis:
+    """An Axis from an Axis, ``"NAME=START:STOP:NUM"`` or ``(name, values)``."""
+    if isinstance(axis, Axis):
+        return axis
+    if isinstance(axis, str):
+        return Axis.parse(axis)
+    name, values = axis
+    return Axis(name, tuple(values))
+
+
+def companion(out: Path, what: str) -> Path:
+    """``FILE.parquet`` -> ``FILE.<what>.parquet``."""
+    stem = out.name[: -len(".parquet")] if out.name.endswith(".parquet") else out.name
+    return out.with_name(f"{stem}.{what}.parquet")
+
+
+def open_store(
+    out: Path | None, second: str, config: dict, resume: bool, flush_interval: float
+) -> tuple[Any, bool]:
+    """The record store of a run and whether a finished output can be reused as is."""
+    if out is None:
+        return MemoryStore(), False
+    out = Path(out)
+    if out.suffix != ".parquet":
+        raise SweepError(f"--out {out}: the output must be a .parquet file")
+    if not out.parent.is_dir():
+        raise SweepError(f"--out {out}: the folder {out.parent} does not exist")
+    if guard_outputs([out, companion(out, second)], config, resume):
+        return None, True
+    ckpt = checkpoint_dir(out)
+    return CheckpointStore(ckpt, config, resume=resume, flush_interval=flush_interval), False
+
+
+def backend_for(workers: int | None, scheduler: Any):
+    try:
+        return make_backend(workers, scheduler)
+    except (ValueError, ConnectionError) as err:
+        raise SweepError(str(err)) from None
+
+
+def unique_sorted(records, key_fields: tuple[str, str]) -> list[dict]:
+    """Records sorted by their key, one per key (a duplicate must equal the first)."""
+    seen: dict[tuple, dict] = {}
+    for r in records:
+        k = tuple(r[f] for f in key_fields)
+        if k in seen:
+            if seen[k] != r and not _nan_equal(seen[k], r):
+                where = dict(zip(key_fields, k, strict=True))
+                raise SweepError(f"two different records for {where}")
+            continue
+        seen[k] = r
+    return [seen[k] for k in sorted(seen)]
+
+
+def _nan_equal(a: Any, b: Any) -> bool:
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_nan_equal(a[k], b[k]) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_nan_equal(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return a == b
+
+
+def evidence_columns(records: list[dict]) -> pd.DataFrame:
+    """``ev_<name>`` columns (float, NaN when absent), names sorted, one row per record."""
+    names = sorted({n for r in records for n in r["evidence"]})
+    return pd.DataFrame(
+        {
+            f"ev_{n}": np.array([r["evidence"].get(n, math.nan) for r in records], dtype=float)
+            for n in names
+        },
+        index=pd.RangeIndex(len(records)),
+    )
+
+
+def period_column(records: list[dict]) -> pd.Series:
+    return pd.array([r["period"] for r in records], dtype="Int64")
+
+
+def reemit_warnings(records: list[dict]) -> None:
+    """Warn once per distinct message the runs raised (they are also in each row)."""
+    counts: Counter = Counter()
+    for r in records:
+        for msg in filter(None, r["warnings"].split(" | ")):
+            counts[msg] += 1
+    for msg, n in counts.items():
+        warnings.warn(f"{n} of {len(records)} runs: {msg}", RuntimeWarning, stacklevel=3)

@@ -1,0 +1,148 @@
+"""The loop every sweep runs: submit tasks, collect records, checkpoint, follow up.
+
+A *plan* decides which tasks exist (a regime map's realizations, a bifurcation diagram's
+values); the engine feeds them to a backend with a bounded number in flight (so memory does
+not grow with the grid), stores each record as it completes, and asks the plan for
+follow-up tasks (continuation to the next value, more realizations for an adaptive cell).
+Plans decide from finished records only, never from their completion order, so the set of
+records is the same for any backend and worker count.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections import Counter, deque
+from collections.abc import Iterator
+from typing import Any, Protocol
+
+from ._backends import SerialBackend, WorkerLost
+from ._tasks import run_task
+
+__all__ = ["SweepInterrupted", "execute"]
+
+MAX_RETRIES = 3
+"""Times a task may lose its worker before the run stops with an error."""
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C stopped a sweep; the finished records are saved (when it has an output).
+
+    Attributes
+    ----------
+    done, total : int
+        Records finished (including those of earlier runs) and records planned.
+    checkpoint : Path or None
+        Where they are saved; None when the sweep had no output file.
+    """
+
+    def __init__(self, done: int, total: int, checkpoint) -> None:
+        self.done, self.total, self.checkpoint = done, total, checkpoint
+        super().__init__(self.message)
+
+    @property
+    def message(self) -> str:
+        if self.checkpoint is None:
+            return (
+                f"interrupted after {self.done} of {self.total} runs; nothing was saved "
+                "(no output file given)"
+            )
+        return (
+            f"interrupted: {self.done} of {self.total} runs are saved in {self.checkpoint}; "
+            "run the same command with --resume to finish"
+        )
+
+
+class Plan(Protocol):
+    """What the engine needs from a sweep."""
+
+    total: int
+    done: int
+
+    def restore(self, record: dict[str, Any]) -> bool: ...
+
+    def start(self) -> Iterator[Any]: ...
+
+    def on_record(self, record: dict[str, Any]) -> list[Any]: ...
+
+
+def _bar(progress: bool, plan: Plan, desc: str):
+    from tqdm.auto import tqdm
+
+    class Bar(tqdm):
+        # No monitor thread: a later local pool forks its workers only from a driver
+        # running a single thread (see ProcessBackend).
+        monitor_interval = 0
+
+    return Bar(
+        total=plan.total,
+        initial=plan.done,
+        desc=desc,
+        unit="run",
+        disable=not progress,
+        file=sys.stderr,
+        smoothing=0.05,
+        dynamic_ncols=True,
+    )
+
+
+def execute(plan: Plan, backend, store, *, progress: bool = False, desc: str = "") -> None:
+    """Run ``plan`` on ``backend``, storing every record in ``store``.
+
+    Records already in ``store`` (a resumed checkpoint) are given to the plan first and not
+    run again. Raises :class:`SweepInterrupted` on Ctrl-C after saving what finished.
+    """
+    store.open()
+    for record in store.restored():
+        plan.restore(record)
+    source = plan.start()
+    queue: deque = deque()
+    inflight: dict[Any, Any] = {}
+    retries: Counter = Counter()
+    window = 1 if isinstance(backend, SerialBackend) else 2 * backend.workers
+    bar = _bar(progress, plan, desc)
+    try:
+        while True:
+            while len(inflight) < window:
+                task = queue.popleft() if queue else next(source, None)
+                if task is None:
+                    break
+                inflight[backend.submit(run_task, task)] = task
+            if not inflight:
+                break
+            for fut in backend.wait_any(list(inflight)):
+                task = inflight.pop(fut)
+                try:
+                    record = backend.result(fut)
+                except WorkerLost as err:
+                    retries[task.key()] += 1
+                    if retries[task.key()] > MAX_RETRIES:
+                        raise RuntimeError(
+                            f"task {task.key()} lost its worker {MAX_RETRIES + 1} times; "
+                            f"the finished records are saved, resume after fixing it ({err})"
+                        ) from err
+                    getattr(backend, "recover", lambda: None)()
+                    queue.appendleft(task)
+                    continue
+                except Exception as err:
+                    raise RuntimeError(
+                        f"task {task.key()} failed ({type(err).__name__}: {err}); reproduce "
+                        f"it with chaoscam.simulate(params, seed={task.seed}, "
+                        f"index={task.sim_index}) and the classifier"
+                    ) from err
+                store.add(record)
+                queue.extend(plan.on_record(record))
+                if bar.total != plan.total:
+                    bar.total = plan.total
+                bar.update(1)
+            store.maybe_flush()
+    except KeyboardInterrupt:
+        backend.cancel(list(inflight))
+        store.flush()
+        raise SweepInterrupted(plan.done, plan.total, store.path) from None
+    except BaseException:
+        backend.cancel(list(inflight))
+        store.flush()
+        raise
+    finally:
+        bar.close()
+    store.flush()

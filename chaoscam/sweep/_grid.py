@@ -1,0 +1,155 @@
+"""Sweep axes (``START:STOP:NUM``), grid validation and the realization-index scheme.
+
+A sweep never changes a kernel: it only builds validated :class:`~chaoscam.Params` for each
+point of a grid and asks :func:`chaoscam.simulate` for realizations ``(seed, index)``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model import FIELD_DOCS, LineLengthStream, ParameterError, Params, field_names
+
+__all__ = ["Axis", "SweepError", "parse_range", "realization_index", "cell_params"]
+
+
+class SweepError(ValueError):
+    """A sweep cannot start or continue as asked: bad axis, checkpoint of another run, ...
+
+    The message says what to change. The command line reports it with exit code 2.
+    """
+
+
+def parse_range(text: str, what: str = "range") -> tuple[float, float, int]:
+    """Parse ``START:STOP:NUM`` (NUM points, both ends included) into (start, stop, num).
+
+    Raises
+    ------
+    SweepError
+        Not three fields, non-numbers, NUM < 1, stop < start, or NUM = 1 with stop != start
+        (one point cannot include two different ends).
+    """
+    parts = text.split(":")
+    if len(parts) != 3:
+        raise SweepError(f"{what} {text!r}: expected START:STOP:NUM (NUM points, ends included)")
+    try:
+        start, stop = float(parts[0]), float(parts[1])
+    except ValueError:
+        raise SweepError(f"{what} {text!r}: START and STOP must be numbers") from None
+    try:
+        num = int(parts[2])
+    except ValueError:
+        raise SweepError(f"{what} {text!r}: NUM must be a whole number") from None
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise SweepError(f"{what} {text!r}: START and STOP must be finite")
+    if num < 1:
+        raise SweepError(f"{what} {text!r}: NUM = {num} must be >= 1")
+    if stop < start:
+        raise SweepError(f"{what} {text!r}: STOP = {stop:g} is below START = {start:g}")
+    if num == 1 and stop != start:
+        raise SweepError(f"{what} {text!r}: one point (NUM = 1) needs STOP = START")
+    if num > 1 and stop == start:
+        raise SweepError(f"{what} {text!r}: {num} points need STOP > START")
+    return start, stop, num
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One swept model parameter and its values.
+
+    Attributes
+    ----------
+    name : str
+        A numeric field of :class:`~chaoscam.Params` (the ``--set`` name), e.g. ``l_lambda``.
+    values : tuple of float
+        The values in sweep order, in the field's SI unit.
+    """
+
+    name: str
+    values: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if self.name not in field_names():
+            Params().replace(**{self.name: 0.0})  # raises with a "did you mean"
+        if FIELD_DOCS[self.name]["choices"] is not None:
+            raise SweepError(f"{self.name} is not numeric and cannot be swept")
+        vals = tuple(float(v) for v in self.values)
+        if not vals:
+            raise SweepError(f"axis {self.name}: no values")
+        if not all(math.isfinite(v) for v in vals):
+            raise SweepError(f"axis {self.name}: values must be finite")
+        object.__setattr__(self, "values", vals)
+
+    @classmethod
+    def linspace(cls, name: str, start: float, stop: float, num: int) -> Axis:
+        """``num`` evenly spaced values from ``start`` to ``stop``, both included."""
+        parse_range(f"{start!r}:{stop!r}:{num}", what=name)
+        return cls(name, tuple(np.linspace(start, stop, num).tolist()))
+
+    @classmethod
+    def parse(cls, text: str, name: str | None = None) -> Axis:
+        """From ``NAME=START:STOP:NUM``, or ``START:STOP:NUM`` when ``name`` is given."""
+        if name is None:
+            name, sep, text = text.partition("=")
+            if not sep or not name.strip():
+                raise SweepError(f"axis {text!r}: expected NAME=START:STOP:NUM")
+            name = name.strip()
+        start, stop, num = parse_range(text, what=f"{name} range")
+        return cls.linspace(name, start, stop, num)
+
+    @property
+    def unit(self) -> str:
+        """SI unit of the swept field."""
+        return FIELD_DOCS[self.name]["unit"]
+
+    def __len__(self) -> int:
+        return len(self.values)
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "values": list(self.values)}
+
+
+def realization_index(cell: int, index: int) -> int:
+    """The :func:`chaoscam.simulate` index of realization ``index`` of grid cell ``cell``.
+
+    The Cantor pairing ``(c + i)(c + i + 1)/2 + i``: a bijection of pairs of non-negative
+    integers onto the non-negative integers. Each (cell, realization) therefore gets its own
+    stream ``SeedSequence(seed, spawn_key=(pair,))``, which depends neither on the worker
+    count nor on how many realizations a cell ends with (adaptive sampling only appends
+    indices), nor on the size of the grid beyond the cell number itself.
+    """
+    c, i = int(cell), int(index)
+    if c < 0 or i < 0:
+        raise SweepError(f"cell = {c} and index = {i} must be >= 0")
+    s = c + i
+    return s * (s + 1) // 2 + i
+
+
+def cell_params(base: Params, changes: dict[str, float]) -> Params:
+    """``base`` with ``changes`` applied, validated as a simulation would need it.
+
+    Beyond the field ranges (a :class:`~chaoscam.ParameterError` naming the field), the
+    random line length must keep some mass above ``l_min``.
+    """
+    p = base.replace(**changes)
+    LineLengthStream(p, 0, 0)  # raises ParameterError when the truncation keeps no mass
+    return p
+
+
+def validate_grid(base: Params, axes: Sequence[Axis]) -> None:
+    """Raise before any work if a grid point gives invalid parameters (names the point)."""
+    names = [a.name for a in axes]
+    if len(set(names)) != len(names):
+        raise SweepError(f"the axes repeat a parameter: {names}")
+    grids = np.meshgrid(*[np.asarray(a.values) for a in axes], indexing="ij")
+    for point in zip(*[g.ravel().tolist() for g in grids], strict=True):
+        changes = dict(zip(names, point, strict=True))
+        try:
+            cell_params(base, changes)
+        except ParameterError as err:
+            where = ", ".join(f"{k} = {v!r}" for k, v in changes.items())
+            raise ParameterError(f"at {where}: {err}") from None

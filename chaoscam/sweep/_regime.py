@@ -1,0 +1,387 @@
+"""Monte Carlo regime maps: a grid of two parameters, N classified realizations per cell.
+
+Paper section 2.5 and Figs. 7-10: over a grid of the line length's mean mu (``l_lambda``)
+and spread sigma (``l_lambda_sigma``), each cell's realizations are simulated and
+classified; the map shows the fraction of each label with its Wilson interval. The same
+machinery serves any two numeric parameters (``omega`` x ``xi`` for the deterministic
+model: with sigma = 0 every realization of a cell is the same, so one per cell suffices).
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .._version import __version__
+from ..model import ParameterError, Params
+from ._checkpoint import read_sweep_metadata, write_parquet
+from ._common import (
+    as_axis,
+    backend_for,
+    companion,
+    evidence_columns,
+    open_store,
+    period_column,
+    reemit_warnings,
+    resolve_classifier,
+    run_settings,
+    unique_sorted,
+)
+from ._engine import execute
+from ._grid import Axis, SweepError, realization_index, validate_grid
+from ._stats import max_halfwidth, summarize_cells
+from ._tasks import RealizationTask, needs_series
+
+__all__ = ["RegimeMap", "regime_map", "read_regime_map"]
+
+DEFAULT_CAP = 1000
+"""Realizations per cell at most under adaptive sampling, unless told otherwise."""
+
+
+@dataclass(frozen=True)
+class RegimeMap:
+    """A regime map: one row per realization and one per cell, with the settings used.
+
+    Attributes
+    ----------
+    realizations : DataFrame
+        One row per realization, sorted by (cell, index): ``cell``, ``index`` (the
+        realization in its cell), the two axis values (columns named by the parameters),
+        ``seed``, ``sim_index`` (the :func:`chaoscam.simulate` index, see
+        :func:`realization_index`), ``status``, ``label``, ``period``, ``n_section``,
+        ``n_impacts``, ``contact_fraction``, ``truncated_mass``, ``reasons``, ``warnings``
+        and one ``ev_<name>`` column per evidence value (NaN where a run has none).
+    cells : DataFrame
+        The per-cell summary of :func:`summarize_cells`.
+    config : dict
+        Everything that fixes the result (base parameters, axes, seed, realizations,
+        duration, transient, classifier, adaptive settings, version).
+    """
+
+    realizations: pd.DataFrame
+    cells: pd.DataFrame
+    config: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def x(self) -> str:
+        return self.config["x"]["name"]
+
+    @property
+    def y(self) -> str:
+        return self.config["y"]["name"]
+
+    def to_parquet(self, path: str | Path) -> None:
+        """Realizations to ``FILE.parquet``, cells to ``FILE.cells.parquet``."""
+        path = Path(path)
+        write_parquet(self.realizations, path, self.config)
+        write_parquet(self.cells, companion(path, "cells"), self.config)
+
+
+def read_regime_map(path: str | Path) -> RegimeMap:
+    """Read a map written by :func:`regime_map` (``FILE.parquet`` and ``FILE.cells.parquet``)."""
+    path = Path(path)
+    meta = read_sweep_metadata(path) or {}
+    return RegimeMap(
+        pd.read_parquet(path), pd.read_parquet(companion(path, "cells")), meta.get("config", {})
+    )
+
+
+class _RegimePlan:
+    """The realizations of each cell, and when adaptive sampling asks for more.
+
+    Adaptive rule (deterministic): a cell starts with ``n0`` realizations; each time all of
+    its first n are finished, if the widest Wilson interval of its labels is wider than
+    ``target`` (half-width) and n < ``cap``, the next ``batch`` indices are added. The
+    decision uses exactly the realizations 0..n-1, so it does not depend on their order.
+    """
+
+    def __init__(
+        self,
+        make_task: Callable,
+        ncells: int,
+        n0: int,
+        batch: int,
+        cap: int,
+        target: float | None,
+        confidence: float,
+    ) -> None:
+        self.make_task = make_task
+        self.n0, self.batch, self.cap, self.target = n0, batch, cap, target
+        self.confidence = confidence
+        self.n_target = [n0] * ncells
+        self.finished: list[set[int]] = [set() for _ in range(ncells)]
+        self.counts: list[Counter] = [Counter() for _ in range(ncells)]
+        self.done = 0
+
+    @property
+    def total(self) -> int:
+        return sum(self.n_target)
+
+    def _add(self, record: dict[str, Any]) -> bool:
+        c, i = record["cell"], record["index"]
+        if i in self.finished[c]:
+            return False
+        self.finished[c].add(i)
+        self.counts[c][record["label"]] += 1
+        self.done += 1
+        return True
+
+    def _wants_more(self, c: int) -> bool:
+        if self.target is None or self.n_target[c] >= self.cap:
+            return False
+        return max_halfwidth(self.counts[c], self.n_target[c], self.confidence) > self.target
+
+    def restore(self, record: dict[str, Any]) -> bool:
+        return self._add(record)
+
+    def _settle(self, c: int) -> None:
+        """Replay the adaptive decisions of a resumed cell from its finished indices."""
+        while self.n_target[c] < self.cap:
+            n = len(self.finished[c])
+            if n < self.n_target[c] or (n == self.n_target[c] and not self._wants_more(c)):
+                return
+            # n > n_target: the earlier run already decided to extend.
+            self.n_target[c] = min(self.n_target[c] + self.batch, self.cap)
+
+    def start(self) -> Iterator[RealizationTask]:
+        if self.target is not None:
+            for c in range(len(self.n_target)):
+                self._settle(c)
+        return self._initial()
+
+    def _initial(self) -> Iterator[RealizationTask]:
+        for c, n in enumerate(self.n_target):
+            for i in range(n):
+                if i not in self.finished[c]:
+                    yield self.make_task(c, i)
+
+    def on_record(self, record: dict[str, Any]) -> list[RealizationTask]:
+        if not self._add(record):
+            return []
+        c = record["cell"]
+        if len(self.finished[c]) == self.n_target[c] and self._wants_more(c):
+            old = self.n_target[c]
+            self.n_target[c] = min(old + self.batch, self.cap)
+            return [self.make_task(c, i) for i in range(old, self.n_target[c])]
+        return []
+
+
+def _cells_frame(x: Axis, y: Axis) -> pd.DataFrame:
+    ix, iy = np.meshgrid(np.arange(len(x)), np.arange(len(y)), indexing="ij")
+    ix, iy = ix.ravel(), iy.ravel()
+    return pd.DataFrame(
+        {
+            "cell": np.arange(ix.size, dtype=np.int64),
+            "ix": ix.astype(np.int64),
+            "iy": iy.astype(np.int64),
+            x.name: np.asarray(x.values)[ix],
+            y.name: np.asarray(y.values)[iy],
+        }
+    )
+
+
+def _rows(records: list[dict], cells: pd.DataFrame, x: Axis, y: Axis) -> pd.DataFrame:
+    cell = np.array([r["cell"] for r in records], dtype=np.int64)
+    head = pd.DataFrame(
+        {
+            "cell": cell,
+            "index": np.array([r["index"] for r in records], dtype=np.int64),
+            x.name: cells[x.name].to_numpy()[cell],
+            y.name: cells[y.name].to_numpy()[cell],
+            "seed": np.array([r["seed"] for r in records], dtype=np.int64),
+            "sim_index": np.array([r["sim_index"] for r in records], dtype=np.int64),
+            "status": [r["status"] for r in records],
+            "label": [r["label"] for r in records],
+            "period": period_column(records),
+        }
+    )
+    for name, dtype in (
+        ("n_section", np.int64),
+        ("n_impacts", np.int64),
+        ("contact_fraction", float),
+        ("truncated_mass", float),
+    ):
+        head[name] = np.array([r[name] for r in records], dtype=dtype)
+    head["reasons"] = [r["reasons"] for r in records]
+    head["warnings"] = [r["warnings"] for r in records]
+    return pd.concat([head, evidence_columns(records)], axis=1)
+
+
+def regime_map(
+    x: Axis | str | tuple,
+    y: Axis | str | tuple,
+    *,
+    base: Params | None = None,
+    realizations: int = 1,
+    seed: int = 0,
+    duration: float = 20.0,
+    transient: float | None = None,
+    classify: Callable | None = None,
+    lyapunov: bool = False,
+    check_step: bool = False,
+    target_halfwidth: float | None = None,
+    max_realizations: int | None = None,
+    confidence: float = 0.95,
+    workers: int | None = None,
+    scheduler: Any = None,
+    out: str | Path | None = None,
+    resume: bool = False,
+    progress: bool = False,
+    flush_interval: float = 1.0,
+) -> RegimeMap:
+    """Monte Carlo regime map over two parameters: classify N realizations in every cell.
+
+    Parameters
+    ----------
+    x, y : Axis, str or (name, values)
+        The axes, e.g. ``Axis.linspace("l_lambda", 0.004, 0.016, 7)`` (mu [m]) and
+        ``"l_lambda_sigma=0:0.004:5"`` (sigma [m]). Cell ``c = ix * len(y) + iy``.
+    base : Params, optional
+        The model for everything not swept (Table 1 defaults).
+    realizations : int
+        N, realizations per cell (the first batch under adaptive sampling).
+    seed : int
+        Master seed. Realization ``i`` of cell ``c`` is ``simulate(params_c, seed=seed,
+        index=realization_index(c, i))``: its line-length stream is
+        ``SeedSequence(seed, spawn_key=(realization_index(c, i),))``, whatever the backend,
+        the worker count or an interruption.
+    duration, transient : float
+        Simulated time and the discarded start [s]; transient None = duration / 2.
+    classify : callable, optional
+        ``classify(trajectory) -> verdict`` (``label``, ``period``, ``evidence``,
+        ``reasons``), picklable for worker processes; default
+        ``chaoscam.classify.classify_trajectory``. Runs that did not end normally are not
+        classified: their label is the status's (``left_reach``, ``diverged``).
+    lyapunov : bool
+        Ask the default classifier for the model's largest Lyapunov exponent (evidence
+        ``lyapunov_model`` [1/s], about twice the cost of a run).
+    check_step : bool
+        Ask the default classifier to re-run each realization with dt / 2 and call it
+        undetermined when the verdict changes (twice the cost).
+    target_halfwidth : float, optional
+        Adaptive sampling: add ``realizations`` more to a cell while the widest 95 % Wilson
+        half-width of its label fractions exceeds this, up to ``max_realizations``.
+    max_realizations : int, optional
+        Cap of adaptive sampling (default 1000).
+    confidence : float
+        Level of the Wilson intervals.
+    workers : int, optional
+        Local worker processes (default: every core; 1 runs in this process), or the worker
+        count of a local Dask cluster when ``scheduler="local"``.
+    scheduler : str or distributed.Client, optional
+        Run on Dask: ``"tcp://HOST:PORT"``, ``"local"`` (a LocalCluster on 127.0.0.1) or a
+        client.
+    out : path, optional
+        ``FILE.parquet``: realizations there, cells in ``FILE.cells.parquet``, and a
+        checkpoint ``FILE.parquet.ckpt/`` while running (removed at the end).
+    resume : bool
+        Continue an interrupted run of the same configuration (or reuse a finished one).
+        Without it an existing output or checkpoint is an error; nothing is overwritten.
+    progress : bool
+        Show a progress bar with ETA on stderr.
+    flush_interval : float
+        Seconds between checkpoint parts [s].
+
+    Returns
+    -------
+    RegimeMap
+
+    Raises
+    ------
+    ParameterError
+        A grid point outside a parameter's range (sigma < 0, mu <= 0, ...), named.
+    SweepError
+        Bad settings, or a checkpoint or output of another configuration.
+    FileExistsError
+        An existing output or checkpoint without ``resume``.
+    SweepInterrupted
+        Ctrl-C; the message says how to resume.
+    """
+    x, y = as_axis(x), as_axis(y)
+    base = Params() if base is None else base
+    duration, transient = run_settings(duration, transient, seed)
+    if isinstance(realizations, bool) or not isinstance(realizations, int) or realizations < 1:
+        raise SweepError(f"realizations = {realizations!r} must be an integer >= 1")
+    adaptive = None
+    if target_halfwidth is not None:
+        if not 0.0 < target_halfwidth < 0.5:
+            raise SweepError(f"target half-width = {target_halfwidth!r} must be in (0, 0.5)")
+        cap = DEFAULT_CAP if max_realizations is None else int(max_realizations)
+        if cap < realizations:
+            raise SweepError(f"max realizations = {cap} is below realizations = {realizations}")
+        adaptive = {
+            "target_halfwidth": float(target_halfwidth),
+            "max_realizations": cap,
+            "batch": realizations,
+        }
+    elif max_realizations is not None:
+        raise SweepError("max realizations applies with a target half-width only")
+    validate_grid(base, [x, y])
+    classify, identity = resolve_classifier(classify, lyapunov, check_step)
+    config = {
+        "kind": "regime_map",
+        "version": __version__,
+        "base": base.to_dict(),
+        "x": x.to_dict(),
+        "y": y.to_dict(),
+        "realizations": realizations,
+        "seed": int(seed),
+        "duration": duration,
+        "transient": transient,
+        "classifier": identity,
+        "adaptive": adaptive,
+        "confidence": float(confidence),
+        "index_scheme": "cantor(cell, index)",
+    }
+    out = None if out is None else Path(out)
+    store, reuse = open_store(out, "cells", config, resume, flush_interval)
+    if reuse:
+        return read_regime_map(out)
+    series = needs_series(classify)
+    cells = _cells_frame(x, y)
+    xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
+
+    def make_task(c: int, i: int) -> RealizationTask:
+        p = base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])})
+        return RealizationTask(
+            c, i, int(seed), realization_index(c, i), p, duration, transient, classify, series
+        )
+
+    plan = _RegimePlan(
+        make_task,
+        len(cells),
+        realizations,
+        batch=realizations,
+        cap=adaptive["max_realizations"] if adaptive else realizations,
+        target=adaptive["target_halfwidth"] if adaptive else None,
+        confidence=confidence,
+    )
+    backend = backend_for(workers, scheduler)
+    try:
+        execute(plan, backend, store, progress=progress, desc="regime map")
+    finally:
+        backend.close()
+    records = unique_sorted(store.records(), ("cell", "index"))
+    reemit_warnings(records)
+    rows = _rows(records, cells, x, y)
+    result = RegimeMap(rows, summarize_cells(rows, cells, confidence=confidence), config)
+    if out is not None:
+        result.to_parquet(out)
+        store.remove()
+    return result
+
+
+def mu_sigma_axes(mu: str, sigma: str) -> tuple[Axis, Axis]:
+    """The paper's axes from ``START:STOP:NUM`` texts: mean and spread of l_lambda [m]."""
+    x, y = Axis.parse(mu, name="l_lambda"), Axis.parse(sigma, name="l_lambda_sigma")
+    if min(x.values) <= 0:
+        raise ParameterError(f"mu = {min(x.values)!r} m: the mean line length must be > 0")
+    if min(y.values) < 0:
+        raise ParameterError(f"sigma = {min(y.values)!r} m: the spread must be >= 0")
+    return x, y

@@ -1,0 +1,159 @@
+"""Per-cell statistics of a regime map: label fractions with Wilson intervals.
+
+Reference: E. B. Wilson, "Probable inference, the law of succession, and statistical
+inference", J. Am. Stat. Assoc. 22 (1927) 209-212; L. D. Brown, T. T. Cai, A. DasGupta,
+"Interval estimation for a binomial proportion", Statist. Sci. 16 (2001) 101-133.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+
+import numpy as np
+import pandas as pd
+from scipy.special import ndtri
+
+__all__ = ["LABEL_ORDER", "wilson_interval", "max_halfwidth", "summarize_cells"]
+
+LABEL_ORDER = (
+    "periodic",
+    "quasiperiodic",
+    "chaotic",
+    "undetermined",
+    "left_reach",
+    "diverged",
+)
+"""Labels of a map in display order: the verdicts, then the non-regular run statuses.
+
+A run that leaves the cam's reach or diverges is labelled by its status and counted like
+any other label; it is never dropped. Ties for the dominant label go to the earlier one.
+"""
+
+LYAPUNOV_EVIDENCE = "lyapunov_model"
+"""Name of the evidence item holding the model's largest Lyapunov exponent [1/s]."""
+
+
+def wilson_interval(k, n, confidence: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
+    """Wilson score interval for a binomial proportion ``k / n``.
+
+    ``(p + z^2/2n -+ z sqrt(p(1-p)/n + z^2/4n^2)) / (1 + z^2/n)`` with ``z`` the two-sided
+    normal quantile of ``confidence`` (1.96 for 95 %). Unlike the Wald interval it stays in
+    [0, 1] and keeps close to its nominal coverage for small ``n`` and ``p`` near 0 or 1
+    (Brown, Cai & DasGupta 2001).
+
+    Parameters
+    ----------
+    k, n : int or array_like
+        Successes and trials, 0 <= k <= n; n = 0 gives (0, 1).
+    confidence : float
+        Two-sided confidence level in (0, 1).
+
+    Returns
+    -------
+    (lo, hi) : ndarray
+        The interval's ends, broadcast over ``k`` and ``n``.
+    """
+    if not 0.0 < confidence < 1.0:
+        raise ValueError(f"confidence = {confidence!r} must be in (0, 1)")
+    k = np.asarray(k, dtype=float)
+    n = np.asarray(n, dtype=float)
+    if np.any(k < 0) or np.any(k > n):
+        raise ValueError("need 0 <= k <= n")
+    z = float(ndtri(0.5 + confidence / 2.0))
+    z2 = z * z
+    with np.errstate(invalid="ignore", divide="ignore"):
+        p = np.where(n > 0, k / n, 0.5)
+        denom = 1.0 + z2 / n
+        centre = (p + z2 / (2.0 * n)) / denom
+        half = z * np.sqrt(p * (1.0 - p) / n + z2 / (4.0 * n * n)) / denom
+        lo = np.where(n > 0, np.clip(centre - half, 0.0, 1.0), 0.0)
+        hi = np.where(n > 0, np.clip(centre + half, 0.0, 1.0), 1.0)
+    # Exact ends where the formula's rounding could leave them off 0 or 1.
+    lo = np.where(k == 0, 0.0, lo)
+    hi = np.where(k == n, 1.0, hi)
+    return lo, hi
+
+
+def max_halfwidth(counts: Mapping[str, int], n: int, confidence: float = 0.95) -> float:
+    """Largest Wilson half-width over the labels of one cell (1 when ``n`` = 0).
+
+    A label never seen has the same half-width as one seen every time and a smaller one
+    than any label seen sometimes, so the maximum over the observed labels is the maximum
+    over all labels.
+    """
+    if n <= 0:
+        return 1.0
+    ks = list(counts.values()) or [0]
+    lo, hi = wilson_interval(ks, [n] * len(ks), confidence)
+    return float(np.max((hi - lo) / 2.0))
+
+
+def _labels(observed: Iterable[str]) -> list[str]:
+    extra = sorted(set(observed) - set(LABEL_ORDER))
+    return list(LABEL_ORDER) + extra
+
+
+def summarize_cells(
+    rows: pd.DataFrame,
+    cells: pd.DataFrame,
+    *,
+    confidence: float = 0.95,
+) -> pd.DataFrame:
+    """One row per grid cell: label fractions, intervals, dominant label, Lyapunov spread.
+
+    Parameters
+    ----------
+    rows : DataFrame
+        One row per realization with columns ``cell``, ``label``, ``truncated_mass`` and,
+        when the classifier gave it, ``ev_lyapunov_model``.
+    cells : DataFrame
+        One row per cell: ``cell``, ``ix``, ``iy`` and the two axis values.
+    confidence : float
+        Level of the Wilson intervals.
+
+    Returns
+    -------
+    DataFrame
+        The columns of ``cells``, then ``n``; ``dominant``; for each label L of
+        `LABEL_ORDER` (and any other label observed): ``n_L``, ``p_L``, ``p_L_lo``,
+        ``p_L_hi``; ``halfwidth`` (the widest interval's half-width); ``lyapunov_mean``,
+        ``lyapunov_std`` (sample standard deviation, NaN below two values) and
+        ``lyapunov_n`` over the finite exponents; ``truncated_mass``, the probability mass
+        of Normal(mu, sigma^2) below ``l_min`` that the truncation removed.
+    """
+    labels = _labels(rows["label"].unique() if len(rows) else [])
+    out = cells.sort_values("cell").reset_index(drop=True).copy()
+    counts = (
+        pd.crosstab(rows["cell"], rows["label"]).reindex(
+            index=out["cell"], columns=labels, fill_value=0
+        )
+        if len(rows)
+        else pd.DataFrame(0, index=out["cell"], columns=labels)
+    )
+    n = counts.sum(axis=1).to_numpy()
+    out["n"] = n.astype(np.int64)
+    k_mat = counts.to_numpy()
+    # argmax keeps the first maximum: ties go to the earlier label of LABEL_ORDER.
+    dominant = np.array(labels, dtype=object)[np.argmax(k_mat, axis=1)]
+    out["dominant"] = np.where(n > 0, dominant, "")
+    half = np.zeros(len(out))
+    for j, lab in enumerate(labels):
+        k = k_mat[:, j]
+        lo, hi = wilson_interval(k, n, confidence)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out[f"n_{lab}"] = k.astype(np.int64)
+            out[f"p_{lab}"] = np.where(n > 0, k / np.maximum(n, 1), np.nan)
+        out[f"p_{lab}_lo"] = lo
+        out[f"p_{lab}_hi"] = hi
+        half = np.maximum(half, (hi - lo) / 2.0)
+    out["halfwidth"] = half
+    col = f"ev_{LYAPUNOV_EVIDENCE}"
+    lam = rows[["cell", col]] if col in rows else pd.DataFrame({"cell": rows["cell"], col: np.nan})
+    lam = lam[np.isfinite(lam[col].to_numpy(dtype=float))]
+    g = lam.groupby("cell")[col]
+    out["lyapunov_mean"] = out["cell"].map(g.mean()).astype(float)
+    out["lyapunov_std"] = out["cell"].map(g.std(ddof=1)).astype(float)
+    out["lyapunov_n"] = out["cell"].map(g.size()).fillna(0).astype(np.int64)
+    mass = rows.groupby("cell")["truncated_mass"].first() if len(rows) else pd.Series(dtype=float)
+    out["truncated_mass"] = out["cell"].map(mass).astype(float)
+    return out

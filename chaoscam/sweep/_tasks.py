@@ -1,0 +1,244 @@
+"""The work a sweep sends to its workers: simulate one realization, classify it, keep a record.
+
+A task is a small frozen dataclass (parameters, settings, the classifier); its record is a
+JSON-safe dict holding the section points or the verdict, never a time series, so the
+driver's and the workers' memory stays flat however large the grid. A record is a pure
+function of its task: the same on any worker, in any order, on any backend.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, is_dataclass
+from typing import Any
+
+from ..model import Params
+from ..simulate import simulate
+
+__all__ = ["DefaultClassifier", "RealizationTask", "BranchTask", "run_task"]
+
+
+@dataclass(frozen=True)
+class DefaultClassifier:
+    """The package classifier, ``chaoscam.classify.classify_trajectory``, imported lazily.
+
+    Parameters
+    ----------
+    lyapunov : bool
+        Also compute the model's largest Lyapunov exponent (evidence ``lyapunov_model``,
+        about twice the cost of the run); what a regime map's ``lyapunov_mean`` /
+        ``lyapunov_std`` summarise.
+    check_step : bool
+        Re-simulate with dt / 2 and call the verdict undetermined if it changes (twice the
+        cost).
+    """
+
+    lyapunov: bool = False
+    check_step: bool = False
+    needs_series = True  # the classifier may use the sampled signal, not only the section
+
+    def __call__(self, traj):
+        from ..classify import classify_trajectory
+
+        return classify_trajectory(traj, lyapunov=self.lyapunov, check_step=self.check_step)
+
+    @staticmethod
+    def available() -> bool:
+        """Whether ``chaoscam.classify`` exists in this build."""
+        try:
+            importlib.import_module("chaoscam.classify")
+        except ModuleNotFoundError as err:
+            if err.name not in ("chaoscam.classify",):
+                raise
+            return False
+        return True
+
+
+def classifier_identity(classify: Callable) -> str:
+    """A stable text naming a classifier and its settings, part of a run's configuration.
+
+    ``module.qualname`` for a function; for an instance, its class's name plus ``repr``
+    (a dataclass's repr lists its fields, so two settings never share an identity).
+    """
+    if isinstance(classify, type) or not callable(classify):
+        raise TypeError(f"classify must be a function or an instance, got {classify!r}")
+    if hasattr(classify, "__qualname__") and hasattr(classify, "__module__"):
+        return f"{classify.__module__}.{classify.__qualname__}"
+    cls = type(classify)
+    text = repr(classify)
+    if not is_dataclass(classify) and " at 0x" in text:  # the default repr names an address
+        text = repr(sorted(getattr(classify, "__dict__", {}).items()))
+    return f"{cls.__module__}.{cls.__qualname__}:{text}"
+
+
+def needs_series(classify: Callable) -> bool:
+    """Whether to simulate with the time series for this classifier.
+
+    A classifier may declare ``needs_series = False`` when the section (and impacts) are
+    enough; otherwise it receives the series (sampled every 1 ms). Either way the series
+    stays in the worker: records hold sections and verdicts only.
+    """
+    return bool(getattr(classify, "needs_series", True))
+
+
+def load_classifier(spec: str) -> Callable:
+    """``MODULE:NAME`` to a classifier: a function, or a class instantiated without arguments."""
+    module, sep, name = spec.partition(":")
+    if not sep or not module or not name:
+        raise ValueError(f"classifier {spec!r}: expected MODULE:NAME")
+    obj = getattr(importlib.import_module(module), name)
+    return obj() if isinstance(obj, type) else obj
+
+
+def _number(v: Any) -> float:
+    if isinstance(v, bool):
+        return float(v)
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        return math.nan
+    return f
+
+
+def verdict_fields(verdict: Any) -> dict[str, Any]:
+    """The parts of a verdict a table keeps: label, period, reasons, evidence values.
+
+    Works with any object with ``label``, ``period``, ``evidence`` (items with ``name``,
+    ``value``) and ``reasons``. Values that are not numbers become NaN; a repeated evidence
+    name keeps its first value.
+    """
+    evidence: dict[str, float] = {}
+    for e in getattr(verdict, "evidence", ()) or ():
+        evidence.setdefault(str(e.name), _number(e.value))
+    period = getattr(verdict, "period", None)
+    return {
+        "label": str(verdict.label),
+        "period": None if period is None else int(period),
+        "reasons": "; ".join(str(r) for r in (getattr(verdict, "reasons", ()) or ())),
+        "evidence": evidence,
+    }
+
+
+def _run(params: Params, task: Any) -> tuple[Any, dict[str, Any]]:
+    """Simulate and classify; a run that did not end normally is labelled by its status."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        traj = simulate(
+            params,
+            duration=task.duration,
+            transient=task.transient,
+            seed=task.seed,
+            index=task.sim_index,
+            series=task.series,
+        )
+        if traj.ok:
+            fields = verdict_fields(task.classify(traj))
+        else:
+            fields = {
+                "label": traj.status.label,
+                "period": None,
+                "reasons": traj.message,
+                "evidence": {},
+            }
+    seen = dict.fromkeys(str(w.message) for w in caught)
+    fields["status"] = traj.status.name
+    fields["warnings"] = " | ".join(seen)
+    return traj, fields
+
+
+@dataclass(frozen=True)
+class RealizationTask:
+    """Realization ``index`` of regime-map cell ``cell`` (simulate index ``sim_index``)."""
+
+    cell: int
+    index: int
+    seed: int
+    sim_index: int
+    params: Params
+    duration: float
+    transient: float
+    classify: Callable
+    series: bool = True
+
+    def key(self) -> tuple[int, int]:
+        return (self.cell, self.index)
+
+    def run(self) -> dict[str, Any]:
+        traj, fields = _run(self.params, self)
+        return {
+            "cell": self.cell,
+            "index": self.index,
+            "seed": self.seed,
+            "sim_index": self.sim_index,
+            "status": fields["status"],
+            "label": fields["label"],
+            "period": fields["period"],
+            "n_section": int(len(traj.section)),
+            "n_impacts": int(traj.stats["n_impacts"]),
+            "contact_fraction": _number(traj.stats["contact_fraction"]),
+            "truncated_mass": _number(traj.stats["truncated_mass"]),
+            "reasons": fields["reasons"],
+            "warnings": fields["warnings"],
+            "evidence": fields["evidence"],
+        }
+
+
+@dataclass(frozen=True)
+class BranchTask:
+    """One point of a bifurcation diagram: value ``value_index``, initial condition ``ic``.
+
+    ``params`` already holds the swept value and the initial state (theta_f0, omega_f0;
+    None = in contact); ``continued`` says the state came from the previous value's run.
+    """
+
+    value_index: int
+    ic: int
+    value: float
+    seed: int
+    sim_index: int
+    params: Params
+    duration: float
+    transient: float
+    classify: Callable
+    continued: bool = False
+    series: bool = True
+
+    def key(self) -> tuple[int, int]:
+        return (self.value_index, self.ic)
+
+    def run(self) -> dict[str, Any]:
+        traj, fields = _run(self.params, self)
+        sec = traj.section
+        nxt = None
+        if traj.ok and len(sec):
+            # The last stroboscopic point lies at cam phase theta_c0 (t = k 2 pi / omega):
+            # a state the next value can start from at t = 0 with the same cam phase.
+            nxt = [float(sec["theta_f"].iloc[-1]), float(sec["omega_f"].iloc[-1])]
+        p = self.params
+        return {
+            "value_index": self.value_index,
+            "ic": self.ic,
+            "value": self.value,
+            "seed": self.seed,
+            "sim_index": self.sim_index,
+            "theta_f0": math.nan if p.theta_f0 is None else float(p.theta_f0),
+            "omega_f0": math.nan if p.omega_f0 is None else float(p.omega_f0),
+            "continued": self.continued,
+            "status": fields["status"],
+            "label": fields["label"],
+            "period": fields["period"],
+            "n_points": int(len(sec)),
+            "reasons": fields["reasons"],
+            "warnings": fields["warnings"],
+            "evidence": fields["evidence"],
+            "section": {c: sec[c].tolist() for c in sec.columns},
+            "next_state": nxt,
+        }
+
+
+def run_task(task: RealizationTask | BranchTask) -> dict[str, Any]:
+    """Run one task (the function every backend calls)."""
+    return task.run()

@@ -1,0 +1,42 @@
+"""The sweeps with the package classifier (chaoscam.classify), once it is in the build."""
+
+import pytest
+
+from chaoscam.sweep import Axis, bifurcation, regime_map
+
+classify = pytest.importorskip("chaoscam.classify")
+
+
+def test_regime_map_with_the_package_classifier():
+    """Every realization gets one of the classifier's labels or a status label."""
+    m = regime_map(
+        Axis("l_lambda", (0.008,)),
+        Axis("l_lambda_sigma", (0.0, 0.002)),
+        realizations=2,
+        duration=4.0,
+        workers=1,
+    )
+    allowed = {"periodic", "quasiperiodic", "chaotic", "undetermined", "left_reach", "diverged"}
+    assert set(m.realizations["label"]) <= allowed
+    assert (m.cells["n"] == 2).all()
+
+
+def test_bifurcation_with_the_package_classifier():
+    """A two-value diagram with the default classifier has one verdict per value."""
+    b = bifurcation("l_lambda", [0.006, 0.010], duration=4.0, workers=1)
+    assert len(b.verdicts) == 2 and len(b.points) > 0
+
+
+def test_lyapunov_exponents_are_summarised_per_cell():
+    """With lyapunov=True each run carries lyapunov_model; the cell has its mean and spread."""
+    m = regime_map(
+        Axis("l_lambda", (0.008,)),
+        Axis("l_lambda_sigma", (0.001,)),
+        realizations=2,
+        duration=3.0,
+        lyapunov=True,
+        workers=1,
+    )
+    assert m.realizations["ev_lyapunov_model"].notna().all()
+    cell = m.cells.iloc[0]
+    assert cell["lyapunov_n"] == 2 and abs(cell["lyapunov_mean"]) < float("inf")

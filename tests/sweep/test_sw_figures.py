@@ -1,0 +1,59 @@
+"""Sweep figures: heatmaps and bifurcation diagrams build from the tidy tables."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from chaoscam.report._sweep_figures import (
+    axis_label,
+    bifurcation_figure,
+    regime_map_figure,
+)
+from chaoscam.sweep import summarize_cells
+
+pytest.importorskip("seaborn")
+
+
+def _cells():
+    rng = np.random.default_rng(np.random.SeedSequence(1))
+    cells = pd.DataFrame(
+        [(3 * i + j, i, j, 0.004 + 0.004 * i, 0.001 * j) for i in range(3) for j in range(3)],
+        columns=["cell", "ix", "iy", "l_lambda", "l_lambda_sigma"],
+    )
+    labels = np.array(["periodic", "chaotic", "quasiperiodic", "left_reach"])
+    rows = pd.DataFrame(
+        {
+            "cell": np.repeat(cells["cell"], 8),
+            "label": labels[rng.integers(0, 4, 72)],
+            "truncated_mass": 0.0,
+        }
+    )
+    return summarize_cells(rows, cells)
+
+
+def test_regime_map_figure_has_labelled_axes_with_units():
+    """Three panels (dominant, P(chaotic), interval width), axes named with units."""
+    fig = regime_map_figure(_cells(), x="l_lambda", y="l_lambda_sigma")
+    axes = [a for a in fig.axes if a.get_title()]
+    assert [a.get_title() for a in axes][0] == "dominant label"
+    assert "interval" in axes[1].get_title()
+    assert all(a.get_xlabel().endswith("[m]") and a.get_ylabel().endswith("[m]") for a in axes)
+    assert "μ" in axes[0].get_xlabel()
+
+
+def test_bifurcation_points_are_rasterised():
+    """Thousands of points are drawn rasterised; the axes carry the units."""
+    n = 5000
+    pts = pd.DataFrame(
+        {
+            "param": "l_lambda",
+            "value": np.repeat(np.linspace(0.001, 0.018, 50), n // 50),
+            "theta_f": np.random.default_rng(0).random(n),
+            "label": "chaotic",
+        }
+    )
+    fig = bifurcation_figure(pts)
+    ax = fig.axes[0]
+    assert all(c.get_rasterized() for c in ax.collections)
+    assert sum(len(c.get_offsets()) for c in ax.collections) == n
+    assert ax.get_xlabel() == axis_label("l_lambda") and ax.get_ylabel().endswith("[rad]")

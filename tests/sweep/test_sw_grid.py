@@ -1,0 +1,58 @@
+"""Sweep axes, grid validation and the realization-index scheme."""
+
+import numpy as np
+import pytest
+
+from chaoscam import ParameterError, Params
+from chaoscam.sweep import Axis, SweepError, parse_range, realization_index
+from chaoscam.sweep._grid import validate_grid
+
+
+def test_fig4_axis_has_69_values_step_quarter_mm():
+    """Fig. 4's l_lambda from 0.001 to 0.018 m in 0.00025 m steps is 0.001:0.018:69."""
+    a = Axis.parse("l_lambda=0.001:0.018:69")
+    assert len(a) == 69 and a.values[0] == 0.001 and a.values[-1] == 0.018
+    assert np.allclose(np.diff(a.values), 0.00025, rtol=1e-9)
+
+
+@pytest.mark.parametrize(
+    "text", ["1:2", "a:2:3", "1:2:x", "1:2:0", "1:2:-3", "2:1:3", "1:2:1", "1:1:3", "1:inf:2"]
+)
+def test_bad_ranges_are_refused(text):
+    """NUM < 1, stop < start, malformed or degenerate ranges raise SweepError."""
+    with pytest.raises(SweepError):
+        parse_range(text)
+
+
+def test_single_point_range():
+    """START:START:1 is one value."""
+    assert parse_range("0.5:0.5:1") == (0.5, 0.5, 1)
+    assert Axis.parse("0.5:0.5:1", name="xi").values == (0.5,)
+
+
+def test_axis_names_are_checked():
+    """An unknown field is a ParameterError with a suggestion; a text field cannot be swept."""
+    with pytest.raises(ParameterError, match="omega"):
+        Axis("omegaa", (1.0,))
+    with pytest.raises(SweepError):
+        Axis("stiffness", (1.0,))
+
+
+def test_realization_index_is_a_bijection_independent_of_grid_shape():
+    """Cantor pairing: distinct (cell, index) give distinct indices, fixed formula."""
+    keys = [(c, i) for c in range(60) for i in range(60)]
+    idx = {realization_index(c, i) for c, i in keys}
+    assert len(idx) == len(keys)
+    assert realization_index(0, 0) == 0 and realization_index(3, 2) == 17
+    with pytest.raises(SweepError):
+        realization_index(-1, 0)
+
+
+def test_grid_validation_names_the_bad_point():
+    """sigma < 0 and mu <= 0 are refused before any run, naming the field."""
+    with pytest.raises(ParameterError, match="l_lambda_sigma"):
+        validate_grid(Params(), [Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (-1e-3,))])
+    with pytest.raises(ParameterError, match="l_lambda"):
+        validate_grid(Params(), [Axis("l_lambda", (0.0, 0.008)), Axis("xi", (0.4,))])
+    with pytest.raises(SweepError, match="repeat"):
+        validate_grid(Params(), [Axis("xi", (0.4,)), Axis("xi", (0.5,))])

@@ -1,0 +1,136 @@
+"""Regime maps: reproducibility, labels never dropped, adaptive sampling, checkpoints."""
+
+import numpy as np
+import pytest
+
+from chaoscam import Params, simulate
+from chaoscam.sweep import (
+    Axis,
+    SweepError,
+    SweepInterrupted,
+    checkpoint_dir,
+    realization_index,
+    regime_map,
+    verdict_fields,
+)
+
+from ._helpers import InterruptOnce, ParityClassifier, SpreadClassifier, frames_equal
+
+MU = Axis("l_lambda", (0.006, 0.010))
+SIGMA = Axis("l_lambda_sigma", (0.0, 0.002))
+KW = dict(
+    realizations=3, seed=11, duration=1.5, transient=0.5, classify=SpreadClassifier(), workers=1
+)
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return regime_map(MU, SIGMA, **KW)
+
+
+def test_rows_and_cells_shape(reference):
+    """One row per (cell, realization), sorted; one summary row per cell with n = N."""
+    r, c = reference.realizations, reference.cells
+    assert len(r) == 4 * 3 and len(c) == 4
+    assert list(zip(r["cell"], r["index"], strict=True)) == [
+        (c_, i) for c_ in range(4) for i in range(3)
+    ]
+    assert (c["n"] == 3).all()
+    assert list(r.columns[:4]) == ["cell", "index", "l_lambda", "l_lambda_sigma"]
+
+
+def test_same_seed_same_table_other_seed_other_random_cells(reference):
+    """Seed fixes the table bit for bit; another seed changes the random cells only."""
+    frames_equal(regime_map(MU, SIGMA, **KW).realizations, reference.realizations)
+    other = regime_map(MU, SIGMA, **{**KW, "seed": 12}).realizations
+    random = reference.realizations["l_lambda_sigma"] > 0
+    a, b = reference.realizations, other
+    assert not np.array_equal(a.loc[random, "ev_spread"], b.loc[random, "ev_spread"])
+    assert np.array_equal(a.loc[~random, "ev_spread"], b.loc[~random, "ev_spread"])
+
+
+def test_row_is_reproduced_by_simulate(reference):
+    """Row (cell, i) is simulate(params_c, seed, realization_index(c, i)) + the classifier."""
+    row = reference.realizations.iloc[5]
+    assert row["sim_index"] == realization_index(row["cell"], row["index"])
+    p = Params(l_lambda=row["l_lambda"], l_lambda_sigma=row["l_lambda_sigma"])
+    traj = simulate(
+        p, duration=1.5, transient=0.5, seed=11, index=int(row["sim_index"]), series=False
+    )
+    f = verdict_fields(SpreadClassifier()(traj))
+    assert f["label"] == row["label"] and f["evidence"]["spread"] == row["ev_spread"]
+
+
+def test_non_regular_runs_are_their_own_label():
+    """omega = 40 rad/s, xi = 0.9 leaves the cam's reach: labelled left_reach, kept."""
+    m = regime_map(
+        Axis("omega", (28.7, 40.0)),
+        Axis("xi", (0.42, 0.9)),
+        duration=2.0,
+        transient=0.5,
+        classify=SpreadClassifier(),
+        workers=1,
+    )
+    row = m.realizations.set_index(["omega", "xi"]).loc[(40.0, 0.9)]
+    assert row["status"] == "LEFT_REACH" and row["label"] == "left_reach"
+    cell = m.cells.set_index(["omega", "xi"]).loc[(40.0, 0.9)]
+    assert cell["dominant"] == "left_reach" and cell["p_left_reach"] == 1.0
+    assert len(m.realizations) == 4
+
+
+def test_adaptive_sampling_adds_batches_until_target_or_cap():
+    """Cells grow by N at a time; they stop once the widest half-width <= target, or at
+    the cap: unanimous cells at 4 (2/2 leaves 0.33 > 0.3, 4/4 leaves 0.25), mixed at 6."""
+    m = regime_map(
+        MU,
+        SIGMA,
+        **{**KW, "realizations": 2, "classify": ParityClassifier()},
+        target_halfwidth=0.3,
+        max_realizations=6,
+    )
+    c = m.cells
+    assert list(c["n"]) == [4, 6, 4, 6]
+    assert ((c["halfwidth"] <= 0.3) | (c["n"] == 6)).all()
+    assert len(m.realizations) == c["n"].sum()
+    r = m.realizations
+    assert list(r.loc[r["cell"] == 1, "index"]) == list(range(6))
+
+
+def test_interrupt_then_resume_gives_the_uninterrupted_table(tmp_path, reference):
+    """Ctrl-C mid-run saves the finished rows; resume finishes to the identical table and
+    recomputes nothing that was saved; the finished output is then reused as is."""
+    out = tmp_path / "m.parquet"
+    cls = InterruptOnce(str(tmp_path / "marker"), victim=realization_index(2, 1))
+    with pytest.raises(SweepInterrupted, match="--resume") as err:
+        regime_map(MU, SIGMA, **{**KW, "classify": cls}, out=out, flush_interval=0)
+    ckpt = checkpoint_dir(out)
+    assert 0 < err.value.done < 12 and ckpt.is_dir() and not out.exists()
+    saved = len(list(ckpt.glob("part-*.jsonl")))
+    assert saved == err.value.done  # one part per record with flush_interval = 0
+    res = regime_map(MU, SIGMA, **{**KW, "classify": cls}, out=out, resume=True, flush_interval=0)
+    frames_equal(res.realizations, reference.realizations)
+    frames_equal(res.cells, reference.cells)
+    assert not ckpt.exists() and out.exists()
+    again = regime_map(MU, SIGMA, **{**KW, "classify": cls}, out=out, resume=True)
+    frames_equal(again.realizations, reference.realizations)
+
+
+def test_existing_output_or_other_configuration_is_refused(tmp_path):
+    """Without resume an existing output is refused untouched; a checkpoint or output of
+    another configuration is refused even with resume."""
+    out = tmp_path / "m.parquet"
+    regime_map(MU, SIGMA, **{**KW, "realizations": 1}, out=out)
+    before = out.read_bytes()
+    with pytest.raises(FileExistsError, match="--resume"):
+        regime_map(MU, SIGMA, **{**KW, "realizations": 1}, out=out)
+    with pytest.raises(SweepError, match="different configuration"):
+        regime_map(MU, SIGMA, **{**KW, "realizations": 2}, out=out, resume=True)
+    assert out.read_bytes() == before
+    out2 = tmp_path / "n.parquet"
+    cls = InterruptOnce(str(tmp_path / "marker"), victim=realization_index(1, 0))
+    with pytest.raises(SweepInterrupted):
+        regime_map(MU, SIGMA, **{**KW, "classify": cls}, out=out2)
+    with pytest.raises(FileExistsError, match="--resume"):
+        regime_map(MU, SIGMA, **{**KW, "classify": cls}, out=out2)
+    with pytest.raises(SweepError, match="different configuration"):
+        regime_map(MU, SIGMA, **{**KW, "classify": cls, "seed": 5}, out=out2, resume=True)
