@@ -1,43 +1,13 @@
-"""The classifier the report uses: the package's, or a documented fallback while it is absent.
-
-``chaoscam.classify.classify_trajectory`` is the package classifier. Where a build does not
-have it yet, the report falls back to :func:`chaoscam.analysis.classify_signal` on the
-follower angle sampled every ``output_dt`` with the stroboscopic section (or to
-:func:`chaoscam.analysis.classify_section` without a series), and says so in the report.
-"""
+"""The classifier the report uses: ``chaoscam.classify.classify_trajectory``."""
 
 from __future__ import annotations
 
-import importlib
-
-__all__ = [
-    "ReportClassifier",
-    "classifier_fingerprint",
-    "classifier_name",
-    "classify",
-    "package_classifier",
-]
-
-
-def package_classifier():
-    """``chaoscam.classify.classify_trajectory`` or None when this build lacks it."""
-    try:
-        module = importlib.import_module("chaoscam.classify")
-    except ModuleNotFoundError as err:
-        if err.name != "chaoscam.classify":
-            raise
-        return None
-    return getattr(module, "classify_trajectory", None)
+__all__ = ["ReportClassifier", "classifier_fingerprint", "classifier_name", "classify"]
 
 
 def classifier_name() -> str:
     """Which classifier :func:`classify` uses, in words."""
-    if package_classifier() is not None:
-        return "chaoscam.classify.classify_trajectory"
-    return (
-        "fallback: chaoscam.analysis.classify_signal on theta_f with the stroboscopic section "
-        "(chaoscam.classify is not in this build)"
-    )
+    return "chaoscam.classify.classify_trajectory"
 
 
 def classifier_fingerprint() -> str:
@@ -45,8 +15,8 @@ def classifier_fingerprint() -> str:
     import hashlib
     from pathlib import Path
 
-    fn = package_classifier()
-    module = importlib.import_module(fn.__module__ if fn else "chaoscam.analysis._classify")
+    from .. import classify as module
+
     try:
         digest = hashlib.sha256(Path(module.__file__).read_bytes()).hexdigest()[:12]
     except (OSError, TypeError):
@@ -55,26 +25,10 @@ def classifier_fingerprint() -> str:
 
 
 def classify(traj):
-    """A :class:`~chaoscam.analysis.Verdict` for a trajectory (package classifier or fallback)."""
-    fn = package_classifier()
-    if fn is not None:
-        return fn(traj)
-    from ..analysis import classify_section, classify_signal
+    """A :class:`~chaoscam.analysis.Verdict` for a trajectory."""
+    from ..classify import classify_trajectory
 
-    section = traj.section[["theta_f", "omega_f"]].to_numpy()
-    if traj.series is not None and len(traj.series) > 64:
-        dt = float(traj.series["t"].diff().median())
-        return classify_signal(
-            traj.series["theta_f"].to_numpy(),
-            dt,
-            traj.params.cam_period,
-            section=section if len(section) >= 8 else None,
-        )
-    if len(section) < 8:
-        from ..analysis import combine
-
-        return combine([], reasons=[f"only {len(section)} section points (8 needed)"])
-    return classify_section(section)
+    return classify_trajectory(traj)
 
 
 class ReportClassifier:

@@ -183,7 +183,7 @@ def add_trajectory(parts: ReportParts, path: str, traj, *, caption: str = "") ->
 
 def add_bifurcation(parts: ReportParts, path: str, bif, *, caption: str = "") -> None:
     """A bifurcation diagram, its verdicts per value and its provenance."""
-    from ._sweep_fallback import bifurcation_figure
+    from ._sweep_figures import bifurcation_figure
 
     name = Path(path).name
     cfg = bif.config or {}
@@ -224,7 +224,7 @@ def add_bifurcation(parts: ReportParts, path: str, bif, *, caption: str = "") ->
 
 def add_regime_map(parts: ReportParts, path: str, rm, *, caption: str = "") -> None:
     """A regime map's figure, its cell table and its provenance."""
-    from ._sweep_fallback import regime_map_figure
+    from ._sweep_figures import regime_map_figure
 
     name = Path(path).name
     cfg = rm.config or {}

@@ -46,13 +46,6 @@ def _save(fig, outdir: Path, name: str) -> Path:
     return path
 
 
-def _sweep_classifier():
-    """None (the sweep's default, the package classifier) or the report's fallback."""
-    from ._classify import ReportClassifier, package_classifier
-
-    return None if package_classifier() is not None else ReportClassifier()
-
-
 def _runs(labels: list[str]) -> list[tuple[str, int]]:
     """Consecutive runs of equal labels: [(label, length), ...]."""
     out: list[tuple[str, int]] = []
@@ -136,7 +129,7 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
 def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 4: bifurcation of θ_f over l_λ ∈ [0.001, 0.018] m (Hertz line stiffness)."""
     from ..sweep import bifurcation
-    from ._sweep_fallback import bifurcation_figure
+    from ._sweep_figures import bifurcation_figure
 
     res = FigureResult(4)
     values = "0.001:0.018:69"  # the paper's step, 0.00025 m
@@ -146,7 +139,6 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
         duration=20.0,
         transient=10.0,
         initial_conditions=1 if quick else 3,
-        classify=_sweep_classifier(),
         workers=workers,
     )
     path = outdir / "fig4.parquet"
@@ -266,7 +258,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     from ..model import Params
     from ..simulate import contact_period
     from ..sweep import bifurcation
-    from ._sweep_fallback import bifurcation_figure
+    from ._sweep_figures import bifurcation_figure
 
     res = FigureResult(6)
     duration, transient = (12.0, 6.0) if quick else (20.0, 10.0)
@@ -282,7 +274,6 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
             base=base,
             duration=duration,
             transient=transient,
-            classify=_sweep_classifier(),
             workers=workers,
         )
         tag = f"fig6-G{g:g}"
@@ -319,7 +310,7 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
     from ..model import Params
     from ..simulate import simulate
     from ..sweep import Axis, regime_map
-    from ._sweep_fallback import regime_map_figure
+    from ._sweep_figures import regime_map_figure
 
     res = FigureResult(7)
     sigmas = tuple(np.round(np.linspace(0.0, 0.004, 5 if quick else 9), 6))
@@ -330,7 +321,6 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
         realizations=n,
         duration=20.0,
         transient=10.0,
-        classify=_sweep_classifier(),
         workers=workers,
     )
     path = outdir / "fig7-10.parquet"
@@ -413,7 +403,6 @@ FIGURES = {3: fig3, 4: fig4, 5: fig5, 6: fig6, 7: fig7_10, 8: fig7_10, 9: fig7_1
 
 def run_paper(*, quick: bool, out: str | Path, figures=None, workers=None, command=None) -> Path:
     """Run the figure scripts and write the report (data and PNGs in ``OUT_DIR/paper-data``)."""
-    from ._classify import classifier_name, package_classifier
     from ._html import ReportParts, add_bifurcation, add_regime_map, add_trajectory, write_report
 
     out = Path(out)
@@ -444,11 +433,6 @@ def run_paper(*, quick: bool, out: str | Path, figures=None, workers=None, comma
         f"{', '.join(map(str, wanted))} in {total:.0f} s "
         f"({', '.join(f'Fig. {r.number}: {r.seconds:.0f} s' for r in results)})."
     )
-    if package_classifier() is None:
-        parts.missing.append(
-            "chaoscam.classify (the package classifier) is not in this build; every label "
-            f"comes from the report's {classifier_name()}."
-        )
     for r in results:
         before = (len(parts.paper_figures), len(parts.regime_maps), len(parts.bifurcations))
         parts.paper_figures.extend(r.figures)

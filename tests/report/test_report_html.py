@@ -140,15 +140,3 @@ def test_out_must_be_html(outputs, tmp_path, capsys):
     """The report's name must end in .html."""
     code = main(["report", str(outputs / "traj.parquet"), "--out", str(tmp_path / "r.txt")])
     assert code == 2 and "html" in capsys.readouterr().err
-
-
-def test_fallback_classifier_labels_a_run(monkeypatch):
-    """Without chaoscam.classify the report's fallback still returns a verdict with evidence."""
-    from chaoscam.analysis import LABELS
-    from chaoscam.report import _classify
-
-    monkeypatch.setattr(_classify, "package_classifier", lambda: None)
-    traj = chaoscam.simulate(duration=4.0, transient=1.0)
-    v = _classify.classify(traj)
-    assert v.label in LABELS and len(v.evidence) > 0
-    assert "fallback" in _classify.classifier_name()
