@@ -7,7 +7,7 @@ __all__ = ["ReportClassifier", "classifier_fingerprint", "classifier_name", "cla
 
 def classifier_name() -> str:
     """Which classifier :func:`classify` uses, in words."""
-    return "chaoscam.classify.classify_trajectory"
+    return "chaoscam.classify.classify_trajectory(lyapunov=True)"
 
 
 def classifier_fingerprint() -> str:
@@ -25,10 +25,11 @@ def classifier_fingerprint() -> str:
 
 
 def classify(traj):
-    """A :class:`~chaoscam.analysis.Verdict` for a trajectory."""
+    """A :class:`~chaoscam.analysis.Verdict` for a trajectory, the model's Lyapunov exponent
+    included (without it a broadband-poor spectrum can pass chaos off as quasiperiodic)."""
     from ..classify import classify_trajectory
 
-    return classify_trajectory(traj)
+    return classify_trajectory(traj, lyapunov=True)
 
 
 class ReportClassifier:

@@ -139,6 +139,7 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
         duration=20.0,
         transient=10.0,
         initial_conditions=1 if quick else 3,
+        lyapunov=True,
         workers=workers,
     )
     path = outdir / "fig4.parquet"
@@ -274,6 +275,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
             base=base,
             duration=duration,
             transient=transient,
+            lyapunov=True,
             workers=workers,
         )
         tag = f"fig6-G{g:g}"
@@ -321,6 +323,7 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
         realizations=n,
         duration=20.0,
         transient=10.0,
+        lyapunov=True,
         workers=workers,
     )
     path = outdir / "fig7-10.parquet"
