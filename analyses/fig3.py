@@ -1,27 +1,10 @@
-"""Paper Fig. 3, reproduced: writes its data and a PNG into OUTDIR.
+"""Paper Fig. 3, reproduced: the contact-line length process (resampled every 0.01 s).
 
-A thin script over :func:`chaoscam.report._paper.fig3`, which `chaoscam paper` also runs.
-
+Writes its data and a PNG into OUTDIR; ``chaoscam paper`` runs the same code.
 Usage: python analyses/fig3.py [--quick] [OUTDIR]   (default OUTDIR: reports/paper-data)
 """
 
-from __future__ import annotations
-
-import sys
-from pathlib import Path
-
-from chaoscam.report._paper import fig3
-
-
-def main(quick: bool, outdir) -> None:
-    """Run Fig. 3 and print what it found against the paper."""
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    result = fig3(quick, outdir)
-    for c in result.comparisons:
-        print(f"{c.figure}: {c.verdict} - {c.found} ({c.reason})")
-
+from chaoscam.report._paper import figure_script
 
 if __name__ == "__main__":
-    args = [a for a in sys.argv[1:] if a != "--quick"]
-    main("--quick" in sys.argv[1:], args[0] if args else "reports/paper-data")
+    figure_script(3)

@@ -1,27 +1,10 @@
-"""Paper Fig. 5, reproduced: writes its data and a PNG into OUTDIR.
+"""Paper Fig. 5, reproduced: fractal stiffness K_n over D for three G.
 
-A thin script over :func:`chaoscam.report._paper.fig5`, which `chaoscam paper` also runs.
-
+Writes its data and a PNG into OUTDIR; ``chaoscam paper`` runs the same code.
 Usage: python analyses/fig5.py [--quick] [OUTDIR]   (default OUTDIR: reports/paper-data)
 """
 
-from __future__ import annotations
-
-import sys
-from pathlib import Path
-
-from chaoscam.report._paper import fig5
-
-
-def main(quick: bool, outdir) -> None:
-    """Run Fig. 5 and print what it found against the paper."""
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    result = fig5(quick, outdir)
-    for c in result.comparisons:
-        print(f"{c.figure}: {c.verdict} - {c.found} ({c.reason})")
-
+from chaoscam.report._paper import figure_script
 
 if __name__ == "__main__":
-    args = [a for a in sys.argv[1:] if a != "--quick"]
-    main("--quick" in sys.argv[1:], args[0] if args else "reports/paper-data")
+    figure_script(5)

@@ -1,27 +1,10 @@
-"""Paper Fig. 6, reproduced: writes its data and a PNG into OUTDIR.
+"""Paper Fig. 6, reproduced: bifurcation over D for G = 1e-9 and 1e-10 m (fractal stiffness).
 
-A thin script over :func:`chaoscam.report._paper.fig6`, which `chaoscam paper` also runs.
-
+Writes its data and a PNG into OUTDIR; ``chaoscam paper`` runs the same code.
 Usage: python analyses/fig6.py [--quick] [OUTDIR]   (default OUTDIR: reports/paper-data)
 """
 
-from __future__ import annotations
-
-import sys
-from pathlib import Path
-
-from chaoscam.report._paper import fig6
-
-
-def main(quick: bool, outdir) -> None:
-    """Run Fig. 6 and print what it found against the paper."""
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    result = fig6(quick, outdir)
-    for c in result.comparisons:
-        print(f"{c.figure}: {c.verdict} - {c.found} ({c.reason})")
-
+from chaoscam.report._paper import figure_script
 
 if __name__ == "__main__":
-    args = [a for a in sys.argv[1:] if a != "--quick"]
-    main("--quick" in sys.argv[1:], args[0] if args else "reports/paper-data")
+    figure_script(6)

@@ -1,27 +1,10 @@
-"""Paper Fig. 8, reproduced: writes its data and a PNG into OUTDIR.
+"""Paper Fig. 8, reproduced: mu = 0.008 m, sigma up to 0.004 m (regime map shared by Figs. 7-10).
 
-A thin script over :func:`chaoscam.report._paper.fig7_10`, which `chaoscam paper` also runs.
-Figs. 7-10 share one script body (a regime map over mu x sigma and six responses).
+Writes its data and a PNG into OUTDIR; ``chaoscam paper`` runs the same code.
 Usage: python analyses/fig8.py [--quick] [OUTDIR]   (default OUTDIR: reports/paper-data)
 """
 
-from __future__ import annotations
-
-import sys
-from pathlib import Path
-
-from chaoscam.report._paper import fig7_10
-
-
-def main(quick: bool, outdir) -> None:
-    """Run Fig. 8 and print what it found against the paper."""
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    result = fig7_10(quick, outdir)
-    for c in result.comparisons:
-        print(f"{c.figure}: {c.verdict} - {c.found} ({c.reason})")
-
+from chaoscam.report._paper import figure_script
 
 if __name__ == "__main__":
-    args = [a for a in sys.argv[1:] if a != "--quick"]
-    main("--quick" in sys.argv[1:], args[0] if args else "reports/paper-data")
+    figure_script(8)

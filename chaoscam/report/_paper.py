@@ -466,3 +466,19 @@ def run_paper(*, quick: bool, out: str | Path, figures=None, workers=None, comma
         )
     title = "chaoscam: the paper's Figs. 3–10 reproduced" + (" (quick run)" if quick else "")
     return write_report(parts, out, title=title, command=command)
+
+
+def figure_script(number: int, argv: list[str] | None = None) -> None:
+    """The body of ``analyses/figN.py``: run Fig. ``number``, print what it found.
+
+    Usage: ``python analyses/figN.py [--quick] [OUTDIR]`` (default OUTDIR: reports/paper-data).
+    """
+    import sys
+
+    argv = sys.argv[1:] if argv is None else argv
+    args = [a for a in argv if a != "--quick"]
+    outdir = Path(args[0] if args else "reports/paper-data")
+    outdir.mkdir(parents=True, exist_ok=True)
+    result = FIGURES[number]("--quick" in argv, outdir)
+    for c in result.comparisons:
+        print(f"{c.figure}: {c.verdict} - {c.found} ({c.reason})")
