@@ -321,6 +321,7 @@ def lyapunov_model(
     u = rng.standard_normal(2)
     u /= np.linalg.norm(u)
     cmp = _Runner(ref.y + d0 * u * scale, cnt_ref.copy(), c, draws, per_step)
+    cmp.cnt[k.I_SAFE_STEP] = 0  # the reference's flight horizon does not hold for a moved state
 
     logs: list[float] = []
     lengths: list[float] = []
@@ -375,6 +376,7 @@ def lyapunov_model(
             break
         cmp.y[:] = ref.y + d0 * (delta / d) * scale
         cmp.cnt[:] = ref.cnt
+        cmp.cnt[k.I_SAFE_STEP] = 0  # the reference's flight horizon does not hold for cmp
         cmp.n_impacts = ref.n_impacts
 
     lg = np.asarray(logs)

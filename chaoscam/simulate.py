@@ -21,6 +21,7 @@ import pandas as pd
 from ._version import __version__
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
+from .integrate._ensemble import run_one
 from .model import (
     LineLengthStream,
     ParameterError,
@@ -221,7 +222,7 @@ def simulate(
 
     while True:
         step_before = cnt[k.I_STEP]
-        code = k.run_chunk(y, cnt, c, n_stop, lam, buf_series, buf_section, buf_impacts)
+        code = run_one(y, cnt, c, n_stop, lam, buf_series, buf_section, buf_impacts)
         if code == k.NEED_BUFFER and cnt[k.I_STEP] == step_before and cnt[k.I_LAM_POS] == 0:
             raise RuntimeError("internal: the kernel asked for buffers but made no progress")
         for name, buf, i in (

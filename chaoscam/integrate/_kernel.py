@@ -71,7 +71,8 @@ I_CONTACT_STEPS = 7  # recorded steps ending in contact
 I_COUNTED_STEPS = 8  # recorded steps
 I_CHATTER = 9  # steps where the chattering guard handed over to the compliant contact
 I_SLOW_CLOSINGS = 10  # closings slower than v_min (no jump applied)
-N_COUNTERS = 11
+I_SAFE_STEP = 11  # the gap provably stays open until grid step I_SAFE_STEP (0 = not known)
+N_COUNTERS = 12
 
 # --- status codes (mirrors chaoscam.integrate.Status) ------------------------------------
 OK = 0
@@ -302,7 +303,10 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
         draws_per_step += np.int64(h / c[C_RESAMPLE_DT]) + 2
 
     g, l1, cdn = geometry(cnt[I_STEP] * h, th, c)  # gap, lever arm, dC/dt.n here
-    t_safe = -1.0  # until this time the gap certainly stays positive (no geometry needed)
+    # Until grid step safe_n the gap certainly stays open (no geometry needed). Kept in the
+    # counters, so that a run resumed after a buffer hand-back is bit-identical to one that
+    # was not interrupted. Whoever changes the state y from outside must reset it to 0.
+    safe_n = cnt[I_SAFE_STEP]
     stale = False  # g, l1, cdn belong to an earlier point (only while the gap is safe)
     while cnt[I_STEP] < n_stop:
         # Room for one more step's worth of outputs and draws, else hand back to Python.
@@ -314,13 +318,14 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
         ):
             y[0] = th
             y[1] = om
+            cnt[I_SAFE_STEP] = safe_n
             return NEED_BUFFER
 
         n = cnt[I_STEP]
         t = n * h
         # Proven flight over several grid steps: one RK4 step of the free pendulum across
         # them, ending on the grid and before any scheduled time or series sample.
-        m = min(np.int64((t_safe - t) / h), merge, n_stop - n)
+        m = min(safe_n - n, merge, n_stop - n)
         if m >= 2:
             m = min(m, np.int64((cnt[I_SECTION_K] * c[C_PERIOD] - t) / h))
             if not resample_on_impact:
@@ -336,6 +341,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             if not (math.isfinite(th) and math.isfinite(om)):
                 y[0] = th
                 y[1] = om
+                cnt[I_SAFE_STEP] = safe_n
                 return NON_FINITE
             if (n + m) * h >= c[C_T_RECORD]:
                 cnt[I_COUNTED_STEPS] += m
@@ -375,7 +381,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 elif t_res == seg_end:
                     is_resample = True
             hs = seg_end - t
-            if hs > 0.0 and seg_end <= t_safe:
+            if hs > 0.0 and seg_end <= safe_n * h:
                 th, om = rk4_flight(th, om, hs, c)  # far from the cam: pure flight
                 t = seg_end
                 stale = True
@@ -404,6 +410,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     if not (0.0 < l1 < c[C_ROD_L]):
                         y[0] = th
                         y[1] = om
+                        cnt[I_SAFE_STEP] = safe_n
                         return LEFT_REACH
                     rate = l1 * om - cdn
                     if -rate > c[C_VMIN]:
@@ -430,7 +437,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 t = seg_end
                 g = g_new
                 if g > 0.0:
-                    t_safe = t + safe_horizon(g, l1, cdn, om, c)
+                    safe_n = np.int64(math.floor((t + safe_horizon(g, l1, cdn, om, c)) / h))
             if is_section:
                 if t >= c[C_T_RECORD]:
                     i = cnt[I_N_SECTION]
@@ -451,15 +458,18 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
         if not (math.isfinite(th) and math.isfinite(om)):
             y[0] = th
             y[1] = om
+            cnt[I_SAFE_STEP] = safe_n
             return NON_FINITE
         if g <= 0.0:
             if not (0.0 < l1 < c[C_ROD_L]):
                 y[0] = th
                 y[1] = om
+                cnt[I_SAFE_STEP] = safe_n
                 return LEFT_REACH
             if -g > c[C_RCAM]:
                 y[0] = th
                 y[1] = om
+                cnt[I_SAFE_STEP] = safe_n
                 return PENETRATION
         if t_end >= c[C_T_RECORD]:
             cnt[I_COUNTED_STEPS] += 1
@@ -474,4 +484,5 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 cnt[I_N_SERIES] += 1
     y[0] = th
     y[1] = om
+    cnt[I_SAFE_STEP] = safe_n
     return OK

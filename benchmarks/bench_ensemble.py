@@ -1,0 +1,42 @@
+"""Ensemble scaling, measured in one run (issue 6): 2 threads against 1 on the same ensemble.
+
+Prints trajectories per second for each thread count and the ratio (target >= 1.8x), and the
+peak memory of a 10,000-member ensemble's arrays per batch (target < 2 GB).
+"""
+
+from __future__ import annotations
+
+import resource
+import time
+
+import numba
+
+from chaoscam import Params
+from chaoscam.integrate import simulate_ensemble
+
+
+def rate(p, members: int, threads: int) -> float:
+    numba.set_num_threads(threads)
+    t0 = time.perf_counter()
+    simulate_ensemble(p, range(members), seed=1, duration=20.0)
+    return members / (time.perf_counter() - t0)
+
+
+def main() -> None:
+    p = Params(l_lambda_sigma=0.002)
+    simulate_ensemble(p, range(2), seed=1, duration=0.1)  # compile or load from cache
+    n = 64
+    one = rate(p, n, 1)
+    two = rate(p, n, min(2, numba.config.NUMBA_NUM_THREADS))
+    print(f"ensemble of {n} x 20 s: 1 thread {one:.1f} traj/s, 2 threads {two:.1f} traj/s, "
+          f"ratio {two / one:.2f}x (target >= 1.8x)")
+    t0 = time.perf_counter()
+    ens = simulate_ensemble(p, range(10_000), seed=1, duration=20.0)
+    wall = time.perf_counter() - t0
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"10,000 x 20 s: {wall:.0f} s ({10_000 / wall:.0f} traj/s), "
+          f"{len(ens.sections)} section points, peak RSS {peak:.0f} MiB (target < 2048 MiB)")
+
+
+if __name__ == "__main__":
+    main()
