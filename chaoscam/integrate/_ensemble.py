@@ -9,6 +9,7 @@ kept; a member that outgrows its impact buffer or its draws is finished on the s
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -23,6 +24,14 @@ from ._constants import kernel_constants
 from ._status import Status
 
 __all__ = ["Ensemble", "run_members", "run_one", "simulate_ensemble"]
+
+# numba's GNU OpenMP layer aborts a process that forks after using it, and the sweeps fork
+# their workers from a driver that has simulated; the workqueue layer is fork-safe (though not
+# safe for parallel calls from several Python threads at once). A user's choice wins.
+if "NUMBA_THREADING_LAYER" not in os.environ:
+    import numba
+
+    numba.config.THREADING_LAYER = "workqueue"
 
 _DRAWS = 2048  # line-length draws per member before a refill
 _IMPACT_ROWS = 256  # impact rows per member per call (only counted, not kept)

@@ -95,3 +95,21 @@ def test_pausing_for_buffers_does_not_change_a_run():
     a = simulate(duration=20.0, series=False)
     b = simulate(duration=20.0, output_dt=2e-6)
     assert a.section.equals(b.section) and a.impacts.equals(b.impacts)
+
+
+def test_a_process_that_simulated_can_fork_workers():
+    """After simulate() in the parent, forked workers still run (fork-safe threading layer)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import multiprocessing as mp, chaoscam\n"
+        "chaoscam.simulate(duration=0.2, series=False)\n"
+        "def f(i):\n"
+        "    return len(chaoscam.simulate(duration=0.2, series=False).section)\n"
+        "if __name__ == '__main__':\n"
+        "    with mp.get_context('fork').Pool(2) as pool:\n"
+        "        print(sum(pool.map(f, range(4))))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "4", out.stderr
