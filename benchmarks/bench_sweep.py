@@ -23,47 +23,17 @@ import resource
 import sys
 import time
 import tracemalloc
-from dataclasses import dataclass
 
 import numpy as np
 
-from chaoscam.sweep import Axis, DefaultClassifier, bifurcation, regime_map
+from chaoscam.sweep import Axis, bifurcation, regime_map
 
 FIG4_BUDGET_S = 60.0
 SPEEDUP_GOAL = 1.8
 
 
-@dataclass(frozen=True)
-class _Verdict:
-    label: str
-    period: int | None
-    evidence: tuple
-    reasons: tuple = ()
-
-
-@dataclass(frozen=True)
-class _Ev:
-    name: str
-    value: float
-
-
-@dataclass(frozen=True)
-class SpreadStandIn:
-    """Stand-in classifier: the spread of theta_f on the section (no physics claim)."""
-
-    needs_series = False
-
-    def __call__(self, traj):
-        th = traj.section["theta_f"].to_numpy()
-        spread = float(np.ptp(th)) if th.size else 0.0
-        label = "periodic" if spread < 1e-6 else "chaotic"
-        return _Verdict(label, 1 if label == "periodic" else None, (_Ev("spread", spread),))
-
-
 def classifier():
-    if DefaultClassifier.available():
-        return None, "chaoscam.classify.classify_trajectory"
-    return SpreadStandIn(), "section-spread stand-in (chaoscam.classify not in this build)"
+    return None, "chaoscam.classify.classify_trajectory"
 
 
 def bench_fig4(classify, workers) -> float:

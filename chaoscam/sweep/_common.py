@@ -35,11 +35,6 @@ def run_settings(duration: float, transient: float | None, seed: int) -> tuple[f
 def resolve_classifier(classify, lyapunov: bool, check_step: bool = False):
     """The classifier to use and its identity; None = the package classifier."""
     if classify is None:
-        if not DefaultClassifier.available():
-            raise SweepError(
-                "the default classifier (chaoscam.classify) is not in this build; pass "
-                "classify=... (command line: --classifier MODULE:NAME)"
-            )
         classify = DefaultClassifier(lyapunov=bool(lyapunov), check_step=bool(check_step))
     elif lyapunov or check_step:
         raise SweepError("lyapunov and check_step apply to the default classifier only")

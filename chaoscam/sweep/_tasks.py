@@ -45,17 +45,6 @@ class DefaultClassifier:
 
         return classify_trajectory(traj, lyapunov=self.lyapunov, check_step=self.check_step)
 
-    @staticmethod
-    def available() -> bool:
-        """Whether ``chaoscam.classify`` exists in this build."""
-        try:
-            importlib.import_module("chaoscam.classify")
-        except ModuleNotFoundError as err:
-            if err.name not in ("chaoscam.classify",):
-                raise
-            return False
-        return True
-
 
 def classifier_identity(classify: Callable) -> str:
     """A stable text naming a classifier and its settings, part of a run's configuration.
