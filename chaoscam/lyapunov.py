@@ -24,7 +24,9 @@ import numpy as np
 from ._version import __version__
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
-from .model import LineLengthStream, ParameterError, Params, contact_angle, contact_angle_rate
+from .integrate._advance import advance
+from .integrate._constants import initial_counters, initial_state
+from .model import LineLengthStream, ParameterError, Params
 
 __all__ = ["ModelLyapunov", "lyapunov_model"]
 
@@ -117,7 +119,7 @@ class _Runner:
     def run_to(self, n_to: int) -> int:
         cnt = self.cnt
         while True:
-            code = k.run_chunk(
+            code = advance(
                 self.y, cnt, self.c, n_to, self.draws.lam, self.series, self.section, self.impacts
             )
             self.n_impacts += int(cnt[k.I_N_IMPACT])
@@ -312,15 +314,13 @@ def lyapunov_model(
     per_step = max(per_step, int(dt / period) + 2)
     draws = _Draws(LineLengthStream(p, seed, index), max(_BLOCK, 4 * per_step))
     c = kernel_constants(p, t_record=0.0, stride=0)
-    th0 = float(contact_angle(p, 0.0)) if p.theta_f0 is None else p.theta_f0
-    om0 = float(contact_angle_rate(p, 0.0)) if p.omega_f0 is None else p.omega_f0
-    cnt_ref = np.zeros(k.N_COUNTERS, dtype=np.int64)
-    cnt_ref[k.I_RESAMPLE_J] = 1
-    ref = _Runner(np.array([th0, om0]), cnt_ref, c, draws, per_step)
+    cnt_ref = initial_counters(p)
+    ref = _Runner(initial_state(p), cnt_ref, c, draws, per_step)
     rng = np.random.default_rng(np.random.SeedSequence(direction_seed))
     u = rng.standard_normal(2)
     u /= np.linalg.norm(u)
-    cmp = _Runner(ref.y + d0 * u * scale, cnt_ref.copy(), c, draws, per_step)
+    cmp = _Runner(ref.y.copy(), cnt_ref.copy(), c, draws, per_step)
+    cmp.y[:2] += d0 * u * scale
     cmp.cnt[k.I_SAFE_STEP] = 0  # the reference's flight horizon does not hold for a moved state
 
     logs: list[float] = []
@@ -333,7 +333,7 @@ def lyapunov_model(
 
     def failed(which: str, code: int) -> ModelLyapunov:
         st = Status(code)
-        t_fail = cmp.cnt[k.I_STEP] * dt if which == "companion" else ref.cnt[k.I_STEP] * dt
+        t_fail = (cmp if which == "companion" else ref).y[k.Y_TIME]
         msg = (
             f"the {which} trajectory ended with status {st.name} at t = {t_fail:.6g} s "
             f"({st.label}): {st.message} No exponent (NaN)."
@@ -362,7 +362,7 @@ def lyapunov_model(
             waited += 1
         postponed += waited > 0
         unsynced += ref.n_impacts != cmp.n_impacts
-        delta = (cmp.y - ref.y) / scale
+        delta = (cmp.y[:2] - ref.y[:2]) / scale
         d = float(np.hypot(delta[0], delta[1]))
         n_now = int(ref.cnt[k.I_STEP])
         if not math.isfinite(d):
@@ -374,7 +374,8 @@ def lyapunov_model(
         n_last = n_now
         if d == 0.0:
             break
-        cmp.y[:] = ref.y + d0 * (delta / d) * scale
+        cmp.y[:] = ref.y
+        cmp.y[:2] += d0 * (delta / d) * scale
         cmp.cnt[:] = ref.cnt
         cmp.cnt[k.I_SAFE_STEP] = 0  # the reference's flight horizon does not hold for cmp
         cmp.n_impacts = ref.n_impacts

@@ -21,13 +21,13 @@ import pandas as pd
 from ._version import __version__
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
-from .integrate._ensemble import run_one
+from .integrate._constants import initial_counters, initial_state
+from .integrate._ensemble import contact_fraction, run_one
 from .model import (
     LineLengthStream,
     ParameterError,
     Params,
     contact_angle,
-    contact_angle_rate,
     gap,
     normal_force,
     truncated_mass,
@@ -206,12 +206,9 @@ def simulate(
     block = max(_BLOCK, 4 * per_step, 4 * (int(p.dt / p.cam_period) + 2))
     stream = LineLengthStream(p, seed, index)
     lam = stream.draw(block)
-    th0 = float(contact_angle(p, 0.0)) if p.theta_f0 is None else p.theta_f0
-    om0 = float(contact_angle_rate(p, 0.0)) if p.omega_f0 is None else p.omega_f0
-    y = np.array([th0, om0])
-    cnt = np.zeros(k.N_COUNTERS, dtype=np.int64)
-    cnt[k.I_SECTION_K] = math.ceil(transient / p.cam_period - 1e-12)
-    cnt[k.I_RESAMPLE_J] = 1
+    y = initial_state(p)
+    th0, om0 = y[k.Y_THETA], y[k.Y_OMEGA]
+    cnt = initial_counters(p, transient=transient)
     c = kernel_constants(p, t_record=transient, stride=stride)
     buf_series = np.empty((block if series else 1, k.SERIES_COLS))
     buf_section = np.empty((block, k.SECTION_COLS))
@@ -221,9 +218,9 @@ def simulate(
         parts["series"].append(np.array([[0.0, th0, om0, lam[0]]]))
 
     while True:
-        step_before = cnt[k.I_STEP]
+        t_before = y[k.Y_TIME]
         code = run_one(y, cnt, c, n_stop, lam, buf_series, buf_section, buf_impacts)
-        if code == k.NEED_BUFFER and cnt[k.I_STEP] == step_before and cnt[k.I_LAM_POS] == 0:
+        if code == k.NEED_BUFFER and y[k.Y_TIME] == t_before and cnt[k.I_LAM_POS] == 0:
             raise RuntimeError("internal: the kernel asked for buffers but made no progress")
         for name, buf, i in (
             ("series", buf_series, k.I_N_SERIES),
@@ -247,9 +244,8 @@ def simulate(
     sec["k"] = sec["k"].astype(np.int64)
     imp = pd.DataFrame(stack("impacts", k.IMPACT_COLS), columns=list(IMPACT_COLUMNS))
     ser = _series_frame(p, stack("series", k.SERIES_COLS)) if series else None
-    counted = int(cnt[k.I_COUNTED_STEPS])
     stats = {
-        "contact_fraction": cnt[k.I_CONTACT_STEPS] / counted if counted else float("nan"),
+        "contact_fraction": contact_fraction(y, cnt, c),
         "n_impacts": len(imp),
         "slow_closings": int(cnt[k.I_SLOW_CLOSINGS]),
         "chatter_handovers": int(cnt[k.I_CHATTER]),
@@ -262,7 +258,11 @@ def simulate(
         "seed": int(seed),
         "index": int(index),
         "output_dt": stride * p.dt if series else None,
-        "solver": "rk4-fixed-step+illinois-events",
+        "solver": (
+            "dopri5-adaptive+interpolant-events"
+            if p.integrator == "adaptive"
+            else "rk4-fixed-step+illinois-events"
+        ),
         "version": __version__,
         "wall_time_s": time.perf_counter() - t0,
     }
@@ -274,7 +274,7 @@ def simulate(
         section=sec,
         impacts=imp,
         stats=stats,
-        final_state=(float(cnt[k.I_STEP] * p.dt), float(y[0]), float(y[1])),
+        final_state=(float(y[k.Y_TIME]), float(y[k.Y_THETA]), float(y[k.Y_OMEGA])),
     )
 
 

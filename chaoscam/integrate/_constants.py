@@ -10,10 +10,10 @@ import math
 
 import numpy as np
 
-from ..model import Params
+from ..model import Params, contact_angle, contact_angle_rate
 from . import _kernel as k
 
-__all__ = ["kernel_constants"]
+__all__ = ["initial_counters", "initial_state", "kernel_constants"]
 
 
 def kernel_constants(p: Params, *, t_record: float = 0.0, stride: int = 0) -> np.ndarray:
@@ -57,4 +57,31 @@ def kernel_constants(p: Params, *, t_record: float = 0.0, stride: int = 0) -> np
     c[k.C_MAX_EVENTS] = p.max_events_per_step
     c[k.C_STRIDE] = stride
     c[k.C_FLIGHT_MERGE] = p.flight_merge
+    c[k.C_METHOD] = k.METHOD_ADAPTIVE if p.integrator == "adaptive" else k.METHOD_RK4
+    c[k.C_RTOL] = p.rtol
+    c[k.C_ATOL] = p.atol
+    c[k.C_H_MAX] = p.h_max
     return c
+
+
+def initial_state(p: Params) -> np.ndarray:
+    """The state vector ``y`` (slots ``_kernel.Y_*``) at t = 0.
+
+    theta_f(0) and theta_f'(0) are ``p.theta_f0`` / ``p.omega_f0``, or in contact with the cam
+    (theta_fc(0) and its rate) when those are None (shared/MODEL.md, decision).
+    """
+    y = np.zeros(k.Y_SIZE)
+    y[k.Y_THETA] = float(contact_angle(p, 0.0)) if p.theta_f0 is None else p.theta_f0
+    y[k.Y_OMEGA] = float(contact_angle_rate(p, 0.0)) if p.omega_f0 is None else p.omega_f0
+    return y
+
+
+def initial_counters(p: Params, *, transient: float = 0.0) -> np.ndarray:
+    """The integer counters (indices ``_kernel.I_*``) at t = 0 for a run recording from
+    ``transient``: the first section index k with k T >= transient, and the first series
+    sample and resampling index 1 (their index-0 points are the initial state)."""
+    cnt = np.zeros(k.N_COUNTERS, dtype=np.int64)
+    cnt[k.I_SECTION_K] = math.ceil(transient / p.cam_period - 1e-12)
+    cnt[k.I_RESAMPLE_J] = 1
+    cnt[k.I_SERIES_J] = 1
+    return cnt

@@ -8,7 +8,6 @@ kept; a member that outgrows its impact buffer or its draws is finished on the s
 
 from __future__ import annotations
 
-import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -18,12 +17,13 @@ import numpy as np
 import pandas as pd
 from numba import njit, prange
 
-from ..model import LineLengthStream, Params, contact_angle, contact_angle_rate
+from ..model import LineLengthStream, Params
 from . import _kernel as k
-from ._constants import kernel_constants
+from ._advance import advance
+from ._constants import initial_counters, initial_state, kernel_constants
 from ._status import Status
 
-__all__ = ["Ensemble", "run_members", "run_one", "simulate_ensemble"]
+__all__ = ["Ensemble", "contact_fraction", "run_members", "run_one", "simulate_ensemble"]
 
 # numba's GNU OpenMP layer aborts a process that forks after using it, and the sweeps fork
 # their workers from a driver that has simulated; the workqueue layer is fork-safe (though not
@@ -39,15 +39,28 @@ _IMPACT_ROWS = 256  # impact rows per member per call (only counted, not kept)
 
 @njit(parallel=True, cache=True)
 def run_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
-    """:func:`_kernel.run_chunk` for each member ``i`` of stacked arrays, in parallel.
+    """:func:`_advance.advance` for each member ``i`` of stacked arrays, in parallel.
 
     The one compiled entry point of every simulation (``chaoscam.simulate`` calls it with a
     single member), so that a realization is bit-identical on every path and thread count.
     """
     for i in prange(y.shape[0]):
-        status[i] = k.run_chunk(
+        status[i] = advance(
             y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i]
         )
+
+
+def contact_fraction(y, cnt, c) -> float:
+    """Fraction of the recorded time spent in contact (gap <= 0); NaN if nothing recorded.
+
+    The fixed-step kernel counts grid steps ending in contact; the adaptive one integrates
+    time (slots ``Y_RECORDED`` and ``Y_CONTACT``).
+    """
+    if c[k.C_METHOD] == k.METHOD_ADAPTIVE:
+        rec = y[k.Y_RECORDED]
+        return float(y[k.Y_CONTACT] / rec) if rec > 0 else float("nan")
+    counted = cnt[k.I_COUNTED_STEPS]
+    return float(cnt[k.I_CONTACT_STEPS] / counted) if counted else float("nan")
 
 
 def run_one(y, cnt, c, n_stop, lam, series, section, impacts) -> int:
@@ -147,16 +160,9 @@ def _run_batch(plist, indices, first, seed, duration, transient):
     extra = max(p.max_events_per_step + p.flight_merge for p in plist) + 2
     streams = [LineLengthStream(p, seed, i) for p, i in zip(plist, indices, strict=True)]
     lam = np.stack([s.draw(_DRAWS + 4 * extra) for s in streams])
-    y = np.empty((n, 2))
-    cnt = np.zeros((n, k.N_COUNTERS), dtype=np.int64)
+    y = np.stack([initial_state(p) for p in plist])
+    cnt = np.stack([initial_counters(p, transient=transient) for p in plist])
     c = np.stack([kernel_constants(p, t_record=transient) for p in plist])
-    for j, p in enumerate(plist):
-        y[j] = (
-            float(contact_angle(p, 0.0)) if p.theta_f0 is None else p.theta_f0,
-            float(contact_angle_rate(p, 0.0)) if p.omega_f0 is None else p.omega_f0,
-        )
-    cnt[:, k.I_SECTION_K] = math.ceil(transient / p0.cam_period - 1e-12)
-    cnt[:, k.I_RESAMPLE_J] = 1
     section = np.empty((n, n_sec, k.SECTION_COLS))
     impacts = np.empty((n, _IMPACT_ROWS + 4 * extra, k.IMPACT_COLS))
     status = np.zeros(n, dtype=np.int64)
@@ -182,14 +188,13 @@ def _run_batch(plist, indices, first, seed, duration, transient):
         block[:, 0] = first + j
         block[:, 1:] = section[j, :m]
         sections.append(block)
-        counted = cnt[j, k.I_COUNTED_STEPS]
         rows.append(
             (
                 first + j,
                 indices[j],
                 Status(int(status[j])).name,
                 int(n_impacts[j] + cnt[j, k.I_N_IMPACT]),
-                cnt[j, k.I_CONTACT_STEPS] / counted if counted else float("nan"),
+                contact_fraction(y[j], cnt[j], c[j]),
             )
         )
     return sections, rows

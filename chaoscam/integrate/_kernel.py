@@ -57,7 +57,14 @@ C_RESAMPLE_DT = 23  # interval between line-length draws [s]; 0 = draw at each i
 C_MAX_EVENTS = 24  # impacts handled in one step before chattering hand-over
 C_STRIDE = 25  # series sample every C_STRIDE steps; 0 = no series
 C_FLIGHT_MERGE = 26  # most grid steps taken as one RK4 step where the gap provably stays open
-N_CONSTANTS = 27
+C_METHOD = 27  # METHOD_RK4 (this module) or METHOD_ADAPTIVE (_adaptive.py)
+C_RTOL = 28  # adaptive: relative tolerance of the step error
+C_ATOL = 29  # adaptive: absolute tolerance [rad and rad/s]
+C_H_MAX = 30  # adaptive: largest step [s]
+N_CONSTANTS = 31
+
+METHOD_RK4 = 0
+METHOD_ADAPTIVE = 1
 
 # --- indices into the integer counters ---------------------------------------------------
 I_STEP = 0  # grid step n of the current time n dt
@@ -72,7 +79,17 @@ I_COUNTED_STEPS = 8  # recorded steps
 I_CHATTER = 9  # steps where the chattering guard handed over to the compliant contact
 I_SLOW_CLOSINGS = 10  # closings slower than v_min (no jump applied)
 I_SAFE_STEP = 11  # the gap provably stays open until grid step I_SAFE_STEP (0 = not known)
-N_COUNTERS = 12
+I_SERIES_J = 12  # adaptive: index j of the next series sample (time j * stride * dt)
+N_COUNTERS = 13
+
+# --- the state vector y ----------------------------------------------------------------------
+Y_THETA = 0  # theta_f [rad]
+Y_OMEGA = 1  # theta_f' [rad/s]
+Y_TIME = 2  # t [s] (the fixed-step kernel keeps it equal to cnt[I_STEP] * dt)
+Y_STEP = 3  # adaptive: the step size to try next [s]; 0 = not known yet
+Y_RECORDED = 4  # adaptive: time integrated after the transient [s]
+Y_CONTACT = 5  # adaptive: of which in contact (gap <= 0) [s]
+Y_SIZE = 6
 
 # --- status codes (mirrors chaoscam.integrate.Status) ------------------------------------
 OK = 0
@@ -265,13 +282,24 @@ def locate_crossing(t, th, om, h, g_start, g_end, K, c):
 
 
 @njit(cache=True)
+def leave(y, cnt, th, om, t, safe_n, code):
+    """Store the state and the flight horizon before returning ``code`` to the driver."""
+    y[Y_THETA] = th
+    y[Y_OMEGA] = om
+    y[Y_TIME] = t
+    cnt[I_SAFE_STEP] = safe_n
+    return code
+
+
+@njit(cache=True)
 def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     """Advance one trajectory from step ``cnt[I_STEP]`` towards ``n_stop``.
 
     Parameters
     ----------
-    y : float64[2]
-        (theta_f [rad], theta_f' [rad/s]) at ``t = cnt[I_STEP] * dt``; updated in place.
+    y : float64[Y_SIZE]
+        (theta_f [rad], theta_f' [rad/s], t [s], ...) at ``t = cnt[I_STEP] * dt``; updated in
+        place (slots ``Y_*``; this kernel reads the first two and writes the time).
     cnt : int64[N_COUNTERS]
         Counters (indices ``I_*``); updated in place.
     c : float64[N_CONSTANTS]
@@ -316,10 +344,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             or cnt[I_N_IMPACT] + max_events > impacts.shape[0]
             or cnt[I_LAM_POS] + draws_per_step >= lam.shape[0]
         ):
-            y[0] = th
-            y[1] = om
-            cnt[I_SAFE_STEP] = safe_n
-            return NEED_BUFFER
+            return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, NEED_BUFFER)
 
         n = cnt[I_STEP]
         t = n * h
@@ -339,10 +364,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             stale = True
             cnt[I_STEP] = n + m
             if not (math.isfinite(th) and math.isfinite(om)):
-                y[0] = th
-                y[1] = om
-                cnt[I_SAFE_STEP] = safe_n
-                return NON_FINITE
+                return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, NON_FINITE)
             if (n + m) * h >= c[C_T_RECORD]:
                 cnt[I_COUNTED_STEPS] += m
                 # Series samples inside the block come from a substep off its start, so that
@@ -408,10 +430,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     if not closing:
                         continue
                     if not (0.0 < l1 < c[C_ROD_L]):
-                        y[0] = th
-                        y[1] = om
-                        cnt[I_SAFE_STEP] = safe_n
-                        return LEFT_REACH
+                        return leave(y, cnt, th, om, t, safe_n, LEFT_REACH)
                     rate = l1 * om - cdn
                     if -rate > c[C_VMIN]:
                         om_after = -c[C_XI] * om + (1.0 + c[C_XI]) * cdn / l1
@@ -456,21 +475,12 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
         # End of the grid step: checks and outputs. Here g and l1 belong to (t_end, th).
         cnt[I_STEP] = n + 1
         if not (math.isfinite(th) and math.isfinite(om)):
-            y[0] = th
-            y[1] = om
-            cnt[I_SAFE_STEP] = safe_n
-            return NON_FINITE
+            return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, NON_FINITE)
         if g <= 0.0:
             if not (0.0 < l1 < c[C_ROD_L]):
-                y[0] = th
-                y[1] = om
-                cnt[I_SAFE_STEP] = safe_n
-                return LEFT_REACH
+                return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, LEFT_REACH)
             if -g > c[C_RCAM]:
-                y[0] = th
-                y[1] = om
-                cnt[I_SAFE_STEP] = safe_n
-                return PENETRATION
+                return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, PENETRATION)
         if t_end >= c[C_T_RECORD]:
             cnt[I_COUNTED_STEPS] += 1
             if g <= 0.0:
@@ -482,7 +492,4 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 series[i, 2] = om
                 series[i, 3] = lam[cnt[I_LAM_POS]]
                 cnt[I_N_SERIES] += 1
-    y[0] = th
-    y[1] = om
-    cnt[I_SAFE_STEP] = safe_n
-    return OK
+    return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, OK)

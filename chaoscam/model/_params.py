@@ -27,6 +27,7 @@ class ParameterError(ValueError):
 STIFFNESS_MODELS = ("hertz", "fractal")
 DAMPING_FORMS = ("hunt_crossley", "paper_literal")
 RESAMPLE_MODES = ("impact", "interval")
+INTEGRATORS = ("rk4", "adaptive")
 
 # (lower, upper, lower_inclusive, upper_inclusive); None = unbounded.
 _POS = (0.0, None, False, None)
@@ -206,6 +207,17 @@ class Params:
     )
 
     # --- Numerics ------------------------------------------------------------------------
+    integrator: str = field(
+        default="rk4",
+        metadata=_meta(
+            "'rk4': the paper's fixed-step RK4 on the grid n dt (the reference); 'adaptive': "
+            "Dormand-Prince 5(4) with error control (rtol, atol), long steps in flight, "
+            "events located on the step's interpolant",
+            "-",
+            None,
+            INTEGRATORS,
+        ),
+    )
     dt: float = field(
         default=2e-6,
         metadata=_meta(
@@ -238,6 +250,26 @@ class Params:
             "-",
             (1, None, True, None),
         ),
+    )
+    rtol: float = field(
+        default=1e-9,
+        metadata=_meta(
+            "adaptive integrator: relative tolerance of the local error of (theta_f, theta_f')",
+            "-",
+            (0.0, 1e-2, False, True),
+        ),
+    )
+    atol: float = field(
+        default=1e-12,
+        metadata=_meta(
+            "adaptive integrator: absolute tolerance of the local error, for theta_f [rad] and "
+            "theta_f' [rad/s]",
+            "rad, rad/s",
+        ),
+    )
+    h_max: float = field(
+        default=0.005,
+        metadata=_meta("adaptive integrator: largest step (flight) [s]", "s"),
     )
 
     # ------------------------------------------------------------------------------------
