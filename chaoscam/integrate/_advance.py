@@ -12,6 +12,7 @@ from __future__ import annotations
 from numba import njit
 
 from . import _kernel as k
+from ._adaptive import run_chunk_adaptive
 
 __all__ = ["advance"]
 
@@ -22,4 +23,6 @@ def advance(y, cnt, c, n_stop, lam, series, section, impacts):
 
     Same arguments and status codes as :func:`chaoscam.integrate._kernel.run_chunk`.
     """
+    if c[k.C_METHOD] == k.METHOD_ADAPTIVE:
+        return run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts)
     return k.run_chunk(y, cnt, c, n_stop, lam, series, section, impacts)

@@ -89,7 +89,10 @@ Y_TIME = 2  # t [s] (the fixed-step kernel keeps it equal to cnt[I_STEP] * dt)
 Y_STEP = 3  # adaptive: the step size to try next [s]; 0 = not known yet
 Y_RECORDED = 4  # adaptive: time integrated after the transient [s]
 Y_CONTACT = 5  # adaptive: of which in contact (gap <= 0) [s]
-Y_SIZE = 6
+Y_ERR_OLD = 6  # adaptive: the last accepted step's error norm (PI step-size control)
+Y_EVENTS = 7  # adaptive: events so far in the grid interval Y_WINDOW (chattering guard)
+Y_WINDOW = 8  # adaptive: that grid interval's index n, [n dt, (n + 1) dt)
+Y_SIZE = 9
 
 # --- status codes (mirrors chaoscam.integrate.Status) ------------------------------------
 OK = 0
@@ -113,10 +116,12 @@ def stiffness(lam, c):
 def geometry(t, th, c):
     """Gap delta, lever arm l_1 and normal cam speed dC/dt . n at time t and angle th."""
     thc = c[C_OMEGA] * t + c[C_THETA_C0]
-    cc = math.cos(thc)
-    sc = math.sin(thc)
-    ct = math.cos(th)
-    st = math.sin(th)
+    return geometry_trig(math.cos(thc), math.sin(thc), math.cos(th), math.sin(th), c)
+
+
+@njit(cache=True)
+def geometry_trig(cc, sc, ct, st, c):
+    """:func:`geometry` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st)."""
     dx = c[C_XO] - c[C_E] * cc
     dy = c[C_YO] - c[C_E] * sc
     delta = -dx * st + dy * ct - c[C_RSUM]
@@ -130,10 +135,16 @@ def geometry(t, th, c):
 def acceleration(t, th, om, K, c):
     """theta_f'' from (1)–(3): gravity, Hunt–Crossley normal force, friction torque."""
     thc = c[C_OMEGA] * t + c[C_THETA_C0]
-    cc = math.cos(thc)
-    sc = math.sin(thc)
-    ct = math.cos(th)
-    st = math.sin(th)
+    return acceleration_trig(math.cos(thc), math.sin(thc), math.cos(th), math.sin(th), om, K, c)
+
+
+@njit(cache=True)
+def acceleration_trig(cc, sc, ct, st, om, K, c):
+    """:func:`acceleration` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st).
+
+    The one home of equations (1)–(3); callers that know the trigonometric values (the
+    adaptive kernel rotates them from a step's start) skip four transcendental calls.
+    """
     cx = c[C_E] * cc
     cy = c[C_E] * sc
     dx = c[C_XO] - cx
@@ -153,7 +164,9 @@ def acceleration(t, th, om, K, c):
             by = cy - c[C_RCAM] * ct
             v_r = c[C_RROD] * om - c[C_OMEGA] * (bx * st - by * ct)
             if c[C_VEPS] > 0.0:
-                sgn = math.tanh(v_r / c[C_VEPS])
+                x = v_r / c[C_VEPS]
+                # tanh(x) rounds to +-1 in float64 for |x| > 19.1: skip the call there.
+                sgn = math.tanh(x) if abs(x) < 20.0 else (1.0 if x > 0.0 else -1.0)
             else:
                 sgn = (v_r > 0.0) - (v_r < 0.0)
             torque += force * l1 - c[C_MU_ARM] * force * sgn

@@ -1,0 +1,113 @@
+"""The adaptive Dormand–Prince path against the fixed-step RK4 reference (issue: performance).
+
+Agreement is stated as in the work-precision benchmark: the first ten impacts faster than
+0.01 m/s of a default run to 1e-6 s and 1e-6 rad, and 20 s of stroboscopic sections of
+periodic responses to 1e-6 rad. The RK4 runs use steps at which RK4 itself is converged to
+well below those tolerances (benchmarks/bench_work_precision.py measures both errors
+against a dt = 2.5e-7 run).
+"""
+
+import numpy as np
+import pytest
+
+from chaoscam import Params, simulate
+from chaoscam.integrate import Status, simulate_ensemble
+from chaoscam.model import ParameterError, gap_rate, lever_arm
+
+ADAPTIVE = Params(integrator="adaptive")
+
+
+def fast_impacts(p, duration=2.0, n=10):
+    imp = simulate(p, duration=duration, series=False).impacts
+    return imp[-imp.gap_rate_before > 0.01].iloc[:n]
+
+
+def test_first_ten_impacts_agree_with_converged_rk4():
+    """At rtol 3e-14 the first ten fast impacts match RK4 (dt 5e-7) within 1e-6 s and rad."""
+    a = fast_impacts(Params(dt=5e-7))
+    b = fast_impacts(ADAPTIVE.replace(rtol=3e-14, atol=1e-14))
+    assert len(a) == len(b) == 10
+    assert np.max(np.abs(a.t.values - b.t.values)) < 1e-6
+    assert np.max(np.abs(a.theta_f.values - b.theta_f.values)) < 1e-6
+
+
+@pytest.mark.parametrize("changes", [{"xi": 0.2}, {"omega": 45.0}], ids=["xi0.2", "omega45"])
+def test_periodic_sections_agree_with_converged_rk4(changes):
+    """With the default tolerances, 20 s of sections match RK4 (dt 1e-6) within 1e-6 rad."""
+    a = simulate(Params(dt=1e-6, **changes), duration=20.0, series=False).section
+    b = simulate(ADAPTIVE.replace(**changes), duration=20.0, series=False).section
+    assert len(a) == len(b) > 90
+    assert np.array_equal(a.k.values, b.k.values)
+    assert np.max(np.abs(a.theta_f.values - b.theta_f.values)) < 1e-6
+    assert np.max(np.abs(a.omega_f.values - b.omega_f.values)) < 1e-4
+
+
+def test_error_shrinks_with_the_tolerance():
+    """The 0.2 s state moves towards converged RK4 as rtol tightens (>= 10x per 100x)."""
+    ref = simulate(Params(dt=2.5e-7), duration=0.2, output_dt=1e-3).series.theta_f.values
+    errs = []
+    for rtol in (1e-9, 1e-11, 1e-13):
+        got = simulate(ADAPTIVE.replace(rtol=rtol, atol=rtol / 100), duration=0.2, output_dt=1e-3)
+        errs.append(np.max(np.abs(got.series.theta_f.values - ref)))
+    assert errs[0] > 10 * errs[1] > 100 * errs[2]
+
+
+def test_impact_law_holds_at_every_adaptive_impact():
+    """Each applied jump sits on the cam (gap rate from the state) and reverses the rate by xi."""
+    p = ADAPTIVE
+    tr = simulate(p, duration=5.0, series=False)
+    imp = tr.impacts
+    assert len(imp) > 20
+    before = gap_rate(p, imp.t.values, imp.theta_f.values, imp.omega_before.values)
+    after = gap_rate(p, imp.t.values, imp.theta_f.values, imp.omega_after.values)
+    np.testing.assert_allclose(before, imp.gap_rate_before.values, rtol=1e-9)
+    np.testing.assert_allclose(after, -p.xi * before, rtol=1e-9, atol=1e-12)
+    assert np.all(before < -p.v_min)
+    np.testing.assert_allclose(lever_arm(p, imp.t.values, imp.theta_f.values), imp.lever_arm)
+
+
+def test_series_and_buffer_hand_backs_do_not_change_the_run():
+    """Sampling (from the interpolant) and buffer pauses leave the trajectory bit-identical."""
+    p = ADAPTIVE.replace(l_lambda_sigma=0.002)
+    a = simulate(p, duration=3.0, seed=3, index=5, transient=1.0, series=False)
+    b = simulate(p, duration=3.0, seed=3, index=5, transient=1.0, output_dt=p.dt)
+    assert a.section.equals(b.section) and a.impacts.equals(b.impacts)
+    assert a.final_state == b.final_state
+    assert len(b.series) == round(2.0 / p.dt) + 1
+    assert np.allclose(np.diff(b.series.t.values), p.dt)
+
+
+def test_ensemble_members_equal_single_adaptive_runs():
+    """The parallel ensemble runs the same adaptive kernel, member for member."""
+    p = ADAPTIVE.replace(l_lambda_sigma=0.002, resample="interval")
+    ens = simulate_ensemble(p, [4, 9], seed=3, duration=4.0)
+    for member, index in enumerate([4, 9]):
+        one = simulate(p, seed=3, index=index, duration=4.0, series=False)
+        got = ens.sections[ens.sections.member == member].drop(columns="member")
+        assert np.array_equal(got.to_numpy(), one.section.to_numpy())
+        assert ens.members.contact_fraction[member] == one.stats["contact_fraction"]
+
+
+def test_contact_fraction_is_integrated_in_time():
+    """The contact fraction of the adaptive path matches the fixed grid's step count."""
+    a = simulate(Params(dt=1e-6, xi=0.2), duration=20.0, transient=10.0, series=False)
+    b = simulate(ADAPTIVE.replace(xi=0.2), duration=20.0, transient=10.0, series=False)
+    assert b.stats["contact_fraction"] == pytest.approx(a.stats["contact_fraction"], abs=1e-4)
+    assert b.settings["solver"].startswith("dopri5")
+
+
+def test_failures_are_labelled_statuses():
+    """Leaving the cam ends an adaptive run with LEFT_REACH; chattering does not hang."""
+    assert simulate(ADAPTIVE.replace(x_O=-0.58), duration=1.0).status is Status.LEFT_REACH
+    tr = simulate(ADAPTIVE.replace(v_min=0.0), duration=1.0, series=False)
+    assert tr.ok and tr.stats["n_impacts"] > 50
+
+
+@pytest.mark.parametrize(
+    "changes, field",
+    [({"integrator": "rk45"}, "integrator"), ({"rtol": 0.0}, "rtol"),
+     ({"rtol": 0.1}, "rtol"), ({"atol": -1.0}, "atol"), ({"h_max": 0.0}, "h_max")],
+)
+def test_bad_integrator_settings_name_the_field(changes, field):
+    with pytest.raises(ParameterError, match=field):
+        Params(**changes)
