@@ -4,12 +4,17 @@ Each member runs the same kernel as :func:`chaoscam.simulate` (:func:`_kernel.ru
 its own line-length draws, so member ``i`` equals ``simulate(params_i, seed=seed,
 index=indices[i], series=False)`` bit for bit. Only sections, impact counts and statuses are
 kept; a member that outgrows its impact buffer or its draws is finished on the serial path.
+
+``backend="gpu"`` runs the same kernel on an NVIDIA GPU, one thread per member
+(:mod:`._gpu`, numba-cuda), equal to this path within ``GPU_TOLERANCE`` on short or periodic
+runs.
 """
 
 from __future__ import annotations
 
 import os
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -18,12 +23,15 @@ import pandas as pd
 from numba import njit, prange
 
 from ..model import LineLengthStream, Params
+from . import _gpu
 from . import _kernel as k
 from ._advance import advance
 from ._constants import initial_counters, initial_state, kernel_constants
 from ._status import Status
 
-__all__ = ["Ensemble", "contact_fraction", "run_members", "run_one", "simulate_ensemble"]
+__all__ = [
+    "BACKENDS", "Ensemble", "contact_fraction", "run_members", "run_one", "simulate_ensemble",
+]
 
 # numba's GNU OpenMP layer aborts a process that forks after using it, and the sweeps fork
 # their workers from a driver that has simulated; the workqueue layer is fork-safe (though not
@@ -35,6 +43,8 @@ if "NUMBA_THREADING_LAYER" not in os.environ:
 
 _DRAWS = 2048  # line-length draws per member before a refill
 _IMPACT_ROWS = 256  # impact rows per member per call (only counted, not kept)
+_CPU_BATCH = 1024
+BACKENDS = ("cpu", "gpu", "auto")
 
 
 @njit(parallel=True, cache=True)
@@ -84,7 +94,8 @@ class Ensemble:
     members : pandas.DataFrame
         member, index, status (name), n_impacts, contact_fraction.
     settings : dict
-        duration, transient, seed, threads, wall time.
+        duration, transient, seed, threads, backend ("cpu" or "gpu", the one used), device,
+        batch, wall time.
     """
 
     sections: pd.DataFrame
@@ -99,7 +110,8 @@ def simulate_ensemble(
     seed: int = 0,
     duration: float = 20.0,
     transient: float = 0.0,
-    batch: int = 1024,
+    batch: int | None = None,
+    backend: str = "cpu",
 ) -> Ensemble:
     """Simulate realizations ``indices`` of one model (or one model per member) in parallel.
 
@@ -112,13 +124,34 @@ def simulate_ensemble(
         Realization indices under ``seed`` (see :func:`chaoscam.simulate`).
     duration, transient : float
         End time and discarded start [s].
-    batch : int
-        Members per compiled call; bounds memory (about 40 kB per member).
+    batch : int, optional
+        Members per compiled call; bounds memory, about 40 kB per member for 20 s runs (of
+        which 40 B per cam period of sections), on the host and, for the GPU, on the device.
+        Default 1024 on the CPU, 65,536 on the GPU (about 2.7 GB).
+    backend : {"cpu", "gpu", "auto"}
+        ``"cpu"``: numba threads over cores (bit-identical to :func:`chaoscam.simulate`).
+        ``"gpu"``: one CUDA thread per member (numba-cuda, ``pip install 'chaoscam[gpu]'``);
+        where it cannot run (see :func:`_gpu.gpu_status`) the CPU path is used after a
+        one-line :class:`GPUFallbackWarning` giving the reason. ``"auto"``: the GPU when
+        available, else the CPU without a notice. ``settings["backend"]`` records the one
+        used.
 
     Notes
     -----
     Threads: numba's thread count (``NUMBA_NUM_THREADS`` or ``numba.set_num_threads``).
+
+    The GPU path equals the CPU path only up to rounding (fused multiply-adds, libdevice
+    trigonometry), which the model amplifies: sections of the first cam period and of
+    periodic configurations after a transient agree within 1e-6 rad and rad/s
+    (``_gpu.GPU_TOLERANCE``); chaotic runs part after a few periods, as any two roundings of
+    them do, and only their statistics compare.
     """
+    use_gpu, device = _pick_backend(backend)
+    if batch is None:
+        batch = _gpu.GPU_BATCH if use_gpu else _CPU_BATCH
+    if int(batch) < 1:
+        raise ValueError(f"batch must be >= 1, got {batch!r}")
+    batch = int(batch)
     indices = [int(i) for i in indices]
     plist = list(params) if isinstance(params, list | tuple) else [params] * len(indices)
     if len(plist) != len(indices):
@@ -129,7 +162,10 @@ def simulate_ensemble(
     sections, rows = [], []
     for start in range(0, len(indices), batch):
         chunk = slice(start, start + batch)
-        s, r = _run_batch(plist[chunk], indices[chunk], start, seed, duration, transient)
+        s, r = _run_batch(
+            plist[chunk], indices[chunk], start, seed, duration, transient,
+            run=_gpu.run_on_gpu if use_gpu else _run_on_cpu,
+        )
         sections.extend(s)
         rows.extend(r)
     cols = ["member", "k", "t", "theta_f", "omega_f", "l_lambda"]
@@ -147,12 +183,32 @@ def simulate_ensemble(
             "transient": transient,
             "seed": seed,
             "threads": numba.get_num_threads(),
+            "backend": "gpu" if use_gpu else "cpu",
+            "device": device,
+            "batch": batch,
             "wall_time_s": time.perf_counter() - t0,
         },
     )
 
 
-def _run_batch(plist, indices, first, seed, duration, transient):
+def _pick_backend(backend: str) -> tuple[bool, str]:
+    """(use the GPU?, the device in words) for ``backend``; warns if "gpu" cannot run."""
+    if backend not in BACKENDS:
+        raise ValueError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, "
+                         f"got {backend!r}")
+    if backend == "cpu":
+        return False, "cpu"
+    ok, reason = _gpu.gpu_status()
+    if ok:
+        return True, reason
+    if backend == "gpu":
+        warnings.warn(f"GPU backend unavailable: {reason}; falling back to the CPU",
+                      _gpu.GPUFallbackWarning, stacklevel=3)
+    return False, "cpu"
+
+
+def _run_batch(plist, indices, first, seed, duration, transient, run=None):
+    """Set up one batch of members, ``run`` it (CPU or GPU) and collect its outputs."""
     n = len(indices)
     p0 = plist[0]
     n_stop = int(round(duration / p0.dt))
@@ -160,27 +216,23 @@ def _run_batch(plist, indices, first, seed, duration, transient):
     extra = max(p.max_events_per_step + p.flight_merge for p in plist) + 2
     streams = [LineLengthStream(p, seed, i) for p, i in zip(plist, indices, strict=True)]
     lam = np.stack([s.draw(_DRAWS + 4 * extra) for s in streams])
-    y = np.stack([initial_state(p) for p in plist])
-    cnt = np.stack([initial_counters(p, transient=transient) for p in plist])
-    c = np.stack([kernel_constants(p, t_record=transient) for p in plist])
+    y = _per_member(initial_state, plist)
+    cnt = _per_member(lambda p: initial_counters(p, transient=transient), plist)
+    c = _per_member(lambda p: kernel_constants(p, t_record=transient), plist)
     section = np.empty((n, n_sec, k.SECTION_COLS))
     impacts = np.empty((n, _IMPACT_ROWS + 4 * extra, k.IMPACT_COLS))
     status = np.zeros(n, dtype=np.int64)
     n_impacts = np.zeros(n, dtype=np.int64)
-    run_members(y, cnt, c, n_stop, lam, np.empty((n, 1, k.SERIES_COLS)), section, impacts, status)
-    # Members that asked for room finish one by one on the same kernel.
-    no_series = np.empty((1, k.SERIES_COLS))
-    for j in np.flatnonzero(status == k.NEED_BUFFER):
-        lam_j = lam[j]
-        while status[j] == k.NEED_BUFFER:
-            n_impacts[j] += cnt[j, k.I_N_IMPACT]
-            cnt[j, k.I_N_IMPACT] = 0
-            pos = cnt[j, k.I_LAM_POS]
-            lam_j = np.concatenate([lam_j[pos:], streams[j].draw(_DRAWS)])
-            cnt[j, k.I_LAM_POS] = 0
-            status[j] = run_one(
-                y[j], cnt[j], c[j], n_stop, lam_j, no_series, section[j], impacts[j]
-            )
+
+    def hand_back(j, lam_j, n_new):
+        """Empty member j's impact rows (counted) and drop its used draws, adding n_new."""
+        n_impacts[j] += cnt[j, k.I_N_IMPACT]
+        cnt[j, k.I_N_IMPACT] = 0
+        pos = cnt[j, k.I_LAM_POS]
+        cnt[j, k.I_LAM_POS] = 0
+        return np.concatenate([lam_j[pos:], streams[j].draw(n_new)])
+
+    (run or _run_on_cpu)(y, cnt, c, n_stop, lam, section, impacts, status, hand_back)
     sections, rows = [], []
     for j in range(n):
         m = cnt[j, k.I_N_SECTION]
@@ -198,3 +250,26 @@ def _run_batch(plist, indices, first, seed, duration, transient):
             )
         )
     return sections, rows
+
+
+def _run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back):
+    """All members in one parallel call; those that asked for room finish one by one."""
+    n = y.shape[0]
+    run_members(y, cnt, c, n_stop, lam, np.empty((n, 1, k.SERIES_COLS)), section, impacts, status)
+    no_series = np.empty((1, k.SERIES_COLS))
+    for j in np.flatnonzero(status == k.NEED_BUFFER):
+        lam_j = lam[j]
+        while status[j] == k.NEED_BUFFER:
+            lam_j = hand_back(j, lam_j, _DRAWS)
+            status[j] = run_one(
+                y[j], cnt[j], c[j], n_stop, lam_j, no_series, section[j], impacts[j]
+            )
+
+
+def _per_member(make, plist) -> np.ndarray:
+    """``make(p)`` stacked over members, computed once per distinct parameter object."""
+    done: dict[int, np.ndarray] = {}
+    for p in plist:
+        if id(p) not in done:
+            done[id(p)] = make(p)
+    return np.stack([done[id(p)] for p in plist])

@@ -1,0 +1,208 @@
+"""Ensembles on an NVIDIA GPU with numba-cuda: one CUDA thread per trajectory.
+
+The kernel is the CPU kernel. :func:`_advance.advance` and everything it calls are
+``@numba.njit`` functions, and numba-cuda compiles such a function for the CUDA target when a
+``@cuda.jit`` kernel calls it (``CUDATypingContext.resolve_value_type`` wraps the CPU
+dispatcher in a device dispatcher built from the same Python source). So the physics has one
+source of truth, and whichever integrator ``advance`` dispatches to runs on the GPU too.
+
+Numerics. The GPU result is not bit-identical to the CPU one: NVVM contracts ``a * b + c``
+into fused multiply-adds and libdevice's sin/cos/tanh may differ from the host libm in the
+last bit. The model amplifies such differences strongly: on the CPU a kick of 1e-15 rad to
+the initial angle is 1e-9 rad at the first section (t = 0.22 s, after the initial stiff
+contact), and the default response is chaotic, so over 20 s GPU and CPU trajectories part
+to O(0.1) like any two roundings of them. What stays comparable, and is compared, are
+sections of the first cam period and of periodic configurations after a transient (e.g.
+``Params(xi=0.2)``, 10 s): equal within 1e-6 rad and rad/s (``GPU_TOLERANCE``; a 1e-12 kick
+moves them by 1e-6 and 1e-8). Ensemble statistics are what a GPU run is for. Under the CUDA
+simulator (``NUMBA_ENABLE_CUDASIM=1``) the kernel calls the compiled CPU code and results are
+bit-identical.
+
+Buffers. Members run on the device until they end or return ``NEED_BUFFER`` (impact rows or
+line-length draws used up). Those are refilled on the host exactly as on the CPU path (the
+impact count moved to the member's total, the used draws replaced by the next ones of the
+same stream, keeping the row width) and the kernel is launched again for them only; the
+other threads return at once. A run resumed after a hand-back is bit-identical to one that
+was not interrupted (see :func:`_kernel.run_chunk`), so this relaunch changes nothing.
+
+numba-cuda is imported lazily, on first use: ``import chaoscam`` never imports it.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.util
+import re
+import types
+
+import numpy as np
+
+from . import _kernel as k
+from ._advance import advance
+
+__all__ = ["GPU_BATCH", "GPU_TOLERANCE", "GPUFallbackWarning", "gpu_status", "run_on_gpu"]
+
+GPU_BATCH = 65_536  # members per device batch: ~42 kB each for 20 s runs (about 2.7 GB)
+GPU_TOLERANCE = 1e-6  # rad and rad/s: GPU against CPU sections, first period or periodic
+_BLOCK = 64  # threads per block: the kernel takes 255 registers a thread on sm_90
+_NUMPY_TRAP = (2, 5)  # numba-cuda <= 0.30.4 compiles no kernel under numpy >= 2.5
+
+
+class GPUFallbackWarning(RuntimeWarning):
+    """``backend="gpu"`` was asked for but cannot run; the CPU path is used instead."""
+
+
+def gpu_status() -> tuple[bool, str]:
+    """Whether the GPU backend can run here, and why (one line).
+
+    Checked in order: the numpy version (numba-cuda, 0.30.4 included, fails to compile any
+    kernel under numpy >= 2.5, which has no ``row_stack``), numba-cuda being installed,
+    a CUDA driver and device. When available, the reason names the device.
+    """
+    trap = _numpy_trap()
+    if trap:
+        return False, trap
+    if importlib.util.find_spec("numba_cuda") is None:
+        return False, "numba-cuda is not installed (pip install 'chaoscam[gpu]')"
+    return _device_status()
+
+
+def _numpy_trap() -> str:
+    """The reason the numpy version rules the backend out, or "" if it does not."""
+    match = re.match(r"(\d+)\.(\d+)", np.__version__)
+    if match and tuple(int(x) for x in match.groups()) >= _NUMPY_TRAP:
+        return (
+            f"numpy {np.__version__} >= 2.5: numba-cuda fails to compile kernels there "
+            "(numpy has no row_stack); pip install 'numpy<2.5'"
+        )
+    return ""
+
+
+@functools.cache
+def _device_status() -> tuple[bool, str]:
+    try:
+        from numba import cuda
+    except ImportError as exc:  # e.g. numba-cuda without the CUDA Python bindings
+        return False, "numba-cuda cannot be imported: " + " ".join(str(exc).split())
+    try:
+        if not cuda.is_available():
+            return False, "no CUDA driver or device found (numba.cuda.is_available() is False)"
+        dev = cuda.get_current_device()
+    except Exception as exc:  # the driver's errors span lines; keep one
+        return False, "no usable CUDA device: " + " ".join(str(exc).split())
+    if _simulated(dev):
+        return True, "CUDA simulator (NUMBA_ENABLE_CUDASIM=1)"
+    name = dev.name.decode() if isinstance(dev.name, bytes) else str(dev.name)
+    major, minor = dev.compute_capability
+    return True, f"{name} (compute capability {major}.{minor})"
+
+
+def _simulated(dev) -> bool:
+    return "simulator" in type(dev).__module__
+
+
+def _advance_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
+    """The kernel's source: ``step`` (``advance``) for each member still to run.
+
+    Its globals ``cuda`` and ``step`` are bound by :func:`_members` in a namespace of its own.
+    """
+    i = cuda.grid(1)  # noqa: F821
+    if i < y.shape[0] and status[i] == k.NEED_BUFFER:
+        status[i] = step(  # noqa: F821
+            y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i]
+        )
+
+
+def _members(cuda, step):
+    """:func:`_advance_members` with ``cuda`` and ``step`` bound as its globals.
+
+    Globals, not a closure, so that the CUDA simulator can swap in its fake ``cuda`` module.
+    """
+    namespace = {"__name__": __name__, "cuda": cuda, "step": step, "k": k}
+    code = _advance_members.__code__
+    return types.FunctionType(code, namespace, "advance_members")
+
+
+def _host_advance(*args):
+    """``advance`` under the simulator: its arrays are wrappers the CPU kernel cannot take."""
+    return advance(*(np.asarray(a) if hasattr(a, "shape") else a for a in args))
+
+
+@functools.cache
+def _kernel():
+    from numba import cuda
+
+    step = _host_advance if _simulated(cuda.get_current_device()) else advance
+    return cuda.jit(_members(cuda, step))
+
+
+def kernel_ptx(cc: tuple[int, int] = (9, 0)) -> str:
+    """PTX of the ensemble kernel for compute capability ``cc``; needs NVVM, not a device.
+
+    numba-cuda asks the current device for the compute capability of device functions even
+    when ``compile_ptx`` is given one, so a stand-in device with ``cc`` is put in its place
+    for the compilation.
+    """
+    from unittest import mock
+
+    import numba.cuda.dispatcher as dispatcher
+    from numba import cuda, float64, int64
+
+    a2, a3 = float64[:, :], float64[:, :, :]
+    sig = (a2, int64[:, :], a2, int64, a2, a3, a3, a3, int64[:])
+    device = types.SimpleNamespace(compute_capability=cc)
+    with mock.patch.object(dispatcher, "get_current_device", lambda: device):
+        ptx, _ = cuda.compile_ptx(_members(cuda, advance), sig, cc=cc)
+    return ptx
+
+
+def kernel_info() -> dict:
+    """Registers and local memory a thread of the compiled kernel uses on this device."""
+    kern = _kernel()
+
+    def first(value):
+        return next(iter(value.values()), None) if isinstance(value, dict) else value
+
+    return {
+        "registers": first(kern.get_regs_per_thread()),
+        "local_bytes": first(kern.get_local_mem_per_thread()),
+        "block": _BLOCK,
+    }
+
+
+def run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back) -> None:
+    """Run stacked members to ``n_stop`` on the GPU; arrays as in ``_ensemble._run_batch``.
+
+    Updates ``y``, ``cnt``, ``lam``, ``section`` and ``status`` in place (``impacts`` stays
+    on the device: only counted). ``hand_back(j, lam_j, n)`` empties member ``j``'s impact
+    rows and returns its draws with the used ones dropped and ``n`` new ones appended.
+    """
+    from numba import cuda
+
+    kern = _kernel()
+    n = y.shape[0]
+    status[:] = k.NEED_BUFFER  # "still to run"
+    d_y, d_cnt, d_c, d_lam, d_status = (cuda.to_device(a) for a in (y, cnt, c, lam, status))
+    d_series = cuda.device_array((n, 1, k.SERIES_COLS))
+    d_section = cuda.device_array(section.shape)
+    d_impacts = cuda.device_array(impacts.shape)
+    blocks = (n + _BLOCK - 1) // _BLOCK
+    while True:
+        kern[blocks, _BLOCK](d_y, d_cnt, d_c, n_stop, d_lam, d_series, d_section, d_impacts,
+                             d_status)
+        d_status.copy_to_host(status)
+        need = np.flatnonzero(status == k.NEED_BUFFER)
+        if need.size == 0:
+            break
+        d_cnt.copy_to_host(cnt)
+        for j in need:  # the same width again: as many new draws as were used
+            lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
+        d_cnt.copy_to_device(cnt)
+        if 8 * need.size < n:
+            for j in need:
+                d_lam[j].copy_to_device(lam[j])
+        else:
+            d_lam.copy_to_device(lam)
+    d_y.copy_to_host(y)
+    d_cnt.copy_to_host(cnt)
+    d_section.copy_to_host(section)

@@ -1,0 +1,189 @@
+"""The GPU ensemble backend (numba-cuda): choice, fallback, numpy guard, kernel, and results.
+
+Without numba-cuda (CI) the simulator and PTX tests skip; without a device the ``gpu`` tests
+skip. The simulator runs the compiled CPU kernel inside the CUDA driver logic, so there the
+backends agree bit for bit; on a device they agree within ``GPU_TOLERANCE``.
+"""
+
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+
+from chaoscam import Params
+from chaoscam.integrate import _ensemble, _gpu, simulate_ensemble
+
+HAS_NUMBA_CUDA = importlib.util.find_spec("numba_cuda") is not None
+needs_numba_cuda = pytest.mark.skipif(not HAS_NUMBA_CUDA, reason="numba-cuda not installed")
+
+
+def _on_device() -> bool:
+    ok, reason = _gpu.gpu_status()
+    return ok and "simulator" not in reason
+
+
+def sections(ens) -> np.ndarray:
+    return ens.sections[["k", "t", "theta_f", "omega_f", "l_lambda"]].to_numpy()
+
+
+@pytest.fixture
+def no_gpu(monkeypatch):
+    monkeypatch.setattr(_gpu, "gpu_status", lambda: (False, "no CUDA device (test)"))
+
+
+def test_unknown_backend_is_refused():
+    """A backend other than cpu, gpu or auto raises a ValueError naming the allowed values."""
+    with pytest.raises(ValueError, match=r"backend must be one of 'cpu', 'gpu', 'auto'"):
+        simulate_ensemble(Params(), [0], duration=0.01, backend="cuda")
+
+
+def test_gpu_without_device_falls_back_with_one_warning(no_gpu):
+    """backend="gpu" without a GPU warns once, with the reason, and equals backend="cpu"."""
+    p = Params(l_lambda_sigma=0.002)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ens = simulate_ensemble(p, range(3), seed=4, duration=0.5, backend="gpu", batch=2)
+    assert len(caught) == 1
+    assert issubclass(caught[0].category, _gpu.GPUFallbackWarning)
+    message = str(caught[0].message)
+    assert "no CUDA device (test)" in message and "CPU" in message and "\n" not in message
+    cpu = simulate_ensemble(p, range(3), seed=4, duration=0.5, backend="cpu")
+    assert ens.settings["backend"] == "cpu"
+    np.testing.assert_array_equal(sections(ens), sections(cpu))
+    assert ens.members.equals(cpu.members)
+
+
+@pytest.mark.skipif(_on_device(), reason="a GPU is available here")
+def test_real_status_without_device_is_a_fallback():
+    """Here (no device) the real status says why, and backend="gpu" warns with that reason."""
+    ok, reason = _gpu.gpu_status()
+    assert not ok and reason and "\n" not in reason
+    with pytest.warns(_gpu.GPUFallbackWarning, match="GPU backend unavailable"):
+        simulate_ensemble(Params(), [0], duration=0.01, backend="gpu")
+
+
+def test_auto_backend_falls_back_silently(no_gpu):
+    """backend="auto" without a GPU runs on the CPU with no warning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ens = simulate_ensemble(Params(), [0], duration=0.01, backend="auto")
+    assert ens.settings["backend"] == "cpu"
+
+
+def test_auto_backend_uses_an_available_gpu(monkeypatch):
+    """backend="auto" dispatches to the GPU launcher when one is available, and records it."""
+    monkeypatch.setattr(_gpu, "gpu_status", lambda: (True, "Fake GPU"))
+    launched = []
+
+    def fake_launcher(*args):
+        launched.append(args[0].shape[0])
+        _ensemble._run_on_cpu(*args)
+
+    monkeypatch.setattr(_gpu, "run_on_gpu", fake_launcher)
+    ens = simulate_ensemble(Params(), range(3), duration=0.01, backend="auto")
+    assert launched == [3]
+    assert ens.settings["backend"] == "gpu" and ens.settings["device"] == "Fake GPU"
+    assert ens.settings["batch"] == _gpu.GPU_BATCH
+
+
+@pytest.mark.parametrize("version", ["2.5.0", "2.5.0rc1", "3.0.0.dev0+git123"])
+def test_numpy_2_5_rules_the_backend_out(monkeypatch, version):
+    """Under numpy >= 2.5 (numba-cuda cannot compile there) the status says why and how to fix."""
+    monkeypatch.setattr(np, "__version__", version)
+    ok, reason = _gpu.gpu_status()
+    assert not ok
+    assert version in reason and "row_stack" in reason and "pip install 'numpy<2.5'" in reason
+    with pytest.warns(_gpu.GPUFallbackWarning, match="row_stack"):
+        ens = simulate_ensemble(Params(), [0], duration=0.01, backend="gpu")
+    assert ens.settings["backend"] == "cpu"
+
+
+@pytest.mark.parametrize("version", ["2.4.6", "2.3.5", "1.26.4"])
+def test_older_numpy_is_not_the_trap(monkeypatch, version):
+    """numpy < 2.5 does not trigger the row_stack guard."""
+    monkeypatch.setattr(np, "__version__", version)
+    assert "row_stack" not in _gpu.gpu_status()[1]
+
+
+def test_import_does_not_load_numba_cuda():
+    """import chaoscam (and its ensemble path) leaves numba.cuda unimported."""
+    code = (
+        "import sys, chaoscam, chaoscam.integrate._ensemble; "
+        "print('numba.cuda' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
+                         text=True)
+    assert out.stdout.strip() == "False"
+
+
+_SIMULATED = """
+import json, numpy as np
+from chaoscam import Params
+from chaoscam.integrate import _ensemble, simulate_ensemble
+_ensemble._DRAWS = 64  # force many draw refills: relaunches on the device
+out = {}
+cases = {
+    "refills": (Params(l_lambda_sigma=0.002, resample="interval", resample_dt=1e-4), 0.5, 0.1),
+    "periodic": (Params(xi=0.2), 0.5, 0.0),
+    "adaptive": (Params(l_lambda_sigma=0.002, integrator="adaptive"), 0.5, 0.0),
+}
+for name, (p, duration, transient) in cases.items():
+    runs = [simulate_ensemble(p, range(5), seed=2, duration=duration, transient=transient,
+                              backend=b, batch=3) for b in ("gpu", "cpu")]
+    a, b = (r.sections.to_numpy() for r in runs)
+    out[name] = {"backend": runs[0].settings["backend"], "shape": a.shape == b.shape,
+                 "n": len(a), "diff": float(np.abs(a - b).max()),
+                 "members": runs[0].members.equals(runs[1].members)}
+print(json.dumps(out))
+"""
+
+
+@needs_numba_cuda
+def test_simulated_gpu_equals_cpu():
+    """Under the CUDA simulator the GPU driver (batches, relaunch after refills) equals the CPU
+    path: the kernel there runs the compiled CPU code, so within GPU_TOLERANCE means equal."""
+    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
+    out = subprocess.run([sys.executable, "-c", _SIMULATED], check=True, capture_output=True,
+                         text=True, env=env, timeout=300)
+    result = json.loads(out.stdout.strip().splitlines()[-1])
+    for case in result.values():
+        assert case["backend"] == "gpu" and case["shape"] and case["n"] > 0
+        assert case["diff"] <= _gpu.GPU_TOLERANCE
+        assert case["members"]
+
+
+@needs_numba_cuda
+def test_kernel_compiles_to_ptx_for_h100():
+    """The ensemble kernel (advance and all it calls) compiles to PTX for sm_90, no device."""
+    try:
+        ptx = _gpu.kernel_ptx((9, 0))
+    except Exception as exc:  # NVVM missing: nothing to check here
+        if "NVVM" in str(exc) or "nvvm" in str(exc):
+            pytest.skip(f"NVVM unavailable: {exc}")
+        raise
+    assert ".target sm_90" in ptx
+    assert ".entry" in ptx and "advance_members" in ptx
+
+
+@pytest.mark.gpu
+@pytest.mark.skipif(not _on_device(), reason="no CUDA device")
+@pytest.mark.parametrize(
+    "params, duration, transient",
+    [(Params(l_lambda_sigma=0.002), 0.25, 0.0), (Params(xi=0.2), 20.0, 10.0)],
+    ids=["first-period", "periodic"],
+)
+def test_device_equals_cpu_within_tolerance(params, duration, transient):
+    """On a GPU, sections of the first cam period and of a periodic orbit equal the CPU's."""
+    runs = [simulate_ensemble(params, range(8), seed=3, duration=duration, transient=transient,
+                              backend=b) for b in ("gpu", "cpu")]
+    assert runs[0].settings["backend"] == "gpu"
+    a, b = (sections(r) for r in runs)
+    assert a.shape == b.shape
+    np.testing.assert_array_equal(a[:, 0], b[:, 0])
+    np.testing.assert_allclose(a[:, 1:], b[:, 1:], rtol=0, atol=_gpu.GPU_TOLERANCE)
+    assert (runs[0].members.status == "OK").all()
