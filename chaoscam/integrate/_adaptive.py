@@ -13,10 +13,15 @@ picks one by ``Params.integrator``. What differs is how time is cut:
   ``J theta'' = -(m g l/2) cos theta``, which *is* the motion until the gap closes, so its
   interpolant is exact up to the crossing even when the step ends past it. A step longer
   than the time over which the gap provably stays open (:func:`_kernel.safe_horizon`) is cut
-  to ``dt``, the grid step: grazes shorter than ``dt`` are not seen, as on the fixed grid.
+  to ``dt``, the grid step, so that it cannot hold several crossings.
 - **In contact** (gap <= 0) the step integrates (1)–(3) with the compliant force; the error
   control resolves the contact oscillation (period ~1e-4 s) only as finely as the tolerance
   asks, instead of ~45 fixed steps a period.
+- **Grazes**: a step whose ends show no sign change but whose gap rate turns (from closing
+  to opening in flight, the reverse in contact) is searched for the turning point on the
+  interpolant; if the gap has changed sign there, the first crossing before it is an event.
+  So a graze shorter than a step is seen (the fixed grid misses those shorter than ``dt``);
+  two turns inside one step are not looked for.
 - **Events**: when the gap changes sign over a step, the crossing is located by Illinois
   regula falsi on the gap along the step's dense output (the 4th-order continuous extension
   of Dormand–Prince, Hairer's ``contd5``) to ``event_tol``; the state there is a
@@ -269,6 +274,37 @@ def locate_on_interpolant(h, th, tr, co, g_start, g_end, s_hi, c):
 
 
 @njit(cache=True, error_model="numpy")
+def turning_point(h, th, om, tr, r, rate0, rate1, c):
+    """The fraction s of the step where the gap rate l_1 theta' - dC/dt.n changes sign.
+
+    Illinois regula falsi on the interpolant, to 1e-9 of the step (the turning point only
+    needs to be good enough to show on which side of zero the gap's extremum lies).
+    """
+    sgn = 1.0 if rate1 > 0.0 else -1.0  # work on sgn * rate: negative at 0, positive at 1
+    a, fa, b, fb = 0.0, sgn * rate0, 1.0, sgn * rate1
+    side = 0
+    for _ in range(100):
+        if b - a <= 1e-9:
+            break
+        m = b - fb * (b - a) / (fb - fa)
+        if not (a < m < b):
+            m = 0.5 * (a + b)
+        _, l1, cdn = geometry_near(m * h, dense(th, r[4], r[5], r[6], r[7], m), th, tr, c)
+        fm = sgn * (l1 * dense(om, r[8], r[9], r[10], r[11], m) - cdn)
+        if fm < 0.0:
+            a, fa = m, fm
+            if side == 1:
+                fb *= 0.5
+            side = 1
+        else:
+            b, fb = m, fm
+            if side == -1:
+                fa *= 0.5
+            side = -1
+    return 0.5 * (a + b)
+
+
+@njit(cache=True, error_model="numpy")
 def leave(y, cnt, th, om, t, h, events, window, code, c):
     """Store the state, the time, the next step size and the event count; return ``code``.
 
@@ -341,7 +377,9 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
                 is_resample = True
         hs = min(h, c[C_H_MAX])
         if flight and hs > dt and hs > k.safe_horizon(g, l1, cdn, om, c):
-            hs = max(dt, k.safe_horizon(g, l1, cdn, om, c))  # near the cam: see module doc
+            # Near the cam a long step could hold several crossings, of which the search
+            # might find a later one: steps there are cut to dt (see module doc).
+            hs = max(dt, k.safe_horizon(g, l1, cdn, om, c))
         clipped = t + hs >= t_next
         if clipped:
             hs = t_next - t
@@ -375,12 +413,21 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             crossing = False
         if crossing:
             s_end = locate_on_interpolant(hs, th, tr, r[4:8], g, g1, 1.0, c)
-        elif not flight and events < max_events:
-            # A contact step that ends in contact may hide a micro-flight: look at its middle.
-            gm, _, _ = geometry_near(0.5 * hs, dense(th, r[4], r[5], r[6], r[7], 0.5), th, tr, c)
-            if gm > 0.0:
-                crossing = True
-                s_end = locate_on_interpolant(hs, th, tr, r[4:8], g, gm, 0.5, c)
+        elif events < max_events:
+            # No sign change between the ends, but the gap rate turns (down to up in flight,
+            # up to down in contact): the gap may cross zero and come back inside the step (a
+            # graze, or a micro-flight). Find the turning point on the interpolant; if the
+            # gap has changed sign there, the first crossing lies before it.
+            rate0 = l1 * om - cdn
+            rate1 = l1_1 * om1 - cdn1
+            if (rate0 < 0.0 < rate1) if flight else (rate1 < 0.0 < rate0):
+                s_turn = turning_point(hs, th, om, tr, r, rate0, rate1, c)
+                g_turn, _, _ = geometry_near(
+                    s_turn * hs, dense(th, r[4], r[5], r[6], r[7], s_turn), th, tr, c
+                )
+                if (g_turn <= 0.0) if flight else (g_turn > 0.0):
+                    crossing = True
+                    s_end = locate_on_interpolant(hs, th, tr, r[4:8], g, g_turn, s_turn, c)
 
         # Series samples in (t, t + s_end hs], from the interpolant.
         t_end = t + s_end * hs if crossing else t1
