@@ -132,7 +132,8 @@ def classify_trajectory(
         (omega = 22 rad/s) gets λ₁ ≈ +0.4 1/s, and the verdict is then "undetermined".
     check_step : bool
         Re-simulate the same realization (params, duration, transient, seed, index, output
-        step) with dt / 2 and classify it the same way (Lyapunov included when asked); if
+        step) with dt / 2 (adaptive integrator: tolerances / 32, see ``Params.refined``) and
+        classify it the same way (Lyapunov included when asked); if
         the label or the period changes, the verdict becomes "undetermined" with that reason
         (MODEL.md: a result must not change when the step is halved). Evidence
         ``step_check`` (value 1 unchanged, 0 changed; the half-step verdict in its detail)
@@ -174,9 +175,12 @@ def classify_trajectory(
         if half.status is not Status.OK
         else _verdict_of(half, lyapunov, discard, options)
     )
-    dt = traj.params.dt
+    fine = traj.params.refined()
     same = hv.label == verdict.label and hv.period == verdict.period
-    what = f"dt = {dt:g} s: {_describe(verdict)}; dt / 2 = {dt / 2:g} s: {_describe(hv)}"
+    what = (
+        f"{traj.params.describe_step()}: {_describe(verdict)}; "
+        f"{fine.describe_step()}: {_describe(hv)}"
+    )
     check = Evidence(
         "step_check",
         int(same),
@@ -188,7 +192,8 @@ def classify_trajectory(
     settings_h = {
         **verdict.settings,
         "step_check": {
-            "dt_half": dt / 2,
+            "dt_half": fine.dt,
+            "refined": fine.describe_step(),
             "label": hv.label,
             "period": hv.period,
             "reasons": list(hv.reasons),
@@ -253,7 +258,7 @@ def _resimulate_half_step(traj: Trajectory) -> Trajectory:
     s = traj.settings
     keep_series = traj.series is not None
     return simulate(
-        traj.params.replace(dt=traj.params.dt / 2),
+        traj.params.refined(),
         duration=s["duration"],
         transient=s["transient"],
         seed=s["seed"],

@@ -321,6 +321,23 @@ class Params:
         """Forcing period 2 pi / omega [s]: the stroboscopic section's interval."""
         return 2.0 * math.pi / self.omega
 
+    def refined(self) -> Params:
+        """The same model integrated about twice as finely: the convergence check's partner.
+
+        Fixed-step RK4: ``dt / 2``. Adaptive: ``rtol`` and ``atol`` / 32, the error reduction
+        of a fifth-order method whose steps halve (its near-cam step cap ``dt`` is halved
+        too). "A result must not change when the step is halved" (shared/MODEL.md).
+        """
+        if self.integrator == "adaptive":
+            return self.replace(dt=self.dt / 2, rtol=self.rtol / 32, atol=self.atol / 32)
+        return self.replace(dt=self.dt / 2)
+
+    def describe_step(self) -> str:
+        """The integrator's resolution in words, e.g. ``dt = 2e-06 s``."""
+        if self.integrator == "adaptive":
+            return f"adaptive, rtol = {self.rtol:g}"
+        return f"dt = {self.dt:g} s"
+
     # --- conveniences --------------------------------------------------------------------
     def replace(self, **changes: Any) -> Params:
         """A copy with ``changes`` applied and validated."""

@@ -111,3 +111,20 @@ def test_failures_are_labelled_statuses():
 def test_bad_integrator_settings_name_the_field(changes, field):
     with pytest.raises(ParameterError, match=field):
         Params(**changes)
+
+
+def test_refined_halves_the_step_or_tightens_the_tolerances():
+    """The convergence check's partner run: dt / 2 for RK4, tolerances / 32 for adaptive."""
+    assert Params().refined().dt == Params().dt / 2
+    fine = ADAPTIVE.refined()
+    assert fine.rtol == ADAPTIVE.rtol / 32 and fine.atol == ADAPTIVE.atol / 32
+
+
+def test_lyapunov_exponent_is_taken_on_the_rk4_grid():
+    """lyapunov_model runs both trajectories on the fixed grid even for adaptive params."""
+    from chaoscam.lyapunov import lyapunov_model
+
+    a = lyapunov_model(Params(xi=0.2), duration=4.0)
+    b = lyapunov_model(ADAPTIVE.replace(xi=0.2), duration=4.0)
+    assert a.exponent == b.exponent
+    assert "asked: adaptive" in b.settings["integrator"]
