@@ -59,8 +59,11 @@ def main() -> None:
     ap.add_argument("--sigma", type=float, default=0.002, help="l_lambda_sigma [m]")
     ap.add_argument("--batch", type=int, default=None, help="GPU members per batch")
     ap.add_argument("--check", type=int, default=64, help="members in the GPU = CPU check")
+    ap.add_argument("--integrator", choices=("rk4", "adaptive"), default="rk4",
+                    help="Params.integrator of every member (both backends)")
     args = ap.parse_args()
-    p = Params(l_lambda_sigma=args.sigma)
+    p = Params(l_lambda_sigma=args.sigma, integrator=args.integrator)
+    print(f"model: default, l_lambda_sigma = {args.sigma:g} m, integrator = {args.integrator}")
 
     threads = min(args.cpu_threads, numba.config.NUMBA_NUM_THREADS)
     numba.set_num_threads(threads)
@@ -97,7 +100,7 @@ def main() -> None:
 
     n = min(args.check, args.members)
     first = max_diff(p, range(n), min(0.25, args.duration), 0.0)
-    periodic = max_diff(Params(xi=0.2), range(min(n, 8)), 20.0, 10.0)
+    periodic = max_diff(Params(xi=0.2, integrator=args.integrator), range(min(n, 8)), 20.0, 10.0)
     tol = _gpu.GPU_TOLERANCE
     verdict = "ok" if max(first, periodic) <= tol else "FAILED"
     print(f"check GPU = CPU within {tol:g} (max |difference| of sections): first cam period "
