@@ -41,7 +41,7 @@ if "NUMBA_THREADING_LAYER" not in os.environ:
 
     numba.config.THREADING_LAYER = "workqueue"
 
-_DRAWS = 2048  # line-length draws per member before a refill
+_DRAWS = 512  # line-length draws per member before a refill (impact resampling; see _draws)
 _IMPACT_ROWS = 256  # impact rows per member per call (only counted, not kept)
 _CPU_BATCH = 1024
 BACKENDS = ("cpu", "gpu", "auto")
@@ -215,7 +215,8 @@ def _run_batch(plist, indices, first, seed, duration, transient, run=None):
     n_sec = int(duration / p0.cam_period) + 4 + int(p0.dt / p0.cam_period)
     extra = max(p.max_events_per_step + p.flight_merge for p in plist) + 2
     streams = [LineLengthStream(p, seed, i) for p, i in zip(plist, indices, strict=True)]
-    lam = np.stack([s.draw(_DRAWS + 4 * extra) for s in streams])
+    n_draws = max(_draws(p, duration) for p in plist) + 4 * extra
+    lam = np.stack([s.draw(n_draws) for s in streams])
     y = _per_member(initial_state, plist)
     cnt = _per_member(lambda p: initial_counters(p, transient=transient), plist)
     c = _per_member(lambda p: kernel_constants(p, t_record=transient), plist)
@@ -253,17 +254,32 @@ def _run_batch(plist, indices, first, seed, duration, transient, run=None):
 
 
 def _run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back):
-    """All members in one parallel call; those that asked for room finish one by one."""
+    """All members in one parallel call; those that asked for room are refilled and run
+    again, in parallel, until none asks (a resumed member is bit-identical to one that was
+    not interrupted, so the pauses change nothing)."""
     n = y.shape[0]
     run_members(y, cnt, c, n_stop, lam, np.empty((n, 1, k.SERIES_COLS)), section, impacts, status)
-    no_series = np.empty((1, k.SERIES_COLS))
-    for j in np.flatnonzero(status == k.NEED_BUFFER):
-        lam_j = lam[j]
-        while status[j] == k.NEED_BUFFER:
-            lam_j = hand_back(j, lam_j, _DRAWS)
-            status[j] = run_one(
-                y[j], cnt[j], c[j], n_stop, lam_j, no_series, section[j], impacts[j]
-            )
+    need = np.flatnonzero(status == k.NEED_BUFFER)
+    while need.size:
+        for j in need:  # the same width again: as many new draws as were used
+            lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
+        sub = (y[need], cnt[need], c[need], lam[need], section[need], impacts[need])
+        sub_status = np.zeros(need.size, dtype=np.int64)
+        run_members(sub[0], sub[1], sub[2], n_stop, sub[3],
+                    np.empty((need.size, 1, k.SERIES_COLS)), sub[4], sub[5], sub_status)
+        y[need], cnt[need], section[need] = sub[0], sub[1], sub[4]
+        status[need] = sub_status
+        need = need[sub_status == k.NEED_BUFFER]
+
+
+def _draws(p: Params, duration: float) -> int:
+    """Line-length draws a member starts with: enough for most runs without a refill.
+
+    One per applied impact (a few hundred in 20 s) or one per resampling interval.
+    """
+    if p.resample == "interval":
+        return int(duration / p.resample_dt) + 64
+    return _DRAWS
 
 
 def _per_member(make, plist) -> np.ndarray:
