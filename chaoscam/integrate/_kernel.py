@@ -89,10 +89,9 @@ Y_TIME = 2  # t [s] (the fixed-step kernel keeps it equal to cnt[I_STEP] * dt)
 Y_STEP = 3  # adaptive: the step size to try next [s]; 0 = not known yet
 Y_RECORDED = 4  # adaptive: time integrated after the transient [s]
 Y_CONTACT = 5  # adaptive: of which in contact (gap <= 0) [s]
-Y_ERR_OLD = 6  # adaptive: the last accepted step's error norm (PI step-size control)
-Y_EVENTS = 7  # adaptive: events so far in the grid interval Y_WINDOW (chattering guard)
-Y_WINDOW = 8  # adaptive: that grid interval's index n, [n dt, (n + 1) dt)
-Y_SIZE = 9
+Y_EVENTS = 6  # adaptive: events so far in the grid interval Y_WINDOW (chattering guard)
+Y_WINDOW = 7  # adaptive: that grid interval's index n, [n dt, (n + 1) dt)
+Y_SIZE = 8
 
 # --- status codes (mirrors chaoscam.integrate.Status) ------------------------------------
 OK = 0

@@ -252,12 +252,12 @@ class Params:
         ),
     )
     rtol: float = field(
-        default=1e-11,
+        default=1e-12,
         metadata=_meta(
             "adaptive integrator: relative tolerance of the local error of (theta_f, theta_f'). "
-            "Default 1e-11: 20 s sections of periodic responses within 1e-6 rad of converged "
+            "Default 1e-12: 20 s sections of periodic responses within 1e-6 rad of converged "
             "fixed-step RK4 (tests); the first ten impacts of the chaotic default run to 1e-6 s "
-            "need 3e-14 (benchmarks/bench_work_precision.py)",
+            "need 1e-13 (benchmarks/bench_work_precision.py)",
             "-",
             (0.0, 1e-2, False, True),
         ),

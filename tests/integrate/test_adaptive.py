@@ -23,8 +23,8 @@ def fast_impacts(p, duration=2.0, n=10):
 
 
 def test_first_ten_impacts_agree_with_converged_rk4():
-    """At rtol 3e-14 the first ten fast impacts match RK4 (dt 5e-7) within 1e-6 s and rad."""
-    a = fast_impacts(Params(dt=5e-7))
+    """At rtol 3e-14 the first ten fast impacts match RK4 (dt 2.5e-7) within 1e-6 s and rad."""
+    a = fast_impacts(Params(dt=2.5e-7))
     b = fast_impacts(ADAPTIVE.replace(rtol=3e-14, atol=1e-14))
     assert len(a) == len(b) == 10
     assert np.max(np.abs(a.t.values - b.t.values)) < 1e-6
@@ -43,13 +43,18 @@ def test_periodic_sections_agree_with_converged_rk4(changes):
 
 
 def test_error_shrinks_with_the_tolerance():
-    """The 0.2 s state moves towards converged RK4 as rtol tightens (>= 10x per 100x)."""
+    """The 0.2 s series moves towards converged RK4 as rtol tightens (>= 5x per decade).
+
+    Measured: 5.6e-7, 7.2e-8, 1.8e-9 rad at rtol 1e-9, 1e-10, 1e-11. Below that the error
+    stays at a few 1e-10 rad, the level at which RK4 itself (dt 5e-7) differs from dt 2.5e-7
+    after the 157 micro-bounces of this phase.
+    """
     ref = simulate(Params(dt=2.5e-7), duration=0.2, output_dt=1e-3).series.theta_f.values
     errs = []
-    for rtol in (1e-9, 1e-11, 1e-13):
+    for rtol in (1e-9, 1e-10, 1e-11):
         got = simulate(ADAPTIVE.replace(rtol=rtol, atol=rtol / 100), duration=0.2, output_dt=1e-3)
         errs.append(np.max(np.abs(got.series.theta_f.values - ref)))
-    assert errs[0] > 10 * errs[1] > 100 * errs[2]
+    assert errs[0] > 5 * errs[1] > 25 * errs[2]
 
 
 def test_impact_law_holds_at_every_adaptive_impact():
