@@ -137,7 +137,7 @@ def add_trajectory(parts: ReportParts, path: str, traj, *, caption: str = "") ->
                 "seed": s.get("seed"),
                 "realization index": s.get("index"),
                 "solver": s.get("solver"),
-                "step dt [s]": p.dt,
+                "integration": p.describe_step(),
                 "duration [s]": s.get("duration"),
                 "transient [s]": s.get("transient"),
                 "package version": s.get("version"),
@@ -289,7 +289,8 @@ def _sweep_settings(cfg: dict[str, Any]) -> dict[str, Any]:
             )
     base = cfg.get("base", {})
     units = {"dt": "s", "l_lambda": "m", "l_lambda_sigma": "m", "G": "m", "D": "-"}
-    for k in ("stiffness", "dt", "l_lambda", "l_lambda_sigma", "D", "G", "resample"):
+    for k in ("integrator", "stiffness", "dt", "rtol", "l_lambda", "l_lambda_sigma", "D", "G",
+              "resample"):
         if k in base:
             rows[f"base {k}" + (f" [{units[k]}]" if k in units else "")] = base[k]
     return rows
