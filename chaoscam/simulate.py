@@ -36,10 +36,8 @@ from .model import (
 __all__ = ["simulate", "Trajectory", "contact_period", "SERIES_COLUMNS"]
 
 SERIES_COLUMNS = ("t", "theta_f", "omega_f", "theta_fc", "gap", "contact", "F_n", "l_lambda")
-SECTION_COLUMNS = ("k", "t", "theta_f", "omega_f", "l_lambda")
-IMPACT_COLUMNS = (
-    "t", "theta_f", "omega_before", "omega_after", "gap_rate_before", "lever_arm", "l_lambda",
-)
+SECTION_COLUMNS = k.SECTION_NAMES
+IMPACT_COLUMNS = k.IMPACT_NAMES
 _BLOCK = 4096  # rows per output buffer and draws per refill
 
 

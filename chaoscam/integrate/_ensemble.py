@@ -92,15 +92,20 @@ class Ensemble:
     sections : pandas.DataFrame
         member, k, t, theta_f, omega_f, l_lambda: the stroboscopic points after the transient.
     members : pandas.DataFrame
-        member, index, status (name), n_impacts, contact_fraction.
+        member, index, status (name), n_impacts, contact_fraction; with ``classify=True``
+        also label and period, the verdict of each member's section.
     settings : dict
         duration, transient, seed, threads, backend ("cpu" or "gpu", the one used), device,
-        batch, wall time.
+        batch, integrators, wall time.
+    impacts : pandas.DataFrame or None
+        With ``keep_impacts=True``: member plus the columns of ``Trajectory.impacts`` (the
+        applied jumps after the transient); else None (only counted).
     """
 
     sections: pd.DataFrame
     members: pd.DataFrame
     settings: dict[str, Any] = field(default_factory=dict)
+    impacts: pd.DataFrame | None = None
 
 
 def simulate_ensemble(
@@ -112,6 +117,8 @@ def simulate_ensemble(
     transient: float = 0.0,
     batch: int | None = None,
     backend: str = "cpu",
+    keep_impacts: bool = False,
+    classify: bool = False,
 ) -> Ensemble:
     """Simulate realizations ``indices`` of one model (or one model per member) in parallel.
 
@@ -135,6 +142,13 @@ def simulate_ensemble(
         one-line :class:`GPUFallbackWarning` giving the reason. ``"auto"``: the GPU when
         available, else the CPU without a notice. ``settings["backend"]`` records the one
         used.
+    keep_impacts : bool
+        Also return every member's impacts (``Ensemble.impacts``); by default they are only
+        counted, so that memory stays flat for long runs.
+    classify : bool
+        Label each member from its section points after the transient
+        (:func:`chaoscam.analysis.classify_section`, what ``classify_trajectory`` does for a
+        run kept without its series): columns ``label`` and ``period`` in ``members``.
 
     Notes
     -----
@@ -159,25 +173,38 @@ def simulate_ensemble(
     if len({(p.dt, p.omega) for p in plist}) > 1:
         raise ValueError("members must share dt and omega")
     t0 = time.perf_counter()
-    sections, rows = [], []
+    sections, rows, impact_rows = [], [], []
     for start in range(0, len(indices), batch):
         chunk = slice(start, start + batch)
-        s, r = _run_batch(
+        s, r, im = _run_batch(
             plist[chunk], indices[chunk], start, seed, duration, transient,
-            run=_gpu.run_on_gpu if use_gpu else _run_on_cpu,
+            run=_gpu.run_on_gpu if use_gpu else _run_on_cpu, keep_impacts=keep_impacts,
         )
         sections.extend(s)
         rows.extend(r)
+        impact_rows.extend(im)
     cols = ["member", "k", "t", "theta_f", "omega_f", "l_lambda"]
     sec = pd.DataFrame(np.concatenate(sections) if sections else np.empty((0, 6)), columns=cols)
     sec[["member", "k"]] = sec[["member", "k"]].astype(np.int64)
+    members = pd.DataFrame(
+        rows, columns=["member", "index", "status", "n_impacts", "contact_fraction"]
+    )
+    if classify:
+        members = _classify_members(members, sec, plist, transient)
+    impacts = None
+    if keep_impacts:
+        icols = ["member", *k.IMPACT_NAMES]
+        impacts = pd.DataFrame(
+            np.concatenate(impact_rows) if impact_rows else np.empty((0, len(icols))),
+            columns=icols,
+        )
+        impacts["member"] = impacts["member"].astype(np.int64)
     import numba
 
     return Ensemble(
         sections=sec,
-        members=pd.DataFrame(
-            rows, columns=["member", "index", "status", "n_impacts", "contact_fraction"]
-        ),
+        members=members,
+        impacts=impacts,
         settings={
             "duration": duration,
             "transient": transient,
@@ -186,6 +213,7 @@ def simulate_ensemble(
             "backend": "gpu" if use_gpu else "cpu",
             "device": device,
             "batch": batch,
+            "integrators": sorted({p.integrator for p in plist}),
             "wall_time_s": time.perf_counter() - t0,
         },
     )
@@ -207,7 +235,26 @@ def _pick_backend(backend: str) -> tuple[bool, str]:
     return False, "cpu"
 
 
-def _run_batch(plist, indices, first, seed, duration, transient, run=None):
+def _classify_members(members, sec, plist, transient) -> pd.DataFrame:
+    """``members`` with the section verdict of each member (label, period)."""
+    from ..analysis import classify_section
+
+    labels, periods = [], []
+    by_member = dict(tuple(sec.groupby("member")))
+    for m, status in zip(members["member"], members["status"], strict=True):
+        points = by_member.get(m)
+        if status != "OK" or points is None:
+            labels.append("undetermined")
+            periods.append(None)
+            continue
+        keep = points["t"] >= transient - 1e-9 * plist[0].cam_period
+        v = classify_section(points.loc[keep, ["theta_f", "omega_f"]].to_numpy(dtype=float))
+        labels.append(v.label)
+        periods.append(v.period)
+    return members.assign(label=labels, period=pd.array(periods, dtype="Int64"))
+
+
+def _run_batch(plist, indices, first, seed, duration, transient, run=None, keep_impacts=False):
     """Set up one batch of members, ``run`` it (CPU or GPU) and collect its outputs."""
     n = len(indices)
     p0 = plist[0]
@@ -225,17 +272,32 @@ def _run_batch(plist, indices, first, seed, duration, transient, run=None):
     status = np.zeros(n, dtype=np.int64)
     n_impacts = np.zeros(n, dtype=np.int64)
 
-    def hand_back(j, lam_j, n_new):
-        """Empty member j's impact rows (counted) and drop its used draws, adding n_new."""
-        n_impacts[j] += cnt[j, k.I_N_IMPACT]
+    kept: list[list[np.ndarray]] = [[] for _ in range(n)]
+
+    def empty_impacts(j):
+        """Count member j's impact rows (and keep them if asked); the rows are free again."""
+        m = cnt[j, k.I_N_IMPACT]
+        if keep_impacts and m:
+            kept[j].append(impacts[j, :m].copy())
+        n_impacts[j] += m
         cnt[j, k.I_N_IMPACT] = 0
+
+    def hand_back(j, lam_j, n_new):
+        """Empty member j's impact rows and drop its used draws, adding n_new."""
+        empty_impacts(j)
         pos = cnt[j, k.I_LAM_POS]
         cnt[j, k.I_LAM_POS] = 0
         return np.concatenate([lam_j[pos:], streams[j].draw(n_new)])
 
-    (run or _run_on_cpu)(y, cnt, c, n_stop, lam, section, impacts, status, hand_back)
-    sections, rows = [], []
+    (run or _run_on_cpu)(
+        y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts
+    )
+    sections, rows, impact_rows = [], [], []
     for j in range(n):
+        empty_impacts(j)
+        if keep_impacts and kept[j]:
+            block = np.concatenate(kept[j])
+            impact_rows.append(np.column_stack([np.full(len(block), first + j), block]))
         m = cnt[j, k.I_N_SECTION]
         block = np.empty((m, 6))
         block[:, 0] = first + j
@@ -246,14 +308,14 @@ def _run_batch(plist, indices, first, seed, duration, transient, run=None):
                 first + j,
                 indices[j],
                 Status(int(status[j])).name,
-                int(n_impacts[j] + cnt[j, k.I_N_IMPACT]),
+                int(n_impacts[j]),
                 contact_fraction(y[j], cnt[j], c[j]),
             )
         )
-    return sections, rows
+    return sections, rows, impact_rows
 
 
-def _run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back):
+def _run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts):
     """All members in one parallel call; those that asked for room are refilled and run
     again, in parallel, until none asks (a resumed member is bit-identical to one that was
     not interrupted, so the pauses change nothing)."""
@@ -267,7 +329,7 @@ def _run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back):
         sub_status = np.zeros(need.size, dtype=np.int64)
         run_members(sub[0], sub[1], sub[2], n_stop, sub[3],
                     np.empty((need.size, 1, k.SERIES_COLS)), sub[4], sub[5], sub_status)
-        y[need], cnt[need], section[need] = sub[0], sub[1], sub[4]
+        y[need], cnt[need], section[need], impacts[need] = sub[0], sub[1], sub[4], sub[5]
         status[need] = sub_status
         need = need[sub_status == k.NEED_BUFFER]
 

@@ -170,12 +170,15 @@ def kernel_info() -> dict:
     }
 
 
-def run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back) -> None:
+def run_on_gpu(
+    y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts=False
+) -> None:
     """Run stacked members to ``n_stop`` on the GPU; arrays as in ``_ensemble._run_batch``.
 
-    Updates ``y``, ``cnt``, ``lam``, ``section`` and ``status`` in place (``impacts`` stays
-    on the device: only counted). ``hand_back(j, lam_j, n)`` empties member ``j``'s impact
-    rows and returns its draws with the used ones dropped and ``n`` new ones appended.
+    Updates ``y``, ``cnt``, ``lam``, ``section`` and ``status`` in place; ``impacts`` is
+    brought back from the device only with ``keep_impacts`` (otherwise only counted).
+    ``hand_back(j, lam_j, n)`` empties member ``j``'s impact rows and returns its draws with
+    the used ones dropped and ``n`` new ones appended.
     """
     from numba import cuda
 
@@ -195,6 +198,9 @@ def run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back) -> N
         if need.size == 0:
             break
         d_cnt.copy_to_host(cnt)
+        if keep_impacts:
+            for j in need:
+                d_impacts[j].copy_to_host(impacts[j])
         for j in need:  # the same width again: as many new draws as were used
             lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
         d_cnt.copy_to_device(cnt)
@@ -206,3 +212,5 @@ def run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back) -> N
     d_y.copy_to_host(y)
     d_cnt.copy_to_host(cnt)
     d_section.copy_to_host(section)
+    if keep_impacts:
+        d_impacts.copy_to_host(impacts)

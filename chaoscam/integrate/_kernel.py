@@ -100,9 +100,13 @@ LEFT_REACH = 2
 NON_FINITE = 3
 PENETRATION = 4
 
+SECTION_NAMES = ("k", "t", "theta_f", "omega_f", "l_lambda")
+IMPACT_NAMES = (
+    "t", "theta_f", "omega_before", "omega_after", "gap_rate_before", "lever_arm", "l_lambda",
+)
 SERIES_COLS = 4  # t, theta_f, omega_f, l_lambda
-SECTION_COLS = 5  # k, t, theta_f, omega_f, l_lambda
-IMPACT_COLS = 7  # t, theta_f, omega_before, omega_after, gap_rate_before, l_1, l_lambda
+SECTION_COLS = len(SECTION_NAMES)
+IMPACT_COLS = len(IMPACT_NAMES)
 
 
 @njit(cache=True)

@@ -131,13 +131,16 @@ cases = {
     "refills": (Params(l_lambda_sigma=0.002, resample="interval", resample_dt=1e-4), 0.5, 0.1),
     "periodic": (Params(xi=0.2), 0.5, 0.0),
     "adaptive": (Params(l_lambda_sigma=0.002, integrator="adaptive"), 0.5, 0.0),
+    "impacts": (Params(l_lambda_sigma=0.002, v_min=0.0), 0.5, 0.0),
 }
 for name, (p, duration, transient) in cases.items():
     runs = [simulate_ensemble(p, range(5), seed=2, duration=duration, transient=transient,
-                              backend=b, batch=3) for b in ("gpu", "cpu")]
+                              backend=b, batch=3, keep_impacts=True) for b in ("gpu", "cpu")]
     a, b = (r.sections.to_numpy() for r in runs)
+    ia, ib = (r.impacts.to_numpy() for r in runs)
     out[name] = {"backend": runs[0].settings["backend"], "shape": a.shape == b.shape,
                  "n": len(a), "diff": float(np.abs(a - b).max()),
+                 "impacts": ia.shape == ib.shape and bool(np.array_equal(ia, ib)),
                  "members": runs[0].members.equals(runs[1].members)}
 print(json.dumps(out))
 """
@@ -154,7 +157,7 @@ def test_simulated_gpu_equals_cpu():
     for case in result.values():
         assert case["backend"] == "gpu" and case["shape"] and case["n"] > 0
         assert case["diff"] <= _gpu.GPU_TOLERANCE
-        assert case["members"]
+        assert case["members"] and case["impacts"]
 
 
 @needs_numba_cuda

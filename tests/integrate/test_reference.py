@@ -106,6 +106,25 @@ def test_ensemble_members_that_refill_equal_single_runs(integrator):
         assert ens.members.n_impacts[member] == len(one.impacts)
 
 
+def test_ensemble_keeps_impacts_and_labels_members():
+    """keep_impacts returns each member's impacts as simulate() has them; classify labels
+    each member from its section (a period-1 orbit: periodic, period 1)."""
+    from chaoscam.integrate import simulate_ensemble
+
+    p = Params(l_lambda_sigma=0.002, v_min=0.0)  # ~900 impacts in 3 s: rows handed back
+    ens = simulate_ensemble(p, [3, 4], seed=1, duration=3.0, transient=1.0, keep_impacts=True)
+    for member, index in enumerate([3, 4]):
+        one = simulate(p, seed=1, index=index, duration=3.0, transient=1.0, series=False)
+        got = ens.impacts[ens.impacts.member == member].drop(columns="member")
+        assert len(got) == ens.members.n_impacts[member] > 256
+        assert np.array_equal(got.to_numpy(), one.impacts.to_numpy())
+    assert simulate_ensemble(p, [0], duration=0.5).impacts is None
+
+    ens = simulate_ensemble(Params(omega=10.0), [0, 1], duration=20.0, transient=10.0,
+                            classify=True)
+    assert list(ens.members.label) == ["periodic"] * 2 and list(ens.members.period) == [1, 1]
+
+
 def test_pausing_for_buffers_does_not_change_a_run():
     """A run sampled at every step (many buffer hand-backs) equals the sections-only run."""
     a = simulate(duration=20.0, series=False)
