@@ -258,7 +258,7 @@ def simulate(
         "index": int(index),
         "output_dt": stride * p.dt if series else None,
         "solver": (
-            "dopri5-adaptive+interpolant-events"
+            "dop853-adaptive+interpolant-events"
             if p.integrator == "adaptive"
             else "rk4-fixed-step+illinois-events"
         ),

@@ -40,6 +40,14 @@ Chattering guard: at most ``max_events_per_step`` events inside one grid interva
 ``I_CHATTER``). The contact fraction is integrated in time (``Y_RECORDED``, ``Y_CONTACT``).
 
 Like the reference kernel this never raises; it returns a status code.
+
+Measured against converged RK4 (``benchmarks/bench_work_precision.py``): the first ten fast
+impacts of the default run within 1e-6 s and rad from rtol 1e-13, 20 s sections of periodic
+responses within 1e-6 rad from rtol 1e-12 (omega = 45 rad/s) or 1e-9 (xi = 0.2). Below
+rtol ~1e-13 the agreement stops improving, at 2-5e-7: the dynamics amplifies differences of
+order 1e-12 s by 3-6x per impact (changing only how the stages' trigonometry is rounded moves
+the third impact of a flight-and-impact run by 1e-11 s), so at that level the runs differ by
+their rounding, not by their truncation error.
 """
 
 from __future__ import annotations

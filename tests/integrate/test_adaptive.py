@@ -1,4 +1,4 @@
-"""The adaptive Dormand–Prince path against the fixed-step RK4 reference (issue: performance).
+"""The adaptive DOP853 path against the fixed-step RK4 reference (issue: performance).
 
 Agreement is stated as in the work-precision benchmark: the first ten impacts faster than
 0.01 m/s of a default run to 1e-6 s and 1e-6 rad, and 20 s of stroboscopic sections of
@@ -98,7 +98,7 @@ def test_contact_fraction_is_integrated_in_time():
     a = simulate(Params(dt=1e-6, xi=0.2), duration=20.0, transient=10.0, series=False)
     b = simulate(ADAPTIVE.replace(xi=0.2), duration=20.0, transient=10.0, series=False)
     assert b.stats["contact_fraction"] == pytest.approx(a.stats["contact_fraction"], abs=1e-4)
-    assert b.settings["solver"].startswith("dopri5")
+    assert b.settings["solver"].startswith("dop853")
 
 
 def test_failures_are_labelled_statuses():
