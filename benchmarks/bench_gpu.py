@@ -26,7 +26,7 @@ import numba
 import numpy as np
 
 from chaoscam import Params
-from chaoscam.integrate import _gpu, simulate_ensemble
+from chaoscam.integrate import _gpu, _kernel, simulate_ensemble
 
 H100_TARGET = 3_000.0  # traj/s
 RATIO_TARGET = 200.0  # GPU / 2-core CPU
@@ -82,7 +82,8 @@ def main() -> None:
 
     t0 = time.perf_counter()
     simulate_ensemble(p, range(64), seed=1, duration=0.01, backend="gpu")
-    info = _gpu.kernel_info()
+    method = _kernel.METHOD_ADAPTIVE if args.integrator == "adaptive" else _kernel.METHOD_RK4
+    info = _gpu.kernel_info(method)
     print(f"GPU: {reason}; kernel compiled in {time.perf_counter() - t0:.1f} s, "
           f"{info.get('registers')} registers and {info.get('local_bytes')} B local memory "
           f"a thread, {info.get('block')} threads a block")

@@ -161,10 +161,12 @@ def test_simulated_gpu_equals_cpu():
 
 
 @needs_numba_cuda
-def test_kernel_compiles_to_ptx_for_h100():
-    """The ensemble kernel (advance and all it calls) compiles to PTX for sm_90, no device."""
+@pytest.mark.parametrize("method", [None, 0, 1], ids=["both", "rk4", "adaptive"])
+def test_kernel_compiles_to_ptx_for_h100(method):
+    """The ensemble kernels (each integrator, and advance with both) compile to PTX for sm_90,
+    without a device."""
     try:
-        ptx = _gpu.kernel_ptx((9, 0))
+        ptx = _gpu.kernel_ptx((9, 0), method)
     except Exception as exc:  # NVVM missing: nothing to check here
         if "NVVM" in str(exc) or "nvvm" in str(exc):
             pytest.skip(f"NVVM unavailable: {exc}")
