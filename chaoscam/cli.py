@@ -19,6 +19,7 @@ __all__ = ["main", "parse_assignments", "UsageError"]
 # Modules that add subcommands, in the order they are listed by --help.
 _COMMAND_MODULES = (
     "chaoscam._cli_simulate",
+    "chaoscam._cli_ensemble",
     "chaoscam._cli_classify",
     "chaoscam.sweep._cli",
     "chaoscam.report._cli",

@@ -12,6 +12,7 @@ runs.
 
 from __future__ import annotations
 
+import math
 import os
 import time
 import warnings
@@ -22,7 +23,7 @@ import numpy as np
 import pandas as pd
 from numba import njit, prange
 
-from ..model import LineLengthStream, Params
+from ..model import LineLengthStream, ParameterError, Params
 from . import _gpu
 from . import _kernel as k
 from ._advance import advance
@@ -160,6 +161,10 @@ def simulate_ensemble(
     (``_gpu.GPU_TOLERANCE``); chaotic runs part after a few periods, as any two roundings of
     them do, and only their statistics compare.
     """
+    if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):
+        raise ParameterError(f"duration = {duration!r} s must be > 0")
+    if not (isinstance(transient, int | float) and 0 <= transient < duration):
+        raise ParameterError(f"transient = {transient!r} s must be in [0, duration = {duration})")
     use_gpu, device = _pick_backend(backend)
     if batch is None:
         batch = _gpu.GPU_BATCH if use_gpu else _CPU_BATCH

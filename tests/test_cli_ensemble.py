@@ -1,0 +1,75 @@
+"""``chaoscam ensemble``: outputs, refusal of bad input, and resuming an interrupted run."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from chaoscam import Params
+from chaoscam.cli import main
+from chaoscam.integrate import simulate_ensemble
+
+ARGS = ["ensemble", "--members", "5", "--duration", "1.0", "--transient", "0.5",
+        "--set", "l_lambda_sigma=0.002", "--seed", "4", "--chunk", "2", "--quiet"]
+
+
+def test_writes_members_sections_impacts_equal_to_the_api(tmp_path):
+    out = tmp_path / "ens.parquet"
+    assert main([*ARGS, "--classify", "--keep-impacts", "--out", str(out)]) == 0
+    members = pd.read_parquet(out)
+    sections = pd.read_parquet(tmp_path / "ens.sections.parquet")
+    impacts = pd.read_parquet(tmp_path / "ens.impacts.parquet")
+    assert not (tmp_path / "ens.parts").exists()
+    api = simulate_ensemble(Params(l_lambda_sigma=0.002), range(5), seed=4, duration=1.0,
+                            transient=0.5, keep_impacts=True, classify=True)
+    assert list(members["index"]) == list(range(5)) and list(members["member"]) == list(range(5))
+    assert np.array_equal(sections.to_numpy(), api.sections.to_numpy())
+    assert np.array_equal(impacts.to_numpy(), api.impacts.to_numpy())
+    assert list(members.label) == list(api.members.label)
+
+
+def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, capsys):
+    """Ctrl-C after the first part keeps it; --resume finishes to the uninterrupted result."""
+    import chaoscam.integrate as integrate
+
+    whole = tmp_path / "whole.parquet"
+    assert main([*ARGS, "--out", str(whole)]) == 0
+    real = integrate.simulate_ensemble
+    calls = []
+
+    def interrupted_on_the_second_part(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(integrate, "simulate_ensemble", interrupted_on_the_second_part)
+    out = tmp_path / "ens.parquet"
+    assert main([*ARGS, "--out", str(out)]) == 130
+    assert "--resume" in capsys.readouterr().err
+    assert not out.exists() and len(list((tmp_path / "ens.parts").glob("*.done"))) == 1
+    monkeypatch.setattr(integrate, "simulate_ensemble", real)
+    assert main([*ARGS, "--out", str(out)]) == 2  # an unfinished run is not overwritten
+    assert main([*ARGS, "--set", "xi=0.3", "--resume", "--out", str(out)]) == 2  # not its config
+    assert main([*ARGS, "--resume", "--out", str(out)]) == 0
+    assert pd.read_parquet(out).equals(pd.read_parquet(whole))
+    a = pd.read_parquet(tmp_path / "ens.sections.parquet")
+    assert a.equals(pd.read_parquet(tmp_path / "whole.sections.parquet"))
+
+
+@pytest.mark.parametrize(
+    "extra, needle",
+    [(["--members", "0"], "members"), (["--set", "omgea=3"], "omgea"),
+     (["--duration", "-1"], "duration"), (["--transient", "5"], "transient")],
+)
+def test_bad_input_exits_2_naming_the_field(tmp_path, capsys, extra, needle):
+    out = tmp_path / "e.parquet"
+    assert main([*ARGS, *extra, "--out", str(out)]) == 2
+    assert needle in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_an_existing_output_is_not_overwritten(tmp_path):
+    out = tmp_path / "e.parquet"
+    out.write_text("keep")
+    assert main([*ARGS, "--out", str(out)]) == 2
+    assert out.read_text() == "keep"
