@@ -14,7 +14,9 @@ import argparse
 import hashlib
 import json
 import shutil
+import sys
 import time
+import warnings
 from pathlib import Path
 
 __all__ = ["register"]
@@ -58,6 +60,7 @@ def run(args: argparse.Namespace) -> int:
 
     from .cli import UsageError, parse_assignments
     from .integrate import simulate_ensemble
+    from .integrate._gpu import GPUFallbackWarning
 
     out: Path = args.out
     if out.suffix != ".parquet":
@@ -108,6 +111,7 @@ def run(args: argparse.Namespace) -> int:
 
     t0 = time.perf_counter()
     done_before = 0
+    noticed = False  # the GPU fallback notice is printed once, on one line
     last = args.first + args.members
     starts = range(args.first, last, args.chunk)
     for start in starts:
@@ -117,14 +121,20 @@ def run(args: argparse.Namespace) -> int:
             done_before += stop - start
             continue
         try:
-            ens = simulate_ensemble(
-                params, range(start, stop), seed=args.seed, duration=args.duration,
-                transient=transient, backend=args.backend, keep_impacts=args.keep_impacts,
-                classify=args.classify,
-            )
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", GPUFallbackWarning)
+                ens = simulate_ensemble(
+                    params, range(start, stop), seed=args.seed, duration=args.duration,
+                    transient=transient, backend=args.backend, keep_impacts=args.keep_impacts,
+                    classify=args.classify,
+                )
+            for w in caught:
+                if issubclass(w.category, GPUFallbackWarning) and not noticed:
+                    print(f"chaoscam: {w.message}", file=sys.stderr, flush=True)
+                    noticed = True
+                elif not issubclass(w.category, GPUFallbackWarning):
+                    warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         except KeyboardInterrupt:
-            import sys
-
             print(f"chaoscam: interrupted; the finished parts are in {parts}: run the same "
                   "command with --resume to continue", file=sys.stderr)
             raise

@@ -73,3 +73,15 @@ def test_an_existing_output_is_not_overwritten(tmp_path):
     out.write_text("keep")
     assert main([*ARGS, "--out", str(out)]) == 2
     assert out.read_text() == "keep"
+
+
+def test_gpu_fallback_is_one_line(tmp_path, capsys, monkeypatch):
+    """--backend gpu without a usable GPU: one stderr line with the reason, CPU results."""
+    from chaoscam.integrate import _gpu
+
+    monkeypatch.setattr(_gpu, "gpu_status", lambda: (False, "no CUDA device (test)"))
+    out = tmp_path / "e.parquet"
+    assert main([*ARGS, "--backend", "gpu", "--out", str(out)]) == 0
+    err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert len(err) == 1 and "no CUDA device (test)" in err[0] and "CPU" in err[0]
+    assert len(pd.read_parquet(out)) == 5
