@@ -64,23 +64,16 @@ from ._kernel import (
     C_EVENT_TOL,
     C_H_MAX,
     C_MAX_EVENTS,
-    C_PERIOD,
     C_RCAM,
-    C_RESAMPLE_DT,
     C_ROD_L,
     C_STRIDE,
     C_T_RECORD,
-    C_VMIN,
-    C_XI,
     I_CHATTER,
     I_LAM_POS,
     I_N_IMPACT,
     I_N_SECTION,
     I_N_SERIES,
-    I_RESAMPLE_J,
-    I_SECTION_K,
     I_SERIES_J,
-    I_SLOW_CLOSINGS,
     I_STEP,
     LEFT_REACH,
     NEED_BUFFER,
@@ -212,7 +205,6 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
     stride = np.int64(c[C_STRIDE])
     samples_per_step = np.int64(c[C_H_MAX] / (stride * dt)) + 2 if stride > 0 else 0
     max_events = np.int64(c[C_MAX_EVENTS])
-    resample_on_impact = c[C_RESAMPLE_DT] <= 0.0
     t_rec = c[C_T_RECORD]
 
     t = y[Y_TIME]
@@ -237,21 +229,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             return leave(y, cnt, th, om, t, h, events, window, NEED_BUFFER, c)
 
         # The step ends at the next scheduled time at the latest.
-        t_next = t_stop
-        is_section = False
-        is_resample = False
-        t_sec = cnt[I_SECTION_K] * c[C_PERIOD]
-        if t_sec <= t_next:
-            t_next = t_sec
-            is_section = True
-        if not resample_on_impact:
-            t_res = cnt[I_RESAMPLE_J] * c[C_RESAMPLE_DT]
-            if t_res < t_next:
-                t_next = t_res
-                is_section = False
-                is_resample = True
-            elif t_res == t_next:
-                is_resample = True
+        t_next, is_section, is_resample = k.next_scheduled(t_stop, cnt, c)
         hs = min(h, c[C_H_MAX])
         if flight and hs > dt and hs > k.safe_horizon(g, l1, cdn, om, c):
             # Near the cam a long step could hold several crossings, of which the search
@@ -350,25 +328,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             if closing:
                 if not (0.0 < l1 < c[C_ROD_L]):
                     return leave(y, cnt, th, om, t, h_next, events, window, LEFT_REACH, c)
-                rate = l1 * om - cdn
-                if -rate > c[C_VMIN]:
-                    om_after = -c[C_XI] * om + (1.0 + c[C_XI]) * cdn / l1
-                    if resample_on_impact:
-                        cnt[I_LAM_POS] += 1
-                        K = k.stiffness(lam[cnt[I_LAM_POS]], c)
-                    if t >= t_rec:
-                        i = cnt[I_N_IMPACT]
-                        impacts[i, 0] = t
-                        impacts[i, 1] = th
-                        impacts[i, 2] = om
-                        impacts[i, 3] = om_after
-                        impacts[i, 4] = rate
-                        impacts[i, 5] = l1
-                        impacts[i, 6] = lam[cnt[I_LAM_POS]]
-                        cnt[I_N_IMPACT] += 1
-                    om = om_after
-                else:
-                    cnt[I_SLOW_CLOSINGS] += 1
+                om, K = k.impact(t, th, om, l1, cdn, K, lam, cnt, impacts, c)
             flight = g > 0.0
             a1 = accel_trig(tr, om, K, c, flight)
             h = min(h_next, hs)  # the event cut the step: do not grow past it
@@ -393,19 +353,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             if -g > c[C_RCAM]:
                 return leave(y, cnt, th, om, t, h, events, window, PENETRATION, c)
         if clipped:
-            if is_section:
-                if t >= t_rec:
-                    i = cnt[I_N_SECTION]
-                    section[i, 0] = cnt[I_SECTION_K]
-                    section[i, 1] = t
-                    section[i, 2] = th
-                    section[i, 3] = om
-                    section[i, 4] = lam[cnt[I_LAM_POS]]
-                    cnt[I_N_SECTION] += 1
-                cnt[I_SECTION_K] += 1
+            K = k.at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, c)
             if is_resample:
-                cnt[I_LAM_POS] += 1
-                cnt[I_RESAMPLE_J] += 1
-                K = k.stiffness(lam[cnt[I_LAM_POS]], c)
                 a1 = accel_trig(tr, om, K, c, flight)
     return leave(y, cnt, th, om, t, h, events, window, OK, c)

@@ -297,6 +297,84 @@ def locate_crossing(t, th, om, h, g_start, g_end, K, c):
     return b
 
 
+@njit(cache=True, inline="always")
+def next_scheduled(t_limit, cnt, c):
+    """The first scheduled time up to ``t_limit``: (time, is_section, is_resample).
+
+    Scheduled times are the stroboscopic sections ``k T`` and, with interval resampling,
+    the line-length draws ``j dt_l``; a step or segment must end exactly there.
+    """
+    t_next = t_limit
+    is_section = False
+    is_resample = False
+    t_sec = cnt[I_SECTION_K] * c[C_PERIOD]
+    if t_sec <= t_next:
+        t_next = t_sec
+        is_section = True
+    if c[C_RESAMPLE_DT] > 0.0:
+        t_res = cnt[I_RESAMPLE_J] * c[C_RESAMPLE_DT]
+        if t_res < t_next:
+            t_next = t_res
+            is_section = False
+            is_resample = True
+        elif t_res == t_next:
+            is_resample = True
+    return t_next, is_section, is_resample
+
+
+@njit(cache=True, inline="always")
+def at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, c):
+    """Record the section point and/or draw the next line length at a scheduled time t.
+
+    Returns the stiffness in use afterwards.
+    """
+    if is_section:
+        if t >= c[C_T_RECORD]:
+            i = cnt[I_N_SECTION]
+            section[i, 0] = cnt[I_SECTION_K]
+            section[i, 1] = t
+            section[i, 2] = th
+            section[i, 3] = om
+            section[i, 4] = lam[cnt[I_LAM_POS]]
+            cnt[I_N_SECTION] += 1
+        cnt[I_SECTION_K] += 1
+    if is_resample:
+        cnt[I_LAM_POS] += 1
+        cnt[I_RESAMPLE_J] += 1
+        K = stiffness(lam[cnt[I_LAM_POS]], c)
+    return K
+
+
+@njit(cache=True, inline="always")
+def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, c):
+    """The impact law (4)–(5) at a located closing at (t, th) with lever arm l1 and dC/dt.n.
+
+    When the approach speed -(l1 theta' - dC/dt.n) exceeds v_min the angular velocity jumps,
+    ``theta'+ = -xi theta'- + (1 + xi) (dC/dt.n) / l1``, a new line length is drawn (impact
+    resampling) and the jump is recorded (after the transient); a slower closing is left to
+    the compliant force and counted. Returns (theta' after, stiffness in use).
+    """
+    rate = l1 * om - cdn
+    if -rate > c[C_VMIN]:
+        om_after = -c[C_XI] * om + (1.0 + c[C_XI]) * cdn / l1
+        if c[C_RESAMPLE_DT] <= 0.0:
+            cnt[I_LAM_POS] += 1
+            K = stiffness(lam[cnt[I_LAM_POS]], c)
+        if t >= c[C_T_RECORD]:
+            i = cnt[I_N_IMPACT]
+            impacts[i, 0] = t
+            impacts[i, 1] = th
+            impacts[i, 2] = om
+            impacts[i, 3] = om_after
+            impacts[i, 4] = rate
+            impacts[i, 5] = l1
+            impacts[i, 6] = lam[cnt[I_LAM_POS]]
+            cnt[I_N_IMPACT] += 1
+        return om_after, K
+    cnt[I_SLOW_CLOSINGS] += 1
+    return om, K
+
+
 @njit(cache=True)
 def leave(y, cnt, th, om, t, safe_n, code):
     """Store the state and the flight horizon before returning ``code`` to the driver."""
@@ -403,21 +481,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
         events = 0
         while t < t_end:
             # The segment ends at the step's end or at the next scheduled time inside it.
-            seg_end = t_end
-            is_section = False
-            is_resample = False
-            t_sec = cnt[I_SECTION_K] * c[C_PERIOD]
-            if t_sec <= seg_end:
-                seg_end = t_sec
-                is_section = True
-            if not resample_on_impact:
-                t_res = cnt[I_RESAMPLE_J] * c[C_RESAMPLE_DT]
-                if t_res < seg_end:
-                    seg_end = t_res
-                    is_section = False
-                    is_resample = True
-                elif t_res == seg_end:
-                    is_resample = True
+            seg_end, is_section, is_resample = next_scheduled(t_end, cnt, c)
             hs = seg_end - t
             if hs > 0.0 and seg_end <= safe_n * h:
                 th, om = rk4_flight(th, om, hs, c)  # far from the cam: pure flight
@@ -447,25 +511,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                         continue
                     if not (0.0 < l1 < c[C_ROD_L]):
                         return leave(y, cnt, th, om, t, safe_n, LEFT_REACH)
-                    rate = l1 * om - cdn
-                    if -rate > c[C_VMIN]:
-                        om_after = -c[C_XI] * om + (1.0 + c[C_XI]) * cdn / l1
-                        if resample_on_impact:
-                            cnt[I_LAM_POS] += 1
-                            K = stiffness(lam[cnt[I_LAM_POS]], c)
-                        if t >= c[C_T_RECORD]:
-                            i = cnt[I_N_IMPACT]
-                            impacts[i, 0] = t
-                            impacts[i, 1] = th
-                            impacts[i, 2] = om
-                            impacts[i, 3] = om_after
-                            impacts[i, 4] = rate
-                            impacts[i, 5] = l1
-                            impacts[i, 6] = lam[cnt[I_LAM_POS]]
-                            cnt[I_N_IMPACT] += 1
-                        om = om_after
-                    else:
-                        cnt[I_SLOW_CLOSINGS] += 1
+                    om, K = impact(t, th, om, l1, cdn, K, lam, cnt, impacts, c)
                     continue
                 th = th_new
                 om = om_new
@@ -473,20 +519,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 g = g_new
                 if g > 0.0:
                     safe_n = np.int64(math.floor((t + safe_horizon(g, l1, cdn, om, c)) / h))
-            if is_section:
-                if t >= c[C_T_RECORD]:
-                    i = cnt[I_N_SECTION]
-                    section[i, 0] = cnt[I_SECTION_K]
-                    section[i, 1] = t
-                    section[i, 2] = th
-                    section[i, 3] = om
-                    section[i, 4] = lam[cnt[I_LAM_POS]]
-                    cnt[I_N_SECTION] += 1
-                cnt[I_SECTION_K] += 1
-            if is_resample:
-                cnt[I_LAM_POS] += 1
-                cnt[I_RESAMPLE_J] += 1
-                K = stiffness(lam[cnt[I_LAM_POS]], c)
+            K = at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, c)
 
         # End of the grid step: checks and outputs. Here g and l1 belong to (t_end, th).
         cnt[I_STEP] = n + 1
