@@ -109,7 +109,7 @@ def locate_on_interpolant(h, th, tr, co, g_start, g_end, s_hi, c):
     ``tr`` is the step's trigonometric base (``trig_at``), ``co`` its interpolant data.
     Returns the bracket's end past the crossing.
     """
-    sgn = 1.0 if g_start > 0.0 else -1.0
+    sgn = 1.0 if g_start > 0.0 else -1.0  # work on sgn * delta, positive at the start
     a, fa, b, fb = 0.0, sgn * g_start, s_hi, sgn * g_end
     tol = c[C_EVENT_TOL] / h
     side = 0
@@ -117,29 +117,13 @@ def locate_on_interpolant(h, th, tr, co, g_start, g_end, s_hi, c):
         width = b - a
         if width <= tol:
             break
-        m = b - fb * width / (fb - fa)
-        if not (a < m < b):
-            m = 0.5 * (a + b)
+        m = k.illinois_point(a, fa, b, fb)
         fm, _, _ = geometry_near(m * h, theta_at(co, m), th, tr, c)
-        fm *= sgn
-        if fm > 0.0:
-            a, fa = m, fm
-            if side == 1:
-                fb *= 0.5
-            side = 1
-        else:
-            b, fb = m, fm
-            if side == -1:
-                fa *= 0.5
-            side = -1
+        a, fa, b, fb, side = k.illinois_update(a, fa, b, fb, m, fm * sgn, side)
         if b - a > 0.5 * width:
             m = 0.5 * (a + b)
             fm, _, _ = geometry_near(m * h, theta_at(co, m), th, tr, c)
-            fm *= sgn
-            if fm > 0.0:
-                a, fa = m, fm
-            else:
-                b, fb = m, fm
+            a, fa, b, fb, _ = k.illinois_update(a, fa, b, fb, m, fm * sgn, 0)
     return b
 
 
@@ -150,27 +134,16 @@ def turning_point(h, th, tr, co, rate0, rate1, c):
     Illinois regula falsi on the interpolant, to 1e-9 of the step (the turning point only
     needs to be good enough to show on which side of zero the gap's extremum lies).
     """
-    sgn = 1.0 if rate1 > 0.0 else -1.0  # work on sgn * rate: negative at 0, positive at 1
+    sgn = -1.0 if rate1 > 0.0 else 1.0  # work on sgn * rate: positive at 0, negative at 1
     a, fa, b, fb = 0.0, sgn * rate0, 1.0, sgn * rate1
     side = 0
     for _ in range(100):
         if b - a <= 1e-9:
             break
-        m = b - fb * (b - a) / (fb - fa)
-        if not (a < m < b):
-            m = 0.5 * (a + b)
+        m = k.illinois_point(a, fa, b, fb)
         _, l1, cdn = geometry_near(m * h, theta_at(co, m), th, tr, c)
         fm = sgn * (l1 * omega_at(co, m) - cdn)
-        if fm < 0.0:
-            a, fa = m, fm
-            if side == 1:
-                fb *= 0.5
-            side = 1
-        else:
-            b, fb = m, fm
-            if side == -1:
-                fa *= 0.5
-            side = -1
+        a, fa, b, fb, side = k.illinois_update(a, fa, b, fb, m, fm, side)
     return 0.5 * (a + b)
 
 

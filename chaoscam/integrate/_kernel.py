@@ -253,6 +253,36 @@ def safe_horizon(g, l1, cdn, om, c):
     return min(horizon, 1.0 / (c[C_GRAV] * c[C_INV_J]))
 
 
+@njit(cache=True, inline="always")
+def illinois_point(a, fa, b, fb):
+    """The next point of regula falsi in the bracket [a, b], where fa > 0 >= fb: the secant's
+    root, or the midpoint when rounding puts that outside the bracket."""
+    m = b - fb * (b - a) / (fb - fa)
+    if not (a < m < b):
+        m = 0.5 * (a + b)
+    return m
+
+
+@njit(cache=True, inline="always")
+def illinois_update(a, fa, b, fb, m, fm, side):
+    """The bracket after f(m) = fm, for Illinois regula falsi (Dowell & Jarratt 1971).
+
+    The end that stays twice in a row has its value halved, which keeps the method
+    superlinear where plain regula falsi stalls. ``side`` remembers the end replaced last.
+    """
+    if fm > 0.0:
+        a, fa = m, fm
+        if side == 1:
+            fb *= 0.5
+        side = 1
+    else:
+        b, fb = m, fm
+        if side == -1:
+            fa *= 0.5
+        side = -1
+    return a, fa, b, fb, side
+
+
 @njit(cache=True)
 def locate_crossing(t, th, om, h, g_start, g_end, K, c):
     """The substep length tau in (0, h] at which the gap delta changes sign.
@@ -269,31 +299,15 @@ def locate_crossing(t, th, om, h, g_start, g_end, K, c):
         width = b - a
         if width <= c[C_EVENT_TOL]:
             break
-        m = b - fb * width / (fb - fa)
-        if not (a < m < b):
-            m = 0.5 * (a + b)
+        m = illinois_point(a, fa, b, fb)
         thm, _ = rk4(t, th, om, m, K, c)
         fm, _, _ = geometry(t + m, thm, c)
-        fm *= s
-        if fm > 0.0:
-            a, fa = m, fm
-            if side == 1:
-                fb *= 0.5
-            side = 1
-        else:
-            b, fb = m, fm
-            if side == -1:
-                fa *= 0.5
-            side = -1
+        a, fa, b, fb, side = illinois_update(a, fa, b, fb, m, fm * s, side)
         if b - a > 0.5 * width:
             m = 0.5 * (a + b)
             thm, _ = rk4(t, th, om, m, K, c)
             fm, _, _ = geometry(t + m, thm, c)
-            fm *= s
-            if fm > 0.0:
-                a, fa = m, fm
-            else:
-                b, fb = m, fm
+            a, fa, b, fb, _ = illinois_update(a, fa, b, fb, m, fm * s, 0)
     return b
 
 
