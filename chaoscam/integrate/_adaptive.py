@@ -204,10 +204,12 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         # The step ends at the next scheduled time at the latest.
         t_next, is_section, is_resample = k.next_scheduled(t_stop, cnt, c)
         hs = min(h, c[C_H_MAX])
-        if flight and hs > dt and hs > k.safe_horizon(g, l1, cdn, om, c):
+        if flight and hs > dt:
             # Near the cam a long step could hold several crossings, of which the search
             # might find a later one: steps there are cut to dt (see module doc).
-            hs = max(dt, k.safe_horizon(g, l1, cdn, om, c))
+            safe = k.safe_horizon(g, l1, cdn, om, c)
+            if hs > safe:
+                hs = max(dt, safe)
         clipped = t + hs >= t_next
         if clipped:
             hs = t_next - t
@@ -280,7 +282,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         if crossing:
             # An event inside the step: a step of the located length from the step's start
             # gives the state there (an integrator state, not an interpolation). Should that
-            # state not yet be past the crossing (the interpolant is only 4th-order accurate),
+            # state not yet be past the crossing (the interpolant only approximates the step),
             # the length grows by 2, 4, 8, ... event tolerances until it is.
             closing = flight
             reach = c[C_EVENT_TOL] / hs
