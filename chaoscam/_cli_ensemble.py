@@ -61,6 +61,7 @@ def run(args: argparse.Namespace) -> int:
     from .cli import UsageError, parse_assignments
     from .integrate import simulate_ensemble
     from .integrate._gpu import GPUFallbackWarning
+    from .sweep._common import run_settings
 
     out: Path = args.out
     if out.suffix != ".parquet":
@@ -72,11 +73,7 @@ def run(args: argparse.Namespace) -> int:
     if args.chunk < 1:
         raise UsageError(f"--chunk = {args.chunk} must be >= 1")
     params = parse_assignments(args.set)
-    transient = args.duration / 2 if args.transient is None else args.transient
-    if not (args.duration > 0):
-        raise UsageError(f"--duration = {args.duration} s must be > 0")
-    if not (0 <= transient < args.duration):
-        raise UsageError(f"--transient = {transient} s must be in [0, duration = {args.duration})")
+    duration, transient = run_settings(args.duration, args.transient, args.seed)
 
     sections_path = out.with_suffix(".sections.parquet")
     impacts_path = out.with_suffix(".impacts.parquet")
@@ -87,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
     config = {
         "params": params.to_dict(),
         "seed": args.seed,
-        "duration": args.duration,
+        "duration": duration,
         "transient": transient,
         "first": args.first,
         "members": args.members,
@@ -124,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", GPUFallbackWarning)
                 ens = simulate_ensemble(
-                    params, range(start, stop), seed=args.seed, duration=args.duration,
+                    params, range(start, stop), seed=args.seed, duration=duration,
                     transient=transient, backend=args.backend, keep_impacts=args.keep_impacts,
                     classify=args.classify,
                 )
