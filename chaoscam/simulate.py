@@ -38,6 +38,7 @@ __all__ = ["simulate", "Trajectory", "contact_period", "SERIES_COLUMNS"]
 SERIES_COLUMNS = ("t", "theta_f", "omega_f", "theta_fc", "gap", "contact", "F_n", "l_lambda")
 SECTION_COLUMNS = k.SECTION_NAMES
 IMPACT_COLUMNS = k.IMPACT_NAMES
+IMPACT_KINDS = k.IMPACT_KINDS
 _BLOCK = 4096  # rows per output buffer and draws per refill
 
 
@@ -60,12 +61,21 @@ class Trajectory:
         Stroboscopic Poincaré section at t = k 2 pi / omega: k, t, theta_f, omega_f, l_lambda.
     impacts : pandas.DataFrame
         The applied restitution jumps: t, theta_f, omega_before, omega_after,
-        gap_rate_before, lever_arm, l_lambda.
+        gap_rate_before, lever_arm, l_lambda, kind ("macro", "micro": slower than
+        ``v_micro``, "chatter_end": the plastic closure ending a complete chattering).
     stats : dict
-        contact_fraction, n_impacts, slow_closings, chatter_handovers, truncated_mass,
+        contact_fraction, n_impacts (and of them n_macro_impacts, n_micro_impacts,
+        n_chatter_ends), slow_closings, chatter_handovers, truncated_mass,
         steps_per_contact_period.
     final_state : tuple
         (t, theta_f, omega_f) where the run stopped.
+    jacobians : ndarray or None
+        With ``tangent=True``: shape (n_sections, 2, 2), the Jacobian of the stroboscopic
+        map d(theta_f, theta_f')(t_k) / d(theta_f, theta_f')(t_k - T) over the period that
+        ends at each section point (through the impacts' saltation matrices).
+    divergence : ndarray or None
+        With ``tangent=True``: the integral of the flow's divergence over each such period
+        (Liouville: ln|det J_k| = divergence_k + 2 ln(xi) per restitution jump).
     """
 
     params: Params
@@ -76,6 +86,8 @@ class Trajectory:
     impacts: pd.DataFrame
     stats: dict[str, Any] = field(default_factory=dict)
     final_state: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    jacobians: np.ndarray | None = field(default=None, repr=False)
+    divergence: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def message(self) -> str:
@@ -92,8 +104,10 @@ class Trajectory:
             f"status: {self.status.name} - {self.message}\n"
             f"simulated: {self.final_state[0]:.4g} s of {self.settings['duration']:.4g} s "
             f"(transient {self.settings['transient']:.4g} s discarded), dt = {self.params.dt:g} s\n"
-            f"impacts: {s['n_impacts']} applied, {s['slow_closings']} slow closings left to the "
-            f"compliant contact, {s['chatter_handovers']} chattering hand-overs\n"
+            f"impacts: {s['n_impacts']} applied ({s['n_macro_impacts']} macro, "
+            f"{s['n_micro_impacts']} micro, {s['n_chatter_ends']} chattering ends), "
+            f"{s['slow_closings']} slow closings left to the compliant contact, "
+            f"{s['chatter_handovers']} chattering-guard hand-overs\n"
             f"contact fraction: {s['contact_fraction']:.4f}\n"
             f"section points: {len(self.section)}"
         )
@@ -154,6 +168,7 @@ def simulate(
     index: int = 0,
     series: bool = True,
     output_dt: float = 1e-3,
+    tangent: bool = False,
     **overrides: Any,
 ) -> Trajectory:
     """Simulate one realization with located impacts: fixed-step RK4 (the paper's method, the
@@ -174,6 +189,12 @@ def simulate(
         Keep the time series; False keeps sections and impacts only (long runs, sweeps).
     output_dt : float
         Sampling interval of the series [s], rounded to a whole number of steps.
+    tangent : bool
+        Also integrate the tangent dynamics through the impacts (:mod:`chaoscam.integrate.
+        _tangent`) and keep the Jacobian of the stroboscopic map over each recorded period
+        (``Trajectory.jacobians``), from which :func:`chaoscam.lyapunov_spectrum` and
+        :func:`chaoscam.periodic_orbit` work. Fixed-step RK4 only. The motion is the same
+        with and without it.
 
     Returns
     -------
@@ -208,7 +229,12 @@ def simulate(
     y = initial_state(p)
     th0, om0 = y[k.Y_THETA], y[k.Y_OMEGA]
     cnt = initial_counters(p, transient=transient)
-    c = kernel_constants(p, t_record=transient, stride=stride)
+    if tangent and p.integrator != "rk4":
+        raise ParameterError(
+            f"tangent=True needs integrator = 'rk4' (got {p.integrator!r}): the tangent "
+            "dynamics are integrated on the RK4 grid only"
+        )
+    c = kernel_constants(p, t_record=transient, stride=stride, tangent=tangent)
     buf_series = np.empty((block if series else 1, k.SERIES_COLS))
     buf_section = np.empty((block, k.SECTION_COLS))
     buf_impacts = np.empty((block, k.IMPACT_COLS))
@@ -239,13 +265,25 @@ def simulate(
     def stack(name: str, ncol: int) -> np.ndarray:
         return np.concatenate(parts[name]) if parts[name] else np.empty((0, ncol))
 
-    sec = pd.DataFrame(stack("section", k.SECTION_COLS), columns=list(SECTION_COLUMNS))
+    sec_all = stack("section", k.SECTION_COLS)
+    n_sec = len(SECTION_COLUMNS)
+    sec = pd.DataFrame(sec_all[:, :n_sec], columns=list(SECTION_COLUMNS))
     sec["k"] = sec["k"].astype(np.int64)
+    jac = None
+    if tangent:
+        jac = sec_all[:, n_sec : n_sec + 4].reshape(-1, 2, 2).transpose(0, 2, 1).copy()
+    div = sec_all[:, n_sec + 4].copy() if tangent else None
     imp = pd.DataFrame(stack("impacts", k.IMPACT_COLS), columns=list(IMPACT_COLUMNS))
+    imp["kind"] = pd.Categorical.from_codes(
+        imp["kind"].to_numpy(dtype=np.int64), categories=list(IMPACT_KINDS)
+    )
     ser = _series_frame(p, stack("series", k.SERIES_COLS)) if series else None
     stats = {
         "contact_fraction": contact_fraction(y, cnt, c),
         "n_impacts": len(imp),
+        "n_macro_impacts": int((imp["kind"] == "macro").sum()),
+        "n_micro_impacts": int((imp["kind"] == "micro").sum()),
+        "n_chatter_ends": int((imp["kind"] == "chatter_end").sum()),
         "slow_closings": int(cnt[k.I_SLOW_CLOSINGS]),
         "chatter_handovers": int(cnt[k.I_CHATTER]),
         "truncated_mass": truncated_mass(p.l_lambda, p.l_lambda_sigma, p.l_min),
@@ -263,6 +301,7 @@ def simulate(
             else "rk4-fixed-step+illinois-events"
         ),
         "version": __version__,
+        "tangent": bool(tangent),
         "wall_time_s": time.perf_counter() - t0,
     }
     return Trajectory(
@@ -274,6 +313,8 @@ def simulate(
         impacts=imp,
         stats=stats,
         final_state=(float(y[k.Y_TIME]), float(y[k.Y_THETA]), float(y[k.Y_OMEGA])),
+        jacobians=jac,
+        divergence=div,
     )
 
 

@@ -29,7 +29,8 @@ def default_run():
 
 
 def test_impact_law_at_every_impact(default_run):
-    """At each applied impact delta ~ 0 and the gap rate reverses: d(delta)+ = -xi d(delta)-."""
+    """At each applied impact delta ~ 0 and the gap rate reverses, d(delta)+ = -xi d(delta)-;
+    at a chattering end (approach slower than v_chatter) it is 0 (plastic closure)."""
     p = default_run.params
     imp = default_run.impacts
     assert len(imp) > 10
@@ -38,7 +39,10 @@ def test_impact_law_at_every_impact(default_run):
     after = gap_rate(p, imp.t.values, imp.theta_f.values, imp.omega_after.values)
     assert np.max(np.abs(d)) < 1e-11
     np.testing.assert_allclose(before, imp.gap_rate_before.values, rtol=1e-12)
-    np.testing.assert_allclose(after, -p.xi * before, rtol=1e-9, atol=1e-12)
+    end = (imp["kind"] == "chatter_end").to_numpy()
+    np.testing.assert_allclose(after[~end], -p.xi * before[~end], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(after[end], 0.0, atol=1e-12)
+    assert np.all(-before[end] < p.v_chatter) and np.all(-before[~end] >= p.v_chatter)
     assert np.all(-before > p.v_min)
 
 

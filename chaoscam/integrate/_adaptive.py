@@ -303,7 +303,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             if closing:
                 if not (0.0 < l1 < c[C_ROD_L]):
                     return leave(y, cnt, th, om, t, h_next, events, window, LEFT_REACH, c)
-                om, K = k.impact(t, th, om, l1, cdn, K, lam, cnt, impacts, c)
+                om, K = k.impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
             flight = g > 0.0
             a1 = accel_trig(tr, om, K, c, flight)
             h = min(h_next, hs)  # the event cut the step: do not grow past it
@@ -328,7 +328,9 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             if -g > c[C_RCAM]:
                 return leave(y, cnt, th, om, t, h, events, window, PENETRATION, c)
         if clipped:
-            K = k.at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, c)
+            K = k.at_scheduled(
+                t, th, om, is_section, is_resample, K, lam, cnt, section, y, c
+            )
             if is_resample:
                 a1 = accel_trig(tr, om, K, c, flight)
     return leave(y, cnt, th, om, t, h, events, window, OK, c)

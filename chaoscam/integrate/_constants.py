@@ -16,7 +16,9 @@ from . import _kernel as k
 __all__ = ["initial_counters", "initial_state", "kernel_constants"]
 
 
-def kernel_constants(p: Params, *, t_record: float = 0.0, stride: int = 0) -> np.ndarray:
+def kernel_constants(
+    p: Params, *, t_record: float = 0.0, stride: int = 0, tangent: bool = False
+) -> np.ndarray:
     """The float64 constants vector indexed by ``_kernel.C_*``.
 
     Parameters
@@ -27,6 +29,9 @@ def kernel_constants(p: Params, *, t_record: float = 0.0, stride: int = 0) -> np
         Outputs (series, section, impacts, contact fraction) are kept from this time [s].
     stride : int
         Keep a series sample every ``stride`` grid steps; 0 keeps none.
+    tangent : bool
+        Integrate the tangent dynamics (fixed-step RK4 only; ignored by the adaptive path,
+        whose section Jacobians stay NaN).
     """
     c = np.zeros(k.N_CONSTANTS)
     xo, yo = p.pivot
@@ -61,6 +66,9 @@ def kernel_constants(p: Params, *, t_record: float = 0.0, stride: int = 0) -> np
     c[k.C_RTOL] = p.rtol
     c[k.C_ATOL] = p.atol
     c[k.C_H_MAX] = p.h_max
+    c[k.C_TANGENT] = 1.0 if tangent and p.integrator == "rk4" else 0.0
+    c[k.C_V_CHATTER] = p.v_chatter
+    c[k.C_V_MICRO] = p.v_micro
     return c
 
 
@@ -73,15 +81,18 @@ def initial_state(p: Params) -> np.ndarray:
     y = np.zeros(k.Y_SIZE)
     y[k.Y_THETA] = float(contact_angle(p, 0.0)) if p.theta_f0 is None else p.theta_f0
     y[k.Y_OMEGA] = float(contact_angle_rate(p, 0.0)) if p.omega_f0 is None else p.omega_f0
+    y[k.Y_J11] = y[k.Y_J22] = 1.0  # the tangent starts from the identity
     return y
 
 
 def initial_counters(p: Params, *, transient: float = 0.0) -> np.ndarray:
     """The integer counters (indices ``_kernel.I_*``) at t = 0 for a run recording from
-    ``transient``: the first section index k with k T >= transient, and the first series
-    sample and resampling index 1 (their index-0 points are the initial state)."""
+    ``transient``: the first section index 0 (sections are scheduled through the transient,
+    where they are not recorded, so that a realization's steps do not depend on the
+    transient and the tangent restarts every period), and the first series sample and
+    resampling index 1 (their index-0 points are the initial state)."""
+    del transient  # the recording starts at kernel_constants' t_record
     cnt = np.zeros(k.N_COUNTERS, dtype=np.int64)
-    cnt[k.I_SECTION_K] = math.ceil(transient / p.cam_period - 1e-12)
     cnt[k.I_RESAMPLE_J] = 1
     cnt[k.I_SERIES_J] = 1
     return cnt

@@ -204,6 +204,9 @@ def simulate_ensemble(
             columns=icols,
         )
         impacts["member"] = impacts["member"].astype(np.int64)
+        impacts["kind"] = pd.Categorical.from_codes(
+            impacts["kind"].to_numpy(dtype=np.int64), categories=list(k.IMPACT_KINDS)
+        )
     import numba
 
     return Ensemble(
@@ -306,7 +309,7 @@ def _run_batch(plist, indices, first, seed, duration, transient, run=None, keep_
         m = cnt[j, k.I_N_SECTION]
         block = np.empty((m, 6))
         block[:, 0] = first + j
-        block[:, 1:] = section[j, :m]
+        block[:, 1:] = section[j, :m, : len(k.SECTION_NAMES)]
         sections.append(block)
         rows.append(
             (

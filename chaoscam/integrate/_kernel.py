@@ -1,8 +1,8 @@
 """Compiled fixed-step RK4 with located impacts: the reference integrator (paper sec. 3).
 
 One call of :func:`run_chunk` advances one trajectory on the grid ``t_n = n dt`` until the end
-step or until an output buffer needs emptying; the Python driver (``chaoscam.simulate``) then
-empties the buffers and calls again. The kernel never raises: it returns a status code
+step or until an output buffer needs emptying; the Python driver then empties the buffers and
+calls again. The kernel never raises: it returns a status code
 (:class:`chaoscam.integrate.Status`).
 
 Within one grid step the interval is cut into *segments* at the scheduled times that fall
@@ -10,16 +10,21 @@ inside it (stroboscopic section times ``k T``, line-length resampling times ``j 
 located impacts. Each segment is one RK4 substep, so the section points are exact RK4 states,
 not interpolations, and the grid itself never shifts.
 
-Impacts (paper (4)–(5), shared/MODEL.md): when the gap ``delta`` is positive at a segment's
-start and non-positive at its end, the crossing time is found by the Illinois variant of
-regula falsi on ``tau -> delta(RK4 substep of length tau)`` down to ``event_tol``; the state is
-taken at the bracket end where ``delta <= 0``. If the approach speed ``-d(delta)/dt`` exceeds
-``v_min`` the restitution jump ``theta'+ = -xi theta'- + (1 + xi) (dC/dt . n) / l_1`` is applied
-and recorded; slower closings are left to the compliant force. Limits: two crossings within one
-segment (a graze shorter than a step) are not seen.
+Impacts (paper (4)–(5), MODEL.md): when the gap ``delta`` is positive at a segment's start and
+non-positive at its end, the crossing time is found by the Illinois variant of regula falsi on
+``tau -> delta(RK4 substep of length tau)`` down to ``event_tol``; the state is taken at the
+bracket end where ``delta <= 0``. There the restitution law applies (:func:`impact`): a jump
+``theta'+ = -xi theta'- + (1 + xi) (dC/dt . n) / l_1``, or, when the approach is slower than
+``v_chatter``, the plastic closure that ends a complete chattering sequence. Limits: two
+crossings within one segment (a graze shorter than a step) are not seen.
 
-All numbers come from the constants vector built by ``chaoscam.integrate.kernel_constants``;
-the names ``C_*`` below index it.
+With ``c[C_TANGENT]`` set, the tangent matrix is integrated with the state
+(:mod:`._tangent`) and multiplied by the saltation matrix at each jump; at each section time
+the Jacobian of the stroboscopic map over the last period is written beside the section point
+and the tangent restarts from the identity. The state is the same with and without it.
+
+The model's equations live in :mod:`._physics`, the array layout in :mod:`._layout` (whose
+names this module re-exports for its callers).
 """
 
 from __future__ import annotations
@@ -29,228 +34,69 @@ import math
 import numpy as np
 from numba import njit
 
-# --- indices into the constants vector (see _constants.py) -------------------------------
-C_OMEGA = 0  # cam speed [rad/s]
-C_THETA_C0 = 1  # cam phase at t = 0 [rad]
-C_E = 2  # eccentricity [m]
-C_XO = 3  # pivot x [m]
-C_YO = 4  # pivot y [m]
-C_RSUM = 5  # R + r [m]
-C_RCAM = 6  # cam radius R [m]
-C_RROD = 7  # rod radius r, in the slip speed [m]
-C_GRAV = 8  # m g l / 2 [N m]
-C_INV_J = 9  # 1 / J [1/(kg m^2)]
-C_HERTZ = 10  # (pi/4) E: K_n = C_HERTZ * l_lambda for the Hertz model [Pa]
-C_K_FIXED = 11  # K_n of the fractal model; 0 selects the Hertz model [N/m]
-C_DAMP_SIGN = 12  # +1 Hunt–Crossley, -1 the paper's literal signs
-C_BETA = 13  # impact damping factor [s/m]
-C_MU_ARM = 14  # mu_f times the friction arm [m]
-C_VEPS = 15  # sign regularisation speed [m/s]; 0 = exact sign
-C_VMIN = 16  # least approach speed of an applied impact [m/s]
-C_XI = 17  # coefficient of restitution
-C_ROD_L = 18  # rod length l [m]
-C_DT = 19  # grid step [s]
-C_EVENT_TOL = 20  # impact-time tolerance [s]
-C_PERIOD = 21  # section interval 2 pi / omega [s]
-C_T_RECORD = 22  # outputs are kept from this time on (transient) [s]
-C_RESAMPLE_DT = 23  # interval between line-length draws [s]; 0 = draw at each impact
-C_MAX_EVENTS = 24  # impacts handled in one step before chattering hand-over
-C_STRIDE = 25  # series sample every C_STRIDE steps; 0 = no series
-C_FLIGHT_MERGE = 26  # most grid steps taken as one RK4 step where the gap provably stays open
-C_METHOD = 27  # METHOD_RK4 (this module) or METHOD_ADAPTIVE (_adaptive.py)
-C_RTOL = 28  # adaptive: relative tolerance of the step error
-C_ATOL = 29  # adaptive: absolute tolerance [rad and rad/s]
-C_H_MAX = 30  # adaptive: largest step [s]
-N_CONSTANTS = 31
-
-METHOD_RK4 = 0
-METHOD_ADAPTIVE = 1
-
-# --- indices into the integer counters ---------------------------------------------------
-I_STEP = 0  # grid step n of the current time n dt
-I_N_SERIES = 1  # rows filled in the series buffer
-I_N_SECTION = 2  # rows filled in the section buffer
-I_N_IMPACT = 3  # rows filled in the impact buffer
-I_LAM_POS = 4  # index of the line length in use in the draws buffer
-I_SECTION_K = 5  # next section index k (time k T)
-I_RESAMPLE_J = 6  # next resampling index j (time j dt_l)
-I_CONTACT_STEPS = 7  # recorded steps ending in contact
-I_COUNTED_STEPS = 8  # recorded steps
-I_CHATTER = 9  # steps where the chattering guard handed over to the compliant contact
-I_SLOW_CLOSINGS = 10  # closings slower than v_min (no jump applied)
-I_SAFE_STEP = 11  # the gap provably stays open until grid step I_SAFE_STEP (0 = not known)
-I_SERIES_J = 12  # adaptive: index j of the next series sample (time j * stride * dt)
-N_COUNTERS = 13
-
-# --- the state vector y ----------------------------------------------------------------------
-Y_THETA = 0  # theta_f [rad]
-Y_OMEGA = 1  # theta_f' [rad/s]
-Y_TIME = 2  # t [s] (the fixed-step kernel keeps it equal to cnt[I_STEP] * dt)
-Y_STEP = 3  # adaptive: the step size to try next [s]; 0 = not known yet
-Y_RECORDED = 4  # adaptive: time integrated after the transient [s]
-Y_CONTACT = 5  # adaptive: of which in contact (gap <= 0) [s]
-Y_EVENTS = 6  # adaptive: events so far in the grid interval Y_WINDOW (chattering guard)
-Y_WINDOW = 7  # adaptive: that grid interval's index n, [n dt, (n + 1) dt)
-Y_SIZE = 8
-
-# --- status codes (mirrors chaoscam.integrate.Status) ------------------------------------
-OK = 0
-NEED_BUFFER = 1
-LEFT_REACH = 2
-NON_FINITE = 3
-PENETRATION = 4
-
-SECTION_NAMES = ("k", "t", "theta_f", "omega_f", "l_lambda")
-IMPACT_NAMES = (
-    "t", "theta_f", "omega_before", "omega_after", "gap_rate_before", "lever_arm", "l_lambda",
+from ._layout import *  # noqa: F403 (the layout's names are part of this module's face)
+from ._layout import (
+    C_DT,
+    C_EVENT_TOL,
+    C_FLIGHT_MERGE,
+    C_MAX_EVENTS,
+    C_PERIOD,
+    C_RCAM,
+    C_RESAMPLE_DT,
+    C_ROD_L,
+    C_STRIDE,
+    C_T_RECORD,
+    C_TANGENT,
+    C_V_CHATTER,
+    C_V_MICRO,
+    C_VMIN,
+    C_XI,
+    I_CHATTER,
+    I_CONTACT_STEPS,
+    I_COUNTED_STEPS,
+    I_LAM_POS,
+    I_N_IMPACT,
+    I_N_SECTION,
+    I_N_SERIES,
+    I_RESAMPLE_J,
+    I_SAFE_STEP,
+    I_SECTION_K,
+    I_SLOW_CLOSINGS,
+    I_STEP,
+    IMPACT_CHATTER_END,
+    IMPACT_MACRO,
+    IMPACT_MICRO,
+    LEFT_REACH,
+    NEED_BUFFER,
+    NON_FINITE,
+    OK,
+    PENETRATION,
+    Y_DIV,
+    Y_J11,
+    Y_J12,
+    Y_J21,
+    Y_J22,
+    Y_OMEGA,
+    Y_THETA,
+    Y_TIME,
 )
-SERIES_COLS = 4  # t, theta_f, omega_f, l_lambda
-SECTION_COLS = len(SECTION_NAMES)
-IMPACT_COLS = len(IMPACT_NAMES)
-
-
-@njit(cache=True)
-def stiffness(lam, c):
-    """K_n for line length ``lam``: Hertz (18) unless a fixed (fractal) value is set."""
-    return c[C_K_FIXED] if c[C_K_FIXED] > 0.0 else c[C_HERTZ] * lam
-
-
-@njit(cache=True)
-def geometry(t, th, c):
-    """Gap delta, lever arm l_1 and normal cam speed dC/dt . n at time t and angle th."""
-    thc = c[C_OMEGA] * t + c[C_THETA_C0]
-    return geometry_trig(math.cos(thc), math.sin(thc), math.cos(th), math.sin(th), c)
-
-
-@njit(cache=True)
-def geometry_trig(cc, sc, ct, st, c):
-    """:func:`geometry` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st)."""
-    dx = c[C_XO] - c[C_E] * cc
-    dy = c[C_YO] - c[C_E] * sc
-    delta = -dx * st + dy * ct - c[C_RSUM]
-    l1 = -(dx * ct + dy * st)
-    ew = c[C_E] * c[C_OMEGA]
-    cdn = ew * sc * st + ew * cc * ct
-    return delta, l1, cdn
-
-
-@njit(cache=True)
-def acceleration(t, th, om, K, c):
-    """theta_f'' from (1)–(3): gravity, Hunt–Crossley normal force, friction torque."""
-    thc = c[C_OMEGA] * t + c[C_THETA_C0]
-    return acceleration_trig(math.cos(thc), math.sin(thc), math.cos(th), math.sin(th), om, K, c)
-
-
-@njit(cache=True)
-def acceleration_trig(cc, sc, ct, st, om, K, c):
-    """:func:`acceleration` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st).
-
-    The one home of equations (1)–(3); callers that know the trigonometric values (the
-    adaptive kernel rotates them from a step's start) skip four transcendental calls.
-    """
-    cx = c[C_E] * cc
-    cy = c[C_E] * sc
-    dx = c[C_XO] - cx
-    dy = c[C_YO] - cy
-    delta = -dx * st + dy * ct - c[C_RSUM]
-    torque = -c[C_GRAV] * ct
-    if delta < 0.0:
-        l1 = -(dx * ct + dy * st)
-        ew = c[C_E] * c[C_OMEGA]
-        cdn = ew * sc * st + ew * cc * ct
-        pen = -delta
-        pen_rate = cdn - l1 * om
-        force = K * pen * (1.0 + c[C_DAMP_SIGN] * c[C_BETA] * pen_rate)
-        if force > 0.0:
-            # slip of the rod surface over the cam at B_c = C - R n
-            bx = cx + c[C_RCAM] * st
-            by = cy - c[C_RCAM] * ct
-            v_r = c[C_RROD] * om - c[C_OMEGA] * (bx * st - by * ct)
-            if c[C_VEPS] > 0.0:
-                x = v_r / c[C_VEPS]
-                # tanh(x) rounds to +-1 in float64 for |x| > 19.1: skip the call there.
-                sgn = math.tanh(x) if abs(x) < 20.0 else (1.0 if x > 0.0 else -1.0)
-            else:
-                sgn = (v_r > 0.0) - (v_r < 0.0)
-            torque += force * l1 - c[C_MU_ARM] * force * sgn
-    return torque * c[C_INV_J]
-
-
-@njit(cache=True)
-def rk4(t, th, om, h, K, c):
-    """One classical fourth-order Runge–Kutta step of length h for (theta_f, theta_f')."""
-    a1 = acceleration(t, th, om, K, c)
-    th2 = th + 0.5 * h * om
-    om2 = om + 0.5 * h * a1
-    a2 = acceleration(t + 0.5 * h, th2, om2, K, c)
-    th3 = th + 0.5 * h * om2
-    om3 = om + 0.5 * h * a2
-    a3 = acceleration(t + 0.5 * h, th3, om3, K, c)
-    th4 = th + h * om3
-    om4 = om + h * a3
-    a4 = acceleration(t + h, th4, om4, K, c)
-    return (
-        th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
-        om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
-    )
-
-
-@njit(cache=True)
-def rk4_flight(th, om, h, c):
-    """RK4 step of the free pendulum J theta'' = -(m g l/2) cos theta (no contact force).
-
-    Exactly the step :func:`rk4` takes whenever the gap stays positive over the step, at a
-    quarter of the cost; :func:`closing_bound` decides when that is guaranteed.
-    """
-    k = -c[C_GRAV] * c[C_INV_J]
-    a1 = k * math.cos(th)
-    om2 = om + 0.5 * h * a1
-    a2 = k * math.cos(th + 0.5 * h * om)
-    om3 = om + 0.5 * h * a2
-    a3 = k * math.cos(th + 0.5 * h * om2)
-    om4 = om + h * a3
-    a4 = k * math.cos(th + h * om3)
-    return (
-        th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
-        om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
-    )
-
-
-@njit(cache=True)
-def gap_accel_bound(om, c):
-    """A bound on |delta''| in flight while |theta'| stays below |om| + 1 rad/s [m/s^2].
-
-    For ``delta = (O - C).n - (R + r)``:
-    ``|delta''| <= e w^2 + 2 e w |theta'| + rho_max (|theta''| + theta'^2)`` with
-    ``rho_max = |O| + e`` and ``|theta''| <= m g l / (2 J)`` in flight.
-    """
-    w = abs(om) + 1.0
-    ew = c[C_E] * c[C_OMEGA]
-    rho = math.hypot(c[C_XO], c[C_YO]) + c[C_E]
-    return ew * c[C_OMEGA] + 2.0 * ew * w + rho * (c[C_GRAV] * c[C_INV_J] + w * w)
-
-
-@njit(cache=True)
-def closing_bound(l1, cdn, om, h, c):
-    """An upper bound on how much the gap can shrink within a time h <= J / (m g l / 2) [m].
-
-    ``|delta(t + s) - delta(t)| <= s |delta'| + s^2/2 max|delta''|``, doubled for safety.
-    Over such an h gravity changes theta' by at most 1 rad/s, as :func:`gap_accel_bound`
-    assumes.
-    """
-    return 2.0 * (h * abs(l1 * om - cdn) + 0.5 * h * h * gap_accel_bound(om, c))
-
-
-@njit(cache=True)
-def safe_horizon(g, l1, cdn, om, c):
-    """The time over which a positive gap g certainly stays positive [s].
-
-    The largest H with ``closing_bound(H) <= g``, capped at J / (m g l / 2).
-    """
-    acc = gap_accel_bound(om, c)
-    v = abs(l1 * om - cdn)
-    horizon = 0.5 * g / (v + math.sqrt(v * v + acc * g))
-    return min(horizon, 1.0 / (c[C_GRAV] * c[C_INV_J]))
+from ._physics import (  # noqa: F401 (re-exported: the adaptive kernel and tests use them)
+    JAC_CONTACT,
+    JAC_FLIGHT,
+    JAC_NATURAL,
+    acceleration,
+    acceleration_jacobian,
+    acceleration_trig,
+    closing_bound,
+    gap_accel_bound,
+    geometry,
+    geometry_trig,
+    rk4,
+    rk4_flight,
+    safe_horizon,
+    stiffness,
+)
+from ._tangent import rk4_flight_tangent, rk4_tangent, saltation
 
 
 @njit(cache=True, inline="always")
@@ -337,10 +183,12 @@ def next_scheduled(t_limit, cnt, c):
 
 
 @njit(cache=True, inline="always")
-def at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, c):
+def at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c):
     """Record the section point and/or draw the next line length at a scheduled time t.
 
-    Returns the stiffness in use afterwards.
+    At a section the tangent matrix (the stroboscopic map's Jacobian over the period that
+    ends here) is written beside the point and restarted from the identity. Returns the
+    stiffness in use afterwards.
     """
     if is_section:
         if t >= c[C_T_RECORD]:
@@ -350,7 +198,10 @@ def at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, c):
             section[i, 2] = th
             section[i, 3] = om
             section[i, 4] = lam[cnt[I_LAM_POS]]
+            for j in range(5):
+                section[i, 5 + j] = y[Y_J11 + j] if c[C_TANGENT] > 0.0 else np.nan
             cnt[I_N_SECTION] += 1
+        reset_tangent(y)
         cnt[I_SECTION_K] += 1
     if is_resample:
         cnt[I_LAM_POS] += 1
@@ -360,33 +211,105 @@ def at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, c):
 
 
 @njit(cache=True, inline="always")
-def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, c):
+def reset_tangent(y):
+    """The tangent matrix back to the identity and the divergence integral to 0."""
+    y[Y_J11] = 1.0
+    y[Y_J21] = 0.0
+    y[Y_J12] = 0.0
+    y[Y_J22] = 1.0
+    y[Y_DIV] = 0.0
+
+
+@njit(cache=True, inline="always")
+def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c):
     """The impact law (4)–(5) at a located closing at (t, th) with lever arm l1 and dC/dt.n.
 
-    When the approach speed -(l1 theta' - dC/dt.n) exceeds v_min the angular velocity jumps,
-    ``theta'+ = -xi theta'- + (1 + xi) (dC/dt.n) / l1``, a new line length is drawn (impact
-    resampling) and the jump is recorded (after the transient); a slower closing is left to
-    the compliant force and counted. Returns (theta' after, stiffness in use).
+    The approach speed is ``v = -(l1 theta' - dC/dt.n)``. When ``v > v_min`` (0 by default:
+    every closing) the angular velocity jumps,
+    ``theta'+ = -xi theta'- + (1 + xi) (dC/dt.n) / l1``, so that the gap rate becomes
+    ``-xi`` times itself. A closing slower than ``v_chatter`` is the end of a complete
+    chattering sequence (the infinitely many ever shorter bounces whose speeds fall by ``xi``
+    each, Nordmark & Piiroinen 2009, Nonlinear Dyn. 58): it is replaced by its accumulation
+    point, a plastic closure ``theta'+ = (dC/dt.n) / l1`` (gap rate 0), after which the
+    compliant contact carries the motion. Each applied jump draws a new line length (impact
+    resampling), multiplies the tangent by its saltation matrix and is recorded (after the
+    transient) with its kind: macro, micro (slower than ``v_micro``) or chatter end. Closings
+    slower than ``v_min`` are left to the compliant force and counted.
+
+    Returns (theta' after, stiffness in use).
     """
     rate = l1 * om - cdn
-    if -rate > c[C_VMIN]:
-        om_after = -c[C_XI] * om + (1.0 + c[C_XI]) * cdn / l1
-        if c[C_RESAMPLE_DT] <= 0.0:
-            cnt[I_LAM_POS] += 1
-            K = stiffness(lam[cnt[I_LAM_POS]], c)
-        if t >= c[C_T_RECORD]:
-            i = cnt[I_N_IMPACT]
-            impacts[i, 0] = t
-            impacts[i, 1] = th
-            impacts[i, 2] = om
-            impacts[i, 3] = om_after
-            impacts[i, 4] = rate
-            impacts[i, 5] = l1
-            impacts[i, 6] = lam[cnt[I_LAM_POS]]
-            cnt[I_N_IMPACT] += 1
-        return om_after, K
-    cnt[I_SLOW_CLOSINGS] += 1
-    return om, K
+    if not (-rate > c[C_VMIN]):
+        cnt[I_SLOW_CLOSINGS] += 1
+        return om, K
+    if -rate < c[C_V_CHATTER]:
+        xi = 0.0
+        kind = IMPACT_CHATTER_END
+    else:
+        xi = c[C_XI]
+        kind = IMPACT_MICRO if -rate < c[C_V_MICRO] else IMPACT_MACRO
+    om_after = -xi * om + (1.0 + xi) * cdn / l1
+    if c[C_TANGENT] > 0.0:
+        s11, s21, s22 = saltation(t, th, om, om_after, l1, cdn, xi, c)
+        v11, v21, v12, v22 = y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22]
+        y[Y_J11] = s11 * v11
+        y[Y_J12] = s11 * v12
+        y[Y_J21] = s21 * v11 + s22 * v21
+        y[Y_J22] = s21 * v12 + s22 * v22
+    if c[C_RESAMPLE_DT] <= 0.0:
+        cnt[I_LAM_POS] += 1
+        K = stiffness(lam[cnt[I_LAM_POS]], c)
+    if t >= c[C_T_RECORD]:
+        i = cnt[I_N_IMPACT]
+        impacts[i, 0] = t
+        impacts[i, 1] = th
+        impacts[i, 2] = om
+        impacts[i, 3] = om_after
+        impacts[i, 4] = rate
+        impacts[i, 5] = l1
+        impacts[i, 6] = lam[cnt[I_LAM_POS]]
+        impacts[i, 7] = kind
+        cnt[I_N_IMPACT] += 1
+    return om_after, K
+
+
+@njit(cache=True, inline="always")
+def step_rk4(t, th, om, h, K, c, y, commit, side):
+    """One RK4 substep of the state; with the tangent on, of the tangent too, its Jacobian
+    taken on ``side`` of the contact surface (:data:`._physics.JAC_NATURAL` and others).
+
+    Returns ``(th, om, v11, v21, v12, v22, div)``, the last five being the tangent after the
+    step (written into ``y`` when ``commit``; the state is always returned, never stored).
+    """
+    if c[C_TANGENT] > 0.0:
+        r = rk4_tangent(t, th, om, h, K, c, y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22], side)
+        if commit:
+            commit_tangent(y, r[2], r[3], r[4], r[5], r[6])
+        return r
+    th1, om1 = rk4(t, th, om, h, K, c)
+    return th1, om1, 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def step_flight(th, om, h, c, y, commit):
+    """:func:`step_rk4` for the free pendulum (:func:`rk4_flight`); divergence 0."""
+    if c[C_TANGENT] > 0.0:
+        r = rk4_flight_tangent(th, om, h, c, y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22])
+        if commit:
+            commit_tangent(y, r[2], r[3], r[4], r[5], 0.0)
+        return r[0], r[1], r[2], r[3], r[4], r[5], 0.0
+    th1, om1 = rk4_flight(th, om, h, c)
+    return th1, om1, 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def commit_tangent(y, v11, v21, v12, v22, div):
+    """Store an accepted step's tangent matrix and add its divergence integral."""
+    y[Y_J11] = v11
+    y[Y_J21] = v21
+    y[Y_J12] = v12
+    y[Y_J22] = v22
+    y[Y_DIV] += div
 
 
 @njit(cache=True)
@@ -406,8 +329,8 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     Parameters
     ----------
     y : float64[Y_SIZE]
-        (theta_f [rad], theta_f' [rad/s], t [s], ...) at ``t = cnt[I_STEP] * dt``; updated in
-        place (slots ``Y_*``; this kernel reads the first two and writes the time).
+        (theta_f [rad], theta_f' [rad/s], t [s], ..., tangent) at ``t = cnt[I_STEP] * dt``;
+        updated in place (slots ``Y_*``).
     cnt : int64[N_COUNTERS]
         Counters (indices ``I_*``); updated in place.
     c : float64[N_CONSTANTS]
@@ -416,7 +339,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
         Grid step at which the run ends.
     lam : float64[:]
         Line-length draws; ``lam[cnt[I_LAM_POS]]`` is the one in use.
-    series, section, impacts : float64[:, 4], [:, 5], [:, 7]
+    series, section, impacts : float64[:, SERIES_COLS], [:, SECTION_COLS], [:, IMPACT_COLS]
         Output buffers, filled from the row counts in ``cnt``.
 
     Returns
@@ -430,8 +353,8 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     samples_per_block = merge // stride + 1 if stride > 0 else 0
     max_events = np.int64(c[C_MAX_EVENTS])
     resample_on_impact = c[C_RESAMPLE_DT] <= 0.0
-    th = y[0]
-    om = y[1]
+    th = y[Y_THETA]
+    om = y[Y_OMEGA]
     K = stiffness(lam[cnt[I_LAM_POS]], c)
     sections_per_step = np.int64(h / c[C_PERIOD]) + 2
     draws_per_step = max_events + 1
@@ -444,6 +367,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     # was not interrupted. Whoever changes the state y from outside must reset it to 0.
     safe_n = cnt[I_SAFE_STEP]
     stale = False  # g, l1, cdn belong to an earlier point (only while the gap is safe)
+    jumped = False  # a rebound was just applied: the opening that follows is flight's
     while cnt[I_STEP] < n_stop:
         # Room for one more step's worth of outputs and draws, else hand back to Python.
         if (
@@ -468,7 +392,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
         if m >= 2:
             th0 = th
             om0 = om
-            th, om = rk4_flight(th0, om0, m * h, c)
+            th, om, _, _, _, _, _ = step_flight(th0, om0, m * h, c, y, True)
             stale = True
             cnt[I_STEP] = n + m
             if not (math.isfinite(th) and math.isfinite(om)):
@@ -498,7 +422,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             seg_end, is_section, is_resample = next_scheduled(t_end, cnt, c)
             hs = seg_end - t
             if hs > 0.0 and seg_end <= safe_n * h:
-                th, om = rk4_flight(th, om, hs, c)  # far from the cam: pure flight
+                th, om, _, _, _, _, _ = step_flight(th, om, hs, c, y, True)  # pure flight
                 t = seg_end
                 stale = True
             elif hs > 0.0:
@@ -506,9 +430,10 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     g, l1, cdn = geometry(t, th, c)
                     stale = False
                 if g > 0.0 and g > closing_bound(l1, cdn, om, hs, c):
-                    th_new, om_new = rk4_flight(th, om, hs, c)  # no contact possible
+                    trial = step_flight(th, om, hs, c, y, False)  # no contact possible
                 else:
-                    th_new, om_new = rk4(t, th, om, hs, K, c)
+                    trial = step_rk4(t, th, om, hs, K, c, y, False, JAC_NATURAL)
+                th_new, om_new = trial[0], trial[1]
                 g_new, l1, cdn = geometry(seg_end, th_new, c)
                 closing = g > 0.0 and g_new <= 0.0
                 if (closing or (g < 0.0 and g_new > 0.0)) and events >= max_events:
@@ -517,7 +442,11 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     # The gap changes sign inside the segment: go to the crossing, so that no
                     # RK4 step straddles the kink of the force at delta = 0, then resume.
                     tau = locate_crossing(t, th, om, hs, g, g_new, K, c)
-                    th, om = rk4(t, th, om, tau, K, c)
+                    # The substep ends on the surface: its Jacobian is the side it comes
+                    # from (flight before a closing and just after a jump, else contact).
+                    side = JAC_FLIGHT if closing or jumped else JAC_CONTACT
+                    th, om, _, _, _, _, _ = step_rk4(t, th, om, tau, K, c, y, True, side)
+                    jumped = False
                     t = t + tau
                     events += 1
                     g, l1, cdn = geometry(t, th, c)
@@ -525,15 +454,21 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                         continue
                     if not (0.0 < l1 < c[C_ROD_L]):
                         return leave(y, cnt, th, om, t, safe_n, LEFT_REACH)
-                    om, K = impact(t, th, om, l1, cdn, K, lam, cnt, impacts, c)
+                    om_before = om
+                    om, K = impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
+                    # after a rebound the point still lies on the surface, moving out
+                    jumped = om != om_before and l1 * om - cdn > 0.0
                     continue
+                if c[C_TANGENT] > 0.0:
+                    commit_tangent(y, trial[2], trial[3], trial[4], trial[5], trial[6])
+                jumped = False
                 th = th_new
                 om = om_new
                 t = seg_end
                 g = g_new
                 if g > 0.0:
                     safe_n = np.int64(math.floor((t + safe_horizon(g, l1, cdn, om, c)) / h))
-            K = at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, c)
+            K = at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)
 
         # End of the grid step: checks and outputs. Here g and l1 belong to (t_end, th).
         cnt[I_STEP] = n + 1

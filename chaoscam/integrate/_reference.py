@@ -117,18 +117,23 @@ def simulate_reference(
             if -rate > p.v_min:
                 l1 = float(lever_arm(p, t, y[0]))
                 cdn = float(normal_cam_speed(p, t, y[0]))
-                om_after = -p.xi * y[1] + (1.0 + p.xi) * cdn / l1
+                # below v_chatter: the plastic closure that ends a complete chattering
+                chatter_end = -rate < p.v_chatter
+                xi = 0.0 if chatter_end else p.xi
+                om_after = -xi * y[1] + (1.0 + xi) * cdn / l1
                 if p.resample == "impact":
                     lam = float(stream.draw(1)[0])
-                impacts.append((t, y[0], y[1], om_after, rate, l1, lam))
+                kind = 2 if chatter_end else (1 if -rate < p.v_micro else 0)
+                impacts.append((t, y[0], y[1], om_after, rate, l1, lam, kind))
                 y[1] = om_after
+                in_contact = chatter_end
             else:
                 in_contact = True
         elif t >= next_resample:
             lam = float(stream.draw(1)[0])
             next_resample += p.resample_dt
     cols = ["t", "theta_f", "omega_before", "omega_after", "gap_rate_before", "lever_arm",
-            "l_lambda"]
+            "l_lambda", "kind"]
     return ReferenceResult(
         impacts=pd.DataFrame(impacts, columns=cols),
         section=pd.DataFrame(section, columns=["k", "t", "theta_f", "omega_f", "l_lambda"]),

@@ -78,8 +78,11 @@ def contact_angle_rate(p: Params, t):
 
 
 def slip_speed(p: Params, t, theta_f, omega_f):
-    """Slip speed v_r = r dtheta_f/dt - (omega z x B_c).u at B_c = C - R n [m/s]."""
+    """Slip speed v_r = r dtheta_f/dt - (omega z x B_c).u at B_c = C + R n [m/s].
+
+    B_c is the cam's surface point facing the rod (MODEL.md; an earlier version used C - R n).
+    """
     (cx, cy), _ = cam_centre(p, t)
     nx, ny = -np.sin(theta_f), np.cos(theta_f)
-    bx, by = cx - p.R * nx, cy - p.R * ny
+    bx, by = cx + p.R * nx, cy + p.R * ny
     return p.r * omega_f - p.omega * (-by * np.cos(theta_f) + bx * np.sin(theta_f))

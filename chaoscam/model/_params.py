@@ -168,10 +168,35 @@ class Params:
         ),
     )
     v_min: float = field(
-        default=1e-3,
+        default=0.0,
         metadata=_meta(
             "least approach speed -d(delta)/dt for which the restitution jump (4) is applied; "
-            "slower closings belong to the compliant contact (decision: micro-impacts)",
+            "slower closings are left to the compliant force. Default 0: the law applies at "
+            "every closing (MODEL.md: a positive v_min lets slow closings rebound almost "
+            "elastically, the sticking phase rattles and the flight amplifies it into bands "
+            "that grow with v_min; the model is the limit v_min -> 0)",
+            "m/s",
+            _NONNEG,
+        ),
+    )
+    v_chatter: float = field(
+        default=1e-6,
+        metadata=_meta(
+            "approach speed below which a closing is taken as the end of a complete "
+            "chattering sequence and replaced by its accumulation point, a plastic closure "
+            "(gap rate 0; Nordmark & Piiroinen 2009). Bounces slower than this last "
+            "< 2 xi v / ((1 - xi) |delta''|) ~ 1e-7 s in all; 0 = simulate every bounce "
+            "(Zeno: the count then depends on dt). Measured convergence: README",
+            "m/s",
+            _NONNEG,
+        ),
+    )
+    v_micro: float = field(
+        default=1e-2,
+        metadata=_meta(
+            "approach speed below which an applied impact is flagged micro (inside a "
+            "chattering sequence) rather than macroscopic (the first, fast impacts after a "
+            "flight, ~0.05-1 m/s); a label in the impact list, no effect on the motion",
             "m/s",
             _NONNEG,
         ),

@@ -11,7 +11,13 @@ from chaoscam.analysis import lyapunov_benettin
 from chaoscam.lyapunov import lyapunov_model
 from chaoscam.model import ParameterError, contact_angle, contact_angle_rate
 
-PERIODIC = Params(e=0.02)  # period-1 response (section period 1, spectrum and 0-1 test agree)
+# The twin-trajectory estimate is kept for comparison where it is valid: responses without
+# chattering sequences (the two trajectories then apply the same impacts). With the default
+# v_min = 0 a sticking phase is a chattering sequence whose micro-impacts the twins do not
+# share, so these checks use the withdrawn v_min = 1e-3 m/s (chaoscam.tangent is the
+# estimate that works through chattering).
+PERIODIC = Params(e=0.02, v_min=1e-3)  # period-1 response
+DEFAULT = Params(v_min=1e-3)
 
 
 def _via_simulate(p: Params, duration: float, n_align: int):
@@ -47,14 +53,15 @@ def test_periodic_response_has_negative_exponent():
 
 
 def test_default_response_has_positive_exponent():
-    """The default model (l_lambda = 8 mm) is irregular: λ₁ > 0 beyond 2 standard errors."""
-    r = lyapunov_model(duration=6.0)
+    """The model with v_min = 1e-3 m/s (l_lambda = 8 mm) is irregular: λ₁ > 0 beyond 2
+    standard errors."""
+    r = lyapunov_model(DEFAULT, duration=6.0)
     assert r.ok and r.n_intervals >= 20
     assert r.exponent > 0.02 / Params().cam_period
     assert r.exponent > 2.0 * r.stderr
 
 
-@pytest.mark.parametrize("p", [PERIODIC, Params()], ids=["periodic", "default"])
+@pytest.mark.parametrize("p", [PERIODIC, DEFAULT], ids=["periodic", "default"])
 def test_agrees_with_the_analysis_layer_on_simulate_restarts(p):
     """Kernel-driven pair and analysis.lyapunov_benettin over simulate() agree (rtol 0.1)."""
     n_align, periods = 3, 14

@@ -8,13 +8,20 @@ from chaoscam import Params, simulate, simulate_reference
 DURATION = 0.7  # three impacts after the initial compliant contact
 
 
+# Integrator cross-checks are made with closings slower than 1 mm/s left to the compliant
+# contact (the withdrawn v_min decision): from the initial contact the default v_min = 0 starts
+# with a chattering sequence of micro-impacts whose times depend on rounding, which is not
+# what these tests measure. The chattering limit has tests of its own (test_chattering.py).
+CHECK = Params(v_min=1e-3)
+
+
 @pytest.fixture(scope="module")
 def reference():
-    return simulate_reference(Params(), DURATION)
+    return simulate_reference(CHECK, DURATION)
 
 
 def first_impacts(dt, n=3):
-    tr = simulate(Params(dt=dt), duration=DURATION, series=False)
+    tr = simulate(CHECK.replace(dt=dt), duration=DURATION, series=False)
     return tr.impacts.iloc[:n]
 
 
@@ -46,7 +53,7 @@ def test_halving_the_step_leaves_first_impacts_unchanged():
 
 def test_reference_and_kernel_sections_agree(reference):
     """The stroboscopic points before the first impacts agree to 1e-6 rad."""
-    ours = simulate(Params(dt=1e-6), duration=DURATION, series=False).section
+    ours = simulate(CHECK.replace(dt=1e-6), duration=DURATION, series=False).section
     n = min(len(ours), len(reference.section))
     assert n >= 3
     assert np.max(np.abs(ours.theta_f.values[:n] - reference.section.theta_f.values[:n])) < 1e-6

@@ -62,18 +62,18 @@ def test_row_is_reproduced_by_simulate(reference):
 
 
 def test_non_regular_runs_are_their_own_label():
-    """omega = 40 rad/s, xi = 0.9 leaves the cam's reach: labelled left_reach, kept."""
+    """omega = 45 rad/s, xi = 0.9 leaves the cam's reach: labelled left_reach, kept."""
     m = regime_map(
-        Axis("omega", (28.7, 40.0)),
+        Axis("omega", (28.7, 45.0)),
         Axis("xi", (0.42, 0.9)),
         duration=2.0,
         transient=0.5,
         classify=SpreadClassifier(),
         workers=1,
     )
-    row = m.realizations.set_index(["omega", "xi"]).loc[(40.0, 0.9)]
+    row = m.realizations.set_index(["omega", "xi"]).loc[(45.0, 0.9)]
     assert row["status"] == "LEFT_REACH" and row["label"] == "left_reach"
-    cell = m.cells.set_index(["omega", "xi"]).loc[(40.0, 0.9)]
+    cell = m.cells.set_index(["omega", "xi"]).loc[(45.0, 0.9)]
     assert cell["dominant"] == "left_reach" and cell["p_left_reach"] == 1.0
     assert len(m.realizations) == 4
 

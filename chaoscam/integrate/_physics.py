@@ -1,0 +1,241 @@
+"""The cam-follower's physics as compiled functions: geometry, equations (1)–(3), RK4 steps.
+
+Everything a kernel needs to know about the model itself lives here; event handling, the
+schedule of outputs and the stepping loop live in :mod:`._kernel` and :mod:`._adaptive`, the
+tangent dynamics in :mod:`._tangent`. Numbers come from the constants vector (``C_*``,
+:mod:`._layout`).
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from ._layout import (
+    C_BETA,
+    C_DAMP_SIGN,
+    C_E,
+    C_GRAV,
+    C_HERTZ,
+    C_INV_J,
+    C_K_FIXED,
+    C_MU_ARM,
+    C_OMEGA,
+    C_RCAM,
+    C_RROD,
+    C_RSUM,
+    C_THETA_C0,
+    C_VEPS,
+    C_XO,
+    C_YO,
+)
+
+
+@njit(cache=True)
+def stiffness(lam, c):
+    """K_n for line length ``lam``: Hertz (18) unless a fixed (fractal) value is set."""
+    return c[C_K_FIXED] if c[C_K_FIXED] > 0.0 else c[C_HERTZ] * lam
+
+
+@njit(cache=True)
+def geometry(t, th, c):
+    """Gap delta, lever arm l_1 and normal cam speed dC/dt . n at time t and angle th."""
+    thc = c[C_OMEGA] * t + c[C_THETA_C0]
+    return geometry_trig(math.cos(thc), math.sin(thc), math.cos(th), math.sin(th), c)
+
+
+@njit(cache=True)
+def geometry_trig(cc, sc, ct, st, c):
+    """:func:`geometry` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st)."""
+    dx = c[C_XO] - c[C_E] * cc
+    dy = c[C_YO] - c[C_E] * sc
+    delta = -dx * st + dy * ct - c[C_RSUM]
+    l1 = -(dx * ct + dy * st)
+    ew = c[C_E] * c[C_OMEGA]
+    cdn = ew * sc * st + ew * cc * ct
+    return delta, l1, cdn
+
+
+@njit(cache=True)
+def acceleration(t, th, om, K, c):
+    """theta_f'' from (1)–(3): gravity, Hunt–Crossley normal force, friction torque."""
+    thc = c[C_OMEGA] * t + c[C_THETA_C0]
+    return acceleration_trig(math.cos(thc), math.sin(thc), math.cos(th), math.sin(th), om, K, c)
+
+
+# Which side of delta = 0 the Jacobian is taken on (the state always uses the actual side).
+JAC_NATURAL = 0  # the side the point lies on
+JAC_FLIGHT = 1  # the free pendulum's, e.g. on a substep that ends at a located closing
+JAC_CONTACT = 2  # the contact force's continuation, e.g. on a substep ending at an opening
+
+
+@njit(cache=True, inline="always")
+def _equations(cc, sc, ct, st, om, K, c, jac, side):
+    """The one home of equations (1)–(3), and, when ``jac``, of their Jacobian.
+
+    Returns ``(theta'', d theta''/d theta, d theta''/d theta')`` (the derivatives are 0 unless
+    ``jac``). With ``delta = (O - C).n - (R + r)``, ``l_1 = (C - O).u`` and
+    ``dC/dt.n = e w (sin th_c sin th + cos th_c cos th)``:
+
+    - ``d delta/d theta = l_1``, ``d l_1/d theta = -(delta + R + r)``,
+      ``d(dC/dt.n)/d theta = e w (sin th_c cos th - cos th_c sin th)``;
+    - ``F_n = K p (1 + s beta p')`` with ``p = -delta``, ``p' = dC/dt.n - l_1 theta'``
+      (s = +1 Hunt–Crossley, -1 the paper's literal signs), clamped at F_n >= 0;
+    - friction torque ``-mu_f a F_n sgn(v_r)`` with the slip speed at ``B_c = C + R n``,
+      ``v_r = r theta' - w (C_x sin th - C_y cos th - R)``.
+
+    The vector field is continuous across delta = 0 (F_n vanishes there), so contact onset
+    and separation need no saltation matrix; its Jacobian jumps there, by ~K l_1^2 / J. A
+    substep that ends at a located crossing has its last stage *on* the surface, so its
+    Jacobian must be taken on the substep's own side (``side``: JAC_FLIGHT before a
+    closing, JAC_CONTACT, the force's continuation past p = 0, before an opening), else
+    the tangent picks up h/6 of that jump.
+    """
+    cx = c[C_E] * cc
+    cy = c[C_E] * sc
+    dx = c[C_XO] - cx
+    dy = c[C_YO] - cy
+    delta = -dx * st + dy * ct - c[C_RSUM]
+    torque = -c[C_GRAV] * ct
+    d_th = c[C_GRAV] * st if jac else 0.0
+    d_om = 0.0
+    in_contact = delta < 0.0
+    if in_contact or (jac and side == JAC_CONTACT):
+        l1 = -(dx * ct + dy * st)
+        ew = c[C_E] * c[C_OMEGA]
+        cdn = ew * sc * st + ew * cc * ct
+        pen = -delta
+        pen_rate = cdn - l1 * om
+        damp = c[C_DAMP_SIGN] * c[C_BETA]
+        shape = 1.0 + damp * pen_rate
+        force = K * pen * shape
+        pressing = force > 0.0 if in_contact else False
+        if side == JAC_CONTACT:
+            jac_on = jac and shape > 0.0
+        else:
+            jac_on = jac and pressing and side == JAC_NATURAL
+        if pressing or jac_on:
+            # slip of the rod surface over the cam at B_c = C + R n (MODEL.md)
+            v_r = c[C_RROD] * om - c[C_OMEGA] * (cx * st - cy * ct - c[C_RCAM])
+            dsgn = 0.0
+            if c[C_VEPS] > 0.0:
+                x = v_r / c[C_VEPS]
+                # tanh(x) rounds to +-1 in float64 for |x| > 19.1: skip the call there.
+                if abs(x) < 20.0:
+                    sgn = math.tanh(x)
+                    dsgn = (1.0 - sgn * sgn) / c[C_VEPS]
+                else:
+                    sgn = 1.0 if x > 0.0 else -1.0
+            else:
+                sgn = (v_r > 0.0) - (v_r < 0.0)
+            if pressing:
+                torque += force * l1 - c[C_MU_ARM] * force * sgn
+            if jac_on:
+                arm = l1 - c[C_MU_ARM] * sgn
+                l1_th = -(delta + c[C_RSUM])
+                rate_th = ew * (sc * ct - cc * st) - l1_th * om
+                f_th = K * (-l1 * shape + pen * damp * rate_th)
+                f_om = -K * pen * damp * l1
+                vr_th = -c[C_OMEGA] * (cx * ct + cy * st)
+                d_th += f_th * arm + force * (l1_th - c[C_MU_ARM] * dsgn * vr_th)
+                d_om += f_om * arm - force * c[C_MU_ARM] * dsgn * c[C_RROD]
+    inv_j = c[C_INV_J]
+    return torque * inv_j, d_th * inv_j, d_om * inv_j
+
+
+@njit(cache=True)
+def acceleration_trig(cc, sc, ct, st, om, K, c):
+    """:func:`acceleration` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st).
+
+    Callers that know the trigonometric values (the adaptive kernel rotates them from a
+    step's start) skip four transcendental calls.
+    """
+    return _equations(cc, sc, ct, st, om, K, c, False, JAC_NATURAL)[0]
+
+
+@njit(cache=True)
+def acceleration_jacobian(t, th, om, K, c, side=JAC_NATURAL):
+    """(theta_f'', d theta_f''/d theta_f, d theta_f''/d theta_f') at (t, th, om) [1/s^2, 1/s],
+    the Jacobian taken on ``side`` of the contact surface (see :func:`_equations`)."""
+    thc = c[C_OMEGA] * t + c[C_THETA_C0]
+    return _equations(
+        math.cos(thc), math.sin(thc), math.cos(th), math.sin(th), om, K, c, True, side
+    )
+
+
+@njit(cache=True)
+def rk4(t, th, om, h, K, c):
+    """One classical fourth-order Runge–Kutta step of length h for (theta_f, theta_f')."""
+    a1 = acceleration(t, th, om, K, c)
+    th2 = th + 0.5 * h * om
+    om2 = om + 0.5 * h * a1
+    a2 = acceleration(t + 0.5 * h, th2, om2, K, c)
+    th3 = th + 0.5 * h * om2
+    om3 = om + 0.5 * h * a2
+    a3 = acceleration(t + 0.5 * h, th3, om3, K, c)
+    th4 = th + h * om3
+    om4 = om + h * a3
+    a4 = acceleration(t + h, th4, om4, K, c)
+    return (
+        th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
+        om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
+    )
+
+
+@njit(cache=True)
+def rk4_flight(th, om, h, c):
+    """RK4 step of the free pendulum J theta'' = -(m g l/2) cos theta (no contact force).
+
+    Exactly the step :func:`rk4` takes whenever the gap stays positive over the step, at a
+    quarter of the cost; :func:`closing_bound` decides when that is guaranteed.
+    """
+    k = -c[C_GRAV] * c[C_INV_J]
+    a1 = k * math.cos(th)
+    om2 = om + 0.5 * h * a1
+    a2 = k * math.cos(th + 0.5 * h * om)
+    om3 = om + 0.5 * h * a2
+    a3 = k * math.cos(th + 0.5 * h * om2)
+    om4 = om + h * a3
+    a4 = k * math.cos(th + h * om3)
+    return (
+        th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
+        om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
+    )
+
+
+@njit(cache=True)
+def gap_accel_bound(om, c):
+    """A bound on |delta''| in flight while |theta'| stays below |om| + 1 rad/s [m/s^2].
+
+    For ``delta = (O - C).n - (R + r)``:
+    ``|delta''| <= e w^2 + 2 e w |theta'| + rho_max (|theta''| + theta'^2)`` with
+    ``rho_max = |O| + e`` and ``|theta''| <= m g l / (2 J)`` in flight.
+    """
+    w = abs(om) + 1.0
+    ew = c[C_E] * c[C_OMEGA]
+    rho = math.hypot(c[C_XO], c[C_YO]) + c[C_E]
+    return ew * c[C_OMEGA] + 2.0 * ew * w + rho * (c[C_GRAV] * c[C_INV_J] + w * w)
+
+
+@njit(cache=True)
+def closing_bound(l1, cdn, om, h, c):
+    """An upper bound on how much the gap can shrink within a time h <= J / (m g l / 2) [m].
+
+    ``|delta(t + s) - delta(t)| <= s |delta'| + s^2/2 max|delta''|``, doubled for safety.
+    Over such an h gravity changes theta' by at most 1 rad/s, as :func:`gap_accel_bound`
+    assumes.
+    """
+    return 2.0 * (h * abs(l1 * om - cdn) + 0.5 * h * h * gap_accel_bound(om, c))
+
+
+@njit(cache=True)
+def safe_horizon(g, l1, cdn, om, c):
+    """The time over which a positive gap g certainly stays positive [s].
+
+    The largest H with ``closing_bound(H) <= g``, capped at J / (m g l / 2).
+    """
+    acc = gap_accel_bound(om, c)
+    v = abs(l1 * om - cdn)
+    horizon = 0.5 * g / (v + math.sqrt(v * v + acc * g))
+    return min(horizon, 1.0 / (c[C_GRAV] * c[C_INV_J]))

@@ -1,0 +1,145 @@
+"""Tangent (variational) dynamics of the cam-follower through its impacts.
+
+The linearised flow ``V' = A(t) V`` with ``A = [[0, 1], [d theta''/d theta,
+d theta''/d theta']]`` is integrated with the state by the *same* RK4 stages
+(:func:`rk4_tangent`), so V is the exact derivative of the discrete RK4 map and the state
+is bit-identical to :func:`._physics.rk4`'s. At a restitution jump (4)–(5) V is multiplied by
+the saltation matrix (:func:`saltation`; Müller 1995, Chaos Solitons Fractals 5(9);
+Leine & Nijmeijer 2004, *Dynamics and Bifurcations of Non-smooth Mechanical Systems*,
+sec. 3.5; Dankowicz & Nordmark 2000, Physica D 136). Contact onset and separation need none:
+the contact force vanishes at delta = 0, so the vector field is continuous there (its Jacobian
+is not, which is why no RK4 step straddles delta = 0).
+
+The same RK4 quadrature gives the integral of the divergence ``tr A = d theta''/d theta'``,
+so that Liouville's formula ``ln |det V| = int tr A dt + sum ln |det S|`` can be checked.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from ._layout import C_E, C_GRAV, C_INV_J, C_OMEGA, C_THETA_C0, C_XO, C_YO
+from ._physics import acceleration_jacobian
+
+
+@njit(cache=True, inline="always")
+def _column(x, y, h, p1, q1, p2, q2, p3, q3, p4, q4):
+    """One column (x, y) of V through the RK4 stages of ``x' = y, y' = p_i x + q_i y``."""
+    x2, y2 = x + 0.5 * h * y, y + 0.5 * h * (p1 * x + q1 * y)
+    x3, y3 = x + 0.5 * h * y2, y + 0.5 * h * (p2 * x2 + q2 * y2)
+    x4, y4 = x + h * y3, y + h * (p3 * x3 + q3 * y3)
+    return (
+        x + h / 6.0 * (y + 2.0 * y2 + 2.0 * y3 + y4),
+        y + h / 6.0 * (p1 * x + q1 * y + 2.0 * (p2 * x2 + q2 * y2)
+                       + 2.0 * (p3 * x3 + q3 * y3) + p4 * x4 + q4 * y4),
+    )
+
+
+@njit(cache=True)
+def rk4_tangent(t, th, om, h, K, c, v11, v21, v12, v22, side):
+    """One RK4 step of the state and of its tangent matrix V (columns (v11, v21), (v12, v22)).
+
+    Returns ``(th, om, v11, v21, v12, v22, div)`` with ``div`` the step's RK4 quadrature of
+    the divergence. The state is computed exactly as :func:`._physics.rk4` does; ``side``
+    says on which side of the contact surface the Jacobian is taken
+    (:data:`._physics.JAC_NATURAL` unless the substep ends at a located crossing).
+    """
+    a1, p1, q1 = acceleration_jacobian(t, th, om, K, c, side)
+    th2 = th + 0.5 * h * om
+    om2 = om + 0.5 * h * a1
+    a2, p2, q2 = acceleration_jacobian(t + 0.5 * h, th2, om2, K, c, side)
+    th3 = th + 0.5 * h * om2
+    om3 = om + 0.5 * h * a2
+    a3, p3, q3 = acceleration_jacobian(t + 0.5 * h, th3, om3, K, c, side)
+    th4 = th + h * om3
+    om4 = om + h * a3
+    a4, p4, q4 = acceleration_jacobian(t + h, th4, om4, K, c, side)
+    # The same stages for each column (x, y) of V: x' = y, y' = p x + q y.
+    n11, n21 = _column(v11, v21, h, p1, q1, p2, q2, p3, q3, p4, q4)
+    n12, n22 = _column(v12, v22, h, p1, q1, p2, q2, p3, q3, p4, q4)
+    div = h / 6.0 * (q1 + 2.0 * q2 + 2.0 * q3 + q4)
+    return (
+        th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
+        om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
+        n11, n21, n12, n22, div,
+    )
+
+
+@njit(cache=True)
+def rk4_flight_tangent(th, om, h, c, v11, v21, v12, v22):
+    """:func:`._physics.rk4_flight` (the free pendulum) with its tangent matrix.
+
+    In flight ``A = [[0, 1], [(m g l / 2J) sin theta, 0]]``: the divergence is zero. Returns
+    ``(th, om, v11, v21, v12, v22)``.
+    """
+    k = -c[C_GRAV] * c[C_INV_J]
+    a1 = k * math.cos(th)
+    om2 = om + 0.5 * h * a1
+    th2 = th + 0.5 * h * om
+    a2 = k * math.cos(th2)
+    om3 = om + 0.5 * h * a2
+    th3 = th + 0.5 * h * om2
+    a3 = k * math.cos(th3)
+    om4 = om + h * a3
+    th4 = th + h * om3
+    a4 = k * math.cos(th4)
+    p1 = -k * math.sin(th)
+    p2 = -k * math.sin(th2)
+    p3 = -k * math.sin(th3)
+    p4 = -k * math.sin(th4)
+    x2, y2 = v11 + 0.5 * h * v21, v21 + 0.5 * h * p1 * v11
+    x3, y3 = v11 + 0.5 * h * y2, v21 + 0.5 * h * p2 * x2
+    x4, y4 = v11 + h * y3, v21 + h * p3 * x3
+    n11 = v11 + h / 6.0 * (v21 + 2.0 * y2 + 2.0 * y3 + y4)
+    n21 = v21 + h / 6.0 * (p1 * v11 + 2.0 * p2 * x2 + 2.0 * p3 * x3 + p4 * x4)
+    x2, y2 = v12 + 0.5 * h * v22, v22 + 0.5 * h * p1 * v12
+    x3, y3 = v12 + 0.5 * h * y2, v22 + 0.5 * h * p2 * x2
+    x4, y4 = v12 + h * y3, v22 + h * p3 * x3
+    n12 = v12 + h / 6.0 * (v22 + 2.0 * y2 + 2.0 * y3 + y4)
+    n22 = v22 + h / 6.0 * (p1 * v12 + 2.0 * p2 * x2 + 2.0 * p3 * x3 + p4 * x4)
+    return (
+        th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
+        om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
+        n11, n21, n12, n22,
+    )
+
+
+@njit(cache=True)
+def saltation(t, th, om_before, om_after, l1, cdn, xi, c):
+    """The saltation matrix S of a restitution jump at a located closing (t, th).
+
+    For the event surface ``h(t, x) = delta(t, theta) = 0`` and the jump
+    ``g(t, x) = (theta, -xi theta' + (1 + xi) q)``, ``q = (dC/dt.n) / l_1``:
+
+    ``S = g_x + (f+ - g_x f- - g_t) h_x^T / (h_t + h_x f-)`` (Müller 1995, eq. 16),
+
+    with ``h_x = (l_1, 0)``, ``h_t + h_x f- = l_1 theta'- - dC/dt.n`` (the gap rate before) and
+    ``f+- = (theta'+-, theta''_flight)``: the contact force vanishes on the surface, so both
+    sides share the free pendulum's acceleration. ``xi`` = 0 gives the plastic closure that
+    ends a complete chattering (a singular S). Whatever the geometry,
+    ``det S = -xi (h_t + h_x f+)/(h_t + h_x f-) = xi^2``.
+
+    Returns ``(s11, s21, s22)``; ``s12`` is 0.
+    """
+    w = c[C_OMEGA]
+    thc = w * t + c[C_THETA_C0]
+    cc, sc = math.cos(thc), math.sin(thc)
+    ct, st = math.cos(th), math.sin(th)
+    ew = c[C_E] * w
+    dx = c[C_XO] - c[C_E] * cc
+    dy = c[C_YO] - c[C_E] * sc
+    l1_th = dx * st - dy * ct
+    cdn_th = ew * (sc * ct - cc * st)
+    l1_t = ew * (cc * st - sc * ct)
+    cdn_t = w * l1_t
+    q_th = (cdn_th * l1 - cdn * l1_th) / (l1 * l1)
+    q_t = (cdn_t * l1 - cdn * l1_t) / (l1 * l1)
+    a_free = -c[C_GRAV] * c[C_INV_J] * ct
+    rate = l1 * om_before - cdn
+    g_th = (1.0 + xi) * q_th
+    w1 = om_after - om_before
+    w2 = a_free - (g_th * om_before - xi * a_free) - (1.0 + xi) * q_t
+    return 1.0 + w1 * l1 / rate, g_th + w2 * l1 / rate, -xi
+
