@@ -5,7 +5,9 @@ advances a state); nothing imports the model or the integrators.
 """
 
 from ._birkhoff import BirkhoffResult, birkhoff_weights, weighted_birkhoff
-from ._classify import classify_section, classify_signal
+from ._classify import classify_signal
+from ._classify_section import classify_section
+from ._evidence import zero_one_evidence
 from ._exponent import as_exponent, exponent_evidence
 from ._lyapunov import (
     LyapunovResult,
@@ -67,5 +69,6 @@ __all__ = [
     "spectrum_analysis",
     "stationarity_ratio",
     "weighted_birkhoff",
+    "zero_one_evidence",
     "zero_one_test",
 ]

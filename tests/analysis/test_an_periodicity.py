@@ -27,7 +27,7 @@ def test_period_of_a_cycle_with_noise_below_tolerance():
 
 
 def test_noise_above_tolerance_hides_the_period():
-    """The same cycle with noise at 1e-2 of its extent has no period at rtol 1e-3."""
+    """The same cycle with noise at 1e-2 of its extent has no period at the default rtol 3e-3."""
     cycle = RNG.uniform(-1, 1, size=(5, 2))
     pts = np.tile(cycle, (12, 1)) + 1e-2 * RNG.standard_normal((60, 2))
     assert section_period(pts).period is None
