@@ -17,9 +17,9 @@ _MIN_HALF = 8
 def birkhoff_weights(n: int) -> np.ndarray:
     """Normalised bump weights ``w(t) = exp(-1 / (t (1 - t)))`` at ``t = k / (n + 1)``.
 
-    The weights of the weighted Birkhoff average ``WB_n(f) = Σ_k ŵ_k f(x_k)`` (Das, Sander
-    & Yorke 2017, eq. 4; Das et al. 2017, eq. 1.3), ``ŵ_k = w(k / (n + 1)) / Σ_j w(j / (n +
-    1))`` for k = 1 .. n. All derivatives of w vanish at both ends, which is what makes the
+    The weights of the weighted Birkhoff average ``WB_n(f) = Σ_k ŵ_k f(x_k)`` (Das, Saiki,
+    Sander & Yorke 2017; Das & Yorke 2018), ``ŵ_k = w(k / (n + 1)) / Σ_j w(j / (n + 1))``
+    for k = 1 .. n. All derivatives of w vanish at both ends, which is what makes the
     average of a smooth function on a quasiperiodic orbit converge faster than any power
     of 1/n (instead of as 1/n for the plain average).
     """
@@ -90,14 +90,14 @@ def weighted_birkhoff(points) -> BirkhoffResult:
     f(x_{m+k-1})``. On a quasiperiodic orbit (a smooth torus with a Diophantine rotation)
     and a smooth f it converges faster than any power of 1/h; on a chaotic orbit only as
     h^{-1/2}. The number of converged digits compares the first h iterates with the next
-    h (Das, Saiki, Sander & Yorke 2017, eq. 1.4),
+    h (the measure of Das, Saiki, Sander & Yorke 2017),
 
         dig = -log10 |WB_h(f)(x_0) - WB_h(f)(x_h)|,
 
     here with f scaled by its range so that dig does not depend on units. Observables:
     each coordinate, cos and sin of the angle φ about the centroid, and the increment
     Δφ_k = φ_{k+1} - φ_k (lifted: cut opposite its circular mean), whose average in turns
-    is the rotation number ρ of a closed curve (Das et al. 2016, sec. 3); ``digits`` is
+    is the rotation number ρ of a closed curve (Das et al. 2017); ``digits`` is
     the smallest over these.
 
     Parameters
@@ -123,8 +123,8 @@ def weighted_birkhoff(points) -> BirkhoffResult:
 
     References: S. Das, Y. Saiki, E. Sander, J. A. Yorke, "Quantitative quasiperiodicity",
     Nonlinearity 30 (2017) 4111; S. Das, E. Sander, J. A. Yorke, "Quasiquasiperiodicity"
-    (2016, arXiv:1607.05796); S. Das, J. A. Yorke, "Super convergence of ergodic averages
-    for quasiperiodic orbits", Nonlinearity 31 (2018) 491.
+    (2016); S. Das, J. A. Yorke, "Super convergence of ergodic averages for quasiperiodic
+    orbits", Nonlinearity 31 (2018) 491.
     """
     x = as_points(points)
     n = x.shape[0]

@@ -64,8 +64,8 @@ class Thresholds:
         Converged digits of the weighted Birkhoff averages (`weighted_birkhoff`) at or
         above which the orbit is quasiperiodic, when no period was found. Measured from
         N = 200 to 4000 points: rotation by the golden mean 8-15, sine circle map (K = 0.5)
-        6.2-13.6, torus section 8.4-13; logistic r = 4 and Hénon 1.2-2.3; a period-8
-        orbit with jitter 1e-4 of its extent 4.6-4.9.
+        6.2-13.6, torus section 8-13; logistic r = 4 and Hénon 1.3-2.3; a period-8
+        orbit with jitter 1e-4 of its extent 4.6-4.9 (noise caps the digits).
     birkhoff_min_points : int
         Fewest points for the Birkhoff evidence to vote (two halves of 100).
     exponent_zero : float
