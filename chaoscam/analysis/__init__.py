@@ -4,7 +4,11 @@ Everything here takes numpy arrays (or, for the Lyapunov routines, a user callab
 advances a state); nothing imports the model or the integrators.
 """
 
-from ._classify import classify_section, classify_signal
+from ._birkhoff import BirkhoffResult, birkhoff_weights, weighted_birkhoff
+from ._classify import classify_signal
+from ._classify_section import classify_section
+from ._evidence import zero_one_evidence
+from ._exponent import as_exponent, exponent_evidence
 from ._lyapunov import (
     LyapunovResult,
     LyapunovSpectrum,
@@ -25,12 +29,15 @@ from ._periodicity import (
 )
 from ._sections import crossing_section, local_maxima
 from ._spectrum import SpectrumResult, power_spectrum, spectrum_analysis
+from ._thresholds import Thresholds
 from ._verdict import LABELS, VOTES, Evidence, Verdict, combine
 from ._zero_one import ZeroOneResult, zero_one_test
 
 __all__ = [
     "LABELS",
     "VOTES",
+    "BirkhoffResult",
+    "Thresholds",
     "DoubtfulEstimateWarning",
     "Evidence",
     "LyapunovResult",
@@ -41,12 +48,15 @@ __all__ = [
     "SpectrumResult",
     "Verdict",
     "ZeroOneResult",
+    "as_exponent",
+    "birkhoff_weights",
     "classify_section",
     "classify_signal",
     "combine",
     "correlation_dimension",
     "crossing_section",
     "embed_angles",
+    "exponent_evidence",
     "local_maxima",
     "lyapunov_benettin",
     "lyapunov_benettin_map",
@@ -58,5 +68,7 @@ __all__ = [
     "section_period",
     "spectrum_analysis",
     "stationarity_ratio",
+    "weighted_birkhoff",
+    "zero_one_evidence",
     "zero_one_test",
 ]

@@ -1,4 +1,4 @@
-"""Entry points: classify section points or a sampled signal into a `Verdict`."""
+"""Classify a sampled signal (with optional section points) into a `Verdict`."""
 
 from __future__ import annotations
 
@@ -6,13 +6,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ._classify_section import classify_section
 from ._evidence import (
-    D2_CHAOTIC,
-    EXPANSION_CHAOTIC,
-    K_CHAOTIC,
-    K_REGULAR,
-    ROTATION_QUASI,
-    STATIONARY,
     lyapunov_evidence,
     safe,
     section_evidence,
@@ -21,121 +16,14 @@ from ._evidence import (
 from ._lyapunov_series import lyapunov_from_series
 from ._sections import local_maxima
 from ._spectrum import spectrum_analysis
+from ._thresholds import Thresholds, resolve
 from ._validate import as_points, as_series
 from ._verdict import Evidence, Verdict, combine
 
 __all__ = ["classify_section", "classify_signal"]
 
 
-def classify_section(
-    points,
-    *,
-    lyapunov: float | None = None,
-    lyapunov_tol: float = 0.02,
-    angle_periods: Sequence[float | None] | None = None,
-    rtol: float = 1e-3,
-    atol=None,
-    max_period: int | None = None,
-    min_points_aperiodic: int = 100,
-    zero_one: bool = True,
-    seed: int = 0,
-) -> Verdict:
-    """Classify map iterates or Poincaré-section points as periodic, quasiperiodic or chaotic.
-
-    Evidence gathered (each an `Evidence` in the verdict):
-
-    * ``section_period`` — recurrence at a fixed lag (`section_period`): periodic with the
-      smallest lag n at which every point returns within ``rtol`` of the set's extent;
-      otherwise "not_periodic" (no period up to N / 2), unless the points have not settled
-      (spread of the second half over the first outside [0.5, 2]: abstains).
-    * ``section_rotation`` — rank-shift consistency R (`rotation_order`): R >= 0.9 votes
-      quasiperiodic (the points advance along a closed curve like a rotation).
-    * ``section_expansion`` — mean one-step log growth of nearest-neighbour distances
-      (`neighbour_expansion`): > 0.1 per iterate votes chaotic.
-    * ``section_dimension`` — correlation dimension (d >= 2 and N >= 500): >= 1.3 votes
-      chaotic (not a curve).
-    * ``section_zero_one`` — 0–1 test on the first coordinate (N >= 100): K >= 0.8 chaotic,
-      K <= 0.2 not chaotic.
-    * ``lyapunov`` — a largest exponent per iterate computed elsewhere (e.g. by
-      `lyapunov_benettin_map`): > `lyapunov_tol` chaotic, else not chaotic.
-
-    With fewer than `min_points_aperiodic` points, rotation and expansion are reported but
-    do not vote: 40–90 points show a period up to N / 2 reliably, but a
-    quasiperiodic/chaotic call from so few points is weak; pass `lyapunov` (or use
-    `classify_signal` with the sampled signal) to decide. The votes are combined by
-    `combine`: a label only when all votes admit it and one names it, else "undetermined".
-
-    Parameters
-    ----------
-    points : array_like, shape (N,) or (N, d)
-        Section points in time order, after the transient. N >= 8.
-    lyapunov : float, optional
-        Largest Lyapunov exponent per iterate of the section map.
-    lyapunov_tol : float
-        |λ₁| below this counts as zero.
-    angle_periods : sequence of float or None, optional
-        Period of each angular coordinate (None for ordinary ones), see `embed_angles`.
-    rtol, atol, max_period
-        Passed to `section_period`.
-    min_points_aperiodic : int
-        Fewest points for the rotation and expansion votes.
-    zero_one : bool
-        Run the 0–1 test when N >= 100.
-    seed : int
-        Seed of the 0–1 test's c values.
-
-    Returns
-    -------
-    Verdict
-        Period in iterates of the section map (forcing periods for a stroboscopic section).
-
-    Raises
-    ------
-    ValueError
-        NaN or infinite points, or points of the wrong shape.
-
-    Notes
-    -----
-    Choice for degenerate input: a set of identical points is a fixed point of the section
-    map and is labelled periodic with period 1 (for a stroboscopic section, a response
-    with the forcing's period). Fewer than 8 points: "undetermined".
-    """
-    x = as_points(points)
-    settings = dict(
-        rtol=rtol,
-        atol=atol,
-        max_period=max_period,
-        lyapunov_tol=lyapunov_tol,
-        angle_periods=None if angle_periods is None else list(angle_periods),
-        min_points_aperiodic=min_points_aperiodic,
-        zero_one=zero_one,
-        seed=seed,
-        thresholds=dict(
-            k_chaotic=K_CHAOTIC,
-            k_regular=K_REGULAR,
-            rotation=ROTATION_QUASI,
-            expansion=EXPANSION_CHAOTIC,
-            dimension=D2_CHAOTIC,
-            stationary=STATIONARY,
-        ),
-    )
-    ev, periods, reasons = section_evidence(
-        x,
-        prefix="section_",
-        angle_periods=angle_periods,
-        rtol=rtol,
-        atol=atol,
-        max_period=max_period,
-        min_points_aperiodic=min_points_aperiodic,
-        zero_one=zero_one,
-        seed=seed,
-    )
-    if lyapunov is not None:
-        ev.append(lyapunov_evidence(lyapunov, lyapunov_tol, "per iterate"))
-    return combine(ev, periods, reasons, settings)
-
-
-def _zero_one_signal(x, dt, forcing_period, seed, per_period, line_freq):
+def _zero_one_signal(x, dt, forcing_period, seed, per_period, line_freq, thr):
     """0–1 test on a map-like sequence derived from the signal (see classify_signal)."""
     if forcing_period is not None:
         t = np.arange(x.size) * dt
@@ -151,7 +39,7 @@ def _zero_one_signal(x, dt, forcing_period, seed, per_period, line_freq):
             f"0-1 test on the signal sampled {per_period} times per forcing period, "
             "minus its forcing-synchronous mean"
         )
-        if np.std(seq) <= 1e-3 * np.std(y):
+        if np.std(seq) <= thr.signal_repeat * np.std(y):
             return Evidence(
                 "zero_one",
                 0.0,
@@ -162,18 +50,18 @@ def _zero_one_signal(x, dt, forcing_period, seed, per_period, line_freq):
         _, seq = local_maxima(x, dt)
         rate = seq.size / (x.size * dt)
         what = "0-1 test on the successive local maxima"
-        if seq.size >= 8 and np.ptp(seq) <= 1e-3 * np.ptp(x):
+        if seq.size >= 8 and np.ptp(seq) <= thr.signal_repeat * np.ptp(x):
             return Evidence(
                 "zero_one",
                 0.0,
                 "not_chaotic",
                 what + ": all maxima equal (a period-1 oscillation), K = 0",
             )
-    e = zero_one_evidence("zero_one", seq, what, seed)
+    e = zero_one_evidence("zero_one", seq, what, seed, thr)
     if e.vote == "chaotic" and line_freq:
         period = rate / line_freq  # samples per period of the slowest line base
         n_cut = seq.size // 10
-        if n_cut < 5.0 * period:
+        if n_cut < thr.zero_one_line_periods * period:
             return Evidence(
                 "zero_one",
                 e.value,
@@ -194,14 +82,15 @@ def classify_signal(
     *,
     lyapunov_tol: float | None = None,
     angle_periods: Sequence[float | None] | None = None,
-    rtol: float = 1e-3,
+    rtol: float | None = None,
     atol=None,
     max_period: int | None = None,
-    min_points_aperiodic: int = 100,
+    min_points_aperiodic: int | None = None,
     series_lyapunov: bool = False,
     zero_one_per_period: int = 4,
     spectrum_options: dict | None = None,
     seed: int = 0,
+    thresholds: Thresholds | None = None,
 ) -> Verdict:
     """Classify a uniformly sampled signal of a flow (with optional section points).
 
@@ -215,10 +104,13 @@ def classify_signal(
       signal: for a forced system, the signal sampled `zero_one_per_period` times per
       forcing period (linear interpolation) minus its forcing-synchronous mean (which is
       periodic and only slows the test's convergence); without forcing, the successive
-      local maxima (`local_maxima`). K >= 0.8 votes chaotic, K <= 0.2 not chaotic. A
-      sequence with nothing left (all maxima equal, or a signal that repeats every forcing
-      period) is K = 0. A chaotic K is not used when the spectrum is a line spectrum whose
-      slowest base period is longer than a fifth of the largest lag (N / 10): a periodic
+      local maxima (`local_maxima`). It votes only where valid (`zero_one_evidence`: at
+      least zero_one_min_points samples, K of the first half and of the whole on the same
+      side of zero_one_chaotic = 0.8 / zero_one_regular = 0.2 and within
+      zero_one_max_change). A sequence with nothing left (all maxima equal, or a signal
+      that repeats every forcing period) is K = 0. A chaotic K is not used when the
+      spectrum is a line spectrum whose slowest base period is longer than a fifth of the
+      largest lag (N / 10; zero_one_line_periods = 5): a periodic
       sequence with a long period makes the displacement grow over every lag the test sees
       (for a period-8 cam response sampled 4 times per forcing period over 20 s, K ≈ 0.9).
     * the section evidence of `classify_section`, when `section` is given (names prefixed
@@ -227,12 +119,16 @@ def classify_signal(
       `lyapunov_benettin` on the equations): > `lyapunov_tol` chaotic, else not chaotic.
     * ``lyapunov_series`` (when `series_lyapunov`): Rosenstein's estimate from the signal
       (`lyapunov_from_series`); it votes only when not doubtful, chaotic when
-      λ T > 0.05 and not chaotic when |λ T| < 0.01 (T the characteristic period).
+      λ T > series_chaotic (0.05) and not chaotic when |λ T| < series_regular (0.01), T
+      the characteristic period.
 
-    Votes are combined by `combine`; when they disagree the label is "undetermined" and
-    `reasons` lists the votes. The period comes from the section when given, else from the
-    spectrum for a forced signal; an unforced periodic signal without section gets period
-    1 (one period of its own fundamental), with a note in `reasons`.
+    Every number above is an entry of `Thresholds`, except the spectrum's own
+    (`spectrum_options`; its broadband tolerance is recorded in
+    ``settings["broadband_tol"]``). Votes are combined by `combine`; when they disagree
+    the label is "undetermined" and `reasons` lists the votes. The period comes from the
+    section when given, else from the spectrum for a forced signal; an unforced periodic
+    signal without section gets period 1 (one period of its own fundamental), with a note
+    in `reasons`.
 
     Parameters
     ----------
@@ -247,7 +143,8 @@ def classify_signal(
     lyapunov : float, optional
         Largest Lyapunov exponent (1/s) computed elsewhere.
     lyapunov_tol : float, optional
-        |λ₁| below this counts as zero; default 0.02 / T with T the forcing period, else
+        |λ₁| below this counts as zero; default ``signal_lyapunov_tol / T`` (0.02 / T) with
+        T the forcing period, else
         the fundamental period of the spectrum.
     angle_periods, rtol, atol, max_period, min_points_aperiodic
         Passed to the section analysis (see `classify_section`).
@@ -259,6 +156,9 @@ def classify_signal(
         Extra keyword arguments of `spectrum_analysis`.
     seed : int
         Seed of the 0–1 test's c values.
+    thresholds : Thresholds, optional
+        The decision thresholds (default `Thresholds()`), recorded in
+        ``settings["thresholds"]``; `rtol` and `min_points_aperiodic` override their entries.
 
     Returns
     -------
@@ -284,30 +184,23 @@ def classify_signal(
         raise ValueError(f"forcing_period must be positive, got {forcing_period}")
     if section is not None:
         section = as_points(section, "section")
+    thr = resolve(thresholds, rtol, min_points_aperiodic)
     settings = dict(
         dt=dt,
         forcing_period=forcing_period,
         lyapunov_tol=lyapunov_tol,
-        rtol=rtol,
+        rtol=thr.period_rtol,
         atol=atol,
         max_period=max_period,
         angle_periods=None if angle_periods is None else list(angle_periods),
-        min_points_aperiodic=min_points_aperiodic,
+        min_points_aperiodic=thr.min_points_aperiodic,
         series_lyapunov=series_lyapunov,
         zero_one_per_period=zero_one_per_period,
         spectrum_options=dict(spectrum_options or {}),
         seed=seed,
-        thresholds=dict(
-            k_chaotic=K_CHAOTIC,
-            k_regular=K_REGULAR,
-            rotation=ROTATION_QUASI,
-            expansion=EXPANSION_CHAOTIC,
-            dimension=D2_CHAOTIC,
-            stationary=STATIONARY,
-            broadband=None,
-        ),
+        thresholds=thr.to_dict(),
     )
-    if x.size < 2 or np.ptp(x) <= 1e-12 * max(1.0, float(np.max(np.abs(x)))):
+    if x.size < 2 or np.ptp(x) <= thr.constant_signal * max(1.0, float(np.max(np.abs(x)))):
         return Verdict(
             "undetermined",
             None,
@@ -328,7 +221,7 @@ def classify_signal(
     if failed:
         ev.append(failed)
     else:
-        settings["thresholds"]["broadband"] = spec.settings["broadband_tol"]
+        settings["broadband_tol"] = spec.settings["broadband_tol"]
         bases = ", ".join(f"{f:.5g}" for f in spec.base_frequencies)
         txt = (
             f"{spec.model}: line model holds {spec.line_fraction:.6f} of the power "
@@ -364,6 +257,7 @@ def classify_signal(
         seed,
         int(zero_one_per_period),
         line_freq,
+        thr,
     )
     ev.append(failed or e01)
 
@@ -371,12 +265,10 @@ def classify_signal(
     if section is not None:
         sev, speriods, sreasons = section_evidence(
             section,
-            prefix="section_",
+            thr,
             angle_periods=angle_periods,
-            rtol=rtol,
             atol=atol,
             max_period=max_period,
-            min_points_aperiodic=min_points_aperiodic,
             zero_one=True,
             seed=seed,
         )
@@ -387,7 +279,7 @@ def classify_signal(
     # --- Lyapunov exponents
     tol = lyapunov_tol
     if tol is None and t_char is not None:
-        tol = 0.02 / t_char
+        tol = thr.signal_lyapunov_tol / t_char
     if lyapunov is not None:
         if tol is None:
             ev.append(
@@ -417,9 +309,9 @@ def classify_signal(
         else:
             lt = res.exponent * t_char
             txt = f"Rosenstein λ₁ = {res.exponent:.4g} (λ₁ T = {lt:.3f})"
-            if lt > 0.05:
+            if lt > thr.series_chaotic:
                 ev.append(Evidence("lyapunov_series", res.exponent, "chaotic", txt))
-            elif abs(lt) < 0.01:
+            elif abs(lt) < thr.series_regular:
                 ev.append(Evidence("lyapunov_series", res.exponent, "not_chaotic", txt))
             else:
                 ev.append(Evidence("lyapunov_series", res.exponent, None, txt + ": inconclusive"))

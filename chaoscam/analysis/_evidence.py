@@ -1,4 +1,4 @@
-"""Evidence builders shared by the classifiers: section, 0–1 test, Lyapunov exponent."""
+"""Evidence builders shared by the classifiers: section, 0–1 test, Birkhoff, Lyapunov exponent."""
 
 from __future__ import annotations
 
@@ -6,7 +6,9 @@ import math
 
 import numpy as np
 
+from ._birkhoff import weighted_birkhoff
 from ._periodicity import (
+    _floor,
     correlation_dimension,
     embed_angles,
     neighbour_expansion,
@@ -14,16 +16,10 @@ from ._periodicity import (
     section_period,
     stationarity_ratio,
 )
+from ._thresholds import Thresholds
 from ._validate import as_points
 from ._verdict import Evidence
 from ._zero_one import zero_one_test
-
-# Decision thresholds (documented in classify_section and classify_signal).
-K_CHAOTIC, K_REGULAR = 0.8, 0.2
-ROTATION_QUASI = 0.9
-EXPANSION_CHAOTIC = 0.1
-D2_CHAOTIC = 1.3
-STATIONARY = (0.5, 2.0)
 
 
 def safe(name: str, fn, *args, **kwargs):
@@ -34,8 +30,43 @@ def safe(name: str, fn, *args, **kwargs):
         return None, Evidence(name, None, None, f"failed: {err}")
 
 
-def zero_one_evidence(name: str, series, what: str, seed: int) -> Evidence:
-    res, failed = safe(name, zero_one_test, series, seed=seed)
+def _k_side(k: float, thr: Thresholds) -> str | None:
+    if k >= thr.zero_one_chaotic:
+        return "chaotic"
+    if k <= thr.zero_one_regular:
+        return "not_chaotic"
+    return None
+
+
+def zero_one_evidence(
+    name: str, series, what: str, seed: int, thresholds: Thresholds | None = None
+) -> Evidence:
+    """The 0–1 test's vote, cast only where the test is valid and has converged in N.
+
+    Validity rule (Gottwald & Melbourne, "On the validity of the 0-1 test for chaos",
+    Nonlinearity 22 (2009) 1367, and "On the implementation of the 0-1 test for chaos",
+    SIAM J. Appl. Dyn. Syst. 8 (2009) 129: K separates 0 from 1 cleanly only for N ~ 1000
+    samples of a map-like, not oversampled, sequence; Melosik & Marszalek, "On the 0/1
+    test for chaos in continuous systems", Bull. Pol. Acad. Sci. Tech. Sci. 64 (2016): an
+    oversampled regular signal can give K near 1): the test votes only when (1) the
+    sequence has at least `Thresholds.zero_one_min_points` samples, (2) it is not flagged
+    as oversampled, and (3) K from the first half and K from the whole lie on the same
+    side of the thresholds (both >= `zero_one_chaotic` or both <= `zero_one_regular`) and
+    differ by at most `zero_one_max_change`. Otherwise it abstains and says which
+    condition failed.
+    """
+    thr = thresholds or Thresholds()
+    x = np.asarray(series, dtype=float)
+    if x.size < thr.zero_one_min_points:
+        return Evidence(
+            name,
+            None,
+            None,
+            f"{what}: {x.size} samples < {thr.zero_one_min_points}: the 0-1 test is not "
+            f"valid this short (run ~{math.ceil(thr.zero_one_min_points / max(x.size, 1))}x "
+            "longer)",
+        )
+    res, failed = safe(name, zero_one_test, x, seed=seed)
     if failed:
         return failed
     if res.message:
@@ -44,14 +75,32 @@ def zero_one_evidence(name: str, series, what: str, seed: int) -> Evidence:
     txt = f"{what}: K = {k:.3f} (median over {res.c.size} c, N = {res.n})"
     if res.oversampled:
         return Evidence(name, k, None, txt + "; flagged as oversampled, not used")
-    if k >= K_CHAOTIC:
-        return Evidence(name, k, "chaotic", txt + f" >= {K_CHAOTIC}")
-    if k <= K_REGULAR:
-        return Evidence(name, k, "not_chaotic", txt + f" <= {K_REGULAR}")
-    return Evidence(name, k, None, txt + f": between {K_REGULAR} and {K_CHAOTIC}, inconclusive")
+    half, failed = safe(name, zero_one_test, x[: x.size // 2], seed=seed)
+    if failed or half.message:
+        return Evidence(name, k, None, txt + "; the first half could not be tested, not used")
+    side, side_half = _k_side(k, thr), _k_side(half.k, thr)
+    txt += f", first half K = {half.k:.3f}"
+    if side is None:
+        return Evidence(
+            name,
+            k,
+            None,
+            txt + f": between {thr.zero_one_regular} and {thr.zero_one_chaotic}, inconclusive",
+        )
+    if side_half != side or abs(half.k - k) > thr.zero_one_max_change:
+        return Evidence(
+            name,
+            k,
+            None,
+            txt + f": K has not converged in N (|ΔK| = {abs(half.k - k):.2f}, limit "
+            f"{thr.zero_one_max_change}); not used, run longer",
+        )
+    bound = f">= {thr.zero_one_chaotic}" if side == "chaotic" else f"<= {thr.zero_one_regular}"
+    return Evidence(name, k, side, txt + f", both {bound}")
 
 
 def lyapunov_evidence(lyap: float, tol: float, unit: str) -> Evidence:
+    """Vote of an exponent without error bar: > tol chaotic, else not chaotic."""
     lyap = float(lyap)
     if not math.isfinite(lyap):
         if lyap == -math.inf:
@@ -63,26 +112,98 @@ def lyapunov_evidence(lyap: float, tol: float, unit: str) -> Evidence:
     return Evidence("lyapunov", lyap, "not_chaotic", txt + ": not positive")
 
 
+def _fmt(a) -> str:
+    return "[" + ", ".join(f"{v:.2g}" for v in np.atleast_1d(a)) + "]"
+
+
+def birkhoff_evidence(name: str, z: np.ndarray, thr: Thresholds) -> Evidence:
+    """Quasiperiodic when the weighted Birkhoff averages converge fast (no period found)."""
+    n = z.shape[0]
+    if n < thr.birkhoff_min_points:
+        return Evidence(
+            name,
+            None,
+            None,
+            f"{n} points < {thr.birkhoff_min_points}: too few for the Birkhoff averages "
+            f"(run ~{math.ceil(thr.birkhoff_min_points / n)}x longer)",
+        )
+    res, failed = safe(name, weighted_birkhoff, z)
+    if failed:
+        return failed
+    rho = res.rotation_number
+    value = rho if math.isfinite(rho) else None
+    txt = (
+        f"weighted Birkhoff averages converged to {res.digits:.1f} digits over 2 x "
+        f"{res.n // 2} points" + (f", rotation number {rho:.10f}" if value is not None else "")
+    )
+    if res.digits >= thr.birkhoff_quasi_digits:
+        return Evidence(
+            name,
+            value,
+            "quasiperiodic",
+            txt + f" >= {thr.birkhoff_quasi_digits:g}: a smooth invariant curve (torus)",
+        )
+    return Evidence(
+        name,
+        value,
+        None,
+        txt + f" < {thr.birkhoff_quasi_digits:g}: slow convergence (chaos, noise or a "
+        "non-smooth set), not a vote",
+    )
+
+
+def _periodic_evidence(prefix, pr, rtol, thr, zero_one):
+    """Evidence list of a section found periodic, with the methods that then abstain."""
+    what = (
+        "all points coincide (a fixed point)"
+        if pr.coincident
+        else f"every point recurs after {pr.period} iterates"
+    )
+    trans = f"; first {pr.transient} points left out as transient" if pr.transient else ""
+    rel = np.max(pr.jitter / np.where(pr.extent > 0, pr.extent, np.inf))
+    ev = [
+        Evidence(
+            f"{prefix}period",
+            pr.period,
+            "periodic",
+            f"{what}: bands {_fmt(pr.jitter)} on an orbit of extent {_fmt(pr.extent)} "
+            f"(per coordinate; widest band {rel:.2g} of the extent), within the tolerance "
+            f"{_fmt(pr.tolerance)} = max(atol, rtol {rtol:g} x extent){trans}",
+        )
+    ]
+    skip = "the section is periodic to the tolerance: only its jitter is left, not used"
+    ev.append(Evidence(f"{prefix}expansion", None, None, skip))
+    ev.append(Evidence(f"{prefix}birkhoff", None, None, skip))
+    if zero_one:
+        ev.append(Evidence(f"{prefix}zero_one", None, None, skip))
+    return ev
+
+
 def section_evidence(
     points,
+    thr: Thresholds,
     *,
-    prefix,
-    angle_periods,
-    rtol,
-    atol,
-    max_period,
-    min_points_aperiodic,
-    zero_one,
-    seed,
+    angle_periods=None,
+    atol=None,
+    max_period=None,
+    zero_one=True,
+    seed=0,
+    prefix="section_",
 ):
     """Evidence from section points; returns (evidence list, periods dict, reasons)."""
-    ev: list[Evidence] = []
+    rtol, min_points_aperiodic = thr.period_rtol, thr.min_points_aperiodic
     reasons: list[str] = []
     x = as_points(points)
     n = x.shape[0]
     z = embed_angles(x, angle_periods)
     pr, failed = safe(
-        f"{prefix}period", section_period, z, rtol=rtol, atol=atol, max_period=max_period
+        f"{prefix}period",
+        section_period,
+        z,
+        rtol=rtol,
+        atol=atol,
+        max_period=max_period,
+        noise_floor=thr.noise_floor,
     )
     if failed:
         return [failed], {}, reasons
@@ -90,25 +211,12 @@ def section_evidence(
         reasons.append(f"section: {pr.message}")
         return [Evidence(f"{prefix}period", None, None, pr.message)], {}, reasons
     if pr.period is not None:
-        what = (
-            "all points coincide (a fixed point)"
-            if pr.coincident
-            else (f"every point recurs after {pr.period} iterates")
-        )
-        trans = f"; first {pr.transient} points left out as transient" if pr.transient else ""
-        ev.append(
-            Evidence(
-                f"{prefix}period",
-                pr.period,
-                "periodic",
-                f"{what} within rtol = {rtol:g} of the extent "
-                f"(worst mismatch {pr.mismatch:.2g} tol){trans}",
-            )
-        )
+        ev = _periodic_evidence(prefix, pr, rtol, thr, zero_one)
         return ev, {f"{prefix}period": pr.period}, reasons
 
+    ev: list[Evidence] = []
     ratio = stationarity_ratio(z)
-    settled = STATIONARY[0] <= ratio <= STATIONARY[1] if math.isfinite(ratio) else True
+    settled = thr.stationary_low <= ratio <= thr.stationary_high if math.isfinite(ratio) else True
     if not settled:
         reasons.append(
             f"section: the points have not settled (second-half/first-half spread "
@@ -129,8 +237,8 @@ def section_evidence(
             f"{prefix}period",
             None,
             "not_periodic",
-            f"no lag 1..{pr.max_period} recurs within rtol = {rtol:g} "
-            f"(closest: {pr.mismatch:.3g} tol)",
+            f"no lag 1..{pr.max_period} has all its bands within rtol = {rtol:g} of the "
+            f"extent (narrowest: {pr.mismatch:.3g} tol)",
         )
     )
 
@@ -143,13 +251,13 @@ def section_evidence(
     )
     if not enough:
         ev.append(Evidence(f"{prefix}rotation", rot.consistency, None, txt + few))
-    elif rot.consistency >= ROTATION_QUASI:
+    elif rot.consistency >= thr.rotation_quasi:
         ev.append(
             Evidence(
                 f"{prefix}rotation",
                 rot.consistency,
                 "quasiperiodic",
-                txt + f" >= {ROTATION_QUASI}: points turn along a closed curve",
+                txt + f" >= {thr.rotation_quasi}: points turn along a closed curve",
             )
         )
     else:
@@ -158,58 +266,74 @@ def section_evidence(
                 f"{prefix}rotation",
                 rot.consistency,
                 None,
-                txt + f" < {ROTATION_QUASI}: no rotation order",
+                txt + f" < {thr.rotation_quasi}: no rotation order",
             )
         )
 
-    g = neighbour_expansion(z)
+    ev.append(birkhoff_evidence(f"{prefix}birkhoff", z, thr))
+
+    floor = _floor(z, atol, thr.noise_floor)
+    g = neighbour_expansion(z, atol=floor)
     txt = f"mean one-step log growth of nearest-neighbour distances {g:.3f}"
     if not math.isfinite(g):
-        ev.append(Evidence(f"{prefix}expansion", None, None, "too few distinct neighbours"))
+        ev.append(
+            Evidence(
+                f"{prefix}expansion",
+                None,
+                None,
+                "too few distinct neighbours above the noise floor",
+            )
+        )
     elif not enough:
         ev.append(Evidence(f"{prefix}expansion", g, None, txt + few))
-    elif g > EXPANSION_CHAOTIC:
+    elif g > thr.expansion_chaotic:
         ev.append(
             Evidence(
                 f"{prefix}expansion",
                 g,
                 "chaotic",
-                txt + f" > {EXPANSION_CHAOTIC}: neighbours separate",
+                txt + f" > {thr.expansion_chaotic}: neighbours separate",
             )
         )
     else:
         ev.append(
             Evidence(
-                f"{prefix}expansion", g, None, txt + f" <= {EXPANSION_CHAOTIC}: no clear stretching"
+                f"{prefix}expansion",
+                g,
+                None,
+                txt + f" <= {thr.expansion_chaotic}: no clear stretching",
             )
         )
 
-    if z.shape[1] >= 2 and n >= 500:
+    if z.shape[1] >= 2 and n >= thr.dimension_min_points:
         d2 = correlation_dimension(z)
         txt = f"correlation dimension D2 = {d2:.2f}"
-        if math.isfinite(d2) and d2 >= D2_CHAOTIC:
+        if math.isfinite(d2) and d2 >= thr.dimension_chaotic:
             ev.append(
                 Evidence(
-                    f"{prefix}dimension", d2, "chaotic", txt + f" >= {D2_CHAOTIC}: not a curve"
+                    f"{prefix}dimension",
+                    d2,
+                    "chaotic",
+                    txt + f" >= {thr.dimension_chaotic}: not a curve",
                 )
             )
         else:
             ev.append(
                 Evidence(
-                    f"{prefix}dimension", d2, None, txt + f" < {D2_CHAOTIC}: a curve or unresolved"
+                    f"{prefix}dimension",
+                    d2,
+                    None,
+                    txt + f" < {thr.dimension_chaotic}: a curve or unresolved",
                 )
             )
     if zero_one:
-        if n >= 100:
-            ev.append(
-                zero_one_evidence(
-                    f"{prefix}zero_one", z[:, 0], "0-1 test on the first section coordinate", seed
-                )
+        ev.append(
+            zero_one_evidence(
+                f"{prefix}zero_one",
+                z[:, 0],
+                "0-1 test on the first section coordinate",
+                seed,
+                thr,
             )
-        else:
-            ev.append(
-                Evidence(
-                    f"{prefix}zero_one", None, None, f"{n} section points < 100: 0-1 test not run"
-                )
-            )
+        )
     return ev, {}, reasons

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._thresholds import Thresholds
 from ._validate import as_points
 
 __all__ = [
@@ -57,16 +58,32 @@ def embed_angles(points, angle_periods: Sequence[float | None] | None = None) ->
     return np.column_stack(cols)
 
 
-def _tolerance(x: np.ndarray, rtol: float, atol) -> np.ndarray:
-    """Per-coordinate tolerance ``max(rtol * extent_j, atol_j)``."""
-    ext = np.ptp(x, axis=0)
-    if atol is None:
-        mag = np.max(np.abs(x), axis=0)
-        g = float(mag.max()) if mag.size else 0.0
-        atol_arr = 1e-6 * np.maximum(mag, 1e-3 * g)
-    else:
-        atol_arr = np.broadcast_to(np.asarray(atol, dtype=float), ext.shape)
-    return np.maximum(np.maximum(rtol * ext, atol_arr), 1e-300)
+def _floor(x: np.ndarray, atol, noise_floor: float) -> np.ndarray:
+    """Per-coordinate absolute floor: `atol` if given, else ``noise_floor · max_j max_k |x_kj|``."""
+    d = x.shape[1]
+    if atol is not None:
+        return np.broadcast_to(np.asarray(atol, dtype=float), (d,)).copy()
+    mag = float(np.max(np.abs(x))) if x.size else 0.0
+    return np.full(d, noise_floor * mag)
+
+
+def _tolerance(x: np.ndarray, rtol: float, atol, noise_floor: float) -> np.ndarray:
+    """Per-coordinate tolerance ``max(rtol · extent_j, atol_j)``, extent_j the range of x_j."""
+    return np.maximum(np.maximum(rtol * np.ptp(x, axis=0), _floor(x, atol, noise_floor)), 1e-300)
+
+
+def _band_widths(y: np.ndarray, p: int) -> np.ndarray:
+    """Range of each band ``y[r::p]`` (r = 0 .. p - 1), shape (p, d)."""
+    m, d = y.shape
+    full = (m // p) * p
+    blocks = y[:full].reshape(-1, p, d)
+    lo, hi = blocks.min(axis=0), blocks.max(axis=0)
+    tail = y[full:]
+    if tail.shape[0]:
+        t = tail.shape[0]
+        lo[:t] = np.minimum(lo[:t], tail)
+        hi[:t] = np.maximum(hi[:t], tail)
+    return hi - lo
 
 
 @dataclass(frozen=True)
@@ -76,22 +93,30 @@ class PeriodResult:
     Attributes
     ----------
     period : int or None
-        Smallest lag n with ``|x_{k+n} - x_k| <= tol`` for every k (after `transient`
-        points), or None.
+        Smallest n for which every band ``x[r::n]`` (after `transient` points) is narrower
+        than the tolerance in every coordinate, or None.
     transient : int
         Leading points left out to find the period (0 when the whole set is periodic).
     max_period : int
         Largest lag tested.
     mismatch : float
-        Largest scaled mismatch ``max_k max_j |x_{k+n,j} - x_{k,j}| / tol_j`` at the period
+        Widest band over the tolerance, ``max_{r,j} width_{r,j} / tol_j``, at the period
         found (<= 1), or the smallest over the lags tested when none was found.
     tolerance : ndarray
-        Per-coordinate tolerance used.
+        Per-coordinate tolerance used, ``max(atol_j, rtol · extent_j)``.
     coincident : bool
         All points coincide within tolerance (a fixed point: period 1).
     message : str
         Why no period could be tested (too few points), else empty.
     settings : dict
+    jitter : ndarray
+        Per coordinate, the widest band at the period found (the measured jitter, in the
+        units of the points); NaN when no period was found.
+    extent : ndarray
+        Per coordinate, the range of the points kept (the orbit's size).
+    separation : float
+        Smallest distance between two band centres at the period found, in tolerances
+        (Chebyshev norm of the differences over tol_j); inf for period 1 or none.
     """
 
     period: int | None
@@ -102,39 +127,64 @@ class PeriodResult:
     coincident: bool
     message: str = ""
     settings: dict = field(default_factory=dict)
+    jitter: np.ndarray = field(default_factory=lambda: np.array([]))
+    extent: np.ndarray = field(default_factory=lambda: np.array([]))
+    separation: float = math.inf
+
+
+def _separation(y: np.ndarray, p: int, tol: np.ndarray) -> float:
+    """Smallest Chebyshev distance between the p band centres, in tolerances."""
+    if p == 1:
+        return math.inf
+    c = np.array([np.median(y[r::p], axis=0) for r in range(p)]) / tol
+    d = np.max(np.abs(c[:, None, :] - c[None, :, :]), axis=-1)
+    d[np.diag_indices(p)] = np.inf
+    return float(d.min())
 
 
 def section_period(
     points,
     *,
-    rtol: float = 1e-3,
+    rtol: float | None = None,
     atol=None,
     max_period: int | None = None,
     min_repeats: int = 2,
     allow_transient: bool = True,
     min_points: int = 8,
+    noise_floor: float | None = None,
 ) -> PeriodResult:
-    """Period of an orbit of section points by recurrence at a fixed lag.
+    """Period of an orbit of section points: the smallest n whose n bands are all narrow.
 
-    The orbit is period n when every point returns near itself after n iterates,
-    ``|x_{k+n,j} - x_{k,j}| <= tol_j`` for all k and every coordinate j, with the tolerance
-    relative to the size of the point cloud, ``tol_j = max(rtol · extent_j, atol_j)``,
-    extent_j the range of coordinate j. The smallest such n is returned. Looking at a lag,
-    instead of clustering, also checks the order in which the clusters are visited.
+    The orbit is period n when the points split, by their index modulo n, into n bands
+    ``B_r = {x_{r + kn}}`` each narrower than the tolerance in every coordinate,
+
+        max_k x_{r+kn, j} - min_k x_{r+kn, j} <= tol_j = max(atol_j, rtol · extent_j),
+
+    with extent_j the range of coordinate j over all the points: the size of the orbit,
+    not the spread within a band. A band's width is the jitter the orbit carries
+    (integration error, a slowly converging transient, noise); it is reported
+    (`PeriodResult.jitter`) next to the extent, so that "period 8, bands 3e-4 rad on an
+    orbit of 0.3 rad" can be read off the result. Bands whose centres lie within one
+    tolerance of each other overlap: such a lag is refused. The smallest n that fits is
+    returned. Looking at the bands of a lag, instead of clustering, also checks the order
+    in which the clusters are visited, and a slow drift along a curve (a quasiperiodic
+    orbit near a resonance p/n) widens the bands over the record and is refused.
 
     Parameters
     ----------
     points : array_like, shape (N,) or (N, d)
         Section points in time order (map iterates, or stroboscopic (θ, ω) points), after
         the transient. Angular coordinates should go through `embed_angles` first.
-    rtol : float
-        Tolerance relative to the extent (1e-3: clusters closer than 0.1 % of the
-        attractor's size merge; a quasiperiodic orbit whose rotation number lies within
-        ~1e-3 / (π n) of p/n is read as period n).
+    rtol : float, optional
+        Band width allowed relative to the extent; default `Thresholds.period_rtol`
+        (3e-3). A quasiperiodic orbit whose rotation number lies within ~rtol / (π N) of
+        p/n is read as period n.
     atol : float or array_like, optional
-        Absolute floor per coordinate. The default, ``1e-6 · max(max|x_j|,
-        1e-3 · max|x|)``, is what makes period 1 detectable: a fixed point's extent is
-        only round-off or integration error, and relative to it no tolerance works.
+        Absolute floor per coordinate, in the units of the points. The default,
+        ``noise_floor · max_j max_k |x_kj|``, is what makes period 1 detectable: a fixed
+        point's extent is only round-off or integration error, and relative to it no
+        tolerance works. Pass the integrator's accuracy when coordinates have very
+        different scales.
     max_period : int, optional
         Largest lag tested; default ``N // min_repeats``.
     min_repeats : int
@@ -145,6 +195,9 @@ def section_period(
         converging transient); the tolerance is then computed on the points kept.
     min_points : int
         Fewer points than this: no test (period None, `message` says so).
+    noise_floor : float, optional
+        Fraction of the largest coordinate magnitude used as `atol` when none is given;
+        default `Thresholds.noise_floor` (1e-6).
 
     Returns
     -------
@@ -155,19 +208,26 @@ def section_period(
     A constant set of points (all within `atol`) is period 1: a fixed point of the section
     map, which for a stroboscopic section is a response with the forcing's period.
     Limits: periods above N / `min_repeats` cannot be seen (with 60 points, up to 30);
-    noise larger than `rtol` × extent hides any period (raise `rtol` or `atol` for noisy
-    or stochastic data).
+    jitter wider than `rtol` × extent hides any period (raise `rtol` or `atol` for noisy
+    or stochastic data); two distinct points of an orbit closer than the tolerance are
+    read as one (right after a period doubling, period n for 2n).
     """
+    defaults = Thresholds()
+    rtol = defaults.period_rtol if rtol is None else float(rtol)
+    noise_floor = defaults.noise_floor if noise_floor is None else float(noise_floor)
     x = as_points(points)
     n = x.shape[0]
     settings = dict(
         rtol=rtol,
         atol=atol,
+        noise_floor=noise_floor,
         max_period=max_period,
         min_repeats=min_repeats,
         allow_transient=allow_transient,
         min_points=min_points,
     )
+    d = x.shape[1]
+    nan = np.full(d, math.nan)
     if n < min_points:
         return PeriodResult(
             None,
@@ -178,6 +238,8 @@ def section_period(
             False,
             f"only {n} section points; the period test needs >= {min_points}",
             settings,
+            nan,
+            np.ptp(x, axis=0) if n else nan,
         )
     starts = [0]
     if allow_transient:
@@ -185,24 +247,42 @@ def section_period(
         starts += list(range(step, n // 2 + 1, step))
     best = math.inf
     max_p_used = 0
-    tol_out = _tolerance(x, rtol, atol)
+    tol_out = _tolerance(x, rtol, atol, noise_floor)
     for k0 in starts:
         y = x[k0:]
         m = y.shape[0]
-        tol = _tolerance(y, rtol, atol)
-        if k0 == 0:
-            tol_out = tol
-        if np.all(np.ptp(y, axis=0) <= tol):
-            return PeriodResult(1, k0, max(1, m // min_repeats), 0.0, tol, True, "", settings)
+        tol = _tolerance(y, rtol, atol, noise_floor)
+        ext = np.ptp(y, axis=0)
+        if np.all(ext <= tol):
+            return PeriodResult(
+                1,
+                k0,
+                max(1, m // min_repeats),
+                float(np.max(ext / tol)),
+                tol,
+                True,
+                "",
+                settings,
+                ext,
+                ext,
+            )
         max_p = m // min_repeats if max_period is None else min(max_period, m // min_repeats)
         max_p_used = max(max_p_used, max_p)
         for p in range(1, max_p + 1):
-            mis = float(np.max(np.abs(y[p:] - y[:-p]) / tol))
+            width = _band_widths(y, p)
+            mis = float(np.max(width / tol))
             if mis <= 1.0:
-                return PeriodResult(p, k0, max_p, mis, tol, False, "", settings)
+                sep = _separation(y, p, tol)
+                if sep > 1.0:
+                    jitter = width.max(axis=0)
+                    return PeriodResult(
+                        p, k0, max_p, mis, tol, False, "", settings, jitter, ext, sep
+                    )
             best = min(best, mis)
     msg = "" if max_p_used >= 1 else f"too few points ({n}) to test any period"
-    return PeriodResult(None, 0, max_p_used, best, tol_out, False, msg, settings)
+    return PeriodResult(
+        None, 0, max_p_used, best, tol_out, False, msg, settings, nan, np.ptp(x, axis=0)
+    )
 
 
 @dataclass(frozen=True)
@@ -280,13 +360,29 @@ def _scaled(x: np.ndarray) -> np.ndarray:
     return (x - x.mean(axis=0)) / np.where(ext > 0, ext, 1.0)
 
 
-def neighbour_expansion(z, *, max_points: int = 2000, min_distance: float = 1e-9) -> float:
+def neighbour_expansion(
+    z, *, max_points: int = 2000, min_distance: float = 1e-9, atol=None
+) -> float:
     """Mean one-step log growth of nearest-neighbour distances on the section.
 
     For each point x_k its nearest neighbour x_k' in the set (coordinates scaled by their
     extent) gives ``g_k = ln(|x_{k+1} - x_{k'+1}| / |x_k - x_k'|)``; the mean of g_k is a
     one-step, finite-resolution estimate of the largest Lyapunov exponent per iterate
     (the first point of Rosenstein et al.'s divergence curve, Physica D 65 (1993) 117).
+
+    Parameters
+    ----------
+    z : array_like, shape (N,) or (N, d)
+        Section points in time order.
+    max_points : int
+        Only the first `max_points` points are used (the cost is O(N²)).
+    min_distance : float
+        Pairs closer than this (in extent-scaled coordinates) are left out (recurrences).
+    atol : float or array_like, optional
+        Absolute noise floor per coordinate, in the units of the points: pairs closer
+        than it are left out, and each point's nearest neighbour is sought beyond it.
+        Without it, the jitter of a periodic orbit (neighbours a jitter apart, mapped onto
+        points an independent jitter apart) reads as growth.
 
     Returns
     -------
@@ -299,19 +395,27 @@ def neighbour_expansion(z, *, max_points: int = 2000, min_distance: float = 1e-9
     -----
     Limits: with N points on a 1-D set the neighbours are ~1/N apart, not infinitesimal,
     so the value is biased towards 0 (saturation) for small N or strong chaos; noise
-    inflates it. Pairs closer than `min_distance` (recurrences) are left out.
+    inflates it. Do not use it on a set that is periodic to the tolerance of
+    `section_period`: there only the jitter is left to measure.
     """
-    x = _scaled(as_points(z)[:max_points])
+    raw = as_points(z)[:max_points]
+    x = _scaled(raw)
     n = x.shape[0]
     if n < 12:
         return math.nan
+    floor = float(min_distance)
+    if atol is not None:
+        ext = np.ptp(raw, axis=0)
+        a = np.broadcast_to(np.asarray(atol, dtype=float), ext.shape)
+        floor = max(floor, float(np.linalg.norm(a / np.where(ext > 0, ext, 1.0))))
     head = x[:-1]
     d2 = np.sum((head[:, None, :] - head[None, :, :]) ** 2, axis=-1)
     np.fill_diagonal(d2, np.inf)
+    d2[d2 <= floor * floor] = np.inf  # the nearest neighbour beyond the noise floor
     nn = np.argmin(d2, axis=1)
     d0 = np.sqrt(d2[np.arange(n - 1), nn])
     d1 = np.linalg.norm(x[1:] - x[nn + 1], axis=1)
-    ok = (d0 > min_distance) & (d1 > 0)
+    ok = np.isfinite(d0) & (d1 > 0)
     if ok.sum() < 10:
         return math.nan
     return float(np.mean(np.log(d1[ok] / d0[ok])))

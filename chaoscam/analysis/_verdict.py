@@ -86,7 +86,8 @@ class Verdict:
     reasons : tuple of str
         Why the label is "undetermined" (disagreement, too little data), or what limits it.
     settings : dict
-        The settings used by each method.
+        The settings used by each method; ``settings["thresholds"]`` is the
+        `Thresholds` table the classifier used (as a dict).
     """
 
     label: str
@@ -99,8 +100,17 @@ class Verdict:
         if self.label not in LABELS:
             raise ValueError(f"unknown label {self.label!r}; expected one of {LABELS}")
 
+    @property
+    def used(self) -> tuple[str, ...]:
+        """Names of the evidence that voted (the rest abstained and did not count)."""
+        return tuple(e.name for e in self.evidence if e.vote is not None)
+
     def to_dict(self) -> dict:
-        """JSON-serialisable dict with keys label, period, evidence, reasons."""
+        """JSON-serialisable dict with keys label, period, evidence, reasons.
+
+        The evidence used is that with a non-null vote (`used`); the thresholds are in
+        `settings`, which this form leaves out.
+        """
         return dict(
             label=self.label,
             period=None if self.period is None else int(self.period),

@@ -3,6 +3,7 @@
 import math
 
 import numpy as np
+import pytest
 
 from chaoscam.analysis import (
     correlation_dimension,
@@ -26,7 +27,7 @@ def test_period_of_a_cycle_with_noise_below_tolerance():
 
 
 def test_noise_above_tolerance_hides_the_period():
-    """The same cycle with noise at 1e-2 of its extent has no period at rtol 1e-3."""
+    """The same cycle with noise at 1e-2 of its extent has no period at the default rtol 3e-3."""
     cycle = RNG.uniform(-1, 1, size=(5, 2))
     pts = np.tile(cycle, (12, 1)) + 1e-2 * RNG.standard_normal((60, 2))
     assert section_period(pts).period is None
@@ -95,3 +96,52 @@ def test_stationarity_ratio_detects_a_shrinking_transient():
     pts = np.column_stack([np.cos(k), np.sin(k)]) * (0.98**k)[:, None]
     assert stationarity_ratio(pts) < 0.5
     assert 0.5 < stationarity_ratio(torus_section(200)) < 2.0
+
+
+def test_fixed_point_with_integration_jitter_at_zero_angle_is_period_one():
+    """A fixed point at θ = 0 with 1e-9 jitter (no extent of its own) is period 1."""
+    pts = np.column_stack([np.zeros(90), np.full(90, 0.35)]) + 1e-9 * RNG.standard_normal((90, 2))
+    res = section_period(pts)
+    assert res.period == 1 and res.coincident
+
+
+def _period_eight(band, n_rep=12):
+    """A period-8 orbit spanning 0.3 rad in θ with bands `band` wide in both coordinates."""
+    theta = np.linspace(-0.15, 0.15, 8)[[0, 4, 2, 6, 1, 5, 3, 7]]
+    cyc = np.column_stack([theta, np.linspace(-1.0, 1.0, 8)])
+    n = 8 * n_rep
+    return np.tile(cyc, (n_rep, 1)) + band * (RNG.uniform(size=(n, 2)) - 0.5)
+
+
+@pytest.mark.parametrize("band", [1e-4, 3e-4])
+def test_period_eight_with_bands_far_below_its_extent(band):
+    """Period 8 with bands of 1e-4 and 3e-4 rad (<= 1e-3 of the 0.3 rad extent) is period 8."""
+    res = section_period(_period_eight(band))
+    assert res.period == 8
+    assert res.jitter[0] <= band and abs(res.extent[0] - 0.3) < 2 * band
+
+
+def test_bands_a_sizeable_fraction_of_the_extent_are_not_a_period():
+    """Bands 1 % of the extent wide (3e-3 rad on 0.3 rad) are refused: no period."""
+    assert section_period(_period_eight(3e-3)).period is None
+
+
+def test_drift_near_a_resonance_is_not_a_period():
+    """A rotation by 1/3 + 1e-5 drifts along its circle: its lag-3 bands are wide, no period."""
+    k = np.arange(1000)
+    a = 2 * math.pi * (1 / 3 + 1e-5) * k
+    assert section_period(np.column_stack([np.cos(a), np.sin(a)])).period is None
+
+
+def test_overlapping_bands_are_refused():
+    """Two bands whose centres lie within one tolerance (atol 1e-3) do not make period 2."""
+    pts = np.tile([0.0, 0.9e-3], 30) + 0.9e-3 * RNG.uniform(size=60)
+    res = section_period(pts, atol=1e-3, allow_transient=False)
+    assert res.period is None
+
+
+def test_expansion_ignores_pairs_below_the_noise_floor():
+    """A fixed point with 1e-9 jitter: growth > 0.1 on the jitter, NaN above a 1e-8 floor."""
+    pts = np.array([[0.2, 0.5]]) + 1e-9 * RNG.standard_normal((300, 2))
+    assert neighbour_expansion(pts) > 0.1
+    assert math.isnan(neighbour_expansion(pts, atol=1e-8))

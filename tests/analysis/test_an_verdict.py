@@ -77,3 +77,9 @@ def test_verdict_is_frozen():
     v = combine([ev("a", "chaotic")])
     with pytest.raises(AttributeError):
         v.label = "periodic"
+
+
+def test_used_names_the_evidence_that_voted():
+    """Verdict.used lists the evidence with a vote, in order, and leaves out abstentions."""
+    v = combine([ev("a", "periodic", 2), ev("b", None), ev("c", "not_chaotic")], {"section_a": 2})
+    assert v.used == ("a", "c")

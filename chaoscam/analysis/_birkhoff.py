@@ -1,0 +1,160 @@
+"""Weighted Birkhoff averages: quasiperiodicity shown by fast convergence; rotation number."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ._validate import as_points
+
+__all__ = ["BirkhoffResult", "birkhoff_weights", "weighted_birkhoff"]
+
+_MIN_HALF = 8
+
+
+def birkhoff_weights(n: int) -> np.ndarray:
+    """Normalised bump weights ``w(t) = exp(-1 / (t (1 - t)))`` at ``t = k / (n + 1)``.
+
+    The weights of the weighted Birkhoff average ``WB_n(f) = Σ_k ŵ_k f(x_k)`` (Das, Saiki,
+    Sander & Yorke 2017; Das & Yorke 2018), ``ŵ_k = w(k / (n + 1)) / Σ_j w(j / (n + 1))``
+    for k = 1 .. n. All derivatives of w vanish at both ends, which is what makes the
+    average of a smooth function on a quasiperiodic orbit converge faster than any power
+    of 1/n (instead of as 1/n for the plain average).
+    """
+    if n < 1:
+        raise ValueError(f"need n >= 1 weights, got {n}")
+    t = np.arange(1, n + 1) / (n + 1.0)
+    w = np.exp(-1.0 / (t * (1.0 - t)))
+    return w / w.sum()
+
+
+@dataclass(frozen=True)
+class BirkhoffResult:
+    """Result of `weighted_birkhoff`.
+
+    Attributes
+    ----------
+    digits : float
+        Converged digits, the smallest over the observables (see `digits_by_observable`);
+        NaN when too few points.
+    digits_by_observable : dict
+        ``-log10(|WB_h(f)(x_0) - WB_h(f)(x_h)| / range(f))`` for each observable f, named
+        "x0", "x1", ... (the coordinates), "cos", "sin" (of the angle about the centroid)
+        and "turn" (the angle increment, in turns). At most 16 (double precision).
+    rotation_number : float
+        Weighted Birkhoff average of the angle increment about the centroid, in turns,
+        in [0, 1): the rotation number of the orbit along its curve (or 1 minus it when
+        the plane of the curve is seen from the other side, d > 2). NaN for d = 1.
+    n : int
+        Points used, ``2 h + 1`` (two averages of h points, h increments each).
+    message : str
+        Why nothing was computed (too few points), else empty.
+    settings : dict
+    """
+
+    digits: float
+    digits_by_observable: dict
+    rotation_number: float
+    n: int
+    message: str = ""
+    settings: dict = field(default_factory=dict)
+
+
+def _plane_angles(x: np.ndarray) -> np.ndarray:
+    """Angle of each point about the centroid (d = 2: axes scaled by their spread, which
+    keeps the orientation of (x0, x1); d > 2: the plane of the two principal axes)."""
+    c = x - x.mean(axis=0)
+    if x.shape[1] == 2:
+        s = c.std(axis=0)
+        u = c / np.where(s > 0, s, 1.0)
+    else:
+        _, s, vt = np.linalg.svd(c, full_matrices=False)
+        u = (c @ vt[:2].T) / np.where(s[:2] > 0, s[:2], 1.0)
+    return np.arctan2(u[:, 1], u[:, 0])
+
+
+def _lifted_turns(phi: np.ndarray) -> np.ndarray:
+    """Angle increments in turns, cut opposite their circular mean so they vary smoothly."""
+    inc = np.diff(phi)
+    mu = float(np.angle(np.mean(np.exp(1j * inc))))
+    return (mu + np.angle(np.exp(1j * (inc - mu)))) / (2.0 * math.pi)
+
+
+def weighted_birkhoff(points) -> BirkhoffResult:
+    """Converged digits of weighted Birkhoff averages, and the rotation number of a curve.
+
+    With the bump weights ``ŵ_k`` of `birkhoff_weights`, the weighted Birkhoff average of
+    an observable f over h iterates starting at x_m is ``WB_h(f)(x_m) = Σ_{k=1}^{h} ŵ_k
+    f(x_{m+k-1})``. On a quasiperiodic orbit (a smooth torus with a Diophantine rotation)
+    and a smooth f it converges faster than any power of 1/h; on a chaotic orbit only as
+    h^{-1/2}. The number of converged digits compares the first h iterates with the next
+    h (the measure of Das, Saiki, Sander & Yorke 2017),
+
+        dig = -log10 |WB_h(f)(x_0) - WB_h(f)(x_h)|,
+
+    here with f scaled by its range so that dig does not depend on units. Observables:
+    each coordinate, cos and sin of the angle φ about the centroid, and the increment
+    Δφ_k = φ_{k+1} - φ_k (lifted: cut opposite its circular mean), whose average in turns
+    is the rotation number ρ of a closed curve (Das et al. 2017); ``digits`` is
+    the smallest over these.
+
+    Parameters
+    ----------
+    points : array_like, shape (N,) or (N, d)
+        Section points (or map iterates) in time order, after the transient; angles
+        embedded as (cos, sin) with `embed_angles`.
+
+    Returns
+    -------
+    BirkhoffResult
+
+    Notes
+    -----
+    Measured (N = 200 .. 4000 points): rotation by the golden mean 8-15 digits, sine circle
+    map at K = 0.5 6-14, torus section 8-13, chaotic logistic (r = 4) and Hénon 1.2-2.3.
+    A periodic orbit converges as fast as a quasiperiodic one (test the period first);
+    jitter or noise of relative size ε caps the digits near -log10 ε (a period-8 orbit
+    with jitter 1e-4 of its extent: ~5), so a noisy torus reads like weak chaos. The angle
+    about the centroid is a coordinate along the curve only when the curve winds once
+    around the centroid (star-shaped); otherwise ρ is not the rotation number, while the
+    digits stay meaningful.
+
+    References: S. Das, Y. Saiki, E. Sander, J. A. Yorke, "Quantitative quasiperiodicity",
+    Nonlinearity 30 (2017) 4111; S. Das, E. Sander, J. A. Yorke, "Quasiquasiperiodicity"
+    (2016); S. Das, J. A. Yorke, "Super convergence of ergodic averages for quasiperiodic
+    orbits", Nonlinearity 31 (2018) 491.
+    """
+    x = as_points(points)
+    n = x.shape[0]
+    h = (n - 1) // 2
+    settings = dict(weight="exp(-1/(t(1-t)))", half=h)
+    if h < _MIN_HALF:
+        return BirkhoffResult(
+            math.nan,
+            {},
+            math.nan,
+            n,
+            f"only {n} points; the Birkhoff averages need >= {2 * _MIN_HALF + 1}",
+            settings,
+        )
+    obs = {f"x{j}": x[: 2 * h, j] for j in range(x.shape[1])}
+    rho = math.nan
+    w = birkhoff_weights(h)
+    if x.shape[1] >= 2:
+        phi = _plane_angles(x[: 2 * h + 1])
+        obs["cos"] = np.cos(phi[: 2 * h])
+        obs["sin"] = np.sin(phi[: 2 * h])
+        obs["turn"] = _lifted_turns(phi)
+    digits = {}
+    for name, f in obs.items():
+        a, b = float(w @ f[:h]), float(w @ f[h : 2 * h])
+        scale = 1.0 if name == "turn" else float(np.ptp(f))
+        if scale <= 0:
+            digits[name] = 16.0
+            continue
+        digits[name] = float(-math.log10(max(abs(a - b) / scale, 1e-16)))
+        if name == "turn":
+            rho = float(np.mod(w @ f[:h] * 0.5 + w @ f[h : 2 * h] * 0.5, 1.0))
+    return BirkhoffResult(min(digits.values()), digits, rho, 2 * h + 1, "", settings)
