@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 import chaoscam
-from chaoscam import Params, ParameterError
+from chaoscam import ParameterError, Params
 from chaoscam.cli import main
 from chaoscam.sweep import SweepError, bifurcation, regime_map
 
