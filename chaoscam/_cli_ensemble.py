@@ -105,15 +105,6 @@ def _run_locked(args: argparse.Namespace) -> int:
 
     out, sections_path, impacts_path = _outputs(out)
     parts = out.with_suffix(".parts")
-    if args.force:
-        discard_checkpoint(parts)
-    elif not (args.resume and parts.exists()):
-        for path in (out, sections_path, impacts_path):
-            if path.exists() and not args.force:
-                raise FileExistsError(
-                    f"{path} exists; choose another --out, remove it, or pass --force to "
-                    "replace it"
-                )
     config = {
         "params": params.to_dict(),
         "seed": args.seed,
@@ -126,6 +117,18 @@ def _run_locked(args: argparse.Namespace) -> int:
         "keep_impacts": args.keep_impacts,
     }
     digest = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:16]
+    if args.force:
+        discard_checkpoint(parts)
+    elif args.resume and not parts.exists() and _finished(out, digest):
+        print(f"already finished: {out} (same configuration); nothing to do")
+        return 0
+    elif not (args.resume and parts.exists()):
+        for path in (out, sections_path, impacts_path):
+            if path.exists() and not args.force:
+                raise FileExistsError(
+                    f"{path} exists; choose another --out, remove it, or pass --force to "
+                    "replace it"
+                )
     manifest = parts / "config.json"
     if parts.exists():
         if not args.resume:
@@ -196,7 +199,7 @@ def _run_locked(args: argparse.Namespace) -> int:
             print(f"members {start}..{stop - 1}: {ens.settings['backend']}, "
                   f"{(stop - start) / ens.settings['wall_time_s']:.1f} traj/s", flush=True)
 
-    members = _commit(parts, starts, names, out)
+    members = _commit(parts, starts, names, out, digest)
     wall = time.perf_counter() - t0
     counts = members["label" if args.classify else "status"].value_counts().to_dict()
     print(f"{args.members} members ({done_before} from an earlier run) in {wall:.1f} s: "
@@ -250,7 +253,34 @@ def _part_done(parts: Path, start: int, names: tuple[str, ...]) -> bool:
     return whole
 
 
-def _commit(parts: Path, starts: range, names: tuple[str, ...], out: Path):
+_META_KEY = b"chaoscam.ensemble"
+
+
+def _finished(out: Path, digest: str) -> bool:
+    """True when ``out`` is the members file of a finished run of this configuration."""
+    import pyarrow.parquet as pq
+
+    try:
+        meta = pq.read_schema(out).metadata or {}
+    except Exception:  # absent, or not a Parquet file: not finished
+        return False
+    return meta.get(_META_KEY) == digest.encode()
+
+
+def _write(frame, path: Path, digest: str | None = None) -> None:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    if digest is not None:
+        meta = dict(table.schema.metadata or {})
+        meta[_META_KEY] = digest.encode()
+        table = table.replace_schema_metadata(meta)
+    with atomic_path(path) as tmp:
+        pq.write_table(table, tmp)
+
+
+def _commit(parts: Path, starts: range, names: tuple[str, ...], out: Path, digest: str):
     """Join the parts into the outputs as one commit: every output written to a temporary
     name, then renamed, the members file last; then the parts are removed (renamed away
     first). A kill at any point leaves either the parts (``--resume`` joins them again) or
@@ -270,8 +300,7 @@ def _commit(parts: Path, starts: range, names: tuple[str, ...], out: Path):
         if name == "members":
             members = frame
         staged[name] = parts / f".staged.{name}.parquet"
-        with atomic_path(staged[name]) as tmp:
-            frame.to_parquet(tmp, index=False)
+        _write(frame, staged[name], digest if name == "members" else None)
     for name in sorted(names, key=lambda n: n == "members"):  # members last
         os.replace(staged[name], targets[name])
     discard_checkpoint(parts)
