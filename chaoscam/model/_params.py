@@ -121,7 +121,10 @@ class Params:
     theta_c0: float = field(
         default=0.0,
         metadata=_meta(
-            "cam phase at t = 0 (decision)", "rad", (-2 * math.pi, 2 * math.pi, True, True)
+            "cam phase at t = 0 (decision); restarts carry the accumulated phase omega t, so "
+            "the practical bound is wide: 1e9 rad (sin keeps ~1e-7 rad there)",
+            "rad",
+            (-1e9, 1e9, True, True),
         ),
     )
     theta_f0: float | None = field(
