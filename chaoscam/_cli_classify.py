@@ -66,12 +66,13 @@ def _print(verdict) -> None:
 
 
 def run_classify(args: argparse.Namespace) -> int:
-    from .classify import classify_trajectory, load_trajectory
+    from ._trajectory_io import TrajectoryFileError, read_trajectory
+    from .classify import classify_trajectory
     from .cli import UsageError
 
     try:
-        traj = load_trajectory(args.trajectory)
-    except (OSError, ValueError) as err:
+        traj = read_trajectory(args.trajectory)
+    except TrajectoryFileError as err:
         raise UsageError(str(err)) from None
     _print(classify_trajectory(traj, lyapunov=args.lyapunov, check_step=args.check_step))
     return 0
@@ -127,6 +128,12 @@ def run_classify_series(args: argparse.Namespace) -> int:
             f"{path}: {rows.size} row(s) with NaN or infinite values in "
             f"{', '.join(args.column)} (first at data row {int(rows[0]) + 1}); remove them"
         )
+    from ._trajectory_io import TrajectoryFileError, check_enough
+
+    try:
+        check_enough(len(data), "rows", path)
+    except TrajectoryFileError as err:
+        raise UsageError(str(err)) from None
     try:
         if args.section:
             points = data[:, 0] if data.shape[1] == 1 else data

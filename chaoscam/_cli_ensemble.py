@@ -6,6 +6,13 @@ skips the chunks already there, after checking that they belong to the same conf
 When all chunks are done they are joined into ``FILE.parquet`` (one row per member),
 ``FILE.sections.parquet`` and, with ``--keep-impacts``, ``FILE.impacts.parquet``, and the parts
 are removed.
+
+The outputs are written as one commit: each to a temporary name first, then renamed, the
+members file last, and only then are the parts removed (renamed away in one step). A run
+killed at any moment can therefore be finished with ``--resume``. Each part's ``.done``
+marker records the size and SHA-256 of the part's files; a part that does not match (torn,
+altered) is computed again, with a one-line notice. The run holds an OS lock on its output,
+so a second process on the same output is refused.
 """
 
 from __future__ import annotations
@@ -13,11 +20,14 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
+import os
 import shutil
 import sys
 import time
 import warnings
 from pathlib import Path
+
+from ._outputs import atomic_path
 
 __all__ = ["register"]
 
@@ -50,37 +60,51 @@ def register(sub) -> None:
     p.add_argument("--chunk", type=int, default=_CHUNK,
                    help=f"realizations per saved part (default {_CHUNK})")
     p.add_argument("--resume", action="store_true", help="continue an interrupted run")
+    p.add_argument("--force", action="store_true",
+                   help="start over: replace existing outputs and discard unfinished parts")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.add_argument("--out", type=Path, required=True, help="members to FILE.parquet")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    import pandas as pd
-
-    from .cli import UsageError, parse_assignments
-    from .integrate import simulate_ensemble
-    from .integrate._gpu import GPUFallbackWarning
-    from .sweep._common import run_settings
+    from ._outputs import OutputLock, check_output
+    from .cli import UsageError
 
     out: Path = args.out
     if out.suffix != ".parquet":
         raise UsageError(f"--out {out}: the output must end in .parquet")
-    if args.members < 1:
-        raise UsageError(f"--members = {args.members} must be >= 1")
-    if args.first < 0:
-        raise UsageError(f"--first = {args.first} must be >= 0")
-    if args.chunk < 1:
-        raise UsageError(f"--chunk = {args.chunk} must be >= 1")
+    if args.force and args.resume:
+        raise UsageError("--force starts over and --resume continues: give one of them")
+    for path in _outputs(out):
+        check_output(path, force=True)  # folder and path now; existence under the lock
+    with OutputLock(out):
+        return _run_locked(args)
+
+
+def _outputs(out: Path) -> tuple[Path, Path, Path]:
+    """members, sections, impacts."""
+    return out, out.with_suffix(".sections.parquet"), out.with_suffix(".impacts.parquet")
+
+
+def _run_locked(args: argparse.Namespace) -> int:
+    from ._checks import whole
+    from .cli import UsageError, parse_assignments
+    from .integrate import simulate_ensemble
+    from .integrate._gpu import GPUFallbackWarning
+    from .sweep._checkpoint import discard_checkpoint
+    from .sweep._common import run_settings
+
+    out: Path = args.out
+    members_n = whole("--members", args.members, low=1)
+    whole("--first", args.first)
+    whole("--chunk", args.chunk, low=1)
     params = parse_assignments(args.set)
     duration, transient = run_settings(args.duration, args.transient, args.seed)
+    _check_budget(params, duration, transient, members_n, args.chunk)
 
-    sections_path = out.with_suffix(".sections.parquet")
-    impacts_path = out.with_suffix(".impacts.parquet")
+    out, sections_path, impacts_path = _outputs(out)
     parts = out.with_suffix(".parts")
-    for path in (out, sections_path, impacts_path):
-        if path.exists():
-            raise FileExistsError(f"{path} exists; choose another --out or remove it")
     config = {
         "params": params.to_dict(),
         "seed": args.seed,
@@ -93,28 +117,53 @@ def run(args: argparse.Namespace) -> int:
         "keep_impacts": args.keep_impacts,
     }
     digest = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:16]
+    if args.force:
+        discard_checkpoint(parts)
+    elif args.resume and not parts.exists() and _finished(out, digest):
+        print(f"already finished: {out} (same configuration); nothing to do")
+        return 0
+    elif not (args.resume and parts.exists()):
+        for path in (out, sections_path, impacts_path):
+            if path.exists() and not args.force:
+                raise FileExistsError(
+                    f"{path} exists; choose another --out, remove it, or pass --force to "
+                    "replace it"
+                )
     manifest = parts / "config.json"
     if parts.exists():
         if not args.resume:
             raise FileExistsError(
-                f"{parts} holds an unfinished run; add --resume to continue it"
+                f"{parts} holds an unfinished run; add --resume to continue it (or --force "
+                "to start over)"
             )
-        old = json.loads(manifest.read_text()) if manifest.exists() else {}
+        try:
+            old = json.loads(manifest.read_text())
+        except (OSError, ValueError):
+            old = {}
         if old.get("digest") != digest:
-            raise UsageError(f"{parts} belongs to another configuration; not resumed")
+            raise UsageError(
+                f"{parts} belongs to another configuration (or has no readable config.json); "
+                "not resumed: use the original command, or --force to start over"
+            )
     else:
-        parts.mkdir(parents=True)
-        manifest.write_text(json.dumps({"digest": digest, "config": config}, indent=1))
+        tmp = parts.with_name(f".tmp-{os.getpid()}-{parts.name}")
+        shutil.rmtree(tmp, ignore_errors=True)
+        tmp.mkdir()
+        _atomic_text(tmp / "config.json", json.dumps({"digest": digest, "config": config},
+                                                     indent=1))
+        os.replace(tmp, parts)
+    for tmp in parts.glob(".tmp-*"):
+        tmp.unlink(missing_ok=True)
 
     t0 = time.perf_counter()
     done_before = 0
     noticed = False  # the GPU fallback notice is printed once, on one line
     last = args.first + args.members
     starts = range(args.first, last, args.chunk)
+    names = ("members", "sections") + (("impacts",) if args.keep_impacts else ())
     for start in starts:
         stop = min(start + args.chunk, last)
-        mark = parts / f"{start:012d}.done"
-        if mark.exists():
+        if _part_done(parts, start, names):
             done_before += stop - start
             continue
         try:
@@ -137,30 +186,20 @@ def run(args: argparse.Namespace) -> int:
             raise
         offset = start - args.first
         tables = {"members": ens.members, "sections": ens.sections, "impacts": ens.impacts}
-        for name, table in tables.items():
-            if table is None:
-                continue
-            table = table.assign(member=table["member"] + offset)
-            tmp = parts / f"{start:012d}.{name}.tmp"
-            table.to_parquet(tmp, index=False)
-            tmp.rename(parts / f"{start:012d}.{name}.parquet")
-        mark.write_text(json.dumps(ens.settings, default=str))
+        files = {}
+        for name in names:
+            table = tables[name].assign(member=tables[name]["member"] + offset)
+            path = parts / f"{start:012d}.{name}.parquet"
+            with atomic_path(path) as tmp:
+                table.to_parquet(tmp, index=False)
+            files[name] = _fingerprint(path)
+        _atomic_text(parts / f"{start:012d}.done",
+                     json.dumps({"files": files, "settings": ens.settings}, default=str))
         if not args.quiet:
             print(f"members {start}..{stop - 1}: {ens.settings['backend']}, "
                   f"{(stop - start) / ens.settings['wall_time_s']:.1f} traj/s", flush=True)
 
-    def joined(name: str) -> pd.DataFrame:
-        return pd.concat(
-            [pd.read_parquet(parts / f"{s:012d}.{name}.parquet") for s in starts],
-            ignore_index=True,
-        )
-
-    members = joined("members")
-    members.to_parquet(out, index=False)
-    joined("sections").to_parquet(sections_path, index=False)
-    if args.keep_impacts:
-        joined("impacts").to_parquet(impacts_path, index=False)
-    shutil.rmtree(parts)
+    members = _commit(parts, starts, names, out, digest)
     wall = time.perf_counter() - t0
     counts = members["label" if args.classify else "status"].value_counts().to_dict()
     print(f"{args.members} members ({done_before} from an earlier run) in {wall:.1f} s: "
@@ -170,3 +209,99 @@ def run(args: argparse.Namespace) -> int:
     if args.keep_impacts:
         print(f"impacts: {impacts_path}")
     return 0
+
+
+def _check_budget(params, duration: float, transient: float, members: int, chunk: int) -> None:
+    """Refuse an ensemble whose joined tables cannot fit in memory; warn about hours."""
+    from ._budget import JobEstimate, check_budget, estimate
+    from .sweep._backends import default_workers
+
+    one = estimate(params, duration=duration, transient=transient)
+    job = JobEstimate((one.bytes * (members + min(chunk, members)),
+                       one.seconds * members / default_workers()))
+    check_budget(job, what="this ensemble", reduce="--members or --duration")
+
+
+def _atomic_text(path: Path, text: str) -> None:
+    from ._outputs import atomic_write_bytes
+
+    atomic_write_bytes(path, text.encode())
+
+
+def _fingerprint(path: Path) -> dict:
+    data = path.read_bytes()
+    return {"bytes": len(data), "sha256": hashlib.sha256(data).hexdigest()}
+
+
+def _part_done(parts: Path, start: int, names: tuple[str, ...]) -> bool:
+    """True when part ``start`` is whole: its marker lists files that match it."""
+    mark = parts / f"{start:012d}.done"
+    if not mark.exists():
+        return False
+    try:
+        files = json.loads(mark.read_text())["files"]
+        whole = all(
+            _fingerprint(parts / f"{start:012d}.{name}.parquet") == files[name]
+            for name in names
+        )
+    except (OSError, ValueError, KeyError, TypeError):
+        whole = False
+    if not whole:
+        print(f"chaoscam: notice: part {start} in {parts} is damaged or incomplete; it is "
+              "computed again", file=sys.stderr, flush=True)
+        mark.unlink(missing_ok=True)
+    return whole
+
+
+_META_KEY = b"chaoscam.ensemble"
+
+
+def _finished(out: Path, digest: str) -> bool:
+    """True when ``out`` is the members file of a finished run of this configuration."""
+    import pyarrow.parquet as pq
+
+    try:
+        meta = pq.read_schema(out).metadata or {}
+    except Exception:  # absent, or not a Parquet file: not finished
+        return False
+    return meta.get(_META_KEY) == digest.encode()
+
+
+def _write(frame, path: Path, digest: str | None = None) -> None:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    if digest is not None:
+        meta = dict(table.schema.metadata or {})
+        meta[_META_KEY] = digest.encode()
+        table = table.replace_schema_metadata(meta)
+    with atomic_path(path) as tmp:
+        pq.write_table(table, tmp)
+
+
+def _commit(parts: Path, starts: range, names: tuple[str, ...], out: Path, digest: str):
+    """Join the parts into the outputs as one commit: every output written to a temporary
+    name, then renamed, the members file last; then the parts are removed (renamed away
+    first). A kill at any point leaves either the parts (``--resume`` joins them again) or
+    the finished outputs."""
+    import pandas as pd
+
+    from .sweep._checkpoint import discard_checkpoint
+
+    targets = dict(zip(("members", "sections", "impacts"), _outputs(out), strict=True))
+    staged = {}
+    members = None
+    for name in names:
+        frame = pd.concat(
+            [pd.read_parquet(parts / f"{s:012d}.{name}.parquet") for s in starts],
+            ignore_index=True,
+        )
+        if name == "members":
+            members = frame
+        staged[name] = parts / f".staged.{name}.parquet"
+        _write(frame, staged[name], digest if name == "members" else None)
+    for name in sorted(names, key=lambda n: n == "members"):  # members last
+        os.replace(staged[name], targets[name])
+    discard_checkpoint(parts)
+    return members

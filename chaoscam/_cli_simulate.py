@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import sys
+import warnings
 from pathlib import Path
 
 __all__ = ["register"]
@@ -27,36 +29,61 @@ def register(sub) -> None:
     p.add_argument("--out", type=Path, help="time series to FILE.parquet or FILE.csv")
     p.add_argument("--section", type=Path, help="stroboscopic section to FILE.csv")
     p.add_argument("--impacts", type=Path, help="impact list to FILE.csv")
+    p.add_argument("--force", action="store_true", help="replace existing output files")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from .cli import UsageError, parse_assignments
+    from ._outputs import atomic_path, check_output
+    from .cli import parse_assignments
     from .simulate import simulate
 
-    if args.out is not None and args.out.suffix not in (".parquet", ".csv"):
-        raise UsageError(f"--out {args.out}: the file must end in .parquet or .csv")
+    out = check_output(args.out, force=args.force, suffixes=(".parquet", ".csv"))
+    section = check_output(args.section, flag="--section", force=args.force)
+    impacts = check_output(args.impacts, flag="--impacts", force=args.force)
     params = parse_assignments(args.set)
-    traj = simulate(
-        params,
+    settings = dict(
         duration=args.duration,
         transient=args.transient,
         seed=args.seed,
         index=args.index,
-        series=args.out is not None,
+        series=out is not None,
         output_dt=args.output_dt,
     )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        traj = simulate(params, **settings)
+    notes = [str(w.message) for w in caught]
+    for note in notes:
+        print(f"chaoscam: warning: {note}", file=sys.stderr)
     print(traj.summary())
-    if args.out is not None:
-        if args.out.suffix == ".parquet":
-            traj.to_parquet(args.out)
-        else:
-            traj.series.to_csv(args.out, index=False)
-        print(f"series: {args.out}")
-    if args.section is not None:
-        traj.section.to_csv(args.section, index=False)
-        print(f"section: {args.section}")
-    if args.impacts is not None:
-        traj.impacts.to_csv(args.impacts, index=False)
-        print(f"impacts: {args.impacts}")
-    return 0
+    for path, label, write in (
+        (out, "series", _series_writer(traj, out)),
+        (section, "section", lambda tmp: traj.section.to_csv(tmp, index=False)),
+        (impacts, "impacts", lambda tmp: traj.impacts.to_csv(tmp, index=False)),
+    ):
+        if path is not None:
+            with atomic_path(path) as tmp:
+                write(tmp)
+            print(f"{label}: {path}")
+    return _exit_code(traj, notes)
+
+
+def _series_writer(traj, out):
+    if out is not None and out.suffix.lower() == ".parquet":
+        return traj.to_parquet
+    return lambda tmp: traj.series.to_csv(tmp, index=False)
+
+
+def _exit_code(traj, notes: list[str]) -> int:
+    """0 when the run simulated what was asked; else 1, with the cause on stderr (and the
+    step-size warning first when there was one: it is then the likely cause)."""
+    from .integrate import Status
+
+    if traj.status is Status.OK:
+        return 0
+    cause = f"likely cause: {notes[0]}. " if notes else ""
+    print(f"chaoscam: the run ended {traj.status.name} at t = {traj.final_state[0]:.6g} s "
+          f"of {traj.settings['duration']:g} s, not the end asked for. {cause}"
+          f"{traj.message}", file=sys.stderr)
+    return 1

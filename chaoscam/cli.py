@@ -61,23 +61,61 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+_SIGTERM = {"seen": False}
+
+
+def _on_sigterm(signum, frame) -> None:
+    """SIGTERM is handled like Ctrl-C (finished work saved, a resume hint), exit 143."""
+    _SIGTERM["seen"] = True
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run the ``chaoscam`` command; returns the exit code.
+
+    0 success, 1 a run that could not do what was asked (its cause printed), 2 bad input
+    (a message naming the field or path, never a traceback), 130 Ctrl-C and 143 SIGTERM
+    (both after saving finished work and saying how to resume).
+    """
+    import signal
+    import threading
+
+    previous = None
+    _SIGTERM["seen"] = False
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    try:
+        code = _dispatch(argv)
+    except KeyboardInterrupt:
+        print("chaoscam: " + ("terminated" if _SIGTERM["seen"] else "interrupted"),
+              file=sys.stderr)
+        code = 130
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+    return 143 if code == 130 and _SIGTERM["seen"] else code
+
+
+def _dispatch(argv: list[str] | None) -> int:
+    from ._outputs import OutputError
+
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
     try:
-        return int(args.func(args) or 0)
-    except (ParameterError, UsageError) as err:
+        code = int(args.func(args) or 0)
+    except (ParameterError, UsageError, OutputError, FileExistsError) as err:
         print(f"chaoscam: error: {err}", file=sys.stderr)
         return 2
-    except FileExistsError as err:
+    except OSError as err:  # a file the command reads or writes: never a traceback
         print(f"chaoscam: error: {err}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("chaoscam: interrupted", file=sys.stderr)
-        return 130
+    except MemoryError:
+        print("chaoscam: error: out of memory; ask for a smaller run", file=sys.stderr)
+        return 1
+    return code
 
 
 if __name__ == "__main__":  # pragma: no cover

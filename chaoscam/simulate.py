@@ -150,13 +150,30 @@ def contact_period(p: Params, l_lambda: float | None = None) -> float:
     return 2.0 * math.pi * math.sqrt(p.inertia / (p.stiffness_at(lam) * l1 * l1))
 
 
-def _check_run(duration: float, transient: float, output_dt: float | None, dt: float) -> None:
-    if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):
-        raise ParameterError(f"duration = {duration!r} s must be > 0")
+def _check_run(
+    p: Params, duration: float, transient: float, output_dt: float | None, seed, index
+) -> tuple[int, int]:
+    """Validate the run's settings and refuse a run that cannot fit in memory."""
+    from ._budget import check_budget, estimate
+    from ._checks import real, whole
+
+    seed, index = whole("seed", seed), whole("index", index)
+    duration = real("duration", duration, low=0.0, strict=True, unit="s")
     if not (isinstance(transient, int | float) and 0 <= transient < duration):
         raise ParameterError(f"transient = {transient!r} s must be in [0, duration = {duration})")
-    if output_dt is not None and not (output_dt >= dt and math.isfinite(output_dt)):
-        raise ParameterError(f"output_dt = {output_dt!r} s must be >= dt = {dt} s")
+    if round(duration / p.dt) < 1:
+        raise ParameterError(
+            f"duration = {duration!r} s is shorter than one step dt = {p.dt!r} s: nothing "
+            "would be simulated"
+        )
+    if output_dt is not None and not (output_dt >= p.dt and math.isfinite(output_dt)):
+        raise ParameterError(f"output_dt = {output_dt!r} s must be >= dt = {p.dt} s")
+    job = estimate(
+        p, duration=duration, transient=transient, series=output_dt is not None,
+        output_dt=output_dt or 1.0,
+    )
+    check_budget(job, what="this run", reduce="duration (or raise output_dt)")
+    return seed, index
 
 
 def simulate(
@@ -202,10 +219,14 @@ def simulate(
         Frozen; ``status`` says how the run ended (it never raises for a run that leaves the
         cam or diverges).
     """
-    p = Params() if params is None else params
+    from ._checks import params_arg, real
+
+    p = params_arg(params)
     if overrides:
         p = p.replace(**overrides)
-    _check_run(duration, transient, output_dt if series else None, p.dt)
+    # output_dt is checked even without a series: a bad value is a mistake either way.
+    output_dt = real("output_dt", output_dt, low=0.0, strict=True, unit="s")
+    seed, index = _check_run(p, duration, transient, output_dt if series else None, seed, index)
     t0 = time.perf_counter()
     n_stop = int(round(duration / p.dt))
     stride = max(1, int(round(output_dt / p.dt))) if series else 0

@@ -52,7 +52,9 @@ class Params:
     """
 
     # --- Table 1 -------------------------------------------------------------------------
-    l: float = field(default=0.6, metadata=_meta("follower (rod) length", "m"))
+    l: float = field(
+        default=0.6, metadata=_meta("follower (rod) length", "m", (0.0, 100.0, False, True))
+    )
     r: float = field(default=0.005, metadata=_meta("follower radius", "m"))
     m: float = field(default=0.3676, metadata=_meta("follower mass", "kg"))
     R: float = field(default=0.09, metadata=_meta("cam radius", "m"))
@@ -72,7 +74,11 @@ class Params:
         default=0.42,
         metadata=_meta("coefficient of restitution, eq. (4)", "-", (0.0, 1.0, True, True)),
     )
-    omega: float = field(default=28.7, metadata=_meta("cam speed", "rad/s"))
+    omega: float = field(
+        default=28.7,
+        metadata=_meta("cam speed (practical bound: 1e4 rad/s, ~95,000 rpm)", "rad/s",
+                       (0.0, 1e4, False, True)),
+    )
     l_lambda: float = field(
         default=0.008,
         metadata=_meta("contact line length l_lambda, the mean mu when random, eq. (18)", "m"),
@@ -97,26 +103,36 @@ class Params:
     )
     x_O: float = field(
         default=-0.5,
-        metadata=_meta("pivot x, cam rotation centre at the origin (decision)", "m", None),
+        metadata=_meta(
+            "pivot x, cam rotation centre at the origin (decision; practical bound 100 m)",
+            "m",
+            (-100.0, 100.0, True, True),
+        ),
     )
     y_O: float | None = field(
         default=None,
         metadata=_meta(
             "pivot y; None = R + r, so the rod is horizontal when touching the cam with the "
-            "cam centre on the x axis (decision)",
+            "cam centre on the x axis (decision; practical bound 100 m)",
             "m",
-            None,
+            (-100.0, 100.0, True, True),
         ),
     )
     theta_c0: float = field(
-        default=0.0, metadata=_meta("cam phase at t = 0 (decision)", "rad", None)
+        default=0.0,
+        metadata=_meta(
+            "cam phase at t = 0 (decision); restarts carry the accumulated phase omega t, so "
+            "the practical bound is wide: 1e9 rad (sin keeps ~1e-7 rad there)",
+            "rad",
+            (-1e9, 1e9, True, True),
+        ),
     )
     theta_f0: float | None = field(
         default=None,
         metadata=_meta(
             "initial follower angle; None = theta_fc(0), in contact (decision, paper sec. 2)",
             "rad",
-            None,
+            (-2 * math.pi, 2 * math.pi, True, True),
         ),
     )
     omega_f0: float | None = field(
@@ -124,7 +140,7 @@ class Params:
         metadata=_meta(
             "initial follower angular velocity; None = d(theta_fc)/dt at t = 0 (decision)",
             "rad/s",
-            None,
+            (-1e4, 1e4, True, True),
         ),
     )
 
@@ -262,9 +278,9 @@ class Params:
         default=8,
         metadata=_meta(
             "chattering guard: impacts handled inside one step before the rest of the step is "
-            "left to the compliant contact",
+            "left to the compliant contact (at most 1024: buffers are sized by it)",
             "-",
-            (1, None, True, None),
+            (1, 1024, True, True),
         ),
     )
 
@@ -275,9 +291,10 @@ class Params:
             "no contact can occur (free pendulum, truncation error ~1e-19 rad per merged "
             "step); the step still ends on the grid. 1 = plain fixed-step RK4 everywhere. "
             "Default 16: 6x faster, and equal to plain RK4 within 5e-9 s / 1e-8 rad on the "
-            "first ten impacts and on 20 s sections of periodic responses (tests)",
+            "first ten impacts and on 20 s sections of periodic responses (tests). At most "
+            "1024: buffers are sized by it",
             "-",
-            (1, None, True, None),
+            (1, 1024, True, True),
         ),
     )
     rtol: float = field(
@@ -307,7 +324,11 @@ class Params:
     # ------------------------------------------------------------------------------------
     def __post_init__(self) -> None:
         for f in fields(self):
-            _validate_field(f, getattr(self, f.name))
+            value = getattr(self, f.name)
+            if type(value).__module__ == "numpy":  # numpy scalars: stored as Python numbers
+                value = value.item()
+                object.__setattr__(self, f.name, value)
+            _validate_field(f, value)
         if self.stiffness == "fractal":
             # Raises a ParameterError naming D or G when (15)/(17) do not apply.
             from ._stiffness import fractal_stiffness

@@ -20,6 +20,7 @@ def register(sub) -> None:
     r.add_argument("inputs", nargs="+", metavar="INPUT", help="chaoscam .parquet outputs")
     r.add_argument("--out", type=Path, required=True, help="the report, FILE.html")
     r.add_argument("--title", default="chaoscam report", help="the report's title")
+    r.add_argument("--force", action="store_true", help="replace an existing report")
     r.set_defaults(func=run_report)
 
     p = sub.add_parser(
@@ -52,14 +53,15 @@ def register(sub) -> None:
         default=None,
         help="worker processes for the sweeps (default: every core)",
     )
+    p.add_argument("--force", action="store_true",
+                   help="replace an existing report (and its paper-data folder's files)")
     p.set_defaults(func=run_paper)
 
 
-def _check_out(out: Path) -> None:
-    from ..cli import UsageError
+def _check_out(out: Path, force: bool) -> None:
+    from .._outputs import check_output
 
-    if out.suffix.lower() != ".html":
-        raise UsageError(f"--out {out}: the report must end in .html")
+    check_output(out, force=force, suffixes=(".html",))
 
 
 def run_report(args: argparse.Namespace) -> int:
@@ -67,7 +69,7 @@ def run_report(args: argparse.Namespace) -> int:
     from ._html import build_report, write_report
     from ._inputs import InputError, load_inputs
 
-    _check_out(args.out)
+    _check_out(args.out, args.force)
     try:
         inputs = load_inputs(args.inputs)
     except InputError as err:
@@ -87,7 +89,9 @@ def run_paper(args: argparse.Namespace) -> int:
     from ._paper import FIGURES
     from ._paper import run_paper as _run
 
-    _check_out(args.out)
+    _check_out(args.out, args.force)
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers {args.workers}: must be >= 1")
     figures = None
     if args.figures:
         try:

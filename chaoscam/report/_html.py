@@ -346,7 +346,9 @@ def build_report(inputs, parts: ReportParts | None = None) -> ReportParts:
 
 def write_report(parts: ReportParts, out: str | Path, *, title: str, command=None) -> Path:
     """Render and write the report; returns the path."""
+    from .._outputs import atomic_write_bytes
+
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(render(parts, title=title, command=command), encoding="utf-8")
+    atomic_write_bytes(out, render(parts, title=title, command=command).encode("utf-8"))
     return out

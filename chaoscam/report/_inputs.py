@@ -47,36 +47,14 @@ def _schema_metadata(path: Path) -> dict[bytes, bytes]:
 
 
 def load_trajectory(path: str | Path):
-    """A :class:`chaoscam.Trajectory` rebuilt from a file written by ``Trajectory.to_parquet``."""
-    import io
+    """A :class:`chaoscam.Trajectory` from a ``Trajectory.to_parquet`` file, read by the one
+    reader ``classify`` uses too (:func:`chaoscam._trajectory_io.read_trajectory`)."""
+    from .._trajectory_io import TrajectoryFileError, read_trajectory
 
-    import pandas as pd
-
-    from ..integrate import Status
-    from ..model import Params
-    from ..simulate import Trajectory
-
-    path = Path(path)
-    meta = _schema_metadata(path)
-    if _TRAJ_KEY not in meta:
-        raise InputError(f"{path}: not a chaoscam trajectory (no chaoscam.trajectory metadata)")
-    prov = json.loads(meta[_TRAJ_KEY])
-    frame = pd.read_parquet(path)
-
-    def part(key: bytes) -> pd.DataFrame:
-        return pd.read_json(io.StringIO(meta[key].decode()), orient="split")
-
-    section = part(b"chaoscam.section")
-    series = frame if "theta_fc" in frame.columns else None
-    return Trajectory(
-        params=Params(**prov["params"]),
-        settings=prov["settings"],
-        status=Status[prov["status"]],
-        series=series,
-        section=section,
-        impacts=part(b"chaoscam.impacts"),
-        stats=prov.get("stats", {}),
-    )
+    try:
+        return read_trajectory(path)
+    except TrajectoryFileError as err:
+        raise InputError(str(err)) from None
 
 
 def _sweep_kind(path: Path, meta: dict[bytes, bytes]) -> str | None:
@@ -117,7 +95,7 @@ def load_inputs(paths: list[str | Path]) -> Inputs:
                     f"{path}: a Parquet file but not a chaoscam trajectory, bifurcation or "
                     "regime map"
                 )
-        except (OSError, ValueError) as err:
+        except (OSError, ValueError, KeyError, TypeError) as err:
             if isinstance(err, InputError):
                 raise
             raise InputError(f"{path}: could not read the {kind} ({err})") from None

@@ -27,11 +27,27 @@ import threading
 from collections.abc import Callable, Iterable
 from typing import Any
 
-__all__ = ["SerialBackend", "ProcessBackend", "DaskBackend", "WorkerLost", "make_backend"]
+__all__ = [
+    "SerialBackend",
+    "ProcessBackend",
+    "DaskBackend",
+    "WorkerLost",
+    "BackendLost",
+    "make_backend",
+]
+
+_DASK_POLL_S = 2.0
+_DASK_NOTICE_S = 10.0
+_DASK_LOST_ERRORS = ("FuturesCancelledError", "CancelledError", "CommClosedError")
 
 
 class WorkerLost(RuntimeError):
     """The worker running a task died; the task can be submitted again."""
+
+
+class BackendLost(RuntimeError):
+    """The backend itself is gone (the Dask scheduler died or the connection to it broke):
+    no task can run until it is restarted; the finished records are kept."""
 
 
 def default_workers() -> int:
@@ -69,8 +85,43 @@ class SerialBackend:
         pass
 
 
-def _ignore_sigint() -> None:
+def _worker_init(parent: int) -> None:
+    """Start-up of a pool worker: Ctrl-C reaches the driver alone, the worker dies with its
+    driver (even one killed with SIGKILL), and it drops the driver's output locks."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    _die_with_parent(parent)
+    from .._outputs import OutputLock
+
+    for fd in OutputLock._held.values():  # a forked worker holds copies of the lock files
+        try:
+            os.close(fd)
+        except OSError:
+            pass
+    OutputLock._held.clear()
+
+
+def _die_with_parent(parent: int) -> None:
+    """Ask Linux for SIGKILL when the parent exits (``prctl(PR_SET_PDEATHSIG)``); elsewhere
+    a daemon thread that polls the parent pid does the same."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(1, signal.SIGKILL, 0, 0, 0) != 0:  # PR_SET_PDEATHSIG = 1
+            raise OSError(ctypes.get_errno(), "prctl")
+    except (OSError, AttributeError):  # pragma: no cover - not Linux
+        threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+    if os.getppid() != parent:  # the driver died before the request took effect
+        os._exit(1)
+
+
+def _watch_parent(parent: int) -> None:  # pragma: no cover - not Linux
+    import time
+
+    while os.getppid() == parent:
+        time.sleep(1.0)
+    os._exit(1)
 
 
 def _warm_kernels() -> None:
@@ -117,7 +168,8 @@ class ProcessBackend:
         return cf.ProcessPoolExecutor(
             max_workers=self.workers,
             mp_context=multiprocessing.get_context(self.start_method),
-            initializer=_ignore_sigint,
+            initializer=_worker_init,
+            initargs=(os.getpid(),),
         )
 
     def submit(self, fn: Callable, arg: Any) -> cf.Future:
@@ -175,6 +227,7 @@ class DaskBackend:
     """
 
     name = "dask"
+    _noticed = False
 
     def __init__(self, scheduler: Any = None, workers: int | None = None) -> None:
         try:
@@ -213,10 +266,52 @@ class DaskBackend:
         return self.client.submit(fn, arg, pure=False)
 
     def wait_any(self, futures: Iterable[Any]) -> set:
-        return self._distributed.wait(list(futures), return_when="FIRST_COMPLETED").done
+        """The finished futures; says once on stderr when no worker is connected."""
+        import sys
+
+        futures = list(futures)
+        waited = 0.0
+        while True:
+            try:
+                done = self._distributed.wait(
+                    futures, timeout=_DASK_POLL_S, return_when="FIRST_COMPLETED"
+                ).done
+            except self._distributed.TimeoutError:
+                done = set()
+            except Exception as err:  # the scheduler is gone or the connection broke
+                raise BackendLost(self._lost(err)) from None
+            if done:
+                return done
+            if self.client.status not in ("running", "connecting"):
+                raise BackendLost(self._lost(None))
+            waited += _DASK_POLL_S
+            if waited >= _DASK_NOTICE_S and not self._noticed and not self._workers_now():
+                print(
+                    f"chaoscam: waiting: no Dask worker is connected to the scheduler "
+                    f"({self.client.scheduler.address}); start one with `dask worker "
+                    "ADDRESS`, or stop with Ctrl-C and --resume later",
+                    file=sys.stderr,
+                    flush=True,
+                )
+                self._noticed = True
+
+    def _workers_now(self) -> int:
+        try:
+            return len(self.client.nthreads())
+        except Exception:
+            return 0
+
+    def _lost(self, err: Exception | None) -> str:
+        detail = f" ({type(err).__name__}: {err})" if err is not None else ""
+        return f"the Dask scheduler was lost{detail}"
 
     def result(self, fut: Any) -> Any:
-        return fut.result()
+        try:
+            return fut.result()
+        except Exception as err:
+            if fut.status == "cancelled" or type(err).__name__ in _DASK_LOST_ERRORS:
+                raise BackendLost(self._lost(err)) from None
+            raise
 
     def cancel(self, futures: Iterable[Any]) -> None:
         futures = list(futures)
@@ -224,10 +319,14 @@ class DaskBackend:
             self.client.cancel(futures)
 
     def close(self) -> None:
-        if self._own_client:
-            self.client.close()
-        if self._cluster is not None:
-            self._cluster.close()
+        # A lost scheduler must not turn the closing into a hang or a traceback.
+        try:
+            if self._own_client:
+                self.client.close(timeout=10)
+            if self._cluster is not None:
+                self._cluster.close(timeout=10)
+        except Exception:
+            pass
 
 
 def make_backend(workers: int | None = None, scheduler: Any = None):

@@ -9,6 +9,7 @@ last section point, following one branch.
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,13 +18,16 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .._checks import whole
 from .._version import __version__
 from ..model import Params, contact_angle
 from ._checkpoint import read_sweep_metadata, write_parquet
 from ._common import (
     backend_for,
+    check_sweep_budget,
     companion,
     evidence_columns,
+    lock_outputs,
     open_store,
     period_column,
     reemit_warnings,
@@ -213,6 +217,7 @@ def bifurcation(
     resume: bool = False,
     progress: bool = False,
     flush_interval: float = 1.0,
+    force: bool = False,
 ) -> Bifurcation:
     """Bifurcation diagram of the stroboscopic section over one parameter (paper Figs. 4, 6).
 
@@ -255,13 +260,14 @@ def bifurcation(
     elif isinstance(values, str):
         axis = Axis.parse(values, name=param)
     else:
-        axis = Axis(param, tuple(values))
+        axis = Axis(param, values)
     base = Params() if base is None else base
     duration, transient = run_settings(duration, transient, seed)
     validate_grid(base, [axis])
-    if isinstance(initial_conditions, int) and not isinstance(initial_conditions, bool):
-        if initial_conditions < 1:
-            raise SweepError(f"initial conditions = {initial_conditions} must be >= 1")
+    if isinstance(initial_conditions, numbers.Integral) and not isinstance(
+        initial_conditions, bool
+    ):
+        initial_conditions = whole("initial conditions", initial_conditions, low=1)
         specs: list[tuple[str, float | None, float | None]] = [
             ("base", base.theta_f0, base.omega_f0)
         ] + [("offset", a, b) for a, b in initial_offsets(initial_conditions)]
@@ -270,6 +276,12 @@ def bifurcation(
         if not specs:
             raise SweepError("initial conditions: the list is empty")
     classify, identity = resolve_classifier(classify, lyapunov, check_step)
+    check_sweep_budget(
+        base, runs=len(axis) * len(specs), duration=duration, transient=transient,
+        series=needs_series(classify), workers=workers, keeps_sections=True,
+        what="this bifurcation diagram", factor=1 + 2 * lyapunov + check_step,
+        reduce="the values, the initial conditions or the duration",
+    )
     config = {
         "kind": "bifurcation",
         "version": __version__,
@@ -284,47 +296,48 @@ def bifurcation(
         "index_scheme": "cantor(value_index, ic)",
     }
     out = None if out is None else Path(out)
-    store, reuse = open_store(out, "verdicts", config, resume, flush_interval)
-    if reuse:
-        return read_bifurcation(out)
+    with lock_outputs(out):
+        store, reuse = open_store(out, "verdicts", config, resume, flush_interval, force)
+        if reuse:
+            return read_bifurcation(out)
 
-    series = needs_series(classify)
+        series = needs_series(classify)
 
-    def make_task(v: int, j: int, state) -> BranchTask:
-        value = axis.values[v]
-        p = base.replace(**{axis.name: value})
-        kind, a, b = specs[j]
-        if state is not None:
-            th, om = state
-        elif kind == "offset":
-            th, om = float(contact_angle(p, 0.0)) + a, b
-        else:
-            th, om = a, b
-        p = p.replace(theta_f0=th, omega_f0=om)
-        return BranchTask(
-            v,
-            j,
-            value,
-            int(seed),
-            realization_index(v, j),
-            p,
-            duration,
-            transient,
-            classify,
-            continued=state is not None,
-            series=series,
-        )
+        def make_task(v: int, j: int, state) -> BranchTask:
+            value = axis.values[v]
+            p = base.replace(**{axis.name: value})
+            kind, a, b = specs[j]
+            if state is not None:
+                th, om = state
+            elif kind == "offset":
+                th, om = float(contact_angle(p, 0.0)) + a, b
+            else:
+                th, om = a, b
+            p = p.replace(theta_f0=th, omega_f0=om)
+            return BranchTask(
+                v,
+                j,
+                value,
+                int(seed),
+                realization_index(v, j),
+                p,
+                duration,
+                transient,
+                classify,
+                continued=state is not None,
+                series=series,
+            )
 
-    plan = _BranchPlan(make_task, len(axis), len(specs), bool(continuation))
-    backend = backend_for(workers, scheduler)
-    try:
-        execute(plan, backend, store, progress=progress, desc=f"bifurcation {axis.name}")
-    finally:
-        backend.close()
-    records = unique_sorted(store.records(), ("value_index", "ic"))
-    reemit_warnings(records)
-    result = Bifurcation(*_tables(records, axis), config)
-    if out is not None:
-        result.to_parquet(out)
-        store.remove()
-    return result
+        plan = _BranchPlan(make_task, len(axis), len(specs), bool(continuation))
+        backend = backend_for(workers, scheduler)
+        try:
+            execute(plan, backend, store, progress=progress, desc=f"bifurcation {axis.name}")
+        finally:
+            backend.close()
+        records = unique_sorted(store.records(), ("value_index", "ic"))
+        reemit_warnings(records)
+        result = Bifurcation(*_tables(records, axis), config)
+        if out is not None:
+            result.to_parquet(out)
+            store.remove()
+        return result

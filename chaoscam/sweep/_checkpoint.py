@@ -2,11 +2,17 @@
 
 Layout, beside the output ``FILE.parquet``: a folder ``FILE.parquet.ckpt/`` holding
 ``manifest.json`` (the run's configuration and its SHA-256) and append-only part files
-``part-NNNNNN.jsonl``, one JSON record per line. Every file is written to a temporary name,
-flushed to disk and moved into place with :func:`os.replace`, so a part is either whole or
-absent whatever moment the process is killed (SIGKILL included); a resumed run reads the
-parts, skips the records they hold and appends new parts. Floats are written with Python's
-shortest round-trip ``repr``, so a record read back is bit-identical to the one written.
+``part-NNNNNN.jsonl``, one JSON record per line and a last line
+``#chaoscam-part n=COUNT sha256=HEX`` (the records' count and the checksum of the bytes
+before it). Every file is written to a temporary name, flushed to disk and moved into place
+with :func:`os.replace`, so a part is either whole or absent whatever moment the process is
+killed (SIGKILL included); a resumed run reads the parts, skips the records they hold and
+appends new parts. A part damaged all the same (a full disk, a copy cut short) is found by
+its trailer: the last part is dropped with a one-line notice and its records recomputed; a
+damaged part before it is refused with a message saying what to do. Floats are written with
+Python's shortest round-trip ``repr``, so a record read back is bit-identical to the one
+written. The run holds an OS lock on its output (:class:`chaoscam._outputs.OutputLock`), so
+two processes never share a checkpoint.
 """
 
 from __future__ import annotations
@@ -14,7 +20,9 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import shutil
+import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -41,12 +49,59 @@ def checkpoint_dir(out: Path) -> Path:
 
 
 def _atomic_write(path: Path, data: bytes) -> None:
-    tmp = path.with_name(f".tmp-{os.getpid()}-{path.name}")
-    with open(tmp, "wb") as fh:
-        fh.write(data)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    from .._outputs import atomic_write_bytes
+
+    atomic_write_bytes(path, data)
+
+
+_TRAILER = b"#chaoscam-part "
+_PART = re.compile(r"part-(\d{6,})\.jsonl")
+
+
+class DamagedPart(ValueError):
+    """A part file whose trailer is missing or does not match its records."""
+
+
+def encode_part(records: list[dict[str, Any]]) -> bytes:
+    """Records as JSON lines, then the trailer with their count and SHA-256."""
+    body = "".join(json.dumps(r, separators=(",", ":")) + "\n" for r in records).encode()
+    digest = hashlib.sha256(body).hexdigest()
+    return body + _TRAILER + f"n={len(records)} sha256={digest}\n".encode()
+
+
+def decode_part(data: bytes) -> list[dict[str, Any]]:
+    """The records of a part; :class:`DamagedPart` when it is torn or altered.
+
+    A part without a trailer (written before trailers existed) is accepted when every line
+    is a JSON object.
+    """
+    body, sep, trailer = data.rpartition(_TRAILER)
+    if sep:
+        fields = dict(f.split("=", 1) for f in trailer.decode("ascii", "replace").split()
+                      if "=" in f)
+        if hashlib.sha256(body).hexdigest() != fields.get("sha256"):
+            raise DamagedPart("its checksum does not match its records")
+    else:
+        body = data
+    try:
+        records = [json.loads(line) for line in body.decode().splitlines() if line.strip()]
+    except (UnicodeDecodeError, ValueError) as err:
+        raise DamagedPart(f"unreadable records ({type(err).__name__})") from None
+    if sep and str(len(records)) != fields.get("n"):
+        raise DamagedPart(f"{len(records)} records where its trailer says {fields.get('n')}")
+    if not all(isinstance(r, dict) for r in records):
+        raise DamagedPart("a line that is not a record")
+    return records
+
+
+def discard_checkpoint(path: Path) -> None:
+    """Delete a checkpoint folder: renamed away first, in one step, so a kill during the
+    deletion never leaves a half-deleted checkpoint that a later --resume would trip over."""
+    if not path.exists():
+        return
+    gone = path.with_name(f".tmp-{os.getpid()}-removed-{path.name}")
+    os.replace(path, gone)
+    shutil.rmtree(gone, ignore_errors=True)
 
 
 class MemoryStore:
@@ -119,7 +174,7 @@ class CheckpointStore:
             for tmp in self.path.glob(".tmp-*"):
                 tmp.unlink(missing_ok=True)
         self._config = config
-        self._seq = 1 + max((int(p.stem.split("-")[1]) for p in self._parts()), default=-1)
+        self._seq = 1 + max((int(_PART.fullmatch(p.name)[1]) for p in self._parts()), default=-1)
 
     def open(self) -> None:
         """Create the folder and its manifest if absent (when the run starts)."""
@@ -149,15 +204,33 @@ class CheckpointStore:
             )
 
     def _parts(self) -> list[Path]:
-        return sorted(self.path.glob("part-*.jsonl")) if self.path.is_dir() else []
+        if not self.path.is_dir():
+            return []
+        return sorted(p for p in self.path.glob("part-*.jsonl") if _PART.fullmatch(p.name))
 
     def restored(self) -> Iterator[dict[str, Any]]:
-        """The records already checkpointed, part by part (streamed, not all in memory)."""
-        for part in self._parts():
-            with open(part) as fh:
-                for line in fh:
-                    if line.strip():
-                        yield json.loads(line)
+        """The records already checkpointed, part by part (streamed, not all in memory).
+
+        A damaged last part (torn by a kill at the wrong moment, a full disk) is removed
+        with a one-line notice on stderr; its records are simply computed again. A damaged
+        part before the last is refused: a :class:`SweepError` says what to do.
+        """
+        parts = self._parts()
+        for i, part in enumerate(parts):
+            try:
+                records = decode_part(part.read_bytes())
+            except DamagedPart as err:
+                if i < len(parts) - 1:
+                    raise SweepError(
+                        f"{part} is damaged ({err}) and is not the last part: delete that "
+                        f"file to compute its records again, or delete {self.path} to start "
+                        "over"
+                    ) from None
+                os.replace(part, part.with_name(f".tmp-{os.getpid()}-damaged-{part.name}"))
+                print(f"chaoscam: notice: {part.name} in {self.path} was torn ({err}); "
+                      "dropped, its runs are computed again", file=sys.stderr, flush=True)
+                return
+            yield from records
 
     def add(self, record: dict[str, Any]) -> None:
         self._pending.append(record)
@@ -172,8 +245,7 @@ class CheckpointStore:
         if not self._pending:
             return
         self.open()
-        text = "".join(json.dumps(r, separators=(",", ":")) + "\n" for r in self._pending)
-        _atomic_write(self.path / f"part-{self._seq:06d}.jsonl", text.encode())
+        _atomic_write(self.path / f"part-{self._seq:06d}.jsonl", encode_part(self._pending))
         self._seq += 1
         self._pending = []
 
@@ -188,11 +260,7 @@ class CheckpointStore:
         It is first renamed away in one step, so a kill during the deletion never leaves a
         half-deleted checkpoint that a later --resume would trip over.
         """
-        if not self.path.exists():
-            return
-        gone = self.path.with_name(f".tmp-{os.getpid()}-removed-{self.path.name}")
-        os.replace(self.path, gone)
-        shutil.rmtree(gone, ignore_errors=True)
+        discard_checkpoint(self.path)
 
 
 def write_parquet(frame: pd.DataFrame, path: Path, config: dict[str, Any]) -> None:
@@ -203,9 +271,10 @@ def write_parquet(frame: pd.DataFrame, path: Path, config: dict[str, Any]) -> No
     table = pa.Table.from_pandas(frame, preserve_index=False)
     meta = dict(table.schema.metadata or {})
     meta[_META_KEY] = json.dumps({"hash": config_hash(config), "config": config}).encode()
-    tmp = path.with_name(f".tmp-{os.getpid()}-{path.name}")
-    pq.write_table(table.replace_schema_metadata(meta), tmp)
-    os.replace(tmp, path)
+    from .._outputs import atomic_path
+
+    with atomic_path(path) as tmp:
+        pq.write_table(table.replace_schema_metadata(meta), tmp)
 
 
 def read_sweep_metadata(path: Path) -> dict[str, Any] | None:

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
 __all__ = ["register"]
+
+_PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
 
 def _common(p: argparse.ArgumentParser) -> None:
@@ -70,6 +73,11 @@ def _common(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--plot", type=Path, default=None, help="also draw the figure to FILE.png/pdf")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="start over: replace existing outputs and discard an existing checkpoint",
+    )
     p.add_argument("--out", type=Path, required=True, help="output FILE.parquet")
 
 
@@ -138,6 +146,7 @@ def register(sub) -> None:
 
 
 def _execution(args) -> dict:
+    from .._outputs import check_output
     from ..cli import UsageError
     from ._tasks import load_classifier
 
@@ -147,8 +156,15 @@ def _execution(args) -> dict:
         raise UsageError("--workers applies to local runs and --scheduler local only")
     if args.out.suffix != ".parquet":
         raise UsageError(f"--out {args.out}: the output must end in .parquet")
-    if args.checkpoint_interval < 0:
-        raise UsageError("--checkpoint-interval must be >= 0")
+    if not (math.isfinite(args.checkpoint_interval) and args.checkpoint_interval >= 0):
+        raise UsageError(
+            f"--checkpoint-interval {args.checkpoint_interval}: must be a finite number >= 0"
+        )
+    if args.force and args.resume:
+        raise UsageError("--force starts over and --resume continues: give one of them")
+    check_output(
+        args.plot, flag="--plot", force=args.force or args.resume, suffixes=_PLOT_SUFFIXES
+    )
     classify = None
     if args.classifier is not None:
         try:
@@ -168,11 +184,13 @@ def _execution(args) -> dict:
         resume=args.resume,
         progress=not args.quiet,
         flush_interval=args.checkpoint_interval,
+        force=args.force,
     )
 
 
 def _call(fn, **kwargs):
-    """Run a sweep; bad settings become usage errors (exit 2), Ctrl-C exit 130."""
+    """Run a sweep; bad settings become usage errors (exit 2); a stopped run returns its
+    exit code (130 Ctrl-C, 1 a lost Dask scheduler) after saying how to resume."""
     from ..cli import UsageError
     from ._engine import SweepInterrupted
     from ._grid import SweepError
@@ -183,7 +201,7 @@ def _call(fn, **kwargs):
         raise UsageError(str(err)) from None
     except SweepInterrupted as err:
         print(f"chaoscam: {err.message}", file=sys.stderr)
-        return None
+        return 130 if err.cause is None else 1
 
 
 def _counts(labels) -> str:
@@ -209,8 +227,8 @@ def run_bifurcation(args: argparse.Namespace) -> int:
         continuation=args.continuation,
         **_execution(args),
     )
-    if res is None:
-        return 130
+    if isinstance(res, int):
+        return res
     v = res.verdicts
     print(
         f"bifurcation over {res.param}: {v['value_index'].nunique()} values x "
@@ -221,7 +239,7 @@ def run_bifurcation(args: argparse.Namespace) -> int:
     if args.plot is not None:
         from ..report._sweep_figures import bifurcation_figure
 
-        bifurcation_figure(res.points).savefig(args.plot, dpi=150)
+        _save_figure(bifurcation_figure(res.points), args.plot)
         print(f"figure: {args.plot}")
     return 0
 
@@ -255,8 +273,8 @@ def run_regime_map(args: argparse.Namespace) -> int:
         max_realizations=args.max_realizations,
         **_execution(args),
     )
-    if res is None:
-        return 130
+    if isinstance(res, int):
+        return res
     c = res.cells
     print(
         f"regime map {res.x} x {res.y}: {len(c)} cells, {len(res.realizations)} realizations\n"
@@ -267,6 +285,13 @@ def run_regime_map(args: argparse.Namespace) -> int:
     if args.plot is not None:
         from ..report._sweep_figures import regime_map_figure
 
-        regime_map_figure(c, x=res.x, y=res.y).savefig(args.plot, dpi=150)
+        _save_figure(regime_map_figure(c, x=res.x, y=res.y), args.plot)
         print(f"figure: {args.plot}")
     return 0
+
+
+def _save_figure(fig, path: Path) -> None:
+    from .._outputs import atomic_path
+
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=150)

@@ -13,7 +13,13 @@ import pandas as pd
 
 from ..model import ParameterError
 from ._backends import make_backend
-from ._checkpoint import CheckpointStore, MemoryStore, checkpoint_dir, guard_outputs
+from ._checkpoint import (
+    CheckpointStore,
+    MemoryStore,
+    checkpoint_dir,
+    discard_checkpoint,
+    guard_outputs,
+)
 from ._grid import Axis, SweepError
 from ._tasks import DefaultClassifier, classifier_identity
 
@@ -47,8 +53,13 @@ def as_axis(axis: Axis | str | tuple) -> Axis:
         return axis
     if isinstance(axis, str):
         return Axis.parse(axis)
-    name, values = axis
-    return Axis(name, tuple(values))
+    try:
+        name, values = axis
+    except (TypeError, ValueError):
+        raise SweepError(
+            f"an axis must be an Axis, 'NAME=START:STOP:NUM' or (name, values), got {axis!r}"
+        ) from None
+    return Axis(name, values)
 
 
 def companion(out: Path, what: str) -> Path:
@@ -57,21 +68,71 @@ def companion(out: Path, what: str) -> Path:
     return out.with_name(f"{stem}.{what}.parquet")
 
 
+def lock_outputs(out: Path | None):
+    """An OS lock on a sweep's output (and so on its checkpoint) for the whole run; a
+    second process on the same output is refused. No output: nothing to lock."""
+    import contextlib
+
+    from .._outputs import OutputLock
+
+    return contextlib.nullcontext() if out is None else OutputLock(out)
+
+
 def open_store(
-    out: Path | None, second: str, config: dict, resume: bool, flush_interval: float
+    out: Path | None,
+    second: str,
+    config: dict,
+    resume: bool,
+    flush_interval: float,
+    force: bool = False,
 ) -> tuple[Any, bool]:
-    """The record store of a run and whether a finished output can be reused as is."""
+    """The record store of a run and whether a finished output can be reused as is.
+
+    Call it holding :func:`lock_outputs`. ``force`` starts over: an existing output is
+    replaced at the end and an existing checkpoint is discarded.
+    """
+    from .._checks import real
+    from .._outputs import check_output
+
+    flush_interval = real("flush_interval", flush_interval, low=0.0, unit="s")
     if out is None:
         return MemoryStore(), False
     out = Path(out)
     if out.suffix != ".parquet":
         raise SweepError(f"--out {out}: the output must be a .parquet file")
-    if not out.parent.is_dir():
-        raise SweepError(f"--out {out}: the folder {out.parent} does not exist")
-    if guard_outputs([out, companion(out, second)], config, resume):
-        return None, True
+    for path in (out, companion(out, second)):
+        check_output(path, force=True)  # the folder and the path; existence is below
     ckpt = checkpoint_dir(out)
+    if force and not resume:
+        discard_checkpoint(ckpt)
+    elif guard_outputs([out, companion(out, second)], config, resume):
+        return None, True
     return CheckpointStore(ckpt, config, resume=resume, flush_interval=flush_interval), False
+
+
+RECORD_BYTES = 4096
+"""Memory of one finished record held by the driver (verdict, evidence, warnings) [bytes]."""
+
+
+def check_sweep_budget(
+    base, *, runs: int, duration: float, transient: float, series: bool, workers,
+    keeps_sections: bool, what: str, reduce: str, factor: float = 1.0,
+) -> None:
+    """Refuse a sweep that cannot fit in memory, warn about one that takes hours.
+
+    ``runs`` realizations of ``base`` (``factor`` times the cost each: the Lyapunov and
+    step checks run more), one per worker in memory at a time, their records (and, with
+    ``keeps_sections``, their section points) all kept by the driver.
+    """
+    from .._budget import JobEstimate, check_budget, estimate
+    from ._backends import default_workers
+
+    n = default_workers() if workers is None else max(1, int(workers))
+    one = estimate(base, duration=duration, transient=transient, series=series)
+    kept = estimate(base, duration=duration, transient=transient) if keeps_sections else None
+    memory = one.bytes * n + runs * (RECORD_BYTES + (kept.bytes / 3 if kept else 0.0))
+    seconds = one.seconds * runs * factor / n
+    check_budget(JobEstimate((memory, seconds)), what=what, reduce=reduce)
 
 
 def backend_for(workers: int | None, scheduler: Any):

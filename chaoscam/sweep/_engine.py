@@ -15,7 +15,8 @@ from collections import Counter, deque
 from collections.abc import Iterator
 from typing import Any, Protocol
 
-from ._backends import SerialBackend, WorkerLost
+from ._backends import BackendLost, SerialBackend, WorkerLost
+from ._grid import SweepError
 from ._tasks import run_task
 
 __all__ = ["SweepInterrupted", "execute"]
@@ -35,19 +36,20 @@ class SweepInterrupted(KeyboardInterrupt):
         Where they are saved; None when the sweep had no output file.
     """
 
-    def __init__(self, done: int, total: int, checkpoint) -> None:
-        self.done, self.total, self.checkpoint = done, total, checkpoint
+    def __init__(self, done: int, total: int, checkpoint, cause: str | None = None) -> None:
+        self.done, self.total, self.checkpoint, self.cause = done, total, checkpoint, cause
         super().__init__(self.message)
 
     @property
     def message(self) -> str:
+        why = "interrupted" if self.cause is None else f"stopped: {self.cause};"
         if self.checkpoint is None:
             return (
-                f"interrupted after {self.done} of {self.total} runs; nothing was saved "
+                f"{why} after {self.done} of {self.total} runs; nothing was saved "
                 "(no output file given)"
             )
         return (
-            f"interrupted: {self.done} of {self.total} runs are saved in {self.checkpoint}; "
+            f"{why} {self.done} of {self.total} runs are saved in {self.checkpoint}; "
             "run the same command with --resume to finish"
         )
 
@@ -93,7 +95,13 @@ def execute(plan: Plan, backend, store, *, progress: bool = False, desc: str = "
     """
     store.open()
     for record in store.restored():
-        plan.restore(record)
+        try:
+            plan.restore(record)
+        except (KeyError, IndexError, TypeError, ValueError) as err:
+            raise SweepError(
+                f"{store.path} holds a record that does not fit this run "
+                f"({type(err).__name__}: {err}); delete that folder to start over"
+            ) from None
     source = plan.start()
     queue: deque = deque()
     inflight: dict[Any, Any] = {}
@@ -139,6 +147,9 @@ def execute(plan: Plan, backend, store, *, progress: bool = False, desc: str = "
         backend.cancel(list(inflight))
         store.flush()
         raise SweepInterrupted(plan.done, plan.total, store.path) from None
+    except BackendLost as err:
+        store.flush()
+        raise SweepInterrupted(plan.done, plan.total, store.path, cause=str(err)) from None
     except BaseException:
         backend.cancel(list(inflight))
         store.flush()

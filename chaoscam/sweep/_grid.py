@@ -24,6 +24,13 @@ class SweepError(ValueError):
     """
 
 
+MAX_AXIS_POINTS = 100_000
+"""Most values on one axis (each is at least one simulation)."""
+
+MAX_GRID_POINTS = 1_000_000
+"""Most points of a grid (cells of a regime map, values of a bifurcation diagram)."""
+
+
 def parse_range(text: str, what: str = "range") -> tuple[float, float, int]:
     """Parse ``START:STOP:NUM`` (NUM points, both ends included) into (start, stop, num).
 
@@ -48,6 +55,11 @@ def parse_range(text: str, what: str = "range") -> tuple[float, float, int]:
         raise SweepError(f"{what} {text!r}: START and STOP must be finite")
     if num < 1:
         raise SweepError(f"{what} {text!r}: NUM = {num} must be >= 1")
+    if num > MAX_AXIS_POINTS:
+        raise SweepError(
+            f"{what} {text!r}: NUM = {num} is more than {MAX_AXIS_POINTS} values on one axis; "
+            "sweep a coarser grid first"
+        )
     if stop < start:
         raise SweepError(f"{what} {text!r}: STOP = {stop:g} is below START = {start:g}")
     if num == 1 and stop != start:
@@ -77,7 +89,17 @@ class Axis:
             Params().replace(**{self.name: 0.0})  # raises with a "did you mean"
         if FIELD_DOCS[self.name]["choices"] is not None:
             raise SweepError(f"{self.name} is not numeric and cannot be swept")
-        vals = tuple(float(v) for v in self.values)
+        if isinstance(self.values, str | bytes) or not hasattr(self.values, "__iter__"):
+            raise SweepError(
+                f"axis {self.name}: values must be a sequence of numbers or "
+                f"'START:STOP:NUM', got {type(self.values).__name__} {self.values!r}"
+            )
+        try:
+            vals = tuple(float(v) for v in self.values)
+        except (TypeError, ValueError):
+            raise SweepError(f"axis {self.name}: values must be numbers") from None
+        if len(vals) > MAX_AXIS_POINTS:
+            raise SweepError(f"axis {self.name}: more than {MAX_AXIS_POINTS} values")
         if not vals:
             raise SweepError(f"axis {self.name}: no values")
         if not all(math.isfinite(v) for v in vals):
@@ -145,6 +167,11 @@ def validate_grid(base: Params, axes: Sequence[Axis]) -> None:
     names = [a.name for a in axes]
     if len(set(names)) != len(names):
         raise SweepError(f"the axes repeat a parameter: {names}")
+    size = math.prod(len(a) for a in axes)
+    if size > MAX_GRID_POINTS:
+        raise SweepError(
+            f"the grid has {size} points, more than {MAX_GRID_POINTS}; sweep a coarser grid"
+        )
     grids = np.meshgrid(*[np.asarray(a.values) for a in axes], indexing="ij")
     for point in zip(*[g.ravel().tolist() for g in grids], strict=True):
         changes = dict(zip(names, point, strict=True))

@@ -18,14 +18,17 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .._checks import whole
 from .._version import __version__
 from ..model import ParameterError, Params
 from ._checkpoint import read_sweep_metadata, write_parquet
 from ._common import (
     as_axis,
     backend_for,
+    check_sweep_budget,
     companion,
     evidence_columns,
+    lock_outputs,
     open_store,
     period_column,
     reemit_warnings,
@@ -234,6 +237,7 @@ def regime_map(
     resume: bool = False,
     progress: bool = False,
     flush_interval: float = 1.0,
+    force: bool = False,
 ) -> RegimeMap:
     """Monte Carlo regime map over two parameters: classify N realizations in every cell.
 
@@ -306,13 +310,14 @@ def regime_map(
     x, y = as_axis(x), as_axis(y)
     base = Params() if base is None else base
     duration, transient = run_settings(duration, transient, seed)
-    if isinstance(realizations, bool) or not isinstance(realizations, int) or realizations < 1:
-        raise SweepError(f"realizations = {realizations!r} must be an integer >= 1")
+    realizations = whole("realizations", realizations, low=1)
     adaptive = None
     if target_halfwidth is not None:
         if not 0.0 < target_halfwidth < 0.5:
             raise SweepError(f"target half-width = {target_halfwidth!r} must be in (0, 0.5)")
-        cap = DEFAULT_CAP if max_realizations is None else int(max_realizations)
+        cap = DEFAULT_CAP if max_realizations is None else whole(
+            "max realizations", max_realizations, low=1
+        )
         if cap < realizations:
             raise SweepError(f"max realizations = {cap} is below realizations = {realizations}")
         adaptive = {
@@ -324,6 +329,12 @@ def regime_map(
         raise SweepError("max realizations applies with a target half-width only")
     validate_grid(base, [x, y])
     classify, identity = resolve_classifier(classify, lyapunov, check_step)
+    check_sweep_budget(
+        base, runs=len(x) * len(y) * (adaptive["max_realizations"] if adaptive else realizations),
+        duration=duration, transient=transient, series=needs_series(classify), workers=workers,
+        keeps_sections=False, what="this regime map", factor=1 + 2 * lyapunov + check_step,
+        reduce="the grid, the realizations or the duration",
+    )
     config = {
         "kind": "regime_map",
         "version": __version__,
@@ -340,41 +351,42 @@ def regime_map(
         "index_scheme": "cantor(cell, index)",
     }
     out = None if out is None else Path(out)
-    store, reuse = open_store(out, "cells", config, resume, flush_interval)
-    if reuse:
-        return read_regime_map(out)
-    series = needs_series(classify)
-    cells = _cells_frame(x, y)
-    xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
+    with lock_outputs(out):
+        store, reuse = open_store(out, "cells", config, resume, flush_interval, force)
+        if reuse:
+            return read_regime_map(out)
+        series = needs_series(classify)
+        cells = _cells_frame(x, y)
+        xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
 
-    def make_task(c: int, i: int) -> RealizationTask:
-        p = base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])})
-        return RealizationTask(
-            c, i, int(seed), realization_index(c, i), p, duration, transient, classify, series
+        def make_task(c: int, i: int) -> RealizationTask:
+            p = base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])})
+            return RealizationTask(
+                c, i, int(seed), realization_index(c, i), p, duration, transient, classify, series
+            )
+
+        plan = _RegimePlan(
+            make_task,
+            len(cells),
+            realizations,
+            batch=realizations,
+            cap=adaptive["max_realizations"] if adaptive else realizations,
+            target=adaptive["target_halfwidth"] if adaptive else None,
+            confidence=confidence,
         )
-
-    plan = _RegimePlan(
-        make_task,
-        len(cells),
-        realizations,
-        batch=realizations,
-        cap=adaptive["max_realizations"] if adaptive else realizations,
-        target=adaptive["target_halfwidth"] if adaptive else None,
-        confidence=confidence,
-    )
-    backend = backend_for(workers, scheduler)
-    try:
-        execute(plan, backend, store, progress=progress, desc="regime map")
-    finally:
-        backend.close()
-    records = unique_sorted(store.records(), ("cell", "index"))
-    reemit_warnings(records)
-    rows = _rows(records, cells, x, y)
-    result = RegimeMap(rows, summarize_cells(rows, cells, confidence=confidence), config)
-    if out is not None:
-        result.to_parquet(out)
-        store.remove()
-    return result
+        backend = backend_for(workers, scheduler)
+        try:
+            execute(plan, backend, store, progress=progress, desc="regime map")
+        finally:
+            backend.close()
+        records = unique_sorted(store.records(), ("cell", "index"))
+        reemit_warnings(records)
+        rows = _rows(records, cells, x, y)
+        result = RegimeMap(rows, summarize_cells(rows, cells, confidence=confidence), config)
+        if out is not None:
+            result.to_parquet(out)
+            store.remove()
+        return result
 
 
 def mu_sigma_axes(mu: str, sigma: str) -> tuple[Axis, Axis]:

@@ -1,0 +1,69 @@
+"""Checks of the plain settings a caller passes (seeds, indices, counts, intervals).
+
+Each raises :class:`~chaoscam.model.ParameterError` naming the setting, what was expected and
+what was given; numpy scalars are accepted and returned as Python numbers.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from typing import Any
+
+from .model import ParameterError
+
+__all__ = ["whole", "real", "params_arg"]
+
+
+def whole(name: str, value: Any, *, low: int = 0, high: int | None = None) -> int:
+    """``value`` as an int in [low, high]; bools, floats (1.5 or 2.0) and text refused."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ParameterError(
+            f"{name} = {value!r} must be an integer >= {low} (got {type(value).__name__})"
+        )
+    value = int(value)
+    if value < low or (high is not None and value > high):
+        top = "" if high is None else f" and <= {high}"
+        raise ParameterError(f"{name} = {value} must be an integer >= {low}{top}")
+    return value
+
+
+def real(
+    name: str,
+    value: Any,
+    *,
+    low: float | None = None,
+    strict: bool = False,
+    unit: str = "",
+    high: float | None = None,
+) -> float:
+    """``value`` as a finite float above ``low`` (``strict``: > low, else >= low)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ParameterError(f"{name} = {value!r} must be a number (got {type(value).__name__})")
+    value = float(value)
+    unit = f" {unit}" if unit else ""
+    if not math.isfinite(value):
+        raise ParameterError(f"{name} = {value!r}{unit} must be finite")
+    if low is not None and (value < low or (strict and value == low)):
+        raise ParameterError(f"{name} = {value!r}{unit} must be {'>' if strict else '>='} {low}")
+    if high is not None and value > high:
+        raise ParameterError(f"{name} = {value!r}{unit} must be <= {high}")
+    return value
+
+
+def params_arg(params: Any):
+    """The ``params`` argument of an API function: a :class:`Params`, or None for defaults."""
+    from .model import Params
+
+    if params is None:
+        return Params()
+    if isinstance(params, Params):
+        return params
+    if isinstance(params, dict):
+        raise TypeError(
+            "params must be a chaoscam.Params, got a dict: use Params(**d), or pass the "
+            "fields as keywords, e.g. simulate(omega=30.0)"
+        )
+    raise TypeError(
+        f"params must be a chaoscam.Params or None, got {type(params).__name__} {params!r}"
+    )

@@ -1,0 +1,190 @@
+"""One rule for every file chaoscam writes: checked first, never overwritten, written whole.
+
+* :func:`check_output` — before any work: the folder exists and is writable, the path is not
+  a directory, and an existing file is refused unless the caller says ``force``.
+* :func:`atomic_path` — write to a temporary name in the same folder, flushed to disk, then
+  :func:`os.replace` into place: a reader (or a resumed run) sees the whole file or none.
+* :class:`OutputLock` — an OS file lock (``fcntl.flock``) beside an output or checkpoint, so
+  a second process on the same output is refused instead of silently losing records.
+
+Every failure is an :class:`OutputError` (a ``ValueError``) whose message names the path and
+says what to do; the command line prints it and exits with code 2.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
+from pathlib import Path
+
+__all__ = ["OutputError", "check_output", "atomic_path", "atomic_write_bytes", "OutputLock"]
+
+
+class OutputError(ValueError):
+    """An output path cannot be written (missing folder, read-only, a directory, exists,
+    or in use by another process)."""
+
+
+def tmp_name(path: Path, tag: str = "") -> Path:
+    """A temporary name beside ``path``, keeping its suffix (matplotlib reads the format
+    from it): ``.tmp-PID[-TAG]-NAME``."""
+    extra = f"-{tag}" if tag else ""
+    return path.with_name(f".tmp-{os.getpid()}{extra}-{path.name}")
+
+
+def check_output(
+    path: str | Path | None,
+    *,
+    flag: str = "--out",
+    force: bool = False,
+    suffixes: tuple[str, ...] | None = None,
+) -> Path | None:
+    """Check that ``path`` can be written, before any work is done.
+
+    Parameters
+    ----------
+    path : path or None
+        The output; None (no output asked for) passes.
+    flag : str
+        How the path was given (``--out``, ``--section``, ...), for the message.
+    force : bool
+        Replace an existing file (``--force``); without it an existing file is refused.
+    suffixes : tuple of str, optional
+        Allowed suffixes (case-insensitive), e.g. ``(".parquet", ".csv")``.
+
+    Raises
+    ------
+    OutputError
+        With the path and what to do.
+    """
+    if path is None:
+        return None
+    path = Path(path)
+    if suffixes is not None and path.suffix.lower() not in suffixes:
+        raise OutputError(f"{flag} {path}: the file must end in {' or '.join(suffixes)}")
+    if path.is_dir():
+        raise OutputError(f"{flag} {path}: is a directory; give a file name")
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise OutputError(f"{flag} {path}: the folder {folder} does not exist; create it first")
+    _probe(folder, f"{flag} {path}")
+    if path.exists() or path.is_symlink():
+        if not force:
+            raise OutputError(
+                f"{flag} {path} exists; nothing was overwritten: choose another name, or "
+                "pass --force to replace it"
+            )
+        if not os.access(path, os.W_OK):
+            raise OutputError(f"{flag} {path}: exists and is read-only")
+    return path
+
+
+def _probe(folder: Path, what: str) -> None:
+    """Create and remove a file in ``folder``: the only sure test that it takes files
+    (``os.access`` says yes to root on a read-only mount)."""
+    probe = folder / f".tmp-{os.getpid()}-probe"
+    try:
+        with open(probe, "x"):
+            pass
+    except OSError as err:
+        raise OutputError(
+            f"{what}: cannot write in the folder {folder} ({err.strerror or err})"
+        ) from None
+    with contextlib.suppress(OSError):
+        probe.unlink()
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """A temporary path to write ``path`` to; moved into place when the block succeeds.
+
+    The file is flushed to disk before the rename, so it is whole or absent whatever moment
+    the process is killed; on an exception the temporary file is removed.
+    """
+    path = Path(path)
+    tmp = tmp_name(path)
+    try:
+        yield tmp
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    finally:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically (see :func:`atomic_path`)."""
+    with atomic_path(path) as tmp:
+        tmp.write_bytes(data)
+
+
+class OutputLock:
+    """An exclusive OS lock on ``path`` (a hidden ``.NAME.lock`` file beside it).
+
+    Taken without waiting: when another process holds it, :class:`OutputError` says so. The
+    lock is released when the holder exits, however it exits (the OS drops ``flock`` locks
+    with the process), so a killed run never leaves a stale lock. Usable as a context
+    manager; re-entrant within one process for the same path.
+    """
+
+    _held: dict[str, int] = {}
+
+    def __init__(self, path: str | Path, what: str = "output") -> None:
+        self.target = Path(path)
+        self.path = self.target.with_name(f".{self.target.name}.lock")
+        self.what = what
+        self._fd: int | None = None
+        self._nested = False
+
+    def acquire(self) -> OutputLock:
+        import fcntl
+
+        key = str(self.path.resolve())
+        if key in OutputLock._held:  # this process holds it already (an API call inside)
+            self._nested = True
+            return self
+        while True:
+            try:
+                fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+            except OSError as err:
+                raise OutputError(f"{self.target}: cannot create the lock file ({err})") from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
+                os.close(fd)
+                raise OutputError(
+                    f"{self.target} is in use by another chaoscam process (pid {holder}); "
+                    f"wait for it to finish, or choose another {self.what}"
+                ) from None
+            # The holder before us may have removed the file after we opened it: then our
+            # lock is on a dead inode; try again on the current file.
+            try:
+                same = os.path.samestat(os.fstat(fd), os.stat(self.path))
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, str(os.getpid()).encode(), 0)
+        self._fd = fd
+        OutputLock._held[key] = fd
+        return self
+
+    def release(self) -> None:
+        if self._nested or self._fd is None:
+            return
+        OutputLock._held.pop(str(self.path.resolve()), None)
+        with contextlib.suppress(OSError):
+            self.path.unlink()  # while still locked: a waiter re-checks the inode
+        os.close(self._fd)
+        self._fd = None
+
+    def __enter__(self) -> OutputLock:
+        return self.acquire()
+
+    def __exit__(self, *exc) -> None:
+        self.release()

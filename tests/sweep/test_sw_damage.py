@@ -1,0 +1,86 @@
+"""Damaged checkpoints: a torn last part is dropped and recomputed, a damaged middle part or
+a record that does not fit is refused with what to do; never a raw decoding traceback."""
+
+import pytest
+
+from chaoscam.sweep import Axis, SweepError, bifurcation, checkpoint_dir, regime_map
+from chaoscam.sweep._checkpoint import DamagedPart, decode_part, encode_part
+
+from ._helpers import InterruptOnce, SpreadClassifier, frames_equal
+
+GRID = dict(realizations=3, seed=3, duration=1.0, transient=0.5, workers=1)
+X, Y = Axis.parse("l_lambda=0.006:0.010:3"), Axis.parse("l_lambda_sigma=0:0.002:2")
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return regime_map(X, Y, classify=SpreadClassifier(), **GRID)
+
+
+def _interrupted(tmp_path, victim=11):
+    """A regime map stopped by Ctrl-C after several one-record parts."""
+    out = tmp_path / "m.parquet"
+    stop = InterruptOnce(str(tmp_path / "marker"), victim)
+    with pytest.raises(KeyboardInterrupt):
+        regime_map(X, Y, classify=stop, out=out, flush_interval=0.0, **GRID)
+    parts = sorted(checkpoint_dir(out).glob("part-*.jsonl"))
+    assert len(parts) >= 3
+    return out, parts, stop
+
+
+def test_part_round_trip_and_damage():
+    """A part decodes to its records; a cut, a flipped byte or garbage are DamagedPart."""
+    records = [{"cell": 1, "x": 0.1}, {"cell": 2, "x": float("inf")}]
+    data = encode_part(records)
+    assert decode_part(data) == records
+    assert decode_part(data.split(b"#chaoscam-part")[0]) == records  # no trailer: legacy
+    for bad in (data[:-10], data[:5] + b"9" + data[6:], b"\xff\xfe" + data, data[:12]):
+        with pytest.raises(DamagedPart):
+            decode_part(bad)
+
+
+@pytest.mark.parametrize("damage", ["truncated", "garbage"])
+def test_torn_last_part_is_recomputed(tmp_path, reference, damage, capsys):
+    """A torn last part (cut short, or garbage bytes) is dropped with a one-line notice and
+    --resume ends with the uninterrupted table."""
+    out, parts, stop = _interrupted(tmp_path)
+    data = parts[-1].read_bytes()
+    parts[-1].write_bytes(data[: len(data) // 2] if damage == "truncated" else b"\xff\x00" * 9)
+    res = regime_map(X, Y, classify=stop, out=out, resume=True, **GRID)
+    notice = [ln for ln in capsys.readouterr().err.splitlines() if "torn" in ln]
+    assert len(notice) == 1 and parts[-1].name in notice[0]
+    frames_equal(res.realizations, reference.realizations)
+
+
+def test_damaged_middle_part_is_refused(tmp_path):
+    """A damaged part before the last one: refused, the message says which file to delete."""
+    out, parts, stop = _interrupted(tmp_path)
+    parts[0].write_bytes(parts[0].read_bytes()[:-7])
+    with pytest.raises(SweepError, match=f"{parts[0].name} is damaged.*delete that file"):
+        regime_map(X, Y, classify=stop, out=out, resume=True, **GRID)
+
+
+def test_record_that_does_not_fit_is_refused(tmp_path):
+    """A well-formed record for a cell the grid does not have: a message, not IndexError."""
+    out, parts, stop = _interrupted(tmp_path)
+    record = decode_part(parts[-1].read_bytes())[0]
+    parts[-1].write_bytes(encode_part([dict(record, cell=999)]))
+    with pytest.raises(SweepError, match="does not fit this run"):
+        regime_map(X, Y, classify=stop, out=out, resume=True, **GRID)
+
+
+def test_bifurcation_torn_last_part(tmp_path, capsys):
+    """The same for a bifurcation diagram: torn last part dropped, same points as a run
+    that was never interrupted."""
+    kw = dict(duration=1.0, transient=0.5, workers=1)
+    values = "0.006:0.010:4"
+    ref = bifurcation("l_lambda", values, classify=SpreadClassifier(), **kw)
+    out = tmp_path / "b.parquet"
+    stop = InterruptOnce(str(tmp_path / "marker"), 3)
+    with pytest.raises(KeyboardInterrupt):
+        bifurcation("l_lambda", values, classify=stop, out=out, flush_interval=0.0, **kw)
+    parts = sorted(checkpoint_dir(out).glob("part-*.jsonl"))
+    parts[-1].write_bytes(parts[-1].read_bytes()[:-3])
+    res = bifurcation("l_lambda", values, classify=stop, out=out, resume=True, **kw)
+    assert "torn" in capsys.readouterr().err
+    frames_equal(res.points, ref.points)

@@ -1,0 +1,163 @@
+"""Bad input, on the command line and through the API: a message naming what is wrong and
+exit code 2 (the API: ParameterError / SweepError / TypeError), never a traceback; numpy
+scalars accepted; a run that could not simulate what was asked exits 1 with the cause."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import chaoscam
+from chaoscam import ParameterError, Params
+from chaoscam.cli import main
+from chaoscam.sweep import SweepError, bifurcation, regime_map
+
+SIM = ["simulate", "--duration", "0.05"]
+BIF = ["bifurcation", "--param", "l_lambda", "--values", "0.006:0.008:2", "--duration", "0.5",
+       "--workers", "1", "--quiet"]
+MAP = ["regime-map", "--mu", "0.006:0.008:2", "--sigma", "0:0.001:2", "--duration", "0.5",
+       "--workers", "1", "--quiet"]
+ENS = ["ensemble", "--members", "2", "--duration", "0.5", "--quiet"]
+
+CLI_CASES = {
+    "seed -1": ([*SIM, "--seed", "-1"], "seed"),
+    "index -1": ([*SIM, "--index", "-1"], "index"),
+    "output-dt 0": ([*SIM, "--output-dt", "0"], "output_dt"),
+    "output-dt -1": ([*SIM, "--output-dt", "-1"], "output_dt"),
+    "output-dt nan": ([*SIM, "--output-dt", "nan"], "output_dt"),
+    "omega 1e300": ([*SIM, "--set", "omega=1e300"], "omega"),
+    "l 1e308": ([*SIM, "--set", "l=1e308"], "l ="),
+    "flight_merge 1e9": ([*SIM, "--set", "flight_merge=1000000000"], "flight_merge"),
+    "max_events 1e12": ([*SIM, "--set", "max_events_per_step=1000000000000"],
+                        "max_events_per_step"),
+    "theta_f0 1e308": ([*SIM, "--set", "theta_f0=1e308"], "theta_f0"),
+    "x_O 1e308": ([*SIM, "--set", "x_O=1e308"], "x_O"),
+    "duration 1e9": (["simulate", "--duration", "1e9", "--out", "OUT.parquet"], "memory"),
+    "dt above duration": (["simulate", "--duration", "0.4", "--set", "dt=1"], "dt"),
+    "values 1e8": ([*BIF[:4], "0.001:0.018:100000000", *BIF[5:], "--out", "OUT.parquet"],
+                   "NUM"),
+    "checkpoint nan": ([*BIF, "--checkpoint-interval", "nan", "--out", "OUT.parquet"],
+                       "--checkpoint-interval"),
+    "checkpoint inf": ([*MAP, "--checkpoint-interval", "inf", "--out", "OUT.parquet"],
+                       "--checkpoint-interval"),
+    "realizations 1e9": ([*MAP, "--realizations", "1000000000", "--out", "OUT.parquet"],
+                         "memory"),
+    "ensemble duration 1e9": (["ensemble", "--members", "2", "--duration", "1e9", "--out",
+                               "OUT.parquet"], "memory"),
+    "ensemble seed -1": ([*ENS, "--seed", "-1", "--out", "OUT.parquet"], "seed"),
+    "paper workers 0": (["paper", "--workers", "0", "--out", "OUT.html"], "--workers"),
+}
+
+
+@pytest.mark.parametrize("case", list(CLI_CASES))
+def test_cli_bad_input_exits_2_naming_the_field(tmp_path, case, capsys):
+    """Each bad input: exit 2, one message naming the field, nothing written."""
+    args, named = CLI_CASES[case]
+    args = [a.replace("OUT", str(tmp_path / "o")) for a in args]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("chaoscam: error:") and named in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_run_that_left_the_model_exits_1_with_the_cause(capsys):
+    """dt too coarse: the run ends LEFT_REACH; exit 1, the step-size warning given as the
+    likely cause (not a raw Python warning)."""
+    assert main(["simulate", "--duration", "0.1", "--set", "dt=0.01"]) == 1
+    err = capsys.readouterr().err
+    assert "LEFT_REACH" in err and "likely cause: dt" in err and "Warning:" not in err
+
+
+def _empty_trajectory(path, rows):
+    traj = chaoscam.simulate(duration=0.2)
+    traj = dataclasses.replace(traj, series=traj.series.iloc[:rows],
+                               section=traj.section.iloc[:rows])
+    traj.to_parquet(path)
+    return path
+
+
+@pytest.mark.parametrize("rows", [0, 1])
+def test_too_little_data_is_an_error(tmp_path, rows, capsys):
+    """A 0- or 1-row trajectory: classify and report both say "too little data" (exit 2)."""
+    path = _empty_trajectory(tmp_path / "t.parquet", rows)
+    assert main(["classify", str(path)]) == 2
+    assert "too little data" in capsys.readouterr().err
+    assert main(["report", str(path), "--out", str(tmp_path / "r.html")]) == 2
+    assert "too little data" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("text", ["x\n", "x\n1.0\n"])
+def test_header_only_or_one_row_csv(tmp_path, text, capsys):
+    """classify-series on a header-only or one-row CSV: "too little data", exit 2."""
+    path = tmp_path / "s.csv"
+    path.write_text(text)
+    assert main(["classify-series", str(path), "--column", "x", "--dt", "0.01"]) == 2
+    assert "too little data" in capsys.readouterr().err
+
+
+def test_report_and_classify_refuse_the_same_files(tmp_path, capsys):
+    """A trajectory without its metadata, or a column missing: both commands, exit 2."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    good = _empty_trajectory(tmp_path / "g.parquet", 50)
+    table = pq.read_table(good)
+    pq.write_table(table.drop(["gap"]), tmp_path / "col.parquet")
+    meta = dict(table.schema.metadata)
+    meta[b"chaoscam.trajectory"] = b"{not json"
+    pq.write_table(table.replace_schema_metadata(meta), tmp_path / "meta.parquet")
+    pq.write_table(pa.table({"x": [1.0]}), tmp_path / "plain.parquet")
+    for name in ("col", "meta", "plain"):
+        path = str(tmp_path / f"{name}.parquet")
+        assert main(["classify", path]) == 2
+        assert main(["report", path, "--out", str(tmp_path / f"{name}.html")]) == 2
+        assert "Traceback" not in capsys.readouterr().err
+
+
+API_TYPE_CASES = [
+    (lambda: chaoscam.simulate("abc"), TypeError, "Params"),
+    (lambda: chaoscam.simulate({"omega": 30}), TypeError, "Params"),
+    (lambda: chaoscam.simulate(seed="a"), ParameterError, "seed"),
+    (lambda: chaoscam.simulate(seed=1.5), ParameterError, "seed"),
+    (lambda: chaoscam.simulate(index=-1), ParameterError, "index"),
+    (lambda: bifurcation("l_lambda", 0.01), SweepError, "sequence"),
+    (lambda: regime_map(("omega", [1e300]), ("xi", [0.4])), ParameterError, "omega"),
+    (lambda: regime_map(("omega", [30.0]), ("xi", [0.4]), flush_interval=math.nan,
+                        out="x.parquet"), ParameterError, "flush_interval"),
+]
+
+
+@pytest.mark.parametrize("i", range(len(API_TYPE_CASES)))
+def test_api_errors_say_what_was_expected(i):
+    call, error, named = API_TYPE_CASES[i]
+    with pytest.raises(error, match=named):
+        call()
+
+
+def test_numpy_scalars_are_accepted():
+    """numpy scalars where numbers are expected: accepted and stored as Python numbers."""
+    p = Params(omega=np.float32(30), max_events_per_step=np.int64(4))
+    assert p.omega == 30.0 and type(p.omega) is float and type(p.max_events_per_step) is int
+    res = regime_map(("l_lambda", [0.008]), ("l_lambda_sigma", [0.0]), duration=0.2,
+                     realizations=np.int64(2), seed=np.int64(1), workers=1,
+                     classify=_Label())
+    assert len(res.realizations) == 2
+    assert chaoscam.simulate(duration=0.05, seed=np.int64(2)).settings["seed"] == 2
+
+
+class _Label:
+    needs_series = False
+
+    def __call__(self, traj):
+        from tests.sweep._helpers import SpreadClassifier
+
+        return SpreadClassifier()(traj)
+
+
+def test_simulate_csv_written_whole(tmp_path):
+    """A CSV written by simulate --out (through a temporary name) is read back whole."""
+    out = tmp_path / "s.csv"
+    assert main(["simulate", "--duration", "0.05", "--out", str(out)]) == 0
+    assert len(pd.read_csv(out)) == 51

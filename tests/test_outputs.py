@@ -1,0 +1,185 @@
+"""One output rule for every command: checked before the work, never overwritten without
+--force, written whole, locked against a second writer."""
+
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from chaoscam._outputs import OutputError, OutputLock, atomic_path, check_output
+from chaoscam.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SLOW = "tests.sweep._helpers:SlowSpreadClassifier"  # 50 ms a run
+
+
+def _sim(*extra):
+    return ["simulate", "--duration", "0.2", *extra]
+
+
+def _traj(tmp_path):
+    path = tmp_path / "run.parquet"
+    assert main(_sim("--out", str(path))) == 0
+    return path
+
+
+def _bif(out, *extra):
+    return ["bifurcation", "--param", "l_lambda", "--values", "0.006:0.008:2",
+            "--duration", "0.5", "--workers", "1", "--quiet", "--out", str(out), *extra]
+
+
+def _map(out, *extra):
+    return ["regime-map", "--mu", "0.006:0.008:2", "--sigma", "0:0.001:2", "--duration", "0.5",
+            "--workers", "1", "--quiet", "--classifier", "tests.sweep._helpers:SpreadClassifier",
+            "--out", str(out), *extra]
+
+
+def _ens(out, *extra):
+    return ["ensemble", "--members", "2", "--duration", "0.5", "--quiet", "--out", str(out),
+            *extra]
+
+
+# Each command and how it names an output: a builder taking the output path.
+COMMANDS = {
+    "simulate --out": lambda p: _sim("--duration", "2000", "--out", str(p)),
+    "simulate --section": lambda p: _sim("--duration", "2000", "--section", str(p)),
+    "simulate --impacts": lambda p: _sim("--duration", "2000", "--impacts", str(p)),
+    "report --out": lambda p: ["report", "IN", "--out", str(p)],
+    "paper --out": lambda p: ["paper", "--figures", "3", "--out", str(p)],
+    "bifurcation --out": lambda p: _bif(p),
+    "bifurcation --plot": lambda p: _bif(p.with_name("b.parquet"), "--plot", str(p)),
+    "regime-map --out": lambda p: _map(p),
+    "ensemble --out": lambda p: _ens(p),
+}
+SUFFIX = {"simulate --out": ".csv", "simulate --section": ".csv", "simulate --impacts": ".csv",
+          "report --out": ".html", "paper --out": ".html", "bifurcation --plot": ".png"}
+
+
+def _args(tmp_path, command, path):
+    args = COMMANDS[command](path)
+    if "IN" in args:
+        args[args.index("IN")] = str(_traj(tmp_path))
+    return args
+
+
+@pytest.mark.parametrize("case", ["missing folder", "a directory", "exists"])
+@pytest.mark.parametrize("command", list(COMMANDS))
+def test_bad_output_refused_before_the_work(tmp_path, command, case, capsys):
+    """Every command refuses a missing folder, a directory or an existing file with exit 2
+    and a message naming the path, before any computation (long runs return at once), and
+    leaves an existing file untouched."""
+    name = "o" + SUFFIX.get(command, ".parquet")
+    path = {"missing folder": tmp_path / "nowhere" / name, "a directory": tmp_path / "d",
+            "exists": tmp_path / name}[case]
+    if case == "a directory":
+        path = tmp_path / ("d" + SUFFIX.get(command, ".parquet"))
+        path.mkdir()
+    if case == "exists":
+        path.write_text("keep me")
+    args = _args(tmp_path, command, path)
+    capsys.readouterr()
+    t0 = time.perf_counter()
+    assert main(args) == 2
+    assert time.perf_counter() - t0 < 5.0
+    err = capsys.readouterr().err
+    assert "error" in err and "Traceback" not in err
+    assert str(path.name) in err or str(path.parent) in err, err
+    if case == "exists":
+        assert path.read_text() == "keep me"
+
+
+def test_force_replaces_and_writes_whole(tmp_path, capsys):
+    """--force replaces an existing output; no temporary file is left beside it."""
+    path = tmp_path / "s.csv"
+    path.write_text("old")
+    assert main(_sim("--section", str(path), "--force")) == 0
+    assert pd.read_csv(path).columns[0] == "k"
+    assert [p.name for p in tmp_path.iterdir()] == ["s.csv"]
+
+
+def test_check_output_unwritable_location_and_suffix(tmp_path):
+    """A location that takes no files, and a wrong suffix, are refused with the path."""
+    with pytest.raises(OutputError, match="cannot write"):
+        check_output("/proc/x.csv")
+    with pytest.raises(OutputError, match=r"\.html"):
+        check_output(tmp_path / "r.txt", suffixes=(".html",))
+    assert check_output(None) is None
+
+
+def test_atomic_path_keeps_the_old_file_on_failure(tmp_path):
+    """A write that fails half-way leaves the old file as it was and no temporary file."""
+    path = tmp_path / "a.txt"
+    path.write_text("old")
+    with pytest.raises(RuntimeError), atomic_path(path) as tmp:
+        tmp.write_text("half")
+        raise RuntimeError("boom")
+    assert path.read_text() == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["a.txt"]
+
+
+def _hold_lock(path: Path):
+    code = (
+        "import sys, time; from chaoscam._outputs import OutputLock; "
+        f"OutputLock({str(path)!r}).acquire(); print('held', flush=True); time.sleep(30)"
+    )
+    proc = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, stdout=subprocess.PIPE,
+                            env=dict(os.environ, PYTHONPATH=str(ROOT)), text=True)
+    assert proc.stdout.readline().strip() == "held"
+    return proc
+
+
+def test_lock_refuses_a_second_process_and_dies_with_its_holder(tmp_path):
+    """A lock held by another process is refused with its pid; once that process is
+    killed the lock is free again (no stale lock)."""
+    target = tmp_path / "m.parquet"
+    proc = _hold_lock(target)
+    try:
+        with pytest.raises(OutputError, match=f"another chaoscam process .pid {proc.pid}"):
+            OutputLock(target).acquire()
+    finally:
+        proc.kill()
+        proc.wait()
+    with OutputLock(target):
+        pass
+    assert not (tmp_path / ".m.parquet.lock").exists()
+
+
+@pytest.mark.parametrize("command", ["regime-map", "bifurcation", "ensemble"])
+def test_locked_output_refused_with_exit_2(tmp_path, command, capsys):
+    """A sweep or ensemble whose output is in use by another process is refused (exit 2)
+    before any work, and writes nothing."""
+    out = tmp_path / "o.parquet"
+    build = {"regime-map": _map, "bifurcation": _bif, "ensemble": _ens}[command]
+    proc = _hold_lock(out)
+    try:
+        assert main(build(out)) == 2
+    finally:
+        proc.kill()
+        proc.wait()
+    assert "in use by another chaoscam process" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == []
+
+
+def test_two_writers_started_together(tmp_path):
+    """Two regime maps on one output started together: one is refused (exit 2, a message),
+    the other ends normally with every row (3 x 2 cells x 4 realizations)."""
+    out = tmp_path / "m.parquet"
+    args = _map(out, "--realizations", "4", "--checkpoint-interval", "0")
+    args[args.index("tests.sweep._helpers:SpreadClassifier")] = SLOW
+    args[args.index("0.006:0.008:2")] = "0.006:0.010:3"
+    code = "import sys; from chaoscam.cli import main; sys.exit(main(sys.argv[1:]))"
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    procs = [subprocess.Popen([sys.executable, "-c", code, *args], cwd=ROOT, env=env,
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+             for _ in range(2)]
+    results = [p.communicate(timeout=120) for p in procs]
+    codes = sorted(p.returncode for p in procs)
+    assert codes == [0, 2], results
+    refused = results[[p.returncode for p in procs].index(2)][1]
+    assert "in use by another chaoscam process" in refused or "exists" in refused, refused
+    assert "Traceback" not in refused
+    assert len(pd.read_parquet(out)) == 24
