@@ -98,9 +98,100 @@ def _evidence_verdict(
     return classify_signal(x, dt, period, section=points, lyapunov=lyap, **opts)
 
 
+MODEL_ATOL = 1e-5
+"""Absolute band tolerance [rad] on the model's section, for θ_f and for θ̇_f·T: bands
+narrower than this are jitter (measured: a sticking period-1 orbit at e = 0.02 m keeps
+1.6e-11 rad in θ_f and 6.9e-6 rad/s in θ̇_f from its contact oscillation, whatever the run
+length). The relative tolerance of the analysis layer's Thresholds applies on top."""
+
+
+def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[Verdict, dict]:
+    """The verdict from the section, the tangent exponent and, for a periodic section of the
+    deterministic model, a certified periodic orbit (:mod:`chaoscam.tangent`)."""
+    from .tangent import periodic_orbit, spectrum_from_jacobians
+
+    p = traj.params.replace(integrator="rk4")  # the tangent lives on the RK4 grid
+    s = traj.settings
+    tr = traj
+    if traj.jacobians is None:
+        tr = simulate(
+            p,
+            duration=s["duration"],
+            transient=s["transient"],
+            seed=s["seed"],
+            index=s["index"],
+            series=False,
+            tangent=True,
+        )
+    period = p.cam_period
+    t0 = s["transient"] + discard
+    sec = tr.section
+    keep = ((sec["t"] >= t0 - 1e-9 * period) & (sec["k"] > 0)).to_numpy()
+    points = sec.loc[keep, _SECTION_COORDS].to_numpy(dtype=float)
+    spec = spectrum_from_jacobians(tr.jacobians[keep], period)
+    opts = {k_: v_ for k_, v_ in options.items() if k_ not in ("lyapunov_tol",)}
+    opts.setdefault("atol", (MODEL_ATOL, MODEL_ATOL / period))
+    v = classify_section(
+        points,
+        exponent=(spec.exponent, float(spec.stderr[0]), spec.n_periods),
+        exponent_time=period,
+        **opts,
+    )
+    extra = {
+        "tangent": {
+            "exponents": [float(x) for x in spec.exponents],
+            "stderr": [float(x) for x in spec.stderr],
+            "n_periods": spec.n_periods,
+            "method": "tangent dynamics through the impacts, QR (chaoscam.tangent)",
+        }
+    }
+    if v.label != "periodic" or p.l_lambda_sigma != 0.0:
+        return v, extra
+    orbit = periodic_orbit(p, points[-1], int(v.period))
+    dist = orbit.distance(points[-min(len(points), 4 * orbit.period) :])
+    extent = float(np.ptp(points[:, 0])) or 1.0
+    sits = dist <= max(1e-6, 3e-3 * extent)
+    extra["periodic_orbit"] = {
+        "period": orbit.period,
+        "converged": orbit.converged,
+        "residual": orbit.residual,
+        "multipliers_abs": [float(abs(m)) for m in orbit.multipliers],
+        "distance": dist,
+        "wall_time_s": orbit.wall_time,
+    }
+    mu = float(np.max(np.abs(orbit.multipliers)))
+    detail = (
+        f"Newton shooting on P^{orbit.period}: residual {orbit.residual:.2g} rad, "
+        f"|mu|max = {mu:.3g}, the run lies within {dist:.2g} rad of the orbit"
+    )
+    if orbit.certified and sits and orbit.period == v.period:
+        e = Evidence("periodic_orbit", orbit.period, "periodic", "certified: " + detail)
+        return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
+    why = (
+        "not converged"
+        if not orbit.converged
+        else "unstable"
+        if not orbit.stable
+        else "the run is not on it"
+        if not sits
+        else "its least period differs"
+    )
+    e = Evidence("periodic_orbit", orbit.period, None, f"not certified ({why}): " + detail)
+    if orbit.converged and not orbit.stable:
+        return Verdict(
+            "undetermined",
+            None,
+            v.evidence + (e,),
+            v.reasons + (f"the section looks periodic but the orbit found is unstable ({detail})",),
+            v.settings,
+        ), extra
+    return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
+
+
 def classify_trajectory(
     traj: Trajectory,
     *,
+    tangent: bool = True,
     lyapunov: bool = False,
     check_step: bool = False,
     discard: float = 0.0,
@@ -121,6 +212,16 @@ def classify_trajectory(
     ----------
     traj : Trajectory
         The run, after its transient (``simulate(..., transient=...)``).
+    tangent : bool
+        Default True: the verdict comes from the section with the tangent exponent of the
+        model through its impacts (:func:`chaoscam.tangent.lyapunov_spectrum`: λ₁ with its
+        standard error; taken from ``traj.jacobians`` or from a re-simulation with
+        ``tangent=True``, ~1.2x a simulation, always on the RK4 grid) and, when the section
+        is periodic and the model deterministic, a periodic orbit found by Newton shooting:
+        converged, attracting (|μ| < 1) and with the run on it, it is recorded as the
+        decisive evidence ``periodic_orbit``; a converged *unstable* orbit makes the
+        verdict "undetermined". ``settings["tangent"]`` and ``settings["periodic_orbit"]``
+        record the numbers. False: the series-based evidence below.
     lyapunov : bool
         Also compute the model's largest Lyapunov exponent through the impacts
         (:func:`chaoscam.lyapunov.lyapunov_model`, same params, duration, transient, seed,
@@ -154,7 +255,9 @@ def classify_trajectory(
     if discard < 0 or not math.isfinite(discard):
         raise ValueError(f"discard = {discard!r} s must be >= 0")
     settings = {
-        "classify": dict(lyapunov=lyapunov, check_step=check_step, discard=discard, **options),
+        "classify": dict(
+            tangent=tangent, lyapunov=lyapunov, check_step=check_step, discard=discard, **options
+        ),
         "trajectory": {
             "params": traj.params.to_dict(),
             "settings": dict(traj.settings),
@@ -164,7 +267,7 @@ def classify_trajectory(
     if traj.status is not Status.OK:
         return _status_verdict(traj, settings)
 
-    verdict, extra = _verdict_of(traj, lyapunov, discard, options)
+    verdict, extra = _verdict_of(traj, lyapunov, discard, options, tangent)
     verdict = _with_settings(verdict, **settings, **extra)
     if not check_step:
         return verdict
@@ -173,7 +276,7 @@ def classify_trajectory(
     hv, _ = (
         (_status_verdict(half, {}), {})
         if half.status is not Status.OK
-        else _verdict_of(half, lyapunov, discard, options)
+        else _verdict_of(half, lyapunov, discard, options, tangent)
     )
     fine = traj.params.refined()
     same = hv.label == verdict.label and hv.period == verdict.period
@@ -217,8 +320,10 @@ def _describe(v: Verdict) -> str:
 
 
 def _verdict_of(
-    traj: Trajectory, lyapunov: bool, discard: float, options: dict
+    traj: Trajectory, lyapunov: bool, discard: float, options: dict, tangent: bool = False
 ) -> tuple[Verdict, dict]:
+    if tangent and not lyapunov:
+        return _tangent_verdict(traj, discard, options)
     if not lyapunov:
         return _evidence_verdict(traj, discard, None, options), {}
     from .lyapunov import lyapunov_model
