@@ -77,6 +77,13 @@ def _status_verdict(traj: Trajectory, settings: dict) -> Verdict:
     )
 
 
+MODEL_ATOL = 1e-5
+"""Absolute band tolerance [rad] on the model's section, for θ_f and for θ̇_f·T: bands
+narrower than this are jitter (measured: a sticking period-1 orbit at e = 0.02 m keeps
+1.6e-11 rad in θ_f and 6.9e-6 rad/s in θ̇_f from its contact oscillation, whatever the run
+length). The relative tolerance of the analysis layer's Thresholds applies on top."""
+
+
 def _evidence_verdict(
     traj: Trajectory, discard: float, lyap: float | None, options: dict
 ) -> Verdict:
@@ -86,6 +93,7 @@ def _evidence_verdict(
     sec = traj.section
     points = sec.loc[sec["t"] >= t0 - 1e-9 * period, _SECTION_COORDS].to_numpy(dtype=float)
     opts = dict(options)
+    opts.setdefault("atol", (MODEL_ATOL, MODEL_ATOL / period))
     if traj.series is None:
         tol = opts.pop("lyapunov_tol", None)
         if tol is not None:
@@ -96,13 +104,6 @@ def _evidence_verdict(
     x = ser.loc[ser["t"] >= t0 - 1e-9 * period, "theta_f"].to_numpy(dtype=float)
     dt = float(traj.settings["output_dt"])
     return classify_signal(x, dt, period, section=points, lyapunov=lyap, **opts)
-
-
-MODEL_ATOL = 1e-5
-"""Absolute band tolerance [rad] on the model's section, for θ_f and for θ̇_f·T: bands
-narrower than this are jitter (measured: a sticking period-1 orbit at e = 0.02 m keeps
-1.6e-11 rad in θ_f and 6.9e-6 rad/s in θ̇_f from its contact oscillation, whatever the run
-length). The relative tolerance of the analysis layer's Thresholds applies on top."""
 
 
 def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[Verdict, dict]:
@@ -131,12 +132,23 @@ def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[V
     spec = spectrum_from_jacobians(tr.jacobians[keep], period)
     opts = {k_: v_ for k_, v_ in options.items() if k_ not in ("lyapunov_tol",)}
     opts.setdefault("atol", (MODEL_ATOL, MODEL_ATOL / period))
-    v = classify_section(
-        points,
-        exponent=(spec.exponent, float(spec.stderr[0]), spec.n_periods),
-        exponent_time=period,
-        **opts,
-    )
+    expo = (spec.exponent, float(spec.stderr[0]), spec.n_periods)
+    if traj.series is None:
+        v = classify_section(points, exponent=expo, exponent_time=period, **opts)
+    else:  # the run's own series and section, with the exponent of the same realization
+        ser = traj.series
+        x = ser.loc[ser["t"] >= t0 - 1e-9 * period, "theta_f"].to_numpy(dtype=float)
+        own = traj.section
+        own_points = own.loc[own["t"] >= t0 - 1e-9 * period, _SECTION_COORDS].to_numpy(float)
+        v = classify_signal(
+            x,
+            float(s["output_dt"]),
+            period,
+            section=own_points,
+            exponent=expo,
+            exponent_time=period,
+            **opts,
+        )
     extra = {
         "tangent": {
             "exponents": [float(x) for x in spec.exponents],
@@ -150,7 +162,7 @@ def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[V
     orbit = periodic_orbit(p, points[-1], int(v.period))
     dist = orbit.distance(points[-min(len(points), 4 * orbit.period) :])
     extent = float(np.ptp(points[:, 0])) or 1.0
-    sits = dist <= max(1e-6, 3e-3 * extent)
+    sits = dist <= max(MODEL_ATOL, 3e-3 * extent)
     extra["periodic_orbit"] = {
         "period": orbit.period,
         "converged": orbit.converged,

@@ -13,6 +13,7 @@ from ._evidence import (
     section_evidence,
     zero_one_evidence,
 )
+from ._exponent import as_exponent, exponent_evidence
 from ._lyapunov_series import lyapunov_from_series
 from ._sections import local_maxima
 from ._spectrum import spectrum_analysis
@@ -91,6 +92,8 @@ def classify_signal(
     spectrum_options: dict | None = None,
     seed: int = 0,
     thresholds: Thresholds | None = None,
+    exponent=None,
+    exponent_time: float = 1.0,
 ) -> Verdict:
     """Classify a uniformly sampled signal of a flow (with optional section points).
 
@@ -156,6 +159,12 @@ def classify_signal(
         Extra keyword arguments of `spectrum_analysis`.
     seed : int
         Seed of the 0–1 test's c values.
+    exponent : float, (float, float), (float, float, int) or object, optional
+        A largest exponent with its standard error (e.g. the model's tangent exponent),
+        judged by its confidence interval (`exponent_evidence`); see `as_exponent`.
+    exponent_time : float
+        Multiplies λ and its error to make them per forcing period (the forcing period for
+        an exponent in 1/s).
     thresholds : Thresholds, optional
         The decision thresholds (default `Thresholds()`), recorded in
         ``settings["thresholds"]``; `rtol` and `min_points_aperiodic` override their entries.
@@ -277,6 +286,9 @@ def classify_signal(
         reasons.extend(sreasons)
 
     # --- Lyapunov exponents
+    if exponent is not None:  # with its confidence interval, per forcing period
+        lam, se, n_int = as_exponent(exponent, exponent_time)
+        ev.append(exponent_evidence(lam, se, n_int, thresholds=thr))
     tol = lyapunov_tol
     if tol is None and t_char is not None:
         tol = thr.signal_lyapunov_tol / t_char

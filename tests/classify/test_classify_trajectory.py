@@ -34,9 +34,22 @@ def test_periodic_run_is_period_1(periodic):
 
 
 def test_section_only_run_is_classified_from_the_section():
-    """series=False: the section alone decides; still period 1."""
+    """series=False: the section with the tangent exponent decides; still period 1, and the
+    sticking orbit (a zero Floquet multiplier) is certified by Newton shooting."""
     tr = chaoscam.simulate(PERIODIC, duration=4.0, transient=2.0, series=False)
     v = classify_trajectory(tr)
+    assert (v.label, v.period) == ("periodic", 1)
+    names = {e.name for e in v.evidence}
+    assert all(n.startswith("section_") for n in names - {"exponent", "periodic_orbit"})
+    orbit = next(e for e in v.evidence if e.name == "periodic_orbit")
+    assert orbit.vote == "periodic" and orbit.detail.startswith("certified")
+    assert min(v.settings["periodic_orbit"]["multipliers_abs"]) < 1e-6
+
+
+def test_without_tangent_the_section_alone_decides():
+    """tangent=False: only section evidence, no exponent or orbit."""
+    tr = chaoscam.simulate(PERIODIC, duration=4.0, transient=2.0, series=False)
+    v = classify_trajectory(tr, tangent=False)
     assert (v.label, v.period) == ("periodic", 1)
     assert all(e.name.startswith("section_") for e in v.evidence)
 
