@@ -157,6 +157,9 @@ def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[V
             "method": "tangent dynamics through the impacts, QR (chaoscam.tangent)",
         }
     }
+    banded = _banded_period(v)
+    if v.label == "undetermined" and banded is not None:
+        return _banded_verdict(v, p, points, banded, extra)
     if v.label != "periodic" or p.l_lambda_sigma != 0.0:
         return v, extra
     orbit = periodic_orbit(p, points[-1], int(v.period))
@@ -198,6 +201,65 @@ def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[V
             v.settings,
         ), extra
     return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
+
+
+def _banded_period(v: Verdict) -> int | None:
+    """n when the section is periodic to the band tolerance (n narrow bands) while the
+    tangent exponent is positive beyond its confidence interval; else None."""
+    votes = {e.name: e for e in v.evidence}
+    sp, ex = votes.get("section_period"), votes.get("exponent")
+    if sp is None or ex is None or sp.vote != "periodic" or ex.vote != "chaotic":
+        return None
+    return int(sp.value)
+
+
+def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
+    """Resolve "n narrow bands but λ₁ > 0": chaotic when no attracting period-n orbit lies in
+    the bands (shooting: unstable or not converged; or a random model, which has none),
+    still undetermined when shooting certifies one (a genuine conflict)."""
+    from .tangent import periodic_orbit
+
+    if p.l_lambda_sigma == 0.0:
+        orbit = periodic_orbit(p, points[-1], n)
+        mu = float(np.max(np.abs(orbit.multipliers)))
+        extra["periodic_orbit"] = {
+            "period": orbit.period,
+            "converged": orbit.converged,
+            "residual": orbit.residual,
+            "multipliers_abs": [float(abs(m)) for m in orbit.multipliers],
+            "wall_time_s": orbit.wall_time,
+        }
+        detail = (
+            f"Newton shooting on P^{n} from the bands: residual {orbit.residual:.2g} rad, "
+            f"converged {orbit.converged}, |mu|max = {mu:.3g}"
+        )
+        if orbit.certified:
+            e = Evidence("periodic_orbit", orbit.period, "periodic", "certified: " + detail)
+            return dataclasses.replace(
+                v,
+                evidence=v.evidence + (e,),
+                reasons=v.reasons
+                + (
+                    "an attracting orbit is certified inside the bands, "
+                    "yet the tangent exponent is positive",
+                ),
+            ), extra
+        why = "unstable" if orbit.converged else "not converged"
+        e = Evidence("periodic_orbit", orbit.period, "not_periodic", f"{why}: " + detail)
+    else:
+        e = Evidence(
+            "periodic_orbit", None, None, "random line length: no periodic orbit to shoot for"
+        )
+    band = Evidence(
+        "banded_chaos",
+        n,
+        "chaotic",
+        f"the section keeps {n} narrow bands while the tangent exponent is positive beyond "
+        "its confidence interval and no attracting period-n orbit lies in them: chaos "
+        f"confined to {n} bands (n-band chaos)",
+    )
+    verdict = Verdict("chaotic", None, v.evidence + (e, band), (), v.settings)
+    return verdict, extra
 
 
 def classify_trajectory(
