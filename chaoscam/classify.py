@@ -24,8 +24,9 @@ from .analysis import Evidence, Verdict, classify_section, classify_signal
 from .integrate import Status
 from .model import Params
 from .simulate import SECTION_COLUMNS, SERIES_COLUMNS, Trajectory, simulate
+from .tangent import periodic_orbit, spectrum_from_jacobians
 
-__all__ = ["classify_trajectory", "classify_file", "load_trajectory"]
+__all__ = ["classify_file", "classify_section_run", "classify_trajectory", "load_trajectory"]
 
 _SECTION_COORDS = ["theta_f", "omega_f"]
 
@@ -106,11 +107,43 @@ def _evidence_verdict(
     return classify_signal(x, dt, period, section=points, lyapunov=lyap, **opts)
 
 
-def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[Verdict, dict]:
-    """The verdict from the section, the tangent exponent and, for a periodic section of the
-    deterministic model, a certified periodic orbit (:mod:`chaoscam.tangent`)."""
-    from .tangent import periodic_orbit, spectrum_from_jacobians
+def _model_options(options: dict, period: float) -> dict:
+    """Analysis options for the model's section: the absolute band tolerance by default."""
+    opts = {k_: v_ for k_, v_ in options.items() if k_ not in ("lyapunov_tol",)}
+    opts.setdefault("atol", (MODEL_ATOL, MODEL_ATOL / period))
+    return opts
 
+
+def classify_section_run(points, jacobians, params: Params, **options: Any) -> Verdict:
+    """The model's verdict from a run's section points and its stroboscopic Jacobians.
+
+    What :func:`classify_trajectory` does for a run kept without its series, for callers
+    that hold only arrays (ensembles): :func:`chaoscam.analysis.classify_section` with the
+    tangent exponent (λ₁ ± stderr by QR on ``jacobians``, one per point, each over the period
+    ending at that point) and the model's absolute band tolerance, then the model-level
+    rules (n-band chaos, the periodic-orbit certificate for the deterministic model).
+    ``settings["tangent"]`` (and ``settings["periodic_orbit"]``) record the numbers.
+    """
+    period = params.cam_period
+    points = np.asarray(points, dtype=float)
+    spec = spectrum_from_jacobians(np.asarray(jacobians, dtype=float), period)
+    v = classify_section(
+        points,
+        exponent=_exponent_of(spec),
+        exponent_time=period,
+        **_model_options(options, period),
+    )
+    v, extra = _with_model_evidence(v, params.replace(integrator="rk4"), points, spec)
+    return _with_settings(v, **extra)
+
+
+def _exponent_of(spec) -> tuple[float, float, int]:
+    return (spec.exponent, float(spec.stderr[0]), spec.n_periods)
+
+
+def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[Verdict, dict]:
+    """The verdict from the section (and series), the tangent exponent and, for a periodic
+    section of the deterministic model, a certified periodic orbit (:mod:`chaoscam.tangent`)."""
     p = traj.params.replace(integrator="rk4")  # the tangent lives on the RK4 grid
     s = traj.settings
     tr = traj
@@ -130,11 +163,9 @@ def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[V
     keep = ((sec["t"] >= t0 - 1e-9 * period) & (sec["k"] > 0)).to_numpy()
     points = sec.loc[keep, _SECTION_COORDS].to_numpy(dtype=float)
     spec = spectrum_from_jacobians(tr.jacobians[keep], period)
-    opts = {k_: v_ for k_, v_ in options.items() if k_ not in ("lyapunov_tol",)}
-    opts.setdefault("atol", (MODEL_ATOL, MODEL_ATOL / period))
-    expo = (spec.exponent, float(spec.stderr[0]), spec.n_periods)
+    opts = _model_options(options, period)
     if traj.series is None:
-        v = classify_section(points, exponent=expo, exponent_time=period, **opts)
+        v = classify_section(points, exponent=_exponent_of(spec), exponent_time=period, **opts)
     else:  # the run's own series and section, with the exponent of the same realization
         ser = traj.series
         x = ser.loc[ser["t"] >= t0 - 1e-9 * period, "theta_f"].to_numpy(dtype=float)
@@ -145,10 +176,16 @@ def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[V
             float(s["output_dt"]),
             period,
             section=own_points,
-            exponent=expo,
+            exponent=_exponent_of(spec),
             exponent_time=period,
             **opts,
         )
+    return _with_model_evidence(v, p, points, spec)
+
+
+def _with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, dict]:
+    """The model-level rules on top of the analysis verdict: n-band chaos, and the
+    periodic-orbit certificate of a periodic section of the deterministic model."""
     extra = {
         "tangent": {
             "exponents": [float(x) for x in spec.exponents],
@@ -160,47 +197,63 @@ def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[V
     banded = _banded_period(v)
     if v.label == "undetermined" and banded is not None:
         return _banded_verdict(v, p, points, banded, extra)
-    if v.label != "periodic" or p.l_lambda_sigma != 0.0:
+    candidate = v.period if v.label == "periodic" else _disputed_period(v)
+    if candidate is None or p.l_lambda_sigma != 0.0:
         return v, extra
-    orbit = periodic_orbit(p, points[-1], int(v.period))
+    orbit = periodic_orbit(p, points[-1], int(candidate))
     dist = orbit.distance(points[-min(len(points), 4 * orbit.period) :])
     extent = float(np.ptp(points[:, 0])) or 1.0
     sits = dist <= max(MODEL_ATOL, 3e-3 * extent)
-    extra["periodic_orbit"] = {
-        "period": orbit.period,
-        "converged": orbit.converged,
-        "residual": orbit.residual,
-        "multipliers_abs": [float(abs(m)) for m in orbit.multipliers],
-        "distance": dist,
-        "wall_time_s": orbit.wall_time,
-    }
+    extra["periodic_orbit"] = _orbit_record(orbit, distance=dist)
     mu = float(np.max(np.abs(orbit.multipliers)))
     detail = (
         f"Newton shooting on P^{orbit.period}: residual {orbit.residual:.2g} rad, "
         f"|mu|max = {mu:.3g}, the run lies within {dist:.2g} rad of the orbit"
     )
-    if orbit.certified and sits and orbit.period == v.period:
+    if orbit.certified and sits and orbit.period == candidate:
         e = Evidence("periodic_orbit", orbit.period, "periodic", "certified: " + detail)
-        return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
-    why = (
-        "not converged"
-        if not orbit.converged
-        else "unstable"
-        if not orbit.stable
-        else "the run is not on it"
-        if not sits
-        else "its least period differs"
-    )
+        if v.label == "periodic":
+            return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
+        # The certificate decides what the section and the exponent left open: an attracting
+        # orbit that the run sits on outweighs a spectral or 0-1 vote on a short series.
+        return Verdict("periodic", orbit.period, v.evidence + (e,), (), v.settings), extra
+    if not orbit.converged:
+        why = "not converged"
+    elif not orbit.stable:
+        why = "unstable"
+    else:
+        why = "the run is not on it" if not sits else "its least period differs"
     e = Evidence("periodic_orbit", orbit.period, None, f"not certified ({why}): " + detail)
     if orbit.converged and not orbit.stable:
+        reason = f"the section looks periodic but the orbit found is unstable ({detail})"
         return Verdict(
-            "undetermined",
-            None,
-            v.evidence + (e,),
-            v.reasons + (f"the section looks periodic but the orbit found is unstable ({detail})",),
-            v.settings,
+            "undetermined", None, v.evidence + (e,), v.reasons + (reason,), v.settings
         ), extra
     return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
+
+
+def _orbit_record(orbit, **more) -> dict:
+    """What a verdict's settings keep of a periodic orbit."""
+    return {
+        "period": orbit.period,
+        "converged": orbit.converged,
+        "residual": orbit.residual,
+        "multipliers_abs": [float(abs(m)) for m in orbit.multipliers],
+        "wall_time_s": orbit.wall_time,
+        **more,
+    }
+
+
+def _disputed_period(v: Verdict) -> int | None:
+    """n when an undetermined verdict's section is periodic (n) and the exponent does not say
+    chaotic: the case a periodic-orbit certificate settles."""
+    votes = {e.name: e for e in v.evidence}
+    sp, ex = votes.get("section_period"), votes.get("exponent")
+    if v.label != "undetermined" or sp is None or sp.vote != "periodic":
+        return None
+    if ex is not None and ex.vote == "chaotic":
+        return None
+    return int(sp.value)
 
 
 def _banded_period(v: Verdict) -> int | None:
@@ -217,18 +270,10 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
     """Resolve "n narrow bands but λ₁ > 0": chaotic when no attracting period-n orbit lies in
     the bands (shooting: unstable or not converged; or a random model, which has none),
     still undetermined when shooting certifies one (a genuine conflict)."""
-    from .tangent import periodic_orbit
-
     if p.l_lambda_sigma == 0.0:
         orbit = periodic_orbit(p, points[-1], n)
         mu = float(np.max(np.abs(orbit.multipliers)))
-        extra["periodic_orbit"] = {
-            "period": orbit.period,
-            "converged": orbit.converged,
-            "residual": orbit.residual,
-            "multipliers_abs": [float(abs(m)) for m in orbit.multipliers],
-            "wall_time_s": orbit.wall_time,
-        }
+        extra["periodic_orbit"] = _orbit_record(orbit)
         detail = (
             f"Newton shooting on P^{n} from the bands: residual {orbit.residual:.2g} rad, "
             f"converged {orbit.converged}, |mu|max = {mu:.3g}"

@@ -27,8 +27,10 @@ from ._periodicity import (
     section_period,
     stationarity_ratio,
 )
+from ._saltation import saltation_matrix
 from ._sections import crossing_section, local_maxima
 from ._spectrum import SpectrumResult, power_spectrum, spectrum_analysis
+from ._tangent_spectrum import TangentSpectrum, spectrum_from_jacobians
 from ._thresholds import Thresholds
 from ._verdict import LABELS, VOTES, Evidence, Verdict, combine
 from ._zero_one import ZeroOneResult, zero_one_test
@@ -46,6 +48,7 @@ __all__ = [
     "RotationResult",
     "SeriesLyapunovResult",
     "SpectrumResult",
+    "TangentSpectrum",
     "Verdict",
     "ZeroOneResult",
     "as_exponent",
@@ -65,8 +68,10 @@ __all__ = [
     "neighbour_expansion",
     "power_spectrum",
     "rotation_order",
+    "saltation_matrix",
     "section_period",
     "spectrum_analysis",
+    "spectrum_from_jacobians",
     "stationarity_ratio",
     "weighted_birkhoff",
     "zero_one_evidence",

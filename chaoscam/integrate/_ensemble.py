@@ -31,7 +31,12 @@ from ._constants import initial_counters, initial_state, kernel_constants
 from ._status import Status
 
 __all__ = [
-    "BACKENDS", "Ensemble", "contact_fraction", "run_members", "run_one", "simulate_ensemble",
+    "BACKENDS",
+    "Ensemble",
+    "contact_fraction",
+    "run_members",
+    "run_one",
+    "simulate_ensemble",
 ]
 
 # numba's GNU OpenMP layer aborts a process that forks after using it, and the sweeps fork
@@ -56,9 +61,7 @@ def run_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
     single member), so that a realization is bit-identical on every path and thread count.
     """
     for i in prange(y.shape[0]):
-        status[i] = advance(
-            y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i]
-        )
+        status[i] = advance(y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i])
 
 
 def contact_fraction(y, cnt, c) -> float:
@@ -78,8 +81,15 @@ def run_one(y, cnt, c, n_stop, lam, series, section, impacts) -> int:
     """:func:`run_members` for one trajectory (arrays of a single member, updated in place)."""
     status = np.zeros(1, dtype=np.int64)
     run_members(
-        y[None], cnt[None], c[None], n_stop, lam[None], series[None], section[None],
-        impacts[None], status,
+        y[None],
+        cnt[None],
+        c[None],
+        n_stop,
+        lam[None],
+        series[None],
+        section[None],
+        impacts[None],
+        status,
     )
     return int(status[0])
 
@@ -147,9 +157,13 @@ def simulate_ensemble(
         Also return every member's impacts (``Ensemble.impacts``); by default they are only
         counted, so that memory stays flat for long runs.
     classify : bool
-        Label each member from its section points after the transient
-        (:func:`chaoscam.analysis.classify_section`, what ``classify_trajectory`` does for a
-        run kept without its series): columns ``label`` and ``period`` in ``members``.
+        Integrate the tangent dynamics too (fixed-step RK4 members) and label each member
+        from its section points and stroboscopic Jacobians after the transient
+        (:func:`chaoscam.classify.classify_section_run`: the tangent exponent, n-band chaos,
+        the periodic-orbit certificate for deterministic members; what
+        ``classify_trajectory`` does for a run kept without its series): columns ``label``
+        and ``period`` in ``members``. A member that did not end OK is labelled by its
+        status (``left_reach``, ``diverged``), as in the sweeps.
 
     Notes
     -----
@@ -182,20 +196,29 @@ def simulate_ensemble(
     for start in range(0, len(indices), batch):
         chunk = slice(start, start + batch)
         s, r, im = _run_batch(
-            plist[chunk], indices[chunk], start, seed, duration, transient,
-            run=_gpu.run_on_gpu if use_gpu else _run_on_cpu, keep_impacts=keep_impacts,
+            plist[chunk],
+            indices[chunk],
+            start,
+            seed,
+            duration,
+            transient,
+            run=_gpu.run_on_gpu if use_gpu else _run_on_cpu,
+            keep_impacts=keep_impacts,
+            tangent=classify,
         )
         sections.extend(s)
         rows.extend(r)
         impact_rows.extend(im)
-    cols = ["member", "k", "t", "theta_f", "omega_f", "l_lambda"]
-    sec = pd.DataFrame(np.concatenate(sections) if sections else np.empty((0, 6)), columns=cols)
+    cols = ["member", *k.SECTION_NAMES]
+    every = np.concatenate(sections) if sections else np.empty((0, 1 + k.SECTION_COLS))
+    sec = pd.DataFrame(every[:, : len(cols)], columns=cols)
     sec[["member", "k"]] = sec[["member", "k"]].astype(np.int64)
     members = pd.DataFrame(
         rows, columns=["member", "index", "status", "n_impacts", "contact_fraction"]
     )
     if classify:
-        members = _classify_members(members, sec, plist, transient)
+        jac = every[:, len(cols) : len(cols) + 4].reshape(-1, 2, 2).transpose(0, 2, 1)
+        members = _classify_members(members, sec, jac, plist, transient)
     impacts = None
     if keep_impacts:
         icols = ["member", *k.IMPACT_NAMES]
@@ -230,39 +253,63 @@ def simulate_ensemble(
 def _pick_backend(backend: str) -> tuple[bool, str]:
     """(use the GPU?, the device in words) for ``backend``; warns if "gpu" cannot run."""
     if backend not in BACKENDS:
-        raise ValueError(f"backend must be one of {', '.join(map(repr, BACKENDS))}, "
-                         f"got {backend!r}")
+        raise ValueError(
+            f"backend must be one of {', '.join(map(repr, BACKENDS))}, got {backend!r}"
+        )
     if backend == "cpu":
         return False, "cpu"
     ok, reason = _gpu.gpu_status()
     if ok:
         return True, reason
     if backend == "gpu":
-        warnings.warn(f"GPU backend unavailable: {reason}; falling back to the CPU",
-                      _gpu.GPUFallbackWarning, stacklevel=3)
+        warnings.warn(
+            f"GPU backend unavailable: {reason}; falling back to the CPU",
+            _gpu.GPUFallbackWarning,
+            stacklevel=3,
+        )
     return False, "cpu"
 
 
-def _classify_members(members, sec, plist, transient) -> pd.DataFrame:
-    """``members`` with the section verdict of each member (label, period)."""
-    from ..analysis import classify_section
+def _classify_members(members, sec, jac, plist, transient) -> pd.DataFrame:
+    """``members`` with each member's verdict (label, period) from its section and its
+    stroboscopic Jacobians: :func:`chaoscam.classify.classify_section_run`, the verdict
+    ``classify_trajectory`` gives a run kept without its series."""
+    from ..classify import classify_section_run
 
     labels, periods = [], []
-    by_member = dict(tuple(sec.groupby("member")))
+    rows = sec["member"].to_numpy()
     for m, status in zip(members["member"], members["status"], strict=True):
-        points = by_member.get(m)
-        if status != "OK" or points is None:
+        pick = rows == m
+        points = sec.loc[pick]
+        if status != "OK" or not pick.any():
+            labels.append(Status[status].label or "undetermined")
+            periods.append(None)
+            continue
+        p = plist[int(m)]
+        keep = ((points["t"] >= transient - 1e-9 * p.cam_period) & (points["k"] > 0)).to_numpy()
+        if keep.sum() < 2:
             labels.append("undetermined")
             periods.append(None)
             continue
-        keep = points["t"] >= transient - 1e-9 * plist[0].cam_period
-        v = classify_section(points.loc[keep, ["theta_f", "omega_f"]].to_numpy(dtype=float))
+        v = classify_section_run(
+            points.loc[keep, ["theta_f", "omega_f"]].to_numpy(dtype=float), jac[pick][keep], p
+        )
         labels.append(v.label)
         periods.append(v.period)
     return members.assign(label=labels, period=pd.array(periods, dtype="Int64"))
 
 
-def _run_batch(plist, indices, first, seed, duration, transient, run=None, keep_impacts=False):
+def _run_batch(
+    plist,
+    indices,
+    first,
+    seed,
+    duration,
+    transient,
+    run=None,
+    keep_impacts=False,
+    tangent=False,
+):
     """Set up one batch of members, ``run`` it (CPU or GPU) and collect its outputs."""
     n = len(indices)
     p0 = plist[0]
@@ -274,7 +321,7 @@ def _run_batch(plist, indices, first, seed, duration, transient, run=None, keep_
     lam = np.stack([s.draw(n_draws) for s in streams])
     y = _per_member(initial_state, plist)
     cnt = _per_member(lambda p: initial_counters(p, transient=transient), plist)
-    c = _per_member(lambda p: kernel_constants(p, t_record=transient), plist)
+    c = _per_member(lambda p: kernel_constants(p, t_record=transient, tangent=tangent), plist)
     section = np.empty((n, n_sec, k.SECTION_COLS))
     impacts = np.empty((n, _IMPACT_ROWS + 4 * extra, k.IMPACT_COLS))
     status = np.zeros(n, dtype=np.int64)
@@ -297,9 +344,7 @@ def _run_batch(plist, indices, first, seed, duration, transient, run=None, keep_
         cnt[j, k.I_LAM_POS] = 0
         return np.concatenate([lam_j[pos:], streams[j].draw(n_new)])
 
-    (run or _run_on_cpu)(
-        y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts
-    )
+    (run or _run_on_cpu)(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts)
     sections, rows, impact_rows = [], [], []
     for j in range(n):
         empty_impacts(j)
@@ -307,9 +352,9 @@ def _run_batch(plist, indices, first, seed, duration, transient, run=None, keep_
             block = np.concatenate(kept[j])
             impact_rows.append(np.column_stack([np.full(len(block), first + j), block]))
         m = cnt[j, k.I_N_SECTION]
-        block = np.empty((m, 6))
+        block = np.empty((m, 1 + k.SECTION_COLS))
         block[:, 0] = first + j
-        block[:, 1:] = section[j, :m, : len(k.SECTION_NAMES)]
+        block[:, 1:] = section[j, :m]
         sections.append(block)
         rows.append(
             (
@@ -335,8 +380,17 @@ def _run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, kee
             lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
         sub = (y[need], cnt[need], c[need], lam[need], section[need], impacts[need])
         sub_status = np.zeros(need.size, dtype=np.int64)
-        run_members(sub[0], sub[1], sub[2], n_stop, sub[3],
-                    np.empty((need.size, 1, k.SERIES_COLS)), sub[4], sub[5], sub_status)
+        run_members(
+            sub[0],
+            sub[1],
+            sub[2],
+            n_stop,
+            sub[3],
+            np.empty((need.size, 1, k.SERIES_COLS)),
+            sub[4],
+            sub[5],
+            sub_status,
+        )
         y[need], cnt[need], section[need], impacts[need] = sub[0], sub[1], sub[4], sub[5]
         status[need] = sub_status
         need = need[sub_status == k.NEED_BUFFER]

@@ -139,7 +139,7 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
         duration=20.0,
         transient=10.0,
         initial_conditions=1 if quick else 3,
-        lyapunov=True,
+        lyapunov=False,
         workers=workers,
     )
     path = outdir / "fig4.parquet"
@@ -275,7 +275,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
             base=base,
             duration=duration,
             transient=transient,
-            lyapunov=True,
+            lyapunov=False,
             workers=workers,
         )
         tag = f"fig6-G{g:g}"
@@ -323,7 +323,7 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
         realizations=n,
         duration=20.0,
         transient=10.0,
-        lyapunov=True,
+        lyapunov=False,
         workers=workers,
     )
     path = outdir / "fig7-10.parquet"

@@ -27,10 +27,14 @@ class DefaultClassifier:
 
     Parameters
     ----------
+    tangent : bool
+        Default True: the verdict uses the tangent exponent through the impacts and, for a
+        periodic section of the deterministic model, a certified periodic orbit (see
+        ``classify_trajectory``); the runs are then simulated with ``tangent=True``.
     lyapunov : bool
-        Also compute the model's largest Lyapunov exponent (evidence ``lyapunov_model``,
-        about twice the cost of the run); what a regime map's ``lyapunov_mean`` /
-        ``lyapunov_std`` summarise.
+        Instead, the model's two-trajectory exponent (evidence ``lyapunov_model``, about
+        twice the cost of the run), kept for comparison; what a regime map's
+        ``lyapunov_mean`` / ``lyapunov_std`` summarise.
     check_step : bool
         Re-simulate with dt / 2 and call the verdict undetermined if it changes (twice the
         cost).
@@ -38,12 +42,20 @@ class DefaultClassifier:
 
     lyapunov: bool = False
     check_step: bool = False
+    tangent: bool = True
     needs_series = True  # the classifier may use the sampled signal, not only the section
+
+    @property
+    def needs_tangent(self) -> bool:
+        """Simulate with the tangent dynamics (so the classifier need not run again)."""
+        return self.tangent and not self.lyapunov
 
     def __call__(self, traj):
         from ..classify import classify_trajectory
 
-        return classify_trajectory(traj, lyapunov=self.lyapunov, check_step=self.check_step)
+        return classify_trajectory(
+            traj, tangent=self.tangent, lyapunov=self.lyapunov, check_step=self.check_step
+        )
 
 
 def classifier_identity(classify: Callable) -> str:
@@ -122,6 +134,8 @@ def _run(params: Params, task: Any) -> tuple[Any, dict[str, Any]]:
             seed=task.seed,
             index=task.sim_index,
             series=task.series,
+            tangent=bool(getattr(task.classify, "needs_tangent", False))
+            and params.integrator == "rk4",
         )
         if traj.ok:
             fields = verdict_fields(task.classify(traj))

@@ -1,0 +1,51 @@
+"""The saltation matrix of a state jump at an event surface (generic, numpy).
+
+For a flow ``x' = f(t, x)`` that jumps ``x+ = g(t, x-)`` where ``h(t, x) = 0``, a
+perturbation is mapped across the event by
+
+``S = g_x + (f+ - g_x f- - g_t) h_x^T / (h_t + h_x . f-)``
+
+(Müller 1995, Chaos Solitons Fractals 5(9), eq. 16; Leine & Nijmeijer 2004, *Dynamics and
+Bifurcations of Non-smooth Mechanical Systems*, sec. 3.5). The model's kernel writes this
+formula out for the restitution law (``chaoscam.integrate._tangent.saltation``); this
+generic form is the reference its tests compare it with, and the one checked on the bouncing
+ball's analytic Floquet multipliers.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["saltation_matrix"]
+
+
+def saltation_matrix(g_x, g_t, f_minus, f_plus, h_x, h_t: float) -> np.ndarray:
+    """``S = g_x + (f+ - g_x f- - g_t) h_x^T / (h_t + h_x . f-)`` (Müller 1995).
+
+    Parameters
+    ----------
+    g_x : array_like, shape (n, n)
+        Jacobian of the jump map with respect to the state.
+    g_t : array_like, shape (n,)
+        Its derivative with respect to time.
+    f_minus, f_plus : array_like, shape (n,)
+        The vector field before and after the jump, at the event.
+    h_x : array_like, shape (n,)
+        Gradient of the event function; ``h_t`` its time derivative.
+
+    Raises
+    ------
+    ValueError
+        For a grazing event (``h_t + h_x . f- = 0``): no saltation matrix exists there.
+    """
+    g_x = np.asarray(g_x, dtype=float)
+    h_x = np.asarray(h_x, dtype=float)
+    rate = float(h_t) + float(h_x @ np.asarray(f_minus, dtype=float))
+    if rate == 0.0:
+        raise ValueError("grazing event (h_t + h_x . f- = 0): the saltation matrix is undefined")
+    w = (
+        np.asarray(f_plus, dtype=float)
+        - g_x @ np.asarray(f_minus, dtype=float)
+        - np.asarray(g_t, dtype=float)
+    )
+    return g_x + np.outer(w, h_x) / rate
