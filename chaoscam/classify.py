@@ -13,6 +13,7 @@ import dataclasses
 import json
 import math
 import re
+import time
 from io import StringIO
 from pathlib import Path
 from typing import Any
@@ -194,6 +195,15 @@ def _with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, 
             "method": "tangent dynamics through the impacts, QR (chaoscam.tangent)",
         }
     }
+    votes = {e.name: e.vote for e in v.evidence}
+    if v.label == "quasiperiodic" and votes.get("exponent") != "not_chaotic":
+        # A torus has lambda_1 = 0: without an exponent that confirms it (zero within its
+        # interval), a quasiperiodic spectrum of a short window is not enough.
+        reason = (
+            "quasiperiodic evidence, but the tangent exponent does not confirm lambda_1 = 0 "
+            "within its interval: run longer"
+        )
+        v = Verdict("undetermined", None, v.evidence, v.reasons + (reason,), v.settings)
     banded = _banded_period(v)
     if v.label == "undetermined" and banded is not None:
         return _banded_verdict(v, p, points, banded, extra)
@@ -307,6 +317,41 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
     return verdict, extra
 
 
+EXTEND_TO = 120.0
+"""Longest recorded time [s] an undetermined verdict is extended to (classify_trajectory):
+the labelled set is settled from 120 s runs, and the tangent exponent's standard error falls
+as the inverse square root of the run (measured ~0.15 1/s after 60 s on the default)."""
+
+
+def _extended(traj, verdict, extra, discard, options, cap) -> tuple[Verdict, dict]:
+    """Re-run the realization 4x longer (section and tangent only) until the verdict settles
+    or the recorded time reaches ``cap``."""
+    s = traj.settings
+    start = s["transient"] + discard
+    recorded = s["duration"] - start
+    t_wall = time.perf_counter()
+    while verdict.label == "undetermined" and recorded < cap:
+        recorded = min(cap, 4.0 * recorded)
+        longer = simulate(
+            traj.params.replace(integrator="rk4"),
+            duration=start + recorded,
+            transient=s["transient"],
+            seed=s["seed"],
+            index=s["index"],
+            series=False,
+            tangent=True,
+        )
+        if longer.status is not Status.OK:
+            break
+        verdict, extra = _tangent_verdict(longer, discard, options)
+        extra["extended"] = {
+            "recorded_s": recorded,
+            "wall_time_s": time.perf_counter() - t_wall,
+            "why": "the verdict on the run as given was undetermined",
+        }
+    return verdict, extra
+
+
 def classify_trajectory(
     traj: Trajectory,
     *,
@@ -314,6 +359,7 @@ def classify_trajectory(
     lyapunov: bool = False,
     check_step: bool = False,
     discard: float = 0.0,
+    extend_to: float | None = EXTEND_TO,
     **options: Any,
 ) -> Verdict:
     """Classify a simulated trajectory from its stroboscopic section and its θ_f(t) series.
@@ -360,6 +406,12 @@ def classify_trajectory(
         does not vote.
     discard : float
         Extra time after the run's transient left out of the classification [s].
+    extend_to : float or None
+        With ``tangent``: when the verdict is "undetermined", the same realization is run
+        longer (4x the recorded time each round, section and tangent only, at most
+        ``extend_to`` seconds recorded; a realization's prefix does not depend on its
+        duration) and classified again, until it settles; ``settings["extended"]`` records
+        the recorded time and wall time used. None: never extend.
     **options
         Passed to the analysis classifier (``rtol``, ``lyapunov_tol`` [1/s], ``seed``, ...).
 
@@ -387,6 +439,8 @@ def classify_trajectory(
         return _status_verdict(traj, settings)
 
     verdict, extra = _verdict_of(traj, lyapunov, discard, options, tangent)
+    if tangent and not lyapunov and extend_to and verdict.label == "undetermined":
+        verdict, extra = _extended(traj, verdict, extra, discard, options, float(extend_to))
     verdict = _with_settings(verdict, **settings, **extra)
     if not check_step:
         return verdict

@@ -7,7 +7,7 @@ __all__ = ["ReportClassifier", "classifier_fingerprint", "classifier_name", "cla
 
 def classifier_name() -> str:
     """Which classifier :func:`classify` uses, in words."""
-    return "chaoscam.classify.classify_trajectory(lyapunov=True)"
+    return "chaoscam.classify.classify_trajectory() (tangent exponent, orbit certificate)"
 
 
 def classifier_fingerprint() -> str:
@@ -25,17 +25,19 @@ def classifier_fingerprint() -> str:
 
 
 def classify(traj):
-    """A :class:`~chaoscam.analysis.Verdict` for a trajectory, the model's Lyapunov exponent
-    included (without it a broadband-poor spectrum can pass chaos off as quasiperiodic)."""
+    """A :class:`~chaoscam.analysis.Verdict` for a trajectory: the package's default
+    classifier (the tangent exponent through the impacts and, for a periodic section, the
+    periodic-orbit certificate), the same configuration the sweeps use."""
     from ..classify import classify_trajectory
 
-    return classify_trajectory(traj, lyapunov=True)
+    return classify_trajectory(traj)
 
 
 class ReportClassifier:
     """A picklable sweep classifier calling :func:`classify` (for ``classify=`` of sweeps)."""
 
     needs_series = True
+    needs_tangent = True
 
     def __call__(self, traj):
         return classify(traj)

@@ -149,3 +149,16 @@ def test_wrong_files_raise_errors_naming_them(tmp_path):
     pq.write_table(pa.table({"x": [1.0, 2.0]}), foreign)
     with pytest.raises(ValueError, match="foreign.parquet.*not a chaoscam trajectory"):
         load_trajectory(foreign)
+
+
+def test_undetermined_short_run_is_extended_until_it_settles():
+    """l_lambda = 1 mm over 10 s recorded: the tangent exponent (2.3 +- 0.9 1/s over 46
+    periods) cannot decide and the 10 s spectrum reads quasiperiodic, so without extension
+    the verdict stays undetermined; extended (4x per round) it settles as chaotic, as the
+    300 s run does (lambda_1 = 2.1 +- 0.09 1/s), and the extension is recorded."""
+    tr = chaoscam.simulate(Params(l_lambda=0.001), duration=20.0, transient=10.0)
+    short = classify_trajectory(tr, extend_to=None)
+    assert short.label == "undetermined"
+    v = classify_trajectory(tr)
+    assert v.label == "chaotic"
+    assert v.settings["extended"]["recorded_s"] > 10.0
