@@ -20,9 +20,21 @@ def register(sub) -> None:
     )
     p.add_argument("trajectory", type=Path, metavar="TRAJ.parquet")
     p.add_argument(
+        "--no-tangent",
+        action="store_true",
+        help="classify from the section and series alone, without the tangent exponent "
+        "through the impacts and the periodic-orbit certificate (the default uses both)",
+    )
+    p.add_argument(
+        "--no-extend",
+        action="store_true",
+        help="do not run an undetermined realization longer (default: up to 120 s recorded)",
+    )
+    p.add_argument(
         "--lyapunov",
         action="store_true",
-        help="add the model's largest Lyapunov exponent (about twice the run's cost)",
+        help="use the two-trajectory exponent instead of the tangent one (kept for "
+        "comparison; about twice the run's cost)",
     )
     p.add_argument(
         "--check-step",
@@ -74,7 +86,15 @@ def run_classify(args: argparse.Namespace) -> int:
         traj = read_trajectory(args.trajectory)
     except TrajectoryFileError as err:
         raise UsageError(str(err)) from None
-    _print(classify_trajectory(traj, lyapunov=args.lyapunov, check_step=args.check_step))
+    _print(
+        classify_trajectory(
+            traj,
+            tangent=not args.no_tangent,
+            extend_to=None if args.no_extend else 120.0,
+            lyapunov=args.lyapunov,
+            check_step=args.check_step,
+        )
+    )
     return 0
 
 

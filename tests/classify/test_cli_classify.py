@@ -107,3 +107,11 @@ def test_series_bad_input_exits_2(tmp_path, capsys, extra, content, message):
         path.write_text(content)
     assert main(["classify-series", str(path), *extra]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_classify_uses_the_tangent_exponent_unless_told_not_to(traj_file, capsys):
+    """By default the verdict carries the tangent exponent; --no-tangent leaves it out."""
+    assert main(["classify", str(traj_file)]) == 0
+    assert "exponent" in {e["name"] for e in _json(capsys)["evidence"]}
+    assert main(["classify", str(traj_file), "--no-tangent", "--no-extend"]) == 0
+    assert "exponent" not in {e["name"] for e in _json(capsys)["evidence"]}
