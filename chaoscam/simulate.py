@@ -210,8 +210,9 @@ def simulate(
         Also integrate the tangent dynamics through the impacts (:mod:`chaoscam.integrate.
         _tangent`) and keep the Jacobian of the stroboscopic map over each recorded period
         (``Trajectory.jacobians``), from which :func:`chaoscam.lyapunov_spectrum` and
-        :func:`chaoscam.periodic_orbit` work. Fixed-step RK4 only. The motion is the same
-        with and without it.
+        :func:`chaoscam.periodic_orbit` work. Both integrators (the adaptive path carries
+        it by an RK4 step along each accepted step). The motion is the same with and
+        without it.
 
     Returns
     -------
@@ -250,11 +251,6 @@ def simulate(
     y = initial_state(p)
     th0, om0 = y[k.Y_THETA], y[k.Y_OMEGA]
     cnt = initial_counters(p, transient=transient)
-    if tangent and p.integrator != "rk4":
-        raise ParameterError(
-            f"tangent=True needs integrator = 'rk4' (got {p.integrator!r}): the tangent "
-            "dynamics are integrated on the RK4 grid only"
-        )
     c = kernel_constants(p, t_record=transient, stride=stride, tangent=tangent)
     buf_series = np.empty((block if series else 1, k.SERIES_COLS))
     buf_section = np.empty((block, k.SECTION_COLS))

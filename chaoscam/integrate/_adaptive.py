@@ -89,7 +89,9 @@ from ._kernel import (
     Y_TIME,
     Y_WINDOW,
 )
+from ._physics import JAC_CONTACT, JAC_FLIGHT, JAC_NATURAL
 from ._stages import accel_trig, geometry_near, trig_at
+from ._tangent import rk4_tangent_along
 
 # Step-size control (Hairer et al. sec. II.4 and their dop853 code): after a step with
 # error norm err, h_new = h * SAFETY * err^(-1/8), limited to [SHRINK_MIN, GROW_MAX] h.
@@ -145,6 +147,33 @@ def turning_point(h, th, tr, co, rate0, rate1, c):
         fm = sgn * (l1 * omega_at(co, m) - cdn)
         a, fa, b, fb, side = k.illinois_update(a, fa, b, fb, m, fm, side)
     return 0.5 * (a + b)
+
+
+@njit(cache=True, error_model="numpy")
+def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side):
+    """With the tangent on, carry it over the accepted step [t, t + s_end h_step] whose
+    state runs from (th, om) to (th1, om1), the midpoint taken from the interpolant ``co``."""
+    if c[k.C_TANGENT] <= 0.0:
+        return
+    sm = 0.5 * s_end
+    r = rk4_tangent_along(
+        t,
+        h,
+        th,
+        om,
+        theta_at(co, sm),
+        omega_at(co, sm),
+        th1,
+        om1,
+        K,
+        c,
+        y[k.Y_J11],
+        y[k.Y_J21],
+        y[k.Y_J12],
+        y[k.Y_J22],
+        side,
+    )
+    k.commit_tangent(y, r[0], r[1], r[2], r[3], r[4])
 
 
 @njit(cache=True, error_model="numpy")
@@ -294,6 +323,9 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
                     break
                 reach *= 2.0
                 s_end = min(1.0, s_end + reach)
+            # the substep ends on the surface: its Jacobian is taken on its own side
+            side = JAC_FLIGHT if closing else JAC_CONTACT
+            advance_tangent(y, c, t, s_end * hs, th, om, co, s_end, r2[0], r2[1], K, side)
             th = r2[0]
             om = r2[1]
             t = t + s_end * hs
@@ -312,6 +344,8 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         # The whole step is accepted. theta'' at its end was evaluated from directly computed
         # trigonometry, as a resumed run does; in a changed mode it is evaluated again.
         step_mode = flight
+        side = JAC_FLIGHT if flight else JAC_NATURAL
+        advance_tangent(y, c, t, t_end - t, th, om, co, 1.0, th1, om1, K, side)
         th = th1
         om = om1
         t = t_end
@@ -328,9 +362,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             if -g > c[C_RCAM]:
                 return leave(y, cnt, th, om, t, h, events, window, PENETRATION, c)
         if clipped:
-            K = k.at_scheduled(
-                t, th, om, is_section, is_resample, K, lam, cnt, section, y, c
-            )
+            K = k.at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)
             if is_resample:
                 a1 = accel_trig(tr, om, K, c, flight)
     return leave(y, cnt, th, om, t, h, events, window, OK, c)

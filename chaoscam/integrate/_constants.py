@@ -30,8 +30,8 @@ def kernel_constants(
     stride : int
         Keep a series sample every ``stride`` grid steps; 0 keeps none.
     tangent : bool
-        Integrate the tangent dynamics (fixed-step RK4 only; ignored by the adaptive path,
-        whose section Jacobians stay NaN).
+        Integrate the tangent dynamics (RK4 on the state's stages for the fixed grid; an RK4
+        step along each accepted DOP853 step on the adaptive path).
     """
     c = np.zeros(k.N_CONSTANTS)
     xo, yo = p.pivot
@@ -66,7 +66,7 @@ def kernel_constants(
     c[k.C_RTOL] = p.rtol
     c[k.C_ATOL] = p.atol
     c[k.C_H_MAX] = p.h_max
-    c[k.C_TANGENT] = 1.0 if tangent and p.integrator == "rk4" else 0.0
+    c[k.C_TANGENT] = 1.0 if tangent else 0.0
     c[k.C_V_CHATTER] = p.v_chatter
     c[k.C_V_MICRO] = p.v_micro
     return c
