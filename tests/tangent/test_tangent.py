@@ -71,8 +71,9 @@ def test_tangent_does_not_change_the_motion():
     a = simulate(duration=3.0, series=False)
     b = simulate(duration=3.0, series=False, tangent=True)
     assert np.array_equal(a.section.to_numpy(), b.section.to_numpy())
-    assert np.array_equal(a.impacts.drop(columns="kind").to_numpy(),
-                          b.impacts.drop(columns="kind").to_numpy())
+    assert np.array_equal(
+        a.impacts.drop(columns="kind").to_numpy(), b.impacts.drop(columns="kind").to_numpy()
+    )
 
 
 def test_spectrum_of_known_matrices():
@@ -141,3 +142,17 @@ def test_adaptive_path_carries_the_tangent_where_the_map_is_smooth():
     a = lyapunov_spectrum(SMOOTH, duration=60.0, transient=30.0)
     b = lyapunov_spectrum(p, duration=60.0, transient=30.0)
     assert b.exponents == pytest.approx(a.exponents, rel=1e-2)
+
+
+@pytest.mark.parametrize("changes", [{}, {"x_O": -0.45}], ids=["default", "pivot"])
+def test_agrees_with_the_two_trajectory_estimate_where_that_is_valid(changes):
+    """Where the twin-trajectory estimate is valid (no chattering ends: v_min = 1e-3, both
+    trajectories apply the same impacts), it and the tangent exponent agree within three
+    combined standard errors (measured: 3.61 +- 0.30 vs 3.47 +- 0.23 1/s; 1.74 vs 1.90)."""
+    from chaoscam.lyapunov import lyapunov_model
+
+    p = Params(v_min=1e-3, **changes)
+    twin = lyapunov_model(p, duration=60.0, transient=20.0)
+    tang = lyapunov_spectrum(p, duration=60.0, transient=20.0)
+    assert twin.unsynced == 0 and twin.exponent > 0 and tang.exponent > 0
+    assert abs(twin.exponent - tang.exponent) <= 3.0 * math.hypot(twin.stderr, tang.stderr[0])
