@@ -18,7 +18,7 @@ from ._lyapunov_series import lyapunov_from_series
 from ._sections import local_maxima
 from ._spectrum import spectrum_analysis
 from ._thresholds import Thresholds, resolve
-from ._validate import as_points, as_series
+from ._validate import MIN_SERIES, as_points, as_series
 from ._verdict import Evidence, Verdict, combine
 
 __all__ = ["classify_section", "classify_signal"]
@@ -186,7 +186,7 @@ def classify_signal(
     and the spectrum resolves subharmonics up to order 9: a periodic call is solid, a
     quasiperiodic versus chaotic call rests on the spectrum and the 0–1 test agreeing.
     """
-    x = as_series(x)
+    x = as_series(x, min_size=MIN_SERIES)
     if not dt > 0:
         raise ValueError(f"dt must be positive, got {dt}")
     if forcing_period is not None and not forcing_period > 0:

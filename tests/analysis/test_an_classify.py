@@ -156,14 +156,14 @@ def test_nan_input_raises():
 
 
 def test_degenerate_input_never_crashes():
-    """Constant, tiny or short inputs give documented verdicts with reasons, never errors."""
+    """Constant or short inputs give documented verdicts with reasons, never crashes (inputs
+    too small to hold an oscillation are refused instead: see the next test)."""
     const_signal = classify_signal(np.full(5000, 0.3), 0.01, 1.0)
     assert const_signal.label == "undetermined" and "constant" in const_signal.reasons[0]
     const_section = classify_section(np.full((40, 2), 0.3))
     assert (const_section.label, const_section.period) == ("periodic", 1)
-    for x in (np.array([1.0]), np.array([1.0, 2.0]), np.sin(np.arange(30.0))):
-        v = classify_signal(x, 0.1)
-        assert v.label == "undetermined" and v.reasons
+    v = classify_signal(np.sin(np.arange(30.0)), 0.1)
+    assert v.label == "undetermined" and v.reasons
     assert classify_section(np.arange(3.0)).label == "undetermined"
 
 
@@ -182,3 +182,15 @@ def test_classify_signal_is_fast():
     t0 = time.perf_counter()
     classify_signal(x, 0.01, 1.0, section=torus_section(100))
     assert time.perf_counter() - t0 < 2.0
+
+
+def test_too_little_data_is_an_error_not_a_verdict():
+    """An empty or nearly empty signal or section is refused ("too little data"), not
+    called an equilibrium."""
+    from chaoscam.analysis import classify_section, classify_signal
+
+    for x in ([], [1.0], np.arange(10.0)):
+        with pytest.raises(ValueError, match="too little data"):
+            classify_signal(x, 0.01)
+    with pytest.raises(ValueError, match="too little data"):
+        classify_section(np.empty((0, 2)))
