@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-
 MIN_SERIES = 16  # fewer samples than this cannot show an oscillation: too little data
 
 
