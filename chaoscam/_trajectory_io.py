@@ -1,16 +1,32 @@
 """The one reader of trajectory files for every command (``classify``, ``report``).
 
 A trajectory file is what ``chaoscam simulate --out FILE.parquet`` (``Trajectory.to_parquet``)
-writes. :func:`read_trajectory` rebuilds it through :func:`chaoscam.classify.load_trajectory`
-(which checks the metadata and columns) and refuses a file that holds too little data to
-classify, so both commands accept and refuse the same files with the same messages.
+writes. :func:`load_trajectory` rebuilds it (checking the metadata and columns), and
+:func:`read_trajectory` also refuses a file that holds too little data to classify, so both
+commands accept and refuse the same files with the same messages.
 """
 
 from __future__ import annotations
 
+import json
+import math
+from io import StringIO
 from pathlib import Path
 
-__all__ = ["TrajectoryFileError", "read_trajectory", "check_enough", "MIN_POINTS"]
+import numpy as np
+import pandas as pd
+
+from .integrate import Status
+from .model import Params
+from .simulate import SECTION_COLUMNS, SERIES_COLUMNS, Trajectory
+
+__all__ = [
+    "MIN_POINTS",
+    "TrajectoryFileError",
+    "check_enough",
+    "load_trajectory",
+    "read_trajectory",
+]
 
 MIN_POINTS = 16
 """Fewest section points or samples a verdict is asked from; fewer is "too little data"."""
@@ -35,8 +51,6 @@ def read_trajectory(path: str | Path, *, need_data: bool = True):
     With ``need_data``, a file with fewer than :data:`MIN_POINTS` section points and series
     samples is refused ("too little data").
     """
-    from .classify import load_trajectory
-
     path = Path(path)
     try:
         traj = load_trajectory(path)
@@ -47,3 +61,79 @@ def read_trajectory(path: str | Path, *, need_data: bool = True):
         n = max(len(traj.section), n_series)
         check_enough(n, "section points and samples", path)
     return traj
+
+
+def load_trajectory(path) -> Trajectory:
+    """Rebuild a :class:`Trajectory` from a Parquet file written by ``Trajectory.to_parquet``.
+
+    The table holds the series (or, for a run without one, the section); the metadata keys
+    ``chaoscam.trajectory`` (params, settings, status, stats), ``chaoscam.section`` and
+    ``chaoscam.impacts`` (JSON, pandas "split" orientation, 10 decimals) hold the rest.
+    ``final_state`` is not stored: it is taken from the last row of the table.
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    ValueError
+        Not a Parquet file, or not one written by chaoscam (the message names the file).
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    try:
+        table = pq.read_table(path)
+    except (pa.ArrowException, OSError) as err:
+        raise ValueError(f"{path}: not a Parquet file ({err})") from err
+    meta = table.schema.metadata or {}
+    missing = [
+        key
+        for key in (b"chaoscam.trajectory", b"chaoscam.section", b"chaoscam.impacts")
+        if key not in meta
+    ]
+    if missing:
+        raise ValueError(
+            f"{path}: not a chaoscam trajectory file (metadata "
+            f"{', '.join(m.decode() for m in missing)} missing; write one with "
+            "`chaoscam simulate --out FILE.parquet` or Trajectory.to_parquet)"
+        )
+    try:
+        prov = json.loads(meta[b"chaoscam.trajectory"])
+        params = Params(**prov["params"])
+        status = Status[prov["status"]]
+        section = pd.read_json(StringIO(meta[b"chaoscam.section"].decode()), orient="split")
+        impacts = pd.read_json(StringIO(meta[b"chaoscam.impacts"].decode()), orient="split")
+        settings = dict(prov["settings"])
+        stats = dict(prov.get("stats", {}))
+    except (KeyError, TypeError, ValueError) as err:
+        raise ValueError(f"{path}: unreadable chaoscam metadata ({err!r})") from err
+    frame = table.to_pandas()
+    cols = tuple(frame.columns)
+    if cols == SERIES_COLUMNS:
+        series = frame
+    elif cols == SECTION_COLUMNS:
+        series = None
+    else:
+        raise ValueError(f"{path}: unexpected columns {list(cols)} for a chaoscam trajectory")
+    section = section.reindex(columns=list(SECTION_COLUMNS))
+    if len(section):
+        section["k"] = section["k"].astype(np.int64)
+    last = frame.iloc[-1] if len(frame) else None
+    final = (
+        (float(last["t"]), float(last["theta_f"]), float(last["omega_f"]))
+        if last is not None
+        else (math.nan, math.nan, math.nan)
+    )
+    return Trajectory(
+        params=params,
+        settings=settings,
+        status=status,
+        series=series,
+        section=section,
+        impacts=impacts,
+        stats=stats,
+        final_state=final,
+    )

@@ -10,21 +10,18 @@ T = 2 pi / omega, and optionally adds the model's own Lyapunov exponent
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import re
 import time
-from io import StringIO
-from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
+from ._trajectory_io import load_trajectory
 from .analysis import Evidence, Verdict, classify_section, classify_signal
 from .integrate import Status
 from .model import Params
-from .simulate import SECTION_COLUMNS, SERIES_COLUMNS, Trajectory, simulate
+from .simulate import Trajectory, simulate
 from .tangent import periodic_orbit, spectrum_from_jacobians
 
 __all__ = ["classify_file", "classify_section_run", "classify_trajectory", "load_trajectory"]
@@ -543,82 +540,6 @@ def _resimulate_half_step(traj: Trajectory) -> Trajectory:
         index=s["index"],
         series=keep_series,
         output_dt=s["output_dt"] if keep_series else 1e-3,
-    )
-
-
-def load_trajectory(path) -> Trajectory:
-    """Rebuild a :class:`Trajectory` from a Parquet file written by ``Trajectory.to_parquet``.
-
-    The table holds the series (or, for a run without one, the section); the metadata keys
-    ``chaoscam.trajectory`` (params, settings, status, stats), ``chaoscam.section`` and
-    ``chaoscam.impacts`` (JSON, pandas "split" orientation, 10 decimals) hold the rest.
-    ``final_state`` is not stored: it is taken from the last row of the table.
-
-    Raises
-    ------
-    FileNotFoundError
-        No such file.
-    ValueError
-        Not a Parquet file, or not one written by chaoscam (the message names the file).
-    """
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
-    try:
-        table = pq.read_table(path)
-    except (pa.ArrowException, OSError) as err:
-        raise ValueError(f"{path}: not a Parquet file ({err})") from err
-    meta = table.schema.metadata or {}
-    missing = [
-        key
-        for key in (b"chaoscam.trajectory", b"chaoscam.section", b"chaoscam.impacts")
-        if key not in meta
-    ]
-    if missing:
-        raise ValueError(
-            f"{path}: not a chaoscam trajectory file (metadata "
-            f"{', '.join(m.decode() for m in missing)} missing; write one with "
-            "`chaoscam simulate --out FILE.parquet` or Trajectory.to_parquet)"
-        )
-    try:
-        prov = json.loads(meta[b"chaoscam.trajectory"])
-        params = Params(**prov["params"])
-        status = Status[prov["status"]]
-        section = pd.read_json(StringIO(meta[b"chaoscam.section"].decode()), orient="split")
-        impacts = pd.read_json(StringIO(meta[b"chaoscam.impacts"].decode()), orient="split")
-        settings = dict(prov["settings"])
-        stats = dict(prov.get("stats", {}))
-    except (KeyError, TypeError, ValueError) as err:
-        raise ValueError(f"{path}: unreadable chaoscam metadata ({err!r})") from err
-    frame = table.to_pandas()
-    cols = tuple(frame.columns)
-    if cols == SERIES_COLUMNS:
-        series = frame
-    elif cols == SECTION_COLUMNS:
-        series = None
-    else:
-        raise ValueError(f"{path}: unexpected columns {list(cols)} for a chaoscam trajectory")
-    section = section.reindex(columns=list(SECTION_COLUMNS))
-    if len(section):
-        section["k"] = section["k"].astype(np.int64)
-    last = frame.iloc[-1] if len(frame) else None
-    final = (
-        (float(last["t"]), float(last["theta_f"]), float(last["omega_f"]))
-        if last is not None
-        else (math.nan, math.nan, math.nan)
-    )
-    return Trajectory(
-        params=params,
-        settings=settings,
-        status=status,
-        series=series,
-        section=section,
-        impacts=impacts,
-        stats=stats,
-        final_state=final,
     )
 
 
