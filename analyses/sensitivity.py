@@ -20,8 +20,8 @@ import pandas as pd
 
 import chaoscam
 from chaoscam import Params
+from chaoscam._simulate import contact_period
 from chaoscam.classify import classify_trajectory
-from chaoscam.simulate import contact_period
 
 DURATION, TRANSIENT = 60.0, 30.0
 

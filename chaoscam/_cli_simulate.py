@@ -35,8 +35,8 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ._outputs import atomic_path, check_output
+    from ._simulate import simulate
     from .cli import parse_assignments
-    from .simulate import simulate
 
     out = check_output(args.out, force=args.force, suffixes=(".parquet", ".csv"))
     section = check_output(args.section, flag="--section", force=args.force)

@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ._simulate import SECTION_COLUMNS, SERIES_COLUMNS, Trajectory
 from .integrate import Status
 from .model import Params
-from .simulate import SECTION_COLUMNS, SERIES_COLUMNS, Trajectory
 
 __all__ = [
     "MIN_POINTS",

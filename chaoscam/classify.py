@@ -1,6 +1,6 @@
 """classify_trajectory(traj) -> Verdict: periodic, quasiperiodic or chaotic, for the model.
 
-The glue between a simulated :class:`~chaoscam.simulate.Trajectory` and the array-only
+The glue between a simulated :class:`~chaoscam._simulate.Trajectory` and the array-only
 analysis layer (:mod:`chaoscam.analysis`): it picks the observables (the stroboscopic
 section (θ_f, θ̇_f) once per cam period and the sampled θ_f(t)), the forcing period
 T = 2 pi / omega, and optionally adds the model's own Lyapunov exponent
@@ -17,11 +17,11 @@ from typing import Any
 
 import numpy as np
 
+from ._simulate import Trajectory, simulate
 from ._trajectory_io import load_trajectory
 from .analysis import Evidence, Verdict, classify_section, classify_signal
 from .integrate import Status
 from .model import Params
-from .simulate import Trajectory, simulate
 from .tangent import periodic_orbit, spectrum_from_jacobians
 
 __all__ = ["classify_file", "classify_section_run", "classify_trajectory", "load_trajectory"]

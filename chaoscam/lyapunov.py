@@ -7,7 +7,7 @@ separation is measured and the companion is pulled back to d0 along it. Both tra
 read the same array of line-length draws, so with a random line length (sigma > 0) they see
 the same noise realization, the one ``simulate(params, seed=seed, index=index)`` sees.
 
-This module sits above the kernels and :mod:`chaoscam.simulate`; the analysis layer
+This module sits above the kernels and :mod:`chaoscam._simulate`; the analysis layer
 (:func:`chaoscam.analysis.lyapunov_benettin`) holds the generic method, which is used here
 as an independent cross-check in the tests.
 """

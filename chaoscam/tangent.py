@@ -11,7 +11,7 @@ saltation matrices, :mod:`chaoscam.integrate._tangent`) and writes beside each s
   matrix ``DP^n`` from the same Jacobians; returns the orbit, its Floquet multipliers and
   whether it is a certified attracting orbit.
 
-This module sits above :mod:`chaoscam.simulate` and the kernels (it drives them); the analysis
+This module sits above :mod:`chaoscam._simulate` and the kernels (it drives them); the analysis
 layer only ever sees the arrays it returns.
 """
 
@@ -57,7 +57,7 @@ def lyapunov_spectrum(
     realization's random map sequence.
     """
     if trajectory is None:
-        from .simulate import simulate
+        from ._simulate import simulate
 
         trajectory = simulate(
             params,

@@ -1,8 +1,20 @@
 """Integrators: the compiled RK4 + event kernel and the solve_ivp reference path."""
 
-from ._constants import kernel_constants
-from ._ensemble import Ensemble, simulate_ensemble
-from ._reference import simulate_reference
-from ._status import Status
+from __future__ import annotations
+
+from .._lazy import lazy_face
+
+# Public names and the submodule that defines each: imported on first use (PEP 562),
+# so that importing the package stays cheap.
+_LAZY = {
+    "Ensemble": ("._ensemble", "Ensemble"),
+    "Status": ("._status", "Status"),
+    "kernel_constants": ("._constants", "kernel_constants"),
+    "simulate_ensemble": ("._ensemble", "simulate_ensemble"),
+    "simulate_reference": ("._reference", "simulate_reference"),
+}
 
 __all__ = ["Ensemble", "Status", "kernel_constants", "simulate_ensemble", "simulate_reference"]
+
+
+__getattr__, __dir__ = lazy_face(__name__, _LAZY)

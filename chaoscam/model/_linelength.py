@@ -9,7 +9,6 @@ spawn_key=(index,))``, whatever the number of workers.
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import ndtr, ndtri
 
 from ._params import ParameterError, Params
 
@@ -28,6 +27,8 @@ def truncated_mass(mu: float, sigma: float, l_min: float) -> float:
     """Probability mass of Normal(mu, sigma^2) below l_min, removed by the truncation."""
     if sigma == 0.0:
         return 0.0 if mu > l_min else 1.0
+    from scipy.special import ndtr  # lazily: scipy.special costs ~0.2 s to import
+
     return float(ndtr((l_min - mu) / sigma))
 
 
@@ -46,6 +47,8 @@ class LineLengthStream:
         self._rng = realization_rng(seed, index) if self.sigma > 0 else None
         if self.sigma > 0:
             self._a = (self.l_min - self.mu) / self.sigma
+            from scipy.special import ndtr
+
             self._tail = float(ndtr(-self._a))
             if self._tail < 1e-12:
                 raise ParameterError(
@@ -58,5 +61,7 @@ class LineLengthStream:
         if self._rng is None:
             return np.full(n, self.mu)
         u = self._rng.random(n)
+        from scipy.special import ndtri
+
         z = -ndtri((1.0 - u) * self._tail)  # 1 - u in (0, 1]: never ndtri(0)
         return self.mu + self.sigma * np.maximum(z, self._a)

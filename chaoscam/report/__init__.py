@@ -9,18 +9,26 @@ layer; in Python::
 matplotlib and jinja2 are imported only when a figure is drawn or a page rendered.
 """
 
-from ._classify import ReportClassifier as ReportClassifier
-from ._classify import classify as classify
-from ._html import Comparison as Comparison
-from ._html import FigureItem as FigureItem
-from ._html import ReportParts as ReportParts
-from ._html import build_report as build_report
-from ._html import write_report as write_report
-from ._inputs import InputError as InputError
-from ._inputs import load_inputs as load_inputs
-from ._inputs import load_trajectory as load_trajectory
-from ._paper import FIGURES as FIGURES
-from ._paper import run_paper as run_paper
+from __future__ import annotations
+
+from .._lazy import lazy_face
+
+# Public names and the submodule that defines each: imported on first use (PEP 562),
+# so that importing the package stays cheap.
+_LAZY = {
+    "Comparison": ("._html", "Comparison"),
+    "FIGURES": ("._paper", "FIGURES"),
+    "FigureItem": ("._html", "FigureItem"),
+    "InputError": ("._inputs", "InputError"),
+    "ReportClassifier": ("._classify", "ReportClassifier"),
+    "ReportParts": ("._html", "ReportParts"),
+    "build_report": ("._html", "build_report"),
+    "classify": ("._classify", "classify"),
+    "load_inputs": ("._inputs", "load_inputs"),
+    "load_trajectory": ("._inputs", "load_trajectory"),
+    "run_paper": ("._paper", "run_paper"),
+    "write_report": ("._html", "write_report"),
+}
 
 __all__ = [
     "FIGURES",
@@ -36,3 +44,6 @@ __all__ = [
     "run_paper",
     "write_report",
 ]
+
+
+__getattr__, __dir__ = lazy_face(__name__, _LAZY)

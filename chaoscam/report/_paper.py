@@ -73,8 +73,8 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 3: the random contact-line length resampled every ``resample_dt`` (a time series)."""
     from matplotlib.figure import Figure
 
+    from .._simulate import simulate
     from ..model import Params
-    from ..simulate import simulate
 
     res = FigureResult(3)
     mu, sigma = 0.008, 0.002
@@ -256,8 +256,8 @@ def fig5(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
 def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 6: bifurcation over D with the fractal stiffness, G = 1e-9 and 1e-10 m."""
+    from .._simulate import contact_period
     from ..model import Params
-    from ..simulate import contact_period
     from ..sweep import bifurcation
     from ._sweep_figures import bifurcation_figure
 
@@ -309,8 +309,8 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
 def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Figs. 7-10: the random line length at μ = 0.008, 0.015, 0.023 m, σ from 0 to 0.004 m."""
+    from .._simulate import simulate
     from ..model import Params
-    from ..simulate import simulate
     from ..sweep import Axis, regime_map
     from ._sweep_figures import regime_map_figure
 

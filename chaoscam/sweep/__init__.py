@@ -6,14 +6,40 @@ processes, or a Dask cluster), checkpoints every finished record so that a kille
 to the identical table, and summarises each cell with Wilson intervals.
 """
 
-from ._backends import DaskBackend, ProcessBackend, SerialBackend, make_backend
-from ._bifurcation import Bifurcation, bifurcation, initial_offsets, read_bifurcation
-from ._checkpoint import checkpoint_dir, config_hash
-from ._engine import SweepInterrupted
-from ._grid import Axis, SweepError, parse_range, realization_index
-from ._regime import RegimeMap, mu_sigma_axes, read_regime_map, regime_map
-from ._stats import LABEL_ORDER, max_halfwidth, summarize_cells, wilson_interval
-from ._tasks import DefaultClassifier, load_classifier, verdict_fields
+from __future__ import annotations
+
+from .._lazy import lazy_face
+
+# Public names and the submodule that defines each: imported on first use (PEP 562),
+# so that importing the package stays cheap.
+_LAZY = {
+    "Axis": ("._grid", "Axis"),
+    "Bifurcation": ("._bifurcation", "Bifurcation"),
+    "DaskBackend": ("._backends", "DaskBackend"),
+    "DefaultClassifier": ("._tasks", "DefaultClassifier"),
+    "LABEL_ORDER": ("._stats", "LABEL_ORDER"),
+    "ProcessBackend": ("._backends", "ProcessBackend"),
+    "RegimeMap": ("._regime", "RegimeMap"),
+    "SerialBackend": ("._backends", "SerialBackend"),
+    "SweepError": ("._grid", "SweepError"),
+    "SweepInterrupted": ("._engine", "SweepInterrupted"),
+    "bifurcation": ("._bifurcation", "bifurcation"),
+    "checkpoint_dir": ("._checkpoint", "checkpoint_dir"),
+    "config_hash": ("._checkpoint", "config_hash"),
+    "initial_offsets": ("._bifurcation", "initial_offsets"),
+    "load_classifier": ("._tasks", "load_classifier"),
+    "make_backend": ("._backends", "make_backend"),
+    "max_halfwidth": ("._stats", "max_halfwidth"),
+    "mu_sigma_axes": ("._regime", "mu_sigma_axes"),
+    "parse_range": ("._grid", "parse_range"),
+    "read_bifurcation": ("._bifurcation", "read_bifurcation"),
+    "read_regime_map": ("._regime", "read_regime_map"),
+    "realization_index": ("._grid", "realization_index"),
+    "regime_map": ("._regime", "regime_map"),
+    "summarize_cells": ("._stats", "summarize_cells"),
+    "verdict_fields": ("._tasks", "verdict_fields"),
+    "wilson_interval": ("._stats", "wilson_interval"),
+}
 
 __all__ = [
     "LABEL_ORDER",
@@ -43,3 +69,6 @@ __all__ = [
     "verdict_fields",
     "wilson_interval",
 ]
+
+
+__getattr__, __dir__ = lazy_face(__name__, _LAZY)

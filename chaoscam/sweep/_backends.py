@@ -126,8 +126,8 @@ def _watch_parent(parent: int) -> None:  # pragma: no cover - not Linux
 
 def _warm_kernels() -> None:
     """Load the compiled kernels (numba cache) in this process: a run of a few steps."""
+    from .._simulate import simulate
     from ..model import Params
-    from ..simulate import simulate
 
     simulate(Params(), duration=1e-4, series=False)
 

@@ -15,8 +15,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, is_dataclass
 from typing import Any
 
+from .._simulate import simulate
 from ..model import Params
-from ..simulate import simulate
 
 __all__ = ["DefaultClassifier", "RealizationTask", "BranchTask", "run_task"]
 

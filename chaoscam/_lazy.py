@@ -1,0 +1,34 @@
+"""Lazy package faces (PEP 562): public names resolved from their submodules on first use.
+
+A package's ``__init__`` lists ``{name: (submodule, attribute)}`` and takes its
+``__getattr__`` and ``__dir__`` from :func:`lazy_face`, so ``import chaoscam`` (and the
+``chaoscam`` command's start-up) loads no numba, pandas or scipy until a name that needs them
+is used. A submodule must not share a public name of its package (the import system would
+bind the module over the name): that is why the driver module is ``_simulate``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+
+
+def lazy_face(
+    package: str, table: dict[str, tuple[str, str]]
+) -> tuple[Callable[[str], object], Callable[[], list[str]]]:
+    """``(__getattr__, __dir__)`` for ``package`` resolving the names of ``table`` lazily."""
+    import sys
+
+    def __getattr__(name: str):
+        try:
+            module, attr = table[name]
+        except KeyError:
+            raise AttributeError(f"module {package!r} has no attribute {name!r}") from None
+        value = getattr(importlib.import_module(module, package), attr)
+        setattr(sys.modules[package], name, value)
+        return value
+
+    def __dir__() -> list[str]:
+        return sorted(set(vars(sys.modules[package])) | set(table))
+
+    return __getattr__, __dir__
