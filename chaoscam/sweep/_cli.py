@@ -94,8 +94,8 @@ def register(sub) -> None:
     b.add_argument(
         "--values",
         required=True,
-        metavar="START:STOP:NUM",
-        help="NUM values from START to STOP, both included",
+        metavar="START:STOP:NUM|V1,V2,...",
+        help="NUM values from START to STOP, both included, or exact values V1,V2,...",
     )
     b.add_argument(
         "--initial-conditions",
@@ -119,10 +119,14 @@ def register(sub) -> None:
         "random line length. Writes one row per realization to FILE.parquet and the "
         "per-cell fractions with 95%% Wilson intervals to FILE.cells.parquet.",
     )
-    r.add_argument("--mu", metavar="START:STOP:NUM", help="mean line length l_lambda [m]")
-    r.add_argument("--sigma", metavar="START:STOP:NUM", help="spread l_lambda_sigma [m]")
-    r.add_argument("--x", metavar="NAME=START:STOP:NUM", help="first axis (instead of --mu)")
-    r.add_argument("--y", metavar="NAME=START:STOP:NUM", help="second axis (instead of --sigma)")
+    r.add_argument("--mu", metavar="START:STOP:NUM|V1,V2,...", help="mean line length l_lambda [m]")
+    r.add_argument("--sigma", metavar="START:STOP:NUM|V1,V2,...", help="spread l_lambda_sigma [m]")
+    r.add_argument(
+        "--x", metavar="NAME=START:STOP:NUM|V1,V2,...", help="first axis (instead of --mu)"
+    )
+    r.add_argument(
+        "--y", metavar="NAME=START:STOP:NUM|V1,V2,...", help="second axis (instead of --sigma)"
+    )
     r.add_argument(
         "--realizations", type=int, default=1, metavar="N", help="realizations per cell (default 1)"
     )
@@ -162,9 +166,7 @@ def _execution(args) -> dict:
         )
     if args.force and args.resume:
         raise UsageError("--force starts over and --resume continues: give one of them")
-    check_output(
-        args.plot, flag="--plot", force=args.force or args.resume, suffixes=_PLOT_SUFFIXES
-    )
+    check_output(args.plot, flag="--plot", force=args.force or args.resume, suffixes=_PLOT_SUFFIXES)
     classify = None
     if args.classifier is not None:
         try:

@@ -114,12 +114,21 @@ class Axis:
 
     @classmethod
     def parse(cls, text: str, name: str | None = None) -> Axis:
-        """From ``NAME=START:STOP:NUM``, or ``START:STOP:NUM`` when ``name`` is given."""
+        """From ``NAME=START:STOP:NUM`` or ``NAME=V1,V2,...`` (exact values, e.g. the paper's
+        ``l_lambda=0.008,0.015,0.023``); without ``NAME=`` when ``name`` is given."""
         if name is None:
             name, sep, text = text.partition("=")
             if not sep or not name.strip():
-                raise SweepError(f"axis {text!r}: expected NAME=START:STOP:NUM")
+                raise SweepError(f"axis {text!r}: expected NAME=START:STOP:NUM or NAME=V1,V2,...")
             name = name.strip()
+        if ":" not in text:
+            try:
+                values = tuple(float(v) for v in text.split(","))
+            except ValueError:
+                raise SweepError(
+                    f"{name} values {text!r}: expected START:STOP:NUM or numbers V1,V2,..."
+                ) from None
+            return cls(name, values)
         start, stop, num = parse_range(text, what=f"{name} range")
         return cls.linspace(name, start, stop, num)
 

@@ -56,3 +56,12 @@ def test_grid_validation_names_the_bad_point():
         validate_grid(Params(), [Axis("l_lambda", (0.0, 0.008)), Axis("xi", (0.4,))])
     with pytest.raises(SweepError, match="repeat"):
         validate_grid(Params(), [Axis("xi", (0.4,)), Axis("xi", (0.5,))])
+
+
+def test_axes_can_name_exact_values():
+    """NAME=V1,V2,... sweeps exactly those values (the paper's mu = 8, 15, 23 mm); a value
+    that is not a number is refused with the axis named."""
+    assert Axis.parse("l_lambda=0.008,0.015,0.023").values == (0.008, 0.015, 0.023)
+    assert Axis.parse("0.42", name="xi").values == (0.42,)
+    with pytest.raises(SweepError, match="xi values"):
+        Axis.parse("xi=0.1,abc")
