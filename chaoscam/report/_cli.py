@@ -53,8 +53,11 @@ def register(sub) -> None:
         default=None,
         help="worker processes for the sweeps (default: every core)",
     )
-    p.add_argument("--force", action="store_true",
-                   help="replace an existing report (and its paper-data folder's files)")
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="replace an existing report (and its paper-data folder's files)",
+    )
     p.set_defaults(func=run_paper)
 
 
@@ -108,6 +111,13 @@ def run_paper(args: argparse.Namespace) -> int:
         + (["--workers", str(args.workers)] if args.workers else [])
         + ["--out", str(args.out)]
     )
-    _run(quick=args.quick, out=args.out, figures=figures, workers=args.workers, command=command)
+    _run(
+        quick=args.quick,
+        out=args.out,
+        figures=figures,
+        workers=args.workers,
+        command=command,
+        echo=True,
+    )
     print(f"report: {args.out}")
     return 0

@@ -289,8 +289,17 @@ def _sweep_settings(cfg: dict[str, Any]) -> dict[str, Any]:
             )
     base = cfg.get("base", {})
     units = {"dt": "s", "l_lambda": "m", "l_lambda_sigma": "m", "G": "m", "D": "-"}
-    for k in ("integrator", "stiffness", "dt", "rtol", "l_lambda", "l_lambda_sigma", "D", "G",
-              "resample"):
+    for k in (
+        "integrator",
+        "stiffness",
+        "dt",
+        "rtol",
+        "l_lambda",
+        "l_lambda_sigma",
+        "D",
+        "G",
+        "resample",
+    ):
         if k in base:
             rows[f"base {k}" + (f" [{units[k]}]" if k in units else "")] = base[k]
     return rows

@@ -404,8 +404,20 @@ FIGURES = {3: fig3, 4: fig4, 5: fig5, 6: fig6, 7: fig7_10, 8: fig7_10, 9: fig7_1
 """Figure number -> script function (Figs. 7-10 share one)."""
 
 
-def run_paper(*, quick: bool, out: str | Path, figures=None, workers=None, command=None) -> Path:
-    """Run the figure scripts and write the report (data and PNGs in ``OUT_DIR/paper-data``)."""
+def run_paper(
+    *, quick: bool, out: str | Path, figures=None, workers=None, command=None, echo=False
+) -> Path:
+    """Run the figure scripts and write the report (data and PNGs in ``OUT_DIR/paper-data``).
+
+    With ``echo`` (the command line), each stage's start and duration go to stderr and the
+    findings, figure by figure, to stdout.
+    """
+    import sys
+
+    def say(text: str) -> None:
+        if echo:
+            print(text, file=sys.stderr, flush=True)
+
     from ._html import ReportParts, add_bifurcation, add_regime_map, add_trajectory, write_report
 
     out = Path(out)
@@ -419,8 +431,9 @@ def run_paper(*, quick: bool, out: str | Path, figures=None, workers=None, comma
     parts = ReportParts()
     t_all = time.perf_counter()
     results = []
-    for fn in funcs:
+    for stage, fn in enumerate(funcs, 1):
         t0 = time.perf_counter()
+        say(f"[{stage}/{len(funcs)}] {fn.__name__} ...")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             try:
@@ -429,6 +442,7 @@ def run_paper(*, quick: bool, out: str | Path, figures=None, workers=None, comma
                 parts.missing.append(f"{fn.__name__}: failed with {type(err).__name__}: {err}")
                 continue
         r.seconds = time.perf_counter() - t0
+        say(f"[{stage}/{len(funcs)}] {fn.__name__}: {r.seconds:.0f} s")
         results.append(r)
     total = time.perf_counter() - t_all
     parts.summary.append(
@@ -459,6 +473,8 @@ def run_paper(*, quick: bool, out: str | Path, figures=None, workers=None, comma
     head = [f"Against the paper, figure by figure: {counted} (see the last table)."]
     head += [f"{c.figure}: {c.verdict} — {c.found}" for c in parts.comparison]
     parts.summary[1:1] = head
+    if echo:
+        print("\n".join([parts.summary[0], *head]), flush=True)
     if quick:
         parts.missing.append(
             "This is a quick run: coarse grids, few realizations, shorter fractal runs; "
