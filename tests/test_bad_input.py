@@ -140,7 +140,7 @@ def test_numpy_scalars_are_accepted():
     """numpy scalars where numbers are expected: accepted and stored as Python numbers."""
     p = Params(omega=np.float32(30), max_events_per_step=np.int64(4))
     assert p.omega == 30.0 and type(p.omega) is float and type(p.max_events_per_step) is int
-    res = regime_map(("l_lambda", [0.008]), ("l_lambda_sigma", [0.0]), duration=0.2,
+    res = regime_map(("l_lambda", [0.008]), ("l_lambda_sigma", [0.001]), duration=0.2,
                      realizations=np.int64(2), seed=np.int64(1), workers=1,
                      classify=_Label())
     assert len(res.realizations) == 2

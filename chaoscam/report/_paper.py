@@ -343,6 +343,8 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
     def cell(mu, sigma):
         r = c.loc[(mu, sigma)]
+        if bool(r.get("deterministic", False)):
+            return r, f"σ = {sigma:g}: {r['dominant']} (deterministic: one run)"
         return r, (
             f"σ = {sigma:g}: dominant {r['dominant']}, P(chaotic) {r['p_chaotic']:.2f} "
             f"[{r['p_chaotic_lo']:.2f}, {r['p_chaotic_hi']:.2f}], "

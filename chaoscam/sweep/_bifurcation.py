@@ -277,9 +277,15 @@ def bifurcation(
             raise SweepError("initial conditions: the list is empty")
     classify, identity = resolve_classifier(classify, lyapunov, check_step)
     check_sweep_budget(
-        base, runs=len(axis) * len(specs), duration=duration, transient=transient,
-        series=needs_series(classify), workers=workers, keeps_sections=True,
-        what="this bifurcation diagram", factor=1 + 2 * lyapunov + check_step,
+        base,
+        runs=len(axis) * len(specs),
+        duration=duration,
+        transient=transient,
+        series=needs_series(classify),
+        workers=workers,
+        keeps_sections=True,
+        what="this bifurcation diagram",
+        factor=1 + 2 * lyapunov + check_step,
         reduce="the values, the initial conditions or the duration",
     )
     config = {

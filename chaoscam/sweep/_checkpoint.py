@@ -77,8 +77,9 @@ def decode_part(data: bytes) -> list[dict[str, Any]]:
     """
     body, sep, trailer = data.rpartition(_TRAILER)
     if sep:
-        fields = dict(f.split("=", 1) for f in trailer.decode("ascii", "replace").split()
-                      if "=" in f)
+        fields = dict(
+            f.split("=", 1) for f in trailer.decode("ascii", "replace").split() if "=" in f
+        )
         if hashlib.sha256(body).hexdigest() != fields.get("sha256"):
             raise DamagedPart("its checksum does not match its records")
     else:
@@ -227,8 +228,12 @@ class CheckpointStore:
                         "over"
                     ) from None
                 os.replace(part, part.with_name(f".tmp-{os.getpid()}-damaged-{part.name}"))
-                print(f"chaoscam: notice: {part.name} in {self.path} was torn ({err}); "
-                      "dropped, its runs are computed again", file=sys.stderr, flush=True)
+                print(
+                    f"chaoscam: notice: {part.name} in {self.path} was torn ({err}); "
+                    "dropped, its runs are computed again",
+                    file=sys.stderr,
+                    flush=True,
+                )
                 return
             yield from records
 

@@ -115,8 +115,17 @@ RECORD_BYTES = 4096
 
 
 def check_sweep_budget(
-    base, *, runs: int, duration: float, transient: float, series: bool, workers,
-    keeps_sections: bool, what: str, reduce: str, factor: float = 1.0,
+    base,
+    *,
+    runs: int,
+    duration: float,
+    transient: float,
+    series: bool,
+    workers,
+    keeps_sections: bool,
+    what: str,
+    reduce: str,
+    factor: float = 1.0,
 ) -> None:
     """Refuse a sweep that cannot fit in memory, warn about one that takes hours.
 

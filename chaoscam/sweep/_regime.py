@@ -113,11 +113,14 @@ class _RegimePlan:
         cap: int,
         target: float | None,
         confidence: float,
+        once: frozenset[int] = frozenset(),
     ) -> None:
         self.make_task = make_task
-        self.n0, self.batch, self.cap, self.target = n0, batch, cap, target
+        self.n0, self.batch, self.target = n0, batch, target
+        # cells in `once` are deterministic (sigma = 0): every realization would be the same
+        self.caps = [1 if c in once else cap for c in range(ncells)]
         self.confidence = confidence
-        self.n_target = [n0] * ncells
+        self.n_target = [1 if c in once else n0 for c in range(ncells)]
         self.finished: list[set[int]] = [set() for _ in range(ncells)]
         self.counts: list[Counter] = [Counter() for _ in range(ncells)]
         self.done = 0
@@ -136,7 +139,7 @@ class _RegimePlan:
         return True
 
     def _wants_more(self, c: int) -> bool:
-        if self.target is None or self.n_target[c] >= self.cap:
+        if self.target is None or self.n_target[c] >= self.caps[c]:
             return False
         return max_halfwidth(self.counts[c], self.n_target[c], self.confidence) > self.target
 
@@ -145,12 +148,12 @@ class _RegimePlan:
 
     def _settle(self, c: int) -> None:
         """Replay the adaptive decisions of a resumed cell from its finished indices."""
-        while self.n_target[c] < self.cap:
+        while self.n_target[c] < self.caps[c]:
             n = len(self.finished[c])
             if n < self.n_target[c] or (n == self.n_target[c] and not self._wants_more(c)):
                 return
             # n > n_target: the earlier run already decided to extend.
-            self.n_target[c] = min(self.n_target[c] + self.batch, self.cap)
+            self.n_target[c] = min(self.n_target[c] + self.batch, self.caps[c])
 
     def start(self) -> Iterator[RealizationTask]:
         if self.target is not None:
@@ -170,7 +173,7 @@ class _RegimePlan:
         c = record["cell"]
         if len(self.finished[c]) == self.n_target[c] and self._wants_more(c):
             old = self.n_target[c]
-            self.n_target[c] = min(old + self.batch, self.cap)
+            self.n_target[c] = min(old + self.batch, self.caps[c])
             return [self.make_task(c, i) for i in range(old, self.n_target[c])]
         return []
 
@@ -315,8 +318,10 @@ def regime_map(
     if target_halfwidth is not None:
         if not 0.0 < target_halfwidth < 0.5:
             raise SweepError(f"target half-width = {target_halfwidth!r} must be in (0, 0.5)")
-        cap = DEFAULT_CAP if max_realizations is None else whole(
-            "max realizations", max_realizations, low=1
+        cap = (
+            DEFAULT_CAP
+            if max_realizations is None
+            else whole("max realizations", max_realizations, low=1)
         )
         if cap < realizations:
             raise SweepError(f"max realizations = {cap} is below realizations = {realizations}")
@@ -330,9 +335,15 @@ def regime_map(
     validate_grid(base, [x, y])
     classify, identity = resolve_classifier(classify, lyapunov, check_step)
     check_sweep_budget(
-        base, runs=len(x) * len(y) * (adaptive["max_realizations"] if adaptive else realizations),
-        duration=duration, transient=transient, series=needs_series(classify), workers=workers,
-        keeps_sections=False, what="this regime map", factor=1 + 2 * lyapunov + check_step,
+        base,
+        runs=len(x) * len(y) * (adaptive["max_realizations"] if adaptive else realizations),
+        duration=duration,
+        transient=transient,
+        series=needs_series(classify),
+        workers=workers,
+        keeps_sections=False,
+        what="this regime map",
+        factor=1 + 2 * lyapunov + check_step,
         reduce="the grid, the realizations or the duration",
     )
     config = {
@@ -349,6 +360,7 @@ def regime_map(
         "adaptive": adaptive,
         "confidence": float(confidence),
         "index_scheme": "cantor(cell, index)",
+        "deterministic_cells": "run once (sigma = 0)",
     }
     out = None if out is None else Path(out)
     with lock_outputs(out):
@@ -358,6 +370,14 @@ def regime_map(
         series = needs_series(classify)
         cells = _cells_frame(x, y)
         xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
+        # A cell with sigma = 0 is deterministic: its realizations would all be the same run,
+        # so it is computed once and reported as such (no interval over identical runs).
+        once = frozenset(
+            c
+            for c in range(len(cells))
+            if base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])}).l_lambda_sigma == 0.0
+        )
+        cells["deterministic"] = [c in once for c in range(len(cells))]
 
         def make_task(c: int, i: int) -> RealizationTask:
             p = base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])})
@@ -373,6 +393,7 @@ def regime_map(
             cap=adaptive["max_realizations"] if adaptive else realizations,
             target=adaptive["target_halfwidth"] if adaptive else None,
             confidence=confidence,
+            once=once,
         )
         backend = backend_for(workers, scheduler)
         try:

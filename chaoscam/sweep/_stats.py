@@ -107,7 +107,9 @@ def summarize_cells(
         One row per realization with columns ``cell``, ``label``, ``truncated_mass`` and,
         when the classifier gave it, ``ev_lyapunov_model``.
     cells : DataFrame
-        One row per cell: ``cell``, ``ix``, ``iy`` and the two axis values.
+        One row per cell: ``cell``, ``ix``, ``iy`` and the two axis values; with a boolean
+        column ``deterministic``, such cells (one run standing for identical realizations)
+        get the point value as their interval.
     confidence : float
         Level of the Wilson intervals.
 
@@ -143,6 +145,10 @@ def summarize_cells(
         with np.errstate(invalid="ignore", divide="ignore"):
             out[f"n_{lab}"] = k.astype(np.int64)
             out[f"p_{lab}"] = np.where(n > 0, k / np.maximum(n, 1), np.nan)
+        if "deterministic" in out:  # one run stands for the cell: no sampling interval
+            det = out["deterministic"].to_numpy(dtype=bool)
+            p_hat = np.where(n > 0, k / np.maximum(n, 1), np.nan)
+            lo, hi = np.where(det, p_hat, lo), np.where(det, p_hat, hi)
         out[f"p_{lab}_lo"] = lo
         out[f"p_{lab}_hi"] = hi
         half = np.maximum(half, (hi - lo) / 2.0)

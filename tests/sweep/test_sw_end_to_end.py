@@ -8,7 +8,8 @@ classify = pytest.importorskip("chaoscam.classify")
 
 
 def test_regime_map_with_the_package_classifier():
-    """Every realization gets one of the classifier's labels or a status label."""
+    """Every realization gets one of the classifier's labels or a status label; the
+    deterministic cell (sigma = 0) runs once, the random one twice."""
     m = regime_map(
         Axis("l_lambda", (0.008,)),
         Axis("l_lambda_sigma", (0.0, 0.002)),
@@ -18,7 +19,8 @@ def test_regime_map_with_the_package_classifier():
     )
     allowed = {"periodic", "quasiperiodic", "chaotic", "undetermined", "left_reach", "diverged"}
     assert set(m.realizations["label"]) <= allowed
-    assert (m.cells["n"] == 2).all()
+    assert m.cells["n"].tolist() == [1, 2]
+    assert m.cells["deterministic"].tolist() == [True, False]
 
 
 def test_bifurcation_with_the_package_classifier():

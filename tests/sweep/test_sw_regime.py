@@ -29,13 +29,15 @@ def reference():
 
 
 def test_rows_and_cells_shape(reference):
-    """One row per (cell, realization), sorted; one summary row per cell with n = N."""
+    """One row per (cell, realization), sorted; one summary row per cell with n = N, except
+    the deterministic cells (sigma = 0: cells 0 and 2), computed once."""
     r, c = reference.realizations, reference.cells
-    assert len(r) == 4 * 3 and len(c) == 4
+    assert len(r) == 2 * 3 + 2 * 1 and len(c) == 4
     assert list(zip(r["cell"], r["index"], strict=True)) == [
-        (c_, i) for c_ in range(4) for i in range(3)
+        (c_, i) for c_ in range(4) for i in range(1 if c_ % 2 == 0 else 3)
     ]
-    assert (c["n"] == 3).all()
+    assert list(c["n"]) == [1, 3, 1, 3]
+    assert list(c["deterministic"]) == [True, False, True, False]
     assert list(r.columns[:4]) == ["cell", "index", "l_lambda", "l_lambda_sigma"]
 
 
@@ -80,7 +82,8 @@ def test_non_regular_runs_are_their_own_label():
 
 def test_adaptive_sampling_adds_batches_until_target_or_cap():
     """Cells grow by N at a time; they stop once the widest half-width <= target, or at
-    the cap: unanimous cells at 4 (2/2 leaves 0.33 > 0.3, 4/4 leaves 0.25), mixed at 6."""
+    the cap: mixed cells at 6; the deterministic cells (sigma = 0) are one run with a point
+    interval (half-width 0), never sampled further."""
     m = regime_map(
         MU,
         SIGMA,
@@ -89,7 +92,8 @@ def test_adaptive_sampling_adds_batches_until_target_or_cap():
         max_realizations=6,
     )
     c = m.cells
-    assert list(c["n"]) == [4, 6, 4, 6]
+    assert list(c["n"]) == [1, 6, 1, 6]
+    assert list(c.loc[c["deterministic"], "halfwidth"]) == [0.0, 0.0]
     assert ((c["halfwidth"] <= 0.3) | (c["n"] == 6)).all()
     assert len(m.realizations) == c["n"].sum()
     r = m.realizations
@@ -100,11 +104,11 @@ def test_interrupt_then_resume_gives_the_uninterrupted_table(tmp_path, reference
     """Ctrl-C mid-run saves the finished rows; resume finishes to the identical table and
     recomputes nothing that was saved; the finished output is then reused as is."""
     out = tmp_path / "m.parquet"
-    cls = InterruptOnce(str(tmp_path / "marker"), victim=realization_index(2, 1))
+    cls = InterruptOnce(str(tmp_path / "marker"), victim=realization_index(3, 1))
     with pytest.raises(SweepInterrupted, match="--resume") as err:
         regime_map(MU, SIGMA, **{**KW, "classify": cls}, out=out, flush_interval=0)
     ckpt = checkpoint_dir(out)
-    assert 0 < err.value.done < 12 and ckpt.is_dir() and not out.exists()
+    assert 0 < err.value.done < 8 and ckpt.is_dir() and not out.exists()
     saved = len(list(ckpt.glob("part-*.jsonl")))
     assert saved == err.value.done  # one part per record with flush_interval = 0
     res = regime_map(MU, SIGMA, **{**KW, "classify": cls}, out=out, resume=True, flush_interval=0)
