@@ -166,7 +166,8 @@ def test_locked_output_refused_with_exit_2(tmp_path, command, capsys):
 
 def test_two_writers_started_together(tmp_path):
     """Two regime maps on one output started together: one is refused (exit 2, a message),
-    the other ends normally with every row (3 x 2 cells x 4 realizations)."""
+    the other ends normally with every row (3 cells x 4 realizations with sigma > 0, and the
+    3 deterministic sigma = 0 cells once each)."""
     out = tmp_path / "m.parquet"
     args = _map(out, "--realizations", "4", "--checkpoint-interval", "0")
     args[args.index("tests.sweep._helpers:SpreadClassifier")] = SLOW
@@ -182,4 +183,4 @@ def test_two_writers_started_together(tmp_path):
     refused = results[[p.returncode for p in procs].index(2)][1]
     assert "in use by another chaoscam process" in refused or "exists" in refused, refused
     assert "Traceback" not in refused
-    assert len(pd.read_parquet(out)) == 24
+    assert len(pd.read_parquet(out)) == 3 * 4 + 3
