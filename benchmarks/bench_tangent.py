@@ -15,18 +15,11 @@ import time
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
+from bench_simulate import best_of  # noqa: E402 (benchmarks/ is on the path of a script)
+
 import chaoscam  # noqa: E402
 from chaoscam import Params  # noqa: E402
 from chaoscam.tangent import lyapunov_spectrum, periodic_orbit  # noqa: E402
-
-
-def best_of(fn, repeat: int) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main() -> None:

@@ -23,6 +23,7 @@ from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
 from .integrate._constants import initial_counters, initial_state
 from .integrate._ensemble import contact_fraction, run_one
+from .integrate._tangent import section_jacobians
 from .model import (
     LineLengthStream,
     ParameterError,
@@ -288,7 +289,7 @@ def simulate(
     sec["k"] = sec["k"].astype(np.int64)
     jac = None
     if tangent:
-        jac = sec_all[:, n_sec : n_sec + 4].reshape(-1, 2, 2).transpose(0, 2, 1).copy()
+        jac = section_jacobians(sec_all)
     div = sec_all[:, n_sec + 4].copy() if tangent else None
     imp = pd.DataFrame(stack("impacts", k.IMPACT_COLS), columns=list(IMPACT_COLUMNS))
     imp["kind"] = pd.Categorical.from_codes(

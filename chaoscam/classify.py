@@ -122,17 +122,26 @@ def classify_section_run(points, jacobians, params: Params, **options: Any) -> V
     rules (n-band chaos, the periodic-orbit certificate for the deterministic model).
     ``settings["tangent"]`` (and ``settings["periodic_orbit"]``) record the numbers.
     """
-    period = params.cam_period
-    points = np.asarray(points, dtype=float)
-    spec = spectrum_from_jacobians(np.asarray(jacobians, dtype=float), period)
+    v, extra = _section_verdict(
+        np.asarray(points, dtype=float),
+        np.asarray(jacobians, dtype=float),
+        params.replace(integrator="rk4"),
+        options,
+    )
+    return _with_settings(v, **extra)
+
+
+def _section_verdict(points, jacobians, p: Params, options: dict) -> tuple[Verdict, dict]:
+    """Section with the tangent exponent, then the model-level rules; (verdict, settings)."""
+    period = p.cam_period
+    spec = spectrum_from_jacobians(jacobians, period)
     v = classify_section(
         points,
         exponent=_exponent_of(spec),
         exponent_time=period,
         **_model_options(options, period),
     )
-    v, extra = _with_model_evidence(v, params.replace(integrator="rk4"), points, spec)
-    return _with_settings(v, **extra)
+    return _with_model_evidence(v, p, points, spec)
 
 
 def _exponent_of(spec) -> tuple[float, float, int]:
@@ -160,24 +169,24 @@ def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[V
     sec = tr.section
     keep = ((sec["t"] >= t0 - 1e-9 * period) & (sec["k"] > 0)).to_numpy()
     points = sec.loc[keep, _SECTION_COORDS].to_numpy(dtype=float)
+    if traj.series is None:
+        return _section_verdict(points, tr.jacobians[keep], p, options)
+    # the run's own series and section, with the exponent of the same realization
     spec = spectrum_from_jacobians(tr.jacobians[keep], period)
     opts = _model_options(options, period)
-    if traj.series is None:
-        v = classify_section(points, exponent=_exponent_of(spec), exponent_time=period, **opts)
-    else:  # the run's own series and section, with the exponent of the same realization
-        ser = traj.series
-        x = ser.loc[ser["t"] >= t0 - 1e-9 * period, "theta_f"].to_numpy(dtype=float)
-        own = traj.section
-        own_points = own.loc[own["t"] >= t0 - 1e-9 * period, _SECTION_COORDS].to_numpy(float)
-        v = classify_signal(
-            x,
-            float(s["output_dt"]),
-            period,
-            section=own_points,
-            exponent=_exponent_of(spec),
-            exponent_time=period,
-            **opts,
-        )
+    ser = traj.series
+    x = ser.loc[ser["t"] >= t0 - 1e-9 * period, "theta_f"].to_numpy(dtype=float)
+    own = traj.section
+    own_points = own.loc[own["t"] >= t0 - 1e-9 * period, _SECTION_COORDS].to_numpy(float)
+    v = classify_signal(
+        x,
+        float(s["output_dt"]),
+        period,
+        section=own_points,
+        exponent=_exponent_of(spec),
+        exponent_time=period,
+        **opts,
+    )
     return _with_model_evidence(v, p, points, spec)
 
 

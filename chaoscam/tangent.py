@@ -28,6 +28,7 @@ from .analysis import TangentSpectrum, spectrum_from_jacobians
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
 from .integrate._constants import initial_counters, initial_state
+from .integrate._tangent import section_jacobians
 from .model import ParameterError, Params
 
 __all__ = [
@@ -130,8 +131,8 @@ class _MapRunner:
         if code != k.OK or len(rows) < self.n + 1:
             return np.full(2, np.nan), np.full((2, 2), np.nan), int(code)
         m = np.eye(2)
-        for r in rows[1 : self.n + 1]:
-            m = np.array([[r[5], r[7]], [r[6], r[8]]]) @ m
+        for jac in section_jacobians(rows[1 : self.n + 1]):
+            m = jac @ m
         return rows[self.n, 2:4].copy(), m, int(code)
 
 

@@ -29,6 +29,7 @@ from . import _kernel as k
 from ._advance import advance
 from ._constants import initial_counters, initial_state, kernel_constants
 from ._status import Status
+from ._tangent import section_jacobians
 
 __all__ = [
     "BACKENDS",
@@ -217,7 +218,7 @@ def simulate_ensemble(
         rows, columns=["member", "index", "status", "n_impacts", "contact_fraction"]
     )
     if classify:
-        jac = every[:, len(cols) : len(cols) + 4].reshape(-1, 2, 2).transpose(0, 2, 1)
+        jac = section_jacobians(every[:, 1:])  # without the member column
         members = _classify_members(members, sec, jac, plist, transient)
     impacts = None
     if keep_impacts:
@@ -277,11 +278,12 @@ def _classify_members(members, sec, jac, plist, transient) -> pd.DataFrame:
     from ..classify import classify_section_run
 
     labels, periods = [], []
-    rows = sec["member"].to_numpy()
+    rows_of = sec.groupby("member").indices  # member -> positions of its section rows
+    empty = np.empty(0, dtype=np.int64)
     for m, status in zip(members["member"], members["status"], strict=True):
-        pick = rows == m
-        points = sec.loc[pick]
-        if status != "OK" or not pick.any():
+        pick = rows_of.get(m, empty)
+        points = sec.iloc[pick]
+        if status != "OK" or not len(pick):
             labels.append(Status[status].label or "undetermined")
             periods.append(None)
             continue

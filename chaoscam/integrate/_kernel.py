@@ -71,6 +71,8 @@ from ._layout import (
     NON_FINITE,
     OK,
     PENETRATION,
+    SECTION_NAMES,
+    SECTION_TANGENT_NAMES,
     Y_DIV,
     Y_J11,
     Y_J12,
@@ -198,8 +200,9 @@ def at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)
             section[i, 2] = th
             section[i, 3] = om
             section[i, 4] = lam[cnt[I_LAM_POS]]
-            for j in range(5):
-                section[i, 5 + j] = y[Y_J11 + j] if c[C_TANGENT] > 0.0 else np.nan
+            start = len(SECTION_NAMES)
+            for j in range(len(SECTION_TANGENT_NAMES)):  # Y_J11 .. Y_DIV, in this order
+                section[i, start + j] = y[Y_J11 + j] if c[C_TANGENT] > 0.0 else np.nan
             cnt[I_N_SECTION] += 1
         reset_tangent(y)
         cnt[I_SECTION_K] += 1

@@ -18,9 +18,10 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
-from ._layout import C_E, C_GRAV, C_INV_J, C_OMEGA, C_THETA_C0, C_XO, C_YO
+from ._layout import C_E, C_GRAV, C_INV_J, C_OMEGA, C_THETA_C0, C_XO, C_YO, SECTION_NAMES
 from ._physics import acceleration_jacobian
 
 
@@ -102,16 +103,9 @@ def rk4_flight_tangent(th, om, h, c, v11, v21, v12, v22):
     p2 = -k * math.sin(th2)
     p3 = -k * math.sin(th3)
     p4 = -k * math.sin(th4)
-    x2, y2 = v11 + 0.5 * h * v21, v21 + 0.5 * h * p1 * v11
-    x3, y3 = v11 + 0.5 * h * y2, v21 + 0.5 * h * p2 * x2
-    x4, y4 = v11 + h * y3, v21 + h * p3 * x3
-    n11 = v11 + h / 6.0 * (v21 + 2.0 * y2 + 2.0 * y3 + y4)
-    n21 = v21 + h / 6.0 * (p1 * v11 + 2.0 * p2 * x2 + 2.0 * p3 * x3 + p4 * x4)
-    x2, y2 = v12 + 0.5 * h * v22, v22 + 0.5 * h * p1 * v12
-    x3, y3 = v12 + 0.5 * h * y2, v22 + 0.5 * h * p2 * x2
-    x4, y4 = v12 + h * y3, v22 + h * p3 * x3
-    n12 = v12 + h / 6.0 * (v22 + 2.0 * y2 + 2.0 * y3 + y4)
-    n22 = v22 + h / 6.0 * (p1 * v12 + 2.0 * p2 * x2 + 2.0 * p3 * x3 + p4 * x4)
+    # the columns of V through the same stages; no damping in flight (q = 0)
+    n11, n21 = _column(v11, v21, h, p1, 0.0, p2, 0.0, p3, 0.0, p4, 0.0)
+    n12, n22 = _column(v12, v22, h, p1, 0.0, p2, 0.0, p3, 0.0, p4, 0.0)
     return (
         th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
         om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
@@ -177,3 +171,13 @@ def rk4_tangent_along(t, h, th0, om0, thm, omm, th1, om1, K, c, v11, v21, v12, v
     n11, n21 = _column(v11, v21, h, p1, q1, p2, q2, p2, q2, p4, q4)
     n12, n22 = _column(v12, v22, h, p1, q1, p2, q2, p2, q2, p4, q4)
     return n11, n21, n12, n22, h / 6.0 * (q1 + 4.0 * q2 + q4)
+
+
+def section_jacobians(rows: np.ndarray) -> np.ndarray:
+    """The (n, 2, 2) Jacobians stored beside section points in kernel section rows.
+
+    Columns ``j11, j21, j12, j22`` (``_layout.SECTION_TANGENT_NAMES``) follow the section's
+    own columns: column-major, so ``J = [[j11, j12], [j21, j22]]``.
+    """
+    start = len(SECTION_NAMES)
+    return rows[:, start : start + 4].reshape(-1, 2, 2).transpose(0, 2, 1).copy()
