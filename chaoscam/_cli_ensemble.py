@@ -89,6 +89,7 @@ def _outputs(out: Path) -> tuple[Path, Path, Path]:
 
 def _run_locked(args: argparse.Namespace) -> int:
     from ._checks import whole
+    from ._ensemble_verdicts import classify_ensemble
     from .cli import UsageError, parse_assignments
     from .integrate import simulate_ensemble
     from .integrate._gpu import GPUFallbackWarning
@@ -172,8 +173,10 @@ def _run_locked(args: argparse.Namespace) -> int:
                 ens = simulate_ensemble(
                     params, range(start, stop), seed=args.seed, duration=duration,
                     transient=transient, backend=args.backend, keep_impacts=args.keep_impacts,
-                    classify=args.classify,
+                    tangent=args.classify,
                 )
+                if args.classify:
+                    ens = classify_ensemble(ens, params)
             for w in caught:
                 if issubclass(w.category, GPUFallbackWarning) and not noticed:
                     print(f"chaoscam: {w.message}", file=sys.stderr, flush=True)

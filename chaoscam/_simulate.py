@@ -151,6 +151,19 @@ def contact_period(p: Params, l_lambda: float | None = None) -> float:
     return 2.0 * math.pi * math.sqrt(p.inertia / (p.stiffness_at(lam) * l1 * l1))
 
 
+def resolution_warning(p: Params) -> str | None:
+    """The warning for a fixed step too coarse for the contact oscillation (fewer than 20
+    steps per contact period), or None. The adaptive path's steps follow the contact."""
+    steps = contact_period(p) / p.dt
+    if steps >= 20 or p.integrator != "rk4":
+        return None
+    return (
+        f"dt = {p.dt:g} s resolves the contact oscillation (period "
+        f"{contact_period(p):.3g} s) with only {steps:.1f} steps; use "
+        f"dt <= {contact_period(p) / 40:.2g} s for a converged run"
+    )
+
+
 def _check_run(
     p: Params, duration: float, transient: float, output_dt: float | None, seed, index
 ) -> tuple[int, int]:
@@ -233,14 +246,9 @@ def simulate(
     n_stop = int(round(duration / p.dt))
     stride = max(1, int(round(output_dt / p.dt))) if series else 0
     steps_per_contact = contact_period(p) / p.dt
-    if steps_per_contact < 20 and p.integrator == "rk4":  # adaptive steps follow the contact
-        warnings.warn(
-            f"dt = {p.dt:g} s resolves the contact oscillation (period "
-            f"{contact_period(p):.3g} s) with only {steps_per_contact:.1f} steps; use "
-            f"dt <= {contact_period(p) / 40:.2g} s for a converged run",
-            RuntimeWarning,
-            stacklevel=2,
-        )
+    coarse = resolution_warning(p)
+    if coarse:
+        warnings.warn(coarse, RuntimeWarning, stacklevel=2)
 
     # Buffers hold at least a few steps' worth of the most a step can produce.
     per_step = p.max_events_per_step + p.flight_merge + 2

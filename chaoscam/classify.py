@@ -210,6 +210,22 @@ def _with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, 
             "within its interval: run longer"
         )
         v = Verdict("undetermined", None, v.evidence, v.reasons + (reason,), v.settings)
+    if (
+        v.label == "periodic"
+        and p.l_lambda_sigma != 0.0
+        and votes.get("exponent") not in ("not_chaotic", "periodic")
+    ):
+        # A random line length has no periodic orbit to shoot for: its periodic response is
+        # a random attractor near one, which contracts (lambda_1 < 0). Without a
+        # certificate, n narrow bands are periodic only when the exponent confirms it;
+        # measured: 8 bands of 1e-3 rad at sigma = 1.5 mm with lambda_1 = 0.53 +- 0.22 per
+        # iterate after 46 periods, chaotic on a longer run.
+        reason = (
+            f"the section repeats with period {v.period} to the band tolerance, but the line "
+            "length is random (no periodic orbit to certify) and the tangent exponent does "
+            "not confirm lambda_1 < 0 within its interval: run longer"
+        )
+        v = Verdict("undetermined", None, v.evidence, v.reasons + (reason,), v.settings)
     banded = _banded_period(v)
     if v.label == "undetermined" and banded is not None:
         return _banded_verdict(v, p, points, banded, extra)
@@ -242,6 +258,18 @@ def _with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, 
     e = Evidence("periodic_orbit", orbit.period, None, f"not certified ({why}): " + detail)
     if orbit.converged and not orbit.stable:
         reason = f"the section looks periodic but the orbit found is unstable ({detail})"
+        return Verdict(
+            "undetermined", None, v.evidence + (e,), v.reasons + (reason,), v.settings
+        ), extra
+    if v.label == "periodic" and votes.get("exponent") != "not_chaotic":
+        # Neither certified nor contracting: measured at xi = 0.45, 6 bands of 1e-4 rad
+        # after 46 periods whose orbit does not converge (|mu| ~ 20) and whose lambda_1 is
+        # positive once the run is 4x longer.
+        reason = (
+            f"the section repeats with period {v.period} but no attracting orbit is "
+            f"certified ({why}) and the tangent exponent does not confirm lambda_1 < 0: "
+            "run longer"
+        )
         return Verdict(
             "undetermined", None, v.evidence + (e,), v.reasons + (reason,), v.settings
         ), extra

@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chaoscam import Params
+from chaoscam import Params, classify_ensemble
 from chaoscam.cli import main
 from chaoscam.integrate import simulate_ensemble
 
@@ -19,12 +19,17 @@ def test_writes_members_sections_impacts_equal_to_the_api(tmp_path):
     sections = pd.read_parquet(tmp_path / "ens.sections.parquet")
     impacts = pd.read_parquet(tmp_path / "ens.impacts.parquet")
     assert not (tmp_path / "ens.parts").exists()
-    api = simulate_ensemble(Params(l_lambda_sigma=0.002), range(5), seed=4, duration=1.0,
-                            transient=0.5, keep_impacts=True, classify=True)
+    p = Params(l_lambda_sigma=0.002)
+    api = classify_ensemble(
+        simulate_ensemble(p, range(5), seed=4, duration=1.0, transient=0.5, keep_impacts=True,
+                          tangent=True),
+        p,
+    )
     assert list(members["index"]) == list(range(5)) and list(members["member"]) == list(range(5))
     assert np.array_equal(sections.to_numpy(), api.sections.to_numpy())
     assert np.array_equal(impacts.to_numpy(), api.impacts.to_numpy())
     assert list(members.label) == list(api.members.label)
+    assert list(members.reasons) == list(api.members.reasons)
 
 
 def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, capsys):

@@ -104,20 +104,25 @@ class Ensemble:
     sections : pandas.DataFrame
         member, k, t, theta_f, omega_f, l_lambda: the stroboscopic points after the transient.
     members : pandas.DataFrame
-        member, index, status (name), n_impacts, contact_fraction; with ``classify=True``
-        also label and period, the verdict of each member's section.
+        member, index, status (name), n_impacts, contact_fraction;
+        :func:`chaoscam.classify.classify_ensemble` adds each member's verdict (label,
+        period, reasons).
     settings : dict
         duration, transient, seed, threads, backend ("cpu" or "gpu", the one used), device,
         batch, integrators, wall time.
     impacts : pandas.DataFrame or None
         With ``keep_impacts=True``: member plus the columns of ``Trajectory.impacts`` (the
         applied jumps after the transient); else None (only counted).
+    jacobians : ndarray or None
+        With ``tangent=True``: the Jacobian of the stroboscopic map over the period ending at
+        each row of ``sections``, shape (len(sections), 2, 2), as ``Trajectory.jacobians``.
     """
 
     sections: pd.DataFrame
     members: pd.DataFrame
     settings: dict[str, Any] = field(default_factory=dict)
     impacts: pd.DataFrame | None = None
+    jacobians: np.ndarray | None = None
 
 
 def simulate_ensemble(
@@ -130,7 +135,7 @@ def simulate_ensemble(
     batch: int | None = None,
     backend: str = "cpu",
     keep_impacts: bool = False,
-    classify: bool = False,
+    tangent: bool = False,
 ) -> Ensemble:
     """Simulate realizations ``indices`` of one model (or one model per member) in parallel.
 
@@ -157,14 +162,11 @@ def simulate_ensemble(
     keep_impacts : bool
         Also return every member's impacts (``Ensemble.impacts``); by default they are only
         counted, so that memory stays flat for long runs.
-    classify : bool
-        Integrate the tangent dynamics too (fixed-step RK4 members) and label each member
-        from its section points and stroboscopic Jacobians after the transient
-        (:func:`chaoscam.classify.classify_section_run`: the tangent exponent, n-band chaos,
-        the periodic-orbit certificate for deterministic members; what
-        ``classify_trajectory`` does for a run kept without its series): columns ``label``
-        and ``period`` in ``members``. A member that did not end OK is labelled by its
-        status (``left_reach``, ``diverged``), as in the sweeps.
+    tangent : bool
+        Integrate the tangent dynamics too and keep each section row's stroboscopic Jacobian
+        (``Ensemble.jacobians``), from which :func:`chaoscam.classify.classify_ensemble`
+        labels the members (the tangent exponent, n-band chaos, the periodic-orbit
+        certificate). The members' motion is the same with and without it.
 
     Notes
     -----
@@ -205,7 +207,7 @@ def simulate_ensemble(
             transient,
             run=_gpu.run_on_gpu if use_gpu else _run_on_cpu,
             keep_impacts=keep_impacts,
-            tangent=classify,
+            tangent=tangent,
         )
         sections.extend(s)
         rows.extend(r)
@@ -217,9 +219,7 @@ def simulate_ensemble(
     members = pd.DataFrame(
         rows, columns=["member", "index", "status", "n_impacts", "contact_fraction"]
     )
-    if classify:
-        jac = section_jacobians(every[:, 1:])  # without the member column
-        members = _classify_members(members, sec, jac, plist, transient)
+    jac = section_jacobians(every[:, 1:]) if tangent else None  # without the member column
     impacts = None
     if keep_impacts:
         icols = ["member", *k.IMPACT_NAMES]
@@ -237,6 +237,7 @@ def simulate_ensemble(
         sections=sec,
         members=members,
         impacts=impacts,
+        jacobians=jac,
         settings={
             "duration": duration,
             "transient": transient,
@@ -246,6 +247,7 @@ def simulate_ensemble(
             "device": device,
             "batch": batch,
             "integrators": sorted({p.integrator for p in plist}),
+            "tangent": bool(tangent),
             "wall_time_s": time.perf_counter() - t0,
         },
     )
@@ -269,36 +271,6 @@ def _pick_backend(backend: str) -> tuple[bool, str]:
             stacklevel=3,
         )
     return False, "cpu"
-
-
-def _classify_members(members, sec, jac, plist, transient) -> pd.DataFrame:
-    """``members`` with each member's verdict (label, period) from its section and its
-    stroboscopic Jacobians: :func:`chaoscam.classify.classify_section_run`, the verdict
-    ``classify_trajectory`` gives a run kept without its series."""
-    from ..classify import classify_section_run
-
-    labels, periods = [], []
-    rows_of = sec.groupby("member").indices  # member -> positions of its section rows
-    empty = np.empty(0, dtype=np.int64)
-    for m, status in zip(members["member"], members["status"], strict=True):
-        pick = rows_of.get(m, empty)
-        points = sec.iloc[pick]
-        if status != "OK" or not len(pick):
-            labels.append(Status[status].label or "undetermined")
-            periods.append(None)
-            continue
-        p = plist[int(m)]
-        keep = ((points["t"] >= transient - 1e-9 * p.cam_period) & (points["k"] > 0)).to_numpy()
-        if keep.sum() < 2:
-            labels.append("undetermined")
-            periods.append(None)
-            continue
-        v = classify_section_run(
-            points.loc[keep, ["theta_f", "omega_f"]].to_numpy(dtype=float), jac[pick][keep], p
-        )
-        labels.append(v.label)
-        periods.append(v.period)
-    return members.assign(label=labels, period=pd.array(periods, dtype="Int64"))
 
 
 def _run_batch(

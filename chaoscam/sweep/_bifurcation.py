@@ -21,9 +21,9 @@ import pandas as pd
 from .._checks import whole
 from .._version import __version__
 from ..model import Params, contact_angle
+from ._batch import resolve_engine, run_plan
 from ._checkpoint import read_sweep_metadata, write_parquet
 from ._common import (
-    backend_for,
     check_sweep_budget,
     companion,
     evidence_columns,
@@ -35,7 +35,6 @@ from ._common import (
     run_settings,
     unique_sorted,
 )
-from ._engine import execute
 from ._grid import Axis, SweepError, realization_index, validate_grid
 from ._tasks import BranchTask, needs_series
 
@@ -218,6 +217,8 @@ def bifurcation(
     progress: bool = False,
     flush_interval: float = 1.0,
     force: bool = False,
+    engine: str = "auto",
+    device: str = "cpu",
 ) -> Bifurcation:
     """Bifurcation diagram of the stroboscopic section over one parameter (paper Figs. 4, 6).
 
@@ -248,6 +249,11 @@ def bifurcation(
         each chain, so only the conditions run in parallel.
     classify, lyapunov, check_step, workers, scheduler, out, resume, progress, flush_interval
         As for :func:`regime_map`; the verdicts go to ``FILE.verdicts.parquet``.
+    engine, device
+        As for :func:`regime_map`: by default the ensemble engine runs the conditions of a
+        value (and, without continuation, many values) as one batch of members; a batch
+        holds members of one omega and dt, so a sweep over ``omega`` or ``dt`` batches the
+        conditions of each value.
 
     Returns
     -------
@@ -276,12 +282,15 @@ def bifurcation(
         if not specs:
             raise SweepError("initial conditions: the list is empty")
     classify, identity = resolve_classifier(classify, lyapunov, check_step)
+    eng = resolve_engine(engine, device, classify, identity, base, (duration, transient),
+                         workers, scheduler)
+    series = eng.name == "process" and needs_series(classify)
     check_sweep_budget(
         base,
         runs=len(axis) * len(specs),
         duration=duration,
         transient=transient,
-        series=needs_series(classify),
+        series=series,
         workers=workers,
         keeps_sections=True,
         what="this bifurcation diagram",
@@ -298,7 +307,8 @@ def bifurcation(
         "transient": transient,
         "initial_conditions": [list(s) for s in specs],
         "continuation": bool(continuation),
-        "classifier": identity,
+        "classifier": eng.identity,
+        "engine": eng.name,
         "index_scheme": "cantor(value_index, ic)",
     }
     out = None if out is None else Path(out)
@@ -306,8 +316,6 @@ def bifurcation(
         store, reuse = open_store(out, "verdicts", config, resume, flush_interval, force)
         if reuse:
             return read_bifurcation(out)
-
-        series = needs_series(classify)
 
         def make_task(v: int, j: int, state) -> BranchTask:
             value = axis.values[v]
@@ -335,11 +343,10 @@ def bifurcation(
             )
 
         plan = _BranchPlan(make_task, len(axis), len(specs), bool(continuation))
-        backend = backend_for(workers, scheduler)
-        try:
-            execute(plan, backend, store, progress=progress, desc=f"bifurcation {axis.name}")
-        finally:
-            backend.close()
+        run_plan(
+            plan, eng, store, workers=workers, scheduler=scheduler, progress=progress,
+            desc=f"bifurcation {axis.name}",
+        )
         records = unique_sorted(store.records(), ("value_index", "ic"))
         reemit_warnings(records)
         result = Bifurcation(*_tables(records, axis), config)

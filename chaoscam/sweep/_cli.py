@@ -49,8 +49,25 @@ def _common(p: argparse.ArgumentParser) -> None:
         "--workers",
         type=int,
         default=None,
-        help="worker processes (default: every core; 1 = this process); with "
-        "--scheduler local, the local Dask cluster's workers",
+        help="cores: worker processes, or the ensemble engine's threads (default: every "
+        "core; 1 = this process, one thread); with --scheduler local, the local Dask "
+        "cluster's workers",
+    )
+    p.add_argument(
+        "--engine",
+        choices=("auto", "ensemble", "process"),
+        default="auto",
+        help="ensemble: realizations in batches through the compiled ensemble call (threads "
+        "over the cores), labelled from section and tangent exponent; process: one worker "
+        "process per core, one task per realization, any classifier; auto (default): "
+        "ensemble for the default classifier, else process",
+    )
+    p.add_argument(
+        "--device",
+        choices=("cpu", "gpu", "auto"),
+        default="cpu",
+        help="where the ensemble engine runs its batches (gpu: NVIDIA, numba-cuda; equal to "
+        "the CPU only within GPU_TOLERANCE); default cpu",
     )
     p.add_argument(
         "--scheduler",
@@ -182,6 +199,8 @@ def _execution(args) -> dict:
         check_step=args.check_step,
         workers=args.workers,
         scheduler=args.scheduler,
+        engine=args.engine,
+        device=args.device,
         out=args.out,
         resume=args.resume,
         progress=not args.quiet,

@@ -87,12 +87,39 @@ def _bar(progress: bool, plan: Plan, desc: str):
     )
 
 
-def execute(plan: Plan, backend, store, *, progress: bool = False, desc: str = "") -> None:
+def _next_task(queue: deque, source: Iterator[Any], pack, size: int):
+    """The next task to submit: one of the plan's, or up to ``size`` of them packed into
+    one (``pack(tasks)``, the ensemble engine's batches); None when there is none."""
+    tasks = []
+    while len(tasks) < size:
+        task = queue.popleft() if queue else next(source, None)
+        if task is None:
+            break
+        tasks.append(task)
+    if not tasks:
+        return None
+    return pack(tuple(tasks)) if pack is not None else tasks[0]
+
+
+def execute(
+    plan: Plan,
+    backend,
+    store,
+    *,
+    progress: bool = False,
+    desc: str = "",
+    pack=None,
+    pack_size: int = 1,
+) -> None:
     """Run ``plan`` on ``backend``, storing every record in ``store``.
 
     Records already in ``store`` (a resumed checkpoint) are given to the plan first and not
-    run again. Raises :class:`SweepInterrupted` on Ctrl-C after saving what finished.
+    run again. With ``pack``, up to ``pack_size`` tasks travel as one (``pack(tasks)``, whose
+    ``run`` returns their records in a list: the ensemble engine); the plan sees each record
+    as if its task ran alone. Raises :class:`SweepInterrupted` on Ctrl-C after saving what
+    finished.
     """
+    size = pack_size if pack is not None else 1
     store.open()
     for record in store.restored():
         try:
@@ -111,7 +138,7 @@ def execute(plan: Plan, backend, store, *, progress: bool = False, desc: str = "
     try:
         while True:
             while len(inflight) < window:
-                task = queue.popleft() if queue else next(source, None)
+                task = _next_task(queue, source, pack, size)
                 if task is None:
                     break
                 inflight[backend.submit(run_task, task)] = task
@@ -129,19 +156,19 @@ def execute(plan: Plan, backend, store, *, progress: bool = False, desc: str = "
                             f"the finished records are saved, resume after fixing it ({err})"
                         ) from err
                     getattr(backend, "recover", lambda: None)()
-                    queue.appendleft(task)
+                    queue.extendleft(reversed(getattr(task, "tasks", (task,))))
                     continue
                 except Exception as err:
                     raise RuntimeError(
                         f"task {task.key()} failed ({type(err).__name__}: {err}); reproduce "
-                        f"it with chaoscam.simulate(params, seed={task.seed}, "
-                        f"index={task.sim_index}) and the classifier"
+                        f"it with {task.hint()} and the classifier"
                     ) from err
-                store.add(record)
-                queue.extend(plan.on_record(record))
-                if bar.total != plan.total:
-                    bar.total = plan.total
-                bar.update(1)
+                for rec in record if isinstance(record, list) else [record]:
+                    store.add(rec)
+                    queue.extend(plan.on_record(rec))
+                    if bar.total != plan.total:
+                        bar.total = plan.total
+                    bar.update(1)
             store.maybe_flush()
     except KeyboardInterrupt:
         backend.cancel(list(inflight))

@@ -21,10 +21,10 @@ import pandas as pd
 from .._checks import whole
 from .._version import __version__
 from ..model import ParameterError, Params
+from ._batch import resolve_engine, run_plan
 from ._checkpoint import read_sweep_metadata, write_parquet
 from ._common import (
     as_axis,
-    backend_for,
     check_sweep_budget,
     companion,
     evidence_columns,
@@ -36,7 +36,6 @@ from ._common import (
     run_settings,
     unique_sorted,
 )
-from ._engine import execute
 from ._grid import Axis, SweepError, realization_index, validate_grid
 from ._stats import max_halfwidth, summarize_cells
 from ._tasks import RealizationTask, needs_series
@@ -241,6 +240,8 @@ def regime_map(
     progress: bool = False,
     flush_interval: float = 1.0,
     force: bool = False,
+    engine: str = "auto",
+    device: str = "cpu",
 ) -> RegimeMap:
     """Monte Carlo regime map over two parameters: classify N realizations in every cell.
 
@@ -294,6 +295,20 @@ def regime_map(
         Show a progress bar with ETA on stderr.
     flush_interval : float
         Seconds between checkpoint parts [s].
+    engine : {"auto", "ensemble", "process"}
+        ``"ensemble"``: the realizations run in batches through the compiled ensemble call
+        (numba threads over ``workers`` cores in this process, or batches on Dask workers)
+        with the tangent dynamics, each labelled from its section and tangent exponent by
+        :func:`chaoscam.classify_ensemble`. ``"process"``: one task per realization in
+        worker processes, classified from its trajectory by ``classify``. ``"auto"``
+        (default): the ensemble engine for the default classifier (no ``lyapunov``, no
+        ``check_step``) and the RK4 integrator, else the process engine. Either way a
+        realization is bit-identical to ``chaoscam.simulate`` of it; ``config["engine"]``
+        records the one used.
+    device : {"cpu", "gpu", "auto"}
+        Where the ensemble engine runs its batches: ``"gpu"`` uses an NVIDIA GPU
+        (numba-cuda), equal to the CPU only within ``GPU_TOLERANCE`` (chaotic members part
+        after a few periods); default ``"cpu"``, bit-identical everywhere.
 
     Returns
     -------
@@ -334,12 +349,15 @@ def regime_map(
         raise SweepError("max realizations applies with a target half-width only")
     validate_grid(base, [x, y])
     classify, identity = resolve_classifier(classify, lyapunov, check_step)
+    eng = resolve_engine(engine, device, classify, identity, base, (duration, transient),
+                         workers, scheduler)
+    series = eng.name == "process" and needs_series(classify)
     check_sweep_budget(
         base,
         runs=len(x) * len(y) * (adaptive["max_realizations"] if adaptive else realizations),
         duration=duration,
         transient=transient,
-        series=needs_series(classify),
+        series=series,
         workers=workers,
         keeps_sections=False,
         what="this regime map",
@@ -356,7 +374,8 @@ def regime_map(
         "seed": int(seed),
         "duration": duration,
         "transient": transient,
-        "classifier": identity,
+        "classifier": eng.identity,
+        "engine": eng.name,
         "adaptive": adaptive,
         "confidence": float(confidence),
         "index_scheme": "cantor(cell, index)",
@@ -367,7 +386,6 @@ def regime_map(
         store, reuse = open_store(out, "cells", config, resume, flush_interval, force)
         if reuse:
             return read_regime_map(out)
-        series = needs_series(classify)
         cells = _cells_frame(x, y)
         xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
         # A cell with sigma = 0 is deterministic: its realizations would all be the same run,
@@ -395,11 +413,10 @@ def regime_map(
             confidence=confidence,
             once=once,
         )
-        backend = backend_for(workers, scheduler)
-        try:
-            execute(plan, backend, store, progress=progress, desc="regime map")
-        finally:
-            backend.close()
+        run_plan(
+            plan, eng, store, workers=workers, scheduler=scheduler, progress=progress,
+            desc="regime map",
+        )
         records = unique_sorted(store.records(), ("cell", "index"))
         reemit_warnings(records)
         rows = _rows(records, cells, x, y)

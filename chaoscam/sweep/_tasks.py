@@ -15,10 +15,13 @@ from collections.abc import Callable
 from dataclasses import dataclass, is_dataclass
 from typing import Any
 
+import pandas as pd
+
 from .._simulate import simulate
+from ..integrate import Status
 from ..model import Params
 
-__all__ = ["DefaultClassifier", "RealizationTask", "BranchTask", "run_task"]
+__all__ = ["DefaultClassifier", "RealizationTask", "BranchTask", "RunSummary", "run_task"]
 
 
 @dataclass(frozen=True)
@@ -123,7 +126,26 @@ def verdict_fields(verdict: Any) -> dict[str, Any]:
     }
 
 
-def _run(params: Params, task: Any) -> tuple[Any, dict[str, Any]]:
+@dataclass(frozen=True)
+class RunSummary:
+    """What a record keeps of one simulated realization, whichever driver ran it.
+
+    ``section`` has the columns of ``Trajectory.section``; ``status`` is a ``Status`` name.
+    """
+
+    status: str
+    section: pd.DataFrame
+    n_impacts: int
+    contact_fraction: float
+    truncated_mass: float
+
+
+def status_fields(status: Status) -> dict[str, Any]:
+    """The verdict fields of a run that did not end normally: labelled by its status."""
+    return {"label": status.label, "period": None, "reasons": status.message, "evidence": {}}
+
+
+def _run(params: Params, task: Any) -> tuple[RunSummary, dict[str, Any]]:
     """Simulate and classify; a run that did not end normally is labelled by its status."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -137,19 +159,18 @@ def _run(params: Params, task: Any) -> tuple[Any, dict[str, Any]]:
             tangent=bool(getattr(task.classify, "needs_tangent", False))
             and params.integrator == "rk4",
         )
-        if traj.ok:
-            fields = verdict_fields(task.classify(traj))
-        else:
-            fields = {
-                "label": traj.status.label,
-                "period": None,
-                "reasons": traj.message,
-                "evidence": {},
-            }
+        fields = verdict_fields(task.classify(traj)) if traj.ok else status_fields(traj.status)
     seen = dict.fromkeys(str(w.message) for w in caught)
     fields["status"] = traj.status.name
     fields["warnings"] = " | ".join(seen)
-    return traj, fields
+    summary = RunSummary(
+        traj.status.name,
+        traj.section,
+        int(traj.stats["n_impacts"]),
+        _number(traj.stats["contact_fraction"]),
+        _number(traj.stats["truncated_mass"]),
+    )
+    return summary, fields
 
 
 @dataclass(frozen=True)
@@ -169,8 +190,15 @@ class RealizationTask:
     def key(self) -> tuple[int, int]:
         return (self.cell, self.index)
 
+    def hint(self) -> str:
+        """How to reproduce the run alone."""
+        return f"chaoscam.simulate(params, seed={self.seed}, index={self.sim_index})"
+
     def run(self) -> dict[str, Any]:
-        traj, fields = _run(self.params, self)
+        return self.record(*_run(self.params, self))
+
+    def record(self, run: RunSummary, fields: dict[str, Any]) -> dict[str, Any]:
+        """The record of this realization from its run and its verdict fields."""
         return {
             "cell": self.cell,
             "index": self.index,
@@ -179,10 +207,10 @@ class RealizationTask:
             "status": fields["status"],
             "label": fields["label"],
             "period": fields["period"],
-            "n_section": int(len(traj.section)),
-            "n_impacts": int(traj.stats["n_impacts"]),
-            "contact_fraction": _number(traj.stats["contact_fraction"]),
-            "truncated_mass": _number(traj.stats["truncated_mass"]),
+            "n_section": int(len(run.section)),
+            "n_impacts": run.n_impacts,
+            "contact_fraction": run.contact_fraction,
+            "truncated_mass": run.truncated_mass,
             "reasons": fields["reasons"],
             "warnings": fields["warnings"],
             "evidence": fields["evidence"],
@@ -212,11 +240,18 @@ class BranchTask:
     def key(self) -> tuple[int, int]:
         return (self.value_index, self.ic)
 
+    def hint(self) -> str:
+        """How to reproduce the run alone."""
+        return f"chaoscam.simulate(params, seed={self.seed}, index={self.sim_index})"
+
     def run(self) -> dict[str, Any]:
-        traj, fields = _run(self.params, self)
-        sec = traj.section
+        return self.record(*_run(self.params, self))
+
+    def record(self, run: RunSummary, fields: dict[str, Any]) -> dict[str, Any]:
+        """The record of this point from its run and its verdict fields."""
+        sec = run.section
         nxt = None
-        if traj.ok and len(sec):
+        if run.status == "OK" and len(sec):
             # The last stroboscopic point lies at cam phase theta_c0 (t = k 2 pi / omega):
             # a state the next value can start from at t = 0 with the same cam phase.
             nxt = [float(sec["theta_f"].iloc[-1]), float(sec["omega_f"].iloc[-1])]

@@ -162,3 +162,45 @@ def test_undetermined_short_run_is_extended_until_it_settles():
     v = classify_trajectory(tr)
     assert v.label == "chaotic"
     assert v.settings["extended"]["recorded_s"] > 10.0
+
+
+# Measured on 20 s runs (10 s transient): 46 section points in n narrow bands that look
+# periodic, with an exponent still undecided; a 4x longer run shows lambda_1 > 0.
+UNSETTLED_BANDS = {
+    "uncertified period 6 (xi = 0.45)": (dict(xi=0.45), 0, "no attracting orbit is certified"),
+    "random line length, 8 bands": (
+        dict(l_lambda=0.008, l_lambda_sigma=0.0015), 8, "the line length is random"
+    ),
+}
+
+
+@pytest.mark.parametrize(("changes", "index", "words"), list(UNSETTLED_BANDS.values()),
+                         ids=list(UNSETTLED_BANDS))
+def test_bands_that_only_look_periodic_are_not_called_periodic(changes, index, words):
+    """Periodic only with a certificate or a contracting exponent; else undetermined, and
+    the extended run settles it (chaotic)."""
+    from chaoscam import Params, simulate
+    from chaoscam.classify import classify_trajectory
+
+    traj = simulate(Params(**changes), duration=20.0, transient=10.0, seed=1, index=index,
+                    series=False, tangent=True)  # the section path, as in ensembles
+    short = classify_trajectory(traj, extend_to=None)
+    assert short.label == "undetermined" and any(words in r for r in short.reasons)
+    settled = classify_trajectory(traj)
+    assert settled.label == "chaotic" and settled.settings["extended"]["recorded_s"] > 10.0
+
+
+def test_classify_ensemble_extends_and_explains_like_classify_trajectory():
+    """The ensemble's members: same verdicts as classify_trajectory, with a reason per
+    undetermined member when not extended."""
+    from chaoscam import Params, classify_ensemble, simulate
+    from chaoscam.classify import classify_trajectory
+    from chaoscam.integrate import simulate_ensemble
+
+    p = Params(xi=0.45)
+    ens = simulate_ensemble(p, [0], seed=1, duration=20.0, transient=10.0, tangent=True)
+    short = classify_ensemble(ens, p, extend_to=None).members.iloc[0]
+    assert short["label"] == "undetermined" and "run longer" in short["reasons"]
+    member = classify_ensemble(ens, p).members.iloc[0]
+    traj = simulate(p, duration=20.0, transient=10.0, seed=1, index=0, tangent=True)
+    assert member["label"] == classify_trajectory(traj).label == "chaotic"

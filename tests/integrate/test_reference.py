@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from chaoscam import Params, simulate, simulate_reference
+from chaoscam import Params, classify_ensemble, simulate, simulate_reference
 
 DURATION = 0.7  # three impacts after the initial compliant contact
 
@@ -127,8 +127,10 @@ def test_ensemble_keeps_impacts_and_labels_members():
         assert np.array_equal(got.to_numpy(), one.impacts.to_numpy())
     assert simulate_ensemble(p, [0], duration=0.5).impacts is None
 
-    ens = simulate_ensemble(Params(omega=10.0), [0, 1], duration=20.0, transient=10.0,
-                            classify=True)
+    p = Params(omega=10.0)
+    ens = classify_ensemble(
+        simulate_ensemble(p, [0, 1], duration=20.0, transient=10.0, tangent=True), p
+    )
     assert list(ens.members.label) == ["periodic"] * 2 and list(ens.members.period) == [1, 1]
 
 

@@ -1,0 +1,67 @@
+"""Regime-map throughput: the ensemble engine against the process engine (issue 13's target).
+
+Run: python benchmarks/bench_regime_engine.py [--quick] [--workers N]
+
+The same (mu, sigma) regime map, equal settings (grid, realizations, duration, transient,
+seed, every core), once with ``engine="process"`` (one worker process per core, one task per
+realization, each simulated with its series and the tangent and classified by
+``classify_trajectory``) and once with ``engine="ensemble"`` (batches through the compiled
+ensemble call on numba threads, labelled by ``classify_ensemble``). Both are warmed first
+(pool start-up and numba cache loads excluded from neither: each run starts its own pool);
+best of two alternated runs each. Prints trajectories per second, the ratio (goal >= 1.8),
+whether the runs' sections statistics agree (n_section, n_impacts, status: bit-identical
+realizations) and how often the labels agree.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+from chaoscam.sweep import Axis, regime_map
+
+GOAL = 1.8
+
+
+def _load() -> str:
+    one, five, _ = os.getloadavg()
+    return f"load average {one:.2f} (1 min), {five:.2f} (5 min)"
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="a smaller map (a smoke test)")
+    ap.add_argument("--workers", type=int, default=None, help="cores (default: all)")
+    args = ap.parse_args()
+    n, reps, duration = (2, 2, 10.0) if args.quick else (3, 6, 20.0)
+    x = Axis.linspace("l_lambda", 0.008, 0.014, n)
+    y = Axis.linspace("l_lambda_sigma", 0.001, 0.002, n)
+    kw = dict(realizations=reps, seed=1, duration=duration, workers=args.workers)
+    runs = n * n * reps
+    print(f"regime map {n}x{n} cells x {reps} realizations x {duration:g} s = {runs} runs; "
+          f"cores {os.cpu_count()}; {_load()}")
+    for engine in ("process", "ensemble"):  # warm: numba caches, imports
+        regime_map(Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.001,)),
+                   realizations=2, duration=1.0, engine=engine, workers=args.workers)
+    times: dict[str, list[float]] = {"process": [], "ensemble": []}
+    tables = {}
+    for _ in range(2):
+        for engine in ("process", "ensemble"):
+            t0 = time.perf_counter()
+            tables[engine] = regime_map(x, y, engine=engine, **kw).realizations
+            times[engine].append(time.perf_counter() - t0)
+    tp, te = min(times["process"]), min(times["ensemble"])
+    a, b = tables["process"], tables["ensemble"]
+    cols = ["cell", "index", "status", "n_section", "n_impacts", "contact_fraction"]
+    same = a[cols].equals(b[cols])
+    agree = float((a["label"] == b["label"]).mean())
+    print(f"process engine: {tp:.1f} s ({runs / tp:.1f} traj/s); ensemble engine: {te:.1f} s "
+          f"({runs / te:.1f} traj/s); ratio {tp / te:.2f} (goal >= {GOAL}, best of 2)")
+    print(f"realizations identical on both engines: {same}; labels agree on {agree:.0%} "
+          f"(process {a['label'].value_counts().to_dict()}, ensemble "
+          f"{b['label'].value_counts().to_dict()}); after: {_load()}")
+
+
+if __name__ == "__main__":
+    main()

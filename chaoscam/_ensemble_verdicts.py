@@ -1,0 +1,137 @@
+"""classify_ensemble(ens, params): a verdict per ensemble member, from arrays only.
+
+An ensemble (:func:`chaoscam.integrate.simulate_ensemble` with ``tangent=True``) keeps no
+time series: each member has its stroboscopic section and the Jacobian of the section map
+over each period. That is what :func:`chaoscam.classify.classify_section_run` needs, the
+verdict :func:`chaoscam.classify_trajectory` gives a run kept without its series: the
+section's structure, the tangent exponent λ₁ ± its standard error, n-band chaos, and for a
+deterministic member (σ = 0) the certificate of a periodic orbit (Newton shooting). The
+regime maps and bifurcation diagrams of :mod:`chaoscam.sweep` label their members here too,
+so a member's verdict is the same whichever driver ran it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+
+from .analysis import Verdict
+from .classify import EXTEND_TO, _with_settings, classify_section_run
+from .integrate import Ensemble, Status, simulate_ensemble
+from .model import Params
+
+__all__ = ["MemberVerdict", "classify_ensemble", "member_verdicts"]
+
+_COORDS = ["theta_f", "omega_f"]
+
+
+@dataclasses.dataclass(frozen=True)
+class MemberVerdict:
+    """One member's label, period and reasons; ``verdict`` is None for a run that did not
+    end normally (labelled by its status: ``left_reach``, ``diverged``) or that has too few
+    section points to judge."""
+
+    label: str
+    period: int | None
+    reasons: str
+    verdict: Verdict | None
+
+
+def _member(status: str, points: pd.DataFrame, jac: np.ndarray, p: Params, transient: float):
+    st = Status[status]
+    if st is not Status.OK:
+        return MemberVerdict(st.label or "undetermined", None, st.message, None)
+    keep = ((points["t"] >= transient - 1e-9 * p.cam_period) & (points["k"] > 0)).to_numpy()
+    if keep.sum() < 2:
+        why = (
+            f"{int(keep.sum())} section point(s) after the transient: too few to judge; "
+            "run longer than the transient by several cam periods"
+        )
+        return MemberVerdict("undetermined", None, why, None)
+    v = classify_section_run(points.loc[keep, _COORDS].to_numpy(dtype=float), jac[keep], p)
+    return MemberVerdict(v.label, v.period, "; ".join(v.reasons), v)
+
+
+def member_verdicts(
+    ens: Ensemble,
+    params: Params | Sequence[Params],
+    *,
+    extend_to: float | None = EXTEND_TO,
+) -> list[MemberVerdict]:
+    """The verdict of every member of ``ens``, in the order of ``ens.members``.
+
+    ``params`` is the model of the run (one for all members, or one per member, as given to
+    ``simulate_ensemble``). As :func:`chaoscam.classify_trajectory` does, an undetermined
+    member is run again longer (4x the recorded time each round, at most ``extend_to``
+    seconds recorded; None: never), all such members in one ensemble call on the backend
+    of ``ens``, until its verdict settles; its verdict's ``settings["extended"]`` records
+    the time used. Raises ValueError when ``ens`` was run without ``tangent=True``.
+    """
+    if ens.jacobians is None:
+        raise ValueError("classify_ensemble needs an ensemble run with tangent=True")
+    members = ens.members
+    plist = list(params) if isinstance(params, list | tuple) else [params] * len(members)
+    verdicts = _verdicts(ens, plist)
+    s = ens.settings
+    recorded = s["duration"] - s["transient"]
+    t_wall = time.perf_counter()
+    pending = [j for j, v in enumerate(verdicts) if _unsettled(v)]
+    while pending and extend_to is not None and recorded < extend_to:
+        recorded = min(extend_to, 4.0 * recorded)
+        sub = [plist[j] for j in pending]
+        longer = simulate_ensemble(
+            sub,
+            [int(members["index"].iat[j]) for j in pending],
+            seed=s["seed"],
+            duration=s["transient"] + recorded,
+            transient=s["transient"],
+            backend=s["backend"],
+            tangent=True,
+        )
+        note = {
+            "recorded_s": recorded,
+            "wall_time_s": time.perf_counter() - t_wall,
+            "why": "the verdict on the run as given was undetermined",
+        }
+        for j, v in zip(pending, _verdicts(longer, sub), strict=True):
+            if v.verdict is not None:  # a longer run that ended early keeps the first verdict
+                extended = _with_settings(v.verdict, extended=note)
+                verdicts[j] = dataclasses.replace(v, verdict=extended)
+        pending = [j for j in pending if _unsettled(verdicts[j])]
+    return verdicts
+
+
+def _unsettled(v: MemberVerdict) -> bool:
+    return v.label == "undetermined" and v.verdict is not None
+
+
+def _verdicts(ens: Ensemble, plist: list[Params]) -> list[MemberVerdict]:
+    transient = float(ens.settings["transient"])
+    rows_of = ens.sections.groupby("member").indices  # member -> positions of its rows
+    empty = np.empty(0, dtype=np.int64)
+    out = []
+    for m, status in zip(ens.members["member"], ens.members["status"], strict=True):
+        pick = rows_of.get(m, empty)
+        out.append(
+            _member(status, ens.sections.iloc[pick], ens.jacobians[pick], plist[int(m)], transient)
+        )
+    return out
+
+
+def classify_ensemble(
+    ens: Ensemble, params: Params | Sequence[Params], *, extend_to: float | None = EXTEND_TO
+) -> Ensemble:
+    """``ens`` with each member's verdict: columns ``label``, ``period`` and ``reasons``
+    (why, in words; for an undetermined member, what is missing) added to ``members``.
+    ``extend_to``: see :func:`member_verdicts`."""
+    verdicts = member_verdicts(ens, params, extend_to=extend_to)
+    members = ens.members.assign(
+        label=[v.label for v in verdicts],
+        period=pd.array([v.period for v in verdicts], dtype="Int64"),
+        reasons=[v.reasons for v in verdicts],
+    )
+    return dataclasses.replace(ens, members=members)

@@ -1,0 +1,249 @@
+"""The ensemble engine of the sweeps: many realizations in one compiled call.
+
+A :class:`BatchTask` packs a sweep's tasks (:class:`~._tasks.RealizationTask`,
+:class:`~._tasks.BranchTask`) and runs them through
+:func:`chaoscam.integrate.simulate_ensemble` (numba threads over the cores; a Dask worker
+runs a whole batch) with the tangent dynamics, then labels each member from its section and
+stroboscopic Jacobians (:func:`chaoscam.classify_ensemble`: section structure, tangent
+exponent, n-band chaos, periodic-orbit certificate). Each task's record is built by the task
+itself (``task.record``), so it has the same fields as on the process engine.
+
+Bit-identity: an ensemble member equals ``simulate(params, seed=seed, index=sim_index)``
+bit for bit, and its verdict uses its own arrays only, so a record does not depend on the
+batch it ran in, the thread count or an interruption.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from .._simulate import resolution_warning
+from ..integrate import Status
+from ..model import Params, truncated_mass
+from ._tasks import RunSummary, status_fields, verdict_fields
+
+__all__ = ["ENGINE_CLASSIFIER", "BatchTask", "batch_size", "run_batch"]
+
+ENGINE_CLASSIFIER = "chaoscam.classify_ensemble(section + tangent exponent)"
+"""The classifier identity a sweep records when it runs on the ensemble engine."""
+
+BATCH_SECONDS = 2.0
+"""Target wall time of one batch [s]: short enough for a prompt Ctrl-C and frequent
+checkpoints, long enough that every thread has several members to balance."""
+
+MAX_BATCH = 256
+"""Members per batch at most (bounds the memory of one compiled call)."""
+
+
+def batch_size(base: Params, duration: float, transient: float, threads: int) -> int:
+    """Members per batch: about :data:`BATCH_SECONDS` of work on ``threads`` threads, from
+    the run-time estimate of :func:`chaoscam._budget.estimate` (at least one per thread)."""
+    from .._budget import estimate
+
+    per_run = max(estimate(base, duration=duration, transient=transient).seconds, 1e-3)
+    n = int(threads * BATCH_SECONDS / per_run)
+    return max(threads, min(n, MAX_BATCH))
+
+
+@dataclass(frozen=True)
+class BatchTask:
+    """Several sweep tasks run as one ensemble; ``run`` returns their records in order."""
+
+    tasks: tuple[Any, ...]
+    backend: str = "cpu"
+
+    def key(self) -> tuple[int, int]:
+        return self.tasks[0].key()
+
+    def hint(self) -> str:
+        return f"a batch of {len(self.tasks)} runs from {self.tasks[0].key()}: " + ", ".join(
+            t.hint() for t in self.tasks[:3]
+        )
+
+    def run(self) -> list[dict[str, Any]]:
+        return run_batch(self.tasks, self.backend)
+
+
+def _group_key(task: Any) -> tuple:
+    p = task.params
+    return (task.seed, task.duration, task.transient, p.dt, p.omega)
+
+
+def run_batch(tasks: Sequence[Any], backend: str = "cpu") -> list[dict[str, Any]]:
+    """The records of ``tasks``, simulated as ensembles of members that share the grid.
+
+    Members of one compiled call must share (seed, duration, transient, dt, omega); the
+    tasks are grouped by those, keeping their order within a group.
+    """
+    from .._ensemble_verdicts import member_verdicts
+    from ..integrate import simulate_ensemble
+
+    groups: dict[tuple, list[int]] = {}
+    for i, t in enumerate(tasks):
+        groups.setdefault(_group_key(t), []).append(i)
+    records: list[dict[str, Any] | None] = [None] * len(tasks)
+    for (seed, duration, transient, _, _), picks in groups.items():
+        plist = [tasks[i].params for i in picks]
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            ens = simulate_ensemble(
+                plist,
+                [tasks[i].sim_index for i in picks],
+                seed=seed,
+                duration=duration,
+                transient=transient,
+                backend=backend,
+                tangent=True,
+            )
+            verdicts = member_verdicts(ens, plist)
+        shared = [str(w.message) for w in caught]
+        rows_of = ens.sections.groupby("member").indices
+        members = ens.members
+        for j, i in enumerate(picks):
+            sec = ens.sections.iloc[rows_of.get(j, [])].drop(columns="member")
+            status = str(members["status"].iat[j])
+            run = RunSummary(
+                status,
+                sec.reset_index(drop=True),
+                int(members["n_impacts"].iat[j]),
+                float(members["contact_fraction"].iat[j]),
+                truncated_mass(plist[j].l_lambda, plist[j].l_lambda_sigma, plist[j].l_min),
+            )
+            v = verdicts[j]
+            if v.verdict is not None:
+                fields = verdict_fields(v.verdict)
+            elif status != "OK":
+                fields = status_fields(Status[status])
+            else:
+                fields = {"label": v.label, "period": None, "reasons": v.reasons, "evidence": {}}
+            seen = [w for w in (resolution_warning(plist[j]), *shared) if w]
+            fields["status"] = status
+            fields["warnings"] = " | ".join(dict.fromkeys(seen))
+            records[i] = tasks[i].record(run, fields)
+    return records  # type: ignore[return-value]
+
+
+ENGINES = ("auto", "ensemble", "process")
+"""How a sweep runs its realizations: ``"ensemble"`` (batches through the compiled
+ensemble call, labelled by :func:`chaoscam.classify_ensemble`), ``"process"`` (one task per
+realization in worker processes, classified from its trajectory by any classifier), or
+``"auto"``: the ensemble engine for the default classifier and the RK4 integrator, else the
+process engine."""
+
+
+@dataclass(frozen=True)
+class Engine:
+    """A sweep's resolved engine: its name, the classifier identity it records, and how
+    the driver runs it (``pack``/``pack_size`` for :func:`._engine.execute`, ``threads``
+    numba threads in this process when local)."""
+
+    name: str
+    identity: str
+    pack: Any = None
+    pack_size: int = 1
+    threads: int | None = None
+
+
+def resolve_engine(
+    engine: str,
+    device: str,
+    classify: Any,
+    identity: str,
+    base: Params,
+    run: tuple[float, float],
+    workers: int | None,
+    scheduler: Any,
+) -> Engine:
+    """The engine a sweep runs on (see :data:`ENGINES`) for ``classify`` (identity
+    ``identity``), the model ``base`` and ``run`` = (duration, transient) [s]; SweepError
+    for a bad choice."""
+    from ._backends import default_workers
+    from ._grid import SweepError
+    from ._tasks import DefaultClassifier
+
+    if engine not in ENGINES:
+        raise SweepError(f"engine = {engine!r} must be one of {', '.join(ENGINES)}")
+    if device not in ("cpu", "gpu", "auto"):
+        raise SweepError(f"device = {device!r} must be one of cpu, gpu, auto")
+    default = (
+        isinstance(classify, DefaultClassifier)
+        and classify.needs_tangent
+        and not classify.check_step
+    )
+    if engine == "auto":
+        engine = "ensemble" if default and base.integrator == "rk4" else "process"
+    if engine == "process":
+        if device != "cpu":
+            raise SweepError("device applies to engine='ensemble' only")
+        return Engine("process", identity)
+    if not default:
+        raise SweepError(
+            "engine='ensemble' labels members from their sections and tangent exponents "
+            "(chaoscam.classify_ensemble): it takes the default classifier, without lyapunov "
+            "or check_step; use engine='process' for another classifier"
+        )
+    if base.integrator != "rk4":
+        raise SweepError(
+            "engine='ensemble' runs the fixed-step RK4 integrator (integrator = 'rk4'); use "
+            "engine='process' for the adaptive one"
+        )
+    threads = None
+    if scheduler is None:
+        threads = default_workers() if workers is None else int(workers)
+        if threads < 1:
+            raise SweepError(f"workers = {threads} must be >= 1")
+    size = batch_size(base, run[0], run[1], threads or 1)
+
+    def pack(tasks: tuple) -> BatchTask:
+        return BatchTask(tasks, device)
+
+    return Engine("ensemble", ENGINE_CLASSIFIER, pack, size, threads)
+
+
+def numba_threads(n: int | None):
+    """A context in which numba runs ``n`` threads (None: leave it), restored after."""
+    import contextlib
+
+    if n is None:
+        return contextlib.nullcontext()
+
+    @contextlib.contextmanager
+    def scope():
+        import numba
+
+        before = numba.get_num_threads()
+        numba.set_num_threads(max(1, min(int(n), numba.config.NUMBA_NUM_THREADS)))
+        try:
+            yield
+        finally:
+            numba.set_num_threads(before)
+
+    return scope()
+
+
+def run_plan(plan, eng: Engine, store, *, workers, scheduler, progress: bool, desc: str) -> None:
+    """Execute a sweep's plan on its engine: the ensemble engine in this process on
+    ``eng.threads`` numba threads (or its batches on Dask), the process engine on a pool of
+    ``workers`` processes (or Dask)."""
+    from ._backends import SerialBackend
+    from ._common import backend_for
+    from ._engine import execute
+
+    local = eng.name == "ensemble" and scheduler is None
+    backend = SerialBackend() if local else backend_for(workers, scheduler)
+    try:
+        with numba_threads(eng.threads):
+            execute(
+                plan,
+                backend,
+                store,
+                progress=progress,
+                desc=desc,
+                pack=eng.pack,
+                pack_size=eng.pack_size,
+            )
+    finally:
+        backend.close()

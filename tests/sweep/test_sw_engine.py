@@ -1,0 +1,115 @@
+"""The ensemble engine: sweeps in batches through the compiled ensemble call.
+
+Its realizations must be the process engine's bit for bit, its labels the ones
+``classify_ensemble`` gives those realizations, and its records independent of the thread
+count, the batch size and an interruption.
+"""
+
+import pandas as pd
+import pytest
+
+from chaoscam import Params, classify_ensemble
+from chaoscam.integrate import simulate_ensemble
+from chaoscam.sweep import Axis, SweepError, _batch, bifurcation, realization_index, regime_map
+
+from ._helpers import SpreadClassifier, frames_equal
+
+# xi = 0.2: a certified period 1 at sigma = 0; sigma = 2 mm: a random, chaotic response
+XI = Axis("xi", (0.2, 0.3))
+SIGMA = Axis("l_lambda_sigma", (0.0, 0.002))
+KW = dict(realizations=3, seed=5, duration=6.0, transient=3.0, base=Params())
+SAME = ["cell", "index", "seed", "sim_index", "status", "n_section", "n_impacts",
+        "contact_fraction", "truncated_mass"]
+
+
+@pytest.fixture(scope="module")
+def maps():
+    return {
+        e: regime_map(XI, SIGMA, engine=e, workers=2, **KW) for e in ("ensemble", "process")
+    }
+
+
+def test_the_engines_simulate_the_same_realizations(maps):
+    """Same runs on both engines; the configuration says which engine ran."""
+    a, b = maps["ensemble"], maps["process"]
+    frames_equal(a.realizations[SAME], b.realizations[SAME])
+    assert a.config["engine"] == "ensemble" and b.config["engine"] == "process"
+    assert a.config["classifier"] != b.config["classifier"]
+
+
+def test_ensemble_labels_are_those_of_classify_ensemble(maps):
+    """Each label is classify_ensemble's verdict on simulate_ensemble of the same member."""
+    rows = maps["ensemble"].realizations
+    for _, row in rows.iterrows():
+        p = Params().replace(xi=row["xi"], l_lambda_sigma=row["l_lambda_sigma"])
+        ens = simulate_ensemble(p, [realization_index(row["cell"], row["index"])], seed=5,
+                                duration=6.0, transient=3.0, tangent=True)
+        member = classify_ensemble(ens, p).members.iloc[0]
+        assert (member["label"], member["period"]) == (row["label"], row["period"])
+    det = rows[rows["l_lambda_sigma"] == 0.0]
+    assert set(det["label"]) <= {"periodic", "chaotic"} and len(det) == 2  # one run a cell
+    assert (det.loc[det["xi"] == 0.2, "period"] == 1).all()
+    assert rows["ev_exponent"].notna().all()
+
+
+def test_threads_and_batches_do_not_change_the_table(maps, monkeypatch):
+    """One thread and batches of one member give the two-thread table bit for bit."""
+    monkeypatch.setattr(_batch, "batch_size", lambda *a, **k: 1)
+    one = regime_map(XI, SIGMA, engine="ensemble", workers=1, **KW)
+    frames_equal(one.realizations, maps["ensemble"].realizations)
+    frames_equal(one.cells, maps["ensemble"].cells)
+
+
+def test_an_interrupted_ensemble_map_resumes_to_the_same_table(maps, tmp_path, monkeypatch):
+    """Ctrl-C after the first batch saves it; --resume finishes to the whole table."""
+    from chaoscam.sweep import SweepInterrupted
+
+    monkeypatch.setattr(_batch, "batch_size", lambda *a, **k: 2)
+    real, calls = _batch.run_batch, []
+
+    def interrupt_second(tasks, backend="cpu"):
+        calls.append(len(tasks))
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(tasks, backend)
+
+    out = tmp_path / "map.parquet"
+    monkeypatch.setattr(_batch, "run_batch", interrupt_second)
+    with pytest.raises(SweepInterrupted) as err:
+        regime_map(XI, SIGMA, engine="ensemble", out=out, **KW)
+    assert "2 of" in str(err.value) and "--resume" in str(err.value)
+    monkeypatch.setattr(_batch, "run_batch", real)
+    done = regime_map(XI, SIGMA, engine="ensemble", out=out, resume=True, **KW)
+    frames_equal(done.realizations, maps["ensemble"].realizations)
+
+
+def test_bifurcation_points_are_the_same_on_both_engines():
+    """Sections of a diagram with continuation: equal on both engines."""
+    kw = dict(duration=4.0, transient=2.0, initial_conditions=2, continuation=True)
+    a = bifurcation("xi", "0.2:0.3:3", engine="ensemble", **kw)
+    b = bifurcation("xi", "0.2:0.3:3", engine="process", workers=1, **kw)
+    cols = [c for c in a.points.columns if c not in ("label", "period")]
+    frames_equal(a.points[cols], b.points[cols])
+    assert a.config["engine"] == "ensemble"
+
+
+@pytest.mark.parametrize(
+    ("kw", "words"),
+    [
+        (dict(engine="fast"), "engine = 'fast' must be one of"),
+        (dict(engine="ensemble", classify=SpreadClassifier()), "use engine='process'"),
+        (dict(engine="ensemble", lyapunov=True), "without lyapunov"),
+        (dict(engine="ensemble", base=Params(integrator="adaptive")), "RK4"),
+        (dict(engine="process", device="gpu"), "device applies to engine='ensemble'"),
+        (dict(device="tpu"), "device = 'tpu'"),
+    ],
+)
+def test_bad_engine_choices_are_refused_with_the_reason(kw, words):
+    with pytest.raises(SweepError, match=words):
+        regime_map(XI, SIGMA, duration=1.0, **kw)
+
+
+def test_auto_picks_the_process_engine_for_another_classifier():
+    m = regime_map(XI, SIGMA, duration=1.0, classify=SpreadClassifier(), workers=1)
+    assert m.config["engine"] == "process"
+    assert isinstance(m.realizations, pd.DataFrame)
