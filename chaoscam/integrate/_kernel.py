@@ -54,6 +54,7 @@ from ._layout import (
     I_CHATTER,
     I_CONTACT_STEPS,
     I_COUNTED_STEPS,
+    I_GRAZES,
     I_LAM_POS,
     I_N_IMPACT,
     I_N_SECTION,
@@ -132,16 +133,17 @@ def illinois_update(a, fa, b, fb, m, fm, side):
 
 
 @njit(cache=True)
-def locate_crossing(t, th, om, h, g_start, g_end, K, c):
-    """The substep length tau in (0, h] at which the gap delta changes sign.
+def locate_crossing(t, th, om, a, g_start, h, g_end, K, c):
+    """The substep length tau in (a, h] at which the gap delta changes sign.
 
-    Illinois regula falsi on ``tau -> delta(RK4 substep of length tau)``, with a bisection
-    whenever an iteration fails to halve the bracket, until the bracket is narrower than the
-    event tolerance. Returns the bracket's right end, past the crossing: delta <= 0 there for
-    a closing, delta >= 0 for an opening.
+    Illinois regula falsi on ``tau -> delta(RK4 substep of length tau)`` over the bracket
+    [a, h] (a = 0 but for a micro-flight that starts on the surface, whose bracket starts at
+    its top), with a bisection whenever an iteration fails to halve the bracket, until the
+    bracket is narrower than the event tolerance. Returns the bracket's right end, past the
+    crossing: delta <= 0 there for a closing, delta >= 0 for an opening.
     """
     s = 1.0 if g_start > 0.0 else -1.0  # work on s * delta, positive at the start
-    a, fa, b, fb = 0.0, s * g_start, h, s * g_end
+    fa, b, fb = s * g_start, h, s * g_end
     side = 0
     for _ in range(400):
         width = b - a
@@ -157,6 +159,36 @@ def locate_crossing(t, th, om, h, g_start, g_end, K, c):
             fm, _, _ = geometry(t + m, thm, c)
             a, fa, b, fb, _ = illinois_update(a, fa, b, fb, m, fm * s, 0)
     return b
+
+
+# The stand-in for a gap of exactly 0 at a segment's start, signed by the gap rate: only its
+# sign matters (event brackets need a nonzero value at their start).
+ON_SURFACE = 1e-300
+
+
+@njit(cache=True)
+def graze_point(t, th, om, h, rate0, rate1, K, c):
+    """The substep length tau in (0, h) at which the gap rate l_1 theta' - dC/dt.n turns.
+
+    Illinois regula falsi on ``tau -> rate(RK4 substep of length tau)`` to 1e-6 of the step
+    (an error e in tau moves the gap's extremum by ~|delta''| e^2 / 2, below 1e-20 m here).
+    Only called where the gap rate changes sign between the segment's ends while the gap
+    does not: the extremum of the gap in between shows whether it crossed zero and came
+    back (a micro-flight, or a graze, shorter than the step). The rate is that of the
+    substep's state, on the side of the surface the segment starts on.
+    """
+    s = 1.0 if rate0 > 0.0 else -1.0  # work on s * rate, positive at 0, negative at h
+    a, fa, b, fb = 0.0, s * rate0, h, s * rate1
+    side = 0
+    for _ in range(200):
+        width = b - a
+        if width <= 1e-6 * h:
+            break
+        m = illinois_point(a, fa, b, fb)
+        thm, omm = rk4(t, th, om, m, K, c)
+        _, l1, cdn = geometry(t + m, thm, c)
+        a, fa, b, fb, side = illinois_update(a, fa, b, fb, m, s * (l1 * omm - cdn), side)
+    return 0.5 * (a + b)
 
 
 @njit(cache=True, inline="always")
@@ -371,6 +403,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     safe_n = cnt[I_SAFE_STEP]
     stale = False  # g, l1, cdn belong to an earlier point (only while the gap is safe)
     jumped = False  # a rebound was just applied: the opening that follows is flight's
+    settled = False  # a plastic closure was just applied: the point stays on the contact side
     while cnt[I_STEP] < n_stop:
         # Room for one more step's worth of outputs and draws, else hand back to Python.
         if (
@@ -432,24 +465,75 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 if stale:
                     g, l1, cdn = geometry(t, th, c)
                     stale = False
-                if g > 0.0 and g > closing_bound(l1, cdn, om, hs, c):
-                    trial = step_flight(th, om, hs, c, y, False)  # no contact possible
+                rate0 = l1 * om - cdn
+                # The side the segment starts on. A located crossing leaves the point on the
+                # surface to rounding (slow closings give delta = 0.0 exactly: 1e-6 m/s over
+                # the 1e-12 s event tolerance is 1e-18 m, below delta's ~1e-16 m resolution).
+                # There the side is the motion's: contact just after a plastic closure (its
+                # gap rate is 0 to rounding, and taking the rounding's sign starts a
+                # ping-pong of zero-length events that only the chattering guard ends), else
+                # flight when moving out (after a rebound, or a located opening).
+                on_surface = g == 0.0 or (jumped and g <= 0.0)
+                gs = g
+                if on_surface:
+                    gs = ON_SURFACE if not settled and (jumped or rate0 > 0.0) else -ON_SURFACE
+                # On the surface the first stage sits at delta ~ 0 on the wrong side of the
+                # Jacobian's jump (~K l_1^2 / J): take it on the side the segment starts on.
+                trial_side = JAC_NATURAL
+                if on_surface:
+                    trial_side = JAC_FLIGHT if gs > 0.0 else JAC_CONTACT
+                trial_full = not (g > 0.0 and g > closing_bound(l1, cdn, om, hs, c))
+                if trial_full:
+                    trial = step_rk4(t, th, om, hs, K, c, y, False, trial_side)
                 else:
-                    trial = step_rk4(t, th, om, hs, K, c, y, False, JAC_NATURAL)
+                    trial = step_flight(th, om, hs, c, y, False)  # no contact possible
                 th_new, om_new = trial[0], trial[1]
                 g_new, l1, cdn = geometry(seg_end, th_new, c)
-                closing = g > 0.0 and g_new <= 0.0
-                if (closing or (g < 0.0 and g_new > 0.0)) and events >= max_events:
+                rate1 = l1 * om_new - cdn
+                closing = gs > 0.0 and g_new <= 0.0
+                crossing = closing or (gs < 0.0 and g_new > 0.0)
+                tau_lo = 0.0  # the crossing lies in (tau_lo, tau_hi], the gap g_lo, g_hi there
+                g_lo = gs
+                tau_hi = hs
+                g_hi = g_new
+                if on_surface and crossing:
+                    if not closing:
+                        crossing = False  # lift-off from the surface: at the segment's start
+                    elif rate0 > 0.0 > rate1:
+                        # A micro-flight from the surface: the gap is rounding noise near the
+                        # start, so the bracket starts at the flight's top.
+                        tau_lo = graze_point(t, th, om, hs, rate0, rate1, K, c)
+                        th_m, _ = rk4(t, th, om, tau_lo, K, c)
+                        g_lo, _, _ = geometry(t + tau_lo, th_m, c)
+                        crossing = g_lo > 0.0
+                        closing = crossing
+                elif not crossing and events < max_events and trial_full:
+                    # No sign change between the ends, but the gap rate turns (closing to
+                    # opening in flight, the reverse in contact): the gap may have crossed
+                    # zero and come back inside the segment. Micro-flights of a chattering
+                    # sequence last ~2 xi v / |delta''| (0.1 us at v = 1e-6 m/s), far below
+                    # dt; unlocated, the step integrates through one without its jump and the
+                    # tangent misses a saltation matrix of size ~|delta''| / v.
+                    if (rate0 < 0.0 < rate1) if gs > 0.0 else (rate1 < 0.0 < rate0):
+                        tau_hi = graze_point(t, th, om, hs, rate0, rate1, K, c)
+                        th_m, _ = rk4(t, th, om, tau_hi, K, c)
+                        g_hi, _, _ = geometry(t + tau_hi, th_m, c)
+                        closing = gs > 0.0 and g_hi <= 0.0
+                        crossing = closing or (gs < 0.0 and g_hi > 0.0)
+                        if crossing:
+                            cnt[I_GRAZES] += 1
+                if crossing and events >= max_events:
                     cnt[I_CHATTER] += 1  # chattering: the rest of the step is left as it is
-                elif closing or (g < 0.0 and g_new > 0.0):
+                elif crossing:
                     # The gap changes sign inside the segment: go to the crossing, so that no
                     # RK4 step straddles the kink of the force at delta = 0, then resume.
-                    tau = locate_crossing(t, th, om, hs, g, g_new, K, c)
+                    tau = locate_crossing(t, th, om, tau_lo, g_lo, tau_hi, g_hi, K, c)
                     # The substep ends on the surface: its Jacobian is the side it comes
                     # from (flight before a closing and just after a jump, else contact).
                     side = JAC_FLIGHT if closing or jumped else JAC_CONTACT
                     th, om, _, _, _, _, _ = step_rk4(t, th, om, tau, K, c, y, True, side)
                     jumped = False
+                    settled = False
                     t = t + tau
                     events += 1
                     g, l1, cdn = geometry(t, th, c)
@@ -458,13 +542,16 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     if not (0.0 < l1 < c[C_ROD_L]):
                         return leave(y, cnt, th, om, t, safe_n, LEFT_REACH)
                     om_before = om
+                    plastic = cdn - l1 * om < c[C_V_CHATTER]  # a chattering end, if applied
                     om, K = impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
                     # after a rebound the point still lies on the surface, moving out
-                    jumped = om != om_before and l1 * om - cdn > 0.0
+                    jumped = om != om_before and not plastic and l1 * om - cdn > 0.0
+                    settled = om != om_before and plastic
                     continue
                 if c[C_TANGENT] > 0.0:
                     commit_tangent(y, trial[2], trial[3], trial[4], trial[5], trial[6])
                 jumped = False
+                settled = False
                 th = th_new
                 om = om_new
                 t = seg_end

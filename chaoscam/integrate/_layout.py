@@ -62,7 +62,8 @@ I_CHATTER = 9  # steps where the chattering guard handed over to the compliant c
 I_SLOW_CLOSINGS = 10  # closings slower than v_min (no jump applied)
 I_SAFE_STEP = 11  # the gap provably stays open until grid step I_SAFE_STEP (0 = not known)
 I_SERIES_J = 12  # adaptive: index j of the next series sample (time j * stride * dt)
-N_COUNTERS = 13
+I_GRAZES = 13  # fixed step: crossings found inside a segment whose ends lie on one side
+N_COUNTERS = 14
 
 # --- the state vector y ----------------------------------------------------------------------
 Y_THETA = 0  # theta_f [rad]
