@@ -336,6 +336,7 @@ def lyapunov_model(
     cmp = _Runner(ref.y.copy(), cnt_ref.copy(), c, draws, per_step)
     cmp.y[:2] += d0 * u * scale
     cmp.cnt[k.I_SAFE_STEP] = 0  # the reference's flight horizon does not hold for a moved state
+    cmp.cnt[k.I_SURFACE] = 0  # nor its surface flags
 
     logs: list[float] = []
     lengths: list[float] = []
@@ -392,6 +393,7 @@ def lyapunov_model(
         cmp.y[:2] += d0 * (delta / d) * scale
         cmp.cnt[:] = ref.cnt
         cmp.cnt[k.I_SAFE_STEP] = 0  # the reference's flight horizon does not hold for cmp
+        cmp.cnt[k.I_SURFACE] = 0  # nor its surface flags
         cmp.n_impacts = ref.n_impacts
 
     lg = np.asarray(logs)

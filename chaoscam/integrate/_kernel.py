@@ -61,6 +61,7 @@ from ._layout import (
     I_N_SERIES,
     I_RESAMPLE_J,
     I_SAFE_STEP,
+    I_SURFACE,
     I_SECTION_K,
     I_SLOW_CLOSINGS,
     I_STEP,
@@ -402,8 +403,10 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     # was not interrupted. Whoever changes the state y from outside must reset it to 0.
     safe_n = cnt[I_SAFE_STEP]
     stale = False  # g, l1, cdn belong to an earlier point (only while the gap is safe)
-    jumped = False  # a rebound was just applied: the opening that follows is flight's
-    settled = False  # a plastic closure was just applied: the point stays on the contact side
+    # The surface flags, kept in the counters across a buffer hand-back (an event may end a
+    # grid step exactly) so that a resumed run is bit-identical to one not interrupted.
+    jumped = (cnt[I_SURFACE] & 1) != 0  # a rebound was just applied: the opening is flight's
+    settled = (cnt[I_SURFACE] & 2) != 0  # a plastic closure: the point stays in contact
     while cnt[I_STEP] < n_stop:
         # Room for one more step's worth of outputs and draws, else hand back to Python.
         if (
@@ -412,6 +415,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             or cnt[I_N_IMPACT] + max_events > impacts.shape[0]
             or cnt[I_LAM_POS] + draws_per_step >= lam.shape[0]
         ):
+            cnt[I_SURFACE] = (1 if jumped else 0) + (2 if settled else 0)
             return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, NEED_BUFFER)
 
         n = cnt[I_STEP]

@@ -63,7 +63,8 @@ I_SLOW_CLOSINGS = 10  # closings slower than v_min (no jump applied)
 I_SAFE_STEP = 11  # the gap provably stays open until grid step I_SAFE_STEP (0 = not known)
 I_SERIES_J = 12  # adaptive: index j of the next series sample (time j * stride * dt)
 I_GRAZES = 13  # fixed step: crossings found inside a segment whose ends lie on one side
-N_COUNTERS = 14
+I_SURFACE = 14  # fixed step: the point's surface flags at a hand-back (1 jumped, 2 settled)
+N_COUNTERS = 15
 
 # --- the state vector y ----------------------------------------------------------------------
 Y_THETA = 0  # theta_f [rad]

@@ -27,6 +27,7 @@ SECTIONS = (
     ("responses", "Representative responses"),
     ("evidence", "Classifier evidence"),
     ("comparison", "The paper against this run"),
+    ("why", "Why the paper differs"),
     ("missing", "What is missing"),
 )
 
@@ -70,6 +71,8 @@ class ReportParts:
     responses: list[FigureItem] = field(default_factory=list)
     evidence: list[dict[str, Any]] = field(default_factory=list)
     comparison: list[Comparison] = field(default_factory=list)
+    why: list[str] = field(default_factory=list)
+    why_figures: list[FigureItem] = field(default_factory=list)
     missing: list[str] = field(default_factory=list)
 
 

@@ -31,6 +31,12 @@ LABEL_COLORS = {
 }
 _OTHER = "#E69F00"
 
+ANNOTATION_PT = 10
+"""Point size of the numbers written in heatmap cells: ~12 px at the report's width."""
+
+ANNOTATE_CELLS = 64
+"""Heatmaps with at most this many cells are annotated (larger ones would not fit the text)."""
+
 _SYMBOLS = {
     "l_lambda": "l_λ",
     "l_lambda_sigma": "σ of l_λ",
@@ -93,6 +99,15 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
     coded = cells.assign(_code=cells["dominant"].map(code).astype(float))
     m = _grid(coded, x, y, "_code")
     colors = [LABEL_COLORS.get(lab, _OTHER) for lab in order] or ["#FFFFFF"]
+    annot = False
+    if "period" in cells and m.size <= ANNOTATE_CELLS:
+        per = _grid(cells.assign(_p=cells["period"].astype(float)), x, y, "_p").to_numpy()
+        dom = _grid(cells, x, y, "dominant").to_numpy()
+        annot = np.where(
+            (dom == "periodic") & np.isfinite(per),
+            np.char.add("P", np.nan_to_num(per).astype(int).astype(str)),
+            "",
+        )
     sns.heatmap(
         m,
         ax=ax,
@@ -103,9 +118,13 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
         linewidths=0.2 if m.size <= 400 else 0,
         linecolor="white",
         mask=m.isna(),
+        annot=annot,
+        fmt="",
+        annot_kws={"fontsize": ANNOTATION_PT, "color": "white", "fontweight": "bold"},
     )
     _ticks(ax, m, x, y, _role(x, y))
-    ax.set_title("dominant label")
+    shown = annot is not False and bool(np.any(annot != ""))
+    ax.set_title("dominant label (Pn: periodic, period n)" if shown else "dominant label")
     ax.legend(
         handles=[Patch(color=LABEL_COLORS.get(lab, _OTHER), label=lab) for lab in order],
         loc="upper left",
@@ -124,13 +143,14 @@ def plot_probability(
 ) -> None:
     """Heatmap of P(label) per cell; small grids are annotated with the 95 % interval.
 
-    ``annotate`` None annotates grids of at most 64 cells with ``p`` and ``[lo, hi]``.
+    ``annotate`` None annotates grids of at most :data:`ANNOTATE_CELLS` cells with ``p``
+    and ``[lo, hi]``.
     """
     import seaborn as sns
 
     m = _grid(cells, x, y, f"p_{label}")
     if annotate is None:
-        annotate = m.size <= 64
+        annotate = m.size <= ANNOTATE_CELLS
     annot = False
     if annotate:
         lo = _grid(cells, x, y, f"p_{label}_lo").to_numpy()
@@ -150,7 +170,7 @@ def plot_probability(
         vmax=1.0,
         annot=annot,
         fmt="",
-        annot_kws={"fontsize": 6},
+        annot_kws={"fontsize": ANNOTATION_PT - 1},
         cbar_kws={"label": f"P({label})"},
         mask=m.isna(),
     )
@@ -178,14 +198,28 @@ def plot_interval_width(cells: pd.DataFrame, x: str, y: str, ax, *, label="chaot
 
 
 def regime_map_figure(cells: pd.DataFrame, *, x: str, y: str, label: str = "chaotic"):
-    """Three panels: dominant label, P(label) (annotated when small), interval width."""
+    """A regime map at the size a report shows it (~1,200 px wide, text >= 10 px there).
+
+    Four panels: the dominant label (periodic cells annotated with their period), P(label)
+    and P(periodic) (annotated with the 95 % interval when the grid is small), and the
+    interval width. A map whose cells are all deterministic (sigma = 0: one run each) has
+    no probabilities to show: one panel, the label and period of each cell.
+    """
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(17, 5), layout="constrained")
-    a, b, c = fig.subplots(1, 3)
+    if "deterministic" in cells and cells["deterministic"].astype(bool).all():
+        fig = Figure(figsize=(9.5, 6.5), layout="constrained")
+        plot_dominant(cells, x, y, fig.subplots())
+        return fig
+    fig = Figure(figsize=(13, 10), layout="constrained")
+    (a, b), (c, d) = fig.subplots(2, 2)
     plot_dominant(cells, x, y, a)
     plot_probability(cells, x, y, b, label=label)
     plot_interval_width(cells, x, y, c, label=label)
+    if f"p_{label}" in cells and "p_periodic" in cells and label != "periodic":
+        plot_probability(cells, x, y, d, label="periodic")
+    else:
+        d.set_axis_off()
     return fig
 
 

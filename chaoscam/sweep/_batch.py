@@ -54,6 +54,7 @@ class BatchTask:
 
     tasks: tuple[Any, ...]
     backend: str = "cpu"
+    extend_to: float | None = 120.0
 
     def key(self) -> tuple[int, int]:
         return self.tasks[0].key()
@@ -64,7 +65,7 @@ class BatchTask:
         )
 
     def run(self) -> list[dict[str, Any]]:
-        return run_batch(self.tasks, self.backend)
+        return run_batch(self.tasks, self.backend, self.extend_to)
 
 
 def _group_key(task: Any) -> tuple:
@@ -72,8 +73,12 @@ def _group_key(task: Any) -> tuple:
     return (task.seed, task.duration, task.transient, p.dt, p.omega)
 
 
-def run_batch(tasks: Sequence[Any], backend: str = "cpu") -> list[dict[str, Any]]:
-    """The records of ``tasks``, simulated as ensembles of members that share the grid.
+def run_batch(
+    tasks: Sequence[Any], backend: str = "cpu", extend_to: float | None = 120.0
+) -> list[dict[str, Any]]:
+    """The records of ``tasks``, simulated as ensembles of members that share the grid;
+    undetermined members are extended up to ``extend_to`` s recorded (see
+    :func:`chaoscam.classify_ensemble`).
 
     Members of one compiled call must share (seed, duration, transient, dt, omega); the
     tasks are grouped by those, keeping their order within a group.
@@ -98,7 +103,7 @@ def run_batch(tasks: Sequence[Any], backend: str = "cpu") -> list[dict[str, Any]
                 backend=backend,
                 tangent=True,
             )
-            verdicts = member_verdicts(ens, plist)
+            verdicts = member_verdicts(ens, plist, extend_to=extend_to)
         shared = [str(w.message) for w in caught]
         rows_of = ens.sections.groupby("member").indices
         members = ens.members
@@ -197,10 +202,12 @@ def resolve_engine(
             raise SweepError(f"workers = {threads} must be >= 1")
     size = batch_size(base, run[0], run[1], threads or 1)
 
-    def pack(tasks: tuple) -> BatchTask:
-        return BatchTask(tasks, device)
+    extend_to = classify.extend_to
 
-    return Engine("ensemble", ENGINE_CLASSIFIER, pack, size, threads)
+    def pack(tasks: tuple) -> BatchTask:
+        return BatchTask(tasks, device, extend_to)
+
+    return Engine("ensemble", f"{ENGINE_CLASSIFIER}, extend_to={extend_to}", pack, size, threads)
 
 
 def numba_threads(n: int | None):

@@ -120,8 +120,10 @@ def summarize_cells(
         `LABEL_ORDER` (and any other label observed): ``n_L``, ``p_L``, ``p_L_lo``,
         ``p_L_hi``; ``halfwidth`` (the widest interval's half-width); ``lyapunov_mean``,
         ``lyapunov_std`` (sample standard deviation, NaN below two values) and
-        ``lyapunov_n`` over the finite exponents; ``truncated_mass``, the probability mass
-        of Normal(mu, sigma^2) below ``l_min`` that the truncation removed.
+        ``lyapunov_n`` over the finite exponents; ``period``, the most frequent period of
+        the cell's periodic realizations (the smallest on a tie; NA when none);
+        ``truncated_mass``, the probability mass of Normal(mu, sigma^2) below ``l_min``
+        that the truncation removed.
     """
     labels = _labels(rows["label"].unique() if len(rows) else [])
     out = cells.sort_values("cell").reset_index(drop=True).copy()
@@ -160,6 +162,10 @@ def summarize_cells(
     out["lyapunov_mean"] = out["cell"].map(g.mean()).astype(float)
     out["lyapunov_std"] = out["cell"].map(g.std(ddof=1)).astype(float)
     out["lyapunov_n"] = out["cell"].map(g.size()).fillna(0).astype(np.int64)
+    per = rows[rows["label"] == "periodic"] if "period" in rows else rows.iloc[:0]
+    per = per[per["period"].notna()] if len(per) else per
+    mode = per.groupby("cell")["period"].agg(lambda s: s.mode().min()) if len(per) else {}
+    out["period"] = pd.array(out["cell"].map(mode), dtype="Int64")
     mass = rows.groupby("cell")["truncated_mass"].first() if len(rows) else pd.Series(dtype=float)
     out["truncated_mass"] = out["cell"].map(mass).astype(float)
     return out

@@ -41,11 +41,16 @@ class DefaultClassifier:
     check_step : bool
         Re-simulate with dt / 2 and call the verdict undetermined if it changes (twice the
         cost).
+    extend_to : float or None
+        Longest recorded time [s] an undetermined verdict is extended to
+        (``classify_trajectory``'s ``extend_to``; default its ``EXTEND_TO``, 120 s); None
+        never extends. Cap it for models whose runs are expensive (a small dt).
     """
 
     lyapunov: bool = False
     check_step: bool = False
     tangent: bool = True
+    extend_to: float | None = 120.0  # chaoscam.classify.EXTEND_TO (tested equal)
     needs_series = True  # the classifier may use the sampled signal, not only the section
 
     @property
@@ -57,7 +62,11 @@ class DefaultClassifier:
         from ..classify import classify_trajectory
 
         return classify_trajectory(
-            traj, tangent=self.tangent, lyapunov=self.lyapunov, check_step=self.check_step
+            traj,
+            tangent=self.tangent,
+            lyapunov=self.lyapunov,
+            check_step=self.check_step,
+            extend_to=self.extend_to,
         )
 
 

@@ -67,11 +67,11 @@ def test_an_interrupted_ensemble_map_resumes_to_the_same_table(maps, tmp_path, m
     monkeypatch.setattr(_batch, "batch_size", lambda *a, **k: 2)
     real, calls = _batch.run_batch, []
 
-    def interrupt_second(tasks, backend="cpu"):
+    def interrupt_second(tasks, backend="cpu", extend_to=None):
         calls.append(len(tasks))
         if len(calls) == 2:
             raise KeyboardInterrupt
-        return real(tasks, backend)
+        return real(tasks, backend, extend_to)
 
     out = tmp_path / "map.parquet"
     monkeypatch.setattr(_batch, "run_batch", interrupt_second)
@@ -113,3 +113,22 @@ def test_auto_picks_the_process_engine_for_another_classifier():
     m = regime_map(XI, SIGMA, duration=1.0, classify=SpreadClassifier(), workers=1)
     assert m.config["engine"] == "process"
     assert isinstance(m.realizations, pd.DataFrame)
+
+
+def test_the_sweeps_default_extension_is_classify_trajectorys():
+    from chaoscam.classify import EXTEND_TO
+    from chaoscam.sweep._tasks import DefaultClassifier
+
+    assert DefaultClassifier().extend_to == _batch.BatchTask(()).extend_to == EXTEND_TO
+
+
+def test_a_capped_extension_is_recorded_and_honoured():
+    """DefaultClassifier(extend_to=None) on the ensemble engine: never extended, and the
+    configuration says so."""
+    from chaoscam.sweep._tasks import DefaultClassifier
+
+    m = regime_map(Axis("xi", (0.45,)), Axis("l_lambda_sigma", (0.0,)), duration=20.0,
+                   transient=10.0, classify=DefaultClassifier(extend_to=None))
+    assert m.config["engine"] == "ensemble" and "extend_to=None" in m.config["classifier"]
+    row = m.realizations.iloc[0]
+    assert row["label"] == "undetermined" and "run longer" in row["reasons"]
