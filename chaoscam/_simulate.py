@@ -29,6 +29,7 @@ from .model import (
     ParameterError,
     Params,
     contact_angle,
+    contact_period,
     gap,
     normal_force,
     truncated_mass,
@@ -137,20 +138,6 @@ class Trajectory:
         pq.write_table(table.replace_schema_metadata(meta), path)
 
 
-def contact_period(p: Params, l_lambda: float | None = None) -> float:
-    """Period of the linearised contact oscillation, 2 pi sqrt(J / (K_n l_1^2)) [s].
-
-    Evaluated at the initial contact's lever arm; the RK4 step should resolve it with ~20 or
-    more steps.
-    """
-    lam = p.l_lambda if l_lambda is None else l_lambda
-    th = contact_angle(p, 0.0)
-    from .model import lever_arm
-
-    l1 = float(lever_arm(p, 0.0, th))
-    return 2.0 * math.pi * math.sqrt(p.inertia / (p.stiffness_at(lam) * l1 * l1))
-
-
 def _check_run(
     p: Params, duration: float, transient: float, output_dt: float | None, seed, index
 ) -> tuple[int, int]:
@@ -173,7 +160,8 @@ def _check_run(
         p, duration=duration, transient=transient, series=output_dt is not None,
         output_dt=output_dt or 1.0,
     )
-    check_budget(job, what="this run", reduce="duration (or raise output_dt)")
+    check_budget(job, what="this run", reduce="duration (or raise output_dt)",
+                 run=(p, duration, "this run"))
     return seed, index
 
 

@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 
     from .model import Params
 
-__all__ = ["main", "parse_assignments", "UsageError"]
+__all__ = ["main", "parse_assignments", "show_warning", "UsageError"]
 
 # Modules that add subcommands, in the order they are listed by --help.
 _COMMAND_MODULES = (
@@ -124,7 +124,14 @@ def _interrupted() -> int:
     return 130
 
 
+def show_warning(message, *args, **kwargs) -> None:
+    """A warning as one line on stderr, ``chaoscam: warning: ...``, printed at once."""
+    print(f"chaoscam: warning: {message}", file=sys.stderr, flush=True)
+
+
 def _dispatch(argv: list[str] | None) -> int:
+    import warnings
+
     from ._outputs import OutputError
     from .model import ParameterError
 
@@ -134,7 +141,9 @@ def _dispatch(argv: list[str] | None) -> int:
         parser.print_help()
         return 2
     try:
-        code = int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = show_warning  # as they come, not at the end of the run
+            code = int(args.func(args) or 0)
     except (ParameterError, UsageError, OutputError, FileExistsError) as err:
         print(f"chaoscam: error: {err}", file=sys.stderr)
         return 2
