@@ -9,7 +9,8 @@ so small that the adaptive steps shrink to picoseconds), not to predict run time
   period after the transient) and twice that for the table built from them;
 * time, fixed-step RK4: :data:`NS_PER_STEP` per grid step ``dt`` (measured on the default
   model, 2-core machine: 8-65 ns a step from periodic to chaotic responses and without
-  flight merging), divided among the workers;
+  flight merging) and :data:`NS_PER_SERIES_ROW` per series row kept, divided among the
+  workers;
 * time, adaptive path: the larger of that and the cost of following the contact,
   :func:`adaptive_seconds` (its formula and measurements are there).
 
@@ -40,6 +41,10 @@ __all__ = [
 
 NS_PER_STEP = 40.0
 """Wall time of one grid step [ns] used for the estimate (measured 8-65 ns)."""
+
+NS_PER_SERIES_ROW = 2000.0
+"""Wall time of one series row [ns]: the table built from the kernel's samples and its file
+(measured 1.2-1.6 us to build, 0.4 us to write to Parquet)."""
 
 WARN_SECONDS = 3600.0
 """Jobs estimated to take longer than this get a warning [s]."""
@@ -107,12 +112,9 @@ def estimate(
     """Estimated (bytes, seconds) of ``runs`` realizations, ``in_memory`` of them held at once."""
     kept = max(0.0, float(duration) - float(transient))
     rows = kept / params.cam_period
-    if series:
-        rows_series = kept / max(float(output_dt), params.dt)
-        per_run = rows_series * SERIES_BYTES_PER_ROW + rows * SECTION_BYTES_PER_ROW
-    else:
-        per_run = rows * SECTION_BYTES_PER_ROW
-    seconds = runs * run_seconds(params, duration) / max(1, int(workers))
+    rows_series = kept / max(float(output_dt), params.dt) if series else 0.0
+    per_run = rows_series * SERIES_BYTES_PER_ROW + rows * SECTION_BYTES_PER_ROW
+    seconds = runs * run_seconds(params, duration, rows_series) / max(1, int(workers))
     return JobEstimate((per_run * in_memory, seconds))
 
 
@@ -163,21 +165,23 @@ def adaptive_seconds(params, duration: float) -> float:
     return float(duration) * share * ADAPTIVE_COST * tolerance / (tc * tc)
 
 
-def run_seconds(params, duration: float) -> float:
-    """Estimated wall time [s] of one run of ``duration`` [s]: grid steps at
-    :data:`NS_PER_STEP`, or for the adaptive path the larger of that and
-    :func:`adaptive_seconds`."""
-    return max(_costs(params, duration))
+def run_seconds(params, duration: float, series_rows: float = 0.0) -> float:
+    """Estimated wall time [s] of one run of ``duration`` [s] keeping ``series_rows``: grid
+    steps at :data:`NS_PER_STEP` and rows at :data:`NS_PER_SERIES_ROW`, or for the adaptive
+    path the larger of that and :func:`adaptive_seconds`."""
+    return max(_costs(params, duration, series_rows))
 
 
-def _costs(params, duration: float) -> tuple[float, float]:
-    """(grid steps, following the contact) estimates of one run [s]."""
-    grid = float(duration) / params.dt * NS_PER_STEP * 1e-9
+def _costs(params, duration: float, series_rows: float = 0.0) -> tuple[float, float]:
+    """(grid steps and series rows, following the contact) estimates of one run [s]."""
+    grid = (float(duration) / params.dt * NS_PER_STEP + series_rows * NS_PER_SERIES_ROW) * 1e-9
     adaptive = params.integrator == "adaptive"
     return grid, adaptive_seconds(params, duration) if adaptive else 0.0
 
 
-def check_run(params, duration: float, *, what: str = "one run") -> bool:
+def check_run(
+    params, duration: float, *, what: str = "one run", series_rows: float = 0.0
+) -> bool:
     """Refuse one run estimated beyond :data:`RUN_REFUSE_SECONDS`, warn beyond
     :data:`RUN_WARN_SECONDS`; the message names the fields that set the cost.
 
@@ -191,7 +195,7 @@ def check_run(params, duration: float, *, what: str = "one run") -> bool:
     ParameterError
         For a run that would take hours.
     """
-    grid, contact = _costs(params, duration)
+    grid, contact = _costs(params, duration, series_rows)
     seconds = max(grid, contact)
     if seconds <= RUN_WARN_SECONDS:
         return False
@@ -210,6 +214,9 @@ def check_run(params, duration: float, *, what: str = "one run") -> bool:
     else:
         text += f": {float(duration) / params.dt:.3g} steps of dt = {params.dt:g} s"
         remedy = "shorten duration or raise dt"
+        if series_rows:
+            text += f" and {series_rows:.3g} series rows"
+            remedy += " or output_dt"
     if seconds > RUN_REFUSE_SECONDS:
         raise ParameterError(f"{text}: refused; {remedy}")
     warnings.warn(f"{text}; {remedy} for a shorter run", RuntimeWarning, stacklevel=3)
@@ -250,8 +257,8 @@ def check_budget(
         The job in words ("this run", "this regime map").
     reduce : str
         The settings to reduce, for the message ("--duration or --output-dt").
-    run : (params, duration, what), optional
-        One run of the job, for :func:`check_run`.
+    run : dict, optional
+        One run of the job: the keyword arguments of :func:`check_run`.
     """
     free = available_memory()
     if not math.isfinite(job.bytes) or job.bytes > free:
@@ -259,7 +266,7 @@ def check_budget(
             f"{what} needs about {_human_bytes(job.bytes)} of memory and this machine has "
             f"{_human_bytes(free)} available: reduce {reduce}"
         )
-    if run is not None and check_run(*run[:2], what=run[2]):
+    if run is not None and check_run(**run):
         return
     if job.seconds > WARN_SECONDS:
         warnings.warn(

@@ -220,7 +220,7 @@ def _check_budget(params, duration: float, transient: float, members: int, chunk
     job = JobEstimate((one.bytes * (members + min(chunk, members)),
                        one.seconds * members / default_workers()))
     check_budget(job, what="this ensemble", reduce="--members or --duration",
-                 run=(params, duration, "each member"))
+                 run=dict(params=params, duration=duration, what="each member"))
 
 
 def _atomic_text(path: Path, text: str) -> None:

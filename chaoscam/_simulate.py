@@ -156,12 +156,13 @@ def _check_run(
         )
     if output_dt is not None and not (output_dt >= p.dt and math.isfinite(output_dt)):
         raise ParameterError(f"output_dt = {output_dt!r} s must be >= dt = {p.dt} s")
+    series_rows = (duration - transient) / output_dt if output_dt is not None else 0.0
     job = estimate(
         p, duration=duration, transient=transient, series=output_dt is not None,
         output_dt=output_dt or 1.0,
     )
     check_budget(job, what="this run", reduce="duration (or raise output_dt)",
-                 run=(p, duration, "this run"))
+                 run=dict(params=p, duration=duration, what="this run", series_rows=series_rows))
     return seed, index
 
 
