@@ -187,3 +187,25 @@ def test_series_too_fine_for_its_length_is_announced_before_the_run(monkeypatch)
 
     with pytest.warns(RuntimeWarning, match=r"will take about .*1.5e\+08 series rows.*output_dt"):
         _check_run(Params(), 300.0, 0.0, 2e-6, 0, 0)
+
+
+def test_left_the_model_labelled_alike_in_ensembles_and_sweeps():
+    """dt = 0.01 s leaves the model (LEFT_REACH): ensemble members and regime-map runs with
+    the default (series) classifier, dt swept as an axis, both say "left_reach"."""
+    from chaoscam.integrate import simulate_ensemble
+
+    ens = simulate_ensemble(Params(dt=0.01), [0, 1], duration=0.5, classify=True)
+    assert list(ens.members["label"]) == ["left_reach", "left_reach"]
+    with pytest.warns(RuntimeWarning):
+        rm = regime_map(("l_lambda", [0.008]), ("dt", [0.01]), duration=0.5, workers=1)
+    assert list(rm.realizations["label"]) == ["left_reach"]
+
+
+def test_failing_classifier_is_one_line_exit_1(tmp_path, capsys):
+    """A classifier that raises: exit 1 and one line saying how to reproduce, no traceback."""
+    args = [*MAP, "--classifier", "tests.sweep._helpers:FailingClassifier",
+            "--out", str(tmp_path / "m.parquet")]
+    assert main(args) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("chaoscam: error: task") and "this classifier has a bug" in err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1

@@ -123,6 +123,10 @@ def verdict_fields(verdict: Any) -> dict[str, Any]:
     }
 
 
+OUTPUT_DT = 1e-3
+"""Series sampling of a sweep's runs [s] (simulate's default), or dt where dt is coarser."""
+
+
 def _run(params: Params, task: Any) -> tuple[Any, dict[str, Any]]:
     """Simulate and classify; a run that did not end normally is labelled by its status."""
     with warnings.catch_warnings(record=True) as caught:
@@ -134,6 +138,7 @@ def _run(params: Params, task: Any) -> tuple[Any, dict[str, Any]]:
             seed=task.seed,
             index=task.sim_index,
             series=task.series,
+            output_dt=max(OUTPUT_DT, params.dt),  # a swept dt may exceed it
             tangent=bool(getattr(task.classify, "needs_tangent", False))
             and params.integrator == "rk4",
         )
