@@ -1,19 +1,24 @@
 """Memory and time of a job, estimated before it starts: refuse what cannot fit, warn about hours.
 
 The estimates are coarse upper-side guesses, meant to catch absurd requests (a duration of
-1e9 s, a series sampled every microsecond for minutes, a billion realizations), not to
-predict run times:
+1e9 s, a series sampled every microsecond for minutes, a billion realizations, an inertia
+so small that the adaptive steps shrink to picoseconds), not to predict run times:
 
 * memory: 8 bytes per number kept — the series (``(duration - transient) / output_dt``
   rows of 4 columns, 8 in the table written), the stroboscopic section (one row of 5 per cam
   period after the transient) and twice that for the table built from them;
-* time: :data:`NS_PER_STEP` per grid step ``dt`` (measured on the default model, 2-core
-  machine: 8-65 ns a step from periodic to chaotic responses and without flight merging),
-  divided among the workers.
+* time, fixed-step RK4: :data:`NS_PER_STEP` per grid step ``dt`` (measured on the default
+  model, 2-core machine: 8-65 ns a step from periodic to chaotic responses and without
+  flight merging) and :data:`NS_PER_SERIES_ROW` per series row kept, divided among the
+  workers;
+* time, adaptive path: the larger of that and the cost of following the contact,
+  :func:`adaptive_seconds` (its formula and measurements are there).
 
 A job whose memory exceeds what this machine has available is refused with a
 :class:`~chaoscam.model.ParameterError` naming the setting to reduce; one estimated to take
-more than :data:`WARN_SECONDS` gets a warning with the estimate.
+more than :data:`WARN_SECONDS` gets a warning with the estimate. One run (a realization) is
+judged on its own too (:func:`check_run`): refused beyond :data:`RUN_REFUSE_SECONDS`, warned
+about beyond :data:`RUN_WARN_SECONDS`, naming the fields that set its cost.
 """
 
 from __future__ import annotations
@@ -24,13 +29,43 @@ import warnings
 
 from .model import ParameterError
 
-__all__ = ["estimate", "check_budget", "available_memory", "JobEstimate"]
+__all__ = [
+    "estimate",
+    "check_budget",
+    "check_run",
+    "run_seconds",
+    "adaptive_seconds",
+    "available_memory",
+    "JobEstimate",
+]
 
 NS_PER_STEP = 40.0
 """Wall time of one grid step [ns] used for the estimate (measured 8-65 ns)."""
 
+NS_PER_SERIES_ROW = 2000.0
+"""Wall time of one series row [ns]: the table built from the kernel's samples and its file
+(measured 1.2-1.6 us to build, 0.4 us to write to Parquet)."""
+
 WARN_SECONDS = 3600.0
 """Jobs estimated to take longer than this get a warning [s]."""
+
+RUN_WARN_SECONDS = 60.0
+"""One run estimated to take longer than this gets a warning [s]."""
+
+RUN_REFUSE_SECONDS = 2 * 3600.0
+"""One run estimated to take longer than this is refused [s]."""
+
+ADAPTIVE_COST = 1e-9
+"""Adaptive path in persistent contact: wall seconds per model second times T_c^2 [s^2]
+(measured 0.9e-10 to 2.1e-9 at rtol = 1e-12; see :func:`adaptive_seconds`)."""
+
+ADAPTIVE_RTOL_EXPONENT = 0.6
+"""How the adaptive path's cost in contact scales with 1 / rtol (measured 0.6 from
+rtol = 1e-13 to 1e-8)."""
+
+ADAPTIVE_FLIGHT_SHARE = 0.1
+"""Cost of a response with flights relative to one in persistent contact (measured 0.006 to
+0.35: contact fractions 0.002 to 0.5)."""
 
 SERIES_BYTES_PER_ROW = 8 * 8  # the kernel's 4 columns and the 8 of the written table
 SECTION_BYTES_PER_ROW = 3 * 5 * 8  # the kernel's buffer, the table and its copy
@@ -77,14 +112,115 @@ def estimate(
     """Estimated (bytes, seconds) of ``runs`` realizations, ``in_memory`` of them held at once."""
     kept = max(0.0, float(duration) - float(transient))
     rows = kept / params.cam_period
-    if series:
-        rows_series = kept / max(float(output_dt), params.dt)
-        per_run = rows_series * SERIES_BYTES_PER_ROW + rows * SECTION_BYTES_PER_ROW
-    else:
-        per_run = rows * SECTION_BYTES_PER_ROW
-    steps = float(duration) / params.dt
-    seconds = runs * steps * NS_PER_STEP * 1e-9 / max(1, int(workers))
+    rows_series = kept / max(float(output_dt), params.dt) if series else 0.0
+    per_run = rows_series * SERIES_BYTES_PER_ROW + rows * SECTION_BYTES_PER_ROW
+    seconds = runs * run_seconds(params, duration, rows_series) / max(1, int(workers))
     return JobEstimate((per_run * in_memory, seconds))
+
+
+def persistent_contact(params) -> bool:
+    """Whether gravity holds the follower on the cam: m g l / (2 J) >= e omega^2 / l_1.
+
+    The left side is the angular acceleration gravity gives the rod, the right the largest
+    the cam asks of it (its centre's acceleration e omega^2 over the lever arm l_1 of the
+    initial contact). Above it the follower rides the cam (contact fraction ~1, measured);
+    below it the response is flights and impacts (contact fractions 0.002-0.5, measured).
+    """
+    from .model import contact_angle, lever_arm
+
+    l1 = float(lever_arm(params, 0.0, contact_angle(params, 0.0)))
+    gravity = params.m * params.g * params.l / (2.0 * params.inertia)
+    return gravity * l1 >= params.e * params.omega**2
+
+
+def adaptive_seconds(params, duration: float) -> float:
+    """Wall time [s] the adaptive path needs to follow the contact for ``duration`` [s].
+
+    ``t_wall = duration * s * ADAPTIVE_COST * (1e-12 / rtol)^ADAPTIVE_RTOL_EXPONENT / T_c^2``
+
+    with ``T_c = 2 pi sqrt(J / (K_n l_1^2))`` the contact's natural period
+    (:func:`chaoscam.model.contact_period`) and ``s = 1`` in persistent contact
+    (:func:`persistent_contact`), else :data:`ADAPTIVE_FLIGHT_SHARE`. The error control
+    must resolve the contact oscillation, so its steps shrink with ``T_c``; measured on this
+    2-core machine, the cost per model second grows as ``1 / T_c^2`` (not ``1 / T_c``: the
+    accepted steps per contact period grow as the period shrinks) — ``t_wall T_c^2 /
+    duration`` stayed within 0.9e-10 to 2.1e-9 s^2 at rtol = 1e-12 over J = 1e-9 to 1e-2
+    kg m^2, the Hertz (l_lambda = 0.002-0.018 m) and fractal stiffness and omega = 15-28.7
+    rad/s in persistent contact, and within 6e-12 to 3.5e-10 s^2 for responses with flights
+    (default model: 1.4e-10). J = 1e-9 kg m^2 gives T_c = 1.4e-8 s and about 530 s per 1e-4 s
+    of model time (measured 85-110 s), where fixed-step RK4 leaves the model at once.
+    Limits: an order of magnitude either way; chattering between contact and micro-flights
+    can cost more.
+    """
+    from .model import contact_period
+
+    try:
+        tc = contact_period(params)
+        share = 1.0 if persistent_contact(params) else ADAPTIVE_FLIGHT_SHARE
+    except (ArithmeticError, ValueError):  # no contact geometry to judge by
+        return 0.0
+    if not (math.isfinite(tc) and tc > 0.0):
+        return 0.0
+    tolerance = (1e-12 / params.rtol) ** ADAPTIVE_RTOL_EXPONENT
+    return float(duration) * share * ADAPTIVE_COST * tolerance / (tc * tc)
+
+
+def run_seconds(params, duration: float, series_rows: float = 0.0) -> float:
+    """Estimated wall time [s] of one run of ``duration`` [s] keeping ``series_rows``: grid
+    steps at :data:`NS_PER_STEP` and rows at :data:`NS_PER_SERIES_ROW`, or for the adaptive
+    path the larger of that and :func:`adaptive_seconds`."""
+    return max(_costs(params, duration, series_rows))
+
+
+def _costs(params, duration: float, series_rows: float = 0.0) -> tuple[float, float]:
+    """(grid steps and series rows, following the contact) estimates of one run [s]."""
+    grid = (float(duration) / params.dt * NS_PER_STEP + series_rows * NS_PER_SERIES_ROW) * 1e-9
+    adaptive = params.integrator == "adaptive"
+    return grid, adaptive_seconds(params, duration) if adaptive else 0.0
+
+
+def check_run(
+    params, duration: float, *, what: str = "one run", series_rows: float = 0.0
+) -> bool:
+    """Refuse one run estimated beyond :data:`RUN_REFUSE_SECONDS`, warn beyond
+    :data:`RUN_WARN_SECONDS`; the message names the fields that set the cost.
+
+    Returns
+    -------
+    bool
+        Whether it warned.
+
+    Raises
+    ------
+    ParameterError
+        For a run that would take hours.
+    """
+    grid, contact = _costs(params, duration, series_rows)
+    seconds = max(grid, contact)
+    if seconds <= RUN_WARN_SECONDS:
+        return False
+    text = f"{what} (duration = {float(duration):g} s) will take about {_human_seconds(seconds)}"
+    if contact > grid:
+        from .model import contact_period
+
+        text += (
+            f" with integrator = 'adaptive': the contact's period 2 pi sqrt(J / (K_n l_1^2))"
+            f" = {contact_period(params):.2g} s (J = {params.inertia:.3g} kg m^2, K_n = "
+            f"{params.stiffness_at(params.l_lambda):.3g} N/m) forces steps that short at "
+            f"rtol = {params.rtol:g}"
+        )
+        remedy = "raise J, lower the stiffness (l_lambda, stiffness), loosen rtol or shorten "
+        remedy += "duration"
+    else:
+        text += f": {float(duration) / params.dt:.3g} steps of dt = {params.dt:g} s"
+        remedy = "shorten duration or raise dt"
+        if series_rows:
+            text += f" and {series_rows:.3g} series rows"
+            remedy += " or output_dt"
+    if seconds > RUN_REFUSE_SECONDS:
+        raise ParameterError(f"{text}: refused; {remedy}")
+    warnings.warn(f"{text}; {remedy} for a shorter run", RuntimeWarning, stacklevel=3)
+    return True
 
 
 def _human_bytes(n: float) -> str:
@@ -96,6 +232,8 @@ def _human_bytes(n: float) -> str:
 
 
 def _human_seconds(s: float) -> str:
+    if s < 120:
+        return f"{s:.3g} s"
     if s < 3600:
         return f"{s / 60:.3g} min"
     if s < 86400 * 3:
@@ -105,8 +243,11 @@ def _human_seconds(s: float) -> str:
     return f"{s / (86400 * 365):.3g} years"
 
 
-def check_budget(job: JobEstimate, *, what: str, reduce: str) -> None:
-    """Refuse a job that cannot fit in memory; warn about one that will take hours.
+def check_budget(
+    job: JobEstimate, *, what: str, reduce: str, run: tuple | None = None
+) -> None:
+    """Refuse a job that cannot fit in memory; judge one run of it (:func:`check_run`);
+    warn about a job that will take hours (unless its run was warned about already).
 
     Parameters
     ----------
@@ -116,6 +257,8 @@ def check_budget(job: JobEstimate, *, what: str, reduce: str) -> None:
         The job in words ("this run", "this regime map").
     reduce : str
         The settings to reduce, for the message ("--duration or --output-dt").
+    run : dict, optional
+        One run of the job: the keyword arguments of :func:`check_run`.
     """
     free = available_memory()
     if not math.isfinite(job.bytes) or job.bytes > free:
@@ -123,10 +266,13 @@ def check_budget(job: JobEstimate, *, what: str, reduce: str) -> None:
             f"{what} needs about {_human_bytes(job.bytes)} of memory and this machine has "
             f"{_human_bytes(free)} available: reduce {reduce}"
         )
+    if run is not None and check_run(**run):
+        return
     if job.seconds > WARN_SECONDS:
         warnings.warn(
-            f"{what} will take about {_human_seconds(job.seconds)} (estimated at "
-            f"{NS_PER_STEP:g} ns per step of dt); reduce {reduce} for a shorter run",
+            f"{what} will take about {_human_seconds(job.seconds)} (a coarse estimate: "
+            f"{NS_PER_STEP:g} ns per step of dt, more on the adaptive path in contact); "
+            f"reduce {reduce} for a shorter run",
             RuntimeWarning,
             stacklevel=3,
         )

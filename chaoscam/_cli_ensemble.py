@@ -222,7 +222,8 @@ def _check_budget(params, duration: float, transient: float, members: int, chunk
     one = estimate(params, duration=duration, transient=transient)
     job = JobEstimate((one.bytes * (members + min(chunk, members)),
                        one.seconds * members / default_workers()))
-    check_budget(job, what="this ensemble", reduce="--members or --duration")
+    check_budget(job, what="this ensemble", reduce="--members or --duration",
+                 run=dict(params=params, duration=duration, what="each member"))
 
 
 def _atomic_text(path: Path, text: str) -> None:

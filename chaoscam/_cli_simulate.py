@@ -36,7 +36,7 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from ._outputs import atomic_path, check_output
     from ._simulate import simulate
-    from .cli import parse_assignments
+    from .cli import parse_assignments, show_warning
 
     out = check_output(args.out, force=args.force, suffixes=(".parquet", ".csv"))
     section = check_output(args.section, flag="--section", force=args.force)
@@ -50,12 +50,16 @@ def run(args: argparse.Namespace) -> int:
         series=out is not None,
         output_dt=args.output_dt,
     )
-    with warnings.catch_warnings(record=True) as caught:
+    notes: list[str] = []
+
+    def note(message, *rest, **kwargs) -> None:  # printed at once: a time estimate comes first
+        notes.append(str(message))
+        show_warning(message)
+
+    with warnings.catch_warnings():
         warnings.simplefilter("always")
+        warnings.showwarning = note
         traj = simulate(params, **settings)
-    notes = [str(w.message) for w in caught]
-    for note in notes:
-        print(f"chaoscam: warning: {note}", file=sys.stderr)
     print(traj.summary())
     for path, label, write in (
         (out, "series", _series_writer(traj, out)),

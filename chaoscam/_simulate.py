@@ -29,6 +29,7 @@ from .model import (
     ParameterError,
     Params,
     contact_angle,
+    contact_period,
     gap,
     normal_force,
     truncated_mass,
@@ -137,20 +138,6 @@ class Trajectory:
         pq.write_table(table.replace_schema_metadata(meta), path)
 
 
-def contact_period(p: Params, l_lambda: float | None = None) -> float:
-    """Period of the linearised contact oscillation, 2 pi sqrt(J / (K_n l_1^2)) [s].
-
-    Evaluated at the initial contact's lever arm; the RK4 step should resolve it with ~20 or
-    more steps.
-    """
-    lam = p.l_lambda if l_lambda is None else l_lambda
-    th = contact_angle(p, 0.0)
-    from .model import lever_arm
-
-    l1 = float(lever_arm(p, 0.0, th))
-    return 2.0 * math.pi * math.sqrt(p.inertia / (p.stiffness_at(lam) * l1 * l1))
-
-
 def resolution_warning(p: Params) -> str | None:
     """The warning for a fixed step too coarse for the contact oscillation (fewer than 20
     steps per contact period), or None. The adaptive path's steps follow the contact."""
@@ -182,11 +169,13 @@ def _check_run(
         )
     if output_dt is not None and not (output_dt >= p.dt and math.isfinite(output_dt)):
         raise ParameterError(f"output_dt = {output_dt!r} s must be >= dt = {p.dt} s")
+    series_rows = (duration - transient) / output_dt if output_dt is not None else 0.0
     job = estimate(
         p, duration=duration, transient=transient, series=output_dt is not None,
         output_dt=output_dt or 1.0,
     )
-    check_budget(job, what="this run", reduce="duration (or raise output_dt)")
+    check_budget(job, what="this run", reduce="duration (or raise output_dt)",
+                 run=dict(params=p, duration=duration, what="this run", series_rows=series_rows))
     return seed, index
 
 

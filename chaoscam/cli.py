@@ -4,17 +4,25 @@ Each subcommand lives with the layer it drives; this module only wires them. A c
 exposes ``register(subparsers)``, which adds its parsers and sets ``func`` on them; ``func``
 takes the parsed arguments and returns an exit code. Bad input exits with code 2 and a message
 naming the field.
+
+Importing this module loads nothing but :mod:`sys`: everything else (argparse, numpy, the
+kernels, the command modules) is imported inside :func:`main`, where a Ctrl-C is caught, so
+a Ctrl-C during start-up ends with one line and exit 130 like one during the work. What runs
+before (the interpreter's own start-up and ``import chaoscam``, about a millisecond) is
+outside the command's reach.
 """
 
 from __future__ import annotations
 
-import argparse
-import importlib
 import sys
 
-from .model import ParameterError, Params
+TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing (start-up time)
+if TYPE_CHECKING:
+    import argparse
 
-__all__ = ["main", "parse_assignments", "UsageError"]
+    from .model import Params
+
+__all__ = ["main", "parse_assignments", "show_warning", "UsageError"]
 
 # Modules that add subcommands, in the order they are listed by --help.
 _COMMAND_MODULES = (
@@ -32,6 +40,8 @@ class UsageError(Exception):
 
 def parse_assignments(items: list[str] | None, base: Params | None = None) -> Params:
     """Params from ``--set NAME=VALUE`` items."""
+    from .model import Params
+
     pairs: dict[str, str] = {}
     for item in items or []:
         name, sep, value = item.partition("=")
@@ -42,6 +52,9 @@ def parse_assignments(items: list[str] | None, base: Params | None = None) -> Pa
 
 
 def build_parser() -> argparse.ArgumentParser:
+    import argparse
+    import importlib
+
     parser = argparse.ArgumentParser(
         prog="chaoscam",
         description="Stochastic dynamics of a cam-follower oblique impact system.",
@@ -75,29 +88,52 @@ def main(argv: list[str] | None = None) -> int:
 
     0 success, 1 a run that could not do what was asked (its cause printed), 2 bad input
     (a message naming the field or path, never a traceback), 130 Ctrl-C and 143 SIGTERM
-    (both after saving finished work and saying how to resume).
+    (both after saving finished work and saying how to resume). A Ctrl-C at any point of
+    this function, the imports of start-up included, gives one line and 130.
     """
-    import signal
-    import threading
-
     previous = None
     _SIGTERM["seen"] = False
-    if threading.current_thread() is threading.main_thread():
-        previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
+        import signal
+        import threading
+
+        if threading.current_thread() is threading.main_thread():
+            previous = signal.signal(signal.SIGTERM, _on_sigterm)
         code = _dispatch(argv)
     except KeyboardInterrupt:
-        print("chaoscam: " + ("terminated" if _SIGTERM["seen"] else "interrupted"),
-              file=sys.stderr)
-        code = 130
+        code = _interrupted()
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
     return 143 if code == 130 and _SIGTERM["seen"] else code
 
 
+def _interrupted() -> int:
+    """Say "interrupted" (or "terminated") once; a second Ctrl-C meanwhile is ignored."""
+    import signal
+    import threading
+
+    main_thread = threading.current_thread() is threading.main_thread()
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
+    try:
+        print("chaoscam: " + ("terminated" if _SIGTERM["seen"] else "interrupted"),
+              file=sys.stderr)
+    finally:
+        if before is not None:
+            signal.signal(signal.SIGINT, before)
+    return 130
+
+
+def show_warning(message, *args, **kwargs) -> None:
+    """A warning as one line on stderr, ``chaoscam: warning: ...``, printed at once."""
+    print(f"chaoscam: warning: {message}", file=sys.stderr, flush=True)
+
+
 def _dispatch(argv: list[str] | None) -> int:
+    import warnings
+
     from ._outputs import OutputError
+    from .model import ParameterError
 
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -105,7 +141,9 @@ def _dispatch(argv: list[str] | None) -> int:
         parser.print_help()
         return 2
     try:
-        code = int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = show_warning  # as they come, not at the end of the run
+            code = int(args.func(args) or 0)
     except (ParameterError, UsageError, OutputError, FileExistsError) as err:
         print(f"chaoscam: error: {err}", file=sys.stderr)
         return 2

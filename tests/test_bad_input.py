@@ -48,6 +48,10 @@ CLI_CASES = {
                                "OUT.parquet"], "memory"),
     "ensemble seed -1": ([*ENS, "--seed", "-1", "--out", "OUT.parquet"], "seed"),
     "paper workers 0": (["paper", "--workers", "0", "--out", "OUT.html"], "--workers"),
+    "map duration 1e9": ([*MAP, "--duration", "1e9", "--out", "OUT.parquet"], "memory"),
+    "bifurcation duration 1e9": ([*BIF, "--duration", "1e9", "--out", "OUT.parquet"], "memory"),
+    "map seed -1": ([*MAP, "--seed", "-1", "--out", "OUT.parquet"], "seed"),
+    "bifurcation seed -1": ([*BIF, "--seed", "-1", "--out", "OUT.parquet"], "seed"),
 }
 
 
@@ -161,3 +165,47 @@ def test_simulate_csv_written_whole(tmp_path):
     out = tmp_path / "s.csv"
     assert main(["simulate", "--duration", "0.05", "--out", str(out)]) == 0
     assert len(pd.read_csv(out)) == 51
+
+
+@pytest.mark.parametrize("x", [[], [1.0]])
+def test_classify_signal_on_too_little_data(x):
+    """classify_signal on an empty or one-sample signal: "too little data", not a verdict."""
+    from chaoscam.classify import classify_signal
+
+    with pytest.raises(ValueError, match="too little data"):
+        classify_signal(np.array(x), 0.01)
+
+
+def test_series_too_fine_for_its_length_is_announced_before_the_run(monkeypatch):
+    """300 s sampled every 2e-6 s (1.5e8 rows, ~10 GB) on a machine with the memory for it:
+    a warning with the estimate and the fields to change, given while checking the settings
+    (before any step is taken)."""
+    import chaoscam._budget
+    from chaoscam._simulate import _check_run
+
+    monkeypatch.setattr(chaoscam._budget, "available_memory", lambda: math.inf)
+
+    with pytest.warns(RuntimeWarning, match=r"will take about .*1.5e\+08 series rows.*output_dt"):
+        _check_run(Params(), 300.0, 0.0, 2e-6, 0, 0)
+
+
+def test_left_the_model_labelled_alike_in_ensembles_and_sweeps():
+    """dt = 0.01 s leaves the model (LEFT_REACH): ensemble members and regime-map runs with
+    the default (series) classifier, dt swept as an axis, both say "left_reach"."""
+    from chaoscam.integrate import simulate_ensemble
+
+    ens = simulate_ensemble(Params(dt=0.01), [0, 1], duration=0.5, classify=True)
+    assert list(ens.members["label"]) == ["left_reach", "left_reach"]
+    with pytest.warns(RuntimeWarning):
+        rm = regime_map(("l_lambda", [0.008]), ("dt", [0.01]), duration=0.5, workers=1)
+    assert list(rm.realizations["label"]) == ["left_reach"]
+
+
+def test_failing_classifier_is_one_line_exit_1(tmp_path, capsys):
+    """A classifier that raises: exit 1 and one line saying how to reproduce, no traceback."""
+    args = [*MAP, "--classifier", "tests.sweep._helpers:FailingClassifier",
+            "--out", str(tmp_path / "m.parquet")]
+    assert main(args) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("chaoscam: error: task") and "this classifier has a bug" in err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1

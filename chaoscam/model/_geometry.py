@@ -11,6 +11,8 @@ direction ``u = (cos theta_f, sin theta_f)``, upward normal ``n = (-sin theta_f,
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ._params import Params
@@ -24,6 +26,7 @@ __all__ = [
     "contact_angle",
     "contact_angle_rate",
     "slip_speed",
+    "contact_period",
 ]
 
 
@@ -86,3 +89,15 @@ def slip_speed(p: Params, t, theta_f, omega_f):
     nx, ny = -np.sin(theta_f), np.cos(theta_f)
     bx, by = cx + p.R * nx, cy + p.R * ny
     return p.r * omega_f - p.omega * (-by * np.cos(theta_f) + bx * np.sin(theta_f))
+
+
+def contact_period(p: Params, l_lambda: float | None = None) -> float:
+    """Period of the linearised contact oscillation, 2 pi sqrt(J / (K_n l_1^2)) [s].
+
+    Evaluated at the initial contact's lever arm; the RK4 step should resolve it with ~20 or
+    more steps, and the adaptive path's cost grows as its inverse square
+    (:func:`chaoscam._budget.adaptive_seconds`).
+    """
+    lam = p.l_lambda if l_lambda is None else l_lambda
+    l1 = float(lever_arm(p, 0.0, contact_angle(p, 0.0)))
+    return 2.0 * math.pi * math.sqrt(p.inertia / (p.stiffness_at(lam) * l1 * l1))

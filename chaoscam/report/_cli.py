@@ -92,7 +92,6 @@ def run_paper(args: argparse.Namespace) -> int:
     from ._paper import FIGURES
     from ._paper import run_paper as _run
 
-    _check_out(args.out, args.force)
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers {args.workers}: must be >= 1")
     figures = None
@@ -118,6 +117,7 @@ def run_paper(args: argparse.Namespace) -> int:
         workers=args.workers,
         command=command,
         echo=True,
+        force=args.force,
     )
     print(f"report: {args.out}")
     return 0

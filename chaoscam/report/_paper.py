@@ -20,10 +20,52 @@ import pandas as pd
 from ._figures import png_bytes, png_data_uri, response_figure
 from ._html import Comparison, FigureItem
 
-__all__ = ["FIGURES", "FigureResult", "run_paper"]
+__all__ = ["FIGURES", "FigureResult", "check_paper_outputs", "data_files", "run_paper"]
 
 MU_PAPER = (0.008, 0.015, 0.023)
 """The mean line lengths of the paper's Figs. 7-10 [m]."""
+
+SIGMA_MAX = 0.004
+"""The largest line-length spread of Figs. 7-10 [m]."""
+
+G_FIG6 = (1e-9, 1e-10)
+"""The fractal roughnesses of Fig. 6 [m]."""
+
+
+def _fig6_tag(g: float) -> str:
+    return f"fig6-G{g:g}"
+
+
+def _fig7_trajectory(mu: float, sigma: float) -> str:
+    return f"fig7-10_mu{mu:g}_sigma{sigma:g}"
+
+
+SENSITIVITY = 0
+"""The stage number of the sensitivity sweeps (not a paper figure; run with every figure)."""
+
+
+def data_files(number: int) -> list[str]:
+    """The files Fig. ``number``'s script (or, for :data:`SENSITIVITY`, the sensitivity
+    stage) writes into the data folder (``paper-data/``): the ``chaoscam paper`` command
+    checks every one of them before any work starts."""
+    bif = (".parquet", ".verdicts.parquet", ".png")
+    if number == 3:
+        return ["fig3.csv", "fig3.png"]
+    if number == 4:
+        return [f"fig4{ext}" for ext in bif]
+    if number == 5:
+        return ["fig5.csv", "fig5.png"]
+    if number == 6:
+        return [f"{_fig6_tag(g)}{ext}" for g in G_FIG6 for ext in bif]
+    if number == SENSITIVITY:
+        return [f"sensitivity-{name}{ext}" for name in ("stiffness", "xi") for ext in bif] + [
+            f"sensitivity-omega-xi{ext}" for ext in (".parquet", ".cells.parquet", ".png")
+        ]
+    names = [f"fig7-10{ext}" for ext in (".parquet", ".cells.parquet", ".png")]
+    for mu in MU_PAPER:
+        for sigma in (0.0, SIGMA_MAX):
+            names += [f"{_fig7_trajectory(mu, sigma)}{ext}" for ext in (".parquet", ".png")]
+    return names
 
 
 @dataclass
@@ -48,9 +90,19 @@ class FigureResult:
 
 
 def _save(fig, outdir: Path, name: str) -> Path:
+    from .._outputs import atomic_write_bytes
+
     path = outdir / f"{name}.png"
-    path.write_bytes(png_bytes(fig, dpi=110))
+    atomic_write_bytes(path, png_bytes(fig, dpi=110))
     return path
+
+
+def _write(path: Path, write) -> None:
+    """``write(tmp)`` to a temporary name, then moved into place (whole or absent)."""
+    from .._outputs import atomic_path
+
+    with atomic_path(path) as tmp:
+        write(tmp)
 
 
 def _runs(labels: list[str]) -> list[tuple[str, int]]:
@@ -88,7 +140,7 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
     p = Params(l_lambda=mu, l_lambda_sigma=sigma, resample="interval")
     traj = simulate(p, duration=4.0 if quick else 20.0, seed=3)
     s = traj.series[["t", "l_lambda"]]
-    s.to_csv(outdir / "fig3.csv", index=False)
+    _write(outdir / "fig3.csv", lambda tmp: s.to_csv(tmp, index=False))
     fig = Figure(figsize=(9, 3.6), layout="constrained")
     ax = fig.subplots()
     ax.plot(s["t"], s["l_lambda"], lw=0.7, color="#0072B2", drawstyle="steps-post")
@@ -215,7 +267,7 @@ def fig5(quick: bool, outdir: Path, workers=None) -> FigureResult:
                 kn = float("nan")
             rows.append({"G": g, "D": float(d), "K_n": kn})
     df = pd.DataFrame(rows)
-    df.to_csv(outdir / "fig5.csv", index=False)
+    _write(outdir / "fig5.csv", lambda tmp: df.to_csv(tmp, index=False))
     fig = Figure(figsize=(8, 4.5), layout="constrained")
     ax = fig.subplots()
     for g, sub in df.groupby("G", sort=False):
@@ -269,10 +321,10 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     from ._sweep_figures import bifurcation_figure
 
     res = FigureResult(6)
-    duration, transient = (12.0, 6.0) if quick else (20.0, 10.0)
+    duration, transient = (8.0, 4.0) if quick else (20.0, 10.0)
     values = "1.36:1.56:6" if quick else "1.36:1.56:21"
     found = []
-    for g in (1e-9, 1e-10):
+    for g in G_FIG6:
         stiffest = Params(stiffness="fractal", D=1.56, G=g)
         dt = float(f"{contact_period(stiffest) / 40:.1e}")  # >= 40 steps per contact period
         base = Params(stiffness="fractal", G=g, dt=dt)
@@ -285,7 +337,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
             classify=_classifier(quick) if not quick else _classifier_no_extension(),
             workers=workers,
         )
-        tag = f"fig6-G{g:g}"
+        tag = _fig6_tag(g)
         path = outdir / f"{tag}.parquet"
         bif.to_parquet(path)
         _save(bifurcation_figure(bif.points), outdir, tag)
@@ -323,8 +375,8 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
     from ._sweep_figures import regime_map_figure
 
     res = FigureResult(7)
-    sigmas = tuple(np.round(np.linspace(0.0, 0.004, 5 if quick else 9), 6))
-    n = 16 if quick else 40
+    sigmas = tuple(np.round(np.linspace(0.0, SIGMA_MAX, 5 if quick else 9), 6))
+    n = 8 if quick else 40
     rm = regime_map(
         Axis("l_lambda", MU_PAPER),
         Axis("l_lambda_sigma", sigmas),
@@ -343,8 +395,8 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
             traj = simulate(
                 Params(l_lambda=mu, l_lambda_sigma=sigma), duration=20.0, transient=10.0, seed=7
             )
-            name = f"fig7-10_mu{mu:g}_sigma{sigma:g}"
-            traj.to_parquet(outdir / f"{name}.parquet")
+            name = _fig7_trajectory(mu, sigma)
+            _write(outdir / f"{name}.parquet", traj.to_parquet)
             _save(response_figure(traj, title=f"μ = {mu} m, σ = {sigma} m"), outdir, name)
             res.trajectories.append((str(outdir / f"{name}.parquet"), traj))
     c = rm.cells.set_index(["l_lambda", "l_lambda_sigma"])
@@ -440,13 +492,44 @@ FIGURES = {3: fig3, 4: fig4, 5: fig5, 6: fig6, 7: fig7_10, 8: fig7_10, 9: fig7_1
 """Figure number -> script function (Figs. 7-10 share one)."""
 
 
+def check_paper_outputs(out: str | Path, figures=None, *, force: bool = False) -> Path:
+    """Check the report and every data file the chosen figures will write, before any work.
+
+    The report ``out`` (``.html``) and, in ``OUT_DIR/paper-data``, each file of
+    :func:`data_files`: an existing one is refused unless ``force``, naming it; a missing or
+    read-only folder, or a ``paper-data`` that is not a folder, is refused too. Returns the
+    data folder. Raises :class:`chaoscam._outputs.OutputError`.
+    """
+    from .._outputs import OutputError, check_output
+
+    out = Path(out)
+    check_output(out, force=force, suffixes=(".html",))
+    outdir = out.parent / "paper-data"
+    if outdir.exists() and not outdir.is_dir():
+        raise OutputError(f"{outdir} exists and is not a folder; the figures' data go there")
+    if outdir.is_dir():
+        stages = sorted(set(figures or FIGURES)) + ([] if figures else [SENSITIVITY])
+        names = dict.fromkeys(n for f in stages for n in data_files(f))
+        for name in names:
+            check_output(outdir / name, flag="paper data", force=force)
+    return outdir
+
+
 def run_paper(
-    *, quick: bool, out: str | Path, figures=None, workers=None, command=None, echo=False
+    *,
+    quick: bool,
+    out: str | Path,
+    figures=None,
+    workers=None,
+    command=None,
+    echo=False,
+    force: bool = False,
 ) -> Path:
     """Run the figure scripts and write the report (data and PNGs in ``OUT_DIR/paper-data``).
 
-    With ``echo`` (the command line), each stage's start and duration go to stderr and the
-    findings, figure by figure, to stdout.
+    Every output is checked first (:func:`check_paper_outputs`): existing files are replaced
+    only with ``force``. With ``echo`` (the command line), each stage's start and duration
+    go to stderr and the findings, figure by figure, to stdout.
     """
     import sys
 
@@ -457,8 +540,8 @@ def run_paper(
     from ._html import ReportParts, add_bifurcation, add_regime_map, add_trajectory, write_report
 
     out = Path(out)
-    outdir = out.parent / "paper-data"
-    outdir.mkdir(parents=True, exist_ok=True)
+    outdir = check_paper_outputs(out, figures, force=force)
+    outdir.mkdir(exist_ok=True)
     wanted = sorted(set(figures or FIGURES))
     funcs = []
     for number in wanted:

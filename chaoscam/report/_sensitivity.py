@@ -20,7 +20,6 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._figures import png_data_uri
 from ._html import FigureItem
 
 __all__ = ["PAPER_K_N", "sensitivity", "label_runs"]
@@ -96,8 +95,9 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     """The three sweeps, their figures and the findings (a FigureResult titled
     "Sensitivity"); ``classify`` as for the sweeps (the report's quick run caps the
     extension of undetermined runs)."""
+    from ..model import Params
     from ..sweep import Axis, bifurcation, regime_map
-    from ._paper import FigureResult, _save
+    from ._paper import FigureResult, _save, png_data_uri
     from ._sweep_figures import bifurcation_figure, regime_map_figure
 
     res = FigureResult(0, title="Sensitivity (why the paper differs)")
@@ -145,7 +145,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     res.bifurcations.append((str(path_x), bif_x))
     v = _first_ic(bif_x)
     res.why.append(
-        "Restitution ξ (Table 1 has 0.5; the paper gives no value we could check): "
+        f"Restitution ξ (Table 1: {Params().xi:g}): "
         + _runs_text(label_runs(v["value"], v["label"], v["period"]), "{:.3g}")
         + ". The regime depends on ξ more than on anything else we varied, so an unknown "
         "restitution law or value in the paper is the most likely source of the difference."

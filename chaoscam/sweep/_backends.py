@@ -14,7 +14,9 @@ Each backend offers the same four verbs to the engine (``submit``, ``wait_any``,
   that dies breaks the pool: the pool is started again and the lost tasks resubmitted.
 * :class:`DaskBackend` — a ``distributed.Client`` on a scheduler address, on an existing
   client, or on a ``LocalCluster`` of worker processes bound to 127.0.0.1. Dask itself
-  reschedules the tasks of a lost worker.
+  reschedules the tasks of a lost worker. A lost scheduler, or no worker connected for
+  :data:`DASK_NO_WORKER_S`, is a :class:`BackendLost`: the engine saves what finished and
+  stops with a resume hint instead of a ``FuturesCancelledError`` or a silent wait.
 """
 
 from __future__ import annotations
@@ -38,6 +40,8 @@ __all__ = [
 
 _DASK_POLL_S = 2.0
 _DASK_NOTICE_S = 10.0
+DASK_NO_WORKER_S = 300.0
+"""Seconds a Dask run waits with no worker connected (after saying so) before it stops."""
 _DASK_LOST_ERRORS = ("FuturesCancelledError", "CancelledError", "CommClosedError")
 
 
@@ -263,14 +267,25 @@ class DaskBackend:
         self.workers = max(1, sum(self.client.nthreads().values()))
 
     def submit(self, fn: Callable, arg: Any):
-        return self.client.submit(fn, arg, pure=False)
+        try:
+            return self.client.submit(fn, arg, pure=False)
+        except Exception as err:
+            if self.client.status != "running":  # closed after the scheduler was lost
+                raise BackendLost(self._lost(err)) from None
+            raise
 
     def wait_any(self, futures: Iterable[Any]) -> set:
-        """The finished futures; says once on stderr when no worker is connected."""
-        import sys
+        """The finished futures.
+
+        With no worker connected it says so once on stderr after ``_DASK_NOTICE_S`` and
+        raises :class:`BackendLost` after :data:`DASK_NO_WORKER_S` without one; a lost
+        scheduler raises it at once.
+        """
+        import time
 
         futures = list(futures)
-        waited = 0.0
+        started = time.monotonic()
+        seen_worker = started  # the last time a worker was known to be connected
         while True:
             try:
                 done = self._distributed.wait(
@@ -284,16 +299,33 @@ class DaskBackend:
                 return done
             if self.client.status not in ("running", "connecting"):
                 raise BackendLost(self._lost(None))
-            waited += _DASK_POLL_S
-            if waited >= _DASK_NOTICE_S and not self._noticed and not self._workers_now():
-                print(
-                    f"chaoscam: waiting: no Dask worker is connected to the scheduler "
-                    f"({self.client.scheduler.address}); start one with `dask worker "
-                    "ADDRESS`, or stop with Ctrl-C and --resume later",
-                    file=sys.stderr,
-                    flush=True,
+            now = time.monotonic()
+            if now - started < _DASK_NOTICE_S:
+                continue
+            if self._workers_now():
+                seen_worker = now
+                continue
+            self._notice_waiting()
+            if now - seen_worker >= DASK_NO_WORKER_S:
+                raise BackendLost(
+                    f"no Dask worker was connected to the scheduler "
+                    f"({self.client.scheduler.address}) for {DASK_NO_WORKER_S:g} s"
                 )
-                self._noticed = True
+
+    def _notice_waiting(self) -> None:
+        import sys
+
+        if self._noticed:
+            return
+        print(
+            f"chaoscam: waiting: no Dask worker is connected to the scheduler "
+            f"({self.client.scheduler.address}); start one with `dask worker ADDRESS`; "
+            f"stopping if none connects within {DASK_NO_WORKER_S:g} s (finished runs are "
+            "saved; --resume continues)",
+            file=sys.stderr,
+            flush=True,
+        )
+        self._noticed = True
 
     def _workers_now(self) -> int:
         try:
@@ -302,8 +334,11 @@ class DaskBackend:
             return 0
 
     def _lost(self, err: Exception | None) -> str:
-        detail = f" ({type(err).__name__}: {err})" if err is not None else ""
-        return f"the Dask scheduler was lost{detail}"
+        """One line for a lost scheduler (the error's own text spans several lines)."""
+        _quiet_reconnect_log()
+        address = getattr(getattr(self.client, "scheduler", None), "address", None) or "?"
+        detail = f" ({type(err).__name__})" if err is not None else ""
+        return f"the Dask scheduler at {address} was lost{detail}"
 
     def result(self, fut: Any) -> Any:
         try:
@@ -327,6 +362,29 @@ class DaskBackend:
                 self._cluster.close(timeout=10)
         except Exception:
             pass
+
+
+class _DropReconnectLog:
+    """Drops what distributed logs while a client whose scheduler is gone is closed: "Failed
+    to reconnect to scheduler" and the traceback of its cancelled reconnection. The lost
+    scheduler has already been reported in one line."""
+
+    def filter(self, record) -> bool:
+        import asyncio
+
+        if "Failed to reconnect to scheduler" in record.getMessage():
+            return False
+        exc = record.exc_info[1] if record.exc_info else None
+        return not isinstance(exc, asyncio.CancelledError)
+
+
+_RECONNECT_FILTER = _DropReconnectLog()
+
+
+def _quiet_reconnect_log() -> None:
+    import logging
+
+    logging.getLogger("distributed.client").addFilter(_RECONNECT_FILTER)  # idempotent
 
 
 def make_backend(workers: int | None = None, scheduler: Any = None):

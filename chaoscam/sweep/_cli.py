@@ -211,15 +211,19 @@ def _execution(args) -> dict:
 
 def _call(fn, **kwargs):
     """Run a sweep; bad settings become usage errors (exit 2); a stopped run returns its
-    exit code (130 Ctrl-C, 1 a lost Dask scheduler) after saying how to resume."""
+    exit code (130 Ctrl-C, 1 a lost Dask scheduler or a failed task) after saying how to
+    resume or reproduce it."""
     from ..cli import UsageError
-    from ._engine import SweepInterrupted
+    from ._engine import SweepInterrupted, TaskFailed
     from ._grid import SweepError
 
     try:
         return fn(**kwargs)
     except SweepError as err:
         raise UsageError(str(err)) from None
+    except TaskFailed as err:
+        print(f"chaoscam: error: {err}", file=sys.stderr)
+        return 1
     except SweepInterrupted as err:
         print(f"chaoscam: {err.message}", file=sys.stderr)
         return 130 if err.cause is None else 1

@@ -19,10 +19,15 @@ from ._backends import BackendLost, SerialBackend, WorkerLost
 from ._grid import SweepError
 from ._tasks import run_task
 
-__all__ = ["SweepInterrupted", "execute"]
+__all__ = ["SweepInterrupted", "TaskFailed", "execute"]
 
 MAX_RETRIES = 3
 """Times a task may lose its worker before the run stops with an error."""
+
+
+class TaskFailed(RuntimeError):
+    """A task raised (a classifier's error, a bug); the finished records are saved. The
+    message says how to reproduce it; the command line prints it and exits 1."""
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -151,7 +156,7 @@ def execute(
                 except WorkerLost as err:
                     retries[task.key()] += 1
                     if retries[task.key()] > MAX_RETRIES:
-                        raise RuntimeError(
+                        raise TaskFailed(
                             f"task {task.key()} lost its worker {MAX_RETRIES + 1} times; "
                             f"the finished records are saved, resume after fixing it ({err})"
                         ) from err
@@ -159,7 +164,7 @@ def execute(
                     queue.extendleft(reversed(getattr(task, "tasks", (task,))))
                     continue
                 except Exception as err:
-                    raise RuntimeError(
+                    raise TaskFailed(
                         f"task {task.key()} failed ({type(err).__name__}: {err}); reproduce "
                         f"it with {task.hint()} and the classifier"
                     ) from err

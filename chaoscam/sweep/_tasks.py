@@ -135,6 +135,10 @@ def verdict_fields(verdict: Any) -> dict[str, Any]:
     }
 
 
+OUTPUT_DT = 1e-3
+"""Series sampling of a sweep's runs [s] (simulate's default), or dt where dt is coarser."""
+
+
 @dataclass(frozen=True)
 class RunSummary:
     """What a record keeps of one simulated realization, whichever driver ran it.
@@ -165,6 +169,7 @@ def _run(params: Params, task: Any) -> tuple[RunSummary, dict[str, Any]]:
             seed=task.seed,
             index=task.sim_index,
             series=task.series,
+            output_dt=max(OUTPUT_DT, params.dt),  # a swept dt may exceed it
             tangent=bool(getattr(task.classify, "needs_tangent", False))
             and params.integrator == "rk4",
         )

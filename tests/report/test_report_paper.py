@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import re
 
+import pytest
+
 from chaoscam.cli import main
 
 
@@ -50,3 +52,73 @@ def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch):
     text = out.read_text()
     assert "boom: failed with RuntimeError: no luck" in text
     assert "Fig. 5 — fractal stiffness against D" in text
+
+
+def _shrink_the_runs(monkeypatch):
+    """Stand-ins for the figures' sweeps and runs: the same calls, two values, a second of
+    model time, the test classifier, in this process."""
+    import chaoscam._simulate
+    import chaoscam.sweep
+    from tests.sweep._helpers import SpreadClassifier
+
+    bif, rmap, sim = chaoscam.sweep.bifurcation, chaoscam.sweep.regime_map, chaoscam.simulate
+    short = dict(duration=0.5, transient=0.25, workers=1, classify=SpreadClassifier())
+
+    def small_bifurcation(param, values, **kw):
+        if not isinstance(values, str):
+            return bif(param, list(values)[:2], **{**kw, **short})
+        start, stop, _ = values.split(":")
+        return bif(param, f"{start}:{stop}:2", **{**kw, **short})
+
+    def small_regime_map(x, y, **kw):
+        return rmap(x, y, **{**kw, **short, "realizations": 2})
+
+    def short_simulate(params, **kw):
+        return sim(params, **{**kw, "duration": 1.0, "transient": 0.0})
+
+    monkeypatch.setattr(chaoscam.sweep, "bifurcation", small_bifurcation)
+    monkeypatch.setattr(chaoscam.sweep, "regime_map", small_regime_map)
+    monkeypatch.setattr(chaoscam._simulate, "simulate", short_simulate)
+
+
+@pytest.mark.parametrize("number", [3, 4, 5, 6, 7, 0])
+def test_data_files_are_exactly_what_the_figures_write(tmp_path, monkeypatch, number):
+    """data_files (what `paper` checks before the work) lists every file the figure script
+    (0: the sensitivity stage) writes, and nothing it does not (runs shrunk, PNGs not drawn)."""
+    from chaoscam.report import _paper
+
+    _shrink_the_runs(monkeypatch)
+    monkeypatch.setattr(_paper, "png_bytes", lambda fig, dpi=None: b"\x89PNG")
+    monkeypatch.setattr(_paper, "png_data_uri", lambda fig, dpi=None: "data:,")
+    stage = _paper._sensitivity_stage if number == _paper.SENSITIVITY else _paper.FIGURES[number]
+    stage(True, tmp_path, workers=1)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(_paper.data_files(number))
+
+
+def test_paper_refuses_any_existing_output_before_the_work(tmp_path, capsys):
+    """An existing data file (not only the report): exit 2 naming it, before any figure
+    runs; --force replaces it."""
+    data = tmp_path / "paper-data"
+    data.mkdir()
+    (data / "fig5.png").write_bytes(b"old")
+    args = ["paper", "--quick", "--figures", "3,5", "--out", str(tmp_path / "p.html")]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("chaoscam: error: paper data") and str(data / "fig5.png") in err
+    assert "--force" in err
+    assert [p.name for p in data.iterdir()] == ["fig5.png"]  # fig3 did not run
+    assert not (tmp_path / "p.html").exists()
+    assert main([*args, "--force"]) == 0
+    assert (data / "fig5.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_paper_unwritable_places_are_refused(tmp_path, capsys):
+    """A paper-data that is a file, or a report folder that does not exist: exit 2 with a
+    message, nothing run."""
+    (tmp_path / "paper-data").write_text("not a folder")
+    assert main(["paper", "--figures", "5", "--out", str(tmp_path / "p.html")]) == 2
+    assert "is not a folder" in capsys.readouterr().err
+    missing = tmp_path / "no" / "p.html"
+    assert main(["paper", "--figures", "5", "--out", str(missing)]) == 2
+    assert "does not exist" in capsys.readouterr().err
+    assert not (tmp_path / "no").exists() and not (tmp_path / "p.html").exists()

@@ -113,3 +113,13 @@ def frames_equal(a, b) -> None:
     import pandas as pd
 
     pd.testing.assert_frame_equal(a, b, check_exact=True)
+
+
+@dataclass(frozen=True)
+class FailingClassifier:
+    """Raises on every run: a classifier with a bug."""
+
+    needs_series = False
+
+    def __call__(self, traj):
+        raise ValueError("this classifier has a bug")

@@ -1,0 +1,62 @@
+"""Ctrl-C while the command starts (importing numpy, pandas, numba and the kernels): one
+line, exit 130, never a traceback."""
+
+import signal
+import subprocess
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# What the console script does, with a mark on stdout just before chaoscam is imported.
+CODE = (
+    "import sys; print('up', flush=True); from chaoscam.cli import main; "
+    "sys.exit(main(sys.argv[1:]))"
+)
+
+
+def test_console_script_runs_cli_main():
+    """The installed `chaoscam` command is chaoscam.cli:main (the function tested here)."""
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    assert project["scripts"]["chaoscam"] == "chaoscam.cli:main"
+
+
+def test_cli_module_loads_nothing_heavy():
+    """Importing chaoscam.cli (all the console script does before main catches Ctrl-C) loads
+    neither argparse nor numpy, pandas or numba: that unguarded window stays ~a millisecond."""
+    code = (
+        "import sys, chaoscam.cli; "
+        "print(sorted({m.split('.')[0] for m in sys.modules} & "
+        "{'argparse', 'numpy', 'pandas', 'numba', 'scipy', 'chaoscam.model'}))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True
+    ).stdout
+    assert out.strip() == "[]"
+
+
+@pytest.mark.parametrize("delay", [0.05, 0.1, 0.2, 0.4])
+def test_ctrl_c_during_start_up_is_one_line(delay):
+    """SIGINT `delay` s after the interpreter is up (while chaoscam imports its layers, or
+    just after): exit 130 and the one line "chaoscam: interrupted", no traceback."""
+    proc = subprocess.Popen(
+        [sys.executable, "-c", CODE, "simulate", "--duration", "20"],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdout.readline() == "up\n"
+        time.sleep(delay)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert "Traceback" not in err, err
+    assert proc.returncode == 130, err
+    assert err.strip() == "chaoscam: interrupted"
