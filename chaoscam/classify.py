@@ -257,7 +257,10 @@ def _with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, 
         why = "the run is not on it" if not sits else "its least period differs"
     e = Evidence("periodic_orbit", orbit.period, None, f"not certified ({why}): " + detail)
     if orbit.converged and not orbit.stable:
-        reason = f"the section looks periodic but the orbit found is unstable ({detail})"
+        reason = (
+            f"the section looks periodic but the orbit found is unstable ({detail}): run "
+            "longer, to see whether the exponent is positive (chaos near an unstable orbit)"
+        )
         return Verdict(
             "undetermined", None, v.evidence + (e,), v.reasons + (reason,), v.settings
         ), extra

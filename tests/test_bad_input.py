@@ -192,9 +192,12 @@ def test_series_too_fine_for_its_length_is_announced_before_the_run(monkeypatch)
 def test_left_the_model_labelled_alike_in_ensembles_and_sweeps():
     """dt = 0.01 s leaves the model (LEFT_REACH): ensemble members and regime-map runs with
     the default (series) classifier, dt swept as an axis, both say "left_reach"."""
+    from chaoscam import classify_ensemble
     from chaoscam.integrate import simulate_ensemble
 
-    ens = simulate_ensemble(Params(dt=0.01), [0, 1], duration=0.5, classify=True)
+    ens = classify_ensemble(
+        simulate_ensemble(Params(dt=0.01), [0, 1], duration=0.5, tangent=True), Params(dt=0.01)
+    )
     assert list(ens.members["label"]) == ["left_reach", "left_reach"]
     with pytest.warns(RuntimeWarning):
         rm = regime_map(("l_lambda", [0.008]), ("dt", [0.01]), duration=0.5, workers=1)

@@ -31,6 +31,9 @@ LABEL_COLORS = {
 }
 _OTHER = "#E69F00"
 
+LOG_AXIS_SPAN = 100.0
+"""A swept value spanning more than this ratio is drawn on a log axis."""
+
 ANNOTATION_PT = 10
 """Point size of the numbers written in heatmap cells: ~12 px at the report's width."""
 
@@ -258,6 +261,9 @@ def plot_bifurcation(
         )
     ax.set_xlabel(axis_label(param) if len(points) else "value")
     ax.set_ylabel(axis_label(coordinate))
+    v = points["value"].to_numpy(dtype=float) if len(points) else np.empty(0)
+    if v.size and v.min() > 0 and v.max() / v.min() > LOG_AXIS_SPAN:
+        ax.set_xscale("log")  # values over several decades (a stiffness sweep)
     if color_by is not None and groups:
         ax.legend(markerscale=6, frameon=False, fontsize="small", title=color_by)
 

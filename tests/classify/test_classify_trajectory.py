@@ -167,9 +167,9 @@ def test_undetermined_short_run_is_extended_until_it_settles():
 # Measured on 20 s runs (10 s transient): 46 section points in n narrow bands that look
 # periodic, with an exponent still undecided; a 4x longer run shows lambda_1 > 0.
 UNSETTLED_BANDS = {
-    "uncertified period 6 (xi = 0.45)": (dict(xi=0.45), 0, "no attracting orbit is certified"),
+    "period 6 whose orbit is unstable (xi = 0.45)": (dict(xi=0.45), 0, "orbit found is unstable"),
     "random line length, 8 bands": (
-        dict(l_lambda=0.008, l_lambda_sigma=0.0015), 8, "the line length is random"
+        dict(l_lambda=0.008, l_lambda_sigma=0.0015), 1, "the line length is random"
     ),
 }
 
@@ -186,6 +186,7 @@ def test_bands_that_only_look_periodic_are_not_called_periodic(changes, index, w
                     series=False, tangent=True)  # the section path, as in ensembles
     short = classify_trajectory(traj, extend_to=None)
     assert short.label == "undetermined" and any(words in r for r in short.reasons)
+    assert "run longer" in short.reasons[-1]  # the reason says what to run
     settled = classify_trajectory(traj)
     assert settled.label == "chaotic" and settled.settings["extended"]["recorded_s"] > 10.0
 
