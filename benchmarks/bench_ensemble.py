@@ -36,15 +36,19 @@ def main() -> None:
     n = 64
     one = rate(p, n, 1)
     two = rate(p, n, min(2, numba.config.NUMBA_NUM_THREADS))
-    print(f"ensemble of {n} x 20 s: 1 thread {one:.1f} traj/s, 2 threads {two:.1f} traj/s, "
-          f"ratio {two / one:.2f}x (target >= 1.8x)")
+    print(
+        f"ensemble of {n} x 20 s: 1 thread {one:.1f} traj/s, 2 threads {two:.1f} traj/s, "
+        f"ratio {two / one:.2f}x (target >= 1.8x)"
+    )
     t0 = time.perf_counter()
     dur = args.memory_duration
     ens = simulate_ensemble(p, range(10_000), seed=1, duration=dur)
     wall = time.perf_counter() - t0
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    print(f"10,000 x {dur:g} s ({args.integrator}): {wall:.0f} s ({10_000 / wall:.0f} traj/s), "
-          f"{len(ens.sections)} section points, peak RSS {peak:.0f} MiB (target < 2048 MiB)")
+    print(
+        f"10,000 x {dur:g} s ({args.integrator}): {wall:.0f} s ({10_000 / wall:.0f} traj/s), "
+        f"{len(ens.sections)} section points, peak RSS {peak:.0f} MiB (target < 2048 MiB)"
+    )
 
 
 if __name__ == "__main__":

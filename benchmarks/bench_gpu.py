@@ -40,8 +40,9 @@ def timed(p, members, duration, backend, **kw):
 
 def max_diff(p, indices, duration, transient) -> float:
     a, b = (
-        simulate_ensemble(p, indices, seed=1, duration=duration, transient=transient,
-                          backend=backend).sections
+        simulate_ensemble(
+            p, indices, seed=1, duration=duration, transient=transient, backend=backend
+        ).sections
         for backend in ("gpu", "cpu")
     )
     if a.shape != b.shape or not np.array_equal(a.k, b.k):
@@ -59,8 +60,12 @@ def main() -> None:
     ap.add_argument("--sigma", type=float, default=0.002, help="l_lambda_sigma [m]")
     ap.add_argument("--batch", type=int, default=None, help="GPU members per batch")
     ap.add_argument("--check", type=int, default=64, help="members in the GPU = CPU check")
-    ap.add_argument("--integrator", choices=("rk4", "adaptive"), default="rk4",
-                    help="Params.integrator of every member (both backends)")
+    ap.add_argument(
+        "--integrator",
+        choices=("rk4", "adaptive"),
+        default="rk4",
+        help="Params.integrator of every member (both backends)",
+    )
     args = ap.parse_args()
     p = Params(l_lambda_sigma=args.sigma, integrator=args.integrator)
     print(f"model: default, l_lambda_sigma = {args.sigma:g} m, integrator = {args.integrator}")
@@ -70,42 +75,56 @@ def main() -> None:
     simulate_ensemble(p, range(2), seed=1, duration=0.1, backend="cpu")  # compile or load
     cpu, cpu_wall = timed(p, args.cpu_members, args.duration, "cpu")
     cpu_rate = args.cpu_members / cpu_wall
-    print(f"CPU ({threads} threads): {args.cpu_members} x {args.duration:g} s in "
-          f"{cpu_wall:.1f} s = {cpu_rate:.1f} traj/s (measured on this sample, extrapolated "
-          f"to any ensemble size)")
+    print(
+        f"CPU ({threads} threads): {args.cpu_members} x {args.duration:g} s in "
+        f"{cpu_wall:.1f} s = {cpu_rate:.1f} traj/s (measured on this sample, extrapolated "
+        f"to any ensemble size)"
+    )
 
     ok, reason = _gpu.gpu_status()
     if not ok or "simulator" in reason:
-        print(f"GPU: no GPU available ({reason}); GPU rate not measured "
-              f"(targets: >= {H100_TARGET:,.0f} traj/s on an H100, >= {RATIO_TARGET:.0f}x CPU)")
+        print(
+            f"GPU: no GPU available ({reason}); GPU rate not measured "
+            f"(targets: >= {H100_TARGET:,.0f} traj/s on an H100, >= {RATIO_TARGET:.0f}x CPU)"
+        )
         return
 
     t0 = time.perf_counter()
     simulate_ensemble(p, range(64), seed=1, duration=0.01, backend="gpu")
     method = _kernel.METHOD_ADAPTIVE if args.integrator == "adaptive" else _kernel.METHOD_RK4
     info = _gpu.kernel_info(method)
-    print(f"GPU: {reason}; kernel compiled in {time.perf_counter() - t0:.1f} s, "
-          f"{info.get('registers')} registers and {info.get('local_bytes')} B local memory "
-          f"a thread, {info.get('block')} threads a block")
+    print(
+        f"GPU: {reason}; kernel compiled in {time.perf_counter() - t0:.1f} s, "
+        f"{info.get('registers')} registers and {info.get('local_bytes')} B local memory "
+        f"a thread, {info.get('block')} threads a block"
+    )
     gpu, gpu_wall = timed(p, args.members, args.duration, "gpu", batch=args.batch)
     gpu_rate = args.members / gpu_wall
     ratio = gpu_rate / cpu_rate
-    print(f"GPU: {args.members:,} x {args.duration:g} s in {gpu_wall:.1f} s = "
-          f"{gpu_rate:,.0f} traj/s (target >= {H100_TARGET:,.0f} on an H100: "
-          f"{'met' if gpu_rate >= H100_TARGET else 'NOT met'})")
-    print(f"ratio GPU / CPU ({threads} threads): {ratio:.0f}x (target >= {RATIO_TARGET:.0f}x: "
-          f"{'met' if ratio >= RATIO_TARGET else 'NOT met'})")
+    print(
+        f"GPU: {args.members:,} x {args.duration:g} s in {gpu_wall:.1f} s = "
+        f"{gpu_rate:,.0f} traj/s (target >= {H100_TARGET:,.0f} on an H100: "
+        f"{'met' if gpu_rate >= H100_TARGET else 'NOT met'})"
+    )
+    print(
+        f"ratio GPU / CPU ({threads} threads): {ratio:.0f}x (target >= {RATIO_TARGET:.0f}x: "
+        f"{'met' if ratio >= RATIO_TARGET else 'NOT met'})"
+    )
     statuses = gpu.members.status.value_counts().to_dict()
-    print(f"GPU statuses {statuses}; impacts per member: GPU {gpu.members.n_impacts.mean():.1f} "
-          f"(all), CPU {cpu.members.n_impacts.mean():.1f} (sample)")
+    print(
+        f"GPU statuses {statuses}; impacts per member: GPU {gpu.members.n_impacts.mean():.1f} "
+        f"(all), CPU {cpu.members.n_impacts.mean():.1f} (sample)"
+    )
 
     n = min(args.check, args.members)
     first = max_diff(p, range(n), min(0.25, args.duration), 0.0)
     periodic = max_diff(Params(xi=0.2, integrator=args.integrator), range(min(n, 8)), 20.0, 10.0)
     tol = _gpu.GPU_TOLERANCE
     verdict = "ok" if max(first, periodic) <= tol else "FAILED"
-    print(f"check GPU = CPU within {tol:g} (max |difference| of sections): first cam period "
-          f"of {n} members {first:.1e}, periodic Params(xi=0.2) {periodic:.1e}: {verdict}")
+    print(
+        f"check GPU = CPU within {tol:g} (max |difference| of sections): first cam period "
+        f"of {n} members {first:.1e}, periodic Params(xi=0.2) {periodic:.1e}: {verdict}"
+    )
 
 
 if __name__ == "__main__":

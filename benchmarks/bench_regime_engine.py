@@ -39,11 +39,19 @@ def main() -> None:
     y = Axis.linspace("l_lambda_sigma", 0.001, 0.002, n)
     kw = dict(realizations=reps, seed=1, duration=duration, workers=args.workers)
     runs = n * n * reps
-    print(f"regime map {n}x{n} cells x {reps} realizations x {duration:g} s = {runs} runs; "
-          f"cores {os.cpu_count()}; {_load()}")
+    print(
+        f"regime map {n}x{n} cells x {reps} realizations x {duration:g} s = {runs} runs; "
+        f"cores {os.cpu_count()}; {_load()}"
+    )
     for engine in ("process", "ensemble"):  # warm: numba caches, imports
-        regime_map(Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.001,)),
-                   realizations=2, duration=1.0, engine=engine, workers=args.workers)
+        regime_map(
+            Axis("l_lambda", (0.008,)),
+            Axis("l_lambda_sigma", (0.001,)),
+            realizations=2,
+            duration=1.0,
+            engine=engine,
+            workers=args.workers,
+        )
     times: dict[str, list[float]] = {"process": [], "ensemble": []}
     tables = {}
     for _ in range(2):
@@ -56,11 +64,15 @@ def main() -> None:
     cols = ["cell", "index", "status", "n_section", "n_impacts", "contact_fraction"]
     same = a[cols].equals(b[cols])
     agree = float((a["label"] == b["label"]).mean())
-    print(f"process engine: {tp:.1f} s ({runs / tp:.1f} traj/s); ensemble engine: {te:.1f} s "
-          f"({runs / te:.1f} traj/s); ratio {tp / te:.2f} (goal >= {GOAL}, best of 2)")
-    print(f"realizations identical on both engines: {same}; labels agree on {agree:.0%} "
-          f"(process {a['label'].value_counts().to_dict()}, ensemble "
-          f"{b['label'].value_counts().to_dict()}); after: {_load()}")
+    print(
+        f"process engine: {tp:.1f} s ({runs / tp:.1f} traj/s); ensemble engine: {te:.1f} s "
+        f"({runs / te:.1f} traj/s); ratio {tp / te:.2f} (goal >= {GOAL}, best of 2)"
+    )
+    print(
+        f"realizations identical on both engines: {same}; labels agree on {agree:.0%} "
+        f"(process {a['label'].value_counts().to_dict()}, ensemble "
+        f"{b['label'].value_counts().to_dict()}); after: {_load()}"
+    )
 
 
 if __name__ == "__main__":

@@ -93,8 +93,10 @@ def report(title: str, rows) -> None:
         ad = best["adaptive"][1]
         for kind in ("rk4 fixed", "rk4 merged"):
             if kind in best:
-                print(f"  ratio {kind} / adaptive at equal accuracy: {best[kind][1] / ad:.1f}x"
-                      + ("  (target >= 10x)" if kind == "rk4 fixed" else ""))
+                print(
+                    f"  ratio {kind} / adaptive at equal accuracy: {best[kind][1] / ad:.1f}x"
+                    + ("  (target >= 10x)" if kind == "rk4 fixed" else "")
+                )
             else:
                 print(f"  {kind}: no step on the ladder meets {TOL:g}")
     else:
@@ -109,19 +111,27 @@ def main() -> None:
     p = Params()
     ref = chaoscam.simulate(fine, duration=2.0, series=False)
     half = chaoscam.simulate(fine.replace(dt=5e-7), duration=2.0, series=False)
-    print(f"reference dt 2.5e-7; dt 5e-7 differs from it by {impact_error(half, ref):.1e} "
-          "on the impacts")
-    report("first ten impacts > 0.01 m/s of the default run (2 s), to 1e-6 s and 1e-6 rad",
-           ladder(p, 2.0, ref, impact_error, 3))
+    print(
+        f"reference dt 2.5e-7; dt 5e-7 differs from it by {impact_error(half, ref):.1e} "
+        "on the impacts"
+    )
+    report(
+        "first ten impacts > 0.01 m/s of the default run (2 s), to 1e-6 s and 1e-6 rad",
+        ladder(p, 2.0, ref, impact_error, 3),
+    )
 
     for changes in ({"xi": 0.2}, {"omega": 45.0}):
         p = Params(**changes)
         ref = chaoscam.simulate(fine.replace(**changes), duration=20.0, series=False)
         half = chaoscam.simulate(fine.replace(dt=5e-7, **changes), duration=20.0, series=False)
-        print(f"\nreference dt 2.5e-7 for {changes}; dt 5e-7 differs by "
-              f"{section_error(half, ref):.1e} rad")
-        report(f"20 s stroboscopic section of {changes} (periodic), to 1e-6 rad",
-               ladder(p, 20.0, ref, section_error, 2))
+        print(
+            f"\nreference dt 2.5e-7 for {changes}; dt 5e-7 differs by "
+            f"{section_error(half, ref):.1e} rad"
+        )
+        report(
+            f"20 s stroboscopic section of {changes} (periodic), to 1e-6 rad",
+            ladder(p, 20.0, ref, section_error, 2),
+        )
 
 
 if __name__ == "__main__":

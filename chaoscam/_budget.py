@@ -179,9 +179,7 @@ def _costs(params, duration: float, series_rows: float = 0.0) -> tuple[float, fl
     return grid, adaptive_seconds(params, duration) if adaptive else 0.0
 
 
-def check_run(
-    params, duration: float, *, what: str = "one run", series_rows: float = 0.0
-) -> bool:
+def check_run(params, duration: float, *, what: str = "one run", series_rows: float = 0.0) -> bool:
     """Refuse one run estimated beyond :data:`RUN_REFUSE_SECONDS`, warn beyond
     :data:`RUN_WARN_SECONDS`; the message names the fields that set the cost.
 
@@ -243,9 +241,7 @@ def _human_seconds(s: float) -> str:
     return f"{s / (86400 * 365):.3g} years"
 
 
-def check_budget(
-    job: JobEstimate, *, what: str, reduce: str, run: tuple | None = None
-) -> None:
+def check_budget(job: JobEstimate, *, what: str, reduce: str, run: tuple | None = None) -> None:
     """Refuse a job that cannot fit in memory; judge one run of it (:func:`check_run`);
     warn about a job that will take hours (unless its run was warned about already).
 

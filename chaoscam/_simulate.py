@@ -171,11 +171,18 @@ def _check_run(
         raise ParameterError(f"output_dt = {output_dt!r} s must be >= dt = {p.dt} s")
     series_rows = (duration - transient) / output_dt if output_dt is not None else 0.0
     job = estimate(
-        p, duration=duration, transient=transient, series=output_dt is not None,
+        p,
+        duration=duration,
+        transient=transient,
+        series=output_dt is not None,
         output_dt=output_dt or 1.0,
     )
-    check_budget(job, what="this run", reduce="duration (or raise output_dt)",
-                 run=dict(params=p, duration=duration, what="this run", series_rows=series_rows))
+    check_budget(
+        job,
+        what="this run",
+        reduce="duration (or raise output_dt)",
+        run=dict(params=p, duration=duration, what="this run", series_rows=series_rows),
+    )
     return seed, index
 
 

@@ -17,12 +17,13 @@ from typing import Any
 
 import numpy as np
 
+from ._model_rules import MODEL_ATOL, with_model_evidence
 from ._simulate import Trajectory, simulate
 from ._trajectory_io import load_trajectory
 from .analysis import Evidence, Verdict, classify_section, classify_signal
 from .integrate import Status
 from .model import Params
-from .tangent import periodic_orbit, spectrum_from_jacobians
+from .tangent import spectrum_from_jacobians
 
 __all__ = ["classify_file", "classify_section_run", "classify_trajectory", "load_trajectory"]
 
@@ -74,13 +75,6 @@ def _status_verdict(traj: Trajectory, settings: dict) -> Verdict:
         ),
         settings,
     )
-
-
-MODEL_ATOL = 1e-5
-"""Absolute band tolerance [rad] on the model's section, for θ_f and for θ̇_f·T: bands
-narrower than this are jitter (measured: a sticking period-1 orbit at e = 0.02 m keeps
-1.6e-11 rad in θ_f and 6.9e-6 rad/s in θ̇_f from its contact oscillation, whatever the run
-length). The relative tolerance of the analysis layer's Thresholds applies on top."""
 
 
 def _evidence_verdict(
@@ -141,7 +135,7 @@ def _section_verdict(points, jacobians, p: Params, options: dict) -> tuple[Verdi
         exponent_time=period,
         **_model_options(options, period),
     )
-    return _with_model_evidence(v, p, points, spec)
+    return with_model_evidence(v, p, points, spec)
 
 
 def _exponent_of(spec) -> tuple[float, float, int]:
@@ -187,171 +181,7 @@ def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[V
         exponent_time=period,
         **opts,
     )
-    return _with_model_evidence(v, p, points, spec)
-
-
-def _with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, dict]:
-    """The model-level rules on top of the analysis verdict: n-band chaos, and the
-    periodic-orbit certificate of a periodic section of the deterministic model."""
-    extra = {
-        "tangent": {
-            "exponents": [float(x) for x in spec.exponents],
-            "stderr": [float(x) for x in spec.stderr],
-            "n_periods": spec.n_periods,
-            "method": "tangent dynamics through the impacts, QR (chaoscam.tangent)",
-        }
-    }
-    votes = {e.name: e.vote for e in v.evidence}
-    if v.label == "quasiperiodic" and votes.get("exponent") != "not_chaotic":
-        # A torus has lambda_1 = 0: without an exponent that confirms it (zero within its
-        # interval), a quasiperiodic spectrum of a short window is not enough.
-        reason = (
-            "quasiperiodic evidence, but the tangent exponent does not confirm lambda_1 = 0 "
-            "within its interval: run longer"
-        )
-        v = Verdict("undetermined", None, v.evidence, v.reasons + (reason,), v.settings)
-    if (
-        v.label == "periodic"
-        and p.l_lambda_sigma != 0.0
-        and votes.get("exponent") not in ("not_chaotic", "periodic")
-    ):
-        # A random line length has no periodic orbit to shoot for: its periodic response is
-        # a random attractor near one, which contracts (lambda_1 < 0). Without a
-        # certificate, n narrow bands are periodic only when the exponent confirms it;
-        # measured: 8 bands of 1e-3 rad at sigma = 1.5 mm with lambda_1 = 0.53 +- 0.22 per
-        # iterate after 46 periods, chaotic on a longer run.
-        reason = (
-            f"the section repeats with period {v.period} to the band tolerance, but the line "
-            "length is random (no periodic orbit to certify) and the tangent exponent does "
-            "not confirm lambda_1 < 0 within its interval: run longer"
-        )
-        v = Verdict("undetermined", None, v.evidence, v.reasons + (reason,), v.settings)
-    banded = _banded_period(v)
-    if v.label == "undetermined" and banded is not None:
-        return _banded_verdict(v, p, points, banded, extra)
-    candidate = v.period if v.label == "periodic" else _disputed_period(v)
-    if candidate is None or p.l_lambda_sigma != 0.0:
-        return v, extra
-    orbit = periodic_orbit(p, points[-1], int(candidate))
-    dist = orbit.distance(points[-min(len(points), 4 * orbit.period) :])
-    extent = float(np.ptp(points[:, 0])) or 1.0
-    sits = dist <= max(MODEL_ATOL, 3e-3 * extent)
-    extra["periodic_orbit"] = _orbit_record(orbit, distance=dist)
-    mu = float(np.max(np.abs(orbit.multipliers)))
-    detail = (
-        f"Newton shooting on P^{orbit.period}: residual {orbit.residual:.2g} rad, "
-        f"|mu|max = {mu:.3g}, the run lies within {dist:.2g} rad of the orbit"
-    )
-    if orbit.certified and sits and orbit.period == candidate:
-        e = Evidence("periodic_orbit", orbit.period, "periodic", "certified: " + detail)
-        if v.label == "periodic":
-            return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
-        # The certificate decides what the section and the exponent left open: an attracting
-        # orbit that the run sits on outweighs a spectral or 0-1 vote on a short series.
-        return Verdict("periodic", orbit.period, v.evidence + (e,), (), v.settings), extra
-    if not orbit.converged:
-        why = "not converged"
-    elif not orbit.stable:
-        why = "unstable"
-    else:
-        why = "the run is not on it" if not sits else "its least period differs"
-    e = Evidence("periodic_orbit", orbit.period, None, f"not certified ({why}): " + detail)
-    if orbit.converged and not orbit.stable:
-        reason = (
-            f"the section looks periodic but the orbit found is unstable ({detail}): run "
-            "longer, to see whether the exponent is positive (chaos near an unstable orbit)"
-        )
-        return Verdict(
-            "undetermined", None, v.evidence + (e,), v.reasons + (reason,), v.settings
-        ), extra
-    if v.label == "periodic" and votes.get("exponent") != "not_chaotic":
-        # Neither certified nor contracting: measured at xi = 0.45, 6 bands of 1e-4 rad
-        # after 46 periods whose orbit does not converge (|mu| ~ 20) and whose lambda_1 is
-        # positive once the run is 4x longer.
-        reason = (
-            f"the section repeats with period {v.period} but no attracting orbit is "
-            f"certified ({why}) and the tangent exponent does not confirm lambda_1 < 0: "
-            "run longer"
-        )
-        return Verdict(
-            "undetermined", None, v.evidence + (e,), v.reasons + (reason,), v.settings
-        ), extra
-    return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
-
-
-def _orbit_record(orbit, **more) -> dict:
-    """What a verdict's settings keep of a periodic orbit."""
-    return {
-        "period": orbit.period,
-        "converged": orbit.converged,
-        "residual": orbit.residual,
-        "multipliers_abs": [float(abs(m)) for m in orbit.multipliers],
-        "wall_time_s": orbit.wall_time,
-        **more,
-    }
-
-
-def _disputed_period(v: Verdict) -> int | None:
-    """n when an undetermined verdict's section is periodic (n) and the exponent does not say
-    chaotic: the case a periodic-orbit certificate settles."""
-    votes = {e.name: e for e in v.evidence}
-    sp, ex = votes.get("section_period"), votes.get("exponent")
-    if v.label != "undetermined" or sp is None or sp.vote != "periodic":
-        return None
-    if ex is not None and ex.vote == "chaotic":
-        return None
-    return int(sp.value)
-
-
-def _banded_period(v: Verdict) -> int | None:
-    """n when the section is periodic to the band tolerance (n narrow bands) while the
-    tangent exponent is positive beyond its confidence interval; else None."""
-    votes = {e.name: e for e in v.evidence}
-    sp, ex = votes.get("section_period"), votes.get("exponent")
-    if sp is None or ex is None or sp.vote != "periodic" or ex.vote != "chaotic":
-        return None
-    return int(sp.value)
-
-
-def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
-    """Resolve "n narrow bands but λ₁ > 0": chaotic when no attracting period-n orbit lies in
-    the bands (shooting: unstable or not converged; or a random model, which has none),
-    still undetermined when shooting certifies one (a genuine conflict)."""
-    if p.l_lambda_sigma == 0.0:
-        orbit = periodic_orbit(p, points[-1], n)
-        mu = float(np.max(np.abs(orbit.multipliers)))
-        extra["periodic_orbit"] = _orbit_record(orbit)
-        detail = (
-            f"Newton shooting on P^{n} from the bands: residual {orbit.residual:.2g} rad, "
-            f"converged {orbit.converged}, |mu|max = {mu:.3g}"
-        )
-        if orbit.certified:
-            e = Evidence("periodic_orbit", orbit.period, "periodic", "certified: " + detail)
-            return dataclasses.replace(
-                v,
-                evidence=v.evidence + (e,),
-                reasons=v.reasons
-                + (
-                    "an attracting orbit is certified inside the bands, "
-                    "yet the tangent exponent is positive",
-                ),
-            ), extra
-        why = "unstable" if orbit.converged else "not converged"
-        e = Evidence("periodic_orbit", orbit.period, "not_periodic", f"{why}: " + detail)
-    else:
-        e = Evidence(
-            "periodic_orbit", None, None, "random line length: no periodic orbit to shoot for"
-        )
-    band = Evidence(
-        "banded_chaos",
-        n,
-        "chaotic",
-        f"the section keeps {n} narrow bands while the tangent exponent is positive beyond "
-        "its confidence interval and no attracting period-n orbit lies in them: chaos "
-        f"confined to {n} bands (n-band chaos)",
-    )
-    verdict = Verdict("chaotic", None, v.evidence + (e, band), (), v.settings)
-    return verdict, extra
+    return with_model_evidence(v, p, points, spec)
 
 
 EXTEND_TO = 120.0

@@ -15,10 +15,30 @@ from chaoscam.cli import main
 from chaoscam.sweep import SweepError, bifurcation, regime_map
 
 SIM = ["simulate", "--duration", "0.05"]
-BIF = ["bifurcation", "--param", "l_lambda", "--values", "0.006:0.008:2", "--duration", "0.5",
-       "--workers", "1", "--quiet"]
-MAP = ["regime-map", "--mu", "0.006:0.008:2", "--sigma", "0:0.001:2", "--duration", "0.5",
-       "--workers", "1", "--quiet"]
+BIF = [
+    "bifurcation",
+    "--param",
+    "l_lambda",
+    "--values",
+    "0.006:0.008:2",
+    "--duration",
+    "0.5",
+    "--workers",
+    "1",
+    "--quiet",
+]
+MAP = [
+    "regime-map",
+    "--mu",
+    "0.006:0.008:2",
+    "--sigma",
+    "0:0.001:2",
+    "--duration",
+    "0.5",
+    "--workers",
+    "1",
+    "--quiet",
+]
 ENS = ["ensemble", "--members", "2", "--duration", "0.5", "--quiet"]
 
 CLI_CASES = {
@@ -30,22 +50,28 @@ CLI_CASES = {
     "omega 1e300": ([*SIM, "--set", "omega=1e300"], "omega"),
     "l 1e308": ([*SIM, "--set", "l=1e308"], "l ="),
     "flight_merge 1e9": ([*SIM, "--set", "flight_merge=1000000000"], "flight_merge"),
-    "max_events 1e12": ([*SIM, "--set", "max_events_per_step=1000000000000"],
-                        "max_events_per_step"),
+    "max_events 1e12": (
+        [*SIM, "--set", "max_events_per_step=1000000000000"],
+        "max_events_per_step",
+    ),
     "theta_f0 1e308": ([*SIM, "--set", "theta_f0=1e308"], "theta_f0"),
     "x_O 1e308": ([*SIM, "--set", "x_O=1e308"], "x_O"),
     "duration 1e9": (["simulate", "--duration", "1e9", "--out", "OUT.parquet"], "memory"),
     "dt above duration": (["simulate", "--duration", "0.4", "--set", "dt=1"], "dt"),
-    "values 1e8": ([*BIF[:4], "0.001:0.018:100000000", *BIF[5:], "--out", "OUT.parquet"],
-                   "NUM"),
-    "checkpoint nan": ([*BIF, "--checkpoint-interval", "nan", "--out", "OUT.parquet"],
-                       "--checkpoint-interval"),
-    "checkpoint inf": ([*MAP, "--checkpoint-interval", "inf", "--out", "OUT.parquet"],
-                       "--checkpoint-interval"),
-    "realizations 1e9": ([*MAP, "--realizations", "1000000000", "--out", "OUT.parquet"],
-                         "memory"),
-    "ensemble duration 1e9": (["ensemble", "--members", "2", "--duration", "1e9", "--out",
-                               "OUT.parquet"], "memory"),
+    "values 1e8": ([*BIF[:4], "0.001:0.018:100000000", *BIF[5:], "--out", "OUT.parquet"], "NUM"),
+    "checkpoint nan": (
+        [*BIF, "--checkpoint-interval", "nan", "--out", "OUT.parquet"],
+        "--checkpoint-interval",
+    ),
+    "checkpoint inf": (
+        [*MAP, "--checkpoint-interval", "inf", "--out", "OUT.parquet"],
+        "--checkpoint-interval",
+    ),
+    "realizations 1e9": ([*MAP, "--realizations", "1000000000", "--out", "OUT.parquet"], "memory"),
+    "ensemble duration 1e9": (
+        ["ensemble", "--members", "2", "--duration", "1e9", "--out", "OUT.parquet"],
+        "memory",
+    ),
     "ensemble seed -1": ([*ENS, "--seed", "-1", "--out", "OUT.parquet"], "seed"),
     "paper workers 0": (["paper", "--workers", "0", "--out", "OUT.html"], "--workers"),
     "map duration 1e9": ([*MAP, "--duration", "1e9", "--out", "OUT.parquet"], "memory"),
@@ -76,8 +102,9 @@ def test_run_that_left_the_model_exits_1_with_the_cause(capsys):
 
 def _empty_trajectory(path, rows):
     traj = chaoscam.simulate(duration=0.2)
-    traj = dataclasses.replace(traj, series=traj.series.iloc[:rows],
-                               section=traj.section.iloc[:rows])
+    traj = dataclasses.replace(
+        traj, series=traj.series.iloc[:rows], section=traj.section.iloc[:rows]
+    )
     traj.to_parquet(path)
     return path
 
@@ -128,8 +155,13 @@ API_TYPE_CASES = [
     (lambda: chaoscam.simulate(index=-1), ParameterError, "index"),
     (lambda: bifurcation("l_lambda", 0.01), SweepError, "sequence"),
     (lambda: regime_map(("omega", [1e300]), ("xi", [0.4])), ParameterError, "omega"),
-    (lambda: regime_map(("omega", [30.0]), ("xi", [0.4]), flush_interval=math.nan,
-                        out="x.parquet"), ParameterError, "flush_interval"),
+    (
+        lambda: regime_map(
+            ("omega", [30.0]), ("xi", [0.4]), flush_interval=math.nan, out="x.parquet"
+        ),
+        ParameterError,
+        "flush_interval",
+    ),
 ]
 
 
@@ -144,9 +176,15 @@ def test_numpy_scalars_are_accepted():
     """numpy scalars where numbers are expected: accepted and stored as Python numbers."""
     p = Params(omega=np.float32(30), max_events_per_step=np.int64(4))
     assert p.omega == 30.0 and type(p.omega) is float and type(p.max_events_per_step) is int
-    res = regime_map(("l_lambda", [0.008]), ("l_lambda_sigma", [0.001]), duration=0.2,
-                     realizations=np.int64(2), seed=np.int64(1), workers=1,
-                     classify=_Label())
+    res = regime_map(
+        ("l_lambda", [0.008]),
+        ("l_lambda_sigma", [0.001]),
+        duration=0.2,
+        realizations=np.int64(2),
+        seed=np.int64(1),
+        workers=1,
+        classify=_Label(),
+    )
     assert len(res.realizations) == 2
     assert chaoscam.simulate(duration=0.05, seed=np.int64(2)).settings["seed"] == 2
 
@@ -206,8 +244,13 @@ def test_left_the_model_labelled_alike_in_ensembles_and_sweeps():
 
 def test_failing_classifier_is_one_line_exit_1(tmp_path, capsys):
     """A classifier that raises: exit 1 and one line saying how to reproduce, no traceback."""
-    args = [*MAP, "--classifier", "tests.sweep._helpers:FailingClassifier",
-            "--out", str(tmp_path / "m.parquet")]
+    args = [
+        *MAP,
+        "--classifier",
+        "tests.sweep._helpers:FailingClassifier",
+        "--out",
+        str(tmp_path / "m.parquet"),
+    ]
     assert main(args) == 1
     err = capsys.readouterr().err
     assert err.startswith("chaoscam: error: task") and "this classifier has a bug" in err

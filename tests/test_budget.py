@@ -46,8 +46,11 @@ def test_minutes_warned_about_ordinary_runs_not():
         check_run(TINY_J, 1e-4)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        for p in (Params(), Params(integrator="adaptive"),
-                  Params(integrator="adaptive", stiffness="fractal")):
+        for p in (
+            Params(),
+            Params(integrator="adaptive"),
+            Params(integrator="adaptive", stiffness="fractal"),
+        ):
             check_run(p, 20.0)
             assert run_seconds(p, 20.0) < RUN_WARN_SECONDS
 
@@ -57,8 +60,7 @@ def test_estimate_scales_as_the_formula_says():
     fixed stiffness) and falls with a looser rtol."""
     p = Params(integrator="adaptive", J=1e-6)
     assert adaptive_seconds(p, 2.0) == pytest.approx(2 * adaptive_seconds(p, 1.0))
-    assert adaptive_seconds(p.replace(J=1e-8), 1.0) == pytest.approx(
-        100 * adaptive_seconds(p, 1.0))
+    assert adaptive_seconds(p.replace(J=1e-8), 1.0) == pytest.approx(100 * adaptive_seconds(p, 1.0))
     assert adaptive_seconds(p.replace(rtol=1e-8), 1.0) < adaptive_seconds(p, 1.0) / 100
 
 
@@ -89,10 +91,20 @@ def test_cli_refuses_hours_with_exit_2(tmp_path, capsys):
     adaptive = ["--set", "integrator=adaptive", "--set", "J=1e-9"]
     cases = [
         ["simulate", *adaptive, "--out", str(tmp_path / "s.parquet")],
-        ["regime-map", "--mu", "0.006:0.008:2", "--sigma", "0:0.001:2", *adaptive,
-         "--workers", "1", "--quiet", "--out", str(tmp_path / "m.parquet")],
-        ["ensemble", "--members", "2", *adaptive, "--quiet",
-         "--out", str(tmp_path / "e.parquet")],
+        [
+            "regime-map",
+            "--mu",
+            "0.006:0.008:2",
+            "--sigma",
+            "0:0.001:2",
+            *adaptive,
+            "--workers",
+            "1",
+            "--quiet",
+            "--out",
+            str(tmp_path / "m.parquet"),
+        ],
+        ["ensemble", "--members", "2", *adaptive, "--quiet", "--out", str(tmp_path / "e.parquet")],
     ]
     for args in cases:
         assert main(args) == 2
@@ -113,10 +125,23 @@ def test_cli_warns_before_the_work():
     first thing on stderr, while the run is still going (then Ctrl-C: exit 130)."""
     code = "import sys; from chaoscam.cli import main; sys.exit(main(sys.argv[1:]))"
     proc = subprocess.Popen(
-        [sys.executable, "-c", code, "simulate", "--set", "integrator=adaptive",
-         "--set", "J=1e-9", "--duration", "1e-4"],
-        cwd=ROOT, env=dict(os.environ, PYTHONPATH=str(ROOT)),
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        [
+            sys.executable,
+            "-c",
+            code,
+            "simulate",
+            "--set",
+            "integrator=adaptive",
+            "--set",
+            "J=1e-9",
+            "--duration",
+            "1e-4",
+        ],
+        cwd=ROOT,
+        env=dict(os.environ, PYTHONPATH=str(ROOT)),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     try:
         first = proc.stderr.readline()

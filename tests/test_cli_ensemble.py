@@ -8,8 +8,22 @@ from chaoscam import Params, classify_ensemble
 from chaoscam.cli import main
 from chaoscam.integrate import simulate_ensemble
 
-ARGS = ["ensemble", "--members", "5", "--duration", "1.0", "--transient", "0.5",
-        "--set", "l_lambda_sigma=0.002", "--seed", "4", "--chunk", "2", "--quiet"]
+ARGS = [
+    "ensemble",
+    "--members",
+    "5",
+    "--duration",
+    "1.0",
+    "--transient",
+    "0.5",
+    "--set",
+    "l_lambda_sigma=0.002",
+    "--seed",
+    "4",
+    "--chunk",
+    "2",
+    "--quiet",
+]
 
 
 def test_writes_members_sections_impacts_equal_to_the_api(tmp_path):
@@ -21,8 +35,9 @@ def test_writes_members_sections_impacts_equal_to_the_api(tmp_path):
     assert not (tmp_path / "ens.parts").exists()
     p = Params(l_lambda_sigma=0.002)
     api = classify_ensemble(
-        simulate_ensemble(p, range(5), seed=4, duration=1.0, transient=0.5, keep_impacts=True,
-                          tangent=True),
+        simulate_ensemble(
+            p, range(5), seed=4, duration=1.0, transient=0.5, keep_impacts=True, tangent=True
+        ),
         p,
     )
     assert list(members["index"]) == list(range(5)) and list(members["member"]) == list(range(5))
@@ -50,7 +65,9 @@ def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, ca
     monkeypatch.setattr(integrate, "simulate_ensemble", interrupted_on_the_second_part)
     out = tmp_path / "ens.parquet"
     assert main([*ARGS, "--out", str(out)]) == 130
-    assert "--resume" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    said = [line for line in err.splitlines() if "interrupted" in line]
+    assert len(said) == 1 and "--resume" in said[0]  # one message, with the resume hint
     assert not out.exists() and len(list((tmp_path / "ens.parts").glob("*.done"))) == 1
     monkeypatch.setattr(integrate, "simulate_ensemble", real)
     assert main([*ARGS, "--out", str(out)]) == 2  # an unfinished run is not overwritten
@@ -63,8 +80,12 @@ def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, ca
 
 @pytest.mark.parametrize(
     "extra, needle",
-    [(["--members", "0"], "members"), (["--set", "omgea=3"], "omgea"),
-     (["--duration", "-1"], "duration"), (["--transient", "5"], "transient")],
+    [
+        (["--members", "0"], "members"),
+        (["--set", "omgea=3"], "omgea"),
+        (["--duration", "-1"], "duration"),
+        (["--transient", "5"], "transient"),
+    ],
 )
 def test_bad_input_exits_2_naming_the_field(tmp_path, capsys, extra, needle):
     out = tmp_path / "e.parquet"
@@ -90,3 +111,13 @@ def test_gpu_fallback_is_one_line(tmp_path, capsys, monkeypatch):
     err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
     assert len(err) == 1 and "no CUDA device (test)" in err[0] and "CPU" in err[0]
     assert len(pd.read_parquet(out)) == 5
+
+
+def test_progress_counts_every_member_from_the_first_batch(tmp_path, capsys):
+    """The progress bar (stderr) has the total from the start and reaches it; the compiled
+    calls are small batches, so it moves before the first part is done."""
+    out = tmp_path / "p.parquet"
+    loud = [a for a in ARGS if a != "--quiet"]
+    assert main([*loud, "--chunk", "5", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert "ensemble:" in err and "/5" in err and "5/5" in err

@@ -8,9 +8,23 @@ import pytest
 
 from chaoscam.cli import main
 
-ARGS = ["ensemble", "--members", "5", "--duration", "1.0", "--transient", "0.5",
-        "--set", "l_lambda_sigma=0.002", "--seed", "4", "--chunk", "2", "--quiet",
-        "--keep-impacts"]
+ARGS = [
+    "ensemble",
+    "--members",
+    "5",
+    "--duration",
+    "1.0",
+    "--transient",
+    "0.5",
+    "--set",
+    "l_lambda_sigma=0.002",
+    "--seed",
+    "4",
+    "--chunk",
+    "2",
+    "--quiet",
+    "--keep-impacts",
+]
 NAMES = ("", ".sections", ".impacts")
 
 
@@ -44,9 +58,12 @@ def test_killed_between_output_files_resumes(tmp_path, monkeypatch, whole, stop,
     """A stop before any of the renames of the final commit (or before the parts are
     removed): --resume finishes, and the outputs equal those of an uninterrupted run."""
     out = tmp_path / "e.parquet"
-    target = {"sections": out.with_name("e.sections.parquet"),
-              "impacts": out.with_name("e.impacts.parquet"), "members": out,
-              "parts removal": tmp_path / f".tmp-{os.getpid()}-removed-e.parts"}[stop]
+    target = {
+        "sections": out.with_name("e.sections.parquet"),
+        "impacts": out.with_name("e.impacts.parquet"),
+        "members": out,
+        "parts removal": tmp_path / f".tmp-{os.getpid()}-removed-e.parts",
+    }[stop]
     _stop_at(monkeypatch, target)
     assert main([*ARGS, "--out", str(out)]) == 130
     monkeypatch.undo()

@@ -8,8 +8,21 @@ from chaoscam.cli import main
 def test_simulate_prints_summary_and_writes_files(tmp_path, capsys):
     """simulate writes series, section and impacts and prints the summary."""
     out, sec, imp = tmp_path / "s.csv", tmp_path / "sec.csv", tmp_path / "imp.csv"
-    code = main(["simulate", "--duration", "1", "--set", "omega=28.7", "--out", str(out),
-                 "--section", str(sec), "--impacts", str(imp)])
+    code = main(
+        [
+            "simulate",
+            "--duration",
+            "1",
+            "--set",
+            "omega=28.7",
+            "--out",
+            str(out),
+            "--section",
+            str(sec),
+            "--impacts",
+            str(imp),
+        ]
+    )
     assert code == 0
     text = capsys.readouterr().out
     assert "status: OK" in text and "contact fraction" in text

@@ -17,10 +17,12 @@ from chaoscam.cli import main  # noqa: E402
 from chaoscam.model import FIELD_DOCS, ParameterError, Params  # noqa: E402
 from chaoscam.sweep import Axis, SweepError  # noqa: E402
 
-QUICK = settings(max_examples=50, deadline=None,
-                 suppress_health_check=[HealthCheck.function_scoped_fixture])
-BIG = settings(max_examples=2000, deadline=None,
-               suppress_health_check=[HealthCheck.function_scoped_fixture])
+QUICK = settings(
+    max_examples=50, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+BIG = settings(
+    max_examples=2000, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 
 NUMERIC = [n for n, d in FIELD_DOCS.items() if d["choices"] is None]
 CHOICE = [n for n, d in FIELD_DOCS.items() if d["choices"] is not None]
@@ -30,10 +32,16 @@ INT_FIELDS = {f.name for f in dataclasses.fields(Params) if f.type == "int"}
 def _outside(name):
     """Values outside the field's range (or not finite)."""
     lo, hi, lo_inc, hi_inc = FIELD_DOCS[name]["range"] or (None, None, None, None)
-    below = [] if lo is None else [st.floats(max_value=lo, exclude_max=lo_inc,
-                                             allow_nan=False, allow_infinity=False)]
-    above = [] if hi is None else [st.floats(min_value=hi, exclude_min=hi_inc,
-                                             allow_nan=False, allow_infinity=False)]
+    below = (
+        []
+        if lo is None
+        else [st.floats(max_value=lo, exclude_max=lo_inc, allow_nan=False, allow_infinity=False)]
+    )
+    above = (
+        []
+        if hi is None
+        else [st.floats(min_value=hi, exclude_min=hi_inc, allow_nan=False, allow_infinity=False)]
+    )
     if name in INT_FIELDS:
         below = [] if lo is None else [st.integers(max_value=int(lo) - (1 if lo_inc else 0))]
         above = [] if hi is None else [st.integers(min_value=int(hi) + (1 if hi_inc else 0))]
@@ -50,8 +58,11 @@ def bad_assignment(draw):
     kind = draw(st.sampled_from(["range", "text", "choice"]))
     if kind == "choice":
         name = draw(st.sampled_from(CHOICE))
-        text = draw(st.text(min_size=1, max_size=12).filter(
-            lambda t: t.strip() not in FIELD_DOCS[name]["choices"] and "\x00" not in t))
+        text = draw(
+            st.text(min_size=1, max_size=12).filter(
+                lambda t: t.strip() not in FIELD_DOCS[name]["choices"] and "\x00" not in t
+            )
+        )
         return name, text
     name = draw(st.sampled_from(NUMERIC))
     if kind == "text":
@@ -95,7 +106,8 @@ def test_fuzz_params_many(tmp_path, case):
 RANGE_TEXT = st.one_of(
     st.text(alphabet="0123456789.:-+eEnaif x", max_size=20),
     st.tuples(st.floats(), st.floats(), st.integers(-5, 10**12)).map(
-        lambda t: f"{t[0]!r}:{t[1]!r}:{t[2]}"),
+        lambda t: f"{t[0]!r}:{t[1]!r}:{t[2]}"
+    ),
 )
 
 
@@ -125,8 +137,11 @@ def test_fuzz_file_inputs(tmp_path, data, suffix):
     path = tmp_path / f"in{suffix}"
     path.write_bytes(data)
     out = tmp_path / "r.html"
-    for args in (["classify", str(path)], ["report", str(path), "--out", str(out)],
-                 ["classify-series", str(path), "--column", "x", "--dt", "0.01"]):
+    for args in (
+        ["classify", str(path)],
+        ["report", str(path), "--out", str(out)],
+        ["classify-series", str(path), "--column", "x", "--dt", "0.01"],
+    ):
         code, err = _run(args)
         assert code == 2, (args, data, err)
         assert "error" in err and (path.name in err or "--column" in err), (args, err)

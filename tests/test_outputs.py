@@ -28,19 +28,45 @@ def _traj(tmp_path):
 
 
 def _bif(out, *extra):
-    return ["bifurcation", "--param", "l_lambda", "--values", "0.006:0.008:2",
-            "--duration", "0.5", "--workers", "1", "--quiet", "--out", str(out), *extra]
+    return [
+        "bifurcation",
+        "--param",
+        "l_lambda",
+        "--values",
+        "0.006:0.008:2",
+        "--duration",
+        "0.5",
+        "--workers",
+        "1",
+        "--quiet",
+        "--out",
+        str(out),
+        *extra,
+    ]
 
 
 def _map(out, *extra):
-    return ["regime-map", "--mu", "0.006:0.008:2", "--sigma", "0:0.001:2", "--duration", "0.5",
-            "--workers", "1", "--quiet", "--classifier", "tests.sweep._helpers:SpreadClassifier",
-            "--out", str(out), *extra]
+    return [
+        "regime-map",
+        "--mu",
+        "0.006:0.008:2",
+        "--sigma",
+        "0:0.001:2",
+        "--duration",
+        "0.5",
+        "--workers",
+        "1",
+        "--quiet",
+        "--classifier",
+        "tests.sweep._helpers:SpreadClassifier",
+        "--out",
+        str(out),
+        *extra,
+    ]
 
 
 def _ens(out, *extra):
-    return ["ensemble", "--members", "2", "--duration", "0.5", "--quiet", "--out", str(out),
-            *extra]
+    return ["ensemble", "--members", "2", "--duration", "0.5", "--quiet", "--out", str(out), *extra]
 
 
 # Each command and how it names an output: a builder taking the output path.
@@ -55,8 +81,14 @@ COMMANDS = {
     "regime-map --out": lambda p: _map(p),
     "ensemble --out": lambda p: _ens(p),
 }
-SUFFIX = {"simulate --out": ".csv", "simulate --section": ".csv", "simulate --impacts": ".csv",
-          "report --out": ".html", "paper --out": ".html", "bifurcation --plot": ".png"}
+SUFFIX = {
+    "simulate --out": ".csv",
+    "simulate --section": ".csv",
+    "simulate --impacts": ".csv",
+    "report --out": ".html",
+    "paper --out": ".html",
+    "bifurcation --plot": ".png",
+}
 
 
 def _args(tmp_path, command, path):
@@ -73,8 +105,11 @@ def test_bad_output_refused_before_the_work(tmp_path, command, case, capsys):
     and a message naming the path, before any computation (long runs return at once), and
     leaves an existing file untouched."""
     name = "o" + SUFFIX.get(command, ".parquet")
-    path = {"missing folder": tmp_path / "nowhere" / name, "a directory": tmp_path / "d",
-            "exists": tmp_path / name}[case]
+    path = {
+        "missing folder": tmp_path / "nowhere" / name,
+        "a directory": tmp_path / "d",
+        "exists": tmp_path / name,
+    }[case]
     if case == "a directory":
         path = tmp_path / ("d" + SUFFIX.get(command, ".parquet"))
         path.mkdir()
@@ -126,8 +161,13 @@ def _hold_lock(path: Path):
         "import sys, time; from chaoscam._outputs import OutputLock; "
         f"OutputLock({str(path)!r}).acquire(); print('held', flush=True); time.sleep(30)"
     )
-    proc = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, stdout=subprocess.PIPE,
-                            env=dict(os.environ, PYTHONPATH=str(ROOT)), text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        env=dict(os.environ, PYTHONPATH=str(ROOT)),
+        text=True,
+    )
     assert proc.stdout.readline().strip() == "held"
     return proc
 
@@ -174,9 +214,17 @@ def test_two_writers_started_together(tmp_path):
     args[args.index("0.006:0.008:2")] = "0.006:0.010:3"
     code = "import sys; from chaoscam.cli import main; sys.exit(main(sys.argv[1:]))"
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    procs = [subprocess.Popen([sys.executable, "-c", code, *args], cwd=ROOT, env=env,
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-             for _ in range(2)]
+    procs = [
+        subprocess.Popen(
+            [sys.executable, "-c", code, *args],
+            cwd=ROOT,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for _ in range(2)
+    ]
     results = [p.communicate(timeout=120) for p in procs]
     codes = sorted(p.returncode for p in procs)
     assert codes == [0, 2], results

@@ -51,7 +51,14 @@ def test_default_run_outputs(default_run):
     tr = default_run
     assert tr.status is Status.OK
     assert list(tr.series.columns) == [
-        "t", "theta_f", "omega_f", "theta_fc", "gap", "contact", "F_n", "l_lambda",
+        "t",
+        "theta_f",
+        "omega_f",
+        "theta_fc",
+        "gap",
+        "contact",
+        "F_n",
+        "l_lambda",
     ]
     assert (tr.series.F_n >= 0).all() and (tr.series.F_n[~tr.series.contact] == 0).all()
     k = tr.section.k.values
@@ -137,8 +144,12 @@ def test_chattering_without_v_min_does_not_hang():
 
 @pytest.mark.parametrize(
     "kwargs, field",
-    [({"duration": -1.0}, "duration"), ({"duration": 1.0, "transient": 2.0}, "transient"),
-     ({"output_dt": 1e-9}, "output_dt"), ({"omgea": 1.0}, "omgea")],
+    [
+        ({"duration": -1.0}, "duration"),
+        ({"duration": 1.0, "transient": 2.0}, "transient"),
+        ({"output_dt": 1e-9}, "output_dt"),
+        ({"omgea": 1.0}, "omgea"),
+    ],
 )
 def test_bad_run_settings_are_refused(kwargs, field):
     """Run settings are validated with a message naming the field."""

@@ -59,6 +59,7 @@ from numba import njit
 
 from . import _kernel as k
 from ._dop853 import ERROR_ORDER, dop853_step, omega_at, theta_at
+from ._events import illinois_point, illinois_update
 from ._kernel import (
     C_DT,
     C_EVENT_TOL,
@@ -119,13 +120,13 @@ def locate_on_interpolant(h, th, tr, co, g_start, g_end, s_hi, c):
         width = b - a
         if width <= tol:
             break
-        m = k.illinois_point(a, fa, b, fb)
+        m = illinois_point(a, fa, b, fb)
         fm, _, _ = geometry_near(m * h, theta_at(co, m), th, tr, c)
-        a, fa, b, fb, side = k.illinois_update(a, fa, b, fb, m, fm * sgn, side)
+        a, fa, b, fb, side = illinois_update(a, fa, b, fb, m, fm * sgn, side)
         if b - a > 0.5 * width:
             m = 0.5 * (a + b)
             fm, _, _ = geometry_near(m * h, theta_at(co, m), th, tr, c)
-            a, fa, b, fb, _ = k.illinois_update(a, fa, b, fb, m, fm * sgn, 0)
+            a, fa, b, fb, _ = illinois_update(a, fa, b, fb, m, fm * sgn, 0)
     return b
 
 
@@ -142,10 +143,10 @@ def turning_point(h, th, tr, co, rate0, rate1, c):
     for _ in range(100):
         if b - a <= 1e-9:
             break
-        m = k.illinois_point(a, fa, b, fb)
+        m = illinois_point(a, fa, b, fb)
         _, l1, cdn = geometry_near(m * h, theta_at(co, m), th, tr, c)
         fm = sgn * (l1 * omega_at(co, m) - cdn)
-        a, fa, b, fb, side = k.illinois_update(a, fa, b, fb, m, fm, side)
+        a, fa, b, fb, side = illinois_update(a, fa, b, fb, m, fm, side)
     return 0.5 * (a + b)
 
 

@@ -136,6 +136,7 @@ def simulate_ensemble(
     backend: str = "cpu",
     keep_impacts: bool = False,
     tangent: bool = False,
+    progress=None,
 ) -> Ensemble:
     """Simulate realizations ``indices`` of one model (or one model per member) in parallel.
 
@@ -167,6 +168,10 @@ def simulate_ensemble(
         (``Ensemble.jacobians``), from which :func:`chaoscam.classify.classify_ensemble`
         labels the members (the tangent exponent, n-band chaos, the periodic-orbit
         certificate). The members' motion is the same with and without it.
+    progress : callable, optional
+        Called with the number of members just finished after each batch (a progress bar's
+        ``update``); a smaller ``batch`` gives more frequent calls (and a Ctrl-C that is
+        honoured sooner: it waits for the compiled call to return).
 
     Notes
     -----
@@ -212,6 +217,8 @@ def simulate_ensemble(
         sections.extend(s)
         rows.extend(r)
         impact_rows.extend(im)
+        if progress is not None:
+            progress(len(r))
     cols = ["member", *k.SECTION_NAMES]
     every = np.concatenate(sections) if sections else np.empty((0, 1 + k.SECTION_COLS))
     sec = pd.DataFrame(every[:, : len(cols)], columns=cols)

@@ -220,8 +220,9 @@ def run_on_gpu(
     d_impacts = cuda.device_array(impacts.shape)
     blocks = (n + _BLOCK - 1) // _BLOCK
     while True:
-        kern[blocks, _BLOCK](d_y, d_cnt, d_c, n_stop, d_lam, d_series, d_section, d_impacts,
-                             d_status)
+        kern[blocks, _BLOCK](
+            d_y, d_cnt, d_c, n_stop, d_lam, d_series, d_section, d_impacts, d_status
+        )
         d_status.copy_to_host(status)
         need = np.flatnonzero(status == k.NEED_BUFFER)
         if need.size == 0:

@@ -101,7 +101,13 @@ SECTION_NAMES = ("k", "t", "theta_f", "omega_f", "l_lambda")
 # integral of the divergence over that period (NaN when the tangent is not integrated).
 SECTION_TANGENT_NAMES = ("j11", "j21", "j12", "j22", "div")
 IMPACT_NAMES = (
-    "t", "theta_f", "omega_before", "omega_after", "gap_rate_before", "lever_arm", "l_lambda",
+    "t",
+    "theta_f",
+    "omega_before",
+    "omega_after",
+    "gap_rate_before",
+    "lever_arm",
+    "l_lambda",
     "kind",
 )
 SERIES_COLS = 4  # t, theta_f, omega_f, l_lambda

@@ -98,7 +98,13 @@ def simulate_reference(
         event.terminal = True
         event.direction = 1.0 if in_contact else -1.0
         sol = solve_ivp(
-            rhs, (t, t_stop), y, method="DOP853", rtol=rtol, atol=atol, events=event,
+            rhs,
+            (t, t_stop),
+            y,
+            method="DOP853",
+            rtol=rtol,
+            atol=atol,
+            events=event,
             dense_output=True,
         )
         t_new = float(sol.t[-1])
@@ -132,8 +138,16 @@ def simulate_reference(
         elif t >= next_resample:
             lam = float(stream.draw(1)[0])
             next_resample += p.resample_dt
-    cols = ["t", "theta_f", "omega_before", "omega_after", "gap_rate_before", "lever_arm",
-            "l_lambda", "kind"]
+    cols = [
+        "t",
+        "theta_f",
+        "omega_before",
+        "omega_after",
+        "gap_rate_before",
+        "lever_arm",
+        "l_lambda",
+        "kind",
+    ]
     return ReferenceResult(
         impacts=pd.DataFrame(impacts, columns=cols),
         section=pd.DataFrame(section, columns=["k", "t", "theta_f", "omega_f", "l_lambda"]),

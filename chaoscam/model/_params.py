@@ -76,8 +76,9 @@ class Params:
     )
     omega: float = field(
         default=28.7,
-        metadata=_meta("cam speed (practical bound: 1e4 rad/s, ~95,000 rpm)", "rad/s",
-                       (0.0, 1e4, False, True)),
+        metadata=_meta(
+            "cam speed (practical bound: 1e4 rad/s, ~95,000 rpm)", "rad/s", (0.0, 1e4, False, True)
+        ),
     )
     l_lambda: float = field(
         default=0.008,

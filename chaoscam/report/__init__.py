@@ -26,7 +26,8 @@ _LAZY = {
     "classify": ("._classify", "classify"),
     "load_inputs": ("._inputs", "load_inputs"),
     "load_trajectory": ("._inputs", "load_trajectory"),
-    "run_paper": ("._paper", "run_paper"),
+    "figure_script": ("._paper_run", "figure_script"),
+    "run_paper": ("._paper_run", "run_paper"),
     "write_report": ("._html", "write_report"),
 }
 
@@ -41,6 +42,7 @@ __all__ = [
     "classify",
     "load_inputs",
     "load_trajectory",
+    "figure_script",
     "run_paper",
     "write_report",
 ]

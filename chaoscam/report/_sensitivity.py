@@ -62,8 +62,7 @@ def _stiffness(quick: bool, outdir: Path, workers, classify):
 
     step = 1.0 if quick else 0.5
     y_f = [float(f"{v:.3g}") for v in 10 ** np.arange(2.0, 11.01, step)] + [2.07e11]
-    bif = bifurcation("Y_f", y_f, duration=20.0, transient=10.0, classify=classify,
-                      workers=workers)
+    bif = bifurcation("Y_f", y_f, duration=20.0, transient=10.0, classify=classify, workers=workers)
     path = outdir / "sensitivity-stiffness.parquet"
     bif.to_parquet(path)
     base = Params()
@@ -80,13 +79,21 @@ def _stiffness_figure(bif, k_n: dict):
     fig = Figure(figsize=(10, 5.5), layout="constrained")
     ax = fig.subplots()
     for lab, g in pts.groupby("label"):
-        ax.scatter(g["K_n"], g["theta_f"], s=4, color=LABEL_COLORS.get(lab, "#E69F00"),
-                   label=lab, rasterized=True)
+        ax.scatter(
+            g["K_n"],
+            g["theta_f"],
+            s=4,
+            color=LABEL_COLORS.get(lab, "#E69F00"),
+            label=lab,
+            rasterized=True,
+        )
     ax.axvspan(*PAPER_K_N, color="#999999", alpha=0.25, lw=0, label="the paper's Hertz range")
     ax.set_xscale("log")
-    ax.set(xlabel="contact stiffness K_n [N/m] (through Y_f)",
-           ylabel="θ_f at the section [rad]",
-           title="Section points against the contact stiffness (ξ = 0.5, ω and l_λ of Table 1)")
+    ax.set(
+        xlabel="contact stiffness K_n [N/m] (through Y_f)",
+        ylabel="θ_f at the section [rad]",
+        title="Section points against the contact stiffness (the rest as in Table 1)",
+    )
     ax.legend(frameon=False, fontsize="medium", markerscale=3)
     return fig
 
@@ -137,8 +144,9 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     res.bifurcations.append((str(path_k), bif_k))
     # 2. restitution
     values = "0.1:0.7:13" if quick else "0.1:0.7:25"
-    bif_x = bifurcation("xi", values, duration=20.0, transient=10.0, classify=classify,
-                        workers=workers)
+    bif_x = bifurcation(
+        "xi", values, duration=20.0, transient=10.0, classify=classify, workers=workers
+    )
     path_x = outdir / "sensitivity-xi.parquet"
     bif_x.to_parquet(path_x)
     _save(bifurcation_figure(bif_x.points), outdir, "sensitivity-xi")
@@ -146,8 +154,9 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     v = _first_ic(bif_x)
     xi0 = Params().xi
     near = v[(v["value"] - xi0).abs() <= 0.05 + 1e-9]
-    near_tags = list(dict.fromkeys(_tag(a, b) for a, b in zip(near["label"], near["period"],
-                                                              strict=True)))
+    near_tags = list(
+        dict.fromkeys(_tag(a, b) for a, b in zip(near["label"], near["period"], strict=True))
+    )
     res.why.append(
         f"Restitution ξ (Table 1: {xi0:g}): "
         + _runs_text(label_runs(v["value"], v["label"], v["period"]), "{:.3g}")
@@ -173,8 +182,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     _save(regime_map_figure(rm.cells, x="omega", y="xi"), outdir, "sensitivity-omega-xi")
     res.regime_maps.append((str(path_m), rm))
     cells = rm.cells
-    tags = pd.Series([_tag(a, b) for a, b in zip(cells["dominant"], cells["period"],
-                                                   strict=True)])
+    tags = pd.Series([_tag(a, b) for a, b in zip(cells["dominant"], cells["period"], strict=True)])
     periods = sorted({int(p) for p in cells["period"].dropna()})
     escape = cells[cells["dominant"] == "left_reach"]
     row_xi = float(cells["xi"].iloc[(cells["xi"] - Params().xi).abs().argmin()])
@@ -186,8 +194,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         + ", ".join(f"{k} {n}" for k, n in tags.value_counts().sort_index().items())
         + f"; periods found: {', '.join(map(str, periods)) or 'none'}"
         + (
-            f"; the follower leaves the cam's reach for ξ ≥ {escape['xi'].min():.3g} "
-            f"(at some ω)"
+            f"; the follower leaves the cam's reach for ξ ≥ {escape['xi'].min():.3g} (at some ω)"
             if len(escape)
             else ""
         )

@@ -40,6 +40,10 @@ ANNOTATION_PT = 10
 ANNOTATE_CELLS = 64
 """Heatmaps with at most this many cells are annotated (larger ones would not fit the text)."""
 
+ANNOTATE_PERIODS = 400
+"""Dominant-label maps with at most this many cells get their periods written in (short
+text, at a smaller size beyond ``ANNOTATE_CELLS``)."""
+
 _SYMBOLS = {
     "l_lambda": "l_λ",
     "l_lambda_sigma": "σ of l_λ",
@@ -103,7 +107,7 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
     m = _grid(coded, x, y, "_code")
     colors = [LABEL_COLORS.get(lab, _OTHER) for lab in order] or ["#FFFFFF"]
     annot = False
-    if "period" in cells and m.size <= ANNOTATE_CELLS:
+    if "period" in cells and m.size <= ANNOTATE_PERIODS:
         per = _grid(cells.assign(_p=cells["period"].astype(float)), x, y, "_p").to_numpy()
         dom = _grid(cells, x, y, "dominant").to_numpy()
         annot = np.where(
@@ -123,7 +127,11 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
         mask=m.isna(),
         annot=annot,
         fmt="",
-        annot_kws={"fontsize": ANNOTATION_PT, "color": "white", "fontweight": "bold"},
+        annot_kws={
+            "fontsize": ANNOTATION_PT if m.size <= ANNOTATE_CELLS else ANNOTATION_PT - 2,
+            "color": "white",
+            "fontweight": "bold",
+        },
     )
     _ticks(ax, m, x, y, _role(x, y))
     shown = annot is not False and bool(np.any(annot != ""))

@@ -282,8 +282,9 @@ def bifurcation(
         if not specs:
             raise SweepError("initial conditions: the list is empty")
     classify, identity = resolve_classifier(classify, lyapunov, check_step)
-    eng = resolve_engine(engine, device, classify, identity, base, (duration, transient),
-                         workers, scheduler)
+    eng = resolve_engine(
+        engine, device, classify, identity, base, (duration, transient), workers, scheduler
+    )
     series = eng.name == "process" and needs_series(classify)
     check_sweep_budget(
         base,
@@ -344,7 +345,12 @@ def bifurcation(
 
         plan = _BranchPlan(make_task, len(axis), len(specs), bool(continuation))
         run_plan(
-            plan, eng, store, workers=workers, scheduler=scheduler, progress=progress,
+            plan,
+            eng,
+            store,
+            workers=workers,
+            scheduler=scheduler,
+            progress=progress,
             desc=f"bifurcation {axis.name}",
         )
         records = unique_sorted(store.records(), ("value_index", "ic"))

@@ -141,8 +141,12 @@ def check_sweep_budget(
     kept = estimate(base, duration=duration, transient=transient) if keeps_sections else None
     memory = one.bytes * n + runs * (RECORD_BYTES + (kept.bytes / 3 if kept else 0.0))
     seconds = one.seconds * runs * factor / n
-    check_budget(JobEstimate((memory, seconds)), what=what, reduce=reduce,
-                 run=dict(params=base, duration=duration, what="each run of the base model"))
+    check_budget(
+        JobEstimate((memory, seconds)),
+        what=what,
+        reduce=reduce,
+        run=dict(params=base, duration=duration, what="each run of the base model"),
+    )
 
 
 def backend_for(workers: int | None, scheduler: Any):

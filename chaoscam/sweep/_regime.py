@@ -349,8 +349,9 @@ def regime_map(
         raise SweepError("max realizations applies with a target half-width only")
     validate_grid(base, [x, y])
     classify, identity = resolve_classifier(classify, lyapunov, check_step)
-    eng = resolve_engine(engine, device, classify, identity, base, (duration, transient),
-                         workers, scheduler)
+    eng = resolve_engine(
+        engine, device, classify, identity, base, (duration, transient), workers, scheduler
+    )
     series = eng.name == "process" and needs_series(classify)
     check_sweep_budget(
         base,
@@ -414,7 +415,12 @@ def regime_map(
             once=once,
         )
         run_plan(
-            plan, eng, store, workers=workers, scheduler=scheduler, progress=progress,
+            plan,
+            eng,
+            store,
+            workers=workers,
+            scheduler=scheduler,
+            progress=progress,
             desc="regime map",
         )
         records = unique_sorted(store.records(), ("cell", "index"))

@@ -169,21 +169,31 @@ def test_undetermined_short_run_is_extended_until_it_settles():
 UNSETTLED_BANDS = {
     "period 6 whose orbit is unstable (xi = 0.45)": (dict(xi=0.45), 0, "orbit found is unstable"),
     "random line length, 8 bands": (
-        dict(l_lambda=0.008, l_lambda_sigma=0.0015), 1, "the line length is random"
+        dict(l_lambda=0.008, l_lambda_sigma=0.0015),
+        1,
+        "the line length is random",
     ),
 }
 
 
-@pytest.mark.parametrize(("changes", "index", "words"), list(UNSETTLED_BANDS.values()),
-                         ids=list(UNSETTLED_BANDS))
+@pytest.mark.parametrize(
+    ("changes", "index", "words"), list(UNSETTLED_BANDS.values()), ids=list(UNSETTLED_BANDS)
+)
 def test_bands_that_only_look_periodic_are_not_called_periodic(changes, index, words):
     """Periodic only with a certificate or a contracting exponent; else undetermined, and
     the extended run settles it (chaotic)."""
     from chaoscam import Params, simulate
     from chaoscam.classify import classify_trajectory
 
-    traj = simulate(Params(**changes), duration=20.0, transient=10.0, seed=1, index=index,
-                    series=False, tangent=True)  # the section path, as in ensembles
+    traj = simulate(
+        Params(**changes),
+        duration=20.0,
+        transient=10.0,
+        seed=1,
+        index=index,
+        series=False,
+        tangent=True,
+    )  # the section path, as in ensembles
     short = classify_trajectory(traj, extend_to=None)
     assert short.label == "undetermined" and any(words in r for r in short.reasons)
     assert "run longer" in short.reasons[-1]  # the reason says what to run

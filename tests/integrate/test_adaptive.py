@@ -119,8 +119,13 @@ def test_failures_are_labelled_statuses():
 
 @pytest.mark.parametrize(
     "changes, field",
-    [({"integrator": "rk45"}, "integrator"), ({"rtol": 0.0}, "rtol"),
-     ({"rtol": 0.1}, "rtol"), ({"atol": -1.0}, "atol"), ({"h_max": 0.0}, "h_max")],
+    [
+        ({"integrator": "rk45"}, "integrator"),
+        ({"rtol": 0.0}, "rtol"),
+        ({"rtol": 0.1}, "rtol"),
+        ({"atol": -1.0}, "atol"),
+        ({"h_max": 0.0}, "h_max"),
+    ],
 )
 def test_bad_integrator_settings_name_the_field(changes, field):
     with pytest.raises(ParameterError, match=field):

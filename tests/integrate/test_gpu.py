@@ -112,12 +112,8 @@ def test_older_numpy_is_not_the_trap(monkeypatch, version):
 
 def test_import_does_not_load_numba_cuda():
     """import chaoscam (and its ensemble path) leaves numba.cuda unimported."""
-    code = (
-        "import sys, chaoscam, chaoscam.integrate._ensemble; "
-        "print('numba.cuda' in sys.modules)"
-    )
-    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
-                         text=True)
+    code = "import sys, chaoscam, chaoscam.integrate._ensemble; print('numba.cuda' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True)
     assert out.stdout.strip() == "False"
 
 
@@ -151,8 +147,14 @@ def test_simulated_gpu_equals_cpu():
     """Under the CUDA simulator the GPU driver (batches, relaunch after refills) equals the CPU
     path: the kernel there runs the compiled CPU code, so within GPU_TOLERANCE means equal."""
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    out = subprocess.run([sys.executable, "-c", _SIMULATED], check=True, capture_output=True,
-                         text=True, env=env, timeout=300)
+    out = subprocess.run(
+        [sys.executable, "-c", _SIMULATED],
+        check=True,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
     result = json.loads(out.stdout.strip().splitlines()[-1])
     for case in result.values():
         assert case["backend"] == "gpu" and case["shape"] and case["n"] > 0
@@ -184,8 +186,12 @@ def test_kernel_compiles_to_ptx_for_h100(method):
 )
 def test_device_equals_cpu_within_tolerance(params, duration, transient):
     """On a GPU, sections of the first cam period and of a periodic orbit equal the CPU's."""
-    runs = [simulate_ensemble(params, range(8), seed=3, duration=duration, transient=transient,
-                              backend=b) for b in ("gpu", "cpu")]
+    runs = [
+        simulate_ensemble(
+            params, range(8), seed=3, duration=duration, transient=transient, backend=b
+        )
+        for b in ("gpu", "cpu")
+    ]
     assert runs[0].settings["backend"] == "gpu"
     a, b = (sections(r) for r in runs)
     assert a.shape == b.shape

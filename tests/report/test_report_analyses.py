@@ -18,7 +18,9 @@ def test_fig5_script_writes_data_and_figure(tmp_path):
     """Running a script writes a PNG and a data file into OUTDIR and prints the comparison."""
     out = subprocess.run(
         [sys.executable, str(ROOT / "analyses" / "fig5.py"), "--quick", str(tmp_path)],
-        check=True, capture_output=True, text=True,
+        check=True,
+        capture_output=True,
+        text=True,
     )
     assert "Fig. 5" in out.stdout
     data = list(tmp_path.glob("*.csv")) + list(tmp_path.glob("*.parquet"))

@@ -48,7 +48,9 @@ def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch):
         raise RuntimeError("no luck")
 
     monkeypatch.setitem(_paper.FIGURES, 3, boom)
-    out = _paper.run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 5])
+    from chaoscam.report import run_paper
+
+    out = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 5])
     text = out.read_text()
     assert "boom: failed with RuntimeError: no luck" in text
     assert "Fig. 5 — fractal stiffness against D" in text

@@ -95,8 +95,9 @@ def test_dask_runs_the_ensemble_engine_batches_bit_for_bit(dask_client):
     """The ensemble engine's batches on Dask workers give the in-process table."""
     kw = dict(realizations=2, seed=3, duration=3.0, transient=1.5, engine="ensemble")
     local = regime_map(MU, SIGMA, **kw, workers=1)
-    frames_equal(regime_map(MU, SIGMA, **kw, scheduler=dask_client).realizations,
-                 local.realizations)
+    frames_equal(
+        regime_map(MU, SIGMA, **kw, scheduler=dask_client).realizations, local.realizations
+    )
 
 
 def test_dask_worker_lost_loses_nothing(dask_client, tmp_path, serial):

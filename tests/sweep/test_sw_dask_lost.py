@@ -61,7 +61,11 @@ def _dask_cluster(tmp_path, workers: int):
             procs.append(
                 _spawn(
                     "distributed.cli.dask_worker",
-                    address, "--nthreads", "1", "--no-nanny", "--no-dashboard",
+                    address,
+                    "--nthreads",
+                    "1",
+                    "--no-nanny",
+                    "--no-dashboard",
                 )  # fmt: skip
             )
         yield sched, address

@@ -18,15 +18,22 @@ from ._helpers import SpreadClassifier, frames_equal
 XI = Axis("xi", (0.2, 0.3))
 SIGMA = Axis("l_lambda_sigma", (0.0, 0.002))
 KW = dict(realizations=3, seed=5, duration=6.0, transient=3.0, base=Params())
-SAME = ["cell", "index", "seed", "sim_index", "status", "n_section", "n_impacts",
-        "contact_fraction", "truncated_mass"]
+SAME = [
+    "cell",
+    "index",
+    "seed",
+    "sim_index",
+    "status",
+    "n_section",
+    "n_impacts",
+    "contact_fraction",
+    "truncated_mass",
+]
 
 
 @pytest.fixture(scope="module")
 def maps():
-    return {
-        e: regime_map(XI, SIGMA, engine=e, workers=2, **KW) for e in ("ensemble", "process")
-    }
+    return {e: regime_map(XI, SIGMA, engine=e, workers=2, **KW) for e in ("ensemble", "process")}
 
 
 def test_the_engines_simulate_the_same_realizations(maps):
@@ -42,8 +49,14 @@ def test_ensemble_labels_are_those_of_classify_ensemble(maps):
     rows = maps["ensemble"].realizations
     for _, row in rows.iterrows():
         p = Params().replace(xi=row["xi"], l_lambda_sigma=row["l_lambda_sigma"])
-        ens = simulate_ensemble(p, [realization_index(row["cell"], row["index"])], seed=5,
-                                duration=6.0, transient=3.0, tangent=True)
+        ens = simulate_ensemble(
+            p,
+            [realization_index(row["cell"], row["index"])],
+            seed=5,
+            duration=6.0,
+            transient=3.0,
+            tangent=True,
+        )
         member = classify_ensemble(ens, p).members.iloc[0]
         assert (member["label"], member["period"]) == (row["label"], row["period"])
     det = rows[rows["l_lambda_sigma"] == 0.0]
@@ -127,8 +140,13 @@ def test_a_capped_extension_is_recorded_and_honoured():
     configuration says so."""
     from chaoscam.sweep._tasks import DefaultClassifier
 
-    m = regime_map(Axis("xi", (0.45,)), Axis("l_lambda_sigma", (0.0,)), duration=20.0,
-                   transient=10.0, classify=DefaultClassifier(extend_to=None))
+    m = regime_map(
+        Axis("xi", (0.45,)),
+        Axis("l_lambda_sigma", (0.0,)),
+        duration=20.0,
+        transient=10.0,
+        classify=DefaultClassifier(extend_to=None),
+    )
     assert m.config["engine"] == "ensemble" and "extend_to=None" in m.config["classifier"]
     row = m.realizations.iloc[0]
     assert row["label"] == "undetermined" and "run longer" in row["reasons"]

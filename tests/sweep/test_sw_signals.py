@@ -27,8 +27,12 @@ def _children(pid: int) -> list[int]:
 def _alive(pids, timeout=10.0) -> list[int]:
     t0 = time.monotonic()
     while True:
-        left = [p for p in pids if Path(f"/proc/{p}").exists()
-                and "Z" not in (Path(f"/proc/{p}/stat").read_text().rsplit(")", 1)[1][:3])]
+        left = [
+            p
+            for p in pids
+            if Path(f"/proc/{p}").exists()
+            and "Z" not in (Path(f"/proc/{p}/stat").read_text().rsplit(")", 1)[1][:3])
+        ]
         if not left or time.monotonic() - t0 > timeout:
             return left
         time.sleep(0.05)

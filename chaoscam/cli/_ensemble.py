@@ -27,7 +27,8 @@ import time
 import warnings
 from pathlib import Path
 
-from ._outputs import atomic_path
+from .._outputs import atomic_path
+from ._options import add_run_options
 
 __all__ = ["register"]
 
@@ -45,31 +46,32 @@ def register(sub) -> None:
     )
     p.add_argument("--members", type=int, required=True, help="number of realizations")
     p.add_argument("--first", type=int, default=0, help="first realization index (default 0)")
-    p.add_argument("--seed", type=int, default=0, help="master seed of the line-length process")
-    p.add_argument("--duration", type=float, default=20.0, help="end time [s] (default 20)")
-    p.add_argument("--transient", type=float, default=None,
-                   help="discarded start [s] (default: half the duration)")
+    add_run_options(p, transient=None)
     p.add_argument(
-        "--set", action="append", metavar="NAME=VALUE", default=[],
-        help="override a model parameter (repeatable), e.g. --set l_lambda_sigma=0.002",
+        "--backend",
+        choices=("cpu", "gpu", "auto"),
+        default="cpu",
+        help="cpu (default), gpu (falls back to the CPU with a notice), or auto",
     )
-    p.add_argument("--backend", choices=("cpu", "gpu", "auto"), default="cpu",
-                   help="cpu (default), gpu (falls back to the CPU with a notice), or auto")
     p.add_argument("--classify", action="store_true", help="label each member from its section")
     p.add_argument("--keep-impacts", action="store_true", help="also write every impact")
-    p.add_argument("--chunk", type=int, default=_CHUNK,
-                   help=f"realizations per saved part (default {_CHUNK})")
+    p.add_argument(
+        "--chunk", type=int, default=_CHUNK, help=f"realizations per saved part (default {_CHUNK})"
+    )
     p.add_argument("--resume", action="store_true", help="continue an interrupted run")
-    p.add_argument("--force", action="store_true",
-                   help="start over: replace existing outputs and discard unfinished parts")
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="start over: replace existing outputs and discard unfinished parts",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.add_argument("--out", type=Path, required=True, help="members to FILE.parquet")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from ._outputs import OutputLock, check_output
-    from .cli import UsageError
+    from .._outputs import OutputLock, check_output
+    from . import UsageError
 
     out: Path = args.out
     if out.suffix != ".parquet":
@@ -88,13 +90,13 @@ def _outputs(out: Path) -> tuple[Path, Path, Path]:
 
 
 def _run_locked(args: argparse.Namespace) -> int:
-    from ._checks import whole
-    from ._ensemble_verdicts import classify_ensemble
-    from .cli import UsageError, parse_assignments
-    from .integrate import simulate_ensemble
-    from .integrate._gpu import GPUFallbackWarning
-    from .sweep._checkpoint import discard_checkpoint
-    from .sweep._common import run_settings
+    from .._checks import whole
+    from .._ensemble_verdicts import classify_ensemble
+    from ..integrate import simulate_ensemble
+    from ..integrate._gpu import GPUFallbackWarning
+    from ..sweep._checkpoint import discard_checkpoint
+    from ..sweep._common import run_settings
+    from . import UsageError, parse_assignments
 
     out: Path = args.out
     members_n = whole("--members", args.members, low=1)
@@ -127,8 +129,7 @@ def _run_locked(args: argparse.Namespace) -> int:
         for path in (out, sections_path, impacts_path):
             if path.exists() and not args.force:
                 raise FileExistsError(
-                    f"{path} exists; choose another --out, remove it, or pass --force to "
-                    "replace it"
+                    f"{path} exists; choose another --out, remove it, or pass --force to replace it"
                 )
     manifest = parts / "config.json"
     if parts.exists():
@@ -150,14 +151,17 @@ def _run_locked(args: argparse.Namespace) -> int:
         tmp = parts.with_name(f".tmp-{os.getpid()}-{parts.name}")
         shutil.rmtree(tmp, ignore_errors=True)
         tmp.mkdir()
-        _atomic_text(tmp / "config.json", json.dumps({"digest": digest, "config": config},
-                                                     indent=1))
+        _atomic_text(
+            tmp / "config.json", json.dumps({"digest": digest, "config": config}, indent=1)
+        )
         os.replace(tmp, parts)
     for tmp in parts.glob(".tmp-*"):
         tmp.unlink(missing_ok=True)
 
     t0 = time.perf_counter()
     done_before = 0
+    bar = _bar(args, args.members)
+    batch = _progress_batch(args.backend)
     noticed = False  # the GPU fallback notice is printed once, on one line
     last = args.first + args.members
     starts = range(args.first, last, args.chunk)
@@ -166,14 +170,22 @@ def _run_locked(args: argparse.Namespace) -> int:
         stop = min(start + args.chunk, last)
         if _part_done(parts, start, names):
             done_before += stop - start
+            bar.update(stop - start)
             continue
         try:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", GPUFallbackWarning)
                 ens = simulate_ensemble(
-                    params, range(start, stop), seed=args.seed, duration=duration,
-                    transient=transient, backend=args.backend, keep_impacts=args.keep_impacts,
+                    params,
+                    range(start, stop),
+                    seed=args.seed,
+                    duration=duration,
+                    transient=transient,
+                    backend=args.backend,
+                    keep_impacts=args.keep_impacts,
                     tangent=args.classify,
+                    batch=batch,
+                    progress=bar.update,
                 )
                 if args.classify:
                     ens = classify_ensemble(ens, params)
@@ -184,9 +196,13 @@ def _run_locked(args: argparse.Namespace) -> int:
                 elif not issubclass(w.category, GPUFallbackWarning):
                     warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         except KeyboardInterrupt:
-            print(f"chaoscam: interrupted; the finished parts are in {parts}: run the same "
-                  "command with --resume to continue", file=sys.stderr)
-            raise
+            bar.close()
+            print(
+                f"chaoscam: interrupted; the finished parts are in {parts}: run the same "
+                "command with --resume to continue",
+                file=sys.stderr,
+            )
+            return 130  # the one message (the sweeps' rule); 143 after SIGTERM
         offset = start - args.first
         tables = {"members": ens.members, "sections": ens.sections, "impacts": ens.impacts}
         files = {}
@@ -196,17 +212,24 @@ def _run_locked(args: argparse.Namespace) -> int:
             with atomic_path(path) as tmp:
                 table.to_parquet(tmp, index=False)
             files[name] = _fingerprint(path)
-        _atomic_text(parts / f"{start:012d}.done",
-                     json.dumps({"files": files, "settings": ens.settings}, default=str))
+        _atomic_text(
+            parts / f"{start:012d}.done",
+            json.dumps({"files": files, "settings": ens.settings}, default=str),
+        )
         if not args.quiet:
-            print(f"members {start}..{stop - 1}: {ens.settings['backend']}, "
-                  f"{(stop - start) / ens.settings['wall_time_s']:.1f} traj/s", flush=True)
+            bar.write(
+                f"members {start}..{stop - 1}: {ens.settings['backend']}, "
+                f"{(stop - start) / ens.settings['wall_time_s']:.1f} traj/s"
+            )
+    bar.close()
 
     members = _commit(parts, starts, names, out, digest)
     wall = time.perf_counter() - t0
     counts = members["label" if args.classify else "status"].value_counts().to_dict()
-    print(f"{args.members} members ({done_before} from an earlier run) in {wall:.1f} s: "
-          + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
+    print(
+        f"{args.members} members ({done_before} from an earlier run) in {wall:.1f} s: "
+        + ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
+    )
     print(f"members: {out}")
     print(f"sections: {sections_path}")
     if args.keep_impacts:
@@ -214,20 +237,56 @@ def _run_locked(args: argparse.Namespace) -> int:
     return 0
 
 
+PROGRESS_PER_THREAD = 16
+"""CPU members per compiled call in the command: about 2 s of work on each thread for 20 s
+runs, so that the progress bar moves (and Ctrl-C is honoured) every few seconds; the
+threads' idle tail at the end of each call costs a few per cent."""
+
+
+def _progress_batch(backend: str) -> int | None:
+    """Members per compiled call: small on the CPU (progress), the default on a GPU."""
+    if backend == "gpu":
+        return None
+    import numba
+
+    return PROGRESS_PER_THREAD * numba.get_num_threads()
+
+
+def _bar(args, total: int):
+    """A progress bar over the members on stderr, with rate and ETA (none with --quiet)."""
+    from tqdm.auto import tqdm
+
+    return tqdm(
+        total=total,
+        unit="member",
+        desc="ensemble",
+        file=sys.stderr,
+        disable=args.quiet,
+        dynamic_ncols=True,
+        smoothing=0.1,
+        mininterval=0.5,
+    )
+
+
 def _check_budget(params, duration: float, transient: float, members: int, chunk: int) -> None:
     """Refuse an ensemble whose joined tables cannot fit in memory; warn about hours."""
-    from ._budget import JobEstimate, check_budget, estimate
-    from .sweep._backends import default_workers
+    from .._budget import JobEstimate, check_budget, estimate
+    from ..sweep._backends import default_workers
 
     one = estimate(params, duration=duration, transient=transient)
-    job = JobEstimate((one.bytes * (members + min(chunk, members)),
-                       one.seconds * members / default_workers()))
-    check_budget(job, what="this ensemble", reduce="--members or --duration",
-                 run=dict(params=params, duration=duration, what="each member"))
+    job = JobEstimate(
+        (one.bytes * (members + min(chunk, members)), one.seconds * members / default_workers())
+    )
+    check_budget(
+        job,
+        what="this ensemble",
+        reduce="--members or --duration",
+        run=dict(params=params, duration=duration, what="each member"),
+    )
 
 
 def _atomic_text(path: Path, text: str) -> None:
-    from ._outputs import atomic_write_bytes
+    from .._outputs import atomic_write_bytes
 
     atomic_write_bytes(path, text.encode())
 
@@ -245,14 +304,17 @@ def _part_done(parts: Path, start: int, names: tuple[str, ...]) -> bool:
     try:
         files = json.loads(mark.read_text())["files"]
         whole = all(
-            _fingerprint(parts / f"{start:012d}.{name}.parquet") == files[name]
-            for name in names
+            _fingerprint(parts / f"{start:012d}.{name}.parquet") == files[name] for name in names
         )
     except (OSError, ValueError, KeyError, TypeError):
         whole = False
     if not whole:
-        print(f"chaoscam: notice: part {start} in {parts} is damaged or incomplete; it is "
-              "computed again", file=sys.stderr, flush=True)
+        print(
+            f"chaoscam: notice: part {start} in {parts} is damaged or incomplete; it is "
+            "computed again",
+            file=sys.stderr,
+            flush=True,
+        )
         mark.unlink(missing_ok=True)
     return whole
 
@@ -291,7 +353,7 @@ def _commit(parts: Path, starts: range, names: tuple[str, ...], out: Path, diges
     the finished outputs."""
     import pandas as pd
 
-    from .sweep._checkpoint import discard_checkpoint
+    from ..sweep._checkpoint import discard_checkpoint
 
     targets = dict(zip(("members", "sections", "impacts"), _outputs(out), strict=True))
     staged = {}

@@ -7,27 +7,15 @@ import math
 import sys
 from pathlib import Path
 
+from ._options import add_run_options
+
 __all__ = ["register"]
 
 _PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
 
 def _common(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--set",
-        action="append",
-        metavar="NAME=VALUE",
-        default=[],
-        help="override a model parameter (repeatable), e.g. --set omega=30",
-    )
-    p.add_argument("--duration", type=float, default=20.0, help="simulated time [s] (default 20)")
-    p.add_argument(
-        "--transient",
-        type=float,
-        default=None,
-        help="discarded start [s] (default: half the duration)",
-    )
-    p.add_argument("--seed", type=int, default=0, help="master seed of the line-length process")
+    add_run_options(p, transient=None)
     p.add_argument(
         "--lyapunov",
         action="store_true",
@@ -168,8 +156,8 @@ def register(sub) -> None:
 
 def _execution(args) -> dict:
     from .._outputs import check_output
-    from ..cli import UsageError
-    from ._tasks import load_classifier
+    from ..sweep._tasks import load_classifier
+    from . import UsageError
 
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers {args.workers}: must be >= 1")
@@ -213,9 +201,9 @@ def _call(fn, **kwargs):
     """Run a sweep; bad settings become usage errors (exit 2); a stopped run returns its
     exit code (130 Ctrl-C, 1 a lost Dask scheduler or a failed task) after saying how to
     resume or reproduce it."""
-    from ..cli import UsageError
-    from ._engine import SweepInterrupted, TaskFailed
-    from ._grid import SweepError
+    from ..sweep._engine import SweepInterrupted, TaskFailed
+    from ..sweep._grid import SweepError
+    from . import UsageError
 
     try:
         return fn(**kwargs)
@@ -234,13 +222,13 @@ def _counts(labels) -> str:
 
 
 def run_bifurcation(args: argparse.Namespace) -> int:
-    from ..cli import parse_assignments
-    from ._bifurcation import bifurcation
-    from ._common import companion
+    from ..sweep._bifurcation import bifurcation
+    from ..sweep._common import companion
+    from . import parse_assignments
 
     base = parse_assignments(args.set)
     if args.initial_conditions < 1:
-        from ..cli import UsageError
+        from . import UsageError
 
         raise UsageError(f"--initial-conditions {args.initial_conditions}: must be >= 1")
     res = _call(
@@ -270,10 +258,10 @@ def run_bifurcation(args: argparse.Namespace) -> int:
 
 
 def run_regime_map(args: argparse.Namespace) -> int:
-    from ..cli import UsageError, parse_assignments
-    from ._common import companion
-    from ._grid import Axis, SweepError
-    from ._regime import mu_sigma_axes, regime_map
+    from ..sweep._common import companion
+    from ..sweep._grid import Axis, SweepError
+    from ..sweep._regime import mu_sigma_axes, regime_map
+    from . import UsageError, parse_assignments
 
     try:
         if (args.mu is None) == (args.x is None):

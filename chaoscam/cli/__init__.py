@@ -1,9 +1,10 @@
 """The ``chaoscam`` command: a thin layer over the API.
 
-Each subcommand lives with the layer it drives; this module only wires them. A command module
-exposes ``register(subparsers)``, which adds its parsers and sets ``func`` on them; ``func``
-takes the parsed arguments and returns an exit code. Bad input exits with code 2 and a message
-naming the field.
+One module per group of subcommands in this package (``_simulate``, ``_ensemble``,
+``_classify``, ``_sweep``, ``_report``), each importing the layer it drives, never the reverse;
+this module only wires them. A command module exposes ``register(subparsers)``, which adds
+its parsers and sets ``func`` on them; ``func`` takes the parsed arguments and returns an
+exit code. Bad input exits with code 2 and a message naming the field.
 
 Importing this module loads nothing but :mod:`sys`: everything else (argparse, numpy, the
 kernels, the command modules) is imported inside :func:`main`, where a Ctrl-C is caught, so
@@ -20,17 +21,17 @@ TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing (start-up
 if TYPE_CHECKING:
     import argparse
 
-    from .model import Params
+    from ..model import Params
 
 __all__ = ["main", "parse_assignments", "show_warning", "UsageError"]
 
 # Modules that add subcommands, in the order they are listed by --help.
 _COMMAND_MODULES = (
-    "chaoscam._cli_simulate",
-    "chaoscam._cli_ensemble",
-    "chaoscam._cli_classify",
-    "chaoscam.sweep._cli",
-    "chaoscam.report._cli",
+    "chaoscam.cli._simulate",
+    "chaoscam.cli._ensemble",
+    "chaoscam.cli._classify",
+    "chaoscam.cli._sweep",
+    "chaoscam.cli._report",
 )
 
 
@@ -40,7 +41,7 @@ class UsageError(Exception):
 
 def parse_assignments(items: list[str] | None, base: Params | None = None) -> Params:
     """Params from ``--set NAME=VALUE`` items."""
-    from .model import Params
+    from ..model import Params
 
     pairs: dict[str, str] = {}
     for item in items or []:
@@ -59,7 +60,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="chaoscam",
         description="Stochastic dynamics of a cam-follower oblique impact system.",
     )
-    from ._version import __version__
+    from .._version import __version__
 
     parser.add_argument("--version", action="version", version=f"chaoscam {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
@@ -116,8 +117,7 @@ def _interrupted() -> int:
     main_thread = threading.current_thread() is threading.main_thread()
     before = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
     try:
-        print("chaoscam: " + ("terminated" if _SIGTERM["seen"] else "interrupted"),
-              file=sys.stderr)
+        print("chaoscam: " + ("terminated" if _SIGTERM["seen"] else "interrupted"), file=sys.stderr)
     finally:
         if before is not None:
             signal.signal(signal.SIGINT, before)
@@ -132,8 +132,8 @@ def show_warning(message, *args, **kwargs) -> None:
 def _dispatch(argv: list[str] | None) -> int:
     import warnings
 
-    from ._outputs import OutputError
-    from .model import ParameterError
+    from .._outputs import OutputError
+    from ..model import ParameterError
 
     parser = build_parser()
     args = parser.parse_args(argv)

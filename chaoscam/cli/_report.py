@@ -68,9 +68,9 @@ def _check_out(out: Path, force: bool) -> None:
 
 
 def run_report(args: argparse.Namespace) -> int:
-    from ..cli import UsageError
-    from ._html import build_report, write_report
-    from ._inputs import InputError, load_inputs
+    from ..report._html import build_report, write_report
+    from ..report._inputs import InputError, load_inputs
+    from . import UsageError
 
     _check_out(args.out, args.force)
     try:
@@ -88,9 +88,9 @@ def run_report(args: argparse.Namespace) -> int:
 
 
 def run_paper(args: argparse.Namespace) -> int:
-    from ..cli import UsageError
-    from ._paper import FIGURES
-    from ._paper import run_paper as _run
+    from ..report._paper import FIGURES
+    from ..report._paper_run import run_paper as _run
+    from . import UsageError
 
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers {args.workers}: must be >= 1")

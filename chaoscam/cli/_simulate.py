@@ -7,6 +7,8 @@ import sys
 import warnings
 from pathlib import Path
 
+from ._options import add_run_options
+
 __all__ = ["register"]
 
 
@@ -17,13 +19,7 @@ def register(sub) -> None:
         description="Simulate one realization of the cam-follower model (RK4 with located "
         "impacts) and print a summary: impacts, contact fraction, status.",
     )
-    p.add_argument("--duration", type=float, default=20.0, help="end time [s] (default 20)")
-    p.add_argument("--transient", type=float, default=0.0, help="discarded start [s]")
-    p.add_argument(
-        "--set", action="append", metavar="NAME=VALUE", default=[],
-        help="override a model parameter (repeatable), e.g. --set omega=30",
-    )
-    p.add_argument("--seed", type=int, default=0, help="seed of the line-length process")
+    add_run_options(p, transient=0.0)
     p.add_argument("--index", type=int, default=0, help="realization index under the seed")
     p.add_argument("--output-dt", type=float, default=1e-3, help="series sampling [s]")
     p.add_argument("--out", type=Path, help="time series to FILE.parquet or FILE.csv")
@@ -34,9 +30,9 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ._outputs import atomic_path, check_output
-    from ._simulate import simulate
-    from .cli import parse_assignments, show_warning
+    from .._outputs import atomic_path, check_output
+    from .._simulate import simulate
+    from . import parse_assignments, show_warning
 
     out = check_output(args.out, force=args.force, suffixes=(".parquet", ".csv"))
     section = check_output(args.section, flag="--section", force=args.force)
@@ -82,12 +78,15 @@ def _series_writer(traj, out):
 def _exit_code(traj, notes: list[str]) -> int:
     """0 when the run simulated what was asked; else 1, with the cause on stderr (and the
     step-size warning first when there was one: it is then the likely cause)."""
-    from .integrate import Status
+    from ..integrate import Status
 
     if traj.status is Status.OK:
         return 0
     cause = f"likely cause: {notes[0]}. " if notes else ""
-    print(f"chaoscam: the run ended {traj.status.name} at t = {traj.final_state[0]:.6g} s "
-          f"of {traj.settings['duration']:g} s, not the end asked for. {cause}"
-          f"{traj.message}", file=sys.stderr)
+    print(
+        f"chaoscam: the run ended {traj.status.name} at t = {traj.final_state[0]:.6g} s "
+        f"of {traj.settings['duration']:g} s, not the end asked for. {cause}"
+        f"{traj.message}",
+        file=sys.stderr,
+    )
     return 1

@@ -78,9 +78,9 @@ def _print(verdict) -> None:
 
 
 def run_classify(args: argparse.Namespace) -> int:
-    from ._trajectory_io import TrajectoryFileError, read_trajectory
-    from .classify import classify_trajectory
-    from .cli import UsageError
+    from .._trajectory_io import TrajectoryFileError, read_trajectory
+    from ..classify import classify_trajectory
+    from . import UsageError
 
     try:
         traj = read_trajectory(args.trajectory)
@@ -102,8 +102,8 @@ def run_classify_series(args: argparse.Namespace) -> int:
     import numpy as np
     import pandas as pd
 
-    from .analysis import classify_section, classify_signal
-    from .cli import UsageError
+    from ..analysis import classify_section, classify_signal
+    from . import UsageError
 
     if args.dt is None and not args.section:
         raise UsageError(
@@ -148,7 +148,7 @@ def run_classify_series(args: argparse.Namespace) -> int:
             f"{path}: {rows.size} row(s) with NaN or infinite values in "
             f"{', '.join(args.column)} (first at data row {int(rows[0]) + 1}); remove them"
         )
-    from ._trajectory_io import TrajectoryFileError, check_enough
+    from .._trajectory_io import TrajectoryFileError, check_enough
 
     try:
         check_enough(len(data), "rows", path)

@@ -1,0 +1,33 @@
+"""Options every run-making subcommand shares: the model overrides and the run's times.
+
+One declaration each, so that ``--set``, ``--duration``, ``--transient`` and ``--seed`` mean
+the same on ``simulate``, ``ensemble``, ``bifurcation`` and ``regime-map``.
+"""
+
+from __future__ import annotations
+
+__all__ = ["add_run_options"]
+
+
+def add_run_options(p, *, transient: float | None) -> None:
+    """``--set``, ``--duration``, ``--transient`` and ``--seed`` on parser ``p``.
+
+    ``transient`` is the default discarded start [s]; None means half the duration (the
+    sweeps and ensembles), 0.0 the whole run (``simulate``).
+    """
+    p.add_argument(
+        "--set",
+        action="append",
+        metavar="NAME=VALUE",
+        default=[],
+        help="override a model parameter (repeatable), e.g. --set omega=30",
+    )
+    p.add_argument("--duration", type=float, default=20.0, help="simulated time [s] (default 20)")
+    p.add_argument(
+        "--transient",
+        type=float,
+        default=transient,
+        help="discarded start [s] (default: "
+        + ("half the duration)" if transient is None else f"{transient:g})"),
+    )
+    p.add_argument("--seed", type=int, default=0, help="master seed of the line-length process")

@@ -1,0 +1,103 @@
+"""Where an event happens inside a fixed step: the gap's sign change, and its turn.
+
+Both are found by the Illinois variant of regula falsi on a function of the substep length
+``tau`` evaluated through one RK4 substep from the segment's start (:func:`._physics.rk4`):
+the gap ``delta`` for a crossing (:func:`locate_crossing`), the gap rate for the extremum
+between two crossings that a step would otherwise step over (:func:`graze_point`).
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+from ._layout import C_EVENT_TOL
+from ._physics import geometry, rk4
+
+
+@njit(cache=True, inline="always")
+def illinois_point(a, fa, b, fb):
+    """The next point of regula falsi in the bracket [a, b], where fa > 0 >= fb: the secant's
+    root, or the midpoint when rounding puts that outside the bracket."""
+    m = b - fb * (b - a) / (fb - fa)
+    if not (a < m < b):
+        m = 0.5 * (a + b)
+    return m
+
+
+@njit(cache=True, inline="always")
+def illinois_update(a, fa, b, fb, m, fm, side):
+    """The bracket after f(m) = fm, for Illinois regula falsi (Dowell & Jarratt 1971).
+
+    The end that stays twice in a row has its value halved, which keeps the method
+    superlinear where plain regula falsi stalls. ``side`` remembers the end replaced last.
+    """
+    if fm > 0.0:
+        a, fa = m, fm
+        if side == 1:
+            fb *= 0.5
+        side = 1
+    else:
+        b, fb = m, fm
+        if side == -1:
+            fa *= 0.5
+        side = -1
+    return a, fa, b, fb, side
+
+
+@njit(cache=True)
+def locate_crossing(t, th, om, a, g_start, h, g_end, K, c):
+    """The substep length tau in (a, h] at which the gap delta changes sign.
+
+    Illinois regula falsi on ``tau -> delta(RK4 substep of length tau)`` over the bracket
+    [a, h] (a = 0 but for a micro-flight that starts on the surface, whose bracket starts at
+    its top), with a bisection whenever an iteration fails to halve the bracket, until the
+    bracket is narrower than the event tolerance. Returns the bracket's right end, past the
+    crossing: delta <= 0 there for a closing, delta >= 0 for an opening.
+    """
+    s = 1.0 if g_start > 0.0 else -1.0  # work on s * delta, positive at the start
+    fa, b, fb = s * g_start, h, s * g_end
+    side = 0
+    for _ in range(400):
+        width = b - a
+        if width <= c[C_EVENT_TOL]:
+            break
+        m = illinois_point(a, fa, b, fb)
+        thm, _ = rk4(t, th, om, m, K, c)
+        fm, _, _ = geometry(t + m, thm, c)
+        a, fa, b, fb, side = illinois_update(a, fa, b, fb, m, fm * s, side)
+        if b - a > 0.5 * width:
+            m = 0.5 * (a + b)
+            thm, _ = rk4(t, th, om, m, K, c)
+            fm, _, _ = geometry(t + m, thm, c)
+            a, fa, b, fb, _ = illinois_update(a, fa, b, fb, m, fm * s, 0)
+    return b
+
+
+# The stand-in for a gap of exactly 0 at a segment's start, signed by the gap rate: only its
+# sign matters (event brackets need a nonzero value at their start).
+ON_SURFACE = 1e-300
+
+
+@njit(cache=True)
+def graze_point(t, th, om, h, rate0, rate1, K, c):
+    """The substep length tau in (0, h) at which the gap rate l_1 theta' - dC/dt.n turns.
+
+    Illinois regula falsi on ``tau -> rate(RK4 substep of length tau)`` to 1e-6 of the step
+    (an error e in tau moves the gap's extremum by ~|delta''| e^2 / 2, below 1e-20 m here).
+    Only called where the gap rate changes sign between the segment's ends while the gap
+    does not: the extremum of the gap in between shows whether it crossed zero and came
+    back (a micro-flight, or a graze, shorter than the step). The rate is that of the
+    substep's state, on the side of the surface the segment starts on.
+    """
+    s = 1.0 if rate0 > 0.0 else -1.0  # work on s * rate, positive at 0, negative at h
+    a, fa, b, fb = 0.0, s * rate0, h, s * rate1
+    side = 0
+    for _ in range(200):
+        width = b - a
+        if width <= 1e-6 * h:
+            break
+        m = illinois_point(a, fa, b, fb)
+        thm, omm = rk4(t, th, om, m, K, c)
+        _, l1, cdn = geometry(t + m, thm, c)
+        a, fa, b, fb, side = illinois_update(a, fa, b, fb, m, s * (l1 * omm - cdn), side)
+    return 0.5 * (a + b)

@@ -1,0 +1,159 @@
+"""``chaoscam paper``: run the figure computations of :mod:`._paper`, write the report.
+
+:func:`run_paper` checks every output first (:func:`check_paper_outputs`), runs each stage
+(the paper's figures, then the sensitivity sweeps) with its time on stderr, and renders one
+self-contained HTML file whose summary sets each figure against the paper;
+:func:`figure_script` is the body of ``analyses/figN.py``.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from pathlib import Path
+
+import pandas as pd
+
+from ._paper import (
+    FIGURES,
+    QUICK_EXTEND_TO,
+    SENSITIVITY,
+    _sensitivity_stage,
+    data_files,
+)
+
+__all__ = ["check_paper_outputs", "figure_script", "run_paper"]
+
+
+def check_paper_outputs(out: str | Path, figures=None, *, force: bool = False) -> Path:
+    """Check the report and every data file the chosen figures will write, before any work.
+
+    The report ``out`` (``.html``) and, in ``OUT_DIR/paper-data``, each file of
+    :func:`data_files`: an existing one is refused unless ``force``, naming it; a missing or
+    read-only folder, or a ``paper-data`` that is not a folder, is refused too. Returns the
+    data folder. Raises :class:`chaoscam._outputs.OutputError`.
+    """
+    from .._outputs import OutputError, check_output
+
+    out = Path(out)
+    check_output(out, force=force, suffixes=(".html",))
+    outdir = out.parent / "paper-data"
+    if outdir.exists() and not outdir.is_dir():
+        raise OutputError(f"{outdir} exists and is not a folder; the figures' data go there")
+    if outdir.is_dir():
+        stages = sorted(set(figures or FIGURES)) + ([] if figures else [SENSITIVITY])
+        names = dict.fromkeys(n for f in stages for n in data_files(f))
+        for name in names:
+            check_output(outdir / name, flag="paper data", force=force)
+    return outdir
+
+
+def run_paper(
+    *,
+    quick: bool,
+    out: str | Path,
+    figures=None,
+    workers=None,
+    command=None,
+    echo=False,
+    force: bool = False,
+) -> Path:
+    """Run the figure scripts and write the report (data and PNGs in ``OUT_DIR/paper-data``).
+
+    Every output is checked first (:func:`check_paper_outputs`): existing files are replaced
+    only with ``force``. With ``echo`` (the command line), each stage's start and duration
+    go to stderr and the findings, figure by figure, to stdout.
+    """
+    import sys
+
+    def say(text: str) -> None:
+        if echo:
+            print(text, file=sys.stderr, flush=True)
+
+    from ._html import ReportParts, add_bifurcation, add_regime_map, add_trajectory, write_report
+
+    out = Path(out)
+    outdir = check_paper_outputs(out, figures, force=force)
+    outdir.mkdir(exist_ok=True)
+    wanted = sorted(set(figures or FIGURES))
+    funcs = []
+    for number in wanted:
+        if FIGURES[number] not in funcs:
+            funcs.append(FIGURES[number])
+    if figures is None:  # the whole report: also the sweeps that explain the differences
+        funcs.append(_sensitivity_stage)
+    parts = ReportParts()
+    t_all = time.perf_counter()
+    results = []
+    for stage, fn in enumerate(funcs, 1):
+        t0 = time.perf_counter()
+        say(f"[{stage}/{len(funcs)}] {fn.__name__} ...")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            try:
+                r = fn(quick, outdir, workers=workers)
+            except Exception as err:  # a figure that fails is reported, not hidden
+                parts.missing.append(f"{fn.__name__}: failed with {type(err).__name__}: {err}")
+                continue
+        r.seconds = time.perf_counter() - t0
+        say(f"[{stage}/{len(funcs)}] {fn.__name__}: {r.seconds:.0f} s")
+        results.append(r)
+    total = time.perf_counter() - t_all
+    parts.summary.append(
+        f"{'Quick' if quick else 'Full'} reproduction of the paper's Figs. "
+        f"{', '.join(map(str, wanted))} in {total:.0f} s "
+        f"({', '.join(f'{r.name}: {r.seconds:.0f} s' for r in results)})."
+    )
+    for r in results:
+        before = (len(parts.paper_figures), len(parts.regime_maps), len(parts.bifurcations))
+        parts.paper_figures.extend(r.figures)
+        for path, rm in r.regime_maps:
+            add_regime_map(parts, path, rm)
+        for path, bif in r.bifurcations:
+            add_bifurcation(parts, path, bif)
+        for path, traj in r.trajectories:
+            add_trajectory(parts, path, traj)
+        new = (
+            [f.id for f in parts.paper_figures[before[0] :]]
+            + [m["figure"].id for m in parts.regime_maps[before[1] :]]
+            + [b["figure"].id for b in parts.bifurcations[before[2] :]]
+        )
+        for c in r.comparisons:
+            c.anchor = c.anchor or (new[0] if new else "")
+        parts.comparison.extend(r.comparisons)
+        parts.missing.extend(r.notes)
+        parts.why.extend(r.why)
+        parts.why_figures.extend(r.why_figures)
+    tally = pd.Series([c.verdict for c in parts.comparison]).value_counts()
+    counted = ", ".join(f"{k}: {v}" for k, v in tally.items())
+    head = [f"Against the paper, figure by figure: {counted} (see the last table)."]
+    head += [f"{c.figure}: {c.verdict} — {c.found}" for c in parts.comparison]
+    head += [f"Why the paper differs: {line}" for line in parts.why]
+    parts.summary[1:1] = head
+    if echo:
+        print("\n".join([parts.summary[0], *head]), flush=True)
+    if quick:
+        parts.missing.append(
+            "This is a quick run: coarse grids, few realizations, shorter fractal runs, "
+            f"undetermined runs extended to {QUICK_EXTEND_TO:g} s recorded (120 s in the full "
+            "report); "
+            "run `chaoscam paper` without --quick for the full grids."
+        )
+    title = "chaoscam: the paper's Figs. 3–10 reproduced" + (" (quick run)" if quick else "")
+    return write_report(parts, out, title=title, command=command)
+
+
+def figure_script(number: int, argv: list[str] | None = None) -> None:
+    """The body of ``analyses/figN.py``: run Fig. ``number``, print what it found.
+
+    Usage: ``python analyses/figN.py [--quick] [OUTDIR]`` (default OUTDIR: reports/paper-data).
+    """
+    import sys
+
+    argv = sys.argv[1:] if argv is None else argv
+    args = [a for a in argv if a != "--quick"]
+    outdir = Path(args[0] if args else "reports/paper-data")
+    outdir.mkdir(parents=True, exist_ok=True)
+    result = FIGURES[number]("--quick" in argv, outdir)
+    for c in result.comparisons:
+        print(f"{c.figure}: {c.verdict} - {c.found} ({c.reason})")
