@@ -120,4 +120,4 @@ def test_progress_counts_every_member_from_the_first_batch(tmp_path, capsys):
     loud = [a for a in ARGS if a != "--quiet"]
     assert main([*loud, "--chunk", "5", "--out", str(out)]) == 0
     err = capsys.readouterr().err
-    assert "ensemble:" in err and "/5" in err and "5/5" in err
+    assert "ensemble (simulated):" in err and "/5" in err and "5/5" in err

@@ -259,7 +259,7 @@ def _bar(args, total: int):
     return tqdm(
         total=total,
         unit="member",
-        desc="ensemble",
+        desc="ensemble (simulated)",
         file=sys.stderr,
         disable=args.quiet,
         dynamic_ncols=True,
