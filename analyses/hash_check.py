@@ -70,6 +70,16 @@ def hashes() -> dict[str, str]:
         if tangent:
             frames.append(pd.DataFrame(tr.jacobians.reshape(len(tr.jacobians), 4)))
         out[name] = _digest(*frames)
+    from chaoscam import lyapunov_model, periodic_orbit
+
+    orbit = periodic_orbit(Params(xi=0.2), (0.0, 0.0), 1)
+    out["periodic orbit xi=0.2"] = hashlib.sha256(
+        np.concatenate([np.ravel(orbit.points), np.abs(orbit.multipliers)]).tobytes()
+    ).hexdigest()
+    lm = lyapunov_model(Params(), duration=4.0, transient=1.0, seed=1)
+    out["lyapunov_model default"] = hashlib.sha256(
+        np.array([lm.exponent, lm.stderr, lm.n_intervals], dtype=float).tobytes()
+    ).hexdigest()
     ens = simulate_ensemble(
         Params(l_lambda_sigma=0.002), range(4), seed=2, duration=4.0, transient=1.0
     )
