@@ -22,7 +22,8 @@ from ._version import __version__
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
 from .integrate._constants import initial_counters, initial_state
-from .integrate._ensemble import contact_fraction, run_one
+from .integrate._driver import Buffers, drive
+from .integrate._ensemble import contact_fraction
 from .integrate._tangent import section_jacobians
 from .model import (
     LineLengthStream,
@@ -257,31 +258,26 @@ def simulate(
     th0, om0 = y[k.Y_THETA], y[k.Y_OMEGA]
     cnt = initial_counters(p, transient=transient)
     c = kernel_constants(p, t_record=transient, stride=stride, tangent=tangent)
-    buf_series = np.empty((block if series else 1, k.SERIES_COLS))
-    buf_section = np.empty((block, k.SECTION_COLS))
-    buf_impacts = np.empty((block, k.IMPACT_COLS))
+    buffers = Buffers.empty(block if series else 1, block, block)
     parts: dict[str, list[np.ndarray]] = {"series": [], "section": [], "impacts": []}
     if series and transient == 0.0:
         parts["series"].append(np.array([[0.0, th0, om0, lam[0]]]))
 
-    while True:
-        t_before = y[k.Y_TIME]
-        code = run_one(y, cnt, c, n_stop, lam, buf_series, buf_section, buf_impacts)
-        if code == k.NEED_BUFFER and y[k.Y_TIME] == t_before and cnt[k.I_LAM_POS] == 0:
-            raise RuntimeError("internal: the kernel asked for buffers but made no progress")
-        for name, buf, i in (
-            ("series", buf_series, k.I_N_SERIES),
-            ("section", buf_section, k.I_N_SECTION),
-            ("impacts", buf_impacts, k.I_N_IMPACT),
-        ):
-            if cnt[i]:
-                parts[name].append(buf[: cnt[i]].copy())
-                cnt[i] = 0
-        if code != k.NEED_BUFFER:
-            break
+    def more_draws(lam: np.ndarray) -> np.ndarray:
         pos = cnt[k.I_LAM_POS]
-        lam = np.concatenate([lam[pos:], stream.draw(block)])
         cnt[k.I_LAM_POS] = 0
+        return np.concatenate([lam[pos:], stream.draw(block)])
+
+    code = drive(
+        y,
+        cnt,
+        c,
+        n_stop,
+        lam,
+        buffers,
+        on_rows=lambda name, rows: parts[name].append(rows.copy()),
+        more_draws=more_draws,
+    )
     status = Status(code)
 
     def stack(name: str, ncol: int) -> np.ndarray:

@@ -26,6 +26,7 @@ from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
 from .integrate._advance import advance
 from .integrate._constants import initial_counters, initial_state
+from .integrate._driver import Buffers, drive
 from .model import LineLengthStream, ParameterError, Params
 
 __all__ = ["ModelLyapunov", "lyapunov_model"]
@@ -105,30 +106,36 @@ class _Draws:
 
 
 class _Runner:
-    """Advances one trajectory with ``run_chunk``; counts the impacts it applies."""
+    """Advances one trajectory through the kernel's driver; counts the impacts it applies."""
 
     def __init__(self, y, cnt, c, draws: _Draws, per_step: int) -> None:
         self.y, self.cnt, self.c, self.draws = y, cnt, c, draws
         self.per_step = per_step
-        self.series = np.empty((1, k.SERIES_COLS))
-        self.section = np.empty((8 * per_step, k.SECTION_COLS))
-        self.impacts = np.empty((8 * per_step, k.IMPACT_COLS))
+        self.buffers = Buffers.empty(1, 8 * per_step, 8 * per_step)
         self.n_impacts = 0
         draws.counters.append(cnt)
 
+    def _on_rows(self, name: str, rows: np.ndarray) -> None:
+        if name == "impacts":
+            self.n_impacts += len(rows)
+
+    def _more_draws(self, lam: np.ndarray) -> np.ndarray:
+        if self.cnt[k.I_LAM_POS] + 2 * self.per_step >= self.draws.lam.shape[0]:
+            self.draws.refill()
+        return self.draws.lam
+
     def run_to(self, n_to: int) -> int:
-        cnt = self.cnt
-        while True:
-            code = advance(
-                self.y, cnt, self.c, n_to, self.draws.lam, self.series, self.section, self.impacts
-            )
-            self.n_impacts += int(cnt[k.I_N_IMPACT])
-            cnt[k.I_N_IMPACT] = 0
-            cnt[k.I_N_SECTION] = 0
-            if code != k.NEED_BUFFER:
-                return int(code)
-            if cnt[k.I_LAM_POS] + 2 * self.per_step >= self.draws.lam.shape[0]:
-                self.draws.refill()
+        return drive(
+            self.y,
+            self.cnt,
+            self.c,
+            n_to,
+            self.draws.lam,
+            self.buffers,
+            on_rows=self._on_rows,
+            more_draws=self._more_draws,
+            run=advance,
+        )
 
 
 def _batch_stderr(values: np.ndarray, n_batches: int = 20) -> float:

@@ -28,6 +28,7 @@ from .analysis import TangentSpectrum, spectrum_from_jacobians
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
 from .integrate._constants import initial_counters, initial_state
+from .integrate._driver import Buffers, drive
 from .integrate._tangent import section_jacobians
 from .model import ParameterError, Params
 
@@ -107,9 +108,7 @@ class _MapRunner:
         self.n = n
         self.n_stop = int(math.floor(n * p.cam_period / p.dt)) + 2
         self.lam = np.full(4096, p.l_lambda)
-        self.series = np.empty((1, k.SERIES_COLS))
-        self.section = np.empty((n + 4 + int(p.dt / p.cam_period), k.SECTION_COLS))
-        self.impacts = np.empty((4096, k.IMPACT_COLS))
+        self.buffers = Buffers.empty(1, n + 4 + int(p.dt / p.cam_period), 4096)
         self.c = kernel_constants(self.p, tangent=True)
         self.calls = 0
 
@@ -119,15 +118,27 @@ class _MapRunner:
         y[k.Y_THETA], y[k.Y_OMEGA] = x
         cnt = initial_counters(self.p)
         self.calls += 1
-        while True:
-            code = k.run_chunk(
-                y, cnt, self.c, self.n_stop, self.lam, self.series, self.section, self.impacts
-            )
-            cnt[k.I_N_IMPACT] = 0
-            if code != k.NEED_BUFFER:
-                break
+        kept: list[np.ndarray] = []
+
+        def on_rows(name: str, rows: np.ndarray) -> None:
+            if name == "section":
+                kept.append(rows.copy())
+
+        def same_draws(lam: np.ndarray) -> np.ndarray:
             cnt[k.I_LAM_POS] = 0  # deterministic: every draw is l_lambda
-        rows = self.section[: cnt[k.I_N_SECTION]]
+            return lam
+
+        code = drive(
+            y,
+            cnt,
+            self.c,
+            self.n_stop,
+            self.lam,
+            self.buffers,
+            on_rows=on_rows,
+            more_draws=same_draws,
+        )
+        rows = np.concatenate(kept) if kept else np.empty((0, k.SECTION_COLS))
         if code != k.OK or len(rows) < self.n + 1:
             return np.full(2, np.nan), np.full((2, 2), np.nan), int(code)
         m = np.eye(2)
