@@ -191,7 +191,7 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     from ._sweep_figures import bifurcation_figure
 
     res = FigureResult(4)
-    values = "0.001:0.018:35" if quick else "0.001:0.018:69"  # the paper's step, 0.00025 m
+    values = "0.001:0.018:25" if quick else "0.001:0.018:69"  # the paper's step, 0.00025 m
     bif = bifurcation(
         "l_lambda",
         values,
@@ -240,7 +240,7 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
             "over l_λ ∈ [0.001, 0.018] m: chaos → period 2 → quasiperiod 2 → chaos",
             f"{len(v)} values: {seq}",
             verdict,
-            why + ("; quick run: one initial condition per value, 35 values" if quick else ""),
+            why + ("; quick run: one initial condition per value, 25 values" if quick else ""),
         )
     )
     return res

@@ -143,7 +143,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     )
     res.bifurcations.append((str(path_k), bif_k))
     # 2. restitution
-    values = "0.1:0.7:13" if quick else "0.1:0.7:25"
+    values = "0.1:0.7:9" if quick else "0.1:0.7:25"
     bif_x = bifurcation(
         "xi", values, duration=20.0, transient=10.0, classify=classify, workers=workers
     )
