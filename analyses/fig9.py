@@ -4,7 +4,7 @@ Writes its data and a PNG into OUTDIR; ``chaoscam paper`` runs the same code.
 Usage: python analyses/fig9.py [--quick] [OUTDIR]   (default OUTDIR: reports/paper-data)
 """
 
-from chaoscam.report import figure_script
+from chaoscam.experiments import figure_script
 
 if __name__ == "__main__":
     figure_script(9)

@@ -26,7 +26,8 @@ def register(sub) -> None:
     p = sub.add_parser(
         "paper",
         help="reproduce the paper's Figs. 3-10 and write the comparison report",
-        description="Run the figure scripts (chaoscam.report._paper: Figs. 3-10), write each "
+        description="Run the figure scripts (chaoscam.experiments: Figs. 3-10 and the "
+        "sensitivity sweeps), write each "
         "figure's data and PNG next to the report (DIR/paper-data/), and build the HTML "
         "report comparing the paper's statements with what this run finds.",
     )
@@ -88,8 +89,8 @@ def run_report(args: argparse.Namespace) -> int:
 
 
 def run_paper(args: argparse.Namespace) -> int:
-    from ..report._paper import FIGURES
-    from ..report._paper_run import run_paper as _run
+    from ..experiments import FIGURES
+    from ..experiments import run_paper as _run
     from . import UsageError
 
     if args.workers is not None and args.workers < 1:

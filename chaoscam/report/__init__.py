@@ -1,7 +1,7 @@
 """Reports: figures (seaborn/matplotlib) and HTML for simulations, regime maps and diagrams.
 
-``chaoscam report INPUT... --out FILE.html`` and ``chaoscam paper [--quick]`` drive this
-layer; in Python::
+``chaoscam report INPUT... --out FILE.html`` drives this layer, and ``chaoscam paper``
+(:mod:`chaoscam.experiments`) renders through it; it only renders. In Python::
 
     from chaoscam.report import build_report, load_inputs, write_report
     write_report(build_report(load_inputs(["run.parquet"])), "run.html", title="run")
@@ -17,7 +17,6 @@ from .._lazy import lazy_face
 # so that importing the package stays cheap.
 _LAZY = {
     "Comparison": ("._html", "Comparison"),
-    "FIGURES": ("._paper", "FIGURES"),
     "FigureItem": ("._html", "FigureItem"),
     "InputError": ("._inputs", "InputError"),
     "ReportClassifier": ("._classify", "ReportClassifier"),
@@ -26,13 +25,10 @@ _LAZY = {
     "classify": ("._classify", "classify"),
     "load_inputs": ("._inputs", "load_inputs"),
     "load_trajectory": ("._inputs", "load_trajectory"),
-    "figure_script": ("._paper_run", "figure_script"),
-    "run_paper": ("._paper_run", "run_paper"),
     "write_report": ("._html", "write_report"),
 }
 
 __all__ = [
-    "FIGURES",
     "Comparison",
     "FigureItem",
     "InputError",
@@ -42,8 +38,6 @@ __all__ = [
     "classify",
     "load_inputs",
     "load_trajectory",
-    "figure_script",
-    "run_paper",
     "write_report",
 ]
 

@@ -31,7 +31,7 @@ def test_paper_rejects_unknown_figure(tmp_path, capsys):
 
 def test_sequence_rule_finds_the_papers_order_and_nothing_else():
     """The Fig. 4 rule: the paper's regimes must appear in order among the label runs."""
-    from chaoscam.report._paper import _is_subsequence, _runs
+    from chaoscam.experiments._paper import _is_subsequence, _runs
 
     wanted = ["chaotic", "periodic-2", "quasiperiodic", "chaotic"]
     labels = ["chaotic", "chaotic", "periodic-2", "quasiperiodic", "periodic", "chaotic"]
@@ -42,13 +42,13 @@ def test_sequence_rule_finds_the_papers_order_and_nothing_else():
 
 def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch):
     """A figure script that raises leaves a report that names the failure."""
-    from chaoscam.report import _paper
+    from chaoscam.experiments import _paper
 
     def boom(quick, outdir, workers=None):
         raise RuntimeError("no luck")
 
     monkeypatch.setitem(_paper.FIGURES, 3, boom)
-    from chaoscam.report import run_paper
+    from chaoscam.experiments import run_paper
 
     out = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 5])
     text = out.read_text()
@@ -87,7 +87,7 @@ def _shrink_the_runs(monkeypatch):
 def test_data_files_are_exactly_what_the_figures_write(tmp_path, monkeypatch, number):
     """data_files (what `paper` checks before the work) lists every file the figure script
     (0: the sensitivity stage) writes, and nothing it does not (runs shrunk, PNGs not drawn)."""
-    from chaoscam.report import _paper
+    from chaoscam.experiments import _paper
 
     _shrink_the_runs(monkeypatch)
     monkeypatch.setattr(_paper, "png_bytes", lambda fig, dpi=None: b"\x89PNG")

@@ -70,7 +70,13 @@ def run_paper(
         if echo:
             print(text, file=sys.stderr, flush=True)
 
-    from ._html import ReportParts, add_bifurcation, add_regime_map, add_trajectory, write_report
+    from ..report._html import (
+        ReportParts,
+        add_bifurcation,
+        add_regime_map,
+        add_trajectory,
+        write_report,
+    )
 
     out = Path(out)
     outdir = check_paper_outputs(out, figures, force=force)

@@ -3,7 +3,7 @@
 One function per figure, ``figN(quick, outdir) -> FigureResult``: it runs the model, writes
 its data (CSV or Parquet) and a PNG into ``outdir``, and states what the paper says, what
 this run found and whether they agree. ``analyses/figN.py`` are thin scripts over these,
-through :func:`._paper_run.figure_script`; :func:`._paper_run.run_paper` runs them all and
+through :func:`._run.figure_script`; :func:`._run.run_paper` runs them all and
 writes the report. The comparison is made by fixed rules written out below; nothing is
 tuned to agree.
 """
@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ._figures import png_bytes, png_data_uri, response_figure
-from ._html import Comparison, FigureItem
+from ..report._figures import png_bytes, png_data_uri, response_figure
+from ..report._html import Comparison, FigureItem
 
 __all__ = ["FIGURES", "FigureResult", "data_files"]
 
@@ -187,8 +187,8 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
 def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 4: bifurcation of θ_f over l_λ ∈ [0.001, 0.018] m (Hertz line stiffness)."""
+    from ..report._sweep_figures import bifurcation_figure
     from ..sweep import bifurcation
-    from ._sweep_figures import bifurcation_figure
 
     res = FigureResult(4)
     values = "0.001:0.018:25" if quick else "0.001:0.018:69"  # the paper's step, 0.00025 m
@@ -317,8 +317,8 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 6: bifurcation over D with the fractal stiffness, G = 1e-9 and 1e-10 m."""
     from .._simulate import contact_period
     from ..model import Params
+    from ..report._sweep_figures import bifurcation_figure
     from ..sweep import bifurcation
-    from ._sweep_figures import bifurcation_figure
 
     res = FigureResult(6)
     duration, transient = (8.0, 4.0) if quick else (20.0, 10.0)
@@ -372,8 +372,8 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Figs. 7-10: the random line length at μ = 0.008, 0.015, 0.023 m, σ from 0 to 0.004 m."""
     from .._simulate import simulate
     from ..model import Params
+    from ..report._sweep_figures import regime_map_figure
     from ..sweep import Axis, regime_map
-    from ._sweep_figures import regime_map_figure
 
     res = FigureResult(7)
     sigmas = tuple(np.round(np.linspace(0.0, SIGMA_MAX, 5 if quick else 9), 6))

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._html import FigureItem
+from ..report._html import FigureItem
 
 __all__ = ["PAPER_K_N", "sensitivity", "label_runs"]
 
@@ -73,7 +73,7 @@ def _stiffness(quick: bool, outdir: Path, workers, classify):
 def _stiffness_figure(bif, k_n: dict):
     from matplotlib.figure import Figure
 
-    from ._sweep_figures import LABEL_COLORS
+    from ..report._sweep_figures import LABEL_COLORS
 
     pts = bif.points.assign(K_n=bif.points["value"].map(k_n))
     fig = Figure(figsize=(10, 5.5), layout="constrained")
@@ -103,9 +103,9 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     "Sensitivity"); ``classify`` as for the sweeps (the report's quick run caps the
     extension of undetermined runs)."""
     from ..model import Params
+    from ..report._sweep_figures import bifurcation_figure, regime_map_figure
     from ..sweep import Axis, bifurcation, regime_map
     from ._paper import FigureResult, _save, png_data_uri
-    from ._sweep_figures import bifurcation_figure, regime_map_figure
 
     res = FigureResult(0, title="Sensitivity (why the paper differs)")
     # 1. stiffness
