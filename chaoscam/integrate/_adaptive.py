@@ -286,8 +286,9 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
     window = np.int64(y[Y_WINDOW])  # grid interval of the chattering guard ...
     events = np.int64(y[Y_EVENTS])  # ... and the events in it so far
 
+    redo = False  # the step is being taken again in contact mode (see below)
     while t < t_stop:
-        if (
+        if not redo and (
             cnt[I_N_SERIES] + samples_per_step > series.shape[0]
             or cnt[I_N_SECTION] + 2 > section.shape[0]
             or cnt[I_N_IMPACT] + 2 > impacts.shape[0]
@@ -366,6 +367,17 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         if crossing and events >= max_events:
             cnt[I_CHATTER] += 1
             crossing = False
+        if flight and not crossing and g1 <= 0.0:
+            # A free-flight step that ends inside the cam without a located closing (a
+            # rebound too weak for its flight's top to show above the surface, or the
+            # chattering guard spent): the free pendulum is not the motion there. The step is
+            # taken again in contact mode, the full equations, with no hand-back in between
+            # (a resumed run makes the same choice from the same state).
+            flight = False
+            redo = True
+            a1 = accel_trig(tr, om, K, c, flight)
+            continue
+        redo = False
         if crossing:
             s_end = locate_on_interpolant(hs, th, tr, co, s_lo, g_lo, s_hi, g_hi, c)
 
