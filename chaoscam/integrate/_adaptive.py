@@ -22,8 +22,15 @@ picks one by ``Params.integrator``. What differs is how time is cut:
 - **Grazes**: a step whose ends show no sign change but whose gap rate turns (from closing
   to opening in flight, the reverse in contact) is searched for the turning point on the
   interpolant; if the gap has changed sign there, the first crossing before it is an event.
-  So a graze shorter than a step is seen (the fixed grid misses those shorter than ``dt``);
-  two turns inside one step are not looked for.
+  So a graze, or a micro-flight of a chattering sequence (0.1-1 us), shorter than a step is
+  seen; two turns inside one step are not looked for.
+- **On the surface**: a located event leaves the point on the surface to rounding. As in
+  the fixed-step kernel, a step from there takes its side from the motion
+  (:func:`surface_mode`: flight after a rebound, contact after a plastic closure, else the
+  gap rate's sign), the flags persisting across buffer hand-backs in ``cnt[I_SURFACE]``; a
+  micro-flight from the surface is bracketed from its top (the gap's maximum).
+- **Tangent**: RK4 substeps of ``V' = A V`` along each accepted step, states from the
+  interpolant (:func:`advance_tangent`), split at events, where the saltation matrix applies.
 - **Events**: when the gap changes sign over a step, the crossing is located by Illinois
   regula falsi on the gap along the step's Hermite interpolant (quintic in theta, from the
   values, rates and accelerations at both ends) to ``event_tol``; the state there is a
@@ -59,7 +66,7 @@ from numba import njit
 
 from . import _kernel as k
 from ._dop853 import ERROR_ORDER, dop853_step, omega_at, theta_at
-from ._events import illinois_point, illinois_update
+from ._events import ON_SURFACE, illinois_point, illinois_update
 from ._kernel import (
     C_DT,
     C_EVENT_TOL,
@@ -69,18 +76,23 @@ from ._kernel import (
     C_ROD_L,
     C_STRIDE,
     C_T_RECORD,
+    C_V_CHATTER,
     I_CHATTER,
+    I_GRAZES,
     I_LAM_POS,
     I_N_IMPACT,
     I_N_SECTION,
     I_N_SERIES,
     I_SERIES_J,
     I_STEP,
+    I_SURFACE,
     LEFT_REACH,
     NEED_BUFFER,
     NON_FINITE,
     OK,
     PENETRATION,
+    SURFACE_JUMPED,
+    SURFACE_SETTLED,
     Y_CONTACT,
     Y_EVENTS,
     Y_OMEGA,
@@ -103,17 +115,39 @@ EXPONENT = -1.0 / (ERROR_ORDER + 1)
 H_FLOOR = 1e-15  # a step this short [s] means the error control cannot be met: NON_FINITE
 
 
+@njit(cache=True, inline="always")
+def surface_mode(g, rate, surf):
+    """(flight, on_surface): the mode a step from gap ``g`` with gap rate ``rate`` takes.
+
+    As in the fixed-step kernel: a located crossing leaves the point on the surface to
+    rounding (slow closings give delta = 0.0 exactly). There the side is the motion's:
+    contact just after a plastic closure (``SURFACE_SETTLED``; its gap rate is 0 to
+    rounding), else flight when moving out (after a rebound, ``SURFACE_JUMPED``, whose gap
+    may be a rounding below 0, or a located opening). Taking the rounding's sign instead
+    makes an opening event of zero length after each rebound, and those fill the chattering
+    guard.
+    """
+    jumped = (surf & SURFACE_JUMPED) != 0
+    settled = (surf & SURFACE_SETTLED) != 0
+    on_surface = g == 0.0 or (jumped and g <= 0.0)
+    if on_surface:
+        return (not settled) and (jumped or rate > 0.0), True
+    return g > 0.0, False
+
+
 @njit(cache=True, error_model="numpy")
-def locate_on_interpolant(h, th, tr, co, g_start, g_end, s_hi, c):
-    """The fraction s in (0, s_hi] of the step at which the gap changes sign, on the interpolant.
+def locate_on_interpolant(h, th, tr, co, s_lo, g_lo, s_hi, g_hi, c):
+    """The fraction s in (s_lo, s_hi] of the step at which the gap changes sign, on the
+    interpolant (s_lo = 0 but for a micro-flight from the surface, whose bracket starts at
+    its top; g_lo and g_hi are the gap at the bracket's ends).
 
     Illinois regula falsi (with bisection when a pass fails to halve the bracket) on
     ``s -> delta(t + s h, theta(s))`` until the bracket is narrower than ``event_tol / h``;
     ``tr`` is the step's trigonometric base (``trig_at``), ``co`` its interpolant data.
     Returns the bracket's end past the crossing.
     """
-    sgn = 1.0 if g_start > 0.0 else -1.0  # work on sgn * delta, positive at the start
-    a, fa, b, fb = 0.0, sgn * g_start, s_hi, sgn * g_end
+    sgn = 1.0 if g_lo > 0.0 else -1.0  # work on sgn * delta, positive at the start
+    a, fa, b, fb = s_lo, sgn * g_lo, s_hi, sgn * g_hi
     tol = c[C_EVENT_TOL] / h
     side = 0
     for _ in range(400):
@@ -151,35 +185,61 @@ def turning_point(h, th, tr, co, rate0, rate1, c):
 
 
 @njit(cache=True, error_model="numpy")
-def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side):
+def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side):
     """With the tangent on, carry it over the accepted step [t, t + s_end h_step] whose
-    state runs from (th, om) to (th1, om1), the midpoint taken from the interpolant ``co``."""
+    state runs from (th, om) to (th1, om1), the inner points taken from the interpolant
+    ``co``: RK4 substeps of V' = A V (:func:`._tangent.rk4_tangent_along`), as many as keep
+    ``h_sub |A|`` <= ``TANGENT_STEP_RATE``, |A| estimated at the step's start.
+
+    One RK4 step of V over a whole DOP853 step would be far too coarse: in contact the error
+    control allows steps of ~1/10 of the contact period, over which RK4 damps the oscillating
+    part of V by ~1e-4 a step, which biased lambda_1 of the default model to about -22 1/s.
+    The first substep's Jacobian is taken on ``side_first`` (the side a step that starts on
+    the surface starts on), the others on ``side``.
+    """
     if c[k.C_TANGENT] <= 0.0:
         return
-    sm = 0.5 * s_end
-    r = rk4_tangent_along(
-        t,
-        h,
-        th,
-        om,
-        theta_at(co, sm),
-        omega_at(co, sm),
-        th1,
-        om1,
-        K,
-        c,
-        y[k.Y_J11],
-        y[k.Y_J21],
-        y[k.Y_J12],
-        y[k.Y_J22],
-        side,
+    _, p0, q0 = k.acceleration_jacobian(t, th, om, K, c, side_first)
+    _, p1, q1 = k.acceleration_jacobian(
+        t + 0.5 * h, theta_at(co, 0.5 * s_end), omega_at(co, 0.5 * s_end), K, c, side
     )
-    k.commit_tangent(y, r[0], r[1], r[2], r[3], r[4])
+    _, p2, q2 = k.acceleration_jacobian(t + h, th1, om1, K, c, side)
+    rate = max(math.sqrt(max(abs(p0), abs(p1), abs(p2))), max(abs(q0), abs(q1), abs(q2)))
+    m = max(1, np.int64(math.ceil(h * rate / k.TANGENT_STEP_RATE)))
+    hm = h / m
+    thb, omb = th, om
+    for i in range(m):
+        if i + 1 == m:
+            the, ome = th1, om1
+        else:
+            se = s_end * (i + 1) / m
+            the, ome = theta_at(co, se), omega_at(co, se)
+        sm = s_end * (i + 0.5) / m
+        r = rk4_tangent_along(
+            t + i * hm,
+            hm,
+            thb,
+            omb,
+            theta_at(co, sm),
+            omega_at(co, sm),
+            the,
+            ome,
+            K,
+            c,
+            y[k.Y_J11],
+            y[k.Y_J21],
+            y[k.Y_J12],
+            y[k.Y_J22],
+            side_first if i == 0 else side,
+        )
+        k.commit_tangent(y, r[0], r[1], r[2], r[3], r[4])
+        thb, omb = the, ome
 
 
 @njit(cache=True, error_model="numpy")
-def leave(y, cnt, th, om, t, h, events, window, code, c):
-    """Store the state, the time, the next step size and the event count; return ``code``.
+def leave(y, cnt, th, om, t, h, events, window, surface, code, c):
+    """Store the state, the time, the next step size, the event count and the surface flags
+    (``surface``: 1 jumped, 2 settled, as ``cnt[I_SURFACE]``); return ``code``.
 
     Everything the loop carries from one step to the next is either stored here or
     recomputed from it the same way inside the loop, so a resumed run is bit-identical.
@@ -191,6 +251,7 @@ def leave(y, cnt, th, om, t, h, events, window, code, c):
     cnt[I_STEP] = np.int64(math.floor(t / c[C_DT] + 1e-9))
     y[Y_EVENTS] = events
     y[Y_WINDOW] = window
+    cnt[I_SURFACE] = surface
     return code
 
 
@@ -217,19 +278,23 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
     K = k.stiffness(lam[cnt[I_LAM_POS]], c)
     tr = trig_at(t, th, c)  # trigonometric base of the next step; renewed when (t, th) move
     g, l1, cdn = k.geometry_trig(tr[1], tr[2], tr[3], tr[4], c)
-    flight = g > 0.0
+    # The surface flags, kept in the counters across a buffer hand-back like the fixed-step
+    # kernel's: JUMPED (a rebound was just applied), SETTLED (a plastic closure).
+    surf = cnt[I_SURFACE]
+    flight, on_surface = surface_mode(g, l1 * om - cdn, surf)
     a1 = accel_trig(tr, om, K, c, flight)
     window = np.int64(y[Y_WINDOW])  # grid interval of the chattering guard ...
     events = np.int64(y[Y_EVENTS])  # ... and the events in it so far
 
+    redo = False  # the step is being taken again in contact mode (see below)
     while t < t_stop:
-        if (
+        if not redo and (
             cnt[I_N_SERIES] + samples_per_step > series.shape[0]
             or cnt[I_N_SECTION] + 2 > section.shape[0]
             or cnt[I_N_IMPACT] + 2 > impacts.shape[0]
             or cnt[I_LAM_POS] + 3 >= lam.shape[0]
         ):
-            return leave(y, cnt, th, om, t, h, events, window, NEED_BUFFER, c)
+            return leave(y, cnt, th, om, t, h, events, window, surf, NEED_BUFFER, c)
 
         # The step ends at the next scheduled time at the latest.
         t_next, is_section, is_resample = k.next_scheduled(t_stop, cnt, c)
@@ -237,7 +302,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         if flight and hs > dt:
             # Near the cam a long step could hold several crossings, of which the search
             # might find a later one: steps there are cut to dt (see module doc).
-            safe = k.safe_horizon(g, l1, cdn, om, c)
+            safe = k.safe_horizon(max(g, 0.0), l1, cdn, om, c)
             if hs > safe:
                 hs = max(dt, safe)
         clipped = t + hs >= t_next
@@ -248,7 +313,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         fac = SAFETY * max(err, 1e-300) ** EXPONENT
         if not (err <= 1.0):
             if not math.isfinite(err) or hs < H_FLOOR:
-                return leave(y, cnt, th, om, t, h, events, window, NON_FINITE, c)
+                return leave(y, cnt, th, om, t, h, events, window, surf, NON_FINITE, c)
             h = hs * max(SHRINK_MIN, fac)
             continue
         h_next = hs * min(GROW_MAX, max(SHRINK_MIN, fac))
@@ -262,29 +327,59 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         a_end = accel_trig(tr1, om1, K, c, flight)  # in the step's mode: the interpolant's
         co = (th, om, a1, th1, om1, a_end, hs)  # data: ends, their rates and accelerations
         s_end = 1.0
-        crossing = (g > 0.0 and g1 <= 0.0) or (g <= 0.0 and g1 > 0.0)
         n_window = np.int64(math.floor((t + hs) / dt))
         if n_window != window:
             window = n_window
             events = 0
+        rate0 = l1 * om - cdn
+        rate1 = l1_1 * om1 - cdn1
+        # The gap at the step's start, signed by the side the step starts on (a point on the
+        # surface has delta = 0 to rounding: the side is the motion's, see surface_mode).
+        gs = g
+        if on_surface:
+            gs = ON_SURFACE if flight else -ON_SURFACE
+        closing = flight and g1 <= 0.0
+        crossing = closing or (not flight and g1 > 0.0)
+        s_lo, g_lo, s_hi, g_hi = 0.0, gs, 1.0, g1  # the crossing lies in (s_lo, s_hi]
+        if on_surface and crossing:
+            if not closing:
+                crossing = False  # lift-off from the surface: at the step's start
+            elif rate0 > 0.0 > rate1:
+                # A micro-flight from the surface: the gap is rounding noise near the start,
+                # so the bracket starts at the flight's top.
+                s_lo = turning_point(hs, th, tr, co, rate0, rate1, c)
+                g_lo, _, _ = geometry_near(s_lo * hs, theta_at(co, s_lo), th, tr, c)
+                crossing = g_lo > 0.0
+                closing = crossing
+        elif not crossing and events < max_events:
+            # No sign change between the ends, but the gap rate turns (down to up in flight,
+            # up to down in contact): the gap may cross zero and come back inside the step (a
+            # graze, or a micro-flight of a chattering sequence, 0.1-1 us). Find the turning
+            # point on the interpolant; if the gap has changed sign there, the first
+            # crossing lies before it.
+            if (rate0 < 0.0 < rate1) if flight else (rate1 < 0.0 < rate0):
+                s_hi = turning_point(hs, th, tr, co, rate0, rate1, c)
+                g_hi, _, _ = geometry_near(s_hi * hs, theta_at(co, s_hi), th, tr, c)
+                closing = flight and g_hi <= 0.0
+                crossing = closing or (not flight and g_hi > 0.0)
+                if crossing:
+                    cnt[I_GRAZES] += 1
         if crossing and events >= max_events:
             cnt[I_CHATTER] += 1
             crossing = False
+        if flight and not crossing and g1 <= 0.0:
+            # A free-flight step that ends inside the cam without a located closing (a
+            # rebound too weak for its flight's top to show above the surface, or the
+            # chattering guard spent): the free pendulum is not the motion there. The step is
+            # taken again in contact mode, the full equations, with no hand-back in between
+            # (a resumed run makes the same choice from the same state).
+            flight = False
+            redo = True
+            a1 = accel_trig(tr, om, K, c, flight)
+            continue
+        redo = False
         if crossing:
-            s_end = locate_on_interpolant(hs, th, tr, co, g, g1, 1.0, c)
-        elif events < max_events:
-            # No sign change between the ends, but the gap rate turns (down to up in flight,
-            # up to down in contact): the gap may cross zero and come back inside the step (a
-            # graze, or a micro-flight). Find the turning point on the interpolant; if the
-            # gap has changed sign there, the first crossing lies before it.
-            rate0 = l1 * om - cdn
-            rate1 = l1_1 * om1 - cdn1
-            if (rate0 < 0.0 < rate1) if flight else (rate1 < 0.0 < rate0):
-                s_turn = turning_point(hs, th, tr, co, rate0, rate1, c)
-                g_turn, _, _ = geometry_near(s_turn * hs, theta_at(co, s_turn), th, tr, c)
-                if (g_turn <= 0.0) if flight else (g_turn > 0.0):
-                    crossing = True
-                    s_end = locate_on_interpolant(hs, th, tr, co, g, g_turn, s_turn, c)
+            s_end = locate_on_interpolant(hs, th, tr, co, s_lo, g_lo, s_hi, g_hi, c)
 
         # Series samples in (t, t + s_end hs], from the interpolant.
         t_end = t + s_end * hs if crossing else t1
@@ -309,12 +404,18 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             if not flight:
                 y[Y_CONTACT] += span
 
+        # The tangent's sides: a step that starts on the surface takes its first Jacobian
+        # on the side it starts on; flight steps the free pendulum's throughout.
+        side = JAC_FLIGHT if flight else JAC_NATURAL
+        side_first = side
+        if on_surface:
+            side_first = JAC_FLIGHT if flight else JAC_CONTACT
+
         if crossing:
             # An event inside the step: a step of the located length from the step's start
             # gives the state there (an integrator state, not an interpolation). Should that
             # state not yet be past the crossing (the interpolant only approximates the step),
             # the length grows by 2, 4, 8, ... event tolerances until it is.
-            closing = flight
             reach = c[C_EVENT_TOL] / hs
             for _ in range(60):
                 r2 = dop853_step(th, om, a1, s_end * hs, tr, K, c, flight)
@@ -326,18 +427,31 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
                 s_end = min(1.0, s_end + reach)
             # the substep ends on the surface: its Jacobian is taken on its own side
             side = JAC_FLIGHT if closing else JAC_CONTACT
-            advance_tangent(y, c, t, s_end * hs, th, om, co, s_end, r2[0], r2[1], K, side)
+            if not on_surface:
+                side_first = side
+            advance_tangent(
+                y, c, t, s_end * hs, th, om, co, s_end, r2[0], r2[1], K, side_first, side
+            )
             th = r2[0]
             om = r2[1]
             t = t + s_end * hs
             events += 1
             tr = tr2
             g, l1, cdn = k.geometry_trig(tr[1], tr[2], tr[3], tr[4], c)
+            surf = 0
             if closing:
                 if not (0.0 < l1 < c[C_ROD_L]):
-                    return leave(y, cnt, th, om, t, h_next, events, window, LEFT_REACH, c)
+                    return leave(y, cnt, th, om, t, h_next, events, window, surf, LEFT_REACH, c)
+                om_before = om
+                plastic = cdn - l1 * om < c[C_V_CHATTER]  # a chattering end, if applied
                 om, K = k.impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
-            flight = g > 0.0
+                if om != om_before:
+                    # after a rebound the point still lies on the surface, moving out
+                    if plastic:
+                        surf = SURFACE_SETTLED
+                    elif l1 * om - cdn > 0.0:
+                        surf = SURFACE_JUMPED
+            flight, on_surface = surface_mode(g, l1 * om - cdn, surf)
             a1 = accel_trig(tr, om, K, c, flight)
             h = min(h_next, hs)  # the event cut the step: do not grow past it
             continue
@@ -345,25 +459,25 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         # The whole step is accepted. theta'' at its end was evaluated from directly computed
         # trigonometry, as a resumed run does; in a changed mode it is evaluated again.
         step_mode = flight
-        side = JAC_FLIGHT if flight else JAC_NATURAL
-        advance_tangent(y, c, t, t_end - t, th, om, co, 1.0, th1, om1, K, side)
+        advance_tangent(y, c, t, t_end - t, th, om, co, 1.0, th1, om1, K, side_first, side)
         th = th1
         om = om1
         t = t_end
         tr = tr1
         g, l1, cdn = g1, l1_1, cdn1
-        flight = g > 0.0
+        surf = 0
+        flight, on_surface = surface_mode(g, l1 * om - cdn, surf)
         h = h_next
         a1 = a_end if flight == step_mode else accel_trig(tr, om, K, c, flight)
         if not (math.isfinite(th) and math.isfinite(om)):
-            return leave(y, cnt, th, om, t, h, events, window, NON_FINITE, c)
+            return leave(y, cnt, th, om, t, h, events, window, surf, NON_FINITE, c)
         if g <= 0.0:
             if not (0.0 < l1 < c[C_ROD_L]):
-                return leave(y, cnt, th, om, t, h, events, window, LEFT_REACH, c)
+                return leave(y, cnt, th, om, t, h, events, window, surf, LEFT_REACH, c)
             if -g > c[C_RCAM]:
-                return leave(y, cnt, th, om, t, h, events, window, PENETRATION, c)
+                return leave(y, cnt, th, om, t, h, events, window, surf, PENETRATION, c)
         if clipped:
             K = k.at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)
             if is_resample:
                 a1 = accel_trig(tr, om, K, c, flight)
-    return leave(y, cnt, th, om, t, h, events, window, OK, c)
+    return leave(y, cnt, th, om, t, h, events, window, surf, OK, c)

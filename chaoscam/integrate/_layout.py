@@ -63,8 +63,11 @@ I_SLOW_CLOSINGS = 10  # closings slower than v_min (no jump applied)
 I_SAFE_STEP = 11  # the gap provably stays open until grid step I_SAFE_STEP (0 = not known)
 I_SERIES_J = 12  # adaptive: index j of the next series sample (time j * stride * dt)
 I_GRAZES = 13  # fixed step: crossings found inside a segment whose ends lie on one side
-I_SURFACE = 14  # fixed step: the point's surface flags at a hand-back (1 jumped, 2 settled)
+I_SURFACE = 14  # the point's surface flags at a hand-back (SURFACE_JUMPED | SURFACE_SETTLED)
 N_COUNTERS = 15
+
+SURFACE_JUMPED = 1  # I_SURFACE bit: a rebound was just applied, the opening is flight's
+SURFACE_SETTLED = 2  # I_SURFACE bit: a plastic closure, the point stays in contact
 
 # --- the state vector y ----------------------------------------------------------------------
 Y_THETA = 0  # theta_f [rad]
@@ -113,3 +116,11 @@ IMPACT_NAMES = (
 SERIES_COLS = 4  # t, theta_f, omega_f, l_lambda
 SECTION_COLS = len(SECTION_NAMES) + len(SECTION_TANGENT_NAMES)
 IMPACT_COLS = len(IMPACT_NAMES)
+
+# --- the adaptive path's tangent -----------------------------------------------------------
+# Largest h |A| of an RK4 substep of the tangent along an accepted DOP853 step, |A| the
+# largest of sqrt|d theta''/d theta| and |d theta''/d theta'| at the step's start, middle and
+# end. The sticking period 1 at e = 0.02 m (whose multiplier is a difference of two close
+# entries of J) gives 0.00381, 0.004153, 0.004154 at 0.1, 0.02, 0.005: 0.02 is converged to
+# ~2e-4 relative. One RK4 step per DOP853 step gave 6.8e-6 there, and lambda_1 = -22 1/s.
+TANGENT_STEP_RATE = 0.02

@@ -161,9 +161,9 @@ def rk4_tangent_along(t, h, th0, om0, thm, omm, th1, om1, K, c, v11, v21, v12, v
     interpolant. Returns ``(v11, v21, v12, v22, div)``.
 
     The adaptive path integrates the state with DOP853 (:mod:`._adaptive`); its tangent is
-    this classical RK4 of ``V' = A(t) V`` over the same step, with A at the step's start,
-    midpoint (twice) and end. Accurate to O((h |A|)^5) per step: the error control keeps
-    contact steps at a fraction of the contact period, and in flight |A| ~ (m g l / 2J)^0.5.
+    this classical RK4 of ``V' = A(t) V`` over a substep, with A at its start, midpoint
+    (twice) and end. Accurate to O((h |A|)^5) per substep: the adaptive path cuts each step
+    into substeps with ``h |A| <= TANGENT_STEP_RATE`` (:func:`._adaptive.advance_tangent`).
     """
     _, p1, q1 = acceleration_jacobian(t, th0, om0, K, c, side)
     _, p2, q2 = acceleration_jacobian(t + 0.5 * h, thm, omm, K, c, side)
