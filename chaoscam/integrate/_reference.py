@@ -29,6 +29,7 @@ from ..model import (
     lever_arm,
     normal_cam_speed,
 )
+from ._layout import IMPACT_NAMES
 
 __all__ = ["simulate_reference", "ReferenceResult"]
 
@@ -138,16 +139,7 @@ def simulate_reference(
         elif t >= next_resample:
             lam = float(stream.draw(1)[0])
             next_resample += p.resample_dt
-    cols = [
-        "t",
-        "theta_f",
-        "omega_before",
-        "omega_after",
-        "gap_rate_before",
-        "lever_arm",
-        "l_lambda",
-        "kind",
-    ]
+    cols = list(IMPACT_NAMES)  # the kernel's impact columns
     return ReferenceResult(
         impacts=pd.DataFrame(impacts, columns=cols),
         section=pd.DataFrame(section, columns=["k", "t", "theta_f", "omega_f", "l_lambda"]),

@@ -21,9 +21,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from .._simulate import resolution_warning
-from ..integrate import Status
 from ..model import Params, truncated_mass
-from ._tasks import RunSummary, status_fields, verdict_fields
+from ._tasks import RunSummary, verdict_fields
 
 __all__ = ["ENGINE_CLASSIFIER", "BatchTask", "batch_size", "run_batch"]
 
@@ -117,13 +116,12 @@ def run_batch(
                 float(members["contact_fraction"].iat[j]),
                 truncated_mass(plist[j].l_lambda, plist[j].l_lambda_sigma, plist[j].l_min),
             )
-            v = verdicts[j]
-            if v.verdict is not None:
-                fields = verdict_fields(v.verdict)
-            elif status != "OK":
-                fields = status_fields(Status[status])
-            else:
-                fields = {"label": v.label, "period": None, "reasons": v.reasons, "evidence": {}}
+            v = verdicts[j]  # without a verdict: labelled by its status, or too short to judge
+            fields = (
+                verdict_fields(v.verdict)
+                if v.verdict is not None
+                else {"label": v.label, "period": None, "reasons": v.reasons, "evidence": {}}
+            )
             seen = [w for w in (resolution_warning(plist[j]), *shared) if w]
             fields["status"] = status
             fields["warnings"] = " | ".join(dict.fromkeys(seen))
@@ -208,6 +206,28 @@ def resolve_engine(
         return BatchTask(tasks, device, extend_to)
 
     return Engine("ensemble", f"{ENGINE_CLASSIFIER}, extend_to={extend_to}", pack, size, threads)
+
+
+def sweep_engine(
+    classify,
+    lyapunov: bool,
+    check_step: bool,
+    engine: str,
+    device: str,
+    base: Params,
+    run: tuple[float, float],
+    workers,
+    scheduler,
+):
+    """(classifier, engine, series?) of a sweep: the classifier resolved
+    (:func:`._common.resolve_classifier`), its engine (:func:`resolve_engine`), and whether
+    its runs keep a series (only the process engine's, for a classifier that asks)."""
+    from ._common import resolve_classifier
+    from ._tasks import needs_series
+
+    classify, identity = resolve_classifier(classify, lyapunov, check_step)
+    eng = resolve_engine(engine, device, classify, identity, base, run, workers, scheduler)
+    return classify, eng, eng.name == "process" and needs_series(classify)
 
 
 def numba_threads(n: int | None):

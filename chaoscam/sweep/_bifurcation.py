@@ -21,7 +21,7 @@ import pandas as pd
 from .._checks import whole
 from .._version import __version__
 from ..model import Params, contact_angle
-from ._batch import resolve_engine, run_plan
+from ._batch import run_plan, sweep_engine
 from ._checkpoint import read_sweep_metadata, write_parquet
 from ._common import (
     check_sweep_budget,
@@ -31,12 +31,11 @@ from ._common import (
     open_store,
     period_column,
     reemit_warnings,
-    resolve_classifier,
     run_settings,
     unique_sorted,
 )
 from ._grid import Axis, SweepError, realization_index, validate_grid
-from ._tasks import BranchTask, needs_series
+from ._tasks import BranchTask
 
 __all__ = ["Bifurcation", "bifurcation", "read_bifurcation", "initial_offsets"]
 
@@ -281,11 +280,17 @@ def bifurcation(
         specs = [("absolute", float(a), float(b)) for a, b in initial_conditions]
         if not specs:
             raise SweepError("initial conditions: the list is empty")
-    classify, identity = resolve_classifier(classify, lyapunov, check_step)
-    eng = resolve_engine(
-        engine, device, classify, identity, base, (duration, transient), workers, scheduler
+    classify, eng, series = sweep_engine(
+        classify,
+        lyapunov,
+        check_step,
+        engine,
+        device,
+        base,
+        (duration, transient),
+        workers,
+        scheduler,
     )
-    series = eng.name == "process" and needs_series(classify)
     check_sweep_budget(
         base,
         runs=len(axis) * len(specs),

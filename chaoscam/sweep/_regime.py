@@ -21,7 +21,7 @@ import pandas as pd
 from .._checks import whole
 from .._version import __version__
 from ..model import ParameterError, Params
-from ._batch import resolve_engine, run_plan
+from ._batch import run_plan, sweep_engine
 from ._checkpoint import read_sweep_metadata, write_parquet
 from ._common import (
     as_axis,
@@ -32,13 +32,12 @@ from ._common import (
     open_store,
     period_column,
     reemit_warnings,
-    resolve_classifier,
     run_settings,
     unique_sorted,
 )
 from ._grid import Axis, SweepError, realization_index, validate_grid
 from ._stats import max_halfwidth, summarize_cells
-from ._tasks import RealizationTask, needs_series
+from ._tasks import RealizationTask
 
 __all__ = ["RegimeMap", "regime_map", "read_regime_map"]
 
@@ -348,11 +347,17 @@ def regime_map(
     elif max_realizations is not None:
         raise SweepError("max realizations applies with a target half-width only")
     validate_grid(base, [x, y])
-    classify, identity = resolve_classifier(classify, lyapunov, check_step)
-    eng = resolve_engine(
-        engine, device, classify, identity, base, (duration, transient), workers, scheduler
+    classify, eng, series = sweep_engine(
+        classify,
+        lyapunov,
+        check_step,
+        engine,
+        device,
+        base,
+        (duration, transient),
+        workers,
+        scheduler,
     )
-    series = eng.name == "process" and needs_series(classify)
     check_sweep_budget(
         base,
         runs=len(x) * len(y) * (adaptive["max_realizations"] if adaptive else realizations),
