@@ -13,17 +13,15 @@ import math
 import time
 import warnings
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from ._version import __version__
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
 from .integrate._constants import initial_counters, initial_state
-from .integrate._driver import Buffers, drive
-from .integrate._ensemble import contact_fraction
+from .integrate._driver import Buffers, check_window, contact_fraction, drive
 from .integrate._tangent import section_jacobians
 from .model import (
     LineLengthStream,
@@ -36,7 +34,10 @@ from .model import (
     truncated_mass,
 )
 
-__all__ = ["simulate", "Trajectory", "contact_period", "SERIES_COLUMNS"]
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = ["simulate", "Trajectory", "RawRun", "raw_run", "contact_period", "SERIES_COLUMNS"]
 
 SERIES_COLUMNS = ("t", "theta_f", "omega_f", "theta_fc", "gap", "contact", "F_n", "l_lambda")
 SECTION_COLUMNS = k.SECTION_NAMES
@@ -102,18 +103,7 @@ class Trajectory:
 
     def summary(self) -> str:
         """A few lines for a terminal."""
-        s = self.stats
-        return (
-            f"status: {self.status.name} - {self.message}\n"
-            f"simulated: {self.final_state[0]:.4g} s of {self.settings['duration']:.4g} s "
-            f"(transient {self.settings['transient']:.4g} s discarded), dt = {self.params.dt:g} s\n"
-            f"impacts: {s['n_impacts']} applied ({s['n_macro_impacts']} macro, "
-            f"{s['n_micro_impacts']} micro, {s['n_chatter_ends']} chattering ends), "
-            f"{s['slow_closings']} slow closings left to the compliant contact, "
-            f"{s['chatter_handovers']} chattering-guard hand-overs\n"
-            f"contact fraction: {s['contact_fraction']:.4f}\n"
-            f"section points: {len(self.section)}"
-        )
+        return _summary(self, len(self.section))
 
     def provenance(self) -> dict[str, Any]:
         """Parameters and settings as a JSON-serialisable dict."""
@@ -157,17 +147,10 @@ def _check_run(
 ) -> tuple[int, int]:
     """Validate the run's settings and refuse a run that cannot fit in memory."""
     from ._budget import check_budget, estimate
-    from ._checks import real, whole
+    from ._checks import whole
 
     seed, index = whole("seed", seed), whole("index", index)
-    duration = real("duration", duration, low=0.0, strict=True, unit="s")
-    if not (isinstance(transient, int | float) and 0 <= transient < duration):
-        raise ParameterError(f"transient = {transient!r} s must be in [0, duration = {duration})")
-    if round(duration / p.dt) < 1:
-        raise ParameterError(
-            f"duration = {duration!r} s is shorter than one step dt = {p.dt!r} s: nothing "
-            "would be simulated"
-        )
+    duration, transient = check_window(duration, transient, dt=p.dt)
     if output_dt is not None and not (output_dt >= p.dt and math.isfinite(output_dt)):
         raise ParameterError(f"output_dt = {output_dt!r} s must be >= dt = {p.dt} s")
     series_rows = (duration - transient) / output_dt if output_dt is not None else 0.0
@@ -231,6 +214,85 @@ def simulate(
         Frozen; ``status`` says how the run ended (it never raises for a run that leaves the
         cam or diverges).
     """
+    return raw_run(
+        params,
+        duration=duration,
+        transient=transient,
+        seed=seed,
+        index=index,
+        series=series,
+        output_dt=output_dt,
+        tangent=tangent,
+        **overrides,
+    ).trajectory()
+
+
+@dataclass(frozen=True)
+class RawRun:
+    """A run's outputs as the kernel wrote them, before they become a :class:`Trajectory`'s
+    tables: what a caller that only prints a summary needs, without importing pandas.
+
+    ``series`` (t, theta_f, omega_f, l_lambda samples, or None), ``section`` (the kernel's
+    ``SECTION_COLS`` columns, tangent slots included) and ``impacts`` (``IMPACT_COLS``) are
+    arrays; the other attributes are those of :class:`Trajectory`.
+    """
+
+    params: Params
+    settings: dict[str, Any]
+    status: Status
+    stats: dict[str, Any]
+    final_state: tuple[float, float, float]
+    series: np.ndarray | None
+    section: np.ndarray
+    impacts: np.ndarray
+
+    @property
+    def message(self) -> str:
+        return self.status.message
+
+    def summary(self) -> str:
+        """A few lines for a terminal (:meth:`Trajectory.summary`)."""
+        return _summary(self, len(self.section))
+
+    def trajectory(self) -> Trajectory:
+        """The run as a :class:`Trajectory` (its tables as pandas DataFrames)."""
+        import pandas as pd
+
+        n_sec = len(SECTION_COLUMNS)
+        sec = pd.DataFrame(self.section[:, :n_sec], columns=list(SECTION_COLUMNS))
+        sec["k"] = sec["k"].astype(np.int64)
+        imp = pd.DataFrame(self.impacts, columns=list(IMPACT_COLUMNS))
+        imp["kind"] = pd.Categorical.from_codes(
+            imp["kind"].to_numpy(dtype=np.int64), categories=list(IMPACT_KINDS)
+        )
+        tangent = self.settings["tangent"]
+        return Trajectory(
+            params=self.params,
+            settings=self.settings,
+            status=self.status,
+            series=None if self.series is None else _series_frame(self.params, self.series),
+            section=sec,
+            impacts=imp,
+            stats=self.stats,
+            final_state=self.final_state,
+            jacobians=section_jacobians(self.section) if tangent else None,
+            divergence=self.section[:, n_sec + 4].copy() if tangent else None,
+        )
+
+
+def raw_run(
+    params: Params | None = None,
+    *,
+    duration: float = 20.0,
+    transient: float = 0.0,
+    seed: int = 0,
+    index: int = 0,
+    series: bool = True,
+    output_dt: float = 1e-3,
+    tangent: bool = False,
+    **overrides: Any,
+) -> RawRun:
+    """:func:`simulate` up to its arrays (same arguments, same checks and warnings)."""
     from ._checks import params_arg, real
 
     p = params_arg(params)
@@ -245,7 +307,7 @@ def simulate(
     steps_per_contact = contact_period(p) / p.dt
     coarse = resolution_warning(p)
     if coarse:
-        warnings.warn(coarse, RuntimeWarning, stacklevel=2)
+        warnings.warn(coarse, RuntimeWarning, stacklevel=3)  # simulate's caller
 
     # Buffers hold at least a few steps' worth of the most a step can produce.
     per_step = p.max_events_per_step + p.flight_merge + 2
@@ -278,30 +340,18 @@ def simulate(
         on_rows=lambda name, rows: parts[name].append(rows.copy()),
         more_draws=more_draws,
     )
-    status = Status(code)
 
     def stack(name: str, ncol: int) -> np.ndarray:
         return np.concatenate(parts[name]) if parts[name] else np.empty((0, ncol))
 
-    sec_all = stack("section", k.SECTION_COLS)
-    n_sec = len(SECTION_COLUMNS)
-    sec = pd.DataFrame(sec_all[:, :n_sec], columns=list(SECTION_COLUMNS))
-    sec["k"] = sec["k"].astype(np.int64)
-    jac = None
-    if tangent:
-        jac = section_jacobians(sec_all)
-    div = sec_all[:, n_sec + 4].copy() if tangent else None
-    imp = pd.DataFrame(stack("impacts", k.IMPACT_COLS), columns=list(IMPACT_COLUMNS))
-    imp["kind"] = pd.Categorical.from_codes(
-        imp["kind"].to_numpy(dtype=np.int64), categories=list(IMPACT_KINDS)
-    )
-    ser = _series_frame(p, stack("series", k.SERIES_COLS)) if series else None
+    imp = stack("impacts", k.IMPACT_COLS)
+    kinds = imp[:, IMPACT_COLUMNS.index("kind")]
     stats = {
         "contact_fraction": contact_fraction(y, cnt, c),
         "n_impacts": len(imp),
-        "n_macro_impacts": int((imp["kind"] == "macro").sum()),
-        "n_micro_impacts": int((imp["kind"] == "micro").sum()),
-        "n_chatter_ends": int((imp["kind"] == "chatter_end").sum()),
+        "n_macro_impacts": int((kinds == k.IMPACT_MACRO).sum()),
+        "n_micro_impacts": int((kinds == k.IMPACT_MICRO).sum()),
+        "n_chatter_ends": int((kinds == k.IMPACT_CHATTER_END).sum()),
         "slow_closings": int(cnt[k.I_SLOW_CLOSINGS]),
         "chatter_handovers": int(cnt[k.I_CHATTER]),
         "truncated_mass": truncated_mass(p.l_lambda, p.l_lambda_sigma, p.l_min),
@@ -322,22 +372,38 @@ def simulate(
         "tangent": bool(tangent),
         "wall_time_s": time.perf_counter() - t0,
     }
-    return Trajectory(
+    return RawRun(
         params=p,
         settings=settings,
-        status=status,
-        series=ser,
-        section=sec,
-        impacts=imp,
+        status=Status(code),
         stats=stats,
         final_state=(float(y[k.Y_TIME]), float(y[k.Y_THETA]), float(y[k.Y_OMEGA])),
-        jacobians=jac,
-        divergence=div,
+        series=stack("series", k.SERIES_COLS) if series else None,
+        section=stack("section", k.SECTION_COLS),
+        impacts=imp,
+    )
+
+
+def _summary(run: Trajectory | RawRun, n_sections: int) -> str:
+    """The terminal lines of :meth:`Trajectory.summary` (and :meth:`RawRun.summary`)."""
+    s = run.stats
+    return (
+        f"status: {run.status.name} - {run.message}\n"
+        f"simulated: {run.final_state[0]:.4g} s of {run.settings['duration']:.4g} s "
+        f"(transient {run.settings['transient']:.4g} s discarded), dt = {run.params.dt:g} s\n"
+        f"impacts: {s['n_impacts']} applied ({s['n_macro_impacts']} macro, "
+        f"{s['n_micro_impacts']} micro, {s['n_chatter_ends']} chattering ends), "
+        f"{s['slow_closings']} slow closings left to the compliant contact, "
+        f"{s['chatter_handovers']} chattering-guard hand-overs\n"
+        f"contact fraction: {run.stats['contact_fraction']:.4f}\n"
+        f"section points: {n_sections}"
     )
 
 
 def _series_frame(p: Params, a: np.ndarray) -> pd.DataFrame:
     """The tidy series: kernel samples plus the observables derived from them."""
+    import pandas as pd
+
     t, th, om, lam = a[:, 0], a[:, 1], a[:, 2], a[:, 3]
     d = gap(p, t, th)
     return pd.DataFrame(

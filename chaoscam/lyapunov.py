@@ -26,7 +26,7 @@ from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
 from .integrate._advance import advance
 from .integrate._constants import initial_counters, initial_state
-from .integrate._driver import Buffers, drive
+from .integrate._driver import Buffers, check_window, drive
 from .model import LineLengthStream, ParameterError, Params
 
 __all__ = ["ModelLyapunov", "lyapunov_model"]
@@ -291,10 +291,7 @@ def lyapunov_model(
     # noise enters the separation: with integrator="adaptive" a period-7 orbit (omega = 45)
     # came out at +0.29 1/s against -0.75 1/s on the grid.
     p = p.replace(integrator="rk4")
-    if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):
-        raise ParameterError(f"duration = {duration!r} s must be > 0")
-    if not (isinstance(transient, int | float) and 0 <= transient < duration):
-        raise ParameterError(f"transient = {transient!r} s must be in [0, duration = {duration})")
+    duration, transient = check_window(duration, transient, dt=p.dt)
     if not (int(renorm_periods) == renorm_periods and renorm_periods >= 1):
         raise ParameterError(f"renorm_periods = {renorm_periods!r} must be an integer >= 1")
     if not (math.isfinite(d0) and d0 > 0):

@@ -31,7 +31,7 @@ def register(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from .._outputs import atomic_path, check_output
-    from .._simulate import simulate
+    from .._simulate import raw_run
     from . import parse_assignments, show_warning
 
     out = check_output(args.out, force=args.force, suffixes=(".parquet", ".csv"))
@@ -55,8 +55,11 @@ def run(args: argparse.Namespace) -> int:
     with warnings.catch_warnings():
         warnings.simplefilter("always")
         warnings.showwarning = note
-        traj = simulate(params, **settings)
-    print(traj.summary())
+        run_ = raw_run(params, **settings)
+    print(run_.summary())
+    if out is None and section is None and impacts is None:
+        return _exit_code(run_, notes)  # nothing to write: no tables (and no pandas) needed
+    traj = run_.trajectory()
     for path, label, write in (
         (out, "series", _series_writer(traj, out)),
         (section, "section", lambda tmp: traj.section.to_csv(tmp, index=False)),

@@ -1,33 +1,147 @@
-"""The one loop that drives a single trajectory through the compiled kernel.
+"""The one loop that drives trajectories through the compiled kernel, and the checks of a
+run's time window.
 
-The kernel (:func:`._ensemble.run_one` → :func:`._advance.advance`) advances until the end
-step or until an output buffer or the line-length draws need attention, and returns
-``NEED_BUFFER`` then. :func:`drive` is the loop every single-trajectory caller goes
-through (``chaoscam.simulate``, the periodic-orbit shooting of :mod:`chaoscam.tangent`, the
-two-trajectory exponent of :mod:`chaoscam.lyapunov`): it hands the filled rows of each buffer
-to the caller, resets the buffer, asks the caller for draws when they run short, and calls
-the kernel again. A resumed call is bit-identical to one that was not interrupted (the
-kernel keeps everything it needs in ``y`` and ``cnt``), so how often the loop pauses does
-not change a result.
+The kernel (:func:`run_members` → :func:`._advance.advance`) advances each member until the
+end step or until an output buffer or the line-length draws need attention, and returns
+``NEED_BUFFER`` then. :func:`drive_members` is the loop every run goes through: launch the
+members still to run, let the caller empty the buffers and refill the draws of those that
+asked, launch those again, until none asks. Its callers differ only in what a launch is and
+what they keep:
 
-The ensemble paths run many members per call (:func:`._ensemble._run_on_cpu`,
-:func:`._gpu.run_on_gpu`); their loops differ in what they keep per member, not in the
-kernel they call.
+- :func:`drive`, one trajectory (``chaoscam.simulate``, the periodic-orbit shooting of
+  :mod:`chaoscam.tangent`, the two-trajectory exponent of :mod:`chaoscam.lyapunov`), hands
+  every buffer's rows to the caller after each launch;
+- the CPU ensemble (:func:`._ensemble._run_on_cpu`) launches the members that asked, in
+  parallel over cores;
+- the GPU ensemble (:func:`._gpu.run_on_gpu`) launches one CUDA thread per member, those
+  that are done returning at once.
+
+A resumed member is bit-identical to one that was not interrupted (the kernel keeps
+everything it needs in ``y`` and ``cnt``), so how often the loop pauses changes no result.
 """
 
 from __future__ import annotations
 
+import math
+import os
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit, prange
 
+from ..model import ParameterError
 from . import _kernel as k
-from ._ensemble import run_one
+from ._advance import advance
 
-__all__ = ["Buffers", "drive"]
+__all__ = [
+    "Buffers",
+    "check_window",
+    "contact_fraction",
+    "drive",
+    "drive_members",
+    "fork_safe_threads",
+    "run_members",
+    "run_one",
+]
 
 _OUTPUTS = (("series", k.I_N_SERIES), ("section", k.I_N_SECTION), ("impacts", k.I_N_IMPACT))
+
+
+def check_window(duration, transient, *, dt: float | None = None) -> tuple[float, float]:
+    """The run's time window validated: ``duration`` > 0 (and at least one step ``dt``),
+    ``transient`` in [0, duration); both [s], returned as floats. Every run's entry point
+    (simulate, ensembles, the exponents, the sweeps) checks its window here."""
+    if isinstance(duration, bool) or not (
+        isinstance(duration, int | float) and math.isfinite(duration) and duration > 0
+    ):
+        raise ParameterError(f"duration = {duration!r} s must be a finite number > 0")
+    if isinstance(transient, bool) or not (
+        isinstance(transient, int | float) and 0 <= transient < duration
+    ):
+        raise ParameterError(f"transient = {transient!r} s must be in [0, duration = {duration})")
+    if dt is not None and round(duration / dt) < 1:
+        raise ParameterError(
+            f"duration = {duration!r} s is shorter than one step dt = {dt!r} s: nothing "
+            "would be simulated"
+        )
+    return float(duration), float(transient)
+
+
+@njit(parallel=True, cache=True)
+def run_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
+    """:func:`_advance.advance` for each member ``i`` of stacked arrays, in parallel.
+
+    The one compiled entry point of every CPU simulation (a single trajectory is a batch of
+    one), so that a realization is bit-identical on every path and thread count.
+    """
+    for i in prange(y.shape[0]):
+        status[i] = advance(y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i])
+
+
+def fork_safe_threads() -> None:
+    """Choose numba's fork-safe "workqueue" threading layer, unless the user chose one.
+
+    numba's GNU OpenMP layer aborts a process that forks after using it, and the sweeps fork
+    their workers from a driver that may have simulated. The layer is fixed at the first
+    parallel call, so every launch of :func:`run_members` comes here first; nothing is
+    changed on import. A user's choice (``NUMBA_THREADING_LAYER``, or
+    ``numba.config.THREADING_LAYER`` set before the first run) wins.
+    """
+    import numba
+
+    if "NUMBA_THREADING_LAYER" not in os.environ and numba.config.THREADING_LAYER == "default":
+        numba.config.THREADING_LAYER = "workqueue"
+
+
+def run_one(y, cnt, c, n_stop, lam, series, section, impacts) -> int:
+    """:func:`run_members` for one trajectory (arrays of a single member, updated in place)."""
+    fork_safe_threads()
+    status = np.zeros(1, dtype=np.int64)
+    run_members(
+        y[None],
+        cnt[None],
+        c[None],
+        n_stop,
+        lam[None],
+        series[None],
+        section[None],
+        impacts[None],
+        status,
+    )
+    return int(status[0])
+
+
+def contact_fraction(y, cnt, c) -> float:
+    """Fraction of the recorded time spent in contact (gap <= 0); NaN if nothing recorded.
+
+    The fixed-step kernel counts grid steps ending in contact; the adaptive one integrates
+    time (slots ``Y_RECORDED`` and ``Y_CONTACT``).
+    """
+    if c[k.C_METHOD] == k.METHOD_ADAPTIVE:
+        rec = y[k.Y_RECORDED]
+        return float(y[k.Y_CONTACT] / rec) if rec > 0 else float("nan")
+    counted = cnt[k.I_COUNTED_STEPS]
+    return float(cnt[k.I_CONTACT_STEPS] / counted) if counted else float("nan")
+
+
+def drive_members(
+    n: int,
+    launch: Callable[[np.ndarray], np.ndarray],
+    refill: Callable[[np.ndarray], None],
+) -> None:
+    """The buffer-refill loop over ``n`` members.
+
+    ``launch(need)`` runs the members whose indices are in ``need`` until each ends or asks
+    for room, and returns their status codes (in the order of ``need``). ``refill(need)``
+    empties the output buffers and renews the line-length draws of the members in ``need``
+    (those that returned ``NEED_BUFFER``); they are then launched again, until none asks.
+    """
+    need = np.arange(n)
+    while need.size:
+        need = need[launch(need) == k.NEED_BUFFER]
+        if need.size:
+            refill(need)
 
 
 @dataclass
@@ -67,11 +181,16 @@ def drive(
     "impacts"; a view, to be copied if kept) after every kernel call, and the buffer is
     emptied. When the kernel stops for room, ``more_draws(lam)`` returns the draws to go on
     with, and must leave ``cnt[I_LAM_POS]`` pointing at the draw in use in them. ``run`` is
-    the compiled call (:func:`._ensemble.run_one`; the two-trajectory exponent passes
+    the compiled call (:func:`run_one`; the two-trajectory exponent passes
     :func:`._advance.advance`, the same kernel without the one-member batch).
     """
-    while True:
-        t_before, pos_before = y[k.Y_TIME], cnt[k.I_LAM_POS]
+    code = k.NEED_BUFFER
+    before = (0.0, 0)  # (time, draw in use) when the last call began
+    filled = False  # whether the last call filled any buffer
+
+    def launch(need: np.ndarray) -> np.ndarray:
+        nonlocal code, before, filled
+        before = (y[k.Y_TIME], cnt[k.I_LAM_POS])
         code = run(y, cnt, c, n_stop, lam, buffers.series, buffers.section, buffers.impacts)
         filled = False
         for name, i in _OUTPUTS:
@@ -79,8 +198,13 @@ def drive(
                 on_rows(name, getattr(buffers, name)[: cnt[i]])
                 cnt[i] = 0
                 filled = True
-        if code != k.NEED_BUFFER:
-            return int(code)
-        if not filled and y[k.Y_TIME] == t_before and cnt[k.I_LAM_POS] == pos_before == 0:
+        return np.array([code])
+
+    def refill(need: np.ndarray) -> None:
+        nonlocal lam
+        if not filled and (y[k.Y_TIME], cnt[k.I_LAM_POS]) == before and before[1] == 0:
             raise RuntimeError("internal: the kernel asked for buffers but made no progress")
         lam = more_draws(lam)
+
+    drive_members(1, launch, refill)
+    return int(code)

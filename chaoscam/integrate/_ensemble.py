@@ -12,87 +12,30 @@ runs.
 
 from __future__ import annotations
 
-import math
-import os
 import time
 import warnings
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
-from numba import njit, prange
 
-from ..model import LineLengthStream, ParameterError, Params
+from ..model import LineLengthStream, Params
 from . import _gpu
 from . import _kernel as k
-from ._advance import advance
 from ._constants import initial_counters, initial_state, kernel_constants
+from ._driver import check_window, contact_fraction, drive_members, fork_safe_threads, run_members
 from ._status import Status
 from ._tangent import section_jacobians
 
-__all__ = [
-    "BACKENDS",
-    "Ensemble",
-    "contact_fraction",
-    "run_members",
-    "run_one",
-    "simulate_ensemble",
-]
+if TYPE_CHECKING:
+    import pandas as pd
 
-# numba's GNU OpenMP layer aborts a process that forks after using it, and the sweeps fork
-# their workers from a driver that has simulated; the workqueue layer is fork-safe (though not
-# safe for parallel calls from several Python threads at once). A user's choice wins.
-if "NUMBA_THREADING_LAYER" not in os.environ:
-    import numba
-
-    numba.config.THREADING_LAYER = "workqueue"
+__all__ = ["BACKENDS", "Ensemble", "simulate_ensemble"]
 
 _DRAWS = 512  # line-length draws per member before a refill (impact resampling; see _draws)
 _IMPACT_ROWS = 256  # impact rows per member per call (only counted, not kept)
 _CPU_BATCH = 1024
 BACKENDS = ("cpu", "gpu", "auto")
-
-
-@njit(parallel=True, cache=True)
-def run_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
-    """:func:`_advance.advance` for each member ``i`` of stacked arrays, in parallel.
-
-    The one compiled entry point of every simulation (``chaoscam.simulate`` calls it with a
-    single member), so that a realization is bit-identical on every path and thread count.
-    """
-    for i in prange(y.shape[0]):
-        status[i] = advance(y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i])
-
-
-def contact_fraction(y, cnt, c) -> float:
-    """Fraction of the recorded time spent in contact (gap <= 0); NaN if nothing recorded.
-
-    The fixed-step kernel counts grid steps ending in contact; the adaptive one integrates
-    time (slots ``Y_RECORDED`` and ``Y_CONTACT``).
-    """
-    if c[k.C_METHOD] == k.METHOD_ADAPTIVE:
-        rec = y[k.Y_RECORDED]
-        return float(y[k.Y_CONTACT] / rec) if rec > 0 else float("nan")
-    counted = cnt[k.I_COUNTED_STEPS]
-    return float(cnt[k.I_CONTACT_STEPS] / counted) if counted else float("nan")
-
-
-def run_one(y, cnt, c, n_stop, lam, series, section, impacts) -> int:
-    """:func:`run_members` for one trajectory (arrays of a single member, updated in place)."""
-    status = np.zeros(1, dtype=np.int64)
-    run_members(
-        y[None],
-        cnt[None],
-        c[None],
-        n_stop,
-        lam[None],
-        series[None],
-        section[None],
-        impacts[None],
-        status,
-    )
-    return int(status[0])
 
 
 @dataclass(frozen=True)
@@ -183,10 +126,7 @@ def simulate_ensemble(
     (``_gpu.GPU_TOLERANCE``); chaotic runs part after a few periods, as any two roundings of
     them do, and only their statistics compare.
     """
-    if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):
-        raise ParameterError(f"duration = {duration!r} s must be > 0")
-    if not (isinstance(transient, int | float) and 0 <= transient < duration):
-        raise ParameterError(f"transient = {transient!r} s must be in [0, duration = {duration})")
+    duration, transient = check_window(duration, transient)
     use_gpu, device = _pick_backend(backend)
     if batch is None:
         batch = _gpu.GPU_BATCH if use_gpu else _CPU_BATCH
@@ -219,6 +159,8 @@ def simulate_ensemble(
         impact_rows.extend(im)
         if progress is not None:
             progress(len(r))
+    import pandas as pd
+
     cols = ["member", *k.SECTION_NAMES]
     every = np.concatenate(sections) if sections else np.empty((0, 1 + k.SECTION_COLS))
     sec = pd.DataFrame(every[:, : len(cols)], columns=cols)
@@ -350,15 +292,18 @@ def _run_batch(
 
 
 def _run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts):
-    """All members in one parallel call; those that asked for room are refilled and run
-    again, in parallel, until none asks (a resumed member is bit-identical to one that was
-    not interrupted, so the pauses change nothing)."""
+    """The members in parallel calls of the driver's loop: all of them first, then those
+    that asked for room, refilled (a resumed member is bit-identical to one that was not
+    interrupted, so the pauses change nothing)."""
+    fork_safe_threads()
     n = y.shape[0]
-    run_members(y, cnt, c, n_stop, lam, np.empty((n, 1, k.SERIES_COLS)), section, impacts, status)
-    need = np.flatnonzero(status == k.NEED_BUFFER)
-    while need.size:
-        for j in need:  # the same width again: as many new draws as were used
-            lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
+
+    def launch(need: np.ndarray) -> np.ndarray:
+        if need.size == n:  # the first call: every member, in place
+            run_members(
+                y, cnt, c, n_stop, lam, np.empty((n, 1, k.SERIES_COLS)), section, impacts, status
+            )
+            return status
         sub = (y[need], cnt[need], c[need], lam[need], section[need], impacts[need])
         sub_status = np.zeros(need.size, dtype=np.int64)
         run_members(
@@ -374,7 +319,13 @@ def _run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, kee
         )
         y[need], cnt[need], section[need], impacts[need] = sub[0], sub[1], sub[4], sub[5]
         status[need] = sub_status
-        need = need[sub_status == k.NEED_BUFFER]
+        return sub_status
+
+    def refill(need: np.ndarray) -> None:
+        for j in need:  # the same width again: as many new draws as were used
+            lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
+
+    drive_members(n, launch, refill)
 
 
 def _draws(p: Params, duration: float) -> int:

@@ -40,6 +40,7 @@ import numpy as np
 from . import _kernel as k
 from ._adaptive import run_chunk_adaptive
 from ._advance import advance
+from ._driver import drive_members
 
 __all__ = ["GPU_BATCH", "GPU_TOLERANCE", "GPUFallbackWarning", "gpu_status", "run_on_gpu"]
 
@@ -219,14 +220,16 @@ def run_on_gpu(
     d_section = cuda.device_array(section.shape)
     d_impacts = cuda.device_array(impacts.shape)
     blocks = (n + _BLOCK - 1) // _BLOCK
-    while True:
+
+    def launch(need: np.ndarray) -> np.ndarray:
+        """Every thread starts; those whose member is done return at once."""
         kern[blocks, _BLOCK](
             d_y, d_cnt, d_c, n_stop, d_lam, d_series, d_section, d_impacts, d_status
         )
         d_status.copy_to_host(status)
-        need = np.flatnonzero(status == k.NEED_BUFFER)
-        if need.size == 0:
-            break
+        return status[need]
+
+    def refill(need: np.ndarray) -> None:
         d_cnt.copy_to_host(cnt)
         if keep_impacts:
             for j in need:
@@ -239,6 +242,8 @@ def run_on_gpu(
                 d_lam[j].copy_to_device(lam[j])
         else:
             d_lam.copy_to_device(lam)
+
+    drive_members(n, launch, refill)
     d_y.copy_to_host(y)
     d_cnt.copy_to_host(cnt)
     d_section.copy_to_host(section)

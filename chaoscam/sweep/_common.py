@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..integrate._driver import check_window
 from ..model import ParameterError
 from ._backends import make_backend
 from ._checkpoint import (
@@ -28,11 +29,9 @@ __all__ = ["run_settings", "resolve_classifier", "companion", "open_store", "evi
 
 def run_settings(duration: float, transient: float | None, seed: int) -> tuple[float, float]:
     """Validated (duration, transient) [s]; transient None = half the duration."""
-    if not (isinstance(duration, int | float) and math.isfinite(duration) and duration > 0):
-        raise ParameterError(f"duration = {duration!r} s must be > 0")
-    transient = 0.5 * float(duration) if transient is None else transient
-    if not (isinstance(transient, int | float) and 0 <= transient < duration):
-        raise ParameterError(f"transient = {transient!r} s must be in [0, duration = {duration})")
+    if transient is None and isinstance(duration, int | float) and not isinstance(duration, bool):
+        transient = 0.5 * float(duration)  # checked with the duration just below
+    duration, transient = check_window(duration, transient)
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise ParameterError(f"seed = {seed!r} must be an integer >= 0")
     return float(duration), float(transient)

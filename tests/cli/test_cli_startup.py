@@ -60,3 +60,34 @@ def test_ctrl_c_during_start_up_is_one_line(delay):
     assert "Traceback" not in err, err
     assert proc.returncode == 130, err
     assert err.strip() == "chaoscam: interrupted"
+
+
+def _modules_after(code: str) -> set[str]:
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True
+    ).stdout
+    return set(out.split())
+
+
+def test_simulate_without_files_never_imports_pandas():
+    """`chaoscam simulate` that only prints its summary builds no tables: pandas (a quarter of
+    a second of start-up) stays unloaded; writing a table loads it."""
+    code = (
+        "import sys; from chaoscam.cli import main; main(['simulate', '--duration', '0.01']); "
+        "print(*sorted({m.split('.')[0] for m in sys.modules}))"
+    )
+    assert "pandas" not in _modules_after(code)
+    assert "numba" in _modules_after(code)  # it did simulate
+
+
+def test_import_and_run_leave_numba_threading_layer_to_first_parallel_launch():
+    """Importing the simulate path changes no process-wide setting; the first run picks the
+    fork-safe layer (unless the user chose one)."""
+    code = (
+        "import numba, chaoscam._simulate as s; print(numba.config.THREADING_LAYER); "
+        "s.raw_run(duration=0.001); print(numba.config.THREADING_LAYER)"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True
+    ).stdout.split()
+    assert out == ["default", "workqueue"]

@@ -1,0 +1,75 @@
+"""The one buffer-refill loop (integrate/_driver.py) and the run window's checks."""
+
+import numpy as np
+import pytest
+
+from chaoscam import Params
+from chaoscam._simulate import raw_run, simulate
+from chaoscam.integrate import _kernel as k
+from chaoscam.integrate._driver import check_window, drive_members
+from chaoscam.model import ParameterError
+
+
+def test_drive_members_relaunches_exactly_those_that_asked():
+    """Member j needs j refills: each launch gets the members still running, each refill the
+    ones that asked, and the loop stops when none asks."""
+    left = np.array([0, 1, 3, 2])  # refills each member still needs
+    launches, refills = [], []
+
+    def launch(need):
+        launches.append(need.tolist())
+        return np.where(left[need] > 0, k.NEED_BUFFER, k.OK)
+
+    def refill(need):
+        refills.append(need.tolist())
+        left[need] -= 1
+
+    drive_members(4, launch, refill)
+    assert launches == [[0, 1, 2, 3], [1, 2, 3], [2, 3], [2]]
+    assert refills == [[1, 2, 3], [2, 3], [2]]
+    assert left.tolist() == [0, 0, 0, 0]
+
+
+def test_drive_members_with_nothing_to_refill_launches_once():
+    calls = []
+    drive_members(3, lambda need: calls.append(need.size) or np.zeros(need.size, int), None)
+    assert calls == [3]
+
+
+@pytest.mark.parametrize(
+    ("duration", "transient", "field"),
+    [
+        (0.0, 0.0, "duration"),
+        (float("nan"), 0.0, "duration"),
+        (True, 0.0, "duration"),
+        ("20", 0.0, "duration"),
+        (20.0, 20.0, "transient"),
+        (20.0, -1.0, "transient"),
+        (20.0, None, "transient"),
+    ],
+)
+def test_check_window_names_the_field_and_its_range(duration, transient, field):
+    with pytest.raises(ParameterError, match=rf"^{field} = .* must be"):
+        check_window(duration, transient)
+
+
+def test_check_window_refuses_a_run_shorter_than_one_step():
+    with pytest.raises(ParameterError, match="shorter than one step"):
+        check_window(1e-7, 0.0, dt=2e-6)
+    assert check_window(20, 5) == (20.0, 5.0)
+
+
+def test_raw_run_is_the_trajectory_without_tables():
+    """simulate() is raw_run() plus its tables: equal stats, summary and arrays."""
+    p = Params(l_lambda_sigma=0.002)
+    raw = raw_run(p, duration=1.0, seed=3, index=2, tangent=True)
+    tr = simulate(p, duration=1.0, seed=3, index=2, tangent=True)
+    assert raw.summary() == tr.summary()
+    assert {n: v for n, v in raw.stats.items()} == tr.stats
+    assert raw.final_state == tr.final_state
+    np.testing.assert_array_equal(raw.section[:, :5], tr.section.to_numpy())
+    np.testing.assert_array_equal(raw.impacts[:, 0], tr.impacts["t"].to_numpy())
+    assert tr.stats["n_impacts"] == len(tr.impacts) > 0
+    kinds = tr.impacts["kind"].value_counts()
+    assert tr.stats["n_micro_impacts"] == kinds.get("micro", 0)
+    assert tr.stats["n_chatter_ends"] == kinds.get("chatter_end", 0)
