@@ -21,6 +21,7 @@ perturbation neither decays nor grows 100-fold; anything else is *unsettled* and
 the labelled set (reported, never forced).
 
 Usage: python analyses/labelled_set.py [OUT.json]   (default tests/data/labelled_set.json)
+       python analyses/labelled_set.py --holdout [OUT.json]   (default tests/data/holdout_set.json)
 """
 
 from __future__ import annotations
@@ -54,6 +55,26 @@ CONFIGS: dict[str, dict] = {
     "mu_f=0.1": {"mu_f": 0.1},
     "sigma=0.002": {"l_lambda_sigma": 0.002},
     "xi=0.2,sigma=0.002": {"xi": 0.2, "l_lambda_sigma": 0.002},
+}
+# A second set, settled by the same rules after the classifier was built and never used to
+# tune it: configurations it had not seen (``--holdout``).
+HOLDOUT: dict[str, dict] = {
+    "omega=15": {"omega": 15.0},
+    "omega=26": {"omega": 26.0},
+    "omega=38": {"omega": 38.0},
+    "omega=50": {"omega": 50.0},
+    "xi=0.3": {"xi": 0.3},
+    "xi=0.35": {"xi": 0.35},
+    "xi=0.45": {"xi": 0.45},
+    "e=0.01": {"e": 0.01},
+    "e=0.025": {"e": 0.025},
+    "l_lambda=0.004": {"l_lambda": 0.004},
+    "l_lambda=0.012": {"l_lambda": 0.012},
+    "x_O=-0.40": {"x_O": -0.40},
+    "mu_f=0.2": {"mu_f": 0.2},
+    "sigma=0.001": {"l_lambda_sigma": 0.001},
+    "xi=0.3,sigma=0.001": {"xi": 0.3, "l_lambda_sigma": 0.001},
+    "omega=26,xi=0.3": {"omega": 26.0, "xi": 0.3},
 }
 TRANSIENT, RECORDED = 100.0, 300.0
 BAND_RTOL = 1e-3  # bands narrower than this fraction of the extent ...
@@ -195,12 +216,16 @@ def main(argv: list[str]) -> None:
     """``[OUT.json]`` measures and settles; ``--from IN.json [OUT.json]`` only re-applies the
     rules to measurements made before."""
     old = {}
+    configs, default = CONFIGS, "labelled_set.json"
+    if argv[:1] == ["--holdout"]:
+        configs, default = HOLDOUT, "holdout_set.json"
+        argv = argv[1:]
     if argv[:1] == ["--from"]:
         old = json.loads(Path(argv[1]).read_text())
         argv = argv[2:]
-    out = Path(argv[0]) if argv else Path(__file__).parents[1] / "tests/data/labelled_set.json"
+    out = Path(argv[0]) if argv else Path(__file__).parents[1] / "tests/data" / default
     table = {}
-    for name, overrides in CONFIGS.items():
+    for name, overrides in configs.items():
         t0 = time.perf_counter()
         if name in old:
             m = {k: v for k, v in old[name].items() if k not in ("label", "period", "why")}
