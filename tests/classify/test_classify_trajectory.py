@@ -167,7 +167,11 @@ def test_undetermined_short_run_is_extended_until_it_settles():
 # Measured on 20 s runs (10 s transient): 46 section points in n narrow bands that look
 # periodic, with an exponent still undecided; a 4x longer run shows lambda_1 > 0.
 UNSETTLED_BANDS = {
-    "period 6 whose orbit is unstable (xi = 0.45)": (dict(xi=0.45), 0, "orbit found is unstable"),
+    "period 7 with no attracting orbit (omega = 26, xi = 0.3)": (
+        dict(omega=26.0, xi=0.3),
+        0,
+        "no attracting orbit is certified",
+    ),
     "random line length, 8 bands": (
         dict(l_lambda=0.008, l_lambda_sigma=0.0015),
         1,
@@ -208,10 +212,37 @@ def test_classify_ensemble_extends_and_explains_like_classify_trajectory():
     from chaoscam.classify import classify_trajectory
     from chaoscam.integrate import simulate_ensemble
 
-    p = Params(xi=0.45)
+    p = Params(omega=26.0, xi=0.3)
     ens = simulate_ensemble(p, [0], seed=1, duration=20.0, transient=10.0, tangent=True)
     short = classify_ensemble(ens, p, extend_to=None).members.iloc[0]
     assert short["label"] == "undetermined" and "run longer" in short["reasons"]
     member = classify_ensemble(ens, p).members.iloc[0]
     traj = simulate(p, duration=20.0, transient=10.0, seed=1, index=0, tangent=True)
     assert member["label"] == classify_trajectory(traj).label == "chaotic"
+
+
+def test_an_orbit_the_grid_calls_unstable_is_certified_on_refined_steps():
+    """xi = 0.45: a sticking period-6 orbit whose dominant multiplier the default grid's tangent
+    overstates (|mu| ~ 2-3 at dt = 2e-6 s, a positive grid exponent) while shooting at dt/2
+    and dt/4 finds it attracting (|mu| < 0.1; lambda_1 = -2.75 +- 0.17 1/s on the adaptive
+    path): periodic 6, with the refined multipliers as its evidence, on the single-run and
+    the ensemble paths alike."""
+    from chaoscam import Params, classify_ensemble, simulate
+    from chaoscam.classify import classify_trajectory
+    from chaoscam.integrate import simulate_ensemble
+    from chaoscam.tangent import periodic_orbit
+
+    p = Params(xi=0.45)
+    traj = simulate(p, duration=20.0, transient=10.0, seed=1, series=False, tangent=True)
+    x = traj.section[["theta_f", "omega_f"]].to_numpy()[-1]
+    assert not periodic_orbit(p, x, 6).stable  # the grid alone would not certify it
+    v = classify_trajectory(traj, extend_to=None)
+    assert (v.label, v.period) == ("periodic", 6)
+    orbit = next(e for e in v.evidence if e.name == "periodic_orbit")
+    assert orbit.vote == "periodic" and "certified at every refined step" in orbit.detail
+    refined = v.settings["periodic_orbit_refined"]
+    assert [r["dt"] for r in refined] == [p.dt / 2, p.dt / 4]
+    assert all(max(r["multipliers_abs"]) < 1 for r in refined)
+    ens = simulate_ensemble(p, [0], seed=1, duration=20.0, transient=10.0, tangent=True)
+    member = classify_ensemble(ens, p, extend_to=None).members.iloc[0]
+    assert (member["label"], member["period"]) == ("periodic", 6)

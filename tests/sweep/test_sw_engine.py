@@ -141,12 +141,12 @@ def test_a_capped_extension_is_recorded_and_honoured():
     from chaoscam.sweep._tasks import DefaultClassifier
 
     m = regime_map(
-        Axis("xi", (0.45,)),
-        Axis("l_lambda_sigma", (0.0,)),
+        Axis("xi", (0.3,)),
+        Axis("omega", (26.0,)),
         duration=20.0,
         transient=10.0,
         classify=DefaultClassifier(extend_to=None),
-    )
+    )  # 7 bands round an unstable orbit: undetermined on 10 s, chaotic on 40 s
     assert m.config["engine"] == "ensemble" and "extend_to=None" in m.config["classifier"]
     row = m.realizations.iloc[0]
     assert row["label"] == "undetermined" and "run longer" in row["reasons"]
