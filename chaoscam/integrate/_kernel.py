@@ -453,14 +453,25 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     # The gap changes sign inside the segment: go to the crossing, so that no
                     # RK4 step straddles the kink of the force at delta = 0, then resume.
                     # A closing ends a free flight: its substep is the free pendulum's (no
-                    # Hertz force from a last stage that overshoots into the cam).
-                    tau = locate_crossing(t, th, om, tau_lo, g_lo, tau_hi, g_hi, K, c, closing)
-                    if closing:
+                    # Hertz force from a last stage that overshoots into the cam by up to
+                    # v event_tol), provided the free pendulum crosses in the bracket too (a
+                    # step far too coarse for the contact may close where free flight does
+                    # not). A micro-flight from the surface keeps the full equations: its
+                    # bracket starts at a top found on them, and its overshoot is < 1e-15 m.
+                    free = False
+                    if closing and not on_surface:
+                        th_f, _ = rk4_flight(th, om, tau_hi, c)
+                        g_f, _, _ = geometry(t + tau_hi, th_f, c)
+                        free = g_f <= 0.0
+                        if free:
+                            g_hi = g_f
+                    tau = locate_crossing(t, th, om, tau_lo, g_lo, tau_hi, g_hi, K, c, free)
+                    if free:
                         th, om, _, _, _, _, _ = step_flight(th, om, tau, c, y, True)
                     else:
                         # The substep ends on the surface: its Jacobian is the side it comes
-                        # from (flight just after a jump, else contact).
-                        side = JAC_FLIGHT if jumped else JAC_CONTACT
+                        # from (flight before a closing and just after a jump, else contact).
+                        side = JAC_FLIGHT if closing or jumped else JAC_CONTACT
                         th, om, _, _, _, _, _ = step_rk4(t, th, om, tau, K, c, y, True, side)
                     jumped = False
                     settled = False

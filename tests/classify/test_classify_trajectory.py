@@ -168,9 +168,11 @@ def test_undetermined_short_run_is_extended_until_it_settles():
 # periodic, with an exponent still undecided; a 4x longer run shows lambda_1 > 0.
 UNSETTLED_BANDS = {
     "period 6 whose orbit is unstable (xi = 0.45)": (dict(xi=0.45), 0, "orbit found is unstable"),
+    # index 2: with the exact clock (issue 10) realization 1's short run already has a
+    # positive exponent beyond its interval (chaotic); 2, 3, 4 are undecided, as 1 was
     "random line length, 8 bands": (
         dict(l_lambda=0.008, l_lambda_sigma=0.0015),
-        1,
+        2,
         "the line length is random",
     ),
 }
