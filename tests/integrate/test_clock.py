@@ -97,7 +97,7 @@ def _run_on_clock(p: Params, th: float, om: float, t_cam: float, n0: int, n_len:
 def test_chattering_ends_do_not_depend_on_the_clock(integrator):
     """The same 3 s of the chaotic default, run with the clock near 20 s and near 280 s
     (the cam angle matched): no closing without an approach speed on either, and the
-    chattering ends agree within 3 % (measured: 561 and 565 on RK4, 572 and 568 adaptive;
+    chattering ends agree within 3 % (measured: 565 and 562 on RK4, 572 and 568 adaptive;
     the old clock gave 1 and 33 closings without a jump, 569 and 434 ends on RK4, and 562
     and 470 ends on the adaptive path)."""
     p = Params(dt=1e-6, integrator=integrator)
