@@ -38,6 +38,10 @@ picks one by ``Params.integrator``. What differs is how time is cut:
   interpolant's error does not enter the trajectory), the impact law (4)–(5) is applied
   exactly as in the reference kernel (jump only if the approach speed exceeds ``v_min``),
   and the next step starts there.
+- **Clock**: every step's and event's length is rounded so that its end time is a double
+  (:func:`._physics.on_clock`), and the cam angle at a step's start is reduced exactly
+  (:func:`._physics.cam_angle`), as in the fixed-step kernel: the end of a chattering
+  sequence is then decided by the dynamics, not by the rounding of ``omega t``.
 - **Scheduled times** (sections ``k T``, line-length resampling ``j dt_l``, the run's end)
   end a step exactly, so section points are integrator states, not interpolations. Series
   samples come from the interpolant, so asking for a series never changes the trajectory.
@@ -308,6 +312,8 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         clipped = t + hs >= t_next
         if clipped:
             hs = t_next - t
+        else:
+            hs = k.on_clock(t, hs)  # the step ends exactly at the time t1 it is stamped with
 
         th1, om1, err = dop853_step(th, om, a1, hs, tr, K, c, flight)
         fac = SAFETY * max(err, 1e-300) ** EXPONENT
@@ -418,8 +424,9 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             # the length grows by 2, 4, 8, ... event tolerances until it is.
             reach = c[C_EVENT_TOL] / hs
             for _ in range(60):
-                r2 = dop853_step(th, om, a1, s_end * hs, tr, K, c, flight)
-                tr2 = trig_at(t + s_end * hs, r2[0], c)
+                h_event = k.on_clock(t, s_end * hs)
+                r2 = dop853_step(th, om, a1, h_event, tr, K, c, flight)
+                tr2 = trig_at(t + h_event, r2[0], c)
                 g2, _, _ = k.geometry_trig(tr2[1], tr2[2], tr2[3], tr2[4], c)
                 if (g2 <= 0.0) if closing else (g2 >= 0.0):
                     break
@@ -429,12 +436,10 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             side = JAC_FLIGHT if closing else JAC_CONTACT
             if not on_surface:
                 side_first = side
-            advance_tangent(
-                y, c, t, s_end * hs, th, om, co, s_end, r2[0], r2[1], K, side_first, side
-            )
+            advance_tangent(y, c, t, h_event, th, om, co, s_end, r2[0], r2[1], K, side_first, side)
             th = r2[0]
             om = r2[1]
-            t = t + s_end * hs
+            t = t + h_event
             events += 1
             tr = tr2
             g, l1, cdn = k.geometry_trig(tr[1], tr[2], tr[3], tr[4], c)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from numba import njit
 
 from ._layout import C_EVENT_TOL
-from ._physics import geometry, rk4
+from ._physics import geometry, on_clock, rk4, rk4_flight
 
 
 @njit(cache=True, inline="always")
@@ -45,14 +45,22 @@ def illinois_update(a, fa, b, fb, m, fm, side):
 
 
 @njit(cache=True)
-def locate_crossing(t, th, om, a, g_start, h, g_end, K, c):
+def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight=False):
     """The substep length tau in (a, h] at which the gap delta changes sign.
+
+    With ``flight`` (a closing: the motion is free flight up to the crossing) the substeps
+    are the free pendulum's (:func:`._physics.rk4_flight`): a full RK4 substep that ends
+    past the crossing would put its last stage inside the cam, where the Hertz force
+    (K ~ 1e9 N/m) of an overshoot of ``v event_tol`` (2e-12 m at 2 m/s) changes theta' by
+    ~1e-8 rad/s, and by a different amount for every place the bracket happens to end.
 
     Illinois regula falsi on ``tau -> delta(RK4 substep of length tau)`` over the bracket
     [a, h] (a = 0 but for a micro-flight that starts on the surface, whose bracket starts at
     its top), with a bisection whenever an iteration fails to halve the bracket, until the
-    bracket is narrower than the event tolerance. Returns the bracket's right end, past the
-    crossing: delta <= 0 there for a closing, delta >= 0 for an opening.
+    bracket is narrower than the event tolerance. Every trial length is rounded so that
+    ``t + tau`` is a double (:func:`._physics.on_clock`), ``a`` and ``h`` being such lengths
+    already. Returns the bracket's right end, past the crossing: delta <= 0 there for a
+    closing, delta >= 0 for an opening.
     """
     s = 1.0 if g_start > 0.0 else -1.0  # work on s * delta, positive at the start
     fa, b, fb = s * g_start, h, s * g_end
@@ -61,13 +69,13 @@ def locate_crossing(t, th, om, a, g_start, h, g_end, K, c):
         width = b - a
         if width <= c[C_EVENT_TOL]:
             break
-        m = illinois_point(a, fa, b, fb)
-        thm, _ = rk4(t, th, om, m, K, c)
+        m = on_clock(t, illinois_point(a, fa, b, fb))
+        thm = rk4_flight(th, om, m, c)[0] if flight else rk4(t, th, om, m, K, c)[0]
         fm, _, _ = geometry(t + m, thm, c)
         a, fa, b, fb, side = illinois_update(a, fa, b, fb, m, fm * s, side)
         if b - a > 0.5 * width:
-            m = 0.5 * (a + b)
-            thm, _ = rk4(t, th, om, m, K, c)
+            m = on_clock(t, 0.5 * (a + b))
+            thm = rk4_flight(th, om, m, c)[0] if flight else rk4(t, th, om, m, K, c)[0]
             fm, _, _ = geometry(t + m, thm, c)
             a, fa, b, fb, _ = illinois_update(a, fa, b, fb, m, fm * s, 0)
     return b
@@ -87,7 +95,8 @@ def graze_point(t, th, om, h, rate0, rate1, K, c):
     Only called where the gap rate changes sign between the segment's ends while the gap
     does not: the extremum of the gap in between shows whether it crossed zero and came
     back (a micro-flight, or a graze, shorter than the step). The rate is that of the
-    substep's state, on the side of the surface the segment starts on.
+    substep's state, on the side of the surface the segment starts on. Trial lengths and the
+    result are rounded so that ``t + tau`` is a double (:func:`._physics.on_clock`).
     """
     s = 1.0 if rate0 > 0.0 else -1.0  # work on s * rate, positive at 0, negative at h
     a, fa, b, fb = 0.0, s * rate0, h, s * rate1
@@ -96,8 +105,8 @@ def graze_point(t, th, om, h, rate0, rate1, K, c):
         width = b - a
         if width <= 1e-6 * h:
             break
-        m = illinois_point(a, fa, b, fb)
+        m = on_clock(t, illinois_point(a, fa, b, fb))
         thm, omm = rk4(t, th, om, m, K, c)
         _, l1, cdn = geometry(t + m, thm, c)
         a, fa, b, fb, side = illinois_update(a, fa, b, fb, m, s * (l1 * omm - cdn), side)
-    return 0.5 * (a + b)
+    return on_clock(t, 0.5 * (a + b))

@@ -19,6 +19,11 @@ bracket end where ``delta <= 0``. There the restitution law applies (:func:`impa
 within one segment (a micro-flight or a graze shorter than a step) are found where the gap
 rate turns inside it (:func:`._events.graze_point`).
 
+The gap is resolved to ~1e-16 m at any time (the last bounces of a chattering sequence rise
+~3e-14 m): the cam angle is reduced exactly (:func:`._physics.cam_angle`) and every substep's
+length is rounded so that its end is the double the kernel stamps it with
+(:func:`._physics.on_clock`), so the state and the clock never part by a rounding of ``t``.
+
 With ``c[C_TANGENT]`` set, the tangent matrix is integrated with the state
 (:mod:`._tangent`) and multiplied by the saltation matrix at each jump; at each section time
 the Jacobian of the stroboscopic map over the last period is written beside the section point
@@ -93,10 +98,12 @@ from ._physics import (  # noqa: F401 (re-exported: the adaptive kernel and test
     acceleration,
     acceleration_jacobian,
     acceleration_trig,
+    cam_angle,
     closing_bound,
     gap_accel_bound,
     geometry,
     geometry_trig,
+    on_clock,
     rk4,
     rk4_flight,
     safe_horizon,
@@ -345,7 +352,8 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
         if m >= 2:
             th0 = th
             om0 = om
-            th, om, _, _, _, _, _ = step_flight(th0, om0, m * h, c, y, True)
+            # the block's length as the difference of its stamped ends (see on_clock)
+            th, om, _, _, _, _, _ = step_flight(th0, om0, (n + m) * h - t, c, y, True)
             stale = True
             cnt[I_STEP] = n + m
             if not (math.isfinite(th) and math.isfinite(om)):
@@ -444,11 +452,27 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 elif crossing:
                     # The gap changes sign inside the segment: go to the crossing, so that no
                     # RK4 step straddles the kink of the force at delta = 0, then resume.
-                    tau = locate_crossing(t, th, om, tau_lo, g_lo, tau_hi, g_hi, K, c)
-                    # The substep ends on the surface: its Jacobian is the side it comes
-                    # from (flight before a closing and just after a jump, else contact).
-                    side = JAC_FLIGHT if closing or jumped else JAC_CONTACT
-                    th, om, _, _, _, _, _ = step_rk4(t, th, om, tau, K, c, y, True, side)
+                    # A closing ends a free flight: its substep is the free pendulum's (no
+                    # Hertz force from a last stage that overshoots into the cam by up to
+                    # v event_tol), provided the free pendulum crosses in the bracket too (a
+                    # step far too coarse for the contact may close where free flight does
+                    # not). A micro-flight from the surface keeps the full equations: its
+                    # bracket starts at a top found on them, and its overshoot is < 1e-15 m.
+                    free = False
+                    if closing and not on_surface:
+                        th_f, _ = rk4_flight(th, om, tau_hi, c)
+                        g_f, _, _ = geometry(t + tau_hi, th_f, c)
+                        free = g_f <= 0.0
+                        if free:
+                            g_hi = g_f
+                    tau = locate_crossing(t, th, om, tau_lo, g_lo, tau_hi, g_hi, K, c, free)
+                    if free:
+                        th, om, _, _, _, _, _ = step_flight(th, om, tau, c, y, True)
+                    else:
+                        # The substep ends on the surface: its Jacobian is the side it comes
+                        # from (flight before a closing and just after a jump, else contact).
+                        side = JAC_FLIGHT if closing or jumped else JAC_CONTACT
+                        th, om, _, _, _, _, _ = step_rk4(t, th, om, tau, K, c, y, True, side)
                     jumped = False
                     settled = False
                     t = t + tau

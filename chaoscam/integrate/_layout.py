@@ -117,6 +117,15 @@ SERIES_COLS = 4  # t, theta_f, omega_f, l_lambda
 SECTION_COLS = len(SECTION_NAMES) + len(SECTION_TANGENT_NAMES)
 IMPACT_COLS = len(IMPACT_NAMES)
 
+# --- the cam angle, reduced exactly (_physics.cam_angle) ---------------------------------
+# Cody & Waite's split of 2 pi into three doubles, the first two with 27 significant bits, so
+# that k * TWO_PI_1 and k * TWO_PI_2 are exact for |k| < 2^26 (omega t + theta_c0 < 4e8 rad).
+TWO_PI_1 = 6.283185303211212
+TWO_PI_2 = 3.968374295837407e-09
+TWO_PI_3 = 2.2884754904439327e-17
+INV_TWO_PI = 0.15915494309189535
+DEKKER_SPLIT = 134217729.0  # 2^27 + 1: splits a double into two halves of 26 bits (Dekker)
+
 # --- the adaptive path's tangent -----------------------------------------------------------
 # Largest h |A| of an RK4 substep of the tangent along an accepted DOP853 step, |A| the
 # largest of sqrt|d theta''/d theta| and |d theta''/d theta'| at the step's start, middle and

@@ -14,7 +14,7 @@ import math
 from numba import njit
 
 from . import _kernel as k
-from ._kernel import C_GRAV, C_INV_J, C_OMEGA, C_THETA_C0
+from ._kernel import C_GRAV, C_INV_J, C_OMEGA
 
 ROTATE_MAX = 0.01  # [rad] rotations by less than this use Taylor polynomials (see rotate)
 
@@ -47,7 +47,7 @@ def rotate(a, ca, sa, b):
 @njit(cache=True, error_model="numpy")
 def trig_at(t, th, c):
     """(cam angle, its cos, its sin, cos th, sin th) at (t, th): a step's trigonometric base."""
-    thc = c[C_OMEGA] * t + c[C_THETA_C0]
+    thc = k.cam_angle(t, c)
     return (thc, math.cos(thc), math.sin(thc), math.cos(th), math.sin(th))
 
 

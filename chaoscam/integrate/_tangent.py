@@ -21,8 +21,8 @@ import math
 import numpy as np
 from numba import njit
 
-from ._layout import C_E, C_GRAV, C_INV_J, C_OMEGA, C_THETA_C0, C_XO, C_YO, SECTION_NAMES
-from ._physics import acceleration_jacobian
+from ._layout import C_E, C_GRAV, C_INV_J, C_OMEGA, C_XO, C_YO, SECTION_NAMES
+from ._physics import acceleration_jacobian, cam_angle
 
 
 @njit(cache=True, inline="always")
@@ -134,7 +134,7 @@ def saltation(t, th, om_before, om_after, l1, cdn, xi, c):
     Returns ``(s11, s21, s22)``; ``s12`` is 0.
     """
     w = c[C_OMEGA]
-    thc = w * t + c[C_THETA_C0]
+    thc = cam_angle(t, c)
     cc, sc = math.cos(thc), math.sin(thc)
     ct, st = math.cos(th), math.sin(th)
     ew = c[C_E] * w

@@ -2,6 +2,7 @@
 
 from ._forces import angular_acceleration, friction_torque, normal_force, stiffness_array
 from ._geometry import (
+    cam_angle,
     cam_centre,
     contact_angle,
     contact_angle_rate,
@@ -22,6 +23,7 @@ __all__ = [
     "ParameterError",
     "Params",
     "angular_acceleration",
+    "cam_angle",
     "cam_centre",
     "composite_modulus",
     "contact_angle",

@@ -167,14 +167,16 @@ def test_undetermined_short_run_is_extended_until_it_settles():
 # Measured on 20 s runs (10 s transient): 46 section points in n narrow bands that look
 # periodic, with an exponent still undecided; a 4x longer run shows lambda_1 > 0.
 UNSETTLED_BANDS = {
-    "period 7 with no attracting orbit (omega = 26, xi = 0.3)": (
+    "period 7 whose orbit is unstable (omega = 26, xi = 0.3)": (
         dict(omega=26.0, xi=0.3),
         0,
-        "no attracting orbit is certified",
+        "orbit found is unstable",
     ),
+    # index 2: with the exact clock (issue 10) realization 1's short run already has a
+    # positive exponent beyond its interval (chaotic); 2, 3, 4 are undecided, as 1 was
     "random line length, 8 bands": (
         dict(l_lambda=0.008, l_lambda_sigma=0.0015),
-        1,
+        2,
         "the line length is random",
     ),
 }

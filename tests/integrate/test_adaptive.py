@@ -46,21 +46,26 @@ def test_periodic_sections_agree_with_converged_rk4(changes):
     assert np.max(np.abs(a.omega_f.values - b.omega_f.values)) < 1e-4
 
 
-def test_error_shrinks_with_the_tolerance():
-    """The 0.2 s series moves towards converged RK4 as rtol tightens (>= 5x per decade on
-    average over two decades, and never growing).
+@pytest.mark.parametrize("rtol", [1e-9, 1e-10, 1e-11])
+def test_adaptive_agrees_with_converged_rk4_through_a_chattering_phase(rtol):
+    """The default model's first 0.2 s (contact, ~800 micro-impacts and chattering ends):
+    the adaptive path stays within 1e-8 rad of RK4 at dt = 2.5e-7 s at every tolerance.
 
-    Measured (contact point B_c = C + R n): 5.7e-8, 2.0e-8, 6.7e-10 rad at rtol 1e-9, 1e-10,
-    1e-11 (it was 5.6e-7, 7.2e-8, 1.8e-9 with the old B_c = C - R n). Below that the error
-    stays at a few 1e-10 rad, the level at which RK4 itself (dt 1.25e-7) differs from
-    dt 2.5e-7 after the micro-bounces of this phase.
+    Measured: 1.6e-9, 2.8e-10, 6.7e-11 rad at rtol 1e-9, 1e-10, 1e-11. This used to assert
+    that the error shrinks monotonically with rtol; with the exact clock (issue 10) it no
+    longer does, and it was never a property of the integrator: a 1e-15 rad change of the
+    cam phase moves these errors by up to 30x (1.6e-9, 1.7e-10, 1.4e-9 rad), on the old
+    kernel as on the new, because each chattering sequence ends on a discontinuous count of
+    bounces. Accuracy where the map is smooth is tested below (Jacobians, multipliers,
+    impacts per period).
     """
-    ref = simulate(RK4.replace(dt=2.5e-7), duration=0.2, output_dt=1e-3).series.theta_f.values
-    errs = []
-    for rtol in (1e-9, 1e-10, 1e-11):
-        got = simulate(ADAPTIVE.replace(rtol=rtol, atol=rtol / 100), duration=0.2, output_dt=1e-3)
-        errs.append(np.max(np.abs(got.series.theta_f.values - ref)))
-    assert errs[0] > errs[1] > errs[2] and errs[0] > 25 * errs[2]
+    p = Params()
+    ref = simulate(p.replace(dt=2.5e-7), duration=0.2, output_dt=1e-3)
+    got = simulate(
+        p.replace(integrator="adaptive", rtol=rtol, atol=rtol / 100), duration=0.2, output_dt=1e-3
+    )
+    assert len(ref.impacts) > 500
+    assert np.max(np.abs(got.series.theta_f.values - ref.series.theta_f.values)) < 1e-8
 
 
 def test_impact_law_holds_at_every_adaptive_impact():

@@ -253,12 +253,16 @@ def test_adaptive_stroboscopic_jacobian_on_the_sticking_orbit():
 @pytest.mark.slow
 def test_default_exponent_converges_under_step_halving():
     """The default (chaotic, 8 narrow bands) lambda_1 converges with dt once every micro-flight
-    is located: measured over 300 s (two initial conditions) 5.99, 3.77, 2.62, 2.35 +- 0.1-0.17
-    1/s at dt = 4e-6 ... 5e-7 s (differences 2.2, 1.15, 0.27). dt = 1e-6 and 5e-7 agree within
-    three combined standard errors; dt = 2e-6 (the default step) does not, and still says
-    positive."""
-    a = lyapunov_spectrum(Params(dt=1e-6), duration=360.0, transient=60.0)
-    b = lyapunov_spectrum(Params(dt=5e-7), duration=360.0, transient=60.0)
-    assert a.exponents[0] > 0 and b.exponents[0] > 0
-    gap = abs(a.exponents[0] - b.exponents[0])
-    assert gap <= 3.0 * math.hypot(a.stderr[0], b.stderr[0])
+    is located and the clock is exact (cam angle reduced exactly, substeps ending on
+    representable times): measured over 300 s (two initial conditions) 2.54, 1.74, 1.51, 1.47,
+    1.32 +- 0.05 1/s at dt = 2e-6 ... 1.25e-7 s, the adaptive path 1.39-1.48 whatever its dt.
+    dt = 5e-7 and 2.5e-7 agree within three combined standard errors, and so do dt = 2.5e-7
+    and the adaptive path (with the naive clock RK4 gave 2.45, 2.26, 2.06 at 5e-7 ... 1.25e-7
+    and the adaptive path 1.48)."""
+    a = lyapunov_spectrum(Params(dt=5e-7), duration=360.0, transient=60.0)
+    b = lyapunov_spectrum(Params(dt=2.5e-7), duration=360.0, transient=60.0)
+    c = lyapunov_spectrum(Params(integrator="adaptive"), duration=360.0, transient=60.0)
+    assert a.exponents[0] > 0 and b.exponents[0] > 0 and c.exponents[0] > 0
+    for x, y in ((a, b), (b, c)):
+        gap = abs(x.exponents[0] - y.exponents[0])
+        assert gap <= 3.0 * math.hypot(x.stderr[0], y.stderr[0])
