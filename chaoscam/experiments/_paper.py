@@ -376,7 +376,7 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
     from ..sweep import Axis, regime_map
 
     res = FigureResult(7)
-    sigmas = tuple(np.round(np.linspace(0.0, SIGMA_MAX, 5 if quick else 9), 6))
+    sigmas = tuple(np.round(np.linspace(0.0, SIGMA_MAX, 3 if quick else 9), 6))
     n = 8 if quick else 40
     rm = regime_map(
         Axis("l_lambda", MU_PAPER),

@@ -166,8 +166,8 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         "stiffness, a plausible source of the difference."
     )
     # 3. (omega, xi) map
-    omegas = (20.0, 50.0, 7) if quick else (10.0, 50.0, 17)
-    xis = (0.1, 0.7, 7) if quick else (0.1, 0.7, 13)
+    omegas = (20.0, 50.0, 6) if quick else (10.0, 50.0, 17)
+    xis = (0.1, 0.7, 6) if quick else (0.1, 0.7, 13)
     rm = regime_map(
         Axis.linspace("omega", *omegas),
         Axis.linspace("xi", *xis),
