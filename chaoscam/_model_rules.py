@@ -97,10 +97,10 @@ def with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, d
     certified = orbit.certified and sits and orbit.period == candidate
     unstable = orbit.converged and not orbit.stable
     if not certified and orbit.converged:  # the grid's multipliers may be at fault
-        better, refined = _refined(p, points, candidate, extent, extra, orbit.points[0])
+        status, better, refined = _refined(p, points, candidate, extent, extra, orbit.points[0])
         detail += "; " + refined
-        unstable = not refined.startswith("mixed")  # (a certified one is taken below)
-        if better is not None:
+        unstable = status in ("unstable", "not converged")
+        if status == "certified":
             orbit, certified = better, True
     if certified:
         e = Evidence("periodic_orbit", orbit.period, "periodic", "certified: " + detail)
@@ -138,16 +138,18 @@ def with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, d
     return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
 
 
-def _refined(p: Params, points, n: int, extent: float, extra: dict, seed=None):
+def _refined(p: Params, points, n: int, extent: float, extra: dict, seed):
     """Shoot for the period-n orbit again at the steps ``dt / ORBIT_REFINE`` in turn, each
-    from the previous orbit (``seed``: the grid's orbit point when it converged, else the
-    run's last section point), with at most ``REFINE_ITER`` Newton iterations, stopping at the
-    first step that does not certify it. Returns (the orbit at the finest step or None, a
-    summary that starts with "certified" when every refined orbit is attracting and the run
-    lies on it, "mixed" when only the first ones are, "unstable" when the first is converged
-    and unstable, else "not converged")."""
+    from the previous orbit (the first from ``seed``, the grid's orbit point), with at most
+    ``REFINE_ITER`` Newton iterations, stopping at the first step that does not certify it.
+
+    Returns (status, the orbit at the finest step when certified else None, a summary of the
+    multipliers). status: "certified" when every refined orbit is attracting and the run lies
+    on it, "mixed" when only the first ones are, "unstable" when the first converged unstable,
+    else "not converged".
+    """
     tail = points[-min(len(points), 4 * n) :]
-    x = points[-1] if seed is None else seed
+    x = seed
     orbits, records, good = [], [], []
     for f in ORBIT_REFINE:
         o = periodic_orbit(p.replace(dt=p.dt / f), x, n, max_iter=REFINE_ITER)
@@ -159,18 +161,18 @@ def _refined(p: Params, points, n: int, extent: float, extra: dict, seed=None):
             break
         x = o.points[0]
     extra["periodic_orbit_refined"] = records
-    mus = ", ".join(
+    mus = "|mu|max " + ", ".join(
         f"{float(np.max(np.abs(o.multipliers))):.3g} at dt/{f}"
         + ("" if o.converged else " (not converged)")
         for o, f in zip(orbits, ORBIT_REFINE, strict=False)
     )
-    if len(good) == len(ORBIT_REFINE) and all(good):
-        return orbits[-1], f"certified at every refined step: |mu|max {mus}"
+    if len(good) == len(ORBIT_REFINE):  # none failed: every refined step certifies it
+        return "certified", orbits[-1], f"certified at every refined step: {mus}"
     if any(good):
-        return None, f"mixed on refined steps: |mu|max {mus}"
+        return "mixed", None, f"mixed on refined steps: {mus}"
     if orbits[0].converged:
-        return None, f"unstable on refined steps, none attracting: |mu|max {mus}"
-    return None, f"not converged on refined steps: |mu|max {mus}"
+        return "unstable", None, f"unstable on refined steps, none attracting: {mus}"
+    return "not converged", None, f"not converged on refined steps: {mus}"
 
 
 def _orbit_record(orbit, **more) -> dict:
@@ -231,10 +233,10 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
                 ),
             ), extra
         extent = float(np.ptp(points[:, 0])) or 1.0
-        better, refined = None, ""
+        status, refined = None, ""
         if orbit.converged:  # an unstable orbit: the grid's multipliers may be at fault
-            better, refined = _refined(p, points, n, extent, extra, orbit.points[0])
-        if refined.startswith("certified"):
+            status, _, refined = _refined(p, points, n, extent, extra, orbit.points[0])
+        if status == "certified":
             e = Evidence("periodic_orbit", n, "periodic", f"{detail}; {refined}")
             note = (
                 f"the tangent exponent on the run's grid is positive, but the period-{n} orbit "
@@ -242,7 +244,7 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
                 "grid's error in the chattering phases"
             )
             return Verdict("periodic", n, v.evidence + (e,), (note,), v.settings), extra
-        if refined.startswith("mixed"):
+        if status == "mixed":
             e = Evidence("periodic_orbit", n, None, f"{detail}; {refined}")
             reason = (
                 f"the period-{n} orbit in the bands changes stability with the step ({refined}):"
