@@ -1,7 +1,5 @@
 """``python -m chaoscam.cli``: the ``chaoscam`` command."""
 
-import sys
+from chaoscam.cli import entry
 
-from chaoscam.cli import main
-
-sys.exit(main())
+entry()

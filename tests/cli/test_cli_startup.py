@@ -19,10 +19,42 @@ CODE = (
 )
 
 
-def test_console_script_runs_cli_main():
-    """The installed `chaoscam` command is chaoscam.cli:main (the function tested here)."""
+def _python(*args: str, check: bool = False) -> subprocess.CompletedProcess:
+    """A fresh interpreter on ``args`` in the project root, its output captured as text."""
+    return subprocess.run(
+        [sys.executable, *args], capture_output=True, text=True, cwd=ROOT, check=check
+    )
+
+
+def test_console_script_runs_cli_entry():
+    """The installed `chaoscam` command is chaoscam.cli:entry, main (the function tested here)
+    and an exit with its code."""
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
-    assert project["scripts"]["chaoscam"] == "chaoscam.cli:main"
+    assert project["scripts"]["chaoscam"] == "chaoscam.cli:entry"
+
+
+def test_entry_exits_with_main_code_after_freezing_the_heap():
+    """entry() exits with main()'s code, the objects frozen out of the exit's collections."""
+    code = (
+        "import gc, chaoscam.cli as c\n"
+        "c.main = lambda: 3\n"
+        "try:\n    c.entry()\n"
+        "except SystemExit as e:\n    print(e.code, gc.get_freeze_count() > 0)\n"
+    )
+    assert _python("-c", code, check=True).stdout.split() == ["3", "True"]
+
+
+@pytest.mark.parametrize("module", ["chaoscam", "chaoscam.cli"])
+def test_python_m_runs_a_command_to_its_end(module, tmp_path):
+    """`python -m chaoscam[.cli] simulate` prints its whole summary, writes its file and
+    exits 0 through entry(); bad input still exits 2 with one line."""
+    out = tmp_path / "impacts.csv"
+    run = _python("-m", module, "simulate", "--duration", "0.2", "--impacts", str(out))
+    assert run.returncode == 0, run.stderr
+    assert "contact fraction" in run.stdout and f"impacts: {out}" in run.stdout
+    assert out.read_text().startswith("t,")
+    bad = _python("-m", module, "simulate", "--duration", "-1")
+    assert bad.returncode == 2 and bad.stderr.startswith("chaoscam: error: duration")
 
 
 def test_cli_module_loads_nothing_heavy():
@@ -33,10 +65,7 @@ def test_cli_module_loads_nothing_heavy():
         "print(sorted({m.split('.')[0] for m in sys.modules} & "
         "{'argparse', 'numpy', 'pandas', 'numba', 'scipy', 'chaoscam.model'}))"
     )
-    out = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True
-    ).stdout
-    assert out.strip() == "[]"
+    assert _python("-c", code, check=True).stdout.strip() == "[]"
 
 
 @pytest.mark.parametrize("delay", [0.05, 0.1, 0.2, 0.4])
