@@ -16,15 +16,16 @@ batch it ran in, the thread count or an interruption.
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from .._simulate import resolution_warning
 from ..model import Params, truncated_mass
 from ._tasks import RunSummary, verdict_fields
 
-__all__ = ["ENGINE_CLASSIFIER", "BatchTask", "batch_size", "run_batch"]
+__all__ = ["ENGINE_CLASSIFIER", "BatchTask", "batch_size", "run_batch", "run_sweep"]
 
 ENGINE_CLASSIFIER = "chaoscam.classify_ensemble(section + tangent exponent)"
 """The classifier identity a sweep records when it runs on the ensemble engine."""
@@ -274,3 +275,47 @@ def run_plan(plan, eng: Engine, store, *, workers, scheduler, progress: bool, de
             )
     finally:
         backend.close()
+
+
+def run_sweep(
+    plan,
+    eng: Engine,
+    *,
+    out: Path | None,
+    second: str,
+    config: dict[str, Any],
+    keys: tuple[str, str],
+    read: Callable[[Path], Any],
+    build: Callable[[list[dict[str, Any]]], Any],
+    resume: bool,
+    force: bool,
+    flush_interval: float,
+    workers,
+    scheduler,
+    progress: bool,
+    desc: str,
+):
+    """The steps every sweep takes around its plan, in one place.
+
+    Lock the output ``out`` (FILE.parquet, with FILE.<second>.parquet beside it; None: kept
+    in memory), open its checkpoint (a finished output of the same ``config`` is reused
+    through ``read`` under ``resume``), run the plan (:func:`run_plan`), sort the records by
+    ``keys`` (one per key), warn once per message the runs raised, ``build`` the result
+    from the records, write it to ``out`` and remove the checkpoint.
+    """
+    from ._common import lock_outputs, open_store, reemit_warnings, unique_sorted
+
+    with lock_outputs(out):
+        store, reuse = open_store(out, second, config, resume, flush_interval, force)
+        if reuse:
+            return read(out)
+        run_plan(
+            plan, eng, store, workers=workers, scheduler=scheduler, progress=progress, desc=desc
+        )
+        records = unique_sorted(store.records(), keys)
+        reemit_warnings(records)
+        result = build(records)
+        if out is not None:
+            result.to_parquet(out)
+            store.remove()
+        return result

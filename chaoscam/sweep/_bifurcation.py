@@ -21,18 +21,14 @@ import pandas as pd
 from .._checks import whole
 from .._version import __version__
 from ..model import Params, contact_angle
-from ._batch import run_plan, sweep_engine
-from ._checkpoint import read_sweep_metadata, write_parquet
+from ._batch import run_sweep, sweep_engine
 from ._common import (
     check_sweep_budget,
-    companion,
     evidence_columns,
-    lock_outputs,
-    open_store,
     period_column,
-    reemit_warnings,
+    read_tables,
     run_settings,
-    unique_sorted,
+    write_tables,
 )
 from ._grid import Axis, SweepError, realization_index, validate_grid
 from ._tasks import BranchTask
@@ -77,20 +73,12 @@ class Bifurcation:
 
     def to_parquet(self, path: str | Path) -> None:
         """Points to ``FILE.parquet``, verdicts to ``FILE.verdicts.parquet``."""
-        path = Path(path)
-        write_parquet(self.points, path, self.config)
-        write_parquet(self.verdicts, companion(path, "verdicts"), self.config)
+        write_tables(path, self.points, "verdicts", self.verdicts, self.config)
 
 
 def read_bifurcation(path: str | Path) -> Bifurcation:
     """Read a diagram written by :func:`bifurcation`."""
-    path = Path(path)
-    meta = read_sweep_metadata(path) or {}
-    return Bifurcation(
-        pd.read_parquet(path),
-        pd.read_parquet(companion(path, "verdicts")),
-        meta.get("config", {}),
-    )
+    return Bifurcation(*read_tables(path, "verdicts"))
 
 
 def initial_offsets(n: int) -> list[tuple[float, float]]:
@@ -317,51 +305,46 @@ def bifurcation(
         "engine": eng.name,
         "index_scheme": "cantor(value_index, ic)",
     }
-    out = None if out is None else Path(out)
-    with lock_outputs(out):
-        store, reuse = open_store(out, "verdicts", config, resume, flush_interval, force)
-        if reuse:
-            return read_bifurcation(out)
 
-        def make_task(v: int, j: int, state) -> BranchTask:
-            value = axis.values[v]
-            p = base.replace(**{axis.name: value})
-            kind, a, b = specs[j]
-            if state is not None:
-                th, om = state
-            elif kind == "offset":
-                th, om = float(contact_angle(p, 0.0)) + a, b
-            else:
-                th, om = a, b
-            p = p.replace(theta_f0=th, omega_f0=om)
-            return BranchTask(
-                v,
-                j,
-                value,
-                int(seed),
-                realization_index(v, j),
-                p,
-                duration,
-                transient,
-                classify,
-                continued=state is not None,
-                series=series,
-            )
-
-        plan = _BranchPlan(make_task, len(axis), len(specs), bool(continuation))
-        run_plan(
-            plan,
-            eng,
-            store,
-            workers=workers,
-            scheduler=scheduler,
-            progress=progress,
-            desc=f"bifurcation {axis.name}",
+    def make_task(v: int, j: int, state) -> BranchTask:
+        value = axis.values[v]
+        p = base.replace(**{axis.name: value})
+        kind, a, b = specs[j]
+        if state is not None:
+            th, om = state
+        elif kind == "offset":
+            th, om = float(contact_angle(p, 0.0)) + a, b
+        else:
+            th, om = a, b
+        p = p.replace(theta_f0=th, omega_f0=om)
+        return BranchTask(
+            v,
+            j,
+            value,
+            int(seed),
+            realization_index(v, j),
+            p,
+            duration,
+            transient,
+            classify,
+            continued=state is not None,
+            series=series,
         )
-        records = unique_sorted(store.records(), ("value_index", "ic"))
-        reemit_warnings(records)
-        result = Bifurcation(*_tables(records, axis), config)
-        if out is not None:
-            result.to_parquet(out)
-            store.remove()
-        return result
+
+    return run_sweep(
+        _BranchPlan(make_task, len(axis), len(specs), bool(continuation)),
+        eng,
+        out=None if out is None else Path(out),
+        second="verdicts",
+        config=config,
+        keys=("value_index", "ic"),
+        read=read_bifurcation,
+        build=lambda records: Bifurcation(*_tables(records, axis), config),
+        resume=resume,
+        force=force,
+        flush_interval=flush_interval,
+        workers=workers,
+        scheduler=scheduler,
+        progress=progress,
+        desc=f"bifurcation {axis.name}",
+    )

@@ -20,11 +20,21 @@ from ._checkpoint import (
     checkpoint_dir,
     discard_checkpoint,
     guard_outputs,
+    read_sweep_metadata,
+    write_parquet,
 )
 from ._grid import Axis, SweepError
 from ._tasks import DefaultClassifier, classifier_identity
 
-__all__ = ["run_settings", "resolve_classifier", "companion", "open_store", "evidence_columns"]
+__all__ = [
+    "run_settings",
+    "resolve_classifier",
+    "companion",
+    "open_store",
+    "evidence_columns",
+    "read_tables",
+    "write_tables",
+]
 
 
 def run_settings(duration: float, transient: float | None, seed: int) -> tuple[float, float]:
@@ -65,6 +75,24 @@ def companion(out: Path, what: str) -> Path:
     """``FILE.parquet`` -> ``FILE.<what>.parquet``."""
     stem = out.name[: -len(".parquet")] if out.name.endswith(".parquet") else out.name
     return out.with_name(f"{stem}.{what}.parquet")
+
+
+def write_tables(
+    path: str | Path, main: pd.DataFrame, second: str, other: pd.DataFrame, config: dict[str, Any]
+) -> None:
+    """A sweep's two tables: ``main`` to ``FILE.parquet``, ``other`` to
+    ``FILE.<second>.parquet``, each written atomically with the configuration."""
+    path = Path(path)
+    write_parquet(main, path, config)
+    write_parquet(other, companion(path, second), config)
+
+
+def read_tables(path: str | Path, second: str) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
+    """(main table, ``second`` table, configuration) of a sweep written by
+    :func:`write_tables`."""
+    path = Path(path)
+    meta = read_sweep_metadata(path) or {}
+    return pd.read_parquet(path), pd.read_parquet(companion(path, second)), meta.get("config", {})
 
 
 def lock_outputs(out: Path | None):
@@ -196,10 +224,11 @@ def period_column(records: list[dict]) -> pd.Series:
 
 
 def reemit_warnings(records: list[dict]) -> None:
-    """Warn once per distinct message the runs raised (they are also in each row)."""
+    """Warn once per distinct message the runs raised (they are also in each row); called
+    by :func:`._batch.run_sweep`, the warning points at the sweep's caller."""
     counts: Counter = Counter()
     for r in records:
         for msg in filter(None, r["warnings"].split(" | ")):
             counts[msg] += 1
     for msg, n in counts.items():
-        warnings.warn(f"{n} of {len(records)} runs: {msg}", RuntimeWarning, stacklevel=3)
+        warnings.warn(f"{n} of {len(records)} runs: {msg}", RuntimeWarning, stacklevel=4)

@@ -21,19 +21,15 @@ import pandas as pd
 from .._checks import whole
 from .._version import __version__
 from ..model import ParameterError, Params
-from ._batch import run_plan, sweep_engine
-from ._checkpoint import read_sweep_metadata, write_parquet
+from ._batch import run_sweep, sweep_engine
 from ._common import (
     as_axis,
     check_sweep_budget,
-    companion,
     evidence_columns,
-    lock_outputs,
-    open_store,
     period_column,
-    reemit_warnings,
+    read_tables,
     run_settings,
-    unique_sorted,
+    write_tables,
 )
 from ._grid import Axis, SweepError, realization_index, validate_grid
 from ._stats import max_halfwidth, summarize_cells
@@ -79,18 +75,12 @@ class RegimeMap:
 
     def to_parquet(self, path: str | Path) -> None:
         """Realizations to ``FILE.parquet``, cells to ``FILE.cells.parquet``."""
-        path = Path(path)
-        write_parquet(self.realizations, path, self.config)
-        write_parquet(self.cells, companion(path, "cells"), self.config)
+        write_tables(path, self.realizations, "cells", self.cells, self.config)
 
 
 def read_regime_map(path: str | Path) -> RegimeMap:
     """Read a map written by :func:`regime_map` (``FILE.parquet`` and ``FILE.cells.parquet``)."""
-    path = Path(path)
-    meta = read_sweep_metadata(path) or {}
-    return RegimeMap(
-        pd.read_parquet(path), pd.read_parquet(companion(path, "cells")), meta.get("config", {})
-    )
+    return RegimeMap(*read_tables(path, "cells"))
 
 
 class _RegimePlan:
@@ -387,55 +377,54 @@ def regime_map(
         "index_scheme": "cantor(cell, index)",
         "deterministic_cells": "run once (sigma = 0)",
     }
-    out = None if out is None else Path(out)
-    with lock_outputs(out):
-        store, reuse = open_store(out, "cells", config, resume, flush_interval, force)
-        if reuse:
-            return read_regime_map(out)
-        cells = _cells_frame(x, y)
-        xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
-        # A cell with sigma = 0 is deterministic: its realizations would all be the same run,
-        # so it is computed once and reported as such (no interval over identical runs).
-        once = frozenset(
-            c
-            for c in range(len(cells))
-            if base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])}).l_lambda_sigma == 0.0
-        )
-        cells["deterministic"] = [c in once for c in range(len(cells))]
+    cells = _cells_frame(x, y)
+    xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
+    # A cell with sigma = 0 is deterministic: its realizations would all be the same run,
+    # so it is computed once and reported as such (no interval over identical runs).
+    once = frozenset(
+        c
+        for c in range(len(cells))
+        if base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])}).l_lambda_sigma == 0.0
+    )
+    cells["deterministic"] = [c in once for c in range(len(cells))]
 
-        def make_task(c: int, i: int) -> RealizationTask:
-            p = base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])})
-            return RealizationTask(
-                c, i, int(seed), realization_index(c, i), p, duration, transient, classify, series
-            )
+    def make_task(c: int, i: int) -> RealizationTask:
+        p = base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])})
+        return RealizationTask(
+            c, i, int(seed), realization_index(c, i), p, duration, transient, classify, series
+        )
 
-        plan = _RegimePlan(
-            make_task,
-            len(cells),
-            realizations,
-            batch=realizations,
-            cap=adaptive["max_realizations"] if adaptive else realizations,
-            target=adaptive["target_halfwidth"] if adaptive else None,
-            confidence=confidence,
-            once=once,
-        )
-        run_plan(
-            plan,
-            eng,
-            store,
-            workers=workers,
-            scheduler=scheduler,
-            progress=progress,
-            desc="regime map",
-        )
-        records = unique_sorted(store.records(), ("cell", "index"))
-        reemit_warnings(records)
+    def build(records: list[dict[str, Any]]) -> RegimeMap:
         rows = _rows(records, cells, x, y)
-        result = RegimeMap(rows, summarize_cells(rows, cells, confidence=confidence), config)
-        if out is not None:
-            result.to_parquet(out)
-            store.remove()
-        return result
+        return RegimeMap(rows, summarize_cells(rows, cells, confidence=confidence), config)
+
+    plan = _RegimePlan(
+        make_task,
+        len(cells),
+        realizations,
+        batch=realizations,
+        cap=adaptive["max_realizations"] if adaptive else realizations,
+        target=adaptive["target_halfwidth"] if adaptive else None,
+        confidence=confidence,
+        once=once,
+    )
+    return run_sweep(
+        plan,
+        eng,
+        out=None if out is None else Path(out),
+        second="cells",
+        config=config,
+        keys=("cell", "index"),
+        read=read_regime_map,
+        build=build,
+        resume=resume,
+        force=force,
+        flush_interval=flush_interval,
+        workers=workers,
+        scheduler=scheduler,
+        progress=progress,
+        desc="regime map",
+    )
 
 
 def mu_sigma_axes(mu: str, sigma: str) -> tuple[Axis, Axis]:
