@@ -69,6 +69,7 @@ import numpy as np
 from numba import njit
 
 from . import _kernel as k
+from . import _steps as steps
 from ._dop853 import ERROR_ORDER, dop853_step, omega_at, theta_at
 from ._events import ON_SURFACE, illinois_point, illinois_update
 from ._kernel import (
@@ -236,7 +237,7 @@ def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side
             y[k.Y_J22],
             side_first if i == 0 else side,
         )
-        k.commit_tangent(y, r[0], r[1], r[2], r[3], r[4])
+        steps.commit_tangent(y, r[0], r[1], r[2], r[3], r[4])
         thb, omb = the, ome
 
 
@@ -301,7 +302,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             return leave(y, cnt, th, om, t, h, events, window, surf, NEED_BUFFER, c)
 
         # The step ends at the next scheduled time at the latest.
-        t_next, is_section, is_resample = k.next_scheduled(t_stop, cnt, c)
+        t_next, is_section, is_resample = steps.next_scheduled(t_stop, cnt, c)
         hs = min(h, c[C_H_MAX])
         if flight and hs > dt:
             # Near the cam a long step could hold several crossings, of which the search
@@ -449,7 +450,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
                     return leave(y, cnt, th, om, t, h_next, events, window, surf, LEFT_REACH, c)
                 om_before = om
                 plastic = cdn - l1 * om < c[C_V_CHATTER]  # a chattering end, if applied
-                om, K = k.impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
+                om, K = steps.impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
                 if om != om_before:
                     # after a rebound the point still lies on the surface, moving out
                     if plastic:
@@ -482,7 +483,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             if -g > c[C_RCAM]:
                 return leave(y, cnt, th, om, t, h, events, window, surf, PENETRATION, c)
         if clipped:
-            K = k.at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)
+            K = steps.at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)
             if is_resample:
                 a1 = accel_trig(tr, om, K, c, flight)
     return leave(y, cnt, th, om, t, h, events, window, surf, OK, c)

@@ -1,0 +1,172 @@
+"""The per-step pieces both integrators share: the schedule of outputs, the impact law and
+the tangent's bookkeeping.
+
+The fixed-step RK4 kernel (:mod:`._kernel`) and the adaptive one (:mod:`._adaptive`) cut
+time differently, but at a scheduled time (a stroboscopic section ``k T``, a line-length
+draw ``j dt_l``) and at a located closing they do exactly the same, here: record the section
+point with the map's Jacobian, draw the next line length, apply the restitution law (4)–(5)
+with its saltation matrix and record the impact. All are inlined into the kernels.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ._layout import (
+    C_PERIOD,
+    C_RESAMPLE_DT,
+    C_T_RECORD,
+    C_TANGENT,
+    C_V_CHATTER,
+    C_V_MICRO,
+    C_VMIN,
+    C_XI,
+    I_LAM_POS,
+    I_N_IMPACT,
+    I_N_SECTION,
+    I_RESAMPLE_J,
+    I_SECTION_K,
+    I_SLOW_CLOSINGS,
+    IMPACT_CHATTER_END,
+    IMPACT_MACRO,
+    IMPACT_MICRO,
+    SECTION_NAMES,
+    SECTION_TANGENT_NAMES,
+    Y_DIV,
+    Y_J11,
+    Y_J12,
+    Y_J21,
+    Y_J22,
+)
+from ._physics import stiffness
+from ._tangent import saltation
+
+__all__ = ["at_scheduled", "commit_tangent", "impact", "next_scheduled", "reset_tangent"]
+
+
+@njit(cache=True, inline="always")
+def next_scheduled(t_limit, cnt, c):
+    """The first scheduled time up to ``t_limit``: (time, is_section, is_resample).
+
+    Scheduled times are the stroboscopic sections ``k T`` and, with interval resampling,
+    the line-length draws ``j dt_l``; a step or segment must end exactly there.
+    """
+    t_next = t_limit
+    is_section = False
+    is_resample = False
+    t_sec = cnt[I_SECTION_K] * c[C_PERIOD]
+    if t_sec <= t_next:
+        t_next = t_sec
+        is_section = True
+    if c[C_RESAMPLE_DT] > 0.0:
+        t_res = cnt[I_RESAMPLE_J] * c[C_RESAMPLE_DT]
+        if t_res < t_next:
+            t_next = t_res
+            is_section = False
+            is_resample = True
+        elif t_res == t_next:
+            is_resample = True
+    return t_next, is_section, is_resample
+
+
+@njit(cache=True, inline="always")
+def at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c):
+    """Record the section point and/or draw the next line length at a scheduled time t.
+
+    At a section the tangent matrix (the stroboscopic map's Jacobian over the period that
+    ends here) is written beside the point and restarted from the identity. Returns the
+    stiffness in use afterwards.
+    """
+    if is_section:
+        if t >= c[C_T_RECORD]:
+            i = cnt[I_N_SECTION]
+            section[i, 0] = cnt[I_SECTION_K]
+            section[i, 1] = t
+            section[i, 2] = th
+            section[i, 3] = om
+            section[i, 4] = lam[cnt[I_LAM_POS]]
+            start = len(SECTION_NAMES)
+            for j in range(len(SECTION_TANGENT_NAMES)):  # Y_J11 .. Y_DIV, in this order
+                section[i, start + j] = y[Y_J11 + j] if c[C_TANGENT] > 0.0 else np.nan
+            cnt[I_N_SECTION] += 1
+        reset_tangent(y)
+        cnt[I_SECTION_K] += 1
+    if is_resample:
+        cnt[I_LAM_POS] += 1
+        cnt[I_RESAMPLE_J] += 1
+        K = stiffness(lam[cnt[I_LAM_POS]], c)
+    return K
+
+
+@njit(cache=True, inline="always")
+def reset_tangent(y):
+    """The tangent matrix back to the identity and the divergence integral to 0."""
+    y[Y_J11] = 1.0
+    y[Y_J21] = 0.0
+    y[Y_J12] = 0.0
+    y[Y_J22] = 1.0
+    y[Y_DIV] = 0.0
+
+
+@njit(cache=True, inline="always")
+def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c):
+    """The impact law (4)–(5) at a located closing at (t, th) with lever arm l1 and dC/dt.n.
+
+    The approach speed is ``v = -(l1 theta' - dC/dt.n)``. When ``v > v_min`` (0 by default:
+    every closing) the angular velocity jumps,
+    ``theta'+ = -xi theta'- + (1 + xi) (dC/dt.n) / l1``, so that the gap rate becomes
+    ``-xi`` times itself. A closing slower than ``v_chatter`` is the end of a complete
+    chattering sequence (the infinitely many ever shorter bounces whose speeds fall by ``xi``
+    each, Nordmark & Piiroinen 2009, Nonlinear Dyn. 58): it is replaced by its accumulation
+    point, a plastic closure ``theta'+ = (dC/dt.n) / l1`` (gap rate 0), after which the
+    compliant contact carries the motion. Each applied jump draws a new line length (impact
+    resampling), multiplies the tangent by its saltation matrix and is recorded (after the
+    transient) with its kind: macro, micro (slower than ``v_micro``) or chatter end. Closings
+    slower than ``v_min`` are left to the compliant force and counted.
+
+    Returns (theta' after, stiffness in use).
+    """
+    rate = l1 * om - cdn
+    if not (-rate > c[C_VMIN]):
+        cnt[I_SLOW_CLOSINGS] += 1
+        return om, K
+    if -rate < c[C_V_CHATTER]:
+        xi = 0.0
+        kind = IMPACT_CHATTER_END
+    else:
+        xi = c[C_XI]
+        kind = IMPACT_MICRO if -rate < c[C_V_MICRO] else IMPACT_MACRO
+    om_after = -xi * om + (1.0 + xi) * cdn / l1
+    if c[C_TANGENT] > 0.0:
+        s11, s21, s22 = saltation(t, th, om, om_after, l1, cdn, xi, c)
+        v11, v21, v12, v22 = y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22]
+        y[Y_J11] = s11 * v11
+        y[Y_J12] = s11 * v12
+        y[Y_J21] = s21 * v11 + s22 * v21
+        y[Y_J22] = s21 * v12 + s22 * v22
+    if c[C_RESAMPLE_DT] <= 0.0:
+        cnt[I_LAM_POS] += 1
+        K = stiffness(lam[cnt[I_LAM_POS]], c)
+    if t >= c[C_T_RECORD]:
+        i = cnt[I_N_IMPACT]
+        impacts[i, 0] = t
+        impacts[i, 1] = th
+        impacts[i, 2] = om
+        impacts[i, 3] = om_after
+        impacts[i, 4] = rate
+        impacts[i, 5] = l1
+        impacts[i, 6] = lam[cnt[I_LAM_POS]]
+        impacts[i, 7] = kind
+        cnt[I_N_IMPACT] += 1
+    return om_after, K
+
+
+@njit(cache=True, inline="always")
+def commit_tangent(y, v11, v21, v12, v22, div):
+    """Store an accepted step's tangent matrix and add its divergence integral."""
+    y[Y_J11] = v11
+    y[Y_J21] = v21
+    y[Y_J12] = v12
+    y[Y_J22] = v22
+    y[Y_DIV] += div
