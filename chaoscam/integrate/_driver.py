@@ -41,7 +41,9 @@ __all__ = [
     "drive",
     "drive_members",
     "fork_safe_threads",
+    "members_kernel",
     "run_members",
+    "run_members_rk4",
     "run_one",
 ]
 
@@ -72,11 +74,34 @@ def check_window(duration, transient, *, dt: float | None = None) -> tuple[float
 def run_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
     """:func:`_advance.advance` for each member ``i`` of stacked arrays, in parallel.
 
-    The one compiled entry point of every CPU simulation (a single trajectory is a batch of
-    one), so that a realization is bit-identical on every path and thread count.
+    The compiled entry point of every CPU simulation (a single trajectory is a batch of
+    one), so that a realization is bit-identical on every path and thread count; a batch
+    whose members all use the fixed-step kernel goes through :func:`run_members_rk4`
+    instead (:func:`members_kernel` picks).
     """
     for i in prange(y.shape[0]):
         status[i] = advance(y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i])
+
+
+@njit(parallel=True, cache=True)
+def run_members_rk4(y, cnt, c, n_stop, lam, series, section, impacts, status):
+    """:func:`run_members` for members that all use the fixed-step RK4 kernel.
+
+    The same compiled :func:`._kernel.run_chunk` that :func:`_advance.advance` calls for them
+    (so the same bits; ``analyses/hash_check.py`` compares), without the adaptive path: a
+    fresh install that runs only RK4 compiles about 7 s less.
+    """
+    for i in prange(y.shape[0]):
+        status[i] = k.run_chunk(
+            y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i]
+        )
+
+
+def members_kernel(c: np.ndarray):
+    """The compiled entry point for members with constants ``c`` (one row per member):
+    :func:`run_members_rk4` when every member uses the RK4 kernel, else
+    :func:`run_members`."""
+    return run_members_rk4 if bool(np.all(c[..., k.C_METHOD] == k.METHOD_RK4)) else run_members
 
 
 def fork_safe_threads() -> None:
@@ -98,7 +123,7 @@ def run_one(y, cnt, c, n_stop, lam, series, section, impacts) -> int:
     """:func:`run_members` for one trajectory (arrays of a single member, updated in place)."""
     fork_safe_threads()
     status = np.zeros(1, dtype=np.int64)
-    run_members(
+    members_kernel(c)(
         y[None],
         cnt[None],
         c[None],

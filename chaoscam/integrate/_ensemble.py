@@ -23,7 +23,13 @@ from ..model import LineLengthStream, Params
 from . import _gpu
 from . import _kernel as k
 from ._constants import initial_counters, initial_state, kernel_constants
-from ._driver import check_window, contact_fraction, drive_members, fork_safe_threads, run_members
+from ._driver import (
+    check_window,
+    contact_fraction,
+    drive_members,
+    fork_safe_threads,
+    members_kernel,
+)
 from ._status import Status
 from ._tangent import section_jacobians
 
@@ -297,6 +303,7 @@ def _run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, kee
     interrupted, so the pauses change nothing)."""
     fork_safe_threads()
     n = y.shape[0]
+    run_members = members_kernel(c)
 
     def launch(need: np.ndarray) -> np.ndarray:
         if need.size == n:  # the first call: every member, in place

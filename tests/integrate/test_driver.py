@@ -73,3 +73,52 @@ def test_raw_run_is_the_trajectory_without_tables():
     kinds = tr.impacts["kind"].value_counts()
     assert tr.stats["n_micro_impacts"] == kinds.get("micro", 0)
     assert tr.stats["n_chatter_ends"] == kinds.get("chatter_end", 0)
+
+
+def _one_member(p: Params, tangent: bool):
+    from chaoscam.integrate._constants import initial_counters, initial_state, kernel_constants
+
+    y = initial_state(p)[None].copy()
+    cnt = initial_counters(p, transient=0.0)[None].copy()
+    c = kernel_constants(p, t_record=0.0, stride=50, tangent=tangent)[None]
+    lam = np.full((1, 64), p.l_lambda)
+    bufs = [np.zeros((1, 4096, n)) for n in (k.SERIES_COLS, k.SECTION_COLS, k.IMPACT_COLS)]
+    return y, cnt, c, lam, bufs
+
+
+@pytest.mark.parametrize("tangent", [False, True])
+def test_rk4_entry_point_is_the_generic_one_bit_for_bit(tangent):
+    """run_members_rk4 (what an all-RK4 batch runs) gives the very bits run_members gives
+    (state, counters and every buffer), over impacts and a chattering phase."""
+    from chaoscam.integrate._driver import members_kernel, run_members, run_members_rk4
+
+    p = Params(xi=0.3)
+    runs = []
+    for entry in (run_members, run_members_rk4):
+        y, cnt, c, lam, bufs = _one_member(p, tangent)
+        status = np.zeros(1, dtype=np.int64)
+        n_stop = int(round(0.3 / p.dt))
+        entry(y, cnt, c, n_stop, lam, *bufs, status)
+        runs.append((y, cnt, status, *bufs))
+    assert runs[1][1][0, k.I_N_IMPACT] > 10  # impacts were applied
+    for a, b in zip(*runs, strict=True):
+        assert np.array_equal(a, b, equal_nan=True)
+    assert members_kernel(_one_member(p, tangent)[2]) is run_members_rk4
+    assert members_kernel(_one_member(p.replace(integrator="adaptive"), tangent)[2]) is run_members
+
+
+def test_an_rk4_run_never_compiles_the_adaptive_kernel():
+    """A fresh process that only simulates with RK4 leaves the adaptive kernel (and the
+    dispatch between both) untouched: nothing of it is compiled or loaded."""
+    import subprocess
+    import sys
+
+    code = (
+        "import chaoscam\n"
+        "from chaoscam.integrate._adaptive import run_chunk_adaptive\n"
+        "from chaoscam.integrate._advance import advance\n"
+        "chaoscam.simulate(duration=0.05, tangent=True)\n"
+        "print(len(run_chunk_adaptive.signatures), len(advance.signatures))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True)
+    assert out.stdout.split() == ["0", "0"]
