@@ -11,17 +11,52 @@ ensemble call on numba threads, labelled by ``classify_ensemble``). Both are war
 best of two alternated runs each. Prints trajectories per second, the ratio (goal >= 1.8),
 whether the runs' sections statistics agree (n_section, n_impacts, status: bit-identical
 realizations) and how often the labels agree.
+
+It also prints each engine's CPU time per trajectory and how busy it kept the cores (CPU time
+over wall time x cores, the pool's workers included), and how much of the ensemble engine's
+time is spent inside the compiled kernel's launches: both engines run the same kernel work
+(the same realizations, extended alike when undetermined), so the ratio cannot exceed the
+process engine's time over that kernel time.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import resource
 import time
 
+from chaoscam.integrate import _ensemble
 from chaoscam.sweep import Axis, regime_map
 
 GOAL = 1.8
+
+
+def _cpu() -> float:
+    """CPU seconds used so far by this process and its finished children."""
+    me = resource.getrusage(resource.RUSAGE_SELF)
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+class _KernelClock:
+    """Wall and CPU time (all threads) spent inside the ensemble engine's compiled launches."""
+
+    def __init__(self) -> None:
+        self.seconds = 0.0
+        self.cpu = 0.0
+        self._pick = _ensemble.members_kernel
+
+    def __call__(self, c):
+        kernel = self._pick(c)
+
+        def timed(*args):
+            t0, c0 = time.perf_counter(), time.process_time()
+            kernel(*args)
+            self.seconds += time.perf_counter() - t0
+            self.cpu += time.process_time() - c0
+
+        return timed
 
 
 def _load() -> str:
@@ -53,13 +88,33 @@ def main() -> None:
             workers=args.workers,
         )
     times: dict[str, list[float]] = {"process": [], "ensemble": []}
+    cpu: dict[str, list[float]] = {"process": [], "ensemble": []}
     tables = {}
+    kernel: list[float] = []
+    clock = _KernelClock()
+    _ensemble.members_kernel = clock
     for _ in range(2):
         for engine in ("process", "ensemble"):
-            t0 = time.perf_counter()
+            t0, c0, k0, kc0 = time.perf_counter(), _cpu(), clock.seconds, clock.cpu
             tables[engine] = regime_map(x, y, engine=engine, **kw).realizations
             times[engine].append(time.perf_counter() - t0)
+            cpu[engine].append(_cpu() - c0)
+            if engine == "ensemble":
+                kernel.append((clock.seconds - k0, clock.cpu - kc0))
     tp, te = min(times["process"]), min(times["ensemble"])
+    cores = args.workers or os.cpu_count() or 1
+    for engine in ("process", "ensemble"):
+        i = times[engine].index(min(times[engine]))
+        print(
+            f"{engine} engine: {cpu[engine][i] / runs:.3f} CPU s per trajectory, cores "
+            f"{cpu[engine][i] / (times[engine][i] * cores):.0%} busy"
+        )
+    wall, busy = kernel[times["ensemble"].index(te)]
+    print(
+        f"ensemble engine: {wall:.1f} s of its {te:.1f} s inside the compiled kernel's launches "
+        f"({busy:.1f} CPU s); both engines do that kernel work, so even with every core busy "
+        f"all the time the ratio cannot exceed {tp / (busy / cores):.2f}"
+    )
     a, b = tables["process"], tables["ensemble"]
     cols = ["cell", "index", "status", "n_section", "n_impacts", "contact_fraction"]
     same = a[cols].equals(b[cols])

@@ -121,7 +121,7 @@ _SIMULATED = """
 import json, numpy as np
 from chaoscam import Params
 from chaoscam.integrate import _ensemble, simulate_ensemble
-_ensemble._DRAWS = 64  # force many draw refills: relaunches on the device
+_ensemble._ROOM.update(gpu=(64, 256), cpu=(64, 256))  # many refills: relaunches on the device
 out = {}
 cases = {
     "refills": (Params(l_lambda_sigma=0.002, resample="interval", resample_dt=1e-4), 0.5, 0.1),
