@@ -71,7 +71,7 @@ from numba import njit
 from . import _kernel as k
 from . import _steps as steps
 from ._dop853 import ERROR_ORDER, dop853_step, omega_at, theta_at
-from ._events import ON_SURFACE, illinois_point, illinois_update
+from ._events import MAX_BRACKET_STEPS, ON_SURFACE, illinois_point, illinois_update
 from ._kernel import (
     C_DT,
     C_EVENT_TOL,
@@ -118,6 +118,10 @@ GROW_MAX = 6.0
 SHRINK_MIN = 1.0 / 3.0
 EXPONENT = -1.0 / (ERROR_ORDER + 1)
 H_FLOOR = 1e-15  # a step this short [s] means the error control cannot be met: NON_FINITE
+ERR_FLOOR = 1e-300  # the error estimate's floor in the step-size factor (0 would give inf)
+TURN_TOL = 1e-9  # width, as a fraction of the step, to which the gap rate's turn is found
+MAX_TURN_STEPS = 100  # passes of that search at most
+MAX_EVENT_GROWTH = 60  # doublings of an event step's overshoot (2^60 event tolerances) at most
 
 
 @njit(cache=True, inline="always")
@@ -155,7 +159,7 @@ def locate_on_interpolant(h, th, tr, co, s_lo, g_lo, s_hi, g_hi, c):
     a, fa, b, fb = s_lo, sgn * g_lo, s_hi, sgn * g_hi
     tol = c[C_EVENT_TOL] / h
     side = 0
-    for _ in range(400):
+    for _ in range(MAX_BRACKET_STEPS):
         width = b - a
         if width <= tol:
             break
@@ -173,14 +177,14 @@ def locate_on_interpolant(h, th, tr, co, s_lo, g_lo, s_hi, g_hi, c):
 def turning_point(h, th, tr, co, rate0, rate1, c):
     """The fraction s of the step where the gap rate l_1 theta' - dC/dt.n changes sign.
 
-    Illinois regula falsi on the interpolant, to 1e-9 of the step (the turning point only
+    Illinois regula falsi on the interpolant, to ``TURN_TOL`` of the step (the turning point only
     needs to be good enough to show on which side of zero the gap's extremum lies).
     """
     sgn = -1.0 if rate1 > 0.0 else 1.0  # work on sgn * rate: positive at 0, negative at 1
     a, fa, b, fb = 0.0, sgn * rate0, 1.0, sgn * rate1
     side = 0
-    for _ in range(100):
-        if b - a <= 1e-9:
+    for _ in range(MAX_TURN_STEPS):
+        if b - a <= TURN_TOL:
             break
         m = illinois_point(a, fa, b, fb)
         _, l1, cdn = geometry_near(m * h, theta_at(co, m), th, tr, c)
@@ -317,7 +321,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             hs = k.on_clock(t, hs)  # the step ends exactly at the time t1 it is stamped with
 
         th1, om1, err = dop853_step(th, om, a1, hs, tr, K, c, flight)
-        fac = SAFETY * max(err, 1e-300) ** EXPONENT
+        fac = SAFETY * max(err, ERR_FLOOR) ** EXPONENT
         if not (err <= 1.0):
             if not math.isfinite(err) or hs < H_FLOOR:
                 return leave(y, cnt, th, om, t, h, events, window, surf, NON_FINITE, c)
@@ -424,7 +428,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             # state not yet be past the crossing (the interpolant only approximates the step),
             # the length grows by 2, 4, 8, ... event tolerances until it is.
             reach = c[C_EVENT_TOL] / hs
-            for _ in range(60):
+            for _ in range(MAX_EVENT_GROWTH):
                 h_event = k.on_clock(t, s_end * hs)
                 r2 = dop853_step(th, om, a1, h_event, tr, K, c, flight)
                 tr2 = trig_at(t + h_event, r2[0], c)

@@ -13,6 +13,18 @@ from numba import njit
 from ._layout import C_EVENT_TOL
 from ._physics import geometry, on_clock, rk4, rk4_flight
 
+MAX_BRACKET_STEPS = 400
+"""Passes of a crossing search at most. Each pass at least halves the bracket (a bisection
+follows any secant step that does not), so 400 take any bracket of doubles below the event
+tolerance; the cap only guards against a gap that returns NaN."""
+
+GRAZE_TOL = 1e-6
+"""Width, as a fraction of the step, to which the turn of the gap rate is found (an error e
+in its time moves the gap's extremum by ~|delta''| e^2 / 2, below 1e-20 m here)."""
+
+MAX_GRAZE_STEPS = 200
+"""Passes of the search for the gap rate's turn at most."""
+
 
 @njit(cache=True, inline="always")
 def illinois_point(a, fa, b, fb):
@@ -65,7 +77,7 @@ def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight=False):
     s = 1.0 if g_start > 0.0 else -1.0  # work on s * delta, positive at the start
     fa, b, fb = s * g_start, h, s * g_end
     side = 0
-    for _ in range(400):
+    for _ in range(MAX_BRACKET_STEPS):
         width = b - a
         if width <= c[C_EVENT_TOL]:
             break
@@ -90,8 +102,8 @@ ON_SURFACE = 1e-300
 def graze_point(t, th, om, h, rate0, rate1, K, c):
     """The substep length tau in (0, h) at which the gap rate l_1 theta' - dC/dt.n turns.
 
-    Illinois regula falsi on ``tau -> rate(RK4 substep of length tau)`` to 1e-6 of the step
-    (an error e in tau moves the gap's extremum by ~|delta''| e^2 / 2, below 1e-20 m here).
+    Illinois regula falsi on ``tau -> rate(RK4 substep of length tau)`` to ``GRAZE_TOL`` of
+    the step.
     Only called where the gap rate changes sign between the segment's ends while the gap
     does not: the extremum of the gap in between shows whether it crossed zero and came
     back (a micro-flight, or a graze, shorter than the step). The rate is that of the
@@ -101,9 +113,9 @@ def graze_point(t, th, om, h, rate0, rate1, K, c):
     s = 1.0 if rate0 > 0.0 else -1.0  # work on s * rate, positive at 0, negative at h
     a, fa, b, fb = 0.0, s * rate0, h, s * rate1
     side = 0
-    for _ in range(200):
+    for _ in range(MAX_GRAZE_STEPS):
         width = b - a
-        if width <= 1e-6 * h:
+        if width <= GRAZE_TOL * h:
             break
         m = on_clock(t, illinois_point(a, fa, b, fb))
         thm, omm = rk4(t, th, om, m, K, c)
