@@ -103,7 +103,7 @@ class Trajectory:
 
     def summary(self) -> str:
         """A few lines for a terminal."""
-        return _summary(self, len(self.section))
+        return _summary(self)
 
     def provenance(self) -> dict[str, Any]:
         """Parameters and settings as a JSON-serialisable dict."""
@@ -252,7 +252,7 @@ class RawRun:
 
     def summary(self) -> str:
         """A few lines for a terminal (:meth:`Trajectory.summary`)."""
-        return _summary(self, len(self.section))
+        return _summary(self)
 
     def trajectory(self) -> Trajectory:
         """The run as a :class:`Trajectory` (its tables as pandas DataFrames)."""
@@ -384,7 +384,7 @@ def raw_run(
     )
 
 
-def _summary(run: Trajectory | RawRun, n_sections: int) -> str:
+def _summary(run: Trajectory | RawRun) -> str:
     """The terminal lines of :meth:`Trajectory.summary` (and :meth:`RawRun.summary`)."""
     s = run.stats
     return (
@@ -395,8 +395,8 @@ def _summary(run: Trajectory | RawRun, n_sections: int) -> str:
         f"{s['n_micro_impacts']} micro, {s['n_chatter_ends']} chattering ends), "
         f"{s['slow_closings']} slow closings left to the compliant contact, "
         f"{s['chatter_handovers']} chattering-guard hand-overs\n"
-        f"contact fraction: {run.stats['contact_fraction']:.4f}\n"
-        f"section points: {n_sections}"
+        f"contact fraction: {s['contact_fraction']:.4f}\n"
+        f"section points: {len(run.section)}"
     )
 
 

@@ -315,7 +315,7 @@ def _run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, kee
     run_members = members_kernel(c)
 
     def launch(need: np.ndarray) -> np.ndarray:
-        if need.size == n:  # the first call: every member, in place
+        if need.size == n:  # every member (the first launch): in place, no copies
             run_members(
                 y, cnt, c, n_stop, lam, np.empty((n, 1, k.SERIES_COLS)), section, impacts, status
             )

@@ -103,8 +103,7 @@ def graze_point(t, th, om, h, rate0, rate1, K, c):
     """The substep length tau in (0, h) at which the gap rate l_1 theta' - dC/dt.n turns.
 
     Illinois regula falsi on ``tau -> rate(RK4 substep of length tau)`` to ``GRAZE_TOL`` of
-    the step.
-    Only called where the gap rate changes sign between the segment's ends while the gap
+    the step. Only called where the gap rate changes sign between the segment's ends while the gap
     does not: the extremum of the gap in between shows whether it crossed zero and came
     back (a micro-flight, or a graze, shorter than the step). The rate is that of the
     substep's state, on the side of the surface the segment starts on. Trial lengths and the
