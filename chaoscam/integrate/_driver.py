@@ -22,8 +22,11 @@ everything it needs in ``y`` and ``cnt``), so how often the loop pauses changes 
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
+import signal
+import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -164,9 +167,42 @@ def drive_members(
     """
     need = np.arange(n)
     while need.size:
-        need = need[launch(need) == k.NEED_BUFFER]
+        with _interrupts_held():
+            codes = launch(need)
+        need = need[codes == k.NEED_BUFFER]
         if need.size:
             refill(need)
+
+
+@contextlib.contextmanager
+def _interrupts_held():
+    """Hold a Ctrl-C (or a SIGTERM handled in Python) that arrives during a launch until
+    the launch returns, then hand it to the handler that was in place.
+
+    Compiled code cannot be interrupted anyway, but a launch also runs Python inside C
+    callbacks: numba's LLVM object cache is called back that way whenever a kernel compiles
+    or its runtime is set up (~0.4 s into every process). A KeyboardInterrupt raised there
+    cannot propagate: Python prints it as "Exception ignored ... Traceback" and the run goes
+    on, the Ctrl-C lost. Only in the main thread (where signal handlers live), and only for
+    signals handled by Python functions (an ignored or default signal is left alone).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[tuple[int, object]] = []
+    before = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        handler = signal.getsignal(sig)
+        if callable(handler):
+            before[sig] = signal.signal(sig, lambda signum, frame: held.append((signum, frame)))
+    try:
+        yield
+    finally:
+        for sig, handler in before.items():
+            signal.signal(sig, handler)
+        if held:
+            signum, frame = held[0]
+            before[signum](signum, frame)  # KeyboardInterrupt, from the default or the CLI's
 
 
 @dataclass

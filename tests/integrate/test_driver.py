@@ -122,3 +122,24 @@ def test_an_rk4_run_never_compiles_the_adaptive_kernel():
     )
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True)
     assert out.stdout.split() == ["0", "0"]
+
+
+def test_a_ctrl_c_inside_a_c_callback_of_a_launch_is_not_lost():
+    """SIGINT that arrives while a launch runs Python inside a C callback (numba's LLVM
+    object cache while a kernel compiles) is held and raised as KeyboardInterrupt once the
+    launch returns, instead of being printed as "Exception ignored" and lost."""
+    import ctypes
+    import signal
+
+    callback = ctypes.CFUNCTYPE(None)(lambda: signal.raise_signal(signal.SIGINT))
+    seen = []
+
+    def launch(need):
+        callback()
+        seen.append("returned")
+        return np.zeros(need.size, dtype=np.int64)
+
+    with pytest.raises(KeyboardInterrupt):
+        drive_members(2, launch, None)
+    assert seen == ["returned"]
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored
