@@ -21,7 +21,7 @@ import pandas as pd
 
 from .analysis import Verdict
 from .classify import EXTEND_TO, _with_settings, classify_section_run
-from .integrate import Ensemble, Status, simulate_ensemble
+from .integrate import Ensemble, Status, extend_ensemble, simulate_ensemble
 from .model import Params
 
 __all__ = ["MemberVerdict", "classify_ensemble", "member_verdicts"]
@@ -69,7 +69,10 @@ def member_verdicts(
     member is run again longer (4x the recorded time each round, at most ``extend_to``
     seconds recorded; None: never), all such members in one ensemble call on the backend
     of ``ens``, until its verdict settles; its verdict's ``settings["extended"]`` records
-    the time used. Raises ValueError when ``ens`` was run without ``tangent=True``.
+    the time used. A run made with ``resumable=True`` is continued from where it stopped
+    (:func:`chaoscam.integrate.extend_ensemble`: the same bits as running it again from
+    t = 0, without repeating the transient and the time already recorded). Raises
+    ValueError when ``ens`` was run without ``tangent=True``.
     """
     if ens.jacobians is None:
         raise ValueError("classify_ensemble needs an ensemble run with tangent=True")
@@ -80,18 +83,29 @@ def member_verdicts(
     recorded = s["duration"] - s["transient"]
     t_wall = time.perf_counter()
     pending = [j for j, v in enumerate(verdicts) if _unsettled(v)]
+    last, at = ens, list(range(len(members)))  # the latest run of each member, and where
     while pending and extend_to is not None and recorded < extend_to:
         recorded = min(extend_to, 4.0 * recorded)
         sub = [plist[j] for j in pending]
-        longer = simulate_ensemble(
-            sub,
-            [int(members["index"].iat[j]) for j in pending],
-            seed=s["seed"],
-            duration=s["transient"] + recorded,
-            transient=s["transient"],
-            backend=s["backend"],
-            tangent=True,
-        )
+        if last.resume is not None:  # continued from its last run: the same bits, sooner
+            longer = extend_ensemble(
+                last,
+                [plist[j] for j in at] if last is not ens else plist,
+                s["transient"] + recorded,
+                members=[at.index(j) for j in pending],
+                resumable=True,
+            )
+        else:
+            longer = simulate_ensemble(
+                sub,
+                [int(members["index"].iat[j]) for j in pending],
+                seed=s["seed"],
+                duration=s["transient"] + recorded,
+                transient=s["transient"],
+                backend=s["backend"],
+                tangent=True,
+            )
+        last, at = longer, list(pending)
         note = {
             "recorded_s": recorded,
             "wall_time_s": time.perf_counter() - t_wall,

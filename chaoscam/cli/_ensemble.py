@@ -184,6 +184,7 @@ def _run_locked(args: argparse.Namespace) -> int:
                     backend=args.backend,
                     keep_impacts=args.keep_impacts,
                     tangent=args.classify,
+                    resumable=args.classify,  # undetermined members are continued
                     batch=batch,
                     progress=bar.update,
                 )

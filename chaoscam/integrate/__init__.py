@@ -9,12 +9,20 @@ from .._lazy import lazy_face
 _LAZY = {
     "Ensemble": ("._ensemble", "Ensemble"),
     "Status": ("._status", "Status"),
+    "extend_ensemble": ("._ensemble", "extend_ensemble"),
     "kernel_constants": ("._constants", "kernel_constants"),
     "simulate_ensemble": ("._ensemble", "simulate_ensemble"),
     "simulate_reference": ("._reference", "simulate_reference"),
 }
 
-__all__ = ["Ensemble", "Status", "kernel_constants", "simulate_ensemble", "simulate_reference"]
+__all__ = [
+    "Ensemble",
+    "Status",
+    "extend_ensemble",
+    "kernel_constants",
+    "simulate_ensemble",
+    "simulate_reference",
+]
 
 
 __getattr__, __dir__ = lazy_face(__name__, _LAZY)

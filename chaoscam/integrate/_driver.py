@@ -157,15 +157,16 @@ def drive_members(
     n: int,
     launch: Callable[[np.ndarray], np.ndarray],
     refill: Callable[[np.ndarray], None],
+    need: np.ndarray | None = None,
 ) -> None:
-    """The buffer-refill loop over ``n`` members.
+    """The buffer-refill loop over ``n`` members (those in ``need``; default all).
 
     ``launch(need)`` runs the members whose indices are in ``need`` until each ends or asks
     for room, and returns their status codes (in the order of ``need``). ``refill(need)``
     empties the output buffers and renews the line-length draws of the members in ``need``
     (those that returned ``NEED_BUFFER``); they are then launched again, until none asks.
     """
-    need = np.arange(n)
+    need = np.arange(n) if need is None else np.asarray(need, dtype=np.int64)
     while need.size:
         with _interrupts_held():
             codes = launch(need)

@@ -3,7 +3,9 @@
 Each member runs the same kernel as :func:`chaoscam.simulate` (:func:`_kernel.run_chunk`) on
 its own line-length draws, so member ``i`` equals ``simulate(params_i, seed=seed,
 index=indices[i], series=False)`` bit for bit. Only sections, impact counts and statuses are
-kept; a member that outgrows its impact buffer or its draws is finished on the serial path.
+kept; a member that fills its impact rows or uses up its draws is refilled and launched
+again (:mod:`._members`, one batch). :func:`extend_ensemble` continues members of a run
+kept ``resumable`` to a longer duration, bit for bit (:mod:`._resume`).
 
 ``backend="gpu"`` runs the same kernel on an NVIDIA GPU, one thread per member
 (:mod:`._gpu`, numba-cuda), equal to this path within ``GPU_TOLERANCE`` on short or periodic
@@ -19,24 +21,19 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..model import LineLengthStream, Params
+from ..model import Params
 from . import _gpu
 from . import _kernel as k
-from ._constants import initial_counters, initial_state, kernel_constants
-from ._driver import (
-    check_window,
-    contact_fraction,
-    drive_members,
-    fork_safe_threads,
-    members_kernel,
-)
-from ._status import Status
+from ._constants import kernel_constants
+from ._driver import check_window
+from ._members import fresh, resumed, run_batch, run_on_cpu
+from ._resume import Resume
 from ._tangent import section_jacobians
 
 if TYPE_CHECKING:
     import pandas as pd
 
-__all__ = ["BACKENDS", "Ensemble", "simulate_ensemble"]
+__all__ = ["BACKENDS", "Ensemble", "extend_ensemble", "simulate_ensemble"]
 
 _ROOM = {"cpu": (2048, 2048), "gpu": (512, 256)}
 """Room per member and launch, on each backend: (line-length draws, impact rows; the rows
@@ -71,6 +68,9 @@ class Ensemble:
     jacobians : ndarray or None
         With ``tangent=True``: the Jacobian of the stroboscopic map over the period ending at
         each row of ``sections``, shape (len(sections), 2, 2), as ``Trajectory.jacobians``.
+    resume : Resume or None
+        With ``resumable=True``: each member's state where :func:`extend_ensemble` can
+        continue it (see :mod:`._resume`).
     """
 
     sections: pd.DataFrame
@@ -78,6 +78,7 @@ class Ensemble:
     settings: dict[str, Any] = field(default_factory=dict)
     impacts: pd.DataFrame | None = None
     jacobians: np.ndarray | None = None
+    resume: Resume | None = field(default=None, repr=False, compare=False)
 
 
 def simulate_ensemble(
@@ -91,6 +92,7 @@ def simulate_ensemble(
     backend: str = "cpu",
     keep_impacts: bool = False,
     tangent: bool = False,
+    resumable: bool = False,
     progress=None,
 ) -> Ensemble:
     """Simulate realizations ``indices`` of one model (or one model per member) in parallel.
@@ -123,6 +125,12 @@ def simulate_ensemble(
         (``Ensemble.jacobians``), from which :func:`chaoscam.classify.classify_ensemble`
         labels the members (the tangent exponent, n-band chaos, the periodic-orbit
         certificate). The members' motion is the same with and without it.
+    resumable : bool
+        Keep each member's state at its last section time before the end
+        (``Ensemble.resume``), so that :func:`extend_ensemble` can continue it to a longer
+        duration instead of running it again; the run's results are the same bits. RK4
+        members only, without ``keep_impacts`` (otherwise ``resume`` is None); it costs one
+        more stop of the compiled call and about 20 kB a member.
     progress : callable, optional
         Called with the number of members just finished after each batch (a progress bar's
         ``update``); a smaller ``batch`` gives more frequent calls (and a Ctrl-C that is
@@ -152,28 +160,132 @@ def simulate_ensemble(
     if len({(p.dt, p.omega) for p in plist}) > 1:
         raise ValueError("members must share dt and omega")
     t0 = time.perf_counter()
-    sections, rows, impact_rows = [], [], []
-    for start in range(0, len(indices), batch):
-        chunk = slice(start, start + batch)
-        s, r, im = _run_batch(
-            plist[chunk],
-            indices[chunk],
-            start,
-            seed,
-            duration,
-            transient,
-            run=_gpu.run_on_gpu if use_gpu else _run_on_cpu,
-            room=_ROOM["gpu" if use_gpu else "cpu"],
-            keep_impacts=keep_impacts,
-            tangent=tangent,
+    room = _ROOM["gpu" if use_gpu else "cpu"]
+    parts = []
+    for first in range(0, len(indices), batch):
+        chunk = slice(first, first + batch)
+        start = fresh(plist[chunk], indices[chunk], seed, duration, transient, tangent, room)
+        parts.append(
+            run_batch(
+                plist[chunk],
+                indices[chunk],
+                start,
+                first,
+                duration,
+                run=_gpu.run_on_gpu if use_gpu else run_on_cpu,
+                room=room,
+                keep_impacts=keep_impacts,
+                resumable=resumable,
+            )
         )
-        sections.extend(s)
-        rows.extend(r)
-        impact_rows.extend(im)
         if progress is not None:
-            progress(len(r))
+            progress(len(parts[-1][1]))
+    settings = {
+        "duration": duration,
+        "transient": transient,
+        "seed": seed,
+        "threads": None,
+        "backend": "gpu" if use_gpu else "cpu",
+        "device": device,
+        "batch": batch,
+        "integrators": sorted({p.integrator for p in plist}),
+        "tangent": bool(tangent),
+    }
+    return _assemble(parts, settings, keep_impacts, t0)
+
+
+def extend_ensemble(
+    ens: Ensemble,
+    params: Params | list[Params],
+    duration: float,
+    *,
+    members=None,
+    resumable: bool = False,
+    progress=None,
+) -> Ensemble:
+    """Members of ``ens`` continued to ``duration``, bit-identical to runs made that long.
+
+    Each member goes on from the copy ``ens.resume`` keeps (a run made with
+    ``resumable=True``), at its last section time before the end, instead of being run
+    again from t = 0 (see :mod:`._resume`); its sections, Jacobians, impact count, contact
+    fraction and status are those of ``simulate_ensemble`` over the longer window.
+
+    Parameters
+    ----------
+    ens : Ensemble
+        A run made with ``resumable=True`` (and without ``keep_impacts``).
+    params : Params or list of Params
+        The model of every member of ``ens``, as given to ``simulate_ensemble``.
+    duration : float
+        The new end time [s], at least that of ``ens``.
+    members : sequence of int, optional
+        Which members (their ``member`` numbers in ``ens``); default all. They are numbered
+        0, 1, ... in the result, in this order (``index`` keeps their realization).
+    resumable : bool
+        Keep a copy again, so that the result can be extended further.
+    progress : callable, optional
+        As for :func:`simulate_ensemble`.
+
+    Raises
+    ------
+    ValueError
+        When ``ens`` holds no copy, ``duration`` is shorter than its run, or ``params``
+        is not the model of its members.
+    """
+    res = ens.resume
+    if res is None:
+        raise ValueError(
+            "this ensemble cannot be continued: run simulate_ensemble with resumable=True "
+            "(the RK4 integrator, without keep_impacts)"
+        )
+    s = ens.settings
+    duration, transient = check_window(duration, s["transient"])
+    if duration < s["duration"]:
+        raise ValueError(f"duration = {duration!r} s is shorter than the run's {s['duration']} s")
+    picks = list(range(len(res))) if members is None else [int(m) for m in members]
+    plist = list(params) if isinstance(params, list | tuple) else [params] * len(res)
+    if len(plist) != len(res):
+        raise ValueError(f"{len(plist)} parameter sets for {len(res)} members")
+    plist = [plist[j] for j in picks]
+    res = res.select(picks)
+    for j, p in enumerate(plist):
+        made = kernel_constants(p, t_record=transient, tangent=s["tangent"])
+        if not np.array_equal(made, res.c[j]):
+            raise ValueError(f"params[{picks[j]}] is not the model member {picks[j]} ran with")
+    indices = [int(ens.members["index"].iat[j]) for j in picks]
+    use_gpu = s["backend"] == "gpu"
+    room = _ROOM["gpu" if use_gpu else "cpu"]
+    t0 = time.perf_counter()
+    parts = []
+    for first in range(0, len(picks), s["batch"]):
+        chunk = slice(first, first + s["batch"])
+        sub = res.select(range(len(picks))[chunk])
+        parts.append(
+            run_batch(
+                plist[chunk],
+                indices[chunk],
+                resumed(sub, plist[chunk], duration, room),
+                first,
+                duration,
+                run=_gpu.run_on_gpu if use_gpu else run_on_cpu,
+                room=room,
+                resumable=resumable,
+            )
+        )
+        if progress is not None:
+            progress(len(parts[-1][1]))
+    return _assemble(parts, {**s, "duration": duration, "continued_from": res.step}, False, t0)
+
+
+def _assemble(parts, settings: dict, keep_impacts: bool, t0: float) -> Ensemble:
+    """The Ensemble of batches' outputs (``_run_batch``'s), in order."""
+    import numba
     import pandas as pd
 
+    sections = [b for part in parts for b in part[0]]
+    rows = [r for part in parts for r in part[1]]
+    impact_rows = [r for part in parts for r in part[2]]
+    resumes = [part[3] for part in parts]
     cols = ["member", *k.SECTION_NAMES]
     every = np.concatenate(sections) if sections else np.empty((0, 1 + k.SECTION_COLS))
     sec = pd.DataFrame(every[:, : len(cols)], columns=cols)
@@ -181,7 +293,8 @@ def simulate_ensemble(
     members = pd.DataFrame(
         rows, columns=["member", "index", "status", "n_impacts", "contact_fraction"]
     )
-    jac = section_jacobians(every[:, 1:]) if tangent else None  # without the member column
+    # the Jacobians from the rows without the member column
+    jac = section_jacobians(every[:, 1:]) if settings["tangent"] else None
     impacts = None
     if keep_impacts:
         icols = ["member", *k.IMPACT_NAMES]
@@ -193,26 +306,15 @@ def simulate_ensemble(
         impacts["kind"] = pd.Categorical.from_codes(
             impacts["kind"].to_numpy(dtype=np.int64), categories=list(k.IMPACT_KINDS)
         )
-    import numba
-
-    return Ensemble(
-        sections=sec,
-        members=members,
-        impacts=impacts,
-        jacobians=jac,
-        settings={
-            "duration": duration,
-            "transient": transient,
-            "seed": seed,
-            "threads": numba.get_num_threads(),
-            "backend": "gpu" if use_gpu else "cpu",
-            "device": device,
-            "batch": batch,
-            "integrators": sorted({p.integrator for p in plist}),
-            "tangent": bool(tangent),
-            "wall_time_s": time.perf_counter() - t0,
-        },
-    )
+    resume = None
+    if resumes and all(r is not None for r in resumes):
+        resume = Resume.join(resumes)
+    settings = {
+        **settings,
+        "threads": numba.get_num_threads(),
+        "wall_time_s": time.perf_counter() - t0,
+    }
+    return Ensemble(sec, members, settings, impacts, jac, resume)
 
 
 def _pick_backend(backend: str) -> tuple[bool, str]:
@@ -233,129 +335,3 @@ def _pick_backend(backend: str) -> tuple[bool, str]:
             stacklevel=3,
         )
     return False, "cpu"
-
-
-def _run_batch(
-    plist,
-    indices,
-    first,
-    seed,
-    duration,
-    transient,
-    run=None,
-    keep_impacts=False,
-    tangent=False,
-    room=_ROOM["cpu"],
-):
-    """Set up one batch of members, ``run`` it (CPU or GPU) and collect its outputs;
-    ``room`` = (draws, impact rows) per member and launch (:data:`_ROOM`)."""
-    n = len(indices)
-    p0 = plist[0]
-    n_stop = int(round(duration / p0.dt))
-    n_sec = int(duration / p0.cam_period) + 4 + int(p0.dt / p0.cam_period)
-    extra = max(p.max_events_per_step + p.flight_merge for p in plist) + 2
-    streams = [LineLengthStream(p, seed, i) for p, i in zip(plist, indices, strict=True)]
-    n_draws = max(_draws(p, duration, room[0]) for p in plist) + 4 * extra
-    lam = np.stack([s.draw(n_draws) for s in streams])
-    y = _per_member(initial_state, plist)
-    cnt = _per_member(lambda p: initial_counters(p, transient=transient), plist)
-    c = _per_member(lambda p: kernel_constants(p, t_record=transient, tangent=tangent), plist)
-    section = np.empty((n, n_sec, k.SECTION_COLS))
-    impacts = np.empty((n, room[1] + 4 * extra, k.IMPACT_COLS))
-    status = np.zeros(n, dtype=np.int64)
-    n_impacts = np.zeros(n, dtype=np.int64)
-
-    kept: list[list[np.ndarray]] = [[] for _ in range(n)]
-
-    def empty_impacts(j):
-        """Count member j's impact rows (and keep them if asked); the rows are free again."""
-        m = cnt[j, k.I_N_IMPACT]
-        if keep_impacts and m:
-            kept[j].append(impacts[j, :m].copy())
-        n_impacts[j] += m
-        cnt[j, k.I_N_IMPACT] = 0
-
-    def hand_back(j, lam_j, n_new):
-        """Empty member j's impact rows and drop its used draws, adding n_new."""
-        empty_impacts(j)
-        pos = cnt[j, k.I_LAM_POS]
-        cnt[j, k.I_LAM_POS] = 0
-        return np.concatenate([lam_j[pos:], streams[j].draw(n_new)])
-
-    (run or _run_on_cpu)(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts)
-    sections, rows, impact_rows = [], [], []
-    for j in range(n):
-        empty_impacts(j)
-        if keep_impacts and kept[j]:
-            block = np.concatenate(kept[j])
-            impact_rows.append(np.column_stack([np.full(len(block), first + j), block]))
-        m = cnt[j, k.I_N_SECTION]
-        block = np.empty((m, 1 + k.SECTION_COLS))
-        block[:, 0] = first + j
-        block[:, 1:] = section[j, :m]
-        sections.append(block)
-        rows.append(
-            (
-                first + j,
-                indices[j],
-                Status(int(status[j])).name,
-                int(n_impacts[j]),
-                contact_fraction(y[j], cnt[j], c[j]),
-            )
-        )
-    return sections, rows, impact_rows
-
-
-def _run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts):
-    """The members in parallel calls of the driver's loop: all of them first, then those
-    that asked for room, refilled (a resumed member is bit-identical to one that was not
-    interrupted, so the pauses change nothing)."""
-    fork_safe_threads()
-    n = y.shape[0]
-    run_members = members_kernel(c)
-
-    def launch(need: np.ndarray) -> np.ndarray:
-        if need.size == n:  # every member (the first launch): in place, no copies
-            run_members(
-                y, cnt, c, n_stop, lam, np.empty((n, 1, k.SERIES_COLS)), section, impacts, status
-            )
-            return status
-        sub = (y[need], cnt[need], c[need], lam[need], section[need], impacts[need])
-        sub_status = np.zeros(need.size, dtype=np.int64)
-        run_members(
-            sub[0],
-            sub[1],
-            sub[2],
-            n_stop,
-            sub[3],
-            np.empty((need.size, 1, k.SERIES_COLS)),
-            sub[4],
-            sub[5],
-            sub_status,
-        )
-        y[need], cnt[need], section[need], impacts[need] = sub[0], sub[1], sub[4], sub[5]
-        status[need] = sub_status
-        return sub_status
-
-    def refill(need: np.ndarray) -> None:
-        for j in need:  # the same width again: as many new draws as were used
-            lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
-
-    drive_members(n, launch, refill)
-
-
-def _draws(p: Params, duration: float, room: int) -> int:
-    """Line-length draws a member starts with: one per resampling interval of the run, or,
-    under impact resampling (one per applied impact), ``room``."""
-    if p.resample == "interval":
-        return int(duration / p.resample_dt) + 64
-    return room
-
-
-def _per_member(make, plist) -> np.ndarray:
-    """``make(p)`` stacked over members, computed once per distinct parameter object."""
-    done: dict[int, np.ndarray] = {}
-    for p in plist:
-        if id(p) not in done:
-            done[id(p)] = make(p)
-    return np.stack([done[id(p)] for p in plist])

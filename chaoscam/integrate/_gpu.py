@@ -205,6 +205,9 @@ def run_on_gpu(
 ) -> None:
     """Run stacked members to ``n_stop`` on the GPU; arrays as in ``_ensemble._run_batch``.
 
+    The members whose ``status`` is ``NEED_BUFFER`` run (every member of a fresh batch);
+    the others keep their code, and their rows.
+
     Updates ``y``, ``cnt``, ``lam``, ``section`` and ``status`` in place; ``impacts`` is
     brought back from the device only with ``keep_impacts`` (otherwise only counted).
     ``hand_back(j, lam_j, n)`` empties member ``j``'s impact rows and returns its draws with
@@ -214,10 +217,9 @@ def run_on_gpu(
 
     kern = _kernel(_batch_method(c))
     n = y.shape[0]
-    status[:] = k.NEED_BUFFER  # "still to run"
     d_y, d_cnt, d_c, d_lam, d_status = (cuda.to_device(a) for a in (y, cnt, c, lam, status))
     d_series = cuda.device_array((n, 1, k.SERIES_COLS))
-    d_section = cuda.device_array(section.shape)
+    d_section = cuda.to_device(section)  # rows of an earlier launch are kept
     d_impacts = cuda.device_array(impacts.shape)
     blocks = (n + _BLOCK - 1) // _BLOCK
 
@@ -243,7 +245,7 @@ def run_on_gpu(
         else:
             d_lam.copy_to_device(lam)
 
-    drive_members(n, launch, refill)
+    drive_members(n, launch, refill, np.flatnonzero(status == k.NEED_BUFFER))
     d_y.copy_to_host(y)
     d_cnt.copy_to_host(cnt)
     d_section.copy_to_host(section)

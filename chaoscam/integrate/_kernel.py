@@ -385,4 +385,6 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 series[i, 2] = om
                 series[i, 3] = lam[cnt[I_LAM_POS]]
                 cnt[I_N_SERIES] += 1
+    # The flags too, for a run continued later from here (``_ensemble.extend_ensemble``).
+    cnt[I_SURFACE] = (1 if jumped else 0) + (2 if settled else 0)
     return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, OK)

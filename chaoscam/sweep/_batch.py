@@ -102,6 +102,7 @@ def run_batch(
                 transient=transient,
                 backend=backend,
                 tangent=True,
+                resumable=extend_to is not None,  # undetermined members are continued
             )
             verdicts = member_verdicts(ens, plist, extend_to=extend_to)
         shared = [str(w.message) for w in caught]

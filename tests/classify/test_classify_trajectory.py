@@ -223,6 +223,35 @@ def test_classify_ensemble_extends_and_explains_like_classify_trajectory():
     assert member["label"] == classify_trajectory(traj).label == "chaotic"
 
 
+def test_a_resumable_ensemble_is_extended_by_continuing_it(monkeypatch):
+    """Undetermined members of a run kept resumable are continued (extend_ensemble), not run
+    again from t = 0, and get the same verdicts, evidence and reasons as when run again."""
+    from chaoscam import Params, _ensemble_verdicts
+    from chaoscam.integrate import simulate_ensemble
+
+    p = Params(omega=26.0, xi=0.3)
+    run = dict(seed=1, duration=20.0, transient=10.0, tangent=True)
+    again = _ensemble_verdicts.member_verdicts(simulate_ensemble(p, [0, 1], **run), p)
+    calls = []
+    real = _ensemble_verdicts.simulate_ensemble
+    monkeypatch.setattr(
+        _ensemble_verdicts,
+        "simulate_ensemble",
+        lambda *a, **kw: calls.append(kw["duration"]) or real(*a, **kw),
+    )
+    kept = simulate_ensemble(p, [0, 1], resumable=True, **run)
+    continued = _ensemble_verdicts.member_verdicts(kept, p)
+    assert calls == []  # no run from t = 0
+    assert any("extended" in v.verdict.settings for v in again)
+    for a, b in zip(again, continued, strict=True):
+        assert (a.label, a.period, a.reasons) == (b.label, b.period, b.reasons)
+        assert a.verdict.evidence == b.verdict.evidence
+        ext_a, ext_b = a.verdict.settings.get("extended"), b.verdict.settings.get("extended")
+        assert (ext_a is None) == (ext_b is None)
+        if ext_a is not None:
+            assert ext_a["recorded_s"] == ext_b["recorded_s"]
+
+
 def test_an_orbit_the_grid_calls_unstable_is_certified_on_refined_steps():
     """xi = 0.45: a sticking period-6 orbit whose dominant multiplier the default grid's tangent
     overstates (|mu| ~ 2-3 at dt = 2e-6 s, a positive grid exponent) while shooting at dt/2

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from chaoscam import Params
-from chaoscam.integrate import _ensemble, _gpu, simulate_ensemble
+from chaoscam.integrate import _gpu, _members, simulate_ensemble
 
 HAS_NUMBA_CUDA = importlib.util.find_spec("numba_cuda") is not None
 needs_numba_cuda = pytest.mark.skipif(not HAS_NUMBA_CUDA, reason="numba-cuda not installed")
@@ -82,7 +82,7 @@ def test_auto_backend_uses_an_available_gpu(monkeypatch):
 
     def fake_launcher(*args):
         launched.append(args[0].shape[0])
-        _ensemble._run_on_cpu(*args)
+        _members.run_on_cpu(*args)
 
     monkeypatch.setattr(_gpu, "run_on_gpu", fake_launcher)
     ens = simulate_ensemble(Params(), range(3), duration=0.01, backend="auto")
