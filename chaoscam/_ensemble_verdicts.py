@@ -61,6 +61,7 @@ def member_verdicts(
     params: Params | Sequence[Params],
     *,
     extend_to: float | None = EXTEND_TO,
+    progress=None,
 ) -> list[MemberVerdict]:
     """The verdict of every member of ``ens``, in the order of ``ens.members``.
 
@@ -73,6 +74,10 @@ def member_verdicts(
     (:func:`chaoscam.integrate.extend_ensemble`: the same bits as running it again from
     t = 0, without repeating the transient and the time already recorded). Raises
     ValueError when ``ens`` was run without ``tangent=True``.
+
+    ``progress``, optional, is called as ``progress(0, extending=m, recorded_s=r)`` before
+    each extension round (m members, to r seconds recorded) and as ``progress(n)`` after
+    each batch of it (n members just run), so that a progress bar can grow its total.
     """
     if ens.jacobians is None:
         raise ValueError("classify_ensemble needs an ensemble run with tangent=True")
@@ -87,6 +92,10 @@ def member_verdicts(
     while pending and extend_to is not None and recorded < extend_to:
         recorded = min(extend_to, 4.0 * recorded)
         sub = [plist[j] for j in pending]
+        step = None
+        if progress is not None:
+            progress(0, extending=len(pending), recorded_s=recorded)
+            step = progress
         if last.resume is not None:  # continued from its last run: the same bits, sooner
             longer = extend_ensemble(
                 last,
@@ -94,6 +103,7 @@ def member_verdicts(
                 s["transient"] + recorded,
                 members=[at.index(j) for j in pending],
                 resumable=True,
+                progress=step,
             )
         else:
             longer = simulate_ensemble(
@@ -104,6 +114,7 @@ def member_verdicts(
                 transient=s["transient"],
                 backend=s["backend"],
                 tangent=True,
+                progress=step,
             )
         last, at = longer, list(pending)
         note = {
@@ -137,12 +148,16 @@ def _verdicts(ens: Ensemble, plist: list[Params]) -> list[MemberVerdict]:
 
 
 def classify_ensemble(
-    ens: Ensemble, params: Params | Sequence[Params], *, extend_to: float | None = EXTEND_TO
+    ens: Ensemble,
+    params: Params | Sequence[Params],
+    *,
+    extend_to: float | None = EXTEND_TO,
+    progress=None,
 ) -> Ensemble:
     """``ens`` with each member's verdict: columns ``label``, ``period`` and ``reasons``
     (why, in words; for an undetermined member, what is missing) added to ``members``.
-    ``extend_to``: see :func:`member_verdicts`."""
-    verdicts = member_verdicts(ens, params, extend_to=extend_to)
+    ``extend_to``, ``progress``: see :func:`member_verdicts`."""
+    verdicts = member_verdicts(ens, params, extend_to=extend_to, progress=progress)
     members = ens.members.assign(
         label=[v.label for v in verdicts],
         period=pd.array([v.period for v in verdicts], dtype="Int64"),

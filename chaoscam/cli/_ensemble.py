@@ -172,6 +172,8 @@ def _run_locked(args: argparse.Namespace) -> int:
             done_before += stop - start
             bar.update(stop - start)
             continue
+        t_chunk = time.perf_counter()
+        bar.set_description(_SIMULATING, refresh=False)
         try:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always", GPUFallbackWarning)
@@ -189,7 +191,7 @@ def _run_locked(args: argparse.Namespace) -> int:
                     progress=bar.update,
                 )
                 if args.classify:
-                    ens = classify_ensemble(ens, params)
+                    ens = classify_ensemble(ens, params, progress=_extending(bar))
             for w in caught:
                 if issubclass(w.category, GPUFallbackWarning) and not noticed:
                     print(f"chaoscam: {w.message}", file=sys.stderr, flush=True)
@@ -220,7 +222,8 @@ def _run_locked(args: argparse.Namespace) -> int:
         if not args.quiet:
             bar.write(
                 f"members {start}..{stop - 1}: {ens.settings['backend']}, "
-                f"{(stop - start) / ens.settings['wall_time_s']:.1f} traj/s"
+                f"{(stop - start) / (time.perf_counter() - t_chunk):.1f} members/s"
+                + (" with their labels" if args.classify else "")
             )
     bar.close()
 
@@ -253,20 +256,41 @@ def _progress_batch(backend: str) -> int | None:
     return PROGRESS_PER_THREAD * numba.get_num_threads()
 
 
+_SIMULATING = "ensemble (simulated)"
+
+
 def _bar(args, total: int):
-    """A progress bar over the members on stderr, with rate and ETA (none with --quiet)."""
+    """A progress bar over the runs on stderr, with rate and ETA (none with --quiet): one
+    per member, and one more per extension of an undetermined member (its total grows when
+    the classifier extends some)."""
     from tqdm.auto import tqdm
 
     return tqdm(
         total=total,
-        unit="member",
-        desc="ensemble (simulated)",
+        unit="run",
+        desc=_SIMULATING,
         file=sys.stderr,
         disable=args.quiet,
         dynamic_ncols=True,
         smoothing=0.1,
         mininterval=0.5,
     )
+
+
+def _extending(bar):
+    """classify_ensemble's progress on ``bar``: an extension round adds its members to the
+    total and says what it runs; its batches advance the bar."""
+
+    def progress(n: int, extending: int = 0, recorded_s: float | None = None) -> None:
+        if extending:
+            bar.total += extending
+            bar.set_description(
+                f"ensemble (extending {extending} undetermined to {recorded_s:g} s recorded)",
+                refresh=False,
+            )
+        bar.update(n)
+
+    return progress
 
 
 def _check_budget(params, duration: float, transient: float, members: int, chunk: int) -> None:

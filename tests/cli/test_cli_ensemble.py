@@ -1,5 +1,7 @@
 """``chaoscam ensemble``: outputs, refusal of bad input, and resuming an interrupted run."""
 
+import re
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -121,3 +123,19 @@ def test_progress_counts_every_member_from_the_first_batch(tmp_path, capsys):
     assert main([*loud, "--chunk", "5", "--out", str(out)]) == 0
     err = capsys.readouterr().err
     assert "ensemble (simulated):" in err and "/5" in err and "5/5" in err
+
+
+def test_progress_counts_the_extensions_too(tmp_path, capsys):
+    """With --classify, members undetermined after the run are extended: the bar says so,
+    its total grows by them, and it still ends full (no silent phase after 100 %)."""
+    out = tmp_path / "x.parquet"
+    args = ["ensemble", "--members", "2", "--duration", "20", "--transient", "10"]
+    sets = ["--set", "omega=26", "--set", "xi=0.3", "--seed", "1", "--classify"]
+    assert main([*args, *sets, "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    grown = re.findall(r"extending (\d+) undetermined to 40 s recorded\)?:.*?(\d+)/(\d+)", err)
+    assert grown, err
+    extended = int(grown[-1][0])
+    assert f"{2 + extended}/{2 + extended}" in err  # the final count is the grown total
+    members = pd.read_parquet(out)
+    assert "undetermined" not in set(members["label"])
