@@ -61,7 +61,8 @@ class Ensemble:
         period, reasons).
     settings : dict
         duration, transient, seed, threads, backend ("cpu" or "gpu", the one used), device,
-        batch, integrators, wall time.
+        batch, integrators, tangent, wall time; from :func:`extend_ensemble` also
+        ``continued_from``, the grid step its members went on from.
     impacts : pandas.DataFrame or None
         With ``keep_impacts=True``: member plus the columns of ``Trajectory.impacts`` (the
         applied jumps after the transient); else None (only counted).

@@ -77,13 +77,14 @@ def run_batch(
     start: _Start,
     first,
     duration,
+    *,
+    room,
     run=None,
     keep_impacts=False,
-    room=(2048, 2048),
     resumable=False,
 ):
     """Run one batch of members from ``start`` to ``duration`` (CPU or GPU) and collect its
-    outputs; ``room`` = (draws, impact rows) per member and launch (:data:`_ROOM`). With
+    outputs; ``room`` = (draws, impact rows) per member and launch (``_ensemble._ROOM``). With
     ``resumable`` the run stops once more on the way, at :func:`._resume.snapshot_step`,
     and returns its copy there too (else None)."""
     run = run or run_on_cpu
