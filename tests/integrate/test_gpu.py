@@ -138,6 +138,16 @@ for name, (p, duration, transient) in cases.items():
                  "n": len(a), "diff": float(np.abs(a - b).max()),
                  "impacts": ia.shape == ib.shape and bool(np.array_equal(ia, ib)),
                  "members": runs[0].members.equals(runs[1].members)}
+# continued on the device from a copy kept on the way (two launches, then a resumed batch)
+p = Params(l_lambda_sigma=0.002)
+kw = dict(seed=2, transient=0.1, tangent=True)
+short = simulate_ensemble(p, range(5), duration=0.3, backend="gpu", batch=3, resumable=True, **kw)
+longer = _ensemble.extend_ensemble(short, p, 0.6)
+made = simulate_ensemble(p, range(5), duration=0.6, backend="cpu", **kw)
+a, b = longer.sections.to_numpy(), made.sections.to_numpy()
+out["continued"] = {"backend": longer.settings["backend"], "shape": a.shape == b.shape,
+                    "n": len(a), "diff": float(np.abs(a - b).max()), "impacts": True,
+                    "members": longer.members.equals(made.members)}
 print(json.dumps(out))
 """
 
