@@ -94,7 +94,7 @@ def _run_locked(args: argparse.Namespace) -> int:
     from .._ensemble_verdicts import classify_ensemble
     from ..integrate import simulate_ensemble
     from ..integrate._gpu import GPUFallbackWarning
-    from ..sweep._checkpoint import discard_checkpoint
+    from ..sweep._checkpoint import discard_checkpoint, remove_leftovers
     from ..sweep._common import run_settings
     from . import UsageError, parse_assignments
 
@@ -120,6 +120,7 @@ def _run_locked(args: argparse.Namespace) -> int:
         "keep_impacts": args.keep_impacts,
     }
     digest = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:16]
+    remove_leftovers(parts)  # of a run killed while it created or deleted its parts
     if args.force:
         discard_checkpoint(parts)
     elif args.resume and not parts.exists() and _finished(out, digest):

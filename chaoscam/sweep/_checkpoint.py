@@ -32,7 +32,15 @@ import pandas as pd
 
 from ._grid import SweepError
 
-__all__ = ["MemoryStore", "CheckpointStore", "config_hash", "checkpoint_dir", "write_parquet"]
+__all__ = [
+    "MemoryStore",
+    "CheckpointStore",
+    "config_hash",
+    "checkpoint_dir",
+    "discard_checkpoint",
+    "remove_leftovers",
+    "write_parquet",
+]
 
 _META_KEY = b"chaoscam.sweep"
 
@@ -95,9 +103,36 @@ def decode_part(data: bytes) -> list[dict[str, Any]]:
     return records
 
 
+def remove_leftovers(path: Path) -> None:
+    """Finish what killed runs left beside ``path``: the ``.tmp-PID-NAME`` and
+    ``.tmp-PID-removed-NAME`` folders (a checkpoint being created, or being deleted by
+    :func:`discard_checkpoint`) of processes PID that no longer run.
+
+    Call it holding the output's lock; a folder whose process still runs is left alone.
+    """
+    for left in path.parent.glob(f".tmp-*-{path.name}"):
+        pid = left.name.split("-", 2)[1]
+        if pid.isdigit() and not _running(int(pid)):
+            shutil.rmtree(left, ignore_errors=True)
+
+
+def _running(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
 def discard_checkpoint(path: Path) -> None:
     """Delete a checkpoint folder: renamed away first, in one step, so a kill during the
-    deletion never leaves a half-deleted checkpoint that a later --resume would trip over."""
+    deletion never leaves a half-deleted checkpoint that a later --resume would trip over
+    (the renamed folder it leaves is removed by the next run, :func:`remove_leftovers`)."""
+    remove_leftovers(path)
     if not path.exists():
         return
     gone = path.with_name(f".tmp-{os.getpid()}-removed-{path.name}")

@@ -21,6 +21,7 @@ from ._checkpoint import (
     discard_checkpoint,
     guard_outputs,
     read_sweep_metadata,
+    remove_leftovers,
     write_parquet,
 )
 from ._grid import Axis, SweepError
@@ -130,6 +131,7 @@ def open_store(
     for path in (out, companion(out, second)):
         check_output(path, force=True)  # the folder and the path; existence is below
     ckpt = checkpoint_dir(out)
+    remove_leftovers(ckpt)  # of a run killed while it created or deleted its checkpoint
     if force and not resume:
         discard_checkpoint(ckpt)
     elif guard_outputs([out, companion(out, second)], config, resume):

@@ -84,3 +84,32 @@ def test_bifurcation_torn_last_part(tmp_path, capsys):
     res = bifurcation("l_lambda", values, classify=stop, out=out, resume=True, **kw)
     assert "torn" in capsys.readouterr().err
     frames_equal(res.points, ref.points)
+
+
+def test_what_a_killed_deletion_left_is_removed_by_the_next_run(tmp_path, reference):
+    """A SIGKILL while a finished run deleted its checkpoint (renamed away, then removed)
+    leaves ``.tmp-PID-removed-NAME``: the next run over that output removes it, also when it
+    only finds the output finished; a folder of a process that still runs stays."""
+    import os
+    import subprocess
+    import sys
+
+    out = tmp_path / "m.parquet"
+    regime_map(X, Y, classify=SpreadClassifier(), out=out, **GRID)
+    dead = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
+    name = checkpoint_dir(out).name
+    killed = tmp_path / f".tmp-{dead}-removed-{name}"
+    created = tmp_path / f".tmp-{dead}-{name}"  # killed while creating its checkpoint
+    mine = tmp_path / f".tmp-{os.getpid()}-removed-{name}"
+    for folder in (killed, created, mine):
+        (folder / "part-000001.jsonl").parent.mkdir()
+        (folder / "part-000001.jsonl").write_text("{}\n")
+    again = regime_map(X, Y, classify=SpreadClassifier(), out=out, resume=True, **GRID)
+    frames_equal(again.cells, reference.cells)
+    assert not killed.exists() and not created.exists()
+    assert mine.exists()  # this process still runs
