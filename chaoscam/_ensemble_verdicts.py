@@ -88,22 +88,21 @@ def member_verdicts(
     recorded = s["duration"] - s["transient"]
     t_wall = time.perf_counter()
     pending = [j for j, v in enumerate(verdicts) if _unsettled(v)]
-    last, at = ens, list(range(len(members)))  # the latest run of each member, and where
+    last, at = ens, list(range(len(members)))  # the latest run, and whose members it holds
     while pending and extend_to is not None and recorded < extend_to:
         recorded = min(extend_to, 4.0 * recorded)
         sub = [plist[j] for j in pending]
-        step = None
         if progress is not None:
             progress(0, extending=len(pending), recorded_s=recorded)
-            step = progress
         if last.resume is not None:  # continued from its last run: the same bits, sooner
+            where = {j: i for i, j in enumerate(at)}
             longer = extend_ensemble(
                 last,
-                [plist[j] for j in at] if last is not ens else plist,
+                [plist[j] for j in at],
                 s["transient"] + recorded,
-                members=[at.index(j) for j in pending],
+                members=[where[j] for j in pending],
                 resumable=True,
-                progress=step,
+                progress=progress,
             )
         else:
             longer = simulate_ensemble(
@@ -114,7 +113,7 @@ def member_verdicts(
                 transient=s["transient"],
                 backend=s["backend"],
                 tangent=True,
-                progress=step,
+                progress=progress,
             )
         last, at = longer, list(pending)
         note = {

@@ -185,7 +185,6 @@ def simulate_ensemble(
         "duration": duration,
         "transient": transient,
         "seed": seed,
-        "threads": None,
         "backend": "gpu" if use_gpu else "cpu",
         "device": device,
         "batch": batch,

@@ -219,7 +219,10 @@ def run_on_gpu(
     n = y.shape[0]
     d_y, d_cnt, d_c, d_lam, d_status = (cuda.to_device(a) for a in (y, cnt, c, lam, status))
     d_series = cuda.device_array((n, 1, k.SERIES_COLS))
-    d_section = cuda.to_device(section)  # rows of an earlier launch are kept
+    if cnt[:, k.I_N_SECTION].any():  # rows of an earlier launch (a resumable run's first)
+        d_section = cuda.to_device(section)
+    else:
+        d_section = cuda.device_array(section.shape)
     d_impacts = cuda.device_array(impacts.shape)
     blocks = (n + _BLOCK - 1) // _BLOCK
 

@@ -63,12 +63,16 @@ def resumed(res: Resume, plist, duration, room) -> _Start:
     y, cnt, c, lam, streams = res.start(_n_draws(plist, duration - res.step * plist[0].dt, room))
     # A member that had ended keeps its code, and is not run.
     status = np.where(res.status == k.OK, k.NEED_BUFFER, res.status)
-    return _Start(res.step, y, cnt, c, lam, streams, res.rows, res.impacts.copy(), status)
+    return _Start(res.step, y, cnt, c, lam, streams, res.rows, res.impacts, status)
+
+
+def _margin(plist) -> int:
+    """Rows and draws one grid step may use beyond the room (events, a merged flight)."""
+    return 4 * (max(p.max_events_per_step + p.flight_merge for p in plist) + 2)
 
 
 def _n_draws(plist, duration, room) -> int:
-    extra = max(p.max_events_per_step + p.flight_merge for p in plist) + 2
-    return max(_draws(p, duration, room[0]) for p in plist) + 4 * extra
+    return max(_draws(p, duration, room[0]) for p in plist) + _margin(plist)
 
 
 def run_batch(
@@ -93,10 +97,9 @@ def run_batch(
     n_stop = int(round(duration / p0.dt))
     t_start = start.step * p0.dt
     n_sec = int((duration - t_start) / p0.cam_period) + 4 + int(p0.dt / p0.cam_period)
-    extra = max(p.max_events_per_step + p.flight_merge for p in plist) + 2
     y, cnt, c, lam, streams = start.y, start.cnt, start.c, start.lam, start.streams
     section = np.empty((n, n_sec, k.SECTION_COLS))
-    impacts = np.empty((n, room[1] + 4 * extra, k.IMPACT_COLS))
+    impacts = np.empty((n, room[1] + _margin(plist), k.IMPACT_COLS))
     status = start.status.copy()
     n_impacts = start.impacts.copy()
 

@@ -132,7 +132,6 @@ def discard_checkpoint(path: Path) -> None:
     """Delete a checkpoint folder: renamed away first, in one step, so a kill during the
     deletion never leaves a half-deleted checkpoint that a later --resume would trip over
     (the renamed folder it leaves is removed by the next run, :func:`remove_leftovers`)."""
-    remove_leftovers(path)
     if not path.exists():
         return
     gone = path.with_name(f".tmp-{os.getpid()}-removed-{path.name}")
