@@ -206,7 +206,7 @@ def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side
     The first substep's Jacobian is taken on ``side_first`` (the side a step that starts on
     the surface starts on), the others on ``side``.
     """
-    if c[k.C_TANGENT] <= 0.0:
+    if not steps.tangent_on(t, c):  # off, or in the transient
         return
     _, p0, q0 = k.acceleration_jacobian(t, th, om, K, c, side_first)
     _, p1, q1 = k.acceleration_jacobian(

@@ -24,10 +24,11 @@ The gap is resolved to ~1e-16 m at any time (the last bounces of a chattering se
 length is rounded so that its end is the double the kernel stamps it with
 (:func:`._physics.on_clock`), so the state and the clock never part by a rounding of ``t``.
 
-With ``c[C_TANGENT]`` set, the tangent matrix is integrated with the state
-(:mod:`._tangent`) and multiplied by the saltation matrix at each jump; at each section time
-the Jacobian of the stroboscopic map over the last period is written beside the section point
-and the tangent restarts from the identity. The state is the same with and without it.
+With ``c[C_TANGENT]`` set, the tangent matrix is integrated with the state (:mod:`._tangent`)
+from shortly before the recording starts (:func:`._steps.tangent_on`) and multiplied by the
+saltation matrix at each jump; at each section time the Jacobian of the stroboscopic map over
+the last period is written beside the section point and the tangent restarts from the
+identity. The state is the same with and without it.
 
 The model's equations live in :mod:`._physics`, the array layout in :mod:`._layout` (whose
 names this module re-exports for its callers), the location of events inside a step in
@@ -53,7 +54,6 @@ from ._layout import (
     C_ROD_L,
     C_STRIDE,
     C_T_RECORD,
-    C_TANGENT,
     C_V_CHATTER,
     I_CHATTER,
     I_CONTACT_STEPS,
@@ -99,19 +99,20 @@ from ._physics import (  # noqa: F401 (re-exported: the adaptive kernel and test
     safe_horizon,
     stiffness,
 )
-from ._steps import at_scheduled, commit_tangent, impact, next_scheduled
+from ._steps import at_scheduled, commit_tangent, impact, next_scheduled, tangent_on
 from ._tangent import rk4_flight_tangent, rk4_tangent
 
 
 @njit(cache=True, inline="always")
 def step_rk4(t, th, om, h, K, c, y, commit, side):
-    """One RK4 substep of the state; with the tangent on, of the tangent too, its Jacobian
-    taken on ``side`` of the contact surface (:data:`._physics.JAC_NATURAL` and others).
+    """One RK4 substep of the state; with the tangent on (:func:`._steps.tangent_on`: not in
+    the transient), of the tangent too, its Jacobian taken on ``side`` of the contact
+    surface (:data:`._physics.JAC_NATURAL` and others).
 
     Returns ``(th, om, v11, v21, v12, v22, div)``, the last five being the tangent after the
     step (written into ``y`` when ``commit``; the state is always returned, never stored).
     """
-    if c[C_TANGENT] > 0.0:
+    if tangent_on(t, c):
         r = rk4_tangent(t, th, om, h, K, c, y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22], side)
         if commit:
             commit_tangent(y, r[2], r[3], r[4], r[5], r[6])
@@ -121,9 +122,9 @@ def step_rk4(t, th, om, h, K, c, y, commit, side):
 
 
 @njit(cache=True, inline="always")
-def step_flight(th, om, h, c, y, commit):
+def step_flight(t, th, om, h, c, y, commit):
     """:func:`step_rk4` for the free pendulum (:func:`rk4_flight`); divergence 0."""
-    if c[C_TANGENT] > 0.0:
+    if tangent_on(t, c):
         r = rk4_flight_tangent(th, om, h, c, y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22])
         if commit:
             commit_tangent(y, r[2], r[3], r[4], r[5], 0.0)
@@ -217,7 +218,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             th0 = th
             om0 = om
             # the block's length as the difference of its stamped ends (see on_clock)
-            th, om, _, _, _, _, _ = step_flight(th0, om0, (n + m) * h - t, c, y, True)
+            th, om, _, _, _, _, _ = step_flight(t, th0, om0, (n + m) * h - t, c, y, True)
             stale = True
             cnt[I_STEP] = n + m
             if not (math.isfinite(th) and math.isfinite(om)):
@@ -247,7 +248,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             seg_end, is_section, is_resample = next_scheduled(t_end, cnt, c)
             hs = seg_end - t
             if hs > 0.0 and seg_end <= safe_n * h:
-                th, om, _, _, _, _, _ = step_flight(th, om, hs, c, y, True)  # pure flight
+                th, om, _, _, _, _, _ = step_flight(t, th, om, hs, c, y, True)  # pure flight
                 t = seg_end
                 stale = True
             elif hs > 0.0:
@@ -275,7 +276,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 if trial_full:
                     trial = step_rk4(t, th, om, hs, K, c, y, False, trial_side)
                 else:
-                    trial = step_flight(th, om, hs, c, y, False)  # no contact possible
+                    trial = step_flight(t, th, om, hs, c, y, False)  # no contact possible
                 th_new, om_new = trial[0], trial[1]
                 g_new, l1, cdn = geometry(seg_end, th_new, c)
                 rate1 = l1 * om_new - cdn
@@ -331,7 +332,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                             g_hi = g_f
                     tau = locate_crossing(t, th, om, tau_lo, g_lo, tau_hi, g_hi, K, c, free)
                     if free:
-                        th, om, _, _, _, _, _ = step_flight(th, om, tau, c, y, True)
+                        th, om, _, _, _, _, _ = step_flight(t, th, om, tau, c, y, True)
                     else:
                         # The substep ends on the surface: its Jacobian is the side it comes
                         # from (flight before a closing and just after a jump, else contact).
@@ -353,7 +354,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     jumped = om != om_before and not plastic and l1 * om - cdn > 0.0
                     settled = om != om_before and plastic
                     continue
-                if c[C_TANGENT] > 0.0:
+                if tangent_on(t, c):
                     commit_tangent(y, trial[2], trial[3], trial[4], trial[5], trial[6])
                 jumped = False
                 settled = False

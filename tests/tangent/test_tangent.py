@@ -76,6 +76,28 @@ def test_tangent_does_not_change_the_motion():
     )
 
 
+@pytest.mark.parametrize(
+    "params",
+    [Params(flight_merge=1), Params(integrator="adaptive")],
+    ids=["rk4 unmerged", "adaptive"],
+)
+@pytest.mark.parametrize("periods", [20.0, 20.37, 20.999], ids=["on", "inside", "just before"])
+def test_tangent_skipped_in_the_transient_changes_no_recorded_jacobian(params, periods):
+    """The tangent is carried only from shortly before the recording starts: the Jacobians
+    written at recorded sections are those of a run that records (so carries the tangent)
+    from t = 0, to the bit, whether the recording starts on a section time, inside a period
+    or just before a section. (Flight is not merged on RK4 here: a merged block may not
+    cross the recording's start, so with merging the states themselves depend on it.)"""
+    T = params.cam_period
+    full = simulate(params, duration=25 * T, tangent=True, series=False)
+    late = simulate(params, duration=25 * T, transient=periods * T, tangent=True, series=False)
+    k0 = int(late.section["k"].iloc[0])
+    assert len(late.section) >= 3
+    same = full.section["k"].to_numpy() >= k0
+    np.testing.assert_array_equal(full.section[same].to_numpy(), late.section.to_numpy())
+    np.testing.assert_array_equal(full.jacobians[same], late.jacobians)
+
+
 def test_spectrum_of_known_matrices():
     """QR on a constant diagonal map gives its log eigenvalues; a singular step gives -inf."""
     jac = np.repeat(np.diag([3.0, 0.5])[None], 100, axis=0)
