@@ -15,11 +15,12 @@ realizations) and how often the labels agree.
 It also prints each engine's CPU time per trajectory and how busy it kept the cores (CPU time
 over wall time x cores, the pool's workers included), and how much of the ensemble engine's
 time is spent inside the compiled kernel's launches. Both engines simulate the same
-realizations and extend the same undetermined ones to the same length; the process engine
-runs an extension again from t = 0, the ensemble engine continues it from where the first
-run stopped (``extend_ensemble``: the same bits, without repeating the transient and the
-time already recorded). With every core busy all the time the ensemble engine would take its
-kernel CPU time over the cores: the ratio's bound, printed too.
+realizations and extend the same undetermined ones to the same length, each continuing an
+extension from where the first run stopped (the same bits, without repeating the transient
+and the time already recorded): the ensemble engine by ``extend_ensemble``, the process
+engine by ``extend_trajectory`` (its runs are kept resumable). With every core busy all the
+time the ensemble engine would take its kernel CPU time over the cores: the ratio's bound,
+printed too.
 """
 
 from __future__ import annotations

@@ -8,6 +8,7 @@ realization's own generator, empties its output buffers, and wraps everything in
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import time
@@ -22,6 +23,7 @@ from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
 from .integrate._constants import initial_counters, initial_state
 from .integrate._driver import Buffers, check_window, contact_fraction, drive
+from .integrate._resume import RunCopy, snapshot_step
 from .integrate._tangent import section_jacobians
 from .model import (
     LineLengthStream,
@@ -80,6 +82,9 @@ class Trajectory:
     divergence : ndarray or None
         With ``tangent=True``: the integral of the flow's divergence over each such period
         (Liouville: ln|det J_k| = divergence_k + 2 ln(xi) per restitution jump).
+    resume : RunCopy or None
+        With ``resumable=True`` (RK4): the copy :func:`chaoscam.extend_trajectory`
+        continues the run from; None otherwise, and for a run read from a file.
     """
 
     params: Params
@@ -92,6 +97,7 @@ class Trajectory:
     final_state: tuple[float, float, float] = (0.0, 0.0, 0.0)
     jacobians: np.ndarray | None = field(default=None, repr=False)
     divergence: np.ndarray | None = field(default=None, repr=False)
+    resume: RunCopy | None = field(default=None, repr=False, compare=False)
 
     @property
     def message(self) -> str:
@@ -180,6 +186,7 @@ def simulate(
     series: bool = True,
     output_dt: float = 1e-3,
     tangent: bool = False,
+    resumable: bool = False,
     **overrides: Any,
 ) -> Trajectory:
     """Simulate one realization with located impacts: fixed-step RK4 (the paper's method, the
@@ -207,6 +214,11 @@ def simulate(
         :func:`chaoscam.periodic_orbit` work. Both integrators (the adaptive path carries
         it by an RK4 step along each accepted step). The motion is the same with and
         without it.
+    resumable : bool
+        Keep a copy of the run's state near its end (``Trajectory.resume``; RK4 only, the
+        adaptive path keeps none), from which :func:`chaoscam.extend_trajectory` makes the
+        run longer without repeating it, to the same bits as a run made that long from
+        t = 0. The copy costs one more stop of the compiled call; the run is the same.
 
     Returns
     -------
@@ -223,6 +235,7 @@ def simulate(
         series=series,
         output_dt=output_dt,
         tangent=tangent,
+        resumable=resumable,
         **overrides,
     ).trajectory()
 
@@ -245,6 +258,7 @@ class RawRun:
     series: np.ndarray | None
     section: np.ndarray
     impacts: np.ndarray
+    resume: RunCopy | None = field(default=None, repr=False, compare=False)
 
     @property
     def message(self) -> str:
@@ -277,6 +291,7 @@ class RawRun:
             final_state=self.final_state,
             jacobians=section_jacobians(self.section) if tangent else None,
             divergence=self.section[:, n_sec + 4].copy() if tangent else None,
+            resume=self.resume,
         )
 
 
@@ -290,6 +305,7 @@ def raw_run(
     series: bool = True,
     output_dt: float = 1e-3,
     tangent: bool = False,
+    resumable: bool = False,
     **overrides: Any,
 ) -> RawRun:
     """:func:`simulate` up to its arrays (same arguments, same checks and warnings)."""
@@ -304,59 +320,21 @@ def raw_run(
     t0 = time.perf_counter()
     n_stop = int(round(duration / p.dt))
     stride = max(1, int(round(output_dt / p.dt))) if series else 0
-    steps_per_contact = contact_period(p) / p.dt
     coarse = resolution_warning(p)
     if coarse:
         warnings.warn(coarse, RuntimeWarning, stacklevel=3)  # simulate's caller
 
-    # Buffers hold at least a few steps' worth of the most a step can produce.
-    per_step = p.max_events_per_step + p.flight_merge + 2
-    if p.resample == "interval":
-        per_step += int(p.dt / p.resample_dt) + 2
-    block = max(_BLOCK, 4 * per_step, 4 * (int(p.dt / p.cam_period) + 2))
     stream = LineLengthStream(p, seed, index)
-    lam = stream.draw(block)
+    lam = stream.draw(output_block(p))
     y = initial_state(p)
     th0, om0 = y[k.Y_THETA], y[k.Y_OMEGA]
     cnt = initial_counters(p, transient=transient)
     c = kernel_constants(p, t_record=transient, stride=stride, tangent=tangent)
-    buffers = Buffers.empty(block if series else 1, block, block)
     parts: dict[str, list[np.ndarray]] = {"series": [], "section": [], "impacts": []}
     if series and transient == 0.0:
         parts["series"].append(np.array([[0.0, th0, om0, lam[0]]]))
-
-    def more_draws(lam: np.ndarray) -> np.ndarray:
-        pos = cnt[k.I_LAM_POS]
-        cnt[k.I_LAM_POS] = 0
-        return np.concatenate([lam[pos:], stream.draw(block)])
-
-    code = drive(
-        y,
-        cnt,
-        c,
-        n_stop,
-        lam,
-        buffers,
-        on_rows=lambda name, rows: parts[name].append(rows.copy()),
-        more_draws=more_draws,
-    )
-
-    def stack(name: str, ncol: int) -> np.ndarray:
-        return np.concatenate(parts[name]) if parts[name] else np.empty((0, ncol))
-
-    imp = stack("impacts", k.IMPACT_COLS)
-    kinds = imp[:, IMPACT_COLUMNS.index("kind")]
-    stats = {
-        "contact_fraction": contact_fraction(y, cnt, c),
-        "n_impacts": len(imp),
-        "n_macro_impacts": int((kinds == k.IMPACT_MACRO).sum()),
-        "n_micro_impacts": int((kinds == k.IMPACT_MICRO).sum()),
-        "n_chatter_ends": int((kinds == k.IMPACT_CHATTER_END).sum()),
-        "slow_closings": int(cnt[k.I_SLOW_CLOSINGS]),
-        "chatter_handovers": int(cnt[k.I_CHATTER]),
-        "truncated_mass": truncated_mass(p.l_lambda, p.l_lambda_sigma, p.l_min),
-        "steps_per_contact_period": steps_per_contact,
-    }
+    run = KernelRun(p, y, cnt, c, lam, stream, parts)
+    code = run.go(n_stop, resumable)
     settings = {
         "duration": float(duration),
         "transient": float(transient),
@@ -372,16 +350,112 @@ def raw_run(
         "tangent": bool(tangent),
         "wall_time_s": time.perf_counter() - t0,
     }
-    return RawRun(
-        params=p,
-        settings=settings,
-        status=Status(code),
-        stats=stats,
-        final_state=(float(y[k.Y_TIME]), float(y[k.Y_THETA]), float(y[k.Y_OMEGA])),
-        series=stack("series", k.SERIES_COLS) if series else None,
-        section=stack("section", k.SECTION_COLS),
-        impacts=imp,
-    )
+    return run.result(code, settings)
+
+
+def output_block(p: Params) -> int:
+    """Rows per output buffer and draws per refill: at least a few steps' worth of the most
+    a step can produce."""
+    per_step = p.max_events_per_step + p.flight_merge + 2
+    if p.resample == "interval":
+        per_step += int(p.dt / p.resample_dt) + 2
+    return max(_BLOCK, 4 * per_step, 4 * (int(p.dt / p.cam_period) + 2))
+
+
+class KernelRun:
+    """One trajectory's arrays on their way through the kernel (:func:`drive`), the rows
+    recorded so far (``parts``) and its draws; for a resumable run also the copy taken on
+    the way (:mod:`chaoscam.integrate._resume`)."""
+
+    def __init__(self, p: Params, y, cnt, c, lam, stream, parts) -> None:
+        self.p, self.y, self.cnt, self.c, self.lam, self.stream = p, y, cnt, c, lam, stream
+        self.parts = parts
+        self.block = output_block(p)
+        self.buffers = Buffers.empty(self.block if c[k.C_STRIDE] > 0 else 1, self.block, self.block)
+        self.mark: tuple | None = None
+
+    def _more_draws(self, lam: np.ndarray) -> np.ndarray:
+        pos = self.cnt[k.I_LAM_POS]
+        self.cnt[k.I_LAM_POS] = 0
+        self.lam = np.concatenate([lam[pos:], self.stream.draw(self.block)])
+        return self.lam
+
+    def _to(self, n_stop: int) -> int:
+        return drive(
+            self.y,
+            self.cnt,
+            self.c,
+            n_stop,
+            self.lam,
+            self.buffers,
+            on_rows=lambda name, rows: self.parts[name].append(rows.copy()),
+            more_draws=self._more_draws,
+        )
+
+    def go(self, n_stop: int, resumable: bool) -> int:
+        """Drive to grid step ``n_stop``; resumable (RK4 only), stop once on the way at
+        :func:`snapshot_step` and keep a copy there. Returns the final status code."""
+        step = snapshot_step(self.p, n_stop) if resumable else None
+        if step is None:
+            return self._to(n_stop)
+        code = self._to(step)
+        cnt = self.cnt.copy()
+        draws = self.lam[cnt[k.I_LAM_POS] :].copy()
+        cnt[k.I_LAM_POS] = 0
+        rows = {name: sum(len(r) for r in part) for name, part in self.parts.items()}
+        self.mark = (step, self.y.copy(), cnt, self.c.copy(), draws, copy.deepcopy(self.stream))
+        self.mark += (rows, code)
+        return self._to(n_stop) if code == k.OK else code
+
+    def result(self, code: int, settings: dict[str, Any]) -> RawRun:
+        """The run's :class:`RawRun` (its copy attached when one was kept)."""
+        p, y, cnt, c = self.p, self.y, self.cnt, self.c
+
+        def stack(name: str, ncol: int) -> np.ndarray:
+            part = self.parts[name]
+            return np.concatenate(part) if part else np.empty((0, ncol))
+
+        series = stack("series", k.SERIES_COLS) if c[k.C_STRIDE] > 0 else None
+        section = stack("section", k.SECTION_COLS)
+        imp = stack("impacts", k.IMPACT_COLS)
+        kinds = imp[:, IMPACT_COLUMNS.index("kind")]
+        stats = {
+            "contact_fraction": contact_fraction(y, cnt, c),
+            "n_impacts": len(imp),
+            "n_macro_impacts": int((kinds == k.IMPACT_MACRO).sum()),
+            "n_micro_impacts": int((kinds == k.IMPACT_MICRO).sum()),
+            "n_chatter_ends": int((kinds == k.IMPACT_CHATTER_END).sum()),
+            "slow_closings": int(cnt[k.I_SLOW_CLOSINGS]),
+            "chatter_handovers": int(cnt[k.I_CHATTER]),
+            "truncated_mass": truncated_mass(p.l_lambda, p.l_lambda_sigma, p.l_min),
+            "steps_per_contact_period": contact_period(p) / p.dt,
+        }
+        resume = None
+        if self.mark is not None:
+            step, y0, cnt0, c0, draws, stream, rows, code0 = self.mark
+            resume = RunCopy(
+                step,
+                y0,
+                cnt0,
+                c0,
+                draws,
+                stream,
+                None if series is None else series[: rows["series"]],
+                section[: rows["section"]],
+                imp[: rows["impacts"]],
+                int(code0),
+            )
+        return RawRun(
+            params=p,
+            settings=settings,
+            status=Status(code),
+            stats=stats,
+            final_state=(float(y[k.Y_TIME]), float(y[k.Y_THETA]), float(y[k.Y_OMEGA])),
+            series=series,
+            section=section,
+            impacts=imp,
+            resume=resume,
+        )
 
 
 def _summary(run: Trajectory | RawRun) -> str:

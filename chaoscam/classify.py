@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ._extend import extend_trajectory
 from ._model_rules import MODEL_ATOL, with_model_evidence
 from ._simulate import Trajectory, simulate
 from ._trajectory_io import load_trajectory
@@ -142,22 +143,40 @@ def _exponent_of(spec) -> tuple[float, float, int]:
     return (spec.exponent, float(spec.stderr[0]), spec.n_periods)
 
 
-def _tangent_verdict(traj: Trajectory, discard: float, options: dict) -> tuple[Verdict, dict]:
-    """The verdict from the section (and series), the tangent exponent and, for a periodic
-    section of the deterministic model, a certified periodic orbit (:mod:`chaoscam.tangent`)."""
-    p = traj.params.replace(integrator="rk4")  # the tangent lives on the RK4 grid
+def _tangent_run(traj: Trajectory) -> Trajectory:
+    """The run whose Jacobians a verdict reads: ``traj`` when simulated with the tangent,
+    else the same realization on the RK4 grid with it, kept resumable (so that an extension
+    goes on from it, :func:`chaoscam.extend_trajectory`)."""
+    if traj.jacobians is not None:
+        return traj
+    return _rk4_tangent_run(traj, traj.settings["duration"])
+
+
+def _rk4_tangent_run(traj: Trajectory, duration: float) -> Trajectory:
+    """The realization of ``traj`` simulated ``duration`` seconds on the RK4 grid (where the
+    tangent lives) with the tangent, without series, kept resumable."""
     s = traj.settings
-    tr = traj
-    if traj.jacobians is None:
-        tr = simulate(
-            p,
-            duration=s["duration"],
-            transient=s["transient"],
-            seed=s["seed"],
-            index=s["index"],
-            series=False,
-            tangent=True,
-        )
+    return simulate(
+        traj.params.replace(integrator="rk4"),
+        duration=duration,
+        transient=s["transient"],
+        seed=s["seed"],
+        index=s["index"],
+        series=False,
+        tangent=True,
+        resumable=True,
+    )
+
+
+def _tangent_verdict(
+    traj: Trajectory, discard: float, options: dict, tr: Trajectory | None = None
+) -> tuple[Verdict, dict]:
+    """The verdict from the section (and series), the tangent exponent of ``tr`` (default
+    :func:`_tangent_run`) and, for a periodic section of the deterministic model, a
+    certified periodic orbit (:mod:`chaoscam.tangent`)."""
+    p = traj.params.replace(integrator="rk4")
+    s = traj.settings
+    tr = _tangent_run(traj) if tr is None else tr
     period = p.cam_period
     t0 = s["transient"] + discard
     sec = tr.section
@@ -190,29 +209,29 @@ the labelled set is settled from 120 s runs, and the tangent exponent's standard
 as the inverse square root of the run (measured ~0.15 1/s after 60 s on the default)."""
 
 
-def _extended(traj, verdict, extra, discard, options, cap) -> tuple[Verdict, dict]:
-    """Re-run the realization 4x longer (section and tangent only) until the verdict settles
-    or the recorded time reaches ``cap``."""
-    s = traj.settings
+def _extended(tr, verdict, extra, discard, options, cap) -> tuple[Verdict, dict]:
+    """Run the realization 4x longer (section and tangent only) until the verdict settles
+    or the recorded time reaches ``cap``: continued from the tangent run ``tr`` (and each
+    round from the last, :func:`chaoscam.extend_trajectory`) when that is an RK4 run, else
+    simulated on the RK4 grid once and continued from there."""
+    s = tr.settings
     start = s["transient"] + discard
     recorded = s["duration"] - start
     t_wall = time.perf_counter()
+    base = tr if tr.params.integrator == "rk4" else None
     while verdict.label == "undetermined" and recorded < cap:
         recorded = min(cap, 4.0 * recorded)
-        longer = simulate(
-            traj.params.replace(integrator="rk4"),
-            duration=start + recorded,
-            transient=s["transient"],
-            seed=s["seed"],
-            index=s["index"],
-            series=False,
-            tangent=True,
-        )
+        if base is None:
+            longer = _rk4_tangent_run(tr, start + recorded)
+        else:
+            longer = extend_trajectory(base, start + recorded, series=False)
+        base = longer
         if longer.status is not Status.OK:
             break
-        verdict, extra = _tangent_verdict(longer, discard, options)
+        verdict, extra = _tangent_verdict(longer, discard, options, longer)
         extra["extended"] = {
             "recorded_s": recorded,
+            "continued_from_s": longer.settings.get("continued_from_s"),
             "wall_time_s": time.perf_counter() - t_wall,
             "why": "the verdict on the run as given was undetermined",
         }
@@ -248,7 +267,7 @@ def classify_trajectory(
         Default True: the verdict comes from the section with the tangent exponent of the
         model through its impacts (:func:`chaoscam.tangent.lyapunov_spectrum`: λ₁ with its
         standard error; taken from ``traj.jacobians`` or from a re-simulation with
-        ``tangent=True``, ~1.2x a simulation, always on the RK4 grid) and, when the section
+        ``tangent=True``, ~1.1x a simulation, always on the RK4 grid) and, when the section
         is periodic and the model deterministic, a periodic orbit found by Newton shooting:
         converged, attracting (|μ| < 1) and with the run on it, it is recorded as the
         decisive evidence ``periodic_orbit``; a converged *unstable* orbit makes the
@@ -278,7 +297,10 @@ def classify_trajectory(
         longer (4x the recorded time each round, section and tangent only, at most
         ``extend_to`` seconds recorded; a realization's prefix does not depend on its
         duration) and classified again, until it settles; ``settings["extended"]`` records
-        the recorded time and wall time used. None: never extend.
+        the recorded time and wall time used. A round goes on from the run before it
+        (:func:`chaoscam.extend_trajectory`) when that run was kept resumable (the sweeps'
+        runs are; one simulated here for its tangent is), else it runs from t = 0: the
+        same bits either way. None: never extend.
     **options
         Passed to the analysis classifier (``rtol``, ``lyapunov_tol`` [1/s], ``seed``, ...).
 
@@ -305,9 +327,10 @@ def classify_trajectory(
     if traj.status is not Status.OK:
         return _status_verdict(traj, settings)
 
-    verdict, extra = _verdict_of(traj, lyapunov, discard, options, tangent)
-    if tangent and not lyapunov and extend_to and verdict.label == "undetermined":
-        verdict, extra = _extended(traj, verdict, extra, discard, options, float(extend_to))
+    tr = _tangent_run(traj) if tangent and not lyapunov else None
+    verdict, extra = _verdict_of(traj, lyapunov, discard, options, tangent, tr)
+    if tr is not None and extend_to and verdict.label == "undetermined":
+        verdict, extra = _extended(tr, verdict, extra, discard, options, float(extend_to))
     verdict = _with_settings(verdict, **settings, **extra)
     if not check_step:
         return verdict
@@ -360,10 +383,15 @@ def _describe(v: Verdict) -> str:
 
 
 def _verdict_of(
-    traj: Trajectory, lyapunov: bool, discard: float, options: dict, tangent: bool = False
+    traj: Trajectory,
+    lyapunov: bool,
+    discard: float,
+    options: dict,
+    tangent: bool = False,
+    tr: Trajectory | None = None,
 ) -> tuple[Verdict, dict]:
     if tangent and not lyapunov:
-        return _tangent_verdict(traj, discard, options)
+        return _tangent_verdict(traj, discard, options, tr)
     if not lyapunov:
         return _evidence_verdict(traj, discard, None, options), {}
     from .lyapunov import lyapunov_model

@@ -18,6 +18,7 @@ LAYERS = (
     "chaoscam._budget",
     "chaoscam.integrate",
     "chaoscam._simulate",
+    "chaoscam._extend",
     "chaoscam._trajectory_io",
     "chaoscam.testsystems",
     "chaoscam.analysis",

@@ -18,6 +18,9 @@ copy of its state there (:class:`Resume`) and goes on to its end; a continuation
 from the copy and records again from that section on. ``tests/integrate/test_resume.py``
 compares continued members with runs made long from the start.
 
+A single run (``simulate(..., resumable=True)``) keeps the same copy, :class:`RunCopy`,
+with the rows it recorded before it; :func:`chaoscam.extend_trajectory` continues it.
+
 Only the fixed-step RK4 kernel: the adaptive one shortens its last step to land on the end
 time, so that its runs are re-run instead.
 """
@@ -33,7 +36,7 @@ import numpy as np
 from ..model import LineLengthStream, Params
 from . import _kernel as k
 
-__all__ = ["Resume", "snapshot_step"]
+__all__ = ["Resume", "RunCopy", "snapshot_step"]
 
 
 def snapshot_step(p: Params, n_stop: int) -> int | None:
@@ -153,3 +156,48 @@ def take(step, y, cnt, c, lam, streams, rows, impacts, status) -> Resume:
         np.asarray(impacts, dtype=np.int64).copy(),
         status.copy(),
     )
+
+
+@dataclass(frozen=True)
+class RunCopy:
+    """One trajectory's state at grid step ``step`` (t = step dt), the copy a resumable
+    ``simulate`` keeps, and the rows it had recorded before that step: what
+    :func:`chaoscam.extend_trajectory` continues it from (see the module's docstring).
+
+    Attributes
+    ----------
+    step : int
+        The grid step of the copy (:func:`snapshot_step`).
+    y, cnt, c : ndarray
+        State, counters (the buffers' row counts and the draw position zeroed) and
+        constants there.
+    draws : ndarray
+        The line-length draws not yet used, in order.
+    stream : LineLengthStream
+        The realization's stream after those draws (never drawn from: copied before use).
+    series, section, impacts : ndarray
+        The rows recorded before ``step``, in the kernel's columns (``SERIES_COLS``,
+        ``SECTION_COLS`` with the tangent's, ``IMPACT_COLS``); ``series`` None when the run
+        kept none.
+    status : int
+        ``OK`` to go on, else the code the run ended with before ``step`` (it left the
+        cam's reach, diverged, ...): a longer run ends the same way.
+    """
+
+    step: int
+    y: np.ndarray
+    cnt: np.ndarray
+    c: np.ndarray
+    draws: np.ndarray
+    stream: LineLengthStream
+    series: np.ndarray | None
+    section: np.ndarray
+    impacts: np.ndarray
+    status: int
+
+    def start(self, n_draws: int) -> tuple:
+        """Fresh arrays to continue from: (y, cnt, c, lam, stream), ``lam`` holding the
+        unused draws and ``n_draws`` more, ``stream`` a copy positioned after them."""
+        stream = copy.deepcopy(self.stream)
+        lam = np.concatenate([self.draws, stream.draw(n_draws)])
+        return self.y.copy(), self.cnt.copy(), self.c.copy(), lam, stream

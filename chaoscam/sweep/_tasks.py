@@ -160,6 +160,7 @@ def status_fields(status: Status) -> dict[str, Any]:
 
 def _run(params: Params, task: Any) -> tuple[RunSummary, dict[str, Any]]:
     """Simulate and classify; a run that did not end normally is labelled by its status."""
+    tangent = bool(getattr(task.classify, "needs_tangent", False)) and params.integrator == "rk4"
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         traj = simulate(
@@ -170,8 +171,8 @@ def _run(params: Params, task: Any) -> tuple[RunSummary, dict[str, Any]]:
             index=task.sim_index,
             series=task.series,
             output_dt=max(OUTPUT_DT, params.dt),  # a swept dt may exceed it
-            tangent=bool(getattr(task.classify, "needs_tangent", False))
-            and params.integrator == "rk4",
+            tangent=tangent,
+            resumable=tangent,  # an undetermined verdict's extension goes on from it
         )
         fields = verdict_fields(task.classify(traj)) if traj.ok else status_fields(traj.status)
     seen = dict.fromkeys(str(w.message) for w in caught)

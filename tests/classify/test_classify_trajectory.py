@@ -252,6 +252,37 @@ def test_a_resumable_ensemble_is_extended_by_continuing_it(monkeypatch):
             assert ext_a["recorded_s"] == ext_b["recorded_s"]
 
 
+@pytest.mark.parametrize("series", [False, True], ids=["tangent run", "series run"])
+def test_a_resumable_run_is_extended_by_continuing_it(monkeypatch, series):
+    """classify_trajectory extends an undetermined run kept resumable by going on from it
+    (extend_trajectory), not by running again from t = 0, with the same verdict, evidence
+    and reasons (the extended verdict reads the longer run's section and Jacobians). A run
+    kept with its series but without the tangent (and a copy) is simulated once with the
+    tangent, resumable, and the extension rounds go on from that."""
+    from chaoscam import Params, classify, simulate
+
+    p = Params(omega=26.0, xi=0.3)
+    run = dict(duration=20.0, transient=10.0, seed=1, index=0)
+    again = classify.classify_trajectory(simulate(p, series=False, tangent=True, **run))
+    calls = []
+    real = classify.simulate
+    monkeypatch.setattr(
+        classify, "simulate", lambda *a, **kw: calls.append(kw["duration"]) or real(*a, **kw)
+    )
+    kept = simulate(p, series=series, tangent=not series, resumable=not series, **run)
+    continued = classify.classify_trajectory(kept)
+    assert calls == ([20.0] if series else [])  # only the tangent run, once
+    assert again.settings["extended"]["continued_from_s"] is None
+    assert 0.0 < continued.settings["extended"]["continued_from_s"] < 50.0
+    assert (again.label, again.period, again.reasons) == (
+        continued.label,
+        continued.period,
+        continued.reasons,
+    )
+    assert again.evidence == continued.evidence
+    assert again.settings["extended"]["recorded_s"] == continued.settings["extended"]["recorded_s"]
+
+
 def test_an_orbit_the_grid_calls_unstable_is_certified_on_refined_steps():
     """xi = 0.45: a sticking period-6 orbit whose dominant multiplier the default grid's tangent
     overstates (|mu| ~ 2-3 at dt = 2e-6 s, a positive grid exponent) while shooting at dt/2

@@ -1,0 +1,106 @@
+"""extend_trajectory: a resumable run made longer equals the run made that long from t = 0."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import chaoscam
+from chaoscam import ParameterError, Params, extend_trajectory, simulate
+
+RUN = dict(transient=3.0, seed=1, index=4, tangent=True)
+
+
+def _assert_same(a, b) -> None:
+    """Every output of two runs, to the bit (statistics NaN-aware)."""
+    for name in ("section", "impacts"):
+        pd.testing.assert_frame_equal(getattr(a, name), getattr(b, name), check_exact=True)
+    assert (a.series is None) == (b.series is None)
+    if a.series is not None:
+        pd.testing.assert_frame_equal(a.series, b.series, check_exact=True)
+    np.testing.assert_array_equal(a.jacobians, b.jacobians)
+    np.testing.assert_array_equal(a.divergence, b.divergence)
+    assert a.stats.keys() == b.stats.keys()
+    for key, va in a.stats.items():
+        assert va == b.stats[key] or (va != va and b.stats[key] != b.stats[key]), key
+    assert a.final_state == b.final_state
+    assert a.status == b.status
+
+
+MODELS = {
+    "default": Params(),
+    "sigma": Params(l_lambda_sigma=0.002),
+    "interval draws": Params(resample="interval", l_lambda_sigma=0.002),
+    "periodic": Params(xi=0.2),
+}
+
+
+@pytest.mark.parametrize("series", [True, False], ids=["series", "sections"])
+@pytest.mark.parametrize("params", MODELS.values(), ids=MODELS.keys())
+def test_two_extensions_equal_runs_made_long_from_the_start(params, series):
+    short = simulate(params, duration=6.0, series=series, resumable=True, **RUN)
+    mid = extend_trajectory(short, 15.0)
+    long = extend_trajectory(mid, 21.0)
+    _assert_same(mid, simulate(params, duration=15.0, series=series, **RUN))
+    _assert_same(long, simulate(params, duration=21.0, series=series, **RUN))
+    assert 0.0 < mid.settings["continued_from_s"] < 6.0
+    assert mid.settings["duration"] == 15.0
+
+
+def test_series_dropped_on_the_way_changes_nothing_else():
+    short = simulate(duration=6.0, series=True, resumable=True, **RUN)
+    longer = extend_trajectory(short, 21.0, series=False)
+    assert longer.series is None
+    _assert_same(longer, simulate(duration=21.0, series=False, **RUN))
+
+
+def test_a_run_that_leaves_the_cam_on_the_way_or_before_the_copy():
+    """xi = 0.7 leaves the cam's reach at t = 1.59 s: the 1.6 s run keeps its copy at
+    7 T = 1.53 s, before that (the continuation meets it again); the 3 s run's copy is
+    after it (nothing is continued)."""
+    p = Params(xi=0.7)
+    kw = dict(RUN, transient=0.5)
+    full = simulate(p, duration=10.0, **kw)
+    assert full.status.name == "LEFT_REACH" and 1.53 < full.final_state[0] < 1.6
+    for short_duration in (1.6, 3.0):
+        short = simulate(p, duration=short_duration, resumable=True, **kw)
+        longer = extend_trajectory(short, 10.0)
+        _assert_same(longer, full)
+    assert longer.settings["continued_from_s"] is None
+
+
+def test_without_a_copy_the_run_is_simulated_again():
+    """Adaptive runs and runs not kept resumable carry no copy; the extension is then a run
+    from t = 0, resumable (the same result)."""
+    for params, resumable in ((Params(integrator="adaptive"), True), (Params(), False)):
+        short = simulate(params, duration=2.0, resumable=resumable, **dict(RUN, transient=1.0))
+        assert short.resume is None
+        longer = extend_trajectory(short, 4.0)
+        assert "continued_from_s" not in longer.settings
+        assert (longer.resume is None) == (params.integrator == "adaptive")
+        _assert_same(longer, simulate(params, duration=4.0, **dict(RUN, transient=1.0)))
+
+
+def test_a_resumable_run_is_the_same_run():
+    a = simulate(duration=5.0, resumable=True, **RUN)
+    _assert_same(a, simulate(duration=5.0, **RUN))
+    assert a.resume is not None and a.resume.step * a.params.dt < 5.0
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        (dict(duration=4.0), "must be >= the run's duration"),
+        (dict(duration=float("nan")), "duration"),
+        (dict(duration=8.0, series=True), "kept no time series"),
+    ],
+)
+def test_bad_requests_say_what_is_wrong(kwargs, words):
+    short = simulate(duration=5.0, series=False, resumable=True, **RUN)
+    with pytest.raises(ParameterError, match=words):
+        extend_trajectory(short, **kwargs)
+
+
+def test_public_name():
+    assert chaoscam.extend_trajectory is extend_trajectory
