@@ -104,3 +104,12 @@ def test_bad_requests_say_what_is_wrong(kwargs, words):
 
 def test_public_name():
     assert chaoscam.extend_trajectory is extend_trajectory
+
+
+@pytest.mark.parametrize("duration", [3.0, 7.0], ids=["same duration", "longer"])
+def test_from_t_zero_with_the_initial_sample(duration):
+    """A run recording from t = 0 (its series starts with the initial state) extended to
+    its own duration or beyond."""
+    kw = dict(RUN, transient=0.0)
+    short = simulate(duration=3.0, resumable=True, **kw)
+    _assert_same(extend_trajectory(short, duration), simulate(duration=duration, **kw))
