@@ -18,6 +18,7 @@ from ._paper import (
     FIGURES,
     QUICK_EXTEND_TO,
     SENSITIVITY,
+    STAGE_TITLES,
     _sensitivity_stage,
     data_files,
 )
@@ -93,16 +94,17 @@ def run_paper(
     results = []
     for stage, fn in enumerate(funcs, 1):
         t0 = time.perf_counter()
-        say(f"[{stage}/{len(funcs)}] {fn.__name__} ...")
+        title = STAGE_TITLES.get(fn, fn.__name__)
+        say(f"[{stage}/{len(funcs)}] {title} ...")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             try:
                 r = fn(quick, outdir, workers=workers)
             except Exception as err:  # a figure that fails is reported, not hidden
-                parts.missing.append(f"{fn.__name__}: failed with {type(err).__name__}: {err}")
+                parts.missing.append(f"{title}: failed with {type(err).__name__}: {err}")
                 continue
         r.seconds = time.perf_counter() - t0
-        say(f"[{stage}/{len(funcs)}] {fn.__name__}: {r.seconds:.0f} s")
+        say(f"[{stage}/{len(funcs)}] {title}: {r.seconds:.0f} s")
         results.append(r)
     total = time.perf_counter() - t_all
     parts.summary.append(

@@ -40,7 +40,7 @@ def test_sequence_rule_finds_the_papers_order_and_nothing_else():
     assert not _is_subsequence(wanted, ["quasiperiodic", "chaotic", "periodic-2", "chaotic"])
 
 
-def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch):
+def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch, capsys):
     """A figure script that raises leaves a report that names the failure."""
     from chaoscam.experiments import _paper
 
@@ -50,10 +50,13 @@ def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch):
     monkeypatch.setitem(_paper.FIGURES, 3, boom)
     from chaoscam.experiments import run_paper
 
-    out = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 5])
+    out = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 5], echo=True)
     text = out.read_text()
     assert "boom: failed with RuntimeError: no luck" in text
     assert "Fig. 5 — fractal stiffness against D" in text
+    err = capsys.readouterr().err  # the stages by their titles, not function names
+    assert "[1/2] boom ...\n[2/2] Fig. 5: fractal stiffness ...\n" in err
+    assert "[2/2] Fig. 5: fractal stiffness: " in err
 
 
 def _shrink_the_runs(monkeypatch):
