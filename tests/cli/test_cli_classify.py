@@ -18,10 +18,25 @@ def traj_file(tmp_path_factory):
     return path
 
 
-def _json(capsys):
+def _json(capsys, extended=False):
     out = json.loads(capsys.readouterr().out)
-    assert set(out) == {"label", "period", "evidence", "reasons"}
+    keys = {"label", "period", "evidence", "reasons"}
+    assert set(out) == (keys | {"extended"} if extended else keys)
     return out
+
+
+def test_classify_says_when_the_verdict_needed_a_longer_run(tmp_path, capsys):
+    """l_lambda = 1 mm, 10 s recorded: undetermined as given, settled by running the
+    realization longer; the JSON says how long (and from where it went on)."""
+    path = tmp_path / "short.parquet"
+    chaoscam.simulate(duration=20.0, transient=10.0, l_lambda=0.001).to_parquet(path)
+    assert main(["classify", str(path)]) == 0
+    out = _json(capsys, extended=True)
+    assert out["label"] == "chaotic"
+    assert out["extended"]["recorded_s"] == 40.0
+    assert 10.0 < out["extended"]["continued_from_s"] < 20.0  # the tangent run, continued
+    assert main(["classify", str(path), "--no-extend"]) == 0
+    assert _json(capsys)["label"] == "undetermined"
 
 
 def test_classify_prints_the_verdict_as_json(traj_file, capsys):
