@@ -493,13 +493,3 @@ QUICK_EXTEND_TO = 40.0
 
 FIGURES = {3: fig3, 4: fig4, 5: fig5, 6: fig6, 7: fig7_10, 8: fig7_10, 9: fig7_10, 10: fig7_10}
 """Figure number -> script function (Figs. 7-10 share one)."""
-
-STAGE_TITLES = {
-    fig3: "Fig. 3: line-length draws",
-    fig4: "Fig. 4: bifurcation over l_λ",
-    fig5: "Fig. 5: fractal stiffness",
-    fig6: "Fig. 6: bifurcation over D",
-    fig7_10: "Figs. 7–10: random line length",
-    _sensitivity_stage: "why the paper differs: sensitivity sweeps",
-}
-"""What ``chaoscam paper`` calls each stage on the terminal."""
