@@ -9,6 +9,7 @@ realization's own generator, empties its output buffers, and wraps everything in
 from __future__ import annotations
 
 import copy
+import dataclasses
 import json
 import math
 import time
@@ -372,7 +373,8 @@ class KernelRun:
         self.parts = parts
         self.block = output_block(p)
         self.buffers = Buffers.empty(self.block if c[k.C_STRIDE] > 0 else 1, self.block, self.block)
-        self.mark: tuple | None = None
+        self.kept: RunCopy | None = None  # its rows are attached by result()
+        self.rows_at_copy: dict[str, int] = {}
 
     def _more_draws(self, lam: np.ndarray) -> np.ndarray:
         pos = self.cnt[k.I_LAM_POS]
@@ -402,9 +404,12 @@ class KernelRun:
         cnt = self.cnt.copy()
         draws = self.lam[cnt[k.I_LAM_POS] :].copy()
         cnt[k.I_LAM_POS] = 0
-        rows = {name: sum(len(r) for r in part) for name, part in self.parts.items()}
-        self.mark = (step, self.y.copy(), cnt, self.c.copy(), draws, copy.deepcopy(self.stream))
-        self.mark += (rows, code)
+        stream = copy.deepcopy(self.stream)
+        none = np.empty((0, 0))
+        self.kept = RunCopy(
+            step, self.y.copy(), cnt, self.c.copy(), draws, stream, None, none, none, code
+        )
+        self.rows_at_copy = {name: sum(map(len, part)) for name, part in self.parts.items()}
         return self._to(n_stop) if code == k.OK else code
 
     def result(self, code: int, settings: dict[str, Any]) -> RawRun:
@@ -431,19 +436,13 @@ class KernelRun:
             "steps_per_contact_period": contact_period(p) / p.dt,
         }
         resume = None
-        if self.mark is not None:
-            step, y0, cnt0, c0, draws, stream, rows, code0 = self.mark
-            resume = RunCopy(
-                step,
-                y0,
-                cnt0,
-                c0,
-                draws,
-                stream,
-                None if series is None else series[: rows["series"]],
-                section[: rows["section"]],
-                imp[: rows["impacts"]],
-                int(code0),
+        if self.kept is not None:  # the rows before it: views of the run's own
+            n = self.rows_at_copy
+            resume = dataclasses.replace(
+                self.kept,
+                series=None if series is None else series[: n["series"]],
+                section=section[: n["section"]],
+                impacts=imp[: n["impacts"]],
             )
         return RawRun(
             params=p,

@@ -228,7 +228,7 @@ def _extended(tr, verdict, extra, discard, options, cap) -> tuple[Verdict, dict]
         base = longer
         if longer.status is not Status.OK:
             break
-        verdict, extra = _tangent_verdict(longer, discard, options, longer)
+        verdict, extra = _tangent_verdict(longer, discard, options)
         extra["extended"] = {
             "recorded_s": recorded,
             "continued_from_s": longer.settings.get("continued_from_s"),
