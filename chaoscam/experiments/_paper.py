@@ -375,7 +375,7 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
     from ..report._sweep_figures import regime_map_figure
     from ..sweep import Axis, regime_map
 
-    res = FigureResult(7)
+    res = FigureResult(7, title="Figs. 7–10")
     sigmas = tuple(np.round(np.linspace(0.0, SIGMA_MAX, 3 if quick else 9), 6))
     n = 8 if quick else 40
     rm = regime_map(

@@ -96,8 +96,11 @@ def test_data_files_are_exactly_what_the_figures_write(tmp_path, monkeypatch, nu
     monkeypatch.setattr(_paper, "png_bytes", lambda fig, dpi=None: b"\x89PNG")
     monkeypatch.setattr(_paper, "png_data_uri", lambda fig, dpi=None: "data:,")
     stage = _paper._sensitivity_stage if number == _paper.SENSITIVITY else _paper.FIGURES[number]
-    stage(True, tmp_path, workers=1)
+    res = stage(True, tmp_path, workers=1)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(_paper.data_files(number))
+    # the summary's timing line names the stage as the paper does
+    names = {7: "Figs. 7–10", 0: "Sensitivity (why the paper differs)"}
+    assert res.name == names.get(number, f"Fig. {number}")
 
 
 def test_paper_refuses_any_existing_output_before_the_work(tmp_path, capsys):
