@@ -8,10 +8,12 @@ between two crossings that a step would otherwise step over (:func:`graze_point`
 
 from __future__ import annotations
 
+import math
+
 from numba import njit
 
 from ._layout import C_EVENT_TOL
-from ._physics import geometry, on_clock, rk4, rk4_flight
+from ._physics import geometry, geometry_trig, on_clock, rk4_flight, rk4_trig
 
 MAX_BRACKET_STEPS = 400
 """Passes of a crossing search at most. Each pass at least halves the bracket (a bisection
@@ -24,6 +26,22 @@ in its time moves the gap's extremum by ~|delta''| e^2 / 2, below 1e-20 m here).
 
 MAX_GRAZE_STEPS = 200
 """Passes of the search for the gap rate's turn at most."""
+
+
+@njit(cache=True, inline="always")
+def gap_after(t, th, om, tau, K, c, trig):
+    """The geometry at the end of one RK4 substep of length tau from (t, th, om):
+    ``(delta, l_1, dC/dt.n, theta_f')`` there.
+
+    ``trig`` is the trigonometry at the substep's start (``(cc, sc, ct, st)``,
+    :func:`._physics.geometry_at`), the same for every trial length of a search; the cam's
+    at ``t + tau`` comes from the substep's last stage. The same bits as
+    :func:`._physics.rk4` followed by :func:`._physics.geometry` at ``t + tau``.
+    """
+    cc, sc, ct, st = trig
+    th1, om1, c4, s4 = rk4_trig(t, th, om, tau, K, c, cc, sc, ct, st)
+    delta, l1, cdn = geometry_trig(c4, s4, math.cos(th1), math.sin(th1), c)
+    return delta, l1, cdn, om1
 
 
 @njit(cache=True, inline="always")
@@ -57,7 +75,7 @@ def illinois_update(a, fa, b, fb, m, fm, side):
 
 
 @njit(cache=True)
-def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight=False):
+def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight, trig):
     """The substep length tau in (a, h] at which the gap delta changes sign.
 
     With ``flight`` (a closing: the motion is free flight up to the crossing) the substeps
@@ -71,8 +89,9 @@ def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight=False):
     its top), with a bisection whenever an iteration fails to halve the bracket, until the
     bracket is narrower than the event tolerance. Every trial length is rounded so that
     ``t + tau`` is a double (:func:`._physics.on_clock`), ``a`` and ``h`` being such lengths
-    already. Returns the bracket's right end, past the crossing: delta <= 0 there for a
-    closing, delta >= 0 for an opening.
+    already. ``trig`` is the trigonometry at (t, th) (:func:`gap_after`). Returns the
+    bracket's right end, past the crossing: delta <= 0 there for a closing, delta >= 0 for
+    an opening.
     """
     s = 1.0 if g_start > 0.0 else -1.0  # work on s * delta, positive at the start
     fa, b, fb = s * g_start, h, s * g_end
@@ -82,15 +101,22 @@ def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight=False):
         if width <= c[C_EVENT_TOL]:
             break
         m = on_clock(t, illinois_point(a, fa, b, fb))
-        thm = rk4_flight(th, om, m, c)[0] if flight else rk4(t, th, om, m, K, c)[0]
-        fm, _, _ = geometry(t + m, thm, c)
+        fm = _gap_at(t, th, om, m, K, c, flight, trig)
         a, fa, b, fb, side = illinois_update(a, fa, b, fb, m, fm * s, side)
         if b - a > 0.5 * width:
             m = on_clock(t, 0.5 * (a + b))
-            thm = rk4_flight(th, om, m, c)[0] if flight else rk4(t, th, om, m, K, c)[0]
-            fm, _, _ = geometry(t + m, thm, c)
+            fm = _gap_at(t, th, om, m, K, c, flight, trig)
             a, fa, b, fb, _ = illinois_update(a, fa, b, fb, m, fm * s, 0)
     return b
+
+
+@njit(cache=True, inline="always")
+def _gap_at(t, th, om, m, K, c, flight, trig):
+    """The gap after a substep of length m from (t, th, om): the free pendulum's, or the full
+    equations' (:func:`gap_after`)."""
+    if flight:
+        return geometry(t + m, rk4_flight(th, om, m, c)[0], c)[0]
+    return gap_after(t, th, om, m, K, c, trig)[0]
 
 
 # The stand-in for a gap of exactly 0 at a segment's start, signed by the gap rate: only its
@@ -99,7 +125,7 @@ ON_SURFACE = 1e-300
 
 
 @njit(cache=True)
-def graze_point(t, th, om, h, rate0, rate1, K, c):
+def graze_point(t, th, om, h, rate0, rate1, K, c, trig):
     """The substep length tau in (0, h) at which the gap rate l_1 theta' - dC/dt.n turns.
 
     Illinois regula falsi on ``tau -> rate(RK4 substep of length tau)`` to ``GRAZE_TOL`` of
@@ -108,6 +134,7 @@ def graze_point(t, th, om, h, rate0, rate1, K, c):
     back (a micro-flight, or a graze, shorter than the step). The rate is that of the
     substep's state, on the side of the surface the segment starts on. Trial lengths and the
     result are rounded so that ``t + tau`` is a double (:func:`._physics.on_clock`).
+    ``trig`` is the trigonometry at (t, th) (:func:`gap_after`).
     """
     s = 1.0 if rate0 > 0.0 else -1.0  # work on s * rate, positive at 0, negative at h
     a, fa, b, fb = 0.0, s * rate0, h, s * rate1
@@ -117,7 +144,6 @@ def graze_point(t, th, om, h, rate0, rate1, K, c):
         if width <= GRAZE_TOL * h:
             break
         m = on_clock(t, illinois_point(a, fa, b, fb))
-        thm, omm = rk4(t, th, om, m, K, c)
-        _, l1, cdn = geometry(t + m, thm, c)
+        _, l1, cdn, omm = gap_after(t, th, om, m, K, c, trig)
         a, fa, b, fb, side = illinois_update(a, fa, b, fb, m, s * (l1 * omm - cdn), side)
     return on_clock(t, 0.5 * (a + b))

@@ -46,7 +46,7 @@ __all__ = ["GPU_BATCH", "GPU_TOLERANCE", "GPUFallbackWarning", "gpu_status", "ru
 
 GPU_BATCH = 65_536  # members per device batch: ~42 kB each for 20 s runs (about 2.7 GB)
 GPU_TOLERANCE = 1e-6  # rad and rad/s: GPU against CPU sections, first period or periodic
-_BLOCK = 64  # threads per block: the kernels take 206-255 registers a thread on sm_90
+_BLOCK = 64  # threads per block: the kernels take 254-255 registers a thread on sm_90
 _NUMPY_TRAP = (2, 5)  # numba-cuda <= 0.30.4 compiles no kernel under numpy >= 2.5
 
 
@@ -128,9 +128,11 @@ def _members(cuda, step):
 def _step_function(method: int | None):
     """The per-member function a kernel calls: the integrator itself when a batch has one.
 
-    A kernel specialised to one integrator needs fewer registers than one that can take
-    either (ptxas, sm_90: 206 for RK4 and 220 for the adaptive path, no spills; 255 with
-    76 B of spill stores and 412 B of spill loads for ``advance``, which holds both).
+    A kernel specialised to one integrator spills less than one that can take either
+    (ptxas 12.9 on :func:`kernel_ptx`'s PTX for sm_90, 255 registers a thread in each case:
+    RK4 132 B of spill stores and 464 B of spill loads (48 and 276 B before its steps shared
+    their trigonometry), the adaptive path 8 and 56 B, ``advance``, which holds both, 592
+    and 1,656 B).
     """
     if method == k.METHOD_RK4:
         return k.run_chunk

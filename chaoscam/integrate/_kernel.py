@@ -42,7 +42,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._events import ON_SURFACE, graze_point, locate_crossing
+from ._events import ON_SURFACE, gap_after, graze_point, locate_crossing
 from ._layout import *  # noqa: F403 (the layout's names are part of this module's face)
 from ._layout import (
     C_DT,
@@ -89,36 +89,43 @@ from ._physics import (  # noqa: F401 (re-exported: the adaptive kernel and test
     acceleration_jacobian,
     acceleration_trig,
     cam_angle,
+    cam_trig,
     closing_bound,
     gap_accel_bound,
     geometry,
+    geometry_at,
     geometry_trig,
     on_clock,
     rk4,
     rk4_flight,
+    rk4_trig,
     safe_horizon,
     stiffness,
 )
 from ._steps import at_scheduled, commit_tangent, impact, next_scheduled, tangent_on
-from ._tangent import rk4_flight_tangent, rk4_tangent
+from ._tangent import rk4_flight_tangent, rk4_tangent_trig
 
 
 @njit(cache=True, inline="always")
-def step_rk4(t, th, om, h, K, c, y, commit, side):
+def step_rk4(t, th, om, h, K, c, y, commit, side, trig):
     """One RK4 substep of the state; with the tangent on (:func:`._steps.tangent_on`: not in
     the transient), of the tangent too, its Jacobian taken on ``side`` of the contact
-    surface (:data:`._physics.JAC_NATURAL` and others).
+    surface (:data:`._physics.JAC_NATURAL` and others). ``trig`` is the trigonometry at the
+    substep's start, ``(cc, sc, ct, st)`` from :func:`._physics.geometry_at`.
 
     Returns ``(th, om, v11, v21, v12, v22, div)``, the last five being the tangent after the
-    step (written into ``y`` when ``commit``; the state is always returned, never stored).
+    step (written into ``y`` when ``commit``; the state is always returned, never stored),
+    and the cam angle's ``(cos, sin)`` at ``t + h``.
     """
+    cc, sc, ct, st = trig
     if tangent_on(t, c):
-        r = rk4_tangent(t, th, om, h, K, c, y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22], side)
+        v11, v21, v12, v22 = y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22]
+        r = rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, side, cc, sc, ct, st)
         if commit:
             commit_tangent(y, r[2], r[3], r[4], r[5], r[6])
-        return r
-    th1, om1 = rk4(t, th, om, h, K, c)
-    return th1, om1, 0.0, 0.0, 0.0, 0.0, 0.0
+        return (r[0], r[1], r[2], r[3], r[4], r[5], r[6]), (r[7], r[8])
+    r = rk4_trig(t, th, om, h, K, c, cc, sc, ct, st)
+    return (r[0], r[1], 0.0, 0.0, 0.0, 0.0, 0.0), (r[2], r[3])
 
 
 @njit(cache=True, inline="always")
@@ -182,12 +189,14 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     if not resample_on_impact:
         draws_per_step += np.int64(h / c[C_RESAMPLE_DT]) + 2
 
-    g, l1, cdn = geometry(cnt[I_STEP] * h, th, c)  # gap, lever arm, dC/dt.n here
+    # gap, lever arm, dC/dt.n here, and the trigonometry they came from (a step from here
+    # takes its first stage from it: :func:`._physics.rk4_trig`)
+    g, l1, cdn, cc0, sc0, ct0, st0 = geometry_at(cnt[I_STEP] * h, th, c)
     # Until grid step safe_n the gap certainly stays open (no geometry needed). Kept in the
     # counters, so that a run resumed after a buffer hand-back is bit-identical to one that
     # was not interrupted. Whoever changes the state y from outside must reset it to 0.
     safe_n = cnt[I_SAFE_STEP]
-    stale = False  # g, l1, cdn belong to an earlier point (only while the gap is safe)
+    stale = False  # g, l1, cdn, trig belong to an earlier point (only while the gap is safe)
     # The surface flags, kept in the counters across a buffer hand-back (an event may end a
     # grid step exactly) so that a resumed run is bit-identical to one not interrupted.
     jumped = (cnt[I_SURFACE] & 1) != 0  # a rebound was just applied: the opening is flight's
@@ -253,8 +262,9 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 stale = True
             elif hs > 0.0:
                 if stale:
-                    g, l1, cdn = geometry(t, th, c)
+                    g, l1, cdn, cc0, sc0, ct0, st0 = geometry_at(t, th, c)
                     stale = False
+                trig0 = (cc0, sc0, ct0, st0)
                 rate0 = l1 * om - cdn
                 # The side the segment starts on. A located crossing leaves the point on the
                 # surface to rounding (slow closings give delta = 0.0 exactly: 1e-6 m/s over
@@ -274,11 +284,15 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     trial_side = JAC_FLIGHT if gs > 0.0 else JAC_CONTACT
                 trial_full = not (g > 0.0 and g > closing_bound(l1, cdn, om, hs, c))
                 if trial_full:
-                    trial = step_rk4(t, th, om, hs, K, c, y, False, trial_side)
+                    trial, cam1 = step_rk4(t, th, om, hs, K, c, y, False, trial_side, trig0)
+                    if t + hs != seg_end:  # (the cam at t + hs, seg_end - t rounded)
+                        cam1 = cam_trig(seg_end, c)
                 else:
                     trial = step_flight(t, th, om, hs, c, y, False)  # no contact possible
+                    cam1 = cam_trig(seg_end, c)
                 th_new, om_new = trial[0], trial[1]
-                g_new, l1, cdn = geometry(seg_end, th_new, c)
+                ct1, st1 = math.cos(th_new), math.sin(th_new)
+                g_new, l1, cdn = geometry_trig(cam1[0], cam1[1], ct1, st1, c)
                 rate1 = l1 * om_new - cdn
                 closing = gs > 0.0 and g_new <= 0.0
                 crossing = closing or (gs < 0.0 and g_new > 0.0)
@@ -292,9 +306,8 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     elif rate0 > 0.0 > rate1:
                         # A micro-flight from the surface: the gap is rounding noise near the
                         # start, so the bracket starts at the flight's top.
-                        tau_lo = graze_point(t, th, om, hs, rate0, rate1, K, c)
-                        th_m, _ = rk4(t, th, om, tau_lo, K, c)
-                        g_lo, _, _ = geometry(t + tau_lo, th_m, c)
+                        tau_lo = graze_point(t, th, om, hs, rate0, rate1, K, c, trig0)
+                        g_lo, _, _, _ = gap_after(t, th, om, tau_lo, K, c, trig0)
                         crossing = g_lo > 0.0
                         closing = crossing
                 elif not crossing and events < max_events and trial_full:
@@ -305,9 +318,8 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     # dt; unlocated, the step integrates through one without its jump and the
                     # tangent misses a saltation matrix of size ~|delta''| / v.
                     if (rate0 < 0.0 < rate1) if gs > 0.0 else (rate1 < 0.0 < rate0):
-                        tau_hi = graze_point(t, th, om, hs, rate0, rate1, K, c)
-                        th_m, _ = rk4(t, th, om, tau_hi, K, c)
-                        g_hi, _, _ = geometry(t + tau_hi, th_m, c)
+                        tau_hi = graze_point(t, th, om, hs, rate0, rate1, K, c, trig0)
+                        g_hi, _, _, _ = gap_after(t, th, om, tau_hi, K, c, trig0)
                         closing = gs > 0.0 and g_hi <= 0.0
                         crossing = closing or (gs < 0.0 and g_hi > 0.0)
                         if crossing:
@@ -330,19 +342,20 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                         free = g_f <= 0.0
                         if free:
                             g_hi = g_f
-                    tau = locate_crossing(t, th, om, tau_lo, g_lo, tau_hi, g_hi, K, c, free)
+                    tau = locate_crossing(t, th, om, tau_lo, g_lo, tau_hi, g_hi, K, c, free, trig0)
                     if free:
                         th, om, _, _, _, _, _ = step_flight(t, th, om, tau, c, y, True)
                     else:
                         # The substep ends on the surface: its Jacobian is the side it comes
                         # from (flight before a closing and just after a jump, else contact).
                         side = JAC_FLIGHT if closing or jumped else JAC_CONTACT
-                        th, om, _, _, _, _, _ = step_rk4(t, th, om, tau, K, c, y, True, side)
+                        r, _ = step_rk4(t, th, om, tau, K, c, y, True, side, trig0)
+                        th, om = r[0], r[1]
                     jumped = False
                     settled = False
                     t = t + tau
                     events += 1
-                    g, l1, cdn = geometry(t, th, c)
+                    g, l1, cdn, cc0, sc0, ct0, st0 = geometry_at(t, th, c)
                     if not closing:
                         continue
                     if not (0.0 < l1 < c[C_ROD_L]):
@@ -362,6 +375,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 om = om_new
                 t = seg_end
                 g = g_new
+                cc0, sc0, ct0, st0 = cam1[0], cam1[1], ct1, st1
                 if g > 0.0:
                     safe_n = np.int64(math.floor((t + safe_horizon(g, l1, cdn, om, c)) / h))
             K = at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)

@@ -22,7 +22,7 @@ import numpy as np
 from numba import njit
 
 from ._layout import C_E, C_GRAV, C_INV_J, C_OMEGA, C_XO, C_YO, SECTION_NAMES
-from ._physics import acceleration_jacobian, cam_angle
+from ._physics import acceleration_jacobian, acceleration_jacobian_trig, cam_angle, cam_trig
 
 
 @njit(cache=True, inline="always")
@@ -56,16 +56,31 @@ def rk4_tangent(t, th, om, h, K, c, v11, v21, v12, v22, side):
     says on which side of the contact surface the Jacobian is taken
     (:data:`._physics.JAC_NATURAL` unless the substep ends at a located crossing).
     """
-    a1, p1, q1 = acceleration_jacobian(t, th, om, K, c, side)
+    cc, sc = cam_trig(t, c)
+    r = rk4_tangent_trig(
+        t, th, om, h, K, c, v11, v21, v12, v22, side, cc, sc, math.cos(th), math.sin(th)
+    )
+    return r[0], r[1], r[2], r[3], r[4], r[5], r[6]
+
+
+@njit(cache=True, inline="always")
+def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, side, cc, sc, ct, st):
+    """:func:`rk4_tangent` given the trigonometry at its start, as
+    :func:`._physics.rk4_trig`: returns ``(th, om, v11, v21, v12, v22, div, cc4, sc4)``,
+    the last two the cam angle's cos/sin at ``t + h``.
+    """
+    a1, p1, q1 = acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, side)
+    cm, sm = cam_trig(t + 0.5 * h, c)
     th2 = th + 0.5 * h * om
     om2 = om + 0.5 * h * a1
-    a2, p2, q2 = acceleration_jacobian(t + 0.5 * h, th2, om2, K, c, side)
+    a2, p2, q2 = acceleration_jacobian_trig(cm, sm, math.cos(th2), math.sin(th2), om2, K, c, side)
     th3 = th + 0.5 * h * om2
     om3 = om + 0.5 * h * a2
-    a3, p3, q3 = acceleration_jacobian(t + 0.5 * h, th3, om3, K, c, side)
+    a3, p3, q3 = acceleration_jacobian_trig(cm, sm, math.cos(th3), math.sin(th3), om3, K, c, side)
+    c4, s4 = cam_trig(t + h, c)
     th4 = th + h * om3
     om4 = om + h * a3
-    a4, p4, q4 = acceleration_jacobian(t + h, th4, om4, K, c, side)
+    a4, p4, q4 = acceleration_jacobian_trig(c4, s4, math.cos(th4), math.sin(th4), om4, K, c, side)
     # The same stages for each column (x, y) of V: x' = y, y' = p x + q y.
     n11, n21 = _column(v11, v21, h, p1, q1, p2, q2, p3, q3, p4, q4)
     n12, n22 = _column(v12, v22, h, p1, q1, p2, q2, p3, q3, p4, q4)
@@ -78,6 +93,8 @@ def rk4_tangent(t, th, om, h, K, c, v11, v21, v12, v22, side):
         n12,
         n22,
         div,
+        c4,
+        s4,
     )
 
 

@@ -63,6 +63,7 @@ def test_located_crossing_is_within_1e_10_s_of_the_root():
         return k.geometry(t0 + tau, k.rk4(t0, th0, om0, tau, K, c)[0], c)[0]
 
     root = brentq(along, 0.0, h, xtol=1e-16, rtol=4 * np.finfo(float).eps)
-    tau = k.locate_crossing(t0, th0, om0, 0.0, g0, h, g1, K, c)
+    trig = k.geometry_at(t0, th0, c)[3:]
+    tau = k.locate_crossing(t0, th0, om0, 0.0, g0, h, g1, K, c, False, trig)
     assert abs(tau - root) <= 1e-10
     assert along(tau) <= 0.0
