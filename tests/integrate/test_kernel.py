@@ -67,3 +67,60 @@ def test_located_crossing_is_within_1e_10_s_of_the_root():
     tau = k.locate_crossing(t0, th0, om0, 0.0, g0, h, g1, K, c, False, trig)
     assert abs(tau - root) <= 1e-10
     assert along(tau) <= 0.0
+
+
+def _textbook_rk4(t, th, om, h, K, c, side=None):
+    """Classical RK4 written out in Python with the kernel's own right-hand side, each stage
+    evaluated at its own time and angle (with ``side``, the Jacobian's stages too)."""
+    from chaoscam.integrate._tangent import _column
+
+    def f(ts, ths, oms):
+        if side is None:
+            return k.acceleration(ts, ths, oms, K, c), 0.0, 0.0
+        return k.acceleration_jacobian(ts, ths, oms, K, c, side)
+
+    a1, p1, q1 = f(t, th, om)
+    th2, om2 = th + 0.5 * h * om, om + 0.5 * h * a1
+    a2, p2, q2 = f(t + 0.5 * h, th2, om2)
+    th3, om3 = th + 0.5 * h * om2, om + 0.5 * h * a2
+    a3, p3, q3 = f(t + 0.5 * h, th3, om3)
+    th4, om4 = th + h * om3, om + h * a3
+    a4, p4, q4 = f(t + h, th4, om4)
+    state = (
+        th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
+        om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
+    )
+    cols = _column.py_func(1.0, 0.0, h, p1, q1, p2, q2, p3, q3, p4, q4)
+    cols += _column.py_func(0.0, 1.0, h, p1, q1, p2, q2, p3, q3, p4, q4)
+    return state, cols, h / 6.0 * (q1 + 2.0 * q2 + 2.0 * q3 + q4)
+
+
+@pytest.mark.parametrize("side", [k.JAC_NATURAL, k.JAC_FLIGHT, k.JAC_CONTACT])
+def test_steps_that_share_trigonometry_are_the_textbook_steps_to_the_bit(side):
+    """rk4_trig / rk4_tangent_trig (stage 1 from the start's geometry, one cam angle for
+    stages 2 and 3, stage 4's cam handed on) and gap_after equal RK4 evaluated stage by stage
+    with the kernel's right-hand side, bit for bit, in flight and in contact."""
+    from chaoscam.integrate._events import gap_after
+    from chaoscam.integrate._tangent import rk4_tangent_trig
+
+    p = Params()
+    c = kernel_constants(p)
+    K = k.stiffness(p.l_lambda, c)
+    rng = np.random.default_rng(1)
+    in_contact = 0
+    for _ in range(100):
+        t = float(rng.uniform(0, 30))
+        th = gap_root(p, t) + float(rng.uniform(-2e-6, 2e-6))  # both sides of the surface
+        om = float(rng.uniform(-3, 3))
+        h = float(rng.choice([2e-6, 1e-5, 3.7e-7]))
+        g, l1, cdn, *trig = k.geometry_at(t, th, c)
+        assert (g, l1, cdn) == k.geometry(t, th, c)
+        in_contact += g < 0.0
+        (th1, om1), cols, div = _textbook_rk4(t, th, om, h, K, c, side)
+        r = rk4_tangent_trig(t, th, om, h, K, c, 1.0, 0.0, 0.0, 1.0, side, *trig)
+        assert r[:2] == (th1, om1) and r[2:6] == cols and r[6] == div
+        assert r[7:] == k.cam_trig(t + h, c)
+        (th1, om1), _, _ = _textbook_rk4(t, th, om, h, K, c)
+        assert k.rk4_trig(t, th, om, h, K, c, *trig)[:2] == (th1, om1)
+        assert gap_after(t, th, om, h, K, c, tuple(trig)) == (*k.geometry(t + h, th1, c), om1)
+    assert 20 < in_contact < 80
