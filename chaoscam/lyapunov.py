@@ -26,7 +26,7 @@ from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
 from .integrate._advance import advance
 from .integrate._constants import initial_counters, initial_state
-from .integrate._driver import Buffers, check_window, drive
+from .integrate._driver import Buffers, advance_pair, check_window, drive
 from .model import LineLengthStream, ParameterError, Params
 
 __all__ = ["ModelLyapunov", "lyapunov_model"]
@@ -136,6 +136,35 @@ class _Runner:
             more_draws=self._more_draws,
             run=advance,
         )
+
+
+def _postpone(ref: _Runner, cmp: _Runner, wait: int, n_stop: int) -> tuple[int, int, str]:
+    """Step both trajectories a grid step at a time until they have applied as many impacts
+    (at most ``wait`` steps, not past ``n_stop``): compiled (:func:`advance_pair`), with the
+    buffers and draws seen to here when it stops for them. Returns (steps waited, status
+    code, which trajectory a code other than OK belongs to)."""
+    waited = 0
+    bufs = [(r.buffers.series, r.buffers.section, r.buffers.impacts) for r in (ref, cmp)]
+    while True:
+        steps, code, who = advance_pair(
+            ref.y, ref.cnt, cmp.y, cmp.cnt, ref.c, ref.draws.lam, *bufs,
+            ref.n_impacts - cmp.n_impacts, wait - waited, n_stop,
+        )  # fmt: skip
+        waited += steps
+        if who == 0:
+            break
+        if code != k.NEED_BUFFER:
+            return waited, code, ("reference", "companion")[who - 1]
+        n1 = int(ref.cnt[k.I_STEP]) + (1 if who == 1 else 0)  # the step under way
+        for name, tr in (("reference", ref), ("companion", cmp))[who - 1 :]:
+            code = tr.run_to(n1)
+            if code != k.OK:
+                return waited, code, name
+        waited += 1
+    for r in (ref, cmp):  # count the impact rows advance_pair left in the buffers
+        r.n_impacts += int(r.cnt[k.I_N_IMPACT])
+        r.cnt[[k.I_N_SERIES, k.I_N_SECTION, k.I_N_IMPACT]] = 0
+    return waited, k.OK, ""
 
 
 def _batch_stderr(values: np.ndarray, n_batches: int = 20) -> float:
@@ -258,7 +287,7 @@ def lyapunov_model(
 
     Cost: two runs of the kernel (about twice ``simulate(series=False)`` of the same
     duration; ``benchmarks/bench_lyapunov_model.py`` measures the ratio), plus one Python
-    call per interval and per postponed step.
+    call per interval (the postponed steps run compiled: :func:`advance_pair`).
 
     Limits: a finite-time average (see `stderr`); near a grazing impact the flow's
     derivative is unbounded and the exponent ill-defined (watch `unsynced`); the chattering
@@ -371,14 +400,9 @@ def lyapunov_model(
             code = tr.run_to(n_to)
             if code != k.OK:
                 return failed(which, code)
-        waited = 0
-        while ref.n_impacts != cmp.n_impacts and waited < wait and ref.cnt[k.I_STEP] < n_stop:
-            n1 = int(ref.cnt[k.I_STEP]) + 1
-            for which, tr in (("reference", ref), ("companion", cmp)):
-                code = tr.run_to(n1)
-                if code != k.OK:
-                    return failed(which, code)
-            waited += 1
+        waited, code, which = _postpone(ref, cmp, wait, n_stop)
+        if code != k.OK:
+            return failed(which, code)
         postponed += waited > 0
         unsynced += ref.n_impacts != cmp.n_impacts
         delta = (cmp.y[:2] - ref.y[:2]) / scale

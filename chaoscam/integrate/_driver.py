@@ -39,6 +39,7 @@ from ._advance import advance
 
 __all__ = [
     "Buffers",
+    "advance_pair",
     "check_window",
     "contact_fraction",
     "drive",
@@ -98,6 +99,41 @@ def run_members_rk4(y, cnt, c, n_stop, lam, series, section, impacts, status):
         status[i] = k.run_chunk(
             y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i]
         )
+
+
+@njit(cache=True)
+def advance_pair(y1, cnt1, y2, cnt2, c, lam, bufs1, bufs2, lead, wait, n_stop):
+    """Advance two trajectories one grid step at a time, both to the same step, until they
+    have applied as many impacts, ``wait`` steps have passed or step ``n_stop`` is reached.
+
+    The two-trajectory exponent's postponed renormalisation (:mod:`chaoscam.lyapunov`),
+    compiled: each step is the :func:`._advance.advance` call a :func:`drive` to the next
+    step makes, without a Python round trip per step (a run that chatters can wait a
+    hundredth of a period, 1,000 steps, at each of many renormalisations). ``bufs1`` and
+    ``bufs2`` are the (series, section, impacts) buffers; impact rows stay in them, so the
+    first has applied ``lead + cnt1[I_N_IMPACT] - cnt2[I_N_IMPACT]`` more impacts than the
+    second (``lead``: the difference in rows already taken out of the buffers).
+
+    Returns ``(steps, code, which)``: the steps both made, and ``which`` = 0 when the loop
+    ended for one of the reasons above, else the trajectory (1 or 2) whose call returned
+    ``code`` (``NEED_BUFFER``, or a failure) on the way to the next step; the first has
+    then made that step when ``which`` is 2.
+    """
+    steps = 0
+    while (
+        lead + cnt1[k.I_N_IMPACT] - cnt2[k.I_N_IMPACT] != 0
+        and steps < wait
+        and cnt1[k.I_STEP] < n_stop
+    ):
+        n1 = cnt1[k.I_STEP] + 1
+        code = advance(y1, cnt1, c, n1, lam, bufs1[0], bufs1[1], bufs1[2])
+        if code != k.OK:
+            return steps, code, 1
+        code = advance(y2, cnt2, c, n1, lam, bufs2[0], bufs2[1], bufs2[2])
+        if code != k.OK:
+            return steps, code, 2
+        steps += 1
+    return steps, k.OK, 0
 
 
 def members_kernel(c: np.ndarray):

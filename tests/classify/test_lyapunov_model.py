@@ -103,3 +103,66 @@ def test_too_short_run_says_so():
     """Fewer intervals than the alignment discards: NaN and a message to lengthen the run."""
     r = lyapunov_model(duration=0.5)
     assert math.isnan(r.exponent) and "lengthen" in r.message
+
+
+def _stepwise_postpone(ref, cmp, wait, n_stop):
+    """The postponement as written before ``advance_pair``: a ``drive`` to the next grid step
+    for each trajectory, one step at a time, in Python."""
+    from chaoscam.integrate import _kernel as k
+
+    waited = 0
+    while ref.n_impacts != cmp.n_impacts and waited < wait and ref.cnt[k.I_STEP] < n_stop:
+        n1 = int(ref.cnt[k.I_STEP]) + 1
+        for which, tr in (("reference", ref), ("companion", cmp)):
+            code = tr.run_to(n1)
+            if code != k.OK:
+                return waited, code, which
+        waited += 1
+    return waited, k.OK, ""
+
+
+@pytest.mark.parametrize(
+    "rows", [None, (12, 40), (40, 12)], ids=["as-is", "ref-small", "cmp-small"]
+)
+def test_compiled_postponement_equals_the_stepwise_one(monkeypatch, rows):
+    """The postponed renormalisations, run compiled (advance_pair; v_min = 0: chattering
+    twins wait often, two of five until their impact counts agree, the others the whole
+    wait), give the exponent of the per-step Python loop to the bit, also when the
+    reference's or the companion's impact buffer (``rows``) fills up on the way, so that
+    the compiled loop stops for it."""
+    import chaoscam.lyapunov as lm
+    from chaoscam.integrate._driver import Buffers
+
+    if rows is not None:
+        made = []
+        init = lm._Runner.__init__
+
+        def small(self, *args):
+            init(self, *args)
+            n = rows[len(made) % 2]  # the reference is made first, then the companion
+            made.append(self)
+            self.buffers = Buffers.empty(1, n, n)
+
+        monkeypatch.setattr(lm._Runner, "__init__", small)
+    stops = []
+    pair = lm.advance_pair
+
+    def counted(*args):
+        out = pair(*args)
+        stops.append(int(out[2]))
+        return out
+
+    monkeypatch.setattr(lm, "advance_pair", counted)
+    p = Params(l_lambda_sigma=0.002)
+    fast = lyapunov_model(p, duration=6.0, index=2)
+    monkeypatch.setattr(lm, "_postpone", _stepwise_postpone)
+    slow = lyapunov_model(p, duration=6.0, index=2)
+    assert fast.postponed > fast.unsynced > 0  # some waits end in agreement, some do not
+    assert (fast.exponent, fast.postponed, fast.unsynced) == (
+        slow.exponent,
+        slow.postponed,
+        slow.unsynced,
+    )
+    assert np.array_equal(fast.running, slow.running)
+    if rows is not None:  # the compiled loop stopped for the small buffer's trajectory
+        assert (1 if rows[0] < rows[1] else 2) in stops
