@@ -47,6 +47,7 @@ __all__ = [
     "fork_safe_threads",
     "members_kernel",
     "run_members",
+    "run_alone",
     "run_members_rk4",
     "run_one",
 ]
@@ -174,6 +175,18 @@ def run_one(y, cnt, c, n_stop, lam, series, section, impacts) -> int:
         status,
     )
     return int(status[0])
+
+
+@njit(nogil=True, cache=True)
+def run_alone(y, cnt, c, n_stop, lam, series, section, impacts):
+    """:func:`._advance.advance` for one trajectory on the calling thread, without the GIL.
+
+    For callers that run single trajectories from several Python threads at once (the
+    periodic-orbit shooting of :mod:`chaoscam.tangent`, run per member by the ensemble
+    verdicts): numba's workqueue threading layer cannot take parallel launches
+    (:func:`run_one`) from two threads at a time. The same compiled kernel, so the same bits.
+    """
+    return advance(y, cnt, c, n_stop, lam, series, section, impacts)
 
 
 def contact_fraction(y, cnt, c) -> float:

@@ -308,3 +308,68 @@ def test_an_orbit_the_grid_calls_unstable_is_certified_on_refined_steps():
     ens = simulate_ensemble(p, [0], seed=1, duration=20.0, transient=10.0, tangent=True)
     member = classify_ensemble(ens, p, extend_to=None).members.iloc[0]
     assert (member["label"], member["period"]) == ("periodic", 6)
+
+
+def test_ensemble_verdicts_on_threads_equal_the_serial_ones(monkeypatch):
+    """Members' verdicts run on the ensemble's threads (the certificates' shooting runs
+    compiled without the GIL) equal those run one after another: label, period, reasons and
+    every piece of evidence, for periodic orbits of periods 1, 6 (refined), 2 and 8 and an
+    undetermined member; the shooting did run on the worker threads."""
+    import dataclasses
+    import threading
+
+    from chaoscam import Params, _model_rules
+    from chaoscam._ensemble_verdicts import member_verdicts
+    from chaoscam.integrate import simulate_ensemble
+
+    models = [Params(xi=0.2), Params(xi=0.45), Params(xi=0.24), Params(e=0.03), Params()]
+    ens = simulate_ensemble(models, [0] * 5, seed=1, duration=20.0, transient=10.0, tangent=True)
+    where = []
+    shoot = _model_rules.periodic_orbit
+
+    def spied(*args, **kw):
+        where.append(threading.current_thread().name)
+        return shoot(*args, **kw)
+
+    monkeypatch.setattr(_model_rules, "periodic_orbit", spied)
+    serial = member_verdicts(
+        dataclasses.replace(ens, settings={**ens.settings, "threads": 1}), models, extend_to=None
+    )
+    assert not any(n.startswith("chaoscam-verdict") for n in where)
+    where.clear()
+    threaded = member_verdicts(
+        dataclasses.replace(ens, settings={**ens.settings, "threads": 2}), models, extend_to=None
+    )
+    assert where and all(n.startswith("chaoscam-verdict") for n in where)
+    assert [(v.label, v.period) for v in threaded] == [
+        ("periodic", 1), ("periodic", 6), ("periodic", 2), ("periodic", 8), ("undetermined", None),
+    ]  # fmt: skip
+    for a, b in zip(serial, threaded, strict=True):
+        assert (a.label, a.period, a.reasons) == (b.label, b.period, b.reasons)
+        assert [(e.name, e.vote, e.detail) for e in a.verdict.evidence] == [
+            (e.name, e.vote, e.detail) for e in b.verdict.evidence
+        ]
+
+
+def test_threaded_calls_keep_order_and_stop_on_an_error():
+    """_threaded returns results in the items' order; an exception reaches the caller and
+    the calls not yet started are cancelled."""
+    import time
+
+    from chaoscam._ensemble_verdicts import _threaded
+
+    assert _threaded(lambda x: (time.sleep(0.01 * (5 - x)), x * x)[1], list(range(5)), 3) == [
+        0, 1, 4, 9, 16,
+    ]  # fmt: skip
+    started = []
+
+    def fail_first(x):
+        started.append(x)
+        if x == 0:
+            raise RuntimeError("member 0")
+        time.sleep(0.05)
+        return x
+
+    with pytest.raises(RuntimeError, match="member 0"):
+        _threaded(fail_first, list(range(40)), 2)
+    assert len(started) < 40
