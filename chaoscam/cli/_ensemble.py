@@ -254,6 +254,9 @@ def _progress_batch(backend: str) -> int | None:
         return None
     import numba
 
+    from ..integrate._driver import fork_safe_threads
+
+    fork_safe_threads()  # asking for the thread count starts numba's threads: fork-safe ones
     return PROGRESS_PER_THREAD * numba.get_num_threads()
 
 

@@ -149,8 +149,9 @@ def fork_safe_threads() -> None:
 
     numba's GNU OpenMP layer aborts a process that forks after using it, and the sweeps fork
     their workers from a driver that may have simulated. The layer is fixed at the first
-    parallel call, so every launch of :func:`run_members` comes here first; nothing is
-    changed on import. A user's choice (``NUMBA_THREADING_LAYER``, or
+    parallel call, and by ``numba.get_num_threads`` / ``set_num_threads`` (they start the
+    threads), so every launch of :func:`run_members` and every such call comes here first;
+    nothing is changed on import. A user's choice (``NUMBA_THREADING_LAYER``, or
     ``numba.config.THREADING_LAYER`` set before the first run) wins.
     """
     import numba

@@ -25,7 +25,7 @@ from ..model import Params
 from . import _gpu
 from . import _kernel as k
 from ._constants import kernel_constants
-from ._driver import check_window
+from ._driver import check_window, fork_safe_threads
 from ._members import fresh, resumed, run_batch, run_on_cpu
 from ._resume import Resume
 from ._tangent import section_jacobians
@@ -281,6 +281,8 @@ def _assemble(parts, settings: dict, keep_impacts: bool, t0: float) -> Ensemble:
     """The Ensemble of batches' outputs (``_run_batch``'s), in order."""
     import numba
     import pandas as pd
+
+    fork_safe_threads()  # asking for the thread count fixes the layer (after a GPU run)
 
     sections = [b for part in parts for b in part[0]]
     rows = [r for part in parts for r in part[1]]

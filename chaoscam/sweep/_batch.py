@@ -243,6 +243,9 @@ def numba_threads(n: int | None):
     def scope():
         import numba
 
+        from ..integrate._driver import fork_safe_threads
+
+        fork_safe_threads()  # numba's threads start here, fixing the layer: fork-safe first
         before = numba.get_num_threads()
         numba.set_num_threads(max(1, min(int(n), numba.config.NUMBA_NUM_THREADS)))
         try:

@@ -150,3 +150,35 @@ def test_a_capped_extension_is_recorded_and_honoured():
     assert m.config["engine"] == "ensemble" and "extend_to=None" in m.config["classifier"]
     row = m.realizations.iloc[0]
     assert row["label"] == "undetermined" and "run longer" in row["reasons"]
+
+
+@pytest.mark.parametrize("first", ["regime_map", "cli_progress_batch"])
+def test_process_engine_forks_after_the_ensemble_engine_ran(first):
+    """A fresh process that first runs the ensemble engine on two threads (which sets
+    numba's thread count, and so starts its threads and fixes the layer before any launch),
+    or asks for the thread count as ``chaoscam ensemble`` does before its first launch,
+    then forks a process-engine pool: the layer is the fork-safe one and the workers live
+    (with the GNU OpenMP layer every worker was killed at its fork: "lost its worker 4
+    times")."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    setup = {
+        "regime_map": "regime_map(x, y, realizations=2, duration=1.0, workers=2, "
+        "engine='ensemble')",
+        "cli_progress_batch": "from chaoscam.cli import _ensemble; "
+        "_ensemble._progress_batch('cpu')",
+    }[first]
+    code = (
+        "import numba; from chaoscam.sweep import Axis, regime_map; "
+        "x = Axis('l_lambda', (0.008, 0.01)); y = Axis('l_lambda_sigma', (0.0, 0.002)); "
+        f"{setup}; print(numba.threading_layer()); "
+        "m = regime_map(x, y, realizations=2, duration=1.0, workers=2, engine='process'); "
+        "print(len(m.realizations))"
+    )
+    root = Path(__file__).resolve().parents[2]
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=root)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.split() == ["workqueue", "6"]
+    assert "Terminating" not in run.stderr
