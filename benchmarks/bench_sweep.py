@@ -3,12 +3,14 @@
 Run: python benchmarks/bench_sweep.py [--quick]
 
 1. Fig. 4's bifurcation diagram: l_lambda over 0.001:0.018:69, 20 s each (10 s transient),
-   every core; budget 60 s on the 2-core machine.
-2. The same regime map with one and with two local worker processes: speed-up (goal >= 1.8),
+   every core, the default engine; budget 60 s on the 2-core machine.
+2. The same regime map with one and with two workers, on each engine: the default
+   ``ensemble`` (numba threads) and ``process`` (worker processes): speed-up (goal >= 1.8),
    the map sized to ~15 s on one worker, best of two alternated runs each, with the load
    average printed beside it.
-3. Memory as the grid grows: the driver's peak traced allocation (tracemalloc, which sees
-   numpy buffers) for 4, 16 and 64 cells, and the largest worker's resident set.
+3. Memory as the grid grows, on each engine: the driver's peak traced allocation
+   (tracemalloc, which sees numpy buffers) for 4, 16 and 64 cells, and (process engine) the
+   largest worker's resident set.
 
 The package classifier (chaoscam.classify) is used when this build has it; otherwise a
 section-spread stand-in, and the line says so (the classifier's own cost is then missing).
@@ -61,27 +63,34 @@ def _load() -> str:
     return f"load average {one:.2f} (1 min), {five:.2f} (5 min)"
 
 
-def _one_run_s(classify, duration: float) -> float:
-    """Seconds for one realization (simulate + classify) in this process, warm."""
+def _one_run_s(classify, duration: float, engine: str) -> float:
+    """Seconds for one realization (simulate + classify) on one worker, warm."""
     x, y = Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.001,))
-    kw = dict(duration=duration, classify=classify, workers=1)
+    kw = dict(duration=duration, classify=classify, workers=1, engine=engine)
     regime_map(x, y, realizations=1, **kw)
     t0 = time.perf_counter()
     regime_map(x, y, realizations=4, **kw)
     return (time.perf_counter() - t0) / 4
 
 
-def bench_speedup(classify, cells: int, serial_s: float, duration: float, repeats: int) -> float:
+def bench_speedup(
+    classify, cells: int, serial_s: float, duration: float, repeats: int, engine: str
+) -> float:
     """The map is sized to take about ``serial_s`` on one worker, so that start-up does not
     dominate; best of ``repeats`` alternated runs of each, so that transient load from
     other users of the machine is less likely to hit both."""
     n = int(round(np.sqrt(cells)))
-    per_run = _one_run_s(classify, duration)
+    per_run = _one_run_s(classify, duration, engine)
     realizations = max(1, int(np.ceil(serial_s / (n * n * per_run))))
-    kw = dict(realizations=realizations, seed=1, duration=duration, classify=classify)
+    kw = dict(
+        realizations=realizations, seed=1, duration=duration, classify=classify, engine=engine
+    )
     x = Axis.linspace("l_lambda", 0.006, 0.012, n)
     y = Axis.linspace("l_lambda_sigma", 0.0, 0.002, n)
-    print(f"  one {duration:g} s realization: {per_run * 1e3:.0f} ms; {realizations} per cell")
+    print(
+        f"{engine} engine: one {duration:g} s realization {per_run * 1e3:.0f} ms; "
+        f"{realizations} per cell"
+    )
     times: dict[int, list[float]] = {1: [], 2: []}
     tables = {}
     print(f"  before: {_load()}")
@@ -93,15 +102,16 @@ def bench_speedup(classify, cells: int, serial_s: float, duration: float, repeat
     t1, t2 = min(times[1]), min(times[2])
     same = tables[1].equals(tables[2])
     print(
-        f"regime map {n}x{n} cells x {realizations} x {duration:g} s: 1 worker {t1:.1f} s, "
+        f"{engine} engine, regime map {n}x{n} cells x {realizations} x {duration:g} s: "
+        f"1 worker {t1:.1f} s, "
         f"2 workers {t2:.1f} s (best of {repeats}), speed-up {t1 / t2:.2f} "
         f"(goal >= {SPEEDUP_GOAL}); tables identical: {same}; after: {_load()}"
     )
     return t1 / t2
 
 
-def bench_memory(classify, duration: float) -> None:
-    print("memory as the grid grows (1 realization per cell, 2 workers):")
+def bench_memory(classify, duration: float, engine: str) -> None:
+    print(f"{engine} engine, memory as the grid grows (1 realization per cell, 2 workers):")
     for n in (2, 4, 8):
         tracemalloc.start()
         m = regime_map(
@@ -111,6 +121,7 @@ def bench_memory(classify, duration: float) -> None:
             duration=duration,
             classify=classify,
             workers=2,
+            engine=engine,
         )
         _, peak = tracemalloc.get_traced_memory()
         tracemalloc.stop()
@@ -119,7 +130,8 @@ def bench_memory(classify, duration: float) -> None:
         child = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
         print(
             f"  {n * n:3d} cells: driver peak {peak / 2**20:6.2f} MiB traced, final table "
-            f"{table / max(rows, 1):.0f} B/row, largest worker RSS so far {child:.0f} MiB"
+            f"{table / max(rows, 1):.0f} B/row"
+            + (f", largest worker RSS so far {child:.0f} MiB" if engine == "process" else "")
         )
 
 
@@ -130,13 +142,15 @@ def main() -> None:
     classify, name = classifier()
     print(f"classifier: {name}; cores: {os.cpu_count()}; python {sys.version.split()[0]}")
     print(f"machine: {_load()} (the 2 cores are shared: a load above ~0.5 skews the ratios)")
-    if args.quick:
-        bench_speedup(classify, cells=4, serial_s=2.0, duration=2.0, repeats=1)
-        bench_memory(classify, duration=1.0)
-        return
-    bench_fig4(classify, workers=None)
-    bench_speedup(classify, cells=16, serial_s=15.0, duration=10.0, repeats=2)
-    bench_memory(classify, duration=2.0)
+    if not args.quick:
+        bench_fig4(classify, workers=None)
+    for engine in ("ensemble", "process"):
+        if args.quick:
+            bench_speedup(classify, 4, serial_s=2.0, duration=2.0, repeats=1, engine=engine)
+            bench_memory(classify, duration=1.0, engine=engine)
+        else:
+            bench_speedup(classify, 16, serial_s=15.0, duration=10.0, repeats=2, engine=engine)
+            bench_memory(classify, duration=2.0, engine=engine)
 
 
 if __name__ == "__main__":
