@@ -28,7 +28,7 @@ MAX_GRAZE_STEPS = 200
 """Passes of the search for the gap rate's turn at most."""
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def gap_after(t, th, om, tau, K, c, trig):
     """The geometry at the end of one RK4 substep of length tau from (t, th, om):
     ``(delta, l_1, dC/dt.n, theta_f')`` there.
@@ -110,7 +110,7 @@ def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight, trig):
     return b
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _gap_at(t, th, om, m, K, c, flight, trig):
     """The gap after a substep of length m from (t, th, om): the free pendulum's, or the full
     equations' (:func:`gap_after`)."""

@@ -99,7 +99,7 @@ def geometry(t, th, c):
     return geometry_trig(math.cos(thc), math.sin(thc), math.cos(th), math.sin(th), c)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def geometry_at(t, th, c):
     """:func:`geometry` and the trigonometry it used: ``(delta, l_1, dC/dt.n, cc, sc, ct,
     st)``, with (cc, sc) the cam angle's cos/sin at t and (ct, st) theta_f's.
@@ -221,7 +221,7 @@ def acceleration_trig(cc, sc, ct, st, om, K, c):
     return _equations(cc, sc, ct, st, om, K, c, False, JAC_NATURAL)[0]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, side):
     """:func:`acceleration_jacobian` given cos/sin of the cam angle (cc, sc) and of theta_f
     (ct, st)."""
@@ -246,7 +246,7 @@ def rk4(t, th, om, h, K, c):
     return r[0], r[1]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def rk4_trig(t, th, om, h, K, c, cc, sc, ct, st):
     """:func:`rk4` given the trigonometry at its start (cam angle at t: cc, sc; theta_f:
     ct, st), e.g. from :func:`geometry_at`; returns ``(th, om, cc4, sc4)``, the last two the

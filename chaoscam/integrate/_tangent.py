@@ -63,7 +63,7 @@ def rk4_tangent(t, th, om, h, K, c, v11, v21, v12, v22, side):
     return r[0], r[1], r[2], r[3], r[4], r[5], r[6]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, side, cc, sc, ct, st):
     """:func:`rk4_tangent` given the trigonometry at its start, as
     :func:`._physics.rk4_trig`: returns ``(th, om, v11, v21, v12, v22, div, cc4, sc4)``,
