@@ -252,12 +252,9 @@ def _progress_batch(backend: str) -> int | None:
     """Members per compiled call: small on the CPU (progress), the default on a GPU."""
     if backend == "gpu":
         return None
-    import numba
+    from ..integrate._driver import thread_count
 
-    from ..integrate._driver import fork_safe_threads
-
-    fork_safe_threads()  # asking for the thread count starts numba's threads: fork-safe ones
-    return PROGRESS_PER_THREAD * numba.get_num_threads()
+    return PROGRESS_PER_THREAD * thread_count()
 
 
 _SIMULATING = "ensemble (simulated)"

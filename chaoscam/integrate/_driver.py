@@ -50,6 +50,7 @@ __all__ = [
     "run_alone",
     "run_members_rk4",
     "run_one",
+    "thread_count",
 ]
 
 _OUTPUTS = (("series", k.I_N_SERIES), ("section", k.I_N_SECTION), ("impacts", k.I_N_IMPACT))
@@ -158,6 +159,15 @@ def fork_safe_threads() -> None:
 
     if "NUMBA_THREADING_LAYER" not in os.environ and numba.config.THREADING_LAYER == "default":
         numba.config.THREADING_LAYER = "workqueue"
+
+
+def thread_count() -> int:
+    """numba's thread count, asked after :func:`fork_safe_threads` (asking starts the
+    threads, which fixes the layer)."""
+    import numba
+
+    fork_safe_threads()
+    return numba.get_num_threads()
 
 
 def run_one(y, cnt, c, n_stop, lam, series, section, impacts) -> int:

@@ -25,7 +25,7 @@ from ..model import Params
 from . import _gpu
 from . import _kernel as k
 from ._constants import kernel_constants
-from ._driver import check_window, fork_safe_threads
+from ._driver import check_window, thread_count
 from ._members import fresh, resumed, run_batch, run_on_cpu
 from ._resume import Resume
 from ._tangent import section_jacobians
@@ -279,10 +279,7 @@ def extend_ensemble(
 
 def _assemble(parts, settings: dict, keep_impacts: bool, t0: float) -> Ensemble:
     """The Ensemble of batches' outputs (``_run_batch``'s), in order."""
-    import numba
     import pandas as pd
-
-    fork_safe_threads()  # asking for the thread count fixes the layer (after a GPU run)
 
     sections = [b for part in parts for b in part[0]]
     rows = [r for part in parts for r in part[1]]
@@ -313,7 +310,7 @@ def _assemble(parts, settings: dict, keep_impacts: bool, t0: float) -> Ensemble:
         resume = Resume.join(resumes)
     settings = {
         **settings,
-        "threads": numba.get_num_threads(),
+        "threads": thread_count(),
         "wall_time_s": time.perf_counter() - t0,
     }
     return Ensemble(sec, members, settings, impacts, jac, resume)

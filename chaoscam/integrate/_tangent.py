@@ -2,7 +2,7 @@
 
 The linearised flow ``V' = A(t) V`` with ``A = [[0, 1], [d theta''/d theta,
 d theta''/d theta']]`` is integrated with the state by the *same* RK4 stages
-(:func:`rk4_tangent`), so V is the exact derivative of the discrete RK4 map and the state
+(:func:`rk4_tangent_trig`), so V is the exact derivative of the discrete RK4 map and the state
 is bit-identical to :func:`._physics.rk4`'s. At a restitution jump (4)–(5) V is multiplied by
 the saltation matrix (:func:`saltation`; Müller 1995, Chaos Solitons Fractals 5(9);
 Leine & Nijmeijer 2004, *Dynamics and Bifurcations of Non-smooth Mechanical Systems*,
@@ -48,26 +48,15 @@ def _column(x, y, h, p1, q1, p2, q2, p3, q3, p4, q4):
 
 
 @njit(cache=True)
-def rk4_tangent(t, th, om, h, K, c, v11, v21, v12, v22, side):
+def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, side, cc, sc, ct, st):
     """One RK4 step of the state and of its tangent matrix V (columns (v11, v21), (v12, v22)).
 
-    Returns ``(th, om, v11, v21, v12, v22, div)`` with ``div`` the step's RK4 quadrature of
-    the divergence. The state is computed exactly as :func:`._physics.rk4` does; ``side``
-    says on which side of the contact surface the Jacobian is taken
-    (:data:`._physics.JAC_NATURAL` unless the substep ends at a located crossing).
-    """
-    cc, sc = cam_trig(t, c)
-    r = rk4_tangent_trig(
-        t, th, om, h, K, c, v11, v21, v12, v22, side, cc, sc, math.cos(th), math.sin(th)
-    )
-    return r[0], r[1], r[2], r[3], r[4], r[5], r[6]
-
-
-@njit(cache=True)
-def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, side, cc, sc, ct, st):
-    """:func:`rk4_tangent` given the trigonometry at its start, as
-    :func:`._physics.rk4_trig`: returns ``(th, om, v11, v21, v12, v22, div, cc4, sc4)``,
-    the last two the cam angle's cos/sin at ``t + h``.
+    Returns ``(th, om, v11, v21, v12, v22, div, cc4, sc4)`` with ``div`` the step's RK4
+    quadrature of the divergence. The state is computed exactly as :func:`._physics.rk4`
+    does; ``side`` says on which side of the contact surface the Jacobian is taken
+    (:data:`._physics.JAC_NATURAL` unless the substep ends at a located crossing). As
+    :func:`._physics.rk4_trig`, it takes the trigonometry at its start (cam angle at t: cc,
+    sc; theta_f: ct, st) and hands on the cam angle's cos/sin at ``t + h`` (cc4, sc4).
     """
     a1, p1, q1 = acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, side)
     cm, sm = cam_trig(t + 0.5 * h, c)
