@@ -25,6 +25,14 @@ def first_impacts(dt, n=3):
     return tr.impacts.iloc[:n]
 
 
+def test_reference_is_converged_at_its_default_tolerance(reference):
+    """The reference moves < 2e-8 s, 1e-8 rad when its rtol is cut tenfold: it is a reference."""
+    tighter = simulate_reference(CHECK, DURATION, rtol=1e-13, atol=1e-15)
+    a, b = reference.impacts.iloc[:3], tighter.impacts.iloc[:3]
+    assert np.max(np.abs(a.t.values - b.t.values)) < 2e-8
+    assert np.max(np.abs(a.theta_f.values - b.theta_f.values)) < 1e-8
+
+
 def test_reference_sees_three_impacts(reference):
     """The reference run has at least three impacts to compare."""
     assert len(reference.impacts) >= 3
