@@ -70,6 +70,7 @@ def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, ca
     err = capsys.readouterr().err
     said = [line for line in err.splitlines() if "interrupted" in line]
     assert len(said) == 1 and "--resume" in said[0]  # one message, with the resume hint
+    assert "2 of 5 members are finished" in said[0]  # what is kept, counted
     assert not out.exists() and len(list((tmp_path / "ens.parts").glob("*.done"))) == 1
     monkeypatch.setattr(integrate, "simulate_ensemble", real)
     assert main([*ARGS, "--out", str(out)]) == 2  # an unfinished run is not overwritten
@@ -113,6 +114,26 @@ def test_gpu_fallback_is_one_line(tmp_path, capsys, monkeypatch):
     err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
     assert len(err) == 1 and "no CUDA device (test)" in err[0] and "CPU" in err[0]
     assert len(pd.read_parquet(out)) == 5
+
+
+@pytest.mark.parametrize(
+    "backend, gpu, chunk", [("cpu", True, 128), ("gpu", False, 1024), ("auto", False, 128),
+                            ("auto", True, 1024)]
+)  # fmt: skip
+def test_default_part_size_follows_the_backend_that_runs(monkeypatch, backend, gpu, chunk):
+    """Without --chunk a part holds 128 members on the CPU (an interruption loses little),
+    1,024 where a GPU runs them; an explicit --chunk wins, and a bad one is refused."""
+    import argparse
+
+    from chaoscam.cli import _ensemble
+    from chaoscam.integrate import _gpu
+    from chaoscam.model import ParameterError
+
+    monkeypatch.setattr(_gpu, "gpu_status", lambda: (gpu, "test"))
+    assert _ensemble._chunk(argparse.Namespace(backend=backend, chunk=None)) == chunk
+    assert _ensemble._chunk(argparse.Namespace(backend=backend, chunk=7)) == 7
+    with pytest.raises(ParameterError, match="--chunk"):
+        _ensemble._chunk(argparse.Namespace(backend=backend, chunk=0))
 
 
 def test_progress_counts_every_member_from_the_first_batch(tmp_path, capsys):
