@@ -242,9 +242,7 @@ def add_regime_map(parts: ReportParts, path: str, rm, *, caption: str = "") -> N
                 _fmt(r[y]),
                 int(r.get("n", 0)),
                 r.get("dominant", ""),
-                f"{r.get('p_chaotic', float('nan')):.2f} "
-                f"[{r.get('p_chaotic_lo', float('nan')):.2f}, "
-                f"{r.get('p_chaotic_hi', float('nan')):.2f}]",
+                _p_chaotic_text(r),
                 f"{r.get('p_quasiperiodic', float('nan')):.2f}",
                 f"{r.get('p_periodic', float('nan')):.2f}",
             )
@@ -267,6 +265,16 @@ def add_regime_map(parts: ReportParts, path: str, rm, *, caption: str = "") -> N
     parts.provenance.append(_provenance_rows(path, "regime map", _sweep_settings(cfg)))
     dom = c["dominant"].value_counts().to_dict() if len(c) else {}
     parts.summary.append(f"{name}: regime map {x} × {y}, dominant labels {_counts(dom)}.")
+
+
+def _p_chaotic_text(r: dict[str, Any]) -> str:
+    """P(chaotic) with its 95 % Wilson interval; a deterministic cell (one run standing for
+    identical realizations, sigma = 0) has no sampling interval and says so instead."""
+    p = f"{r.get('p_chaotic', float('nan')):.2f}"
+    if bool(r.get("deterministic", False)):
+        return f"{p} (deterministic: one run)"
+    lo, hi = r.get("p_chaotic_lo", float("nan")), r.get("p_chaotic_hi", float("nan"))
+    return f"{p} [{lo:.2f}, {hi:.2f}]"
 
 
 def _sweep_settings(cfg: dict[str, Any]) -> dict[str, Any]:

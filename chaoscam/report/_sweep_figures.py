@@ -167,10 +167,18 @@ def plot_probability(
         lo = _grid(cells, x, y, f"p_{label}_lo").to_numpy()
         hi = _grid(cells, x, y, f"p_{label}_hi").to_numpy()
         p = m.to_numpy()
+        det = (
+            _grid(cells, x, y, "deterministic").fillna(False).to_numpy(dtype=bool)
+            if "deterministic" in cells
+            else np.zeros(p.shape, dtype=bool)
+        )
         annot = np.array(
             [
-                [f"{a:.2f}\n[{b:.2f}, {c:.2f}]" for a, b, c in zip(ra, rb, rc, strict=True)]
-                for ra, rb, rc in zip(p, lo, hi, strict=True)
+                [
+                    f"{a:.2f}\none run" if d else f"{a:.2f}\n[{b:.2f}, {c:.2f}]"
+                    for a, b, c, d in zip(ra, rb, rc, rd, strict=True)
+                ]
+                for ra, rb, rc, rd in zip(p, lo, hi, det, strict=True)
             ]
         )
     sns.heatmap(

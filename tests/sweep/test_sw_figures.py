@@ -57,3 +57,24 @@ def test_bifurcation_points_are_rasterised():
     assert all(c.get_rasterized() for c in ax.collections)
     assert sum(len(c.get_offsets()) for c in ax.collections) == n
     assert ax.get_xlabel() == axis_label("l_lambda") and ax.get_ylabel().endswith("[rad]")
+
+
+def test_deterministic_cells_show_one_run_not_an_interval():
+    """A sigma = 0 cell is one run standing for identical realizations: its annotation and its
+    row in the report's table say so, with no [lo, hi] interval; the other cells keep theirs."""
+    from matplotlib.figure import Figure
+
+    from chaoscam.report._html import _p_chaotic_text
+    from chaoscam.report._sweep_figures import plot_probability
+
+    cells = _cells().assign(deterministic=lambda c: c["l_lambda_sigma"] == 0.0)
+    ax = Figure().subplots()
+    plot_probability(cells, "l_lambda", "l_lambda_sigma", ax, annotate=True)
+    texts = [t.get_text() for t in ax.texts]
+    assert sum("one run" in t for t in texts) == 3  # the sigma = 0 row
+    assert sum("[" in t for t in texts) == 6
+    rows = cells.to_dict("records")
+    shown = [_p_chaotic_text(r) for r in rows]
+    for r, s in zip(rows, shown, strict=True):
+        assert ("deterministic: one run" in s) == r["deterministic"]
+        assert ("[" in s) != r["deterministic"]
