@@ -16,7 +16,15 @@ from typing import Any
 
 from ._figures import png_data_uri, response_figure
 
-__all__ = ["Comparison", "FigureItem", "build_report", "git_commit", "render", "write_report"]
+__all__ = [
+    "Comparison",
+    "FigureItem",
+    "build_report",
+    "git_commit",
+    "render",
+    "uncommitted_sources",
+    "write_report",
+]
 
 SECTIONS = (
     ("summary", "Summary of findings"),
@@ -107,6 +115,35 @@ def git_commit(start: Path | None = None) -> str | None:
             return None
         return None
     return None
+
+
+SOURCES = ("chaoscam", "analyses", "pyproject.toml")
+"""What a report's numbers come from: changes there that are not committed are named in its
+provenance (a report and its data are not)."""
+
+
+def uncommitted_sources(start: Path | None = None) -> list[str] | None:
+    """Tracked files under :data:`SOURCES` that differ from the commit checked out (``git
+    status``), so that a report built from an uncommitted tree does not pass for the commit
+    it names; None when git or the checkout is not there."""
+    import subprocess
+
+    here = Path(start or Path(__file__)).resolve()
+    root = next((d for d in [here, *here.parents] if (d / ".git").exists()), None)
+    if root is None:
+        return None
+    try:
+        out = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no", "--", *SOURCES],
+            cwd=root,
+            capture_output=True,
+            text=True,
+            timeout=20,
+            check=True,
+        ).stdout
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return sorted(line[3:] for line in out.splitlines() if len(line) > 3)
 
 
 def _counts(counts: dict) -> str:
@@ -329,6 +366,13 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
         undefined=jinja2.StrictUndefined,
     )
     commit = git_commit()
+    if commit:
+        changed = uncommitted_sources()
+        if changed:
+            shown = ", ".join(changed[:5]) + (
+                f" and {len(changed) - 5} more" if len(changed) > 5 else ""
+            )
+            commit += f" plus uncommitted changes to {shown}"
     return env.get_template("report.html").render(
         title=title,
         sections=SECTIONS,
