@@ -112,13 +112,12 @@ def _run_locked(args: argparse.Namespace) -> int:
     out: Path = args.out
     members_n = whole("--members", args.members, low=1)
     whole("--first", args.first)
-    chunk = _chunk(args)
     params = parse_assignments(args.set)
     duration, transient = run_settings(args.duration, args.transient, args.seed)
-    _check_budget(params, duration, transient, members_n, chunk)
-
     out, sections_path, impacts_path = _outputs(out)
     parts = out.with_suffix(".parts")
+    chunk = _chunk(args, parts)
+    _check_budget(params, duration, transient, members_n, chunk)
     config = {
         "params": params.to_dict(),
         "seed": args.seed,
@@ -261,13 +260,22 @@ runs, so that the progress bar moves (and Ctrl-C is honoured) every few seconds;
 threads' idle tail at the end of each call costs a few per cent."""
 
 
-def _chunk(args: argparse.Namespace) -> int:
-    """Members per saved part: ``--chunk``, else :data:`CPU_CHUNK` or :data:`GPU_CHUNK` for
-    the backend that will run (``auto``: the GPU where one can run)."""
+def _chunk(args: argparse.Namespace, parts: Path) -> int:
+    """Members per saved part: ``--chunk``; else, resuming, the part size the interrupted run
+    in ``parts`` started with (so that a run begun with another default, or on a GPU, can be
+    resumed by the same command); else :data:`CPU_CHUNK` or :data:`GPU_CHUNK` for the
+    backend that will run (``auto``: the GPU where one can run)."""
     from .._checks import whole
 
     if args.chunk is not None:
         return whole("--chunk", args.chunk, low=1)
+    if args.resume and not args.force:
+        try:
+            stored = json.loads((parts / "config.json").read_text())["config"]["chunk"]
+        except (OSError, ValueError, KeyError, TypeError):
+            stored = None
+        if isinstance(stored, int) and not isinstance(stored, bool) and stored >= 1:
+            return stored
     on_gpu = args.backend == "gpu"
     if args.backend == "auto":
         from ..integrate._gpu import gpu_status

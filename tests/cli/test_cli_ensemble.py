@@ -75,7 +75,9 @@ def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, ca
     monkeypatch.setattr(integrate, "simulate_ensemble", real)
     assert main([*ARGS, "--out", str(out)]) == 2  # an unfinished run is not overwritten
     assert main([*ARGS, "--set", "xi=0.3", "--resume", "--out", str(out)]) == 2  # not its config
-    assert main([*ARGS, "--resume", "--out", str(out)]) == 0
+    # resumed without --chunk: the part size the run started with (2), not today's default
+    unsized = [a for i, a in enumerate(ARGS) if "--chunk" not in ARGS[max(i - 1, 0) : i + 1]]
+    assert main([*unsized, "--resume", "--out", str(out)]) == 0
     assert pd.read_parquet(out).equals(pd.read_parquet(whole))
     a = pd.read_parquet(tmp_path / "ens.sections.parquet")
     assert a.equals(pd.read_parquet(tmp_path / "whole.sections.parquet"))
@@ -120,7 +122,9 @@ def test_gpu_fallback_is_one_line(tmp_path, capsys, monkeypatch):
     "backend, gpu, chunk", [("cpu", True, 128), ("gpu", False, 1024), ("auto", False, 128),
                             ("auto", True, 1024)]
 )  # fmt: skip
-def test_default_part_size_follows_the_backend_that_runs(monkeypatch, backend, gpu, chunk):
+def test_default_part_size_follows_the_backend_that_runs(
+    tmp_path, monkeypatch, backend, gpu, chunk
+):
     """Without --chunk a part holds 128 members on the CPU (an interruption loses little),
     1,024 where a GPU runs them; an explicit --chunk wins, and a bad one is refused."""
     import argparse
@@ -130,10 +134,15 @@ def test_default_part_size_follows_the_backend_that_runs(monkeypatch, backend, g
     from chaoscam.model import ParameterError
 
     monkeypatch.setattr(_gpu, "gpu_status", lambda: (gpu, "test"))
-    assert _ensemble._chunk(argparse.Namespace(backend=backend, chunk=None)) == chunk
-    assert _ensemble._chunk(argparse.Namespace(backend=backend, chunk=7)) == 7
+
+    def ns(size, resume=False):
+        return argparse.Namespace(backend=backend, chunk=size, resume=resume, force=False)
+
+    assert _ensemble._chunk(ns(None), tmp_path / "none.parts") == chunk
+    assert _ensemble._chunk(ns(None, resume=True), tmp_path / "none.parts") == chunk
+    assert _ensemble._chunk(ns(7), tmp_path / "none.parts") == 7
     with pytest.raises(ParameterError, match="--chunk"):
-        _ensemble._chunk(argparse.Namespace(backend=backend, chunk=0))
+        _ensemble._chunk(ns(0), tmp_path / "none.parts")
 
 
 def test_progress_counts_every_member_from_the_first_batch(tmp_path, capsys):
