@@ -142,18 +142,13 @@ def _run_locked(args: argparse.Namespace) -> int:
                 raise FileExistsError(
                     f"{path} exists; choose another --out, remove it, or pass --force to replace it"
                 )
-    manifest = parts / "config.json"
     if parts.exists():
         if not args.resume:
             raise FileExistsError(
                 f"{parts} holds an unfinished run; add --resume to continue it (or --force "
                 "to start over)"
             )
-        try:
-            old = json.loads(manifest.read_text())
-        except (OSError, ValueError):
-            old = {}
-        if old.get("digest") != digest:
+        if _manifest(parts).get("digest") != digest:
             raise UsageError(
                 f"{parts} belongs to another configuration (or has no readable config.json); "
                 "not resumed: use the original command, or --force to start over"
@@ -211,7 +206,7 @@ def _run_locked(args: argparse.Namespace) -> int:
                     warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         except KeyboardInterrupt:
             bar.close()
-            kept = sum(min(s + chunk, last) - s for s in starts if s < start)
+            kept = start - args.first  # the parts before this one, all finished
             print(
                 f"chaoscam: interrupted; {kept} of {args.members} members are finished and "
                 f"kept in {parts} (parts of {chunk}): run the same command with --resume to "
@@ -260,6 +255,16 @@ runs, so that the progress bar moves (and Ctrl-C is honoured) every few seconds;
 threads' idle tail at the end of each call costs a few per cent."""
 
 
+def _manifest(parts: Path) -> dict:
+    """The ``config.json`` of an unfinished run's parts (digest and configuration), or an
+    empty dict when there is none or it cannot be read."""
+    try:
+        saved = json.loads((parts / "config.json").read_text())
+    except (OSError, ValueError):
+        return {}
+    return saved if isinstance(saved, dict) else {}
+
+
 def _chunk(args: argparse.Namespace, parts: Path) -> int:
     """Members per saved part: ``--chunk``; else, resuming, the part size the interrupted run
     in ``parts`` started with (so that a run begun with another default, or on a GPU, can be
@@ -270,10 +275,8 @@ def _chunk(args: argparse.Namespace, parts: Path) -> int:
     if args.chunk is not None:
         return whole("--chunk", args.chunk, low=1)
     if args.resume and not args.force:
-        try:
-            stored = json.loads((parts / "config.json").read_text())["config"]["chunk"]
-        except (OSError, ValueError, KeyError, TypeError):
-            stored = None
+        saved = _manifest(parts).get("config")
+        stored = saved.get("chunk") if isinstance(saved, dict) else None
         if isinstance(stored, int) and not isinstance(stored, bool) and stored >= 1:
             return stored
     on_gpu = args.backend == "gpu"
