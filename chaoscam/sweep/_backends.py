@@ -241,6 +241,9 @@ class DaskBackend:
                 "the Dask backend needs dask.distributed: pip install 'chaoscam[dask]'"
             ) from None
         self._distributed = distributed
+        # Installed before the first connection: the background sender may log a closed
+        # comm before the driver notices the scheduler is gone.
+        _quiet_lost_connection_log()
         self._cluster = None
         self._own_client = True
         if isinstance(scheduler, distributed.Client):
@@ -335,7 +338,6 @@ class DaskBackend:
 
     def _lost(self, err: Exception | None) -> str:
         """One line for a lost scheduler (the error's own text spans several lines)."""
-        _quiet_reconnect_log()
         address = getattr(getattr(self.client, "scheduler", None), "address", None) or "?"
         detail = f" ({type(err).__name__})" if err is not None else ""
         return f"the Dask scheduler at {address} was lost{detail}"
@@ -364,27 +366,43 @@ class DaskBackend:
             pass
 
 
-class _DropReconnectLog:
-    """Drops what distributed logs while a client whose scheduler is gone is closed: "Failed
-    to reconnect to scheduler" and the traceback of its cancelled reconnection. The lost
-    scheduler has already been reported in one line."""
+class _DropLostConnectionLog:
+    """Drops what distributed logs in this process when its connection to the scheduler
+    closes: "Failed to reconnect to scheduler", and the tracebacks of a closed comm
+    (``CommClosedError``, e.g. "Batched Comm Closed" from the background sender) or of a
+    cancelled reconnection. The lost scheduler is reported in one line
+    (:meth:`DaskBackend._lost`); these records would put tracebacks around it, in an order
+    that depends on which thread notices first."""
 
     def filter(self, record) -> bool:
         import asyncio
 
+        from distributed.comm.core import CommClosedError
+
         if "Failed to reconnect to scheduler" in record.getMessage():
             return False
         exc = record.exc_info[1] if record.exc_info else None
-        return not isinstance(exc, asyncio.CancelledError)
+        return not isinstance(exc, (asyncio.CancelledError, CommClosedError))
 
 
-_RECONNECT_FILTER = _DropReconnectLog()
+_LOST_CONNECTION_FILTER = _DropLostConnectionLog()
+
+# The loggers that report a client's connection closing (a logger's filters apply to the
+# records logged on it, not to those of its children, so each is named).
+_CLIENT_CONNECTION_LOGGERS = (
+    "distributed.client",
+    "distributed.batched",
+    "distributed.core",
+    "distributed.comm.tcp",
+    "distributed.utils",
+)
 
 
-def _quiet_reconnect_log() -> None:
+def _quiet_lost_connection_log() -> None:
     import logging
 
-    logging.getLogger("distributed.client").addFilter(_RECONNECT_FILTER)  # idempotent
+    for name in _CLIENT_CONNECTION_LOGGERS:
+        logging.getLogger(name).addFilter(_LOST_CONNECTION_FILTER)  # idempotent
 
 
 def make_backend(workers: int | None = None, scheduler: Any = None):

@@ -107,6 +107,44 @@ def test_scheduler_killed_mid_run_saves_and_resumes_locally(tmp_path, uninterrup
     frames_equal(pd.read_parquet(tmp_path / "m.cells.parquet"), uninterrupted.cells)
 
 
+def test_closed_connection_logs_dropped_from_the_first_connection():
+    """Once a Dask backend is connected, distributed's records of a closed comm (the
+    background sender's "Batched Comm Closed" traceback, which CI once printed before the
+    one-line message) and of a failed reconnection reach no handler; other records do."""
+    import logging
+
+    from distributed.comm.core import CommClosedError
+
+    from chaoscam.sweep._backends import _CLIENT_CONNECTION_LOGGERS, DaskBackend
+
+    class Keep(logging.Handler):
+        def __init__(self):
+            super().__init__(logging.DEBUG)
+            self.records = []
+
+        def emit(self, record):
+            self.records.append(record)
+
+    with distributed.LocalCluster(
+        n_workers=0, host="127.0.0.1", dashboard_address="127.0.0.1:0"
+    ) as cluster:
+        backend = DaskBackend(cluster.scheduler_address)
+        backend.close()
+    for name in _CLIENT_CONNECTION_LOGGERS:
+        logger, keep = logging.getLogger(name), Keep()
+        logger.addHandler(keep)
+        try:
+            try:
+                raise CommClosedError("in <TCP (closed) Client->Scheduler>")
+            except CommClosedError:
+                logger.error("Batched Comm Closed %r", "comm", exc_info=True)
+            logger.error("Failed to reconnect to scheduler after 30.00 seconds, closing client")
+            logger.error("an unrelated record")
+        finally:
+            logger.removeHandler(keep)
+        assert [r.getMessage() for r in keep.records] == ["an unrelated record"], name
+
+
 def test_no_worker_says_so_and_stops(tmp_path, monkeypatch, capsys):
     """A scheduler with no worker: the driver says it is waiting (even with --quiet), then
     stops after the bounded wait with exit 1 and the resume hint, the checkpoint kept."""
