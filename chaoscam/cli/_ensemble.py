@@ -129,11 +129,14 @@ def _run_locked(args: argparse.Namespace) -> int:
         "classify": args.classify,
         "keep_impacts": args.keep_impacts,
     }
-    digest = hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:16]
+    digest = _digest(config)
+    # What the finished members file is stamped with: the part size decides where the run is
+    # saved on the way, not what it computes, so a finished run is recognised under any.
+    result = _digest({k: v for k, v in config.items() if k != "chunk"})
     remove_leftovers(parts)  # of a run killed while it created or deleted its parts
     if args.force:
         discard_checkpoint(parts)
-    elif args.resume and not parts.exists() and _finished(out, digest):
+    elif args.resume and not parts.exists() and _finished(out, (result, digest)):
         print(f"already finished: {out} (same configuration); nothing to do")
         return 0
     elif not (args.resume and parts.exists()):
@@ -235,7 +238,7 @@ def _run_locked(args: argparse.Namespace) -> int:
             )
     bar.close()
 
-    members = _commit(parts, starts, names, out, digest)
+    members = _commit(parts, starts, names, out, result)
     wall = time.perf_counter() - t0
     counts = members["label" if args.classify else "status"].value_counts().to_dict()
     print(
@@ -387,15 +390,21 @@ def _part_done(parts: Path, start: int, names: tuple[str, ...]) -> bool:
 _META_KEY = b"chaoscam.ensemble"
 
 
-def _finished(out: Path, digest: str) -> bool:
-    """True when ``out`` is the members file of a finished run of this configuration."""
+def _digest(config: dict) -> str:
+    return hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def _finished(out: Path, digests: tuple[str, ...]) -> bool:
+    """True when ``out`` is the members file of a finished run of this configuration: its
+    stamp is one of ``digests`` (that of the configuration without the part size; files
+    finished before that change carry the digest with it)."""
     import pyarrow.parquet as pq
 
     try:
         meta = pq.read_schema(out).metadata or {}
     except Exception:  # absent, or not a Parquet file: not finished
         return False
-    return meta.get(_META_KEY) == digest.encode()
+    return meta.get(_META_KEY) in {d.encode() for d in digests}
 
 
 def _write(frame, path: Path, digest: str | None = None) -> None:

@@ -83,6 +83,23 @@ def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, ca
     assert a.equals(pd.read_parquet(tmp_path / "whole.sections.parquet"))
 
 
+def test_resuming_a_finished_run_under_another_part_size_does_nothing(tmp_path, capsys):
+    """--resume on a finished output says "already finished" whatever the part size (it
+    decides where the run is saved, not what it computes); another configuration is still
+    refused, and the output is left as it was."""
+    out = tmp_path / "e.parquet"
+    assert main([*ARGS, "--out", str(out)]) == 0
+    before = out.read_bytes()
+    capsys.readouterr()
+    unsized = [a for i, a in enumerate(ARGS) if "--chunk" not in ARGS[max(i - 1, 0) : i + 1]]
+    for args in (ARGS, unsized, [*unsized, "--chunk", "3"]):
+        assert main([*args, "--resume", "--out", str(out)]) == 0
+        assert "already finished" in capsys.readouterr().out
+    assert main([*ARGS, "--set", "xi=0.3", "--resume", "--out", str(out)]) == 2
+    assert "exists" in capsys.readouterr().err
+    assert out.read_bytes() == before
+
+
 @pytest.mark.parametrize(
     "extra, needle",
     [
