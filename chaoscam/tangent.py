@@ -28,7 +28,7 @@ from .analysis import TangentSpectrum, spectrum_from_jacobians
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
 from .integrate._constants import initial_counters, initial_state
-from .integrate._driver import Buffers, drive, run_alone
+from .integrate._driver import Buffers, alone_kernel, drive
 from .integrate._tangent import section_jacobians
 from .model import ParameterError, Params
 
@@ -139,7 +139,7 @@ class _MapRunner:
             self.buffers,
             on_rows=on_rows,
             more_draws=same_draws,
-            run=run_alone,  # on this thread: verdicts shoot for several members at once
+            run=alone_kernel(self.c),  # this thread: verdicts shoot several members at once
         )
         rows = np.concatenate(kept) if kept else np.empty((0, k.SECTION_COLS))
         if code != k.OK or len(rows) < self.n + 1:

@@ -45,9 +45,11 @@ __all__ = [
     "drive",
     "drive_members",
     "fork_safe_threads",
+    "alone_kernel",
     "members_kernel",
     "run_members",
     "run_alone",
+    "run_alone_rk4",
     "run_members_rk4",
     "run_one",
     "thread_count",
@@ -120,6 +122,9 @@ def advance_pair(y1, cnt1, y2, cnt2, c, lam, bufs1, bufs2, lead, wait, n_stop):
     ended for one of the reasons above, else the trajectory (1 or 2) whose call returned
     ``code`` (``NEED_BUFFER``, or a failure) on the way to the next step; the first has
     then made that step when ``which`` is 2.
+
+    RK4 trajectories only (:func:`._kernel.run_chunk`; the exponent is always taken on the
+    RK4 grid), so that a fresh install does not compile the adaptive kernel for it.
     """
     steps = 0
     while (
@@ -128,21 +133,33 @@ def advance_pair(y1, cnt1, y2, cnt2, c, lam, bufs1, bufs2, lead, wait, n_stop):
         and cnt1[k.I_STEP] < n_stop
     ):
         n1 = cnt1[k.I_STEP] + 1
-        code = advance(y1, cnt1, c, n1, lam, bufs1[0], bufs1[1], bufs1[2])
+        code = k.run_chunk(y1, cnt1, c, n1, lam, bufs1[0], bufs1[1], bufs1[2])
         if code != k.OK:
             return steps, code, 1
-        code = advance(y2, cnt2, c, n1, lam, bufs2[0], bufs2[1], bufs2[2])
+        code = k.run_chunk(y2, cnt2, c, n1, lam, bufs2[0], bufs2[1], bufs2[2])
         if code != k.OK:
             return steps, code, 2
         steps += 1
     return steps, k.OK, 0
 
 
+def _all_rk4(c: np.ndarray) -> bool:
+    """Whether every member with constants ``c`` (one row each, or one row) uses RK4."""
+    return bool(np.all(c[..., k.C_METHOD] == k.METHOD_RK4))
+
+
 def members_kernel(c: np.ndarray):
     """The compiled entry point for members with constants ``c`` (one row per member):
     :func:`run_members_rk4` when every member uses the RK4 kernel, else
     :func:`run_members`."""
-    return run_members_rk4 if bool(np.all(c[..., k.C_METHOD] == k.METHOD_RK4)) else run_members
+    return run_members_rk4 if _all_rk4(c) else run_members
+
+
+def alone_kernel(c: np.ndarray):
+    """The compiled single-trajectory call for constants ``c``, without the GIL:
+    :func:`run_alone_rk4` for the RK4 kernel, else :func:`run_alone`. Picking keeps the
+    adaptive kernel out of an RK4 process: compiling it costs a fresh install ~10 s."""
+    return run_alone_rk4 if _all_rk4(c) else run_alone
 
 
 def fork_safe_threads() -> None:
@@ -198,6 +215,14 @@ def run_alone(y, cnt, c, n_stop, lam, series, section, impacts):
     (:func:`run_one`) from two threads at a time. The same compiled kernel, so the same bits.
     """
     return advance(y, cnt, c, n_stop, lam, series, section, impacts)
+
+
+@njit(nogil=True, cache=True)
+def run_alone_rk4(y, cnt, c, n_stop, lam, series, section, impacts):
+    """:func:`run_alone` for a trajectory on the fixed-step RK4 kernel: the same compiled
+    :func:`._kernel.run_chunk` that :func:`._advance.advance` calls for it (the same bits),
+    without compiling the adaptive path (:func:`alone_kernel` picks)."""
+    return k.run_chunk(y, cnt, c, n_stop, lam, series, section, impacts)
 
 
 def contact_fraction(y, cnt, c) -> float:
@@ -304,7 +329,8 @@ def drive(
     emptied. When the kernel stops for room, ``more_draws(lam)`` returns the draws to go on
     with, and must leave ``cnt[I_LAM_POS]`` pointing at the draw in use in them. ``run`` is
     the compiled call (:func:`run_one`; the two-trajectory exponent passes
-    :func:`._advance.advance`, the same kernel without the one-member batch).
+    :func:`._kernel.run_chunk`, the same RK4 kernel without the one-member batch, and the
+    periodic-orbit shooting :func:`alone_kernel`'s pick).
     """
     code = k.NEED_BUFFER
     before = (0.0, 0)  # (time, draw in use) when the last call began

@@ -124,6 +124,49 @@ def test_an_rk4_run_never_compiles_the_adaptive_kernel():
     assert out.stdout.split() == ["0", "0"]
 
 
+def test_rk4_verdicts_and_exponents_never_compile_the_adaptive_kernel():
+    """A fresh process that classifies an RK4 run (tangent exponent, periodic-orbit shooting)
+    and takes the two-trajectory exponent compiles neither the adaptive kernel nor the
+    dispatch between both (on a fresh install that took ~10 s for nothing)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import chaoscam\n"
+        "from chaoscam.integrate._adaptive import run_chunk_adaptive\n"
+        "from chaoscam.integrate._advance import advance\n"
+        "p = chaoscam.Params(xi=0.2)\n"
+        "t = chaoscam.simulate(p, duration=4.0, transient=2.0, tangent=True)\n"
+        "v = chaoscam.classify_trajectory(t)\n"
+        "chaoscam.lyapunov_model(p, duration=1.0, transient=0.5)\n"
+        "print(v.label, any(e.name == 'periodic_orbit' for e in v.evidence))\n"
+        "print(len(run_chunk_adaptive.signatures), len(advance.signatures))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True)
+    shot, compiled = out.stdout.splitlines()[-2:]
+    assert shot.split()[1] == "True"  # the certificate's shooting ran
+    assert compiled.split() == ["0", "0"]
+
+
+def test_single_trajectory_entry_points_pick_rk4_and_agree_bit_for_bit():
+    """run_alone_rk4 (what shooting an RK4 orbit runs) gives the very bits run_alone gives,
+    and alone_kernel picks it only for RK4 constants."""
+    from chaoscam.integrate._driver import alone_kernel, run_alone, run_alone_rk4
+
+    p = Params(xi=0.3)
+    runs = []
+    for entry in (run_alone, run_alone_rk4):
+        y, cnt, c, lam, bufs = _one_member(p, True)
+        n_stop = int(round(0.3 / p.dt))
+        code = entry(y[0], cnt[0], c[0], n_stop, lam[0], bufs[0][0], bufs[1][0], bufs[2][0])
+        runs.append((y, cnt, np.array([code]), *bufs))
+    assert runs[1][1][0, k.I_N_IMPACT] > 10
+    for a, b in zip(*runs, strict=True):
+        assert np.array_equal(a, b, equal_nan=True)
+    assert alone_kernel(_one_member(p, True)[2][0]) is run_alone_rk4
+    assert alone_kernel(_one_member(p.replace(integrator="adaptive"), True)[2][0]) is run_alone
+
+
 def test_a_ctrl_c_inside_a_c_callback_of_a_launch_is_not_lost():
     """SIGINT that arrives while a launch runs Python inside a C callback (numba's LLVM
     object cache while a kernel compiles) is held and raised as KeyboardInterrupt once the
