@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..report._figures import png_bytes, png_data_uri, response_figure
+from ..report._figures import png_bytes, png_uri, response_figure
 from ..report._html import Comparison, FigureItem
 
 __all__ = ["FIGURES", "FigureResult", "data_files"]
@@ -76,9 +76,10 @@ class FigureResult:
     title: str = ""
     figures: list[FigureItem] = field(default_factory=list)
     comparisons: list[Comparison] = field(default_factory=list)
-    bifurcations: list[tuple[str, Any]] = field(default_factory=list)
-    regime_maps: list[tuple[str, Any]] = field(default_factory=list)
-    trajectories: list[tuple[str, Any]] = field(default_factory=list)
+    # (data file, result, its figure rendered by _save) for the report to embed
+    bifurcations: list[tuple[str, Any, bytes]] = field(default_factory=list)
+    regime_maps: list[tuple[str, Any, bytes]] = field(default_factory=list)
+    trajectories: list[tuple[str, Any, bytes]] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     why: list[str] = field(default_factory=list)
     why_figures: list[FigureItem] = field(default_factory=list)
@@ -89,12 +90,14 @@ class FigureResult:
         return self.title or f"Fig. {self.number}"
 
 
-def _save(fig, outdir: Path, name: str) -> Path:
+def _save(fig, outdir: Path, name: str) -> bytes:
+    """Render ``fig`` once and write it to ``outdir/name.png``; returns the PNG, which the
+    report embeds as it is (rendering is a fifth of a quick report's time: never twice)."""
     from .._outputs import atomic_write_bytes
 
-    path = outdir / f"{name}.png"
-    atomic_write_bytes(path, png_bytes(fig, dpi=110))
-    return path
+    png = png_bytes(fig, dpi=110)
+    atomic_write_bytes(outdir / f"{name}.png", png)
+    return png
 
 
 def _write(path: Path, write) -> None:
@@ -151,14 +154,14 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
         title=f"l_λ ~ N(μ, σ²) truncated at l_min, resampled every {p.resample_dt} s",
     )
     ax.legend(frameon=False)
-    _save(fig, outdir, "fig3")
+    png = _save(fig, outdir, "fig3")
     draws = s["l_lambda"].to_numpy()[:: max(1, int(round(p.resample_dt / 1e-3)))]
     m, sd, n = float(draws.mean()), float(draws.std(ddof=1)), len(draws)
     res.figures.append(
         FigureItem(
             "fig3",
             "Fig. 3 — random contact-line length over time",
-            png_data_uri(fig),
+            png_uri(png),
             f"Step plot of the line length l_lambda in m against time in s, around mu = {mu} m.",
             f"{n} draws: mean {m:.5f} m, standard deviation {sd:.5f} m "
             f"(set: μ = {mu}, σ = {sigma}; "
@@ -203,8 +206,8 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     )
     path = outdir / "fig4.parquet"
     bif.to_parquet(path)
-    _save(bifurcation_figure(bif.points), outdir, "fig4")
-    res.bifurcations.append((str(path), bif))
+    png = _save(bifurcation_figure(bif.points), outdir, "fig4")
+    res.bifurcations.append((str(path), bif, png))
     v = bif.verdicts[bif.verdicts["ic"] == 0].sort_values("value")
     labels = [
         "periodic-2" if (lab == "periodic" and pd.notna(per) and int(per) == 2) else lab
@@ -278,13 +281,13 @@ def fig5(quick: bool, outdir: Path, workers=None) -> FigureResult:
         title="Majumdar–Bhushan joint stiffness, eqs. (15)/(17)",
     )
     ax.legend(frameon=False)
-    _save(fig, outdir, "fig5")
+    png = _save(fig, outdir, "fig5")
     hertz = p.stiffness_at(p.l_lambda)
     res.figures.append(
         FigureItem(
             "fig5",
             "Fig. 5 — fractal stiffness against D",
-            png_data_uri(fig),
+            png_uri(png),
             "Three curves of K_n in N/m (log scale) against D from 1.36 to 1.56, one per G.",
             f"Table 1 values for E, k, φ, A_r. For scale, the Hertz line stiffness at "
             f"l_λ = {p.l_lambda} m is {hertz:.3g} N/m; the fractal values are "
@@ -340,8 +343,8 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
         tag = _fig6_tag(g)
         path = outdir / f"{tag}.parquet"
         bif.to_parquet(path)
-        _save(bifurcation_figure(bif.points), outdir, tag)
-        res.bifurcations.append((str(path), bif))
+        png = _save(bifurcation_figure(bif.points), outdir, tag)
+        res.bifurcations.append((str(path), bif, png))
         counts = bif.verdicts["label"].value_counts().to_dict()
         found.append(f"G = {g:g} m (dt = {dt:g} s): " + _counts(counts))
     res.comparisons.append(
@@ -389,8 +392,8 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
     )
     path = outdir / "fig7-10.parquet"
     rm.to_parquet(path)
-    _save(regime_map_figure(rm.cells, x="l_lambda", y="l_lambda_sigma"), outdir, "fig7-10")
-    res.regime_maps.append((str(path), rm))
+    png = _save(regime_map_figure(rm.cells, x="l_lambda", y="l_lambda_sigma"), outdir, "fig7-10")
+    res.regime_maps.append((str(path), rm, png))
     for mu in MU_PAPER:
         for sigma in (0.0, max(sigmas)):
             traj = simulate(
@@ -398,8 +401,8 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
             )
             name = _fig7_trajectory(mu, sigma)
             _write(outdir / f"{name}.parquet", traj.to_parquet)
-            _save(response_figure(traj, title=f"μ = {mu} m, σ = {sigma} m"), outdir, name)
-            res.trajectories.append((str(outdir / f"{name}.parquet"), traj))
+            png = _save(response_figure(traj, title=f"μ = {mu} m, σ = {sigma} m"), outdir, name)
+            res.trajectories.append((str(outdir / f"{name}.parquet"), traj, png))
     c = rm.cells.set_index(["l_lambda", "l_lambda_sigma"])
 
     def cell(mu, sigma):

@@ -124,12 +124,12 @@ def run_paper(
     for r in results:
         before = (len(parts.paper_figures), len(parts.regime_maps), len(parts.bifurcations))
         parts.paper_figures.extend(r.figures)
-        for path, rm in r.regime_maps:
-            add_regime_map(parts, path, rm)
-        for path, bif in r.bifurcations:
-            add_bifurcation(parts, path, bif)
-        for path, traj in r.trajectories:
-            add_trajectory(parts, path, traj)
+        for path, rm, png in r.regime_maps:
+            add_regime_map(parts, path, rm, png=png)
+        for path, bif, png in r.bifurcations:
+            add_bifurcation(parts, path, bif, png=png)
+        for path, traj, png in r.trajectories:
+            add_trajectory(parts, path, traj, png=png)
         new = (
             [f.id for f in parts.paper_figures[before[0] :]]
             + [m["figure"].id for m in parts.regime_maps[before[1] :]]

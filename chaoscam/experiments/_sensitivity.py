@@ -148,15 +148,16 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     "Sensitivity"); ``classify`` as for the sweeps (the report's quick run caps the
     extension of undetermined runs)."""
     from ..model import Params
+    from ..report._figures import png_uri
     from ..report._sweep_figures import bifurcation_figure, regime_map_figure
     from ..sweep import Axis, bifurcation, regime_map
-    from ._paper import FigureResult, _save, png_data_uri
+    from ._paper import FigureResult, _save
 
     res = FigureResult(0, title="Sensitivity (why the paper differs)")
     # 1. stiffness
     bif_k, path_k, k_n = _stiffness(quick, outdir, workers, classify)
     fig = _stiffness_figure(bif_k, k_n)
-    _save(fig, outdir, "sensitivity-stiffness")
+    png_k = _save(fig, outdir, "sensitivity-stiffness")
     v = _first_ic(bif_k)
     kv = v["value"].map(k_n).to_numpy()
     runs = label_runs(kv, v["label"], v["period"])
@@ -179,22 +180,22 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         FigureItem(
             "sensitivity-stiffness",
             "Sensitivity to the contact stiffness",
-            png_data_uri(fig),
+            png_uri(png_k),
             "Section angle against contact stiffness on a log axis, coloured by verdict, "
             "with the paper's stiffness range shaded.",
             f"{len(v)} stiffnesses, 20 s runs (10 s transient), one initial condition; "
             f"labels from the default classifier. Data: {path_k.name}.",
         )
     )
-    res.bifurcations.append((str(path_k), bif_k))
+    res.bifurcations.append((str(path_k), bif_k, png_k))
     # 2. restitution
     bif_x = bifurcation(
         "xi", xi_values(quick), duration=20.0, transient=10.0, classify=classify, workers=workers
     )
     path_x = outdir / "sensitivity-xi.parquet"
     bif_x.to_parquet(path_x)
-    _save(bifurcation_figure(bif_x.points), outdir, "sensitivity-xi")
-    res.bifurcations.append((str(path_x), bif_x))
+    png_x = _save(bifurcation_figure(bif_x.points), outdir, "sensitivity-xi")
+    res.bifurcations.append((str(path_x), bif_x, png_x))
     res.why.append(restitution_finding(_first_ic(bif_x), Params().xi, flat))
     # 3. (omega, xi) map
     omegas = (20.0, 50.0, 6) if quick else (10.0, 50.0, 17)
@@ -210,8 +211,8 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     )
     path_m = outdir / "sensitivity-omega-xi.parquet"
     rm.to_parquet(path_m)
-    _save(regime_map_figure(rm.cells, x="omega", y="xi"), outdir, "sensitivity-omega-xi")
-    res.regime_maps.append((str(path_m), rm))
+    png_m = _save(regime_map_figure(rm.cells, x="omega", y="xi"), outdir, "sensitivity-omega-xi")
+    res.regime_maps.append((str(path_m), rm, png_m))
     cells = rm.cells
     tags = pd.Series([_tag(a, b) for a, b in zip(cells["dominant"], cells["period"], strict=True)])
     periods = sorted({int(p) for p in cells["period"].dropna()})

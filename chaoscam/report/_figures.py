@@ -11,7 +11,7 @@ import io
 
 import numpy as np
 
-__all__ = ["png_data_uri", "png_bytes", "response_figure"]
+__all__ = ["png_bytes", "png_uri", "response_figure"]
 
 
 def png_bytes(fig, dpi: int = 96) -> bytes:
@@ -24,9 +24,10 @@ def png_bytes(fig, dpi: int = 96) -> bytes:
     return buf.getvalue()
 
 
-def png_data_uri(fig, dpi: int = 96) -> str:
-    """``data:image/png;base64,...`` of a figure, for an ``<img src>`` that needs no network."""
-    return "data:image/png;base64," + base64.b64encode(png_bytes(fig, dpi)).decode("ascii")
+def png_uri(png: bytes) -> str:
+    """``data:image/png;base64,...`` of PNG bytes already rendered (:func:`png_bytes`), for an
+    ``<img src>`` that needs no network."""
+    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
 
 
 def response_figure(traj, title: str = ""):

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ._figures import png_data_uri, response_figure
+from ._figures import png_bytes, png_uri, response_figure
 
 __all__ = [
     "Comparison",
@@ -160,8 +160,15 @@ def _provenance_rows(source: str, kind: str, rows: dict[str, Any]) -> dict[str, 
     return {"source": source, "kind": kind, "rows": [(k, _fmt(v)) for k, v in rows.items()]}
 
 
-def add_trajectory(parts: ReportParts, path: str, traj, *, caption: str = "") -> None:
-    """A trajectory's response figure, its classification and its provenance."""
+def add_trajectory(
+    parts: ReportParts, path: str, traj, *, caption: str = "", png: bytes | None = None
+) -> None:
+    """A trajectory's response figure, its classification and its provenance.
+
+    ``png``: the response figure already rendered (:func:`._figures.png_bytes`, the paper's
+    stages render each figure once, for its file and for the report); without it the figure
+    is drawn here, titled with the file name and the label.
+    """
     from ._classify import classifier_name, classify
 
     name = Path(path).name
@@ -191,13 +198,14 @@ def add_trajectory(parts: ReportParts, path: str, traj, *, caption: str = "") ->
         )
     )
     label = verdict.label + (f" (period {verdict.period})" if verdict.period else "")
-    fig = response_figure(traj, title=f"{name}: {label}")
+    if png is None:
+        png = png_bytes(response_figure(traj, title=f"{name}: {label}"))
     fid = f"resp-{len(parts.responses) + 1}"
     parts.responses.append(
         FigureItem(
             fid,
             f"Response of {name}",
-            png_data_uri(fig),
+            png_uri(png),
             f"Four panels for {name}: follower angle and persistent-contact angle over the "
             f"last 2 s, phase portrait, stroboscopic Poincaré section and spectrum of theta_f; "
             f"classified {label}.",
@@ -221,8 +229,11 @@ def add_trajectory(parts: ReportParts, path: str, traj, *, caption: str = "") ->
     parts.summary.append(f"{name}: {label} ({traj.status.name}).")
 
 
-def add_bifurcation(parts: ReportParts, path: str, bif, *, caption: str = "") -> None:
-    """A bifurcation diagram, its verdicts per value and its provenance."""
+def add_bifurcation(
+    parts: ReportParts, path: str, bif, *, caption: str = "", png: bytes | None = None
+) -> None:
+    """A bifurcation diagram, its verdicts per value and its provenance (``png``: its figure
+    already rendered, else drawn here)."""
     from ._sweep_figures import bifurcation_figure
 
     name = Path(path).name
@@ -230,14 +241,15 @@ def add_bifurcation(parts: ReportParts, path: str, bif, *, caption: str = "") ->
     param = cfg.get("axis", {}).get("name", "value")
     v = bif.verdicts
     counts = v["label"].value_counts().to_dict() if len(v) else {}
-    fig = bifurcation_figure(bif.points)
+    if png is None:
+        png = png_bytes(bifurcation_figure(bif.points))
     ev_cols = [c for c in v.columns if c.startswith("ev_")]
     parts.bifurcations.append(
         {
             "figure": FigureItem(
                 f"bif-{len(parts.bifurcations) + 1}",
                 f"Bifurcation diagram over {param} ({name})",
-                png_data_uri(fig),
+                png_uri(png),
                 f"Stroboscopic section theta_f in rad against {param}, coloured by the "
                 f"classifier's label; label counts {_counts(counts)}.",
                 caption
@@ -262,15 +274,19 @@ def add_bifurcation(parts: ReportParts, path: str, bif, *, caption: str = "") ->
     parts.summary.append(f"{name}: bifurcation over {param}, labels {_counts(counts)}.")
 
 
-def add_regime_map(parts: ReportParts, path: str, rm, *, caption: str = "") -> None:
-    """A regime map's figure, its cell table and its provenance."""
+def add_regime_map(
+    parts: ReportParts, path: str, rm, *, caption: str = "", png: bytes | None = None
+) -> None:
+    """A regime map's figure, its cell table and its provenance (``png``: its figure already
+    rendered, else drawn here)."""
     from ._sweep_figures import regime_map_figure
 
     name = Path(path).name
     cfg = rm.config or {}
     x, y = cfg.get("x", {}).get("name", "x"), cfg.get("y", {}).get("name", "y")
     c = rm.cells
-    fig = regime_map_figure(c, x=x, y=y)
+    if png is None:
+        png = png_bytes(regime_map_figure(c, x=x, y=y))
     rows = []
     for r in c.sort_values([x, y]).to_dict("records"):
         rows.append(
@@ -289,7 +305,7 @@ def add_regime_map(parts: ReportParts, path: str, rm, *, caption: str = "") -> N
             "figure": FigureItem(
                 f"map-{len(parts.regime_maps) + 1}",
                 f"Regime map {x} × {y} ({name})",
-                png_data_uri(fig),
+                png_uri(png),
                 f"Heatmaps over {x} and {y}: dominant label per cell, probability of chaos "
                 "with its 95% Wilson interval, and the interval width.",
                 caption or f"{len(rm.realizations)} realizations in {len(c)} cells.",

@@ -94,7 +94,6 @@ def test_data_files_are_exactly_what_the_figures_write(tmp_path, monkeypatch, nu
 
     _shrink_the_runs(monkeypatch)
     monkeypatch.setattr(_paper, "png_bytes", lambda fig, dpi=None: b"\x89PNG")
-    monkeypatch.setattr(_paper, "png_data_uri", lambda fig, dpi=None: "data:,")
     stage = _paper._sensitivity_stage if number == _paper.SENSITIVITY else _paper.FIGURES[number]
     res = stage(True, tmp_path, workers=1)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(_paper.data_files(number))
@@ -130,3 +129,35 @@ def test_paper_unwritable_places_are_refused(tmp_path, capsys):
     assert main(["paper", "--figures", "5", "--out", str(missing)]) == 2
     assert "does not exist" in capsys.readouterr().err
     assert not (tmp_path / "no").exists() and not (tmp_path / "p.html").exists()
+
+
+def test_each_figure_is_rendered_once_and_the_report_embeds_its_file(tmp_path, monkeypatch):
+    """The paper's stages render every figure once: the report embeds the very PNG written
+    to paper-data (rendering was a fifth of a quick report's time, each figure drawn twice)."""
+    import base64
+
+    import chaoscam.report._classify
+    from chaoscam import classify_trajectory
+    from chaoscam.experiments import _paper, run_paper
+    from chaoscam.report import _figures, _html
+
+    _shrink_the_runs(monkeypatch)
+    quick = lambda traj: classify_trajectory(traj, tangent=False, extend_to=None)  # noqa: E731
+    monkeypatch.setattr(chaoscam.report._classify, "classify", quick)
+    rendered = []
+
+    def stub(fig, dpi=96):  # a distinct stand-in PNG per rendering
+        rendered.append(b"\x89PNG-%d" % len(rendered))
+        return rendered[-1]
+
+    for module in (_paper, _html, _figures):
+        monkeypatch.setattr(module, "png_bytes", stub)
+    out = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 4, 5, 7])
+    files = {p.name: p.read_bytes() for p in (tmp_path / "paper-data").glob("*.png")}
+    assert len(files) == 10  # figs 3, 4, 5, the map and six responses
+    assert sorted(rendered) == sorted(files.values())  # once each, nothing else drawn
+    text = out.read_text()
+    embedded = {
+        base64.b64decode(u) for u in re.findall(r'src="data:image/png;base64,([^"]+)"', text)
+    }
+    assert embedded == set(files.values())
