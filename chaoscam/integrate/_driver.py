@@ -47,12 +47,16 @@ __all__ = [
     "fork_safe_threads",
     "alone_kernel",
     "members_kernel",
+    "members_on_this_thread",
+    "on_this_thread",
     "run_members",
     "run_alone",
     "run_alone_rk4",
     "run_members_rk4",
     "run_one",
     "thread_count",
+    "StopRequested",
+    "check_stop",
 ]
 
 _OUTPUTS = (("series", k.I_N_SERIES), ("section", k.I_N_SECTION), ("impacts", k.I_N_IMPACT))
@@ -180,9 +184,11 @@ def fork_safe_threads() -> None:
 
 def thread_count() -> int:
     """numba's thread count, asked after :func:`fork_safe_threads` (asking starts the
-    threads, which fixes the layer)."""
+    threads, which fixes the layer); 1 inside :func:`members_on_this_thread`."""
     import numba
 
+    if on_this_thread():
+        return 1
     fork_safe_threads()
     return numba.get_num_threads()
 
@@ -223,6 +229,48 @@ def run_alone_rk4(y, cnt, c, n_stop, lam, series, section, impacts):
     :func:`._kernel.run_chunk` that :func:`._advance.advance` calls for it (the same bits),
     without compiling the adaptive path (:func:`alone_kernel` picks)."""
     return k.run_chunk(y, cnt, c, n_stop, lam, series, section, impacts)
+
+
+_here = threading.local()
+
+
+class StopRequested(Exception):
+    """A run driven by :func:`members_on_this_thread` was asked to stop (its ``stop`` event
+    was set): raised between two compiled calls, the members' state left as it was."""
+
+
+@contextlib.contextmanager
+def members_on_this_thread(stop: threading.Event | None = None):
+    """Within this context the calling thread runs its ensembles' members one after another
+    through the compiled nogil call (:func:`alone_kernel`), not on numba's ``prange``
+    threads; :func:`on_this_thread` says so to :func:`._members.run_on_cpu` and to the
+    verdicts.
+
+    For callers that run several ensembles at once from their own threads (the sweeps'
+    thread backend, one batch per core): numba's workqueue layer takes one parallel launch
+    at a time, and a batch on one thread leaves no core waiting for its slowest member while
+    other batches run. The members are the same compiled :func:`._kernel.run_chunk`, so the
+    same bits. ``stop``: when set, the next call raises :class:`StopRequested` (a prompt
+    Ctrl-C; a compiled call itself cannot be interrupted).
+    """
+    before = getattr(_here, "stop", None), getattr(_here, "active", False)
+    _here.stop, _here.active = stop, True
+    try:
+        yield
+    finally:
+        _here.stop, _here.active = before
+
+
+def on_this_thread() -> bool:
+    """Whether the calling thread is inside :func:`members_on_this_thread`."""
+    return getattr(_here, "active", False)
+
+
+def check_stop() -> None:
+    """Raise :class:`StopRequested` if this thread's run was asked to stop."""
+    stop = getattr(_here, "stop", None)
+    if stop is not None and stop.is_set():
+        raise StopRequested("stopped on request")
 
 
 def contact_fraction(y, cnt, c) -> float:

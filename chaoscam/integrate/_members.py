@@ -14,7 +14,15 @@ import numpy as np
 from ..model import LineLengthStream, Params
 from . import _kernel as k
 from ._constants import initial_counters, initial_state, kernel_constants
-from ._driver import contact_fraction, drive_members, fork_safe_threads, members_kernel
+from ._driver import (
+    alone_kernel,
+    check_stop,
+    contact_fraction,
+    drive_members,
+    fork_safe_threads,
+    members_kernel,
+    on_this_thread,
+)
 from ._resume import Resume, snapshot_step, take
 from ._status import Status
 
@@ -158,7 +166,38 @@ def run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep
     """The members in parallel calls of the driver's loop: those whose ``status`` is
     ``NEED_BUFFER`` first (every member of a fresh batch), then those that asked for room,
     refilled (a resumed member is bit-identical to one that was not interrupted, so the
-    pauses change nothing); the others keep their code."""
+    pauses change nothing); the others keep their code. Inside
+    :func:`._driver.members_on_this_thread` the members run one after another on the calling
+    thread (:func:`_one_by_one`)."""
+    if on_this_thread():
+        launch = _one_by_one(y, cnt, c, n_stop, lam, section, impacts, status)
+    else:
+        launch = _in_parallel(y, cnt, c, n_stop, lam, section, impacts, status)
+
+    def refill(need: np.ndarray) -> None:
+        for j in need:  # the same width again: as many new draws as were used
+            lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
+
+    drive_members(y.shape[0], launch, refill, np.flatnonzero(status == k.NEED_BUFFER))
+
+
+def _one_by_one(y, cnt, c, n_stop, lam, section, impacts, status):
+    """A launch of the members ``need`` on this thread, each through the compiled nogil call
+    on its rows in place (the same :func:`._kernel.run_chunk` as the parallel launch)."""
+    run = alone_kernel(c)
+    series = np.empty((1, k.SERIES_COLS))
+
+    def launch(need: np.ndarray) -> np.ndarray:
+        for j in need:
+            check_stop()
+            status[j] = run(y[j], cnt[j], c[j], n_stop, lam[j], series, section[j], impacts[j])
+        return status[need]
+
+    return launch
+
+
+def _in_parallel(y, cnt, c, n_stop, lam, section, impacts, status):
+    """A launch of the members ``need`` on numba's threads (``prange``)."""
     fork_safe_threads()
     n = y.shape[0]
     run_members = members_kernel(c)
@@ -186,11 +225,7 @@ def run_on_cpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep
         status[need] = sub_status
         return sub_status
 
-    def refill(need: np.ndarray) -> None:
-        for j in need:  # the same width again: as many new draws as were used
-            lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
-
-    drive_members(n, launch, refill, np.flatnonzero(status == k.NEED_BUFFER))
+    return launch
 
 
 def _draws(p: Params, duration: float, room: int) -> int:

@@ -4,6 +4,10 @@ Each backend offers the same four verbs to the engine (``submit``, ``wait_any``,
 ``close``); a record never depends on which backend or how many workers computed it.
 
 * :class:`SerialBackend` — one worker, in this process (no start-up cost).
+* :class:`ThreadBackend` — ``workers`` threads of this process, each running its tasks'
+  ensembles one member at a time through the compiled call without the GIL (the ensemble
+  engine's local backend): a task's slowest member no longer leaves the other cores
+  waiting, as a ``prange`` launch over one batch does.
 * :class:`ProcessBackend` — ``concurrent.futures.ProcessPoolExecutor``, workers ignoring
   SIGINT so that Ctrl-C reaches the driver alone. On Linux the workers are forked from the
   driver after it has loaded the compiled kernels, so they start in milliseconds instead of
@@ -31,6 +35,7 @@ from typing import Any
 
 __all__ = [
     "SerialBackend",
+    "ThreadBackend",
     "ProcessBackend",
     "DaskBackend",
     "WorkerLost",
@@ -87,6 +92,51 @@ class SerialBackend:
 
     def close(self) -> None:
         pass
+
+
+class ThreadBackend:
+    """Tasks on ``workers`` threads of this process (the ensemble engine's local backend).
+
+    Each task runs inside :func:`chaoscam.integrate._driver.members_on_this_thread`: its
+    ensembles' members one after another through the compiled call, which releases the GIL,
+    so ``workers`` tasks simulate at once and a task's slow member delays only its own
+    thread (numba's workqueue layer takes one parallel launch at a time, and a launch over a
+    batch waits for its slowest member). The members are the same compiled kernel, so the
+    records are the same bits as on one thread. ``cancel`` asks the running tasks to stop
+    between two compiled calls (a prompt Ctrl-C); ``close`` joins the threads, so that a
+    process pool forked later in this process forks a single-threaded driver.
+    """
+
+    name = "threads"
+
+    def __init__(self, workers: int) -> None:
+        self.workers = int(workers)
+        self._stop = threading.Event()
+        self._pool = cf.ThreadPoolExecutor(self.workers, thread_name_prefix="chaoscam-batch")
+
+    def _run(self, fn: Callable, arg: Any) -> Any:
+        from ..integrate._driver import members_on_this_thread
+
+        with members_on_this_thread(self._stop):
+            return fn(arg)
+
+    def submit(self, fn: Callable, arg: Any) -> cf.Future:
+        return self._pool.submit(self._run, fn, arg)
+
+    def wait_any(self, futures: Iterable[cf.Future]) -> set:
+        return cf.wait(list(futures), return_when=cf.FIRST_COMPLETED).done
+
+    def result(self, fut: cf.Future) -> Any:
+        return fut.result()
+
+    def cancel(self, futures: Iterable[cf.Future]) -> None:
+        self._stop.set()
+        for fut in futures:
+            fut.cancel()
+
+    def close(self) -> None:
+        self._stop.set()  # tasks still running stop at their next compiled call
+        self._pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _worker_init(parent: int) -> None:

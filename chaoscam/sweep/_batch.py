@@ -143,13 +143,15 @@ process engine."""
 class Engine:
     """A sweep's resolved engine: its name, the classifier identity it records, and how
     the driver runs it (``pack``/``pack_size`` for :func:`._engine.execute`, ``threads``
-    numba threads in this process when local)."""
+    numba threads in this process when local, ``task_threads`` > 1: that many batches at
+    once on the threads of a :class:`._backends.ThreadBackend`)."""
 
     name: str
     identity: str
     pack: Any = None
     pack_size: int = 1
     threads: int | None = None
+    task_threads: int = 1
 
 
 def resolve_engine(
@@ -200,14 +202,20 @@ def resolve_engine(
         threads = default_workers() if workers is None else int(workers)
         if threads < 1:
             raise SweepError(f"workers = {threads} must be >= 1")
-    size = batch_size(base, run[0], run[1], threads or 1)
+    # Local CPU batches run one per thread, each a batch's work on one core (a GPU batch
+    # fills its device; a Dask worker runs numba threads over its own cores).
+    by_task = threads if threads is not None and threads > 1 and device == "cpu" else 1
+    size = batch_size(base, run[0], run[1], 1 if by_task > 1 else threads or 1)
 
     extend_to = classify.extend_to
 
     def pack(tasks: tuple) -> BatchTask:
         return BatchTask(tasks, device, extend_to)
 
-    return Engine("ensemble", f"{ENGINE_CLASSIFIER}, extend_to={extend_to}", pack, size, threads)
+    identity = f"{ENGINE_CLASSIFIER}, extend_to={extend_to}"
+    if by_task > 1:
+        return Engine("ensemble", identity, pack, size, None, by_task)
+    return Engine("ensemble", identity, pack, size, threads)
 
 
 def sweep_engine(
@@ -257,15 +265,18 @@ def numba_threads(n: int | None):
 
 
 def run_plan(plan, eng: Engine, store, *, workers, scheduler, progress: bool, desc: str) -> None:
-    """Execute a sweep's plan on its engine: the ensemble engine in this process on
-    ``eng.threads`` numba threads (or its batches on Dask), the process engine on a pool of
-    ``workers`` processes (or Dask)."""
-    from ._backends import SerialBackend
+    """Execute a sweep's plan on its engine: the ensemble engine in this process, one batch
+    per thread on ``eng.task_threads`` threads or one batch at a time on ``eng.threads``
+    numba threads (or its batches on Dask), the process engine on a pool of ``workers``
+    processes (or Dask)."""
+    from ._backends import SerialBackend, ThreadBackend
     from ._common import backend_for
     from ._engine import execute
 
-    local = eng.name == "ensemble" and scheduler is None
-    backend = SerialBackend() if local else backend_for(workers, scheduler)
+    if eng.name == "ensemble" and scheduler is None:
+        backend = ThreadBackend(eng.task_threads) if eng.task_threads > 1 else SerialBackend()
+    else:
+        backend = backend_for(workers, scheduler)
     try:
         with numba_threads(eng.threads):
             execute(

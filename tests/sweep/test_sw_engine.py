@@ -74,7 +74,8 @@ def test_threads_and_batches_do_not_change_the_table(maps, monkeypatch):
 
 
 def test_an_interrupted_ensemble_map_resumes_to_the_same_table(maps, tmp_path, monkeypatch):
-    """Ctrl-C after the first batch saves it; --resume finishes to the whole table."""
+    """Ctrl-C after the first batch saves it; --resume finishes to the whole table (one
+    worker: the batches run one after another in this thread)."""
     from chaoscam.sweep import SweepInterrupted
 
     monkeypatch.setattr(_batch, "batch_size", lambda *a, **k: 2)
@@ -89,10 +90,62 @@ def test_an_interrupted_ensemble_map_resumes_to_the_same_table(maps, tmp_path, m
     out = tmp_path / "map.parquet"
     monkeypatch.setattr(_batch, "run_batch", interrupt_second)
     with pytest.raises(SweepInterrupted) as err:
-        regime_map(XI, SIGMA, engine="ensemble", out=out, **KW)
+        regime_map(XI, SIGMA, engine="ensemble", out=out, workers=1, **KW)
     assert "2 of" in str(err.value) and "--resume" in str(err.value)
     monkeypatch.setattr(_batch, "run_batch", real)
-    done = regime_map(XI, SIGMA, engine="ensemble", out=out, resume=True, **KW)
+    done = regime_map(XI, SIGMA, engine="ensemble", out=out, resume=True, workers=1, **KW)
+    frames_equal(done.realizations, maps["ensemble"].realizations)
+
+
+def test_two_workers_run_batches_on_threads_and_a_ctrl_c_stops_them(maps, tmp_path, monkeypatch):
+    """With two workers the batches run on two threads at once, each member by member
+    (no prange launch); a Ctrl-C in the waiting driver saves the finished batches, stops
+    the running one at its next compiled call, leaves no thread behind, and --resume
+    finishes to the table of one thread."""
+    import threading
+
+    from chaoscam.integrate import _members
+    from chaoscam.integrate._driver import StopRequested
+    from chaoscam.sweep import SweepInterrupted, _backends
+
+    monkeypatch.setattr(_batch, "batch_size", lambda *a, **k: 2)
+    monkeypatch.setattr(_members, "members_kernel", None)  # a prange launch would fail
+    seen, stopped, waits, calls = set(), [], [], []
+    interrupted = threading.Event()
+    real_run, real_wait = _batch.run_batch, _backends.ThreadBackend.wait_any
+
+    def on_thread(tasks, backend="cpu", extend_to=None):
+        seen.add(threading.current_thread().name)
+        calls.append(1)
+        if len(calls) == 2:  # the second batch is under way when Ctrl-C comes
+            assert interrupted.wait(60)
+        try:
+            return real_run(tasks, backend, extend_to)
+        except StopRequested:
+            stopped.append(len(tasks))
+            raise
+
+    def ctrl_c_on_second_wait(self, futures):
+        waits.append(1)
+        if len(waits) == 2:  # after the first finished batch was stored
+            interrupted.set()
+            raise KeyboardInterrupt
+        return real_wait(self, futures)
+
+    monkeypatch.setattr(_batch, "run_batch", on_thread)
+    monkeypatch.setattr(_backends.ThreadBackend, "wait_any", ctrl_c_on_second_wait)
+    before = threading.active_count()
+    out = tmp_path / "map.parquet"
+    with pytest.raises(SweepInterrupted) as err:
+        regime_map(XI, SIGMA, engine="ensemble", out=out, workers=2, **KW)
+    saved = int(str(err.value).split(" of ")[0].split()[-1])
+    assert 2 <= saved < 8 and "--resume" in str(err.value)
+    assert threading.active_count() == before  # the batch threads were joined
+    assert len(seen) == 2 and all(n.startswith("chaoscam-batch") for n in seen)
+    assert stopped  # a batch under way stopped between two compiled calls
+    monkeypatch.setattr(_batch, "run_batch", real_run)
+    monkeypatch.setattr(_backends.ThreadBackend, "wait_any", real_wait)
+    done = regime_map(XI, SIGMA, engine="ensemble", out=out, resume=True, workers=2, **KW)
     frames_equal(done.realizations, maps["ensemble"].realizations)
 
 
@@ -154,12 +207,12 @@ def test_a_capped_extension_is_recorded_and_honoured():
 
 @pytest.mark.parametrize("first", ["regime_map", "cli_progress_batch"])
 def test_process_engine_forks_after_the_ensemble_engine_ran(first):
-    """A fresh process that first runs the ensemble engine on two threads (which sets
-    numba's thread count, and so starts its threads and fixes the layer before any launch),
-    or asks for the thread count as ``chaoscam ensemble`` does before its first launch,
-    then forks a process-engine pool: the layer is the fork-safe one and the workers live
-    (with the GNU OpenMP layer every worker was killed at its fork: "lost its worker 4
-    times")."""
+    """A fresh process that first runs the ensemble engine with two workers (its batch
+    threads run members one by one: numba's threads are never started), or asks for the
+    thread count as ``chaoscam ensemble`` does before its first launch (which starts them
+    and fixes the layer), then forks a process-engine pool: the layer is unset or the
+    fork-safe one and the workers live (with the GNU OpenMP layer every worker was killed
+    at its fork: "lost its worker 4 times")."""
     import subprocess
     import sys
     from pathlib import Path
@@ -173,12 +226,14 @@ def test_process_engine_forks_after_the_ensemble_engine_ran(first):
     code = (
         "import numba; from chaoscam.sweep import Axis, regime_map; "
         "x = Axis('l_lambda', (0.008, 0.01)); y = Axis('l_lambda_sigma', (0.0, 0.002)); "
-        f"{setup}; print(numba.threading_layer()); "
+        f"{setup}\ntry:\n    print(numba.threading_layer())\nexcept ValueError:\n"
+        "    print('unset')\n"
         "m = regime_map(x, y, realizations=2, duration=1.0, workers=2, engine='process'); "
         "print(len(m.realizations))"
     )
     root = Path(__file__).resolve().parents[2]
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=root)
     assert run.returncode == 0, run.stderr[-2000:]
-    assert run.stdout.split() == ["workqueue", "6"]
+    layer = {"regime_map": "unset", "cli_progress_batch": "workqueue"}[first]
+    assert run.stdout.split() == [layer, "6"]
     assert "Terminating" not in run.stderr
