@@ -5,7 +5,7 @@ Run: python benchmarks/bench_sweep.py [--quick]
 1. Fig. 4's bifurcation diagram: l_lambda over 0.001:0.018:69, 20 s each (10 s transient),
    every core, the default engine; budget 60 s on the 2-core machine.
 2. The same regime map with one and with two workers, on each engine: the default
-   ``ensemble`` (numba threads) and ``process`` (worker processes): speed-up (goal >= 1.8),
+   ``ensemble`` (batches on threads) and ``process`` (worker processes): speed-up (goal >= 1.8),
    the map sized to ~15 s on one worker, best of two alternated runs each, with the load
    average printed beside it.
 3. Memory as the grid grows, on each engine: the driver's peak traced allocation
