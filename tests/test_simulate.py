@@ -160,8 +160,8 @@ def test_bad_run_settings_are_refused(kwargs, field):
 def test_compilation_is_cached_across_processes():
     """A second process loads the kernel from numba's cache instead of compiling it."""
     code = (
-        "import chaoscam; from chaoscam.integrate._driver import run_members_rk4; "
-        "chaoscam.simulate(duration=0.01); print(sum(run_members_rk4.stats.cache_hits.values()))"
+        "import chaoscam; from chaoscam.integrate._driver import run_alone_rk4; "
+        "chaoscam.simulate(duration=0.01); print(sum(run_alone_rk4.stats.cache_hits.values()))"
     )
     subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True)

@@ -194,21 +194,11 @@ def thread_count() -> int:
 
 
 def run_one(y, cnt, c, n_stop, lam, series, section, impacts) -> int:
-    """:func:`run_members` for one trajectory (arrays of a single member, updated in place)."""
-    fork_safe_threads()
-    status = np.zeros(1, dtype=np.int64)
-    members_kernel(c)(
-        y[None],
-        cnt[None],
-        c[None],
-        n_stop,
-        lam[None],
-        series[None],
-        section[None],
-        impacts[None],
-        status,
-    )
-    return int(status[0])
+    """One trajectory (arrays of a single member, updated in place) on the calling thread:
+    :func:`alone_kernel`'s pick, the compiled kernel the parallel entry points run for each
+    member (so the same bits), without a ``prange`` launch for a batch of one (which
+    compiled a parallel kernel and started numba's threads for every single run)."""
+    return int(alone_kernel(c)(y, cnt, c, n_stop, lam, series, section, impacts))
 
 
 @njit(nogil=True, cache=True)

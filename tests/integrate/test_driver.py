@@ -127,7 +127,8 @@ def test_an_rk4_run_never_compiles_the_adaptive_kernel():
 def test_rk4_verdicts_and_exponents_never_compile_the_adaptive_kernel():
     """A fresh process that classifies an RK4 run (tangent exponent, periodic-orbit shooting)
     and takes the two-trajectory exponent compiles neither the adaptive kernel nor the
-    dispatch between both (on a fresh install that took ~10 s for nothing)."""
+    dispatch between both (on a fresh install that took ~10 s for nothing), nor a parallel
+    kernel: a single run is not a prange launch over a batch of one."""
     import subprocess
     import sys
 
@@ -135,17 +136,19 @@ def test_rk4_verdicts_and_exponents_never_compile_the_adaptive_kernel():
         "import chaoscam\n"
         "from chaoscam.integrate._adaptive import run_chunk_adaptive\n"
         "from chaoscam.integrate._advance import advance\n"
+        "from chaoscam.integrate._driver import run_members, run_members_rk4\n"
         "p = chaoscam.Params(xi=0.2)\n"
         "t = chaoscam.simulate(p, duration=4.0, transient=2.0, tangent=True)\n"
         "v = chaoscam.classify_trajectory(t)\n"
         "chaoscam.lyapunov_model(p, duration=1.0, transient=0.5)\n"
         "print(v.label, any(e.name == 'periodic_orbit' for e in v.evidence))\n"
-        "print(len(run_chunk_adaptive.signatures), len(advance.signatures))\n"
+        "print(len(run_chunk_adaptive.signatures), len(advance.signatures), "
+        "len(run_members.signatures), len(run_members_rk4.signatures))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True)
     shot, compiled = out.stdout.splitlines()[-2:]
     assert shot.split()[1] == "True"  # the certificate's shooting ran
-    assert compiled.split() == ["0", "0"]
+    assert compiled.split() == ["0", "0", "0", "0"]
 
 
 def test_single_trajectory_entry_points_pick_rk4_and_agree_bit_for_bit():
