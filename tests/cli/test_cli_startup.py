@@ -110,16 +110,20 @@ def test_simulate_without_files_never_imports_pandas():
 
 
 def test_import_and_run_leave_numba_threading_layer_to_first_parallel_launch():
-    """Importing the simulate path changes no process-wide setting; the first run picks the
+    """Importing the simulate path changes no process-wide setting, nor does a single run
+    (it launches nothing parallel); the first parallel launch (an ensemble) picks the
     fork-safe layer (unless the user chose one)."""
     code = (
         "import numba, chaoscam._simulate as s; print(numba.config.THREADING_LAYER); "
-        "s.raw_run(duration=0.001); print(numba.config.THREADING_LAYER)"
+        "s.raw_run(duration=0.001); print(numba.config.THREADING_LAYER); "
+        "from chaoscam.integrate import simulate_ensemble; "
+        "simulate_ensemble(s.Params(), [0, 1], duration=0.001); "
+        "print(numba.config.THREADING_LAYER)"
     )
     out = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True
     ).stdout.split()
-    assert out == ["default", "workqueue"]
+    assert out == ["default", "default", "workqueue"]
 
 
 def test_ctrl_c_inside_an_import_lock_callback_is_sent_again(monkeypatch):
