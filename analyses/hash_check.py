@@ -31,6 +31,7 @@ RUNS = {
     "default rk4, tangent": dict(tangent=True),
     "xi=0.2 rk4": dict(xi=0.2),
     "sigma=2mm rk4": dict(l_lambda_sigma=0.002, index=3),
+    "sigma=2mm rk4, impact resampling": dict(l_lambda_sigma=0.002, resample="impact", index=3),
     "omega=45 rk4": dict(omega=45.0),
     "default adaptive": dict(integrator="adaptive"),
     "e=0.02 sticking": dict(e=0.02),

@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from chaoscam import ParameterError, Params, Status, simulate
@@ -93,11 +94,48 @@ def test_same_seed_same_realization_and_indices_differ():
     assert not np.array_equal(a.impacts.l_lambda.values[:n], c.impacts.l_lambda.values[:n])
 
 
-def test_line_length_is_redrawn_at_each_impact():
-    """In 'impact' mode every applied impact carries a fresh draw."""
-    tr = simulate(Params(l_lambda_sigma=0.002), duration=2.0, series=False)
+def test_line_length_is_redrawn_at_each_applied_impact_in_impact_mode():
+    """In 'impact' mode every applied impact, micro-impacts included, carries a fresh draw."""
+    tr = simulate(Params(l_lambda_sigma=0.002, resample="impact"), duration=2.0, series=False)
     lam = tr.impacts.l_lambda.values
     assert len(np.unique(lam)) == len(lam) and lam.min() > tr.params.l_min
+
+
+def test_each_contact_has_its_own_line_in_contact_mode():
+    """Default 'contact' mode: each macro impact draws a new line; the micro-impacts and the
+    chattering end that follow it in the same contact keep it."""
+    tr = simulate(Params(l_lambda_sigma=0.002), duration=2.0, series=False)
+    imp = tr.impacts
+    kind = imp["kind"].astype(str).to_numpy()
+    lam = imp.l_lambda.to_numpy()
+    macro = kind == "macro"
+    assert macro.sum() >= 10 and (~macro).sum() > 10 * macro.sum()  # mostly micro-impacts
+    assert len(np.unique(lam[macro])) == macro.sum()
+    contact_line = pd.Series(np.where(macro, lam, np.nan)).ffill().to_numpy()
+    after_first = np.arange(len(lam)) >= np.argmax(macro)
+    np.testing.assert_array_equal(lam[after_first], contact_line[after_first])
+
+
+def test_contact_resampling_makes_the_realization_independent_of_the_step():
+    """The line lengths of a realization, at its macro impacts and its sections, are the same
+    at dt and dt/2 under 'contact' resampling, although the micro-impact count changes with
+    dt; under 'impact' resampling that count shifts the draws."""
+
+    def lines(p, dt):
+        tr = simulate(p.replace(dt=dt), duration=2.0, seed=5, series=False)
+        imp = tr.impacts
+        return imp.l_lambda[imp["kind"] == "macro"].to_numpy(), tr.section.l_lambda.to_numpy()
+
+    p = Params(l_lambda_sigma=0.002)
+    (a, sa), (b, sb) = lines(p, 2e-6), lines(p, 1e-6)
+    assert len(a) == len(b) >= 10
+    np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(sa, sb)
+    (a, _), (b, _) = (
+        lines(p.replace(resample="impact"), 2e-6),
+        lines(p.replace(resample="impact"), 1e-6),
+    )
+    assert not np.array_equal(a, b)
 
 
 def test_interval_resampling_changes_only_on_the_grid():
@@ -181,3 +219,4 @@ def test_parquet_round_trip_keeps_provenance(tmp_path):
     meta = json.loads(table.schema.metadata[b"chaoscam.trajectory"])
     assert meta["params"]["omega"] == 28.7 and meta["settings"]["duration"] == 0.5
     assert table.num_rows == len(tr.series)
+

@@ -69,6 +69,7 @@ def kernel_constants(
     c[k.C_TANGENT] = 1.0 if tangent else 0.0
     c[k.C_V_CHATTER] = p.v_chatter
     c[k.C_V_MICRO] = p.v_micro
+    c[k.C_RESAMPLE_EVERY] = 1.0 if p.resample == "impact" else 0.0
     return c
 
 

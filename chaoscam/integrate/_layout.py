@@ -32,7 +32,7 @@ C_DT = 19  # grid step [s]
 C_EVENT_TOL = 20  # impact-time tolerance [s]
 C_PERIOD = 21  # section interval 2 pi / omega [s]
 C_T_RECORD = 22  # outputs are kept from this time on (transient) [s]
-C_RESAMPLE_DT = 23  # interval between line-length draws [s]; 0 = draw at each impact
+C_RESAMPLE_DT = 23  # interval between line-length draws [s]; 0 = draw at impacts
 C_MAX_EVENTS = 24  # impacts handled in one step before chattering hand-over
 C_STRIDE = 25  # series sample every C_STRIDE steps; 0 = no series
 C_FLIGHT_MERGE = 26  # most grid steps taken as one RK4 step where the gap provably stays open
@@ -43,7 +43,8 @@ C_H_MAX = 30  # adaptive: largest step [s]
 C_TANGENT = 31  # 1: integrate the tangent (variational) dynamics with the state; 0: do not
 C_V_CHATTER = 32  # approach speed below which a closing ends a complete chattering [m/s]
 C_V_MICRO = 33  # approach speed below which an applied impact is flagged micro [m/s]
-N_CONSTANTS = 34
+C_RESAMPLE_EVERY = 34  # impact resampling: 1 draws at every applied jump, 0 at macro ones
+N_CONSTANTS = 35
 
 METHOD_RK4 = 0
 METHOD_ADAPTIVE = 1

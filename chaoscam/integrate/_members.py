@@ -230,7 +230,7 @@ def _in_parallel(y, cnt, c, n_stop, lam, section, impacts, status):
 
 def _draws(p: Params, duration: float, room: int) -> int:
     """Line-length draws a member starts with: one per resampling interval of the run, or,
-    under impact resampling (one per applied impact), ``room``."""
+    under impact resampling (one per macro impact, or per applied jump), ``room``."""
     if p.resample == "interval":
         return int(duration / p.resample_dt) + 64
     return room

@@ -132,9 +132,9 @@ def simulate_reference(
                 chatter_end = -rate < p.v_chatter
                 xi = 0.0 if chatter_end else p.xi
                 om_after = -xi * y[1] + (1.0 + xi) * cdn / l1
-                if p.resample == "impact":
-                    lam = float(stream.draw(1)[0])
                 kind = 2 if chatter_end else (1 if -rate < p.v_micro else 0)
+                if p.resample == "impact" or (p.resample == "contact" and kind == 0):
+                    lam = float(stream.draw(1)[0])
                 impacts.append((t, y[0], y[1], om_after, rate, l1, lam, kind))
                 y[1] = om_after
                 in_contact = chatter_end

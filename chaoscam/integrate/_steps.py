@@ -16,6 +16,7 @@ from numba import njit
 from ._layout import (
     C_PERIOD,
     C_RESAMPLE_DT,
+    C_RESAMPLE_EVERY,
     C_T_RECORD,
     C_TANGENT,
     C_V_CHATTER,
@@ -149,10 +150,12 @@ def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c):
     chattering sequence (the infinitely many ever shorter bounces whose speeds fall by ``xi``
     each, Nordmark & Piiroinen 2009, Nonlinear Dyn. 58): it is replaced by its accumulation
     point, a plastic closure ``theta'+ = (dC/dt.n) / l1`` (gap rate 0), after which the
-    compliant contact carries the motion. Each applied jump draws a new line length (impact
-    resampling), multiplies the tangent by its saltation matrix and is recorded (after the
-    transient) with its kind: macro, micro (slower than ``v_micro``) or chatter end. Closings
-    slower than ``v_min`` are left to the compliant force and counted.
+    compliant contact carries the motion. Each applied jump multiplies the tangent by its
+    saltation matrix and is recorded (after the transient) with its kind: macro, micro (slower
+    than ``v_micro``) or chatter end. Under impact resampling a macro impact draws a new line
+    length (``resample="contact"``: a new contact), and so does every applied jump under
+    ``resample="impact"``. Closings slower than ``v_min`` are left to the compliant force and
+    counted.
 
     Returns (theta' after, stiffness in use).
     """
@@ -174,7 +177,7 @@ def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c):
         y[Y_J12] = s11 * v12
         y[Y_J21] = s21 * v11 + s22 * v21
         y[Y_J22] = s21 * v12 + s22 * v22
-    if c[C_RESAMPLE_DT] <= 0.0:
+    if c[C_RESAMPLE_DT] <= 0.0 and (kind == IMPACT_MACRO or c[C_RESAMPLE_EVERY] > 0.0):
         cnt[I_LAM_POS] += 1
         K = stiffness(lam[cnt[I_LAM_POS]], c)
     if t >= c[C_T_RECORD]:
