@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._run_warnings import run_warnings
 from ._version import __version__
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
@@ -134,19 +135,6 @@ class Trajectory:
             frame_json = getattr(self, name).to_json(orient="split", double_precision=15)
             meta[f"chaoscam.{name}".encode()] = frame_json.encode()
         pq.write_table(table.replace_schema_metadata(meta), path)
-
-
-def resolution_warning(p: Params) -> str | None:
-    """The warning for a fixed step too coarse for the contact oscillation (fewer than 20
-    steps per contact period), or None. The adaptive path's steps follow the contact."""
-    steps = contact_period(p) / p.dt
-    if steps >= 20 or p.integrator != "rk4":
-        return None
-    return (
-        f"dt = {p.dt:g} s resolves the contact oscillation (period "
-        f"{contact_period(p):.3g} s) with only {steps:.1f} steps; use "
-        f"dt <= {contact_period(p) / 40:.2g} s for a converged run"
-    )
 
 
 def _check_run(
@@ -321,9 +309,8 @@ def raw_run(
     t0 = time.perf_counter()
     n_stop = int(round(duration / p.dt))
     stride = max(1, int(round(output_dt / p.dt))) if series else 0
-    coarse = resolution_warning(p)
-    if coarse:
-        warnings.warn(coarse, RuntimeWarning, stacklevel=3)  # simulate's caller
+    for text in run_warnings(p):
+        warnings.warn(text, RuntimeWarning, stacklevel=3)  # simulate's caller
 
     stream = LineLengthStream(p, seed, index)
     lam = stream.draw(output_block(p))

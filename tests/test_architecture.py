@@ -16,6 +16,7 @@ LAYERS = (
     "chaoscam._checks",
     "chaoscam._outputs",
     "chaoscam._budget",
+    "chaoscam._run_warnings",
     "chaoscam.integrate",
     "chaoscam._simulate",
     "chaoscam._extend",

@@ -3,6 +3,7 @@
 import math
 import subprocess
 import sys
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -220,3 +221,20 @@ def test_parquet_round_trip_keeps_provenance(tmp_path):
     assert meta["params"]["omega"] == 28.7 and meta["settings"]["duration"] == 0.5
     assert table.num_rows == len(tr.series)
 
+
+def test_no_gravity_is_a_run_not_a_crash():
+    """g = 0 is allowed: the run ends with a status (the flight horizon has no gravity cap),
+    instead of a ZeroDivisionError in the kernel."""
+    tr = simulate(Params(g=0.0), duration=0.5, series=False)
+    assert tr.status is Status.OK and len(tr.impacts) > 0
+
+
+def test_a_spread_the_fractal_stiffness_ignores_is_warned():
+    """With stiffness = 'fractal' (K_n independent of l_lambda) a positive l_lambda_sigma
+    gets one warning naming the field; without a spread there is none."""
+    p = Params(stiffness="fractal", dt=4e-7)
+    with pytest.warns(RuntimeWarning, match="l_lambda_sigma = 0.002 m has no effect"):
+        simulate(p.replace(l_lambda_sigma=0.002), duration=0.01, series=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        simulate(p, duration=0.01, series=False)

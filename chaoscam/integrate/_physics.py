@@ -326,9 +326,12 @@ def closing_bound(l1, cdn, om, h, c):
 def safe_horizon(g, l1, cdn, om, c):
     """The time over which a positive gap g certainly stays positive [s].
 
-    The largest H with ``closing_bound(H) <= g``, capped at J / (m g l / 2).
+    The largest H with ``closing_bound(H) <= g``, capped at J / (m g l / 2) (the time in
+    which gravity can change theta' by 1 rad/s; no cap without gravity).
     """
     acc = gap_accel_bound(om, c)
     v = abs(l1 * om - cdn)
     horizon = 0.5 * g / (v + math.sqrt(v * v + acc * g))
-    return min(horizon, 1.0 / (c[C_GRAV] * c[C_INV_J]))
+    if c[C_GRAV] > 0.0:
+        horizon = min(horizon, 1.0 / (c[C_GRAV] * c[C_INV_J]))
+    return horizon

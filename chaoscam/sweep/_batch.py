@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._simulate import resolution_warning
+from .._run_warnings import run_warnings
 from ..model import Params, truncated_mass
 from ._tasks import RunSummary, verdict_fields
 
@@ -124,7 +124,7 @@ def run_batch(
                 if v.verdict is not None
                 else {"label": v.label, "period": None, "reasons": v.reasons, "evidence": {}}
             )
-            seen = [w for w in (resolution_warning(plist[j]), *shared) if w]
+            seen = [w for w in (*run_warnings(plist[j]), *shared) if w]
             fields["status"] = status
             fields["warnings"] = " | ".join(dict.fromkeys(seen))
             records[i] = tasks[i].record(run, fields)

@@ -1,0 +1,44 @@
+"""The warnings a run gets before it starts: settings that run but do not do what they say.
+
+Used by :func:`chaoscam.simulate` (as ``RuntimeWarning``) and by the sweeps (in each
+realization's ``warnings`` column).
+"""
+
+from __future__ import annotations
+
+from .model import Params, contact_period
+
+__all__ = ["ignored_sigma_warning", "resolution_warning", "run_warnings"]
+
+
+def resolution_warning(p: Params) -> str | None:
+    """The warning for a fixed step too coarse for the contact oscillation (fewer than 20
+    steps per contact period), or None. The adaptive path's steps follow the contact."""
+    steps = contact_period(p) / p.dt
+    if steps >= 20 or p.integrator != "rk4":
+        return None
+    return (
+        f"dt = {p.dt:g} s resolves the contact oscillation (period "
+        f"{contact_period(p):.3g} s) with only {steps:.1f} steps; use "
+        f"dt <= {contact_period(p) / 40:.2g} s for a converged run"
+    )
+
+
+def ignored_sigma_warning(p: Params) -> str | None:
+    """The warning for a line-length spread that cannot act, or None: the fractal joint's
+    K_n (MODEL.md (15)/(17)) does not depend on the line length, so with
+    ``stiffness="fractal"`` a positive ``l_lambda_sigma`` is drawn and recorded but changes
+    nothing in the motion."""
+    if p.stiffness != "fractal" or p.l_lambda_sigma == 0.0:
+        return None
+    return (
+        f"l_lambda_sigma = {p.l_lambda_sigma:g} m has no effect with stiffness = 'fractal' "
+        "(its K_n does not depend on the line length); use stiffness = 'hertz' for a random "
+        "contact stiffness"
+    )
+
+
+def run_warnings(p: Params) -> list[str]:
+    """Every warning a run of ``p`` gets before it starts (:func:`resolution_warning`,
+    :func:`ignored_sigma_warning`)."""
+    return [w for w in (resolution_warning(p), ignored_sigma_warning(p)) if w]
