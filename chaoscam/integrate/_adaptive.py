@@ -73,6 +73,7 @@ from . import _steps as steps
 from ._dop853 import ERROR_ORDER, dop853_step, omega_at, theta_at
 from ._events import MAX_BRACKET_STEPS, ON_SURFACE, illinois_point, illinois_update
 from ._kernel import (
+    C_CALL_STEPS,
     C_DT,
     C_EVENT_TOL,
     C_H_MAX,
@@ -296,9 +297,13 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
     events = np.int64(y[Y_EVENTS])  # ... and the events in it so far
 
     redo = False  # the step is being taken again in contact mode (see below)
+    budget = np.int64(c[C_CALL_STEPS])  # steps before a hand-back (Ctrl-C is seen between)
+    taken = np.int64(0)
     while t < t_stop:
+        taken += 1
         if not redo and (
-            cnt[I_N_SERIES] + samples_per_step > series.shape[0]
+            (budget > 0 and taken > budget)
+            or cnt[I_N_SERIES] + samples_per_step > series.shape[0]
             or cnt[I_N_SECTION] + 2 > section.shape[0]
             or cnt[I_N_IMPACT] + 2 > impacts.shape[0]
             or cnt[I_LAM_POS] + 3 >= lam.shape[0]

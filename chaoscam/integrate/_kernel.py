@@ -45,6 +45,7 @@ from numba import njit
 from ._events import ON_SURFACE, gap_after, graze_point, locate_crossing
 from ._layout import *  # noqa: F403 (the layout's names are part of this module's face)
 from ._layout import (
+    C_CALL_STEPS,
     C_DT,
     C_FLIGHT_MERGE,
     C_MAX_EVENTS,
@@ -201,10 +202,14 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     # grid step exactly) so that a resumed run is bit-identical to one not interrupted.
     jumped = (cnt[I_SURFACE] & 1) != 0  # a rebound was just applied: the opening is flight's
     settled = (cnt[I_SURFACE] & 2) != 0  # a plastic closure: the point stays in contact
+    budget = np.int64(c[C_CALL_STEPS])  # steps before a hand-back (Ctrl-C is seen between)
+    taken = np.int64(0)
     while cnt[I_STEP] < n_stop:
         # Room for one more step's worth of outputs and draws, else hand back to Python.
+        taken += 1
         if (
-            cnt[I_N_SERIES] + samples_per_block > series.shape[0]
+            (budget > 0 and taken > budget)
+            or cnt[I_N_SERIES] + samples_per_block > series.shape[0]
             or cnt[I_N_SECTION] + sections_per_step > section.shape[0]
             or cnt[I_N_IMPACT] + max_events > impacts.shape[0]
             or cnt[I_LAM_POS] + draws_per_step >= lam.shape[0]

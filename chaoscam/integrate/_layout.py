@@ -44,7 +44,8 @@ C_TANGENT = 31  # 1: integrate the tangent (variational) dynamics with the state
 C_V_CHATTER = 32  # approach speed below which a closing ends a complete chattering [m/s]
 C_V_MICRO = 33  # approach speed below which an applied impact is flagged micro [m/s]
 C_RESAMPLE_EVERY = 34  # impact resampling: 1 draws at every applied jump, 0 at macro ones
-N_CONSTANTS = 35
+C_CALL_STEPS = 35  # most loop iterations in one compiled call, then a hand-back; 0 = no limit
+N_CONSTANTS = 36
 
 METHOD_RK4 = 0
 METHOD_ADAPTIVE = 1

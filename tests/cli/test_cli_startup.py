@@ -147,3 +147,31 @@ def test_ctrl_c_inside_an_import_lock_callback_is_sent_again(monkeypatch):
     assert sent == [(os.getpid(), signal.SIGINT)]
     with pytest.raises(KeyboardInterrupt):
         cli._on_sigint(signal.SIGINT, sys._getframe())
+
+
+def test_sigterm_stops_a_single_run_whose_cam_period_holds_many_steps():
+    """SIGTERM reaches a `simulate` inside the compiled kernel: with omega = 1 rad/s and
+    dt = 2e-8 s a cam period holds 3e8 steps, and a compiled call that ran to the next
+    section ignored the signal for minutes; with the kernel's step budget per call the run
+    ends within seconds, exit 143 and one line."""
+    proc = subprocess.Popen(
+        [sys.executable, "-c", CODE, "simulate", "--duration", "20"]
+        + ["--set", "omega=1", "--set", "dt=2e-8"],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdout.readline() == "up\n"
+        time.sleep(10.0)  # imported and compiled (or still compiling): inside the run
+        assert proc.poll() is None
+        sent = time.monotonic()
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=120)
+        waited = time.monotonic() - sent
+    finally:
+        proc.kill()
+    assert proc.returncode == 143, err
+    assert "Traceback" not in err and err.strip() == "chaoscam: terminated", err
+    assert waited < 10.0, waited

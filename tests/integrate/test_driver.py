@@ -5,6 +5,7 @@ import pytest
 
 from chaoscam import Params
 from chaoscam._simulate import raw_run, simulate
+from chaoscam.integrate import _adaptive
 from chaoscam.integrate import _kernel as k
 from chaoscam.integrate._driver import check_window, drive_members
 from chaoscam.model import ParameterError
@@ -189,3 +190,27 @@ def test_a_ctrl_c_inside_a_c_callback_of_a_launch_is_not_lost():
         drive_members(2, launch, None)
     assert seen == ["returned"]
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # restored
+
+
+@pytest.mark.parametrize("integrator, budget", [("rk4", 1000), ("adaptive", 200)])
+def test_a_compiled_call_hands_back_after_its_step_budget(monkeypatch, integrator, budget):
+    """A compiled call returns to Python after at most C_CALL_STEPS loop iterations (so that
+    Ctrl-C and SIGTERM are seen between calls however many steps a cam period holds), and the
+    many hand-backs change no bit of the run."""
+    from chaoscam.integrate import _constants
+    from chaoscam.integrate import _kernel as k
+
+    p = Params(omega=10.0, integrator=integrator)  # all contact: one grid step per iteration
+    whole = simulate(p, duration=0.5, series=False)
+    monkeypatch.setitem(_constants.CALL_STEPS, integrator, budget)
+    c = _constants.kernel_constants(p)
+    assert c[k.C_CALL_STEPS] == budget
+    y, cnt = _constants.initial_state(p), _constants.initial_counters(p)
+    bufs = [np.zeros((4096, n)) for n in (k.SERIES_COLS, k.SECTION_COLS, k.IMPACT_COLS)]
+    lam = np.full(4096, p.l_lambda)
+    run = k.run_chunk if integrator == "rk4" else _adaptive.run_chunk_adaptive
+    code = run(y, cnt, c, int(round(0.5 / p.dt)), lam, *bufs)
+    assert code == k.NEED_BUFFER and 0.0 < y[k.Y_TIME] < 0.01  # far from the end, buffers empty
+    assert integrator != "rk4" or cnt[k.I_STEP] <= budget
+    chunked = simulate(p, duration=0.5, series=False)
+    assert chunked.section.equals(whole.section) and chunked.impacts.equals(whole.impacts)
