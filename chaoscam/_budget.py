@@ -172,9 +172,30 @@ def run_seconds(params, duration: float, series_rows: float = 0.0) -> float:
     return max(_costs(params, duration, series_rows))
 
 
+def _steps(params, duration: float) -> tuple[float, str, str]:
+    """(the least number of steps a run takes, why, what shortens it): grid steps of dt, the
+    adaptive path's steps of at most h_max, and a step cut at every interval resampling."""
+    duration = float(duration)
+    found = [(duration / params.dt, f"steps of dt = {params.dt:g} s", "raise dt")]
+    if params.integrator == "adaptive":
+        found.append(
+            (duration / params.h_max, f"steps of at most h_max = {params.h_max:g} s", "raise h_max")
+        )
+    if params.resample == "interval":
+        found.append(
+            (
+                duration / params.resample_dt,
+                f"line-length draws every resample_dt = {params.resample_dt:g} s",
+                "raise resample_dt",
+            )
+        )
+    return max(found)
+
+
 def _costs(params, duration: float, series_rows: float = 0.0) -> tuple[float, float]:
     """(grid steps and series rows, following the contact) estimates of one run [s]."""
-    grid = (float(duration) / params.dt * NS_PER_STEP + series_rows * NS_PER_SERIES_ROW) * 1e-9
+    steps = _steps(params, duration)[0]
+    grid = (steps * NS_PER_STEP + series_rows * NS_PER_SERIES_ROW) * 1e-9
     adaptive = params.integrator == "adaptive"
     return grid, adaptive_seconds(params, duration) if adaptive else 0.0
 
@@ -210,8 +231,9 @@ def check_run(params, duration: float, *, what: str = "one run", series_rows: fl
         remedy = "raise J, lower the stiffness (l_lambda, stiffness), loosen rtol or shorten "
         remedy += "duration"
     else:
-        text += f": {float(duration) / params.dt:.3g} steps of dt = {params.dt:g} s"
-        remedy = "shorten duration or raise dt"
+        steps, why, raise_ = _steps(params, duration)
+        text += f": {steps:.3g} {why}"
+        remedy = f"shorten duration or {raise_}"
         if series_rows:
             text += f" and {series_rows:.3g} series rows"
             remedy += " or output_dt"

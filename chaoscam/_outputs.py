@@ -4,6 +4,7 @@
   a directory, and an existing file is refused unless the caller says ``force``.
 * :func:`atomic_path` — write to a temporary name in the same folder, flushed to disk, then
   :func:`os.replace` into place: a reader (or a resumed run) sees the whole file or none.
+  Without ``--force`` the final move refuses a file that appeared meanwhile (``replace=False``).
 * :class:`OutputLock` — an OS file lock (``fcntl.flock``) beside an output or checkpoint, so
   a second process on the same output is refused instead of silently losing records.
 
@@ -96,11 +97,17 @@ def _probe(folder: Path, what: str) -> None:
 
 
 @contextlib.contextmanager
-def atomic_path(path: str | Path) -> Iterator[Path]:
+def atomic_path(path: str | Path, *, replace: bool = True) -> Iterator[Path]:
     """A temporary path to write ``path`` to; moved into place when the block succeeds.
 
     The file is flushed to disk before the rename, so it is whole or absent whatever moment
     the process is killed; on an exception the temporary file is removed.
+
+    ``replace=False`` (an output checked absent, without ``--force``) puts the file in place
+    only if ``path`` still does not exist, atomically (a hard link, which refuses an existing
+    name): a file that another process wrote there while this one worked is kept, and this
+    one's result is kept beside it (:func:`conflict_name`) with an :class:`OutputError` that
+    names both.
     """
     path = Path(path)
     tmp = tmp_name(path)
@@ -108,15 +115,35 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
         yield tmp
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
-        os.replace(tmp, path)
+        if replace:
+            os.replace(tmp, path)
+        else:
+            _place_new(tmp, path)
     finally:
         with contextlib.suppress(OSError):
             tmp.unlink()
 
 
-def atomic_write_bytes(path: str | Path, data: bytes) -> None:
+def conflict_name(path: Path) -> Path:
+    """Where a result goes when ``path`` appeared meanwhile: ``NAME.PID.SUFFIX`` beside it."""
+    return path.with_name(f"{path.stem}.{os.getpid()}{path.suffix}")
+
+
+def _place_new(tmp: Path, path: Path) -> None:
+    try:
+        os.link(tmp, path)
+    except FileExistsError:
+        kept = conflict_name(path)
+        os.replace(tmp, kept)
+        raise OutputError(
+            f"{path} appeared while this run was working (another process wrote it); it was "
+            f"not overwritten, and this run's result is in {kept}"
+        ) from None
+
+
+def atomic_write_bytes(path: str | Path, data: bytes, *, replace: bool = True) -> None:
     """Write ``data`` to ``path`` atomically (see :func:`atomic_path`)."""
-    with atomic_path(path) as tmp:
+    with atomic_path(path, replace=replace) as tmp:
         tmp.write_bytes(data)
 
 

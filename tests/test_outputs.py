@@ -232,3 +232,83 @@ def test_two_writers_started_together(tmp_path):
     assert "in use by another chaoscam process" in refused or "exists" in refused, refused
     assert "Traceback" not in refused
     assert len(pd.read_parquet(out)) == 3 * 4 + 3
+
+
+def test_atomic_path_without_replace_keeps_a_file_that_appeared_meanwhile(tmp_path):
+    """replace=False (an output checked absent, no --force): a file another process wrote
+    while this one worked is kept as it is, this one's result goes beside it as NAME.PID.SUFFIX,
+    and the error names both."""
+    from chaoscam._outputs import conflict_name
+
+    out = tmp_path / "x.csv"
+    with pytest.raises(OutputError, match="appeared while this run was working") as err:
+        with atomic_path(out, replace=False) as tmp:
+            tmp.write_text("ours")
+            out.write_text("theirs")  # another process, meanwhile
+    assert out.read_text() == "theirs"
+    assert conflict_name(out).read_text() == "ours" and str(conflict_name(out)) in str(err.value)
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".tmp")] == []
+    fresh = tmp_path / "y.csv"
+    with atomic_path(fresh, replace=False) as tmp:
+        tmp.write_text("ours")
+    assert fresh.read_text() == "ours"
+
+
+def test_a_sweep_does_not_replace_an_output_written_during_its_run(tmp_path, monkeypatch, capsys):
+    """A file written at the sweep's --out while it runs (by a command that took no lock on it)
+    is not replaced at the end: exit 2, the file kept, the sweep's table beside it, and the
+    checkpoint kept: nothing is lost."""
+    from chaoscam.sweep import _batch
+
+    out = tmp_path / "b.parquet"
+    run_plan = _batch.run_plan
+
+    def meanwhile(*args, **kwargs):
+        out.write_text("theirs")
+        return run_plan(*args, **kwargs)
+
+    monkeypatch.setattr(_batch, "run_plan", meanwhile)
+    assert main(_bif(out)) == 2
+    assert "appeared while this run was working" in capsys.readouterr().err
+    assert out.read_text() == "theirs"
+    assert len(pd.read_parquet(tmp_path / f"b.{os.getpid()}.parquet")) > 0
+    assert (tmp_path / "b.parquet.ckpt").is_dir()
+
+
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        (["--out", "a.csv", "--section", "a.csv"], "both name"),
+        (["--section", "s.csv", "--impacts", "s.csv"], "both name"),
+        (["--section", "s.parquet"], "must end in .csv"),
+        (["--impacts", "i.parquet"], "must end in .csv"),
+    ],
+)
+def test_simulate_refuses_outputs_that_clash_or_lie_about_their_format(
+    tmp_path, monkeypatch, capsys, extra, message
+):
+    """Two outputs of one simulate naming one file (the second replaced the first), and a
+    section or impact list (CSV) named .parquet: exit 2 before any work, nothing written."""
+    monkeypatch.chdir(tmp_path)
+    assert main(_sim(*extra)) == 2
+    assert message in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_resume_does_not_replace_an_existing_plot(tmp_path, capsys):
+    """--resume continues a sweep's table; a plot exists only after a finished run, so an
+    existing --plot file is refused under --resume as without it (exit 2, kept)."""
+    plot = tmp_path / "p.png"
+    plot.write_text("mine")
+    code = main(_bif(tmp_path / "b.parquet", "--plot", str(plot), "--resume"))
+    assert code == 2 and "--plot" in capsys.readouterr().err
+    assert plot.read_text() == "mine"
+
+
+def test_a_classifier_that_is_not_callable_is_a_usage_error(tmp_path, capsys):
+    """--classifier naming a number (not a function or class): exit 2 with one line that
+    names it, no traceback, and no checkpoint left behind."""
+    assert main(_bif(tmp_path / "b.parquet", "--classifier", "math:pi")) == 2
+    err = capsys.readouterr().err
+    assert "--classifier math:pi" in err and "not a function" in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []

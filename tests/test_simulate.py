@@ -238,3 +238,25 @@ def test_a_spread_the_fractal_stiffness_ignores_is_warned():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         simulate(p, duration=0.01, series=False)
+
+
+def test_unknown_field_in_params_names_it_like_replace():
+    """Params(foo=1) raises the ParameterError of .replace (the field, close names, the known
+    ones), not the dataclass's TypeError."""
+    with pytest.raises(ParameterError, match=r"unknown parameter 'omgea'.*Did you mean omega"):
+        Params(omgea=30.0)
+
+
+@pytest.mark.parametrize(
+    "changes, field",
+    [
+        (dict(integrator="adaptive", h_max=1e-12), "h_max"),
+        (dict(resample="interval", resample_dt=1e-12, l_lambda_sigma=0.001), "resample_dt"),
+    ],
+)
+def test_runs_that_would_take_hours_for_other_fields_than_dt_are_refused(changes, field):
+    """The run-time estimate counts the adaptive path's steps of at most h_max and the step
+    cuts of interval resampling, not only steps of dt: such runs are refused with the field
+    named, instead of starting and never finishing."""
+    with pytest.raises(ParameterError, match=rf"refused; shorten duration or raise {field}"):
+        simulate(Params(**changes), duration=0.5)

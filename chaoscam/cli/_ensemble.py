@@ -27,7 +27,7 @@ import time
 import warnings
 from pathlib import Path
 
-from .._outputs import atomic_path
+from .._outputs import OutputError, atomic_path
 from ._options import add_run_options
 
 __all__ = ["register"]
@@ -166,6 +166,9 @@ def _run_locked(args: argparse.Namespace) -> int:
         os.replace(tmp, parts)
     for tmp in parts.glob(".tmp-*"):
         tmp.unlink(missing_ok=True)
+    # Outputs there now are --force's or this run's (a commit cut short); one that appears
+    # while the members run is not replaced at the end.
+    ours = {p for p in (out, sections_path, impacts_path) if p.exists()}
 
     t0 = time.perf_counter()
     done_before = 0
@@ -238,7 +241,7 @@ def _run_locked(args: argparse.Namespace) -> int:
             )
     bar.close()
 
-    members = _commit(parts, starts, names, out, result)
+    members = _commit(parts, starts, names, out, result, ours)
     wall = time.perf_counter() - t0
     counts = members["label" if args.classify else "status"].value_counts().to_dict()
     print(
@@ -420,11 +423,15 @@ def _write(frame, path: Path, digest: str | None = None) -> None:
         pq.write_table(table, tmp)
 
 
-def _commit(parts: Path, starts: range, names: tuple[str, ...], out: Path, digest: str):
+def _commit(
+    parts: Path, starts: range, names: tuple[str, ...], out: Path, digest: str, ours: set[Path]
+):
     """Join the parts into the outputs as one commit: every output written to a temporary
     name, then renamed, the members file last; then the parts are removed (renamed away
     first). A kill at any point leaves either the parts (``--resume`` joins them again) or
-    the finished outputs."""
+    the finished outputs. An output not in ``ours`` is put in place only if its name is
+    still free (a hard link): one that another process wrote meanwhile is kept, the outputs
+    placed so far are taken back, and the parts stay for a ``--resume`` once it is moved."""
     import pandas as pd
 
     from ..sweep._checkpoint import discard_checkpoint
@@ -441,7 +448,22 @@ def _commit(parts: Path, starts: range, names: tuple[str, ...], out: Path, diges
             members = frame
         staged[name] = parts / f".staged.{name}.parquet"
         _write(frame, staged[name], digest if name == "members" else None)
+    placed = []
     for name in sorted(names, key=lambda n: n == "members"):  # members last
-        os.replace(staged[name], targets[name])
+        target = targets[name]
+        if target in ours:
+            os.replace(staged[name], target)
+            continue
+        try:
+            os.link(staged[name], target)
+        except FileExistsError:
+            for p in placed:
+                p.unlink(missing_ok=True)
+            raise OutputError(
+                f"{target} appeared while this run was working (another process wrote it); "
+                f"it was not overwritten. The finished members are kept in {parts}: move "
+                f"{target} away and run the same command with --resume to write them"
+            ) from None
+        placed.append(target)
     discard_checkpoint(parts)
     return members

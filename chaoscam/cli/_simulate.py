@@ -35,8 +35,9 @@ def run(args: argparse.Namespace) -> int:
     from . import parse_assignments, show_warning
 
     out = check_output(args.out, force=args.force, suffixes=(".parquet", ".csv"))
-    section = check_output(args.section, flag="--section", force=args.force)
-    impacts = check_output(args.impacts, flag="--impacts", force=args.force)
+    section = check_output(args.section, flag="--section", force=args.force, suffixes=(".csv",))
+    impacts = check_output(args.impacts, flag="--impacts", force=args.force, suffixes=(".csv",))
+    _distinct(("--out", out), ("--section", section), ("--impacts", impacts))
     params = parse_assignments(args.set)
     settings = dict(
         duration=args.duration,
@@ -66,10 +67,25 @@ def run(args: argparse.Namespace) -> int:
         (impacts, "impacts", lambda tmp: traj.impacts.to_csv(tmp, index=False)),
     ):
         if path is not None:
-            with atomic_path(path) as tmp:
+            with atomic_path(path, replace=args.force) as tmp:
                 write(tmp)
             print(f"{label}: {path}")
     return _exit_code(traj, notes)
+
+
+def _distinct(*named) -> None:
+    """Refuse two outputs of one run that name the same file (the second would replace the
+    first)."""
+    from .._outputs import OutputError
+
+    seen: dict = {}
+    for flag, path in named:
+        if path is None:
+            continue
+        key = path.resolve()
+        if key in seen:
+            raise OutputError(f"{seen[key]} and {flag} both name {path}; give each its own file")
+        seen[key] = flag
 
 
 def _series_writer(traj, out):

@@ -122,7 +122,7 @@ def register(sub) -> None:
         help="Monte Carlo regime map over (mu, sigma) or any two parameters",
         description="In each cell of a grid, simulate and classify N realizations of the "
         "random line length. Writes one row per realization to FILE.parquet and the "
-        "per-cell fractions with 95%% Wilson intervals to FILE.cells.parquet.",
+        "per-cell fractions with 95% Wilson intervals to FILE.cells.parquet.",
     )
     r.add_argument("--mu", metavar="START:STOP:NUM|V1,V2,...", help="mean line length l_lambda [m]")
     r.add_argument("--sigma", metavar="START:STOP:NUM|V1,V2,...", help="spread l_lambda_sigma [m]")
@@ -171,7 +171,7 @@ def _execution(args) -> dict:
         )
     if args.force and args.resume:
         raise UsageError("--force starts over and --resume continues: give one of them")
-    check_output(args.plot, flag="--plot", force=args.force or args.resume, suffixes=_PLOT_SUFFIXES)
+    check_output(args.plot, flag="--plot", force=args.force, suffixes=_PLOT_SUFFIXES)
     classify = None
     if args.classifier is not None:
         try:

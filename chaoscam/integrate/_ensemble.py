@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .._checks import params_arg, whole
 from ..model import Params
 from . import _gpu
 from . import _kernel as k
@@ -154,8 +155,12 @@ def simulate_ensemble(
     if int(batch) < 1:
         raise ValueError(f"batch must be >= 1, got {batch!r}")
     batch = int(batch)
-    indices = [int(i) for i in indices]
-    plist = list(params) if isinstance(params, list | tuple) else [params] * len(indices)
+    seed = whole("seed", seed)
+    indices = [whole("index", i) for i in indices]
+    if isinstance(params, list | tuple):
+        plist = [params_arg(q) for q in params]
+    else:
+        plist = [params_arg(params)] * len(indices)
     if len(plist) != len(indices):
         raise ValueError(f"{len(plist)} parameter sets for {len(indices)} indices")
     if len({(p.dt, p.omega) for p in plist}) > 1:

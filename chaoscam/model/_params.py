@@ -10,6 +10,7 @@ Impact System", Table 1 (SI units throughout).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass, field, fields
 from typing import Any
@@ -213,10 +214,9 @@ class Params:
     v_micro: float = field(
         default=1e-2,
         metadata=_meta(
-            "approach speed below which an applied impact is flagged micro (inside a "
-            "chattering sequence) rather than macroscopic (the first, fast impacts after a "
-            "flight, ~0.05-1 m/s); a label in the impact list, and under resample = "
-            "'contact' the impacts that begin a new contact (no other effect on the motion)",
+            "approach speed below which an applied impact is micro (in a chattering "
+            "sequence), not macro (the fast impacts after a flight, ~0.05-1 m/s): a label, "
+            "and under resample = 'contact' the start of a new contact's line",
             "m/s",
             _NONNEG,
         ),
@@ -239,12 +239,10 @@ class Params:
     resample: str = field(
         default="contact",
         metadata=_meta(
-            "when a new line length is drawn: at each macroscopic impact ('contact', default: "
-            "each contact has its own line; the micro-impacts and the chattering end of a "
-            "persistent contact keep it), at every applied jump ('impact', micro-impacts "
-            "included: ~98% of the draws, and their number depends on dt, so a realization's "
-            "line lengths change with the step), or every resample_dt ('interval', the "
-            "paper's Fig. 3)",
+            "when a new line length is drawn: at each macro impact ('contact', default: each "
+            "contact has its own line), at every applied jump ('impact': micro-impacts too, "
+            "whose count changes with dt, and the draws with it; docs/model.md), or every "
+            "resample_dt ('interval', the paper's Fig. 3)",
             "-",
             None,
             RESAMPLE_MODES,
@@ -415,6 +413,21 @@ class Params:
         return base.replace(**{k: parse_value(k, v) for k, v in assignments.items()})
 
 
+_dataclass_init = Params.__init__
+
+
+@functools.wraps(_dataclass_init)
+def _checked_init(self, *args: Any, **kwargs: Any) -> None:
+    """The dataclass's __init__, an unknown keyword refused as by .replace."""
+    unknown = set(kwargs) - set(field_names())
+    if unknown:
+        raise ParameterError(_unknown_message(sorted(unknown)[0]))
+    _dataclass_init(self, *args, **kwargs)
+
+
+Params.__init__ = _checked_init  # type: ignore[method-assign]
+
+
 def field_names() -> tuple[str, ...]:
     return tuple(f.name for f in fields(Params))
 
@@ -444,7 +457,8 @@ def parse_value(name: str, text: str) -> Any:
     try:
         return int(text) if f.type == "int" else float(text)
     except ValueError:
-        raise ParameterError(f"{name} = {text!r} is not a number") from None
+        kind = "an integer" if f.type == "int" else "a number"
+        raise ParameterError(f"{name} = {text!r} must be {kind}") from None
 
 
 def _describe_range(rng: tuple) -> str:

@@ -318,12 +318,17 @@ def run_sweep(
     ``keys`` (one per key), warn once per message the runs raised, ``build`` the result
     from the records, write it to ``out`` and remove the checkpoint.
     """
-    from ._common import lock_outputs, open_store, reemit_warnings, unique_sorted
+    from ._common import companion, lock_outputs, open_store, reemit_warnings, unique_sorted
 
     with lock_outputs(out):
         store, reuse = open_store(out, second, config, resume, flush_interval, force)
         if reuse:
             return read(out)
+        # Outputs there now are this configuration's (a resumed run's) or --force's; any
+        # other that appears while the plan runs is not replaced at the end.
+        replace = force or (
+            out is not None and any(p.exists() for p in (out, companion(out, second)))
+        )
         run_plan(
             plan, eng, store, workers=workers, scheduler=scheduler, progress=progress, desc=desc
         )
@@ -331,6 +336,6 @@ def run_sweep(
         reemit_warnings(records)
         result = build(records)
         if out is not None:
-            result.to_parquet(out)
+            result.to_parquet(out, replace=replace)
             store.remove()
         return result

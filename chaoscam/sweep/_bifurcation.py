@@ -71,9 +71,10 @@ class Bifurcation:
     def param(self) -> str:
         return self.config["axis"]["name"]
 
-    def to_parquet(self, path: str | Path) -> None:
-        """Points to ``FILE.parquet``, verdicts to ``FILE.verdicts.parquet``."""
-        write_tables(path, self.points, "verdicts", self.verdicts, self.config)
+    def to_parquet(self, path: str | Path, *, replace: bool = True) -> None:
+        """Points to ``FILE.parquet``, verdicts to ``FILE.verdicts.parquet``
+        (``replace=False``: never over an existing file)."""
+        write_tables(path, self.points, "verdicts", self.verdicts, self.config, replace=replace)
 
 
 def read_bifurcation(path: str | Path) -> Bifurcation:

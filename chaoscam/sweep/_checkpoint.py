@@ -302,8 +302,11 @@ class CheckpointStore:
         discard_checkpoint(self.path)
 
 
-def write_parquet(frame: pd.DataFrame, path: Path, config: dict[str, Any]) -> None:
-    """Write ``frame`` atomically, with the configuration and its hash as file metadata."""
+def write_parquet(
+    frame: pd.DataFrame, path: Path, config: dict[str, Any], *, replace: bool = True
+) -> None:
+    """Write ``frame`` atomically, with the configuration and its hash as file metadata
+    (``replace=False``: never over a file that exists; :func:`chaoscam._outputs.atomic_path`)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -312,7 +315,7 @@ def write_parquet(frame: pd.DataFrame, path: Path, config: dict[str, Any]) -> No
     meta[_META_KEY] = json.dumps({"hash": config_hash(config), "config": config}).encode()
     from .._outputs import atomic_path
 
-    with atomic_path(path) as tmp:
+    with atomic_path(path, replace=replace) as tmp:
         pq.write_table(table.replace_schema_metadata(meta), tmp)
 
 

@@ -79,13 +79,20 @@ def companion(out: Path, what: str) -> Path:
 
 
 def write_tables(
-    path: str | Path, main: pd.DataFrame, second: str, other: pd.DataFrame, config: dict[str, Any]
+    path: str | Path,
+    main: pd.DataFrame,
+    second: str,
+    other: pd.DataFrame,
+    config: dict[str, Any],
+    *,
+    replace: bool = True,
 ) -> None:
     """A sweep's two tables: ``main`` to ``FILE.parquet``, ``other`` to
-    ``FILE.<second>.parquet``, each written atomically with the configuration."""
+    ``FILE.<second>.parquet``, each written atomically with the configuration (``replace=
+    False``: never over an existing file)."""
     path = Path(path)
-    write_parquet(main, path, config)
-    write_parquet(other, companion(path, second), config)
+    write_parquet(main, path, config, replace=replace)
+    write_parquet(other, companion(path, second), config, replace=replace)
 
 
 def read_tables(path: str | Path, second: str) -> tuple[pd.DataFrame, pd.DataFrame, dict]:

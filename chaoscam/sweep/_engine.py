@@ -54,7 +54,7 @@ class SweepInterrupted(KeyboardInterrupt):
                 "(no output file given)"
             )
         return (
-            f"{why} {self.done} of {self.total} runs are saved in {self.checkpoint}; "
+            f"{why.rstrip(';')}; {self.done} of {self.total} runs are saved in {self.checkpoint}; "
             "run the same command with --resume to finish"
         )
 

@@ -73,9 +73,10 @@ class RegimeMap:
     def y(self) -> str:
         return self.config["y"]["name"]
 
-    def to_parquet(self, path: str | Path) -> None:
-        """Realizations to ``FILE.parquet``, cells to ``FILE.cells.parquet``."""
-        write_tables(path, self.realizations, "cells", self.cells, self.config)
+    def to_parquet(self, path: str | Path, *, replace: bool = True) -> None:
+        """Realizations to ``FILE.parquet``, cells to ``FILE.cells.parquet``
+        (``replace=False``: never over an existing file)."""
+        write_tables(path, self.realizations, "cells", self.cells, self.config, replace=replace)
 
 
 def read_regime_map(path: str | Path) -> RegimeMap:

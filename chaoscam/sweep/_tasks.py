@@ -103,7 +103,17 @@ def load_classifier(spec: str) -> Callable:
     if not sep or not module or not name:
         raise ValueError(f"classifier {spec!r}: expected MODULE:NAME")
     obj = getattr(importlib.import_module(module), name)
-    return obj() if isinstance(obj, type) else obj
+    if isinstance(obj, type):
+        try:
+            obj = obj()
+        except TypeError as err:
+            raise ValueError(f"the class {name} cannot be made without arguments ({err})") from None
+    if not callable(obj):
+        raise ValueError(
+            f"{name} is a {type(obj).__name__} ({obj!r}), not a function or a class; a "
+            "classifier takes a trajectory and returns a verdict"
+        )
+    return obj
 
 
 def _number(v: Any) -> float:

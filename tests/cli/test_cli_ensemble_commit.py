@@ -42,15 +42,17 @@ def _same(out, whole):
 
 
 def _stop_at(monkeypatch, target):
-    """os.replace raises KeyboardInterrupt (a kill) when it would create ``target``."""
-    real = os.replace
+    """os.replace or os.link (a fresh output is linked into place, never over a file)
+    raises KeyboardInterrupt (a kill) when it would create ``target``."""
+    for name in ("replace", "link"):
+        real = getattr(os, name)
 
-    def replace(src, dst):
-        if os.fspath(dst) == os.fspath(target):
-            raise KeyboardInterrupt
-        real(src, dst)
+        def make(src, dst, real=real):
+            if os.fspath(dst) == os.fspath(target):
+                raise KeyboardInterrupt
+            real(src, dst)
 
-    monkeypatch.setattr(os, "replace", replace)
+        monkeypatch.setattr(os, name, make)
 
 
 @pytest.mark.parametrize("stop", ["sections", "impacts", "members", "parts removal"])
@@ -92,4 +94,29 @@ def test_force_starts_over(tmp_path, whole):
     assert main([*ARGS, "--out", str(out)]) == 2
     assert main([*ARGS, "--out", str(out), "--force", "--resume"]) == 2
     assert main([*ARGS, "--out", str(out), "--force"]) == 0
+    _same(out, whole)
+
+
+def test_an_output_written_during_the_run_is_not_replaced(tmp_path, monkeypatch, whole, capsys):
+    """A sections file that another process writes while the members run is kept: exit 2
+    naming it, no output placed, and the parts kept, from which --resume (once it is moved
+    away) writes the same outputs as an uninterrupted run."""
+    import chaoscam.integrate
+
+    out = tmp_path / "e.parquet"
+    sections = out.with_name("e.sections.parquet")
+    run = chaoscam.integrate.simulate_ensemble
+
+    def meanwhile(*args, **kwargs):
+        sections.write_text("theirs")
+        return run(*args, **kwargs)
+
+    monkeypatch.setattr(chaoscam.integrate, "simulate_ensemble", meanwhile)
+    assert main([*ARGS, "--out", str(out)]) == 2
+    assert "appeared while this run was working" in capsys.readouterr().err
+    assert sections.read_text() == "theirs" and not out.exists()
+    assert out.with_suffix(".parts").is_dir()
+    monkeypatch.setattr(chaoscam.integrate, "simulate_ensemble", run)
+    sections.unlink()
+    assert main([*ARGS, "--out", str(out), "--resume"]) == 0
     _same(out, whole)

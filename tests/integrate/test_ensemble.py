@@ -4,7 +4,8 @@ refills, with impacts kept, and labelled by classify_ensemble."""
 import numpy as np
 import pytest
 
-from chaoscam import Params, classify_ensemble, simulate
+from chaoscam import ParameterError, Params, classify_ensemble, simulate
+from chaoscam.integrate import simulate_ensemble
 
 
 def test_ensemble_members_equal_single_runs():
@@ -57,3 +58,25 @@ def test_ensemble_keeps_impacts_and_labels_members():
         simulate_ensemble(p, [0, 1], duration=20.0, transient=10.0, tangent=True), p
     )
     assert list(ens.members.label) == ["periodic"] * 2 and list(ens.members.period) == [1, 1]
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(indices=[0.5, 1.7]), r"index = 0.5 must be an integer"),
+        (dict(indices=[-1]), r"index = -1 must be an integer >= 0"),
+        (dict(indices=[0], seed=None), r"seed = None must be an integer"),
+        (dict(indices=[0], seed=-1), r"seed = -1 must be an integer >= 0"),
+    ],
+)
+def test_ensemble_indices_and_seed_are_checked(kwargs, message):
+    """Indices and seed are whole numbers >= 0, as for simulate: 0.5 was silently 0, and
+    seed=None a TypeError from deep inside."""
+    with pytest.raises(ParameterError, match=message):
+        simulate_ensemble(Params(l_lambda_sigma=0.002), duration=0.01, **kwargs)
+
+
+def test_ensemble_params_as_a_dict_says_what_to_do():
+    """A dict for params gets simulate's TypeError (use Params(**d)), not an AttributeError."""
+    with pytest.raises(TypeError, match=r"use Params\(\*\*d\)"):
+        simulate_ensemble({"omega": 30.0}, [0], duration=0.01)
