@@ -175,6 +175,10 @@ class OutputLock:
         while True:
             try:
                 fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+            except FileNotFoundError:
+                raise OutputError(
+                    f"{self.target}: the folder {self.path.parent} does not exist; create it first"
+                ) from None
             except OSError as err:
                 raise OutputError(f"{self.target}: cannot create the lock file ({err})") from None
             try:

@@ -312,3 +312,12 @@ def test_a_classifier_that_is_not_callable_is_a_usage_error(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--classifier math:pi" in err and "not a function" in err and "Traceback" not in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_api_sweep_into_a_missing_folder_names_the_folder(tmp_path):
+    """bifurcation(out='nodir/x.parquet') says the folder does not exist (it said it could not
+    create a lock file)."""
+    from chaoscam.sweep import bifurcation
+
+    with pytest.raises(OutputError, match=r"the folder .*nodir does not exist; create it first"):
+        bifurcation("l_lambda", [0.008], duration=0.1, out=tmp_path / "nodir" / "x.parquet")

@@ -339,8 +339,8 @@ def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> 
         return False
     if not resume:
         raise FileExistsError(
-            f"{existing[0]} exists: pass --resume to finish or reuse that run, or choose "
-            "another --out (nothing was overwritten)"
+            f"{existing[0]} exists: pass --resume (resume=True in Python) to finish or reuse "
+            "that run, or choose another --out (nothing was overwritten)"
         )
     meta = read_sweep_metadata(outputs[0]) if outputs[0].exists() else None
     if meta is None or meta.get("hash") != config_hash(config):
