@@ -447,6 +447,8 @@ class KernelRun:
 def _summary(run: Trajectory | RawRun) -> str:
     """The terminal lines of :meth:`Trajectory.summary` (and :meth:`RawRun.summary`)."""
     s = run.stats
+    fraction = s["contact_fraction"]
+    contact = "n/a (no step recorded)" if math.isnan(fraction) else f"{fraction:.4f}"
     return (
         f"status: {run.status.name} - {run.message}\n"
         f"simulated: {run.final_state[0]:.4g} s of {run.settings['duration']:.4g} s "
@@ -455,7 +457,7 @@ def _summary(run: Trajectory | RawRun) -> str:
         f"{s['n_micro_impacts']} micro, {s['n_chatter_ends']} chattering ends), "
         f"{s['slow_closings']} slow closings left to the compliant contact, "
         f"{s['chatter_handovers']} chattering-guard hand-overs\n"
-        f"contact fraction: {s['contact_fraction']:.4f}\n"
+        f"contact fraction: {contact}\n"
         f"section points: {len(run.section)}"
     )
 

@@ -260,3 +260,11 @@ def test_runs_that_would_take_hours_for_other_fields_than_dt_are_refused(changes
     named, instead of starting and never finishing."""
     with pytest.raises(ParameterError, match=rf"refused; shorten duration or raise {field}"):
         simulate(Params(**changes), duration=0.5)
+
+
+def test_summary_of_a_run_with_no_recorded_step_says_so():
+    """A run that leaves the cam's reach before its first step has no contact fraction: the
+    summary says n/a instead of printing nan."""
+    tr = simulate(Params(x_O=-0.58), duration=1.0, series=False)
+    assert "contact fraction: n/a (no step recorded)" in tr.summary()
+    assert "nan" not in tr.summary()

@@ -221,11 +221,26 @@ def _counts(labels) -> str:
     return ", ".join(f"{k} {v}" for k, v in labels.value_counts().sort_index().items())
 
 
+def _not_set(items: list[str] | None, swept: dict[str, str]) -> None:
+    """Refuse ``--set NAME=VALUE`` for a parameter the sweep varies: the axis would silently
+    override it."""
+    from . import UsageError
+
+    for item in items or []:
+        name = item.partition("=")[0].strip()
+        if name in swept:
+            raise UsageError(
+                f"--set {item}: {name} is swept by {swept[name]}, which gives its values; "
+                "drop the --set"
+            )
+
+
 def run_bifurcation(args: argparse.Namespace) -> int:
     from ..sweep._bifurcation import bifurcation
     from ..sweep._common import companion
     from . import parse_assignments
 
+    _not_set(args.set, {args.param: "--param"})
     base = parse_assignments(args.set)
     if args.initial_conditions < 1:
         from . import UsageError
@@ -275,6 +290,9 @@ def run_regime_map(args: argparse.Namespace) -> int:
             y = Axis.parse(args.sigma, name="l_lambda_sigma") if args.sigma else Axis.parse(args.y)
     except SweepError as err:
         raise UsageError(str(err)) from None
+    _not_set(
+        args.set, {x.name: "--mu" if args.mu else "--x", y.name: "--sigma" if args.sigma else "--y"}
+    )
     base = parse_assignments(args.set)
     res = _call(
         regime_map,

@@ -156,6 +156,9 @@ def simulate_ensemble(
         raise ValueError(f"batch must be >= 1, got {batch!r}")
     batch = int(batch)
     seed = whole("seed", seed)
+    if hasattr(indices, "__len__"):  # before the list is made: range(10**10) would hang there
+        one = params[0] if isinstance(params, list | tuple) and params else params
+        _check_memory(params_arg(one), duration, transient, len(indices))
     indices = [whole("index", i) for i in indices]
     if isinstance(params, list | tuple):
         plist = [params_arg(q) for q in params]
@@ -197,6 +200,16 @@ def simulate_ensemble(
         "tangent": bool(tangent),
     }
     return _assemble(parts, settings, keep_impacts, t0)
+
+
+def _check_memory(p: Params, duration: float, transient: float, members: int) -> None:
+    """Refuse an ensemble whose sections cannot fit in this machine's memory (the CLI's
+    ``chaoscam ensemble`` refuses it too, with its parts on disk)."""
+    from .._budget import JobEstimate, check_budget, estimate
+
+    one = estimate(p, duration=duration, transient=transient)
+    job = JobEstimate((one.bytes * members, 0.0))
+    check_budget(job, what=f"an ensemble of {members} members", reduce="the members or duration")
 
 
 def extend_ensemble(

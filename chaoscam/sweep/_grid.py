@@ -117,9 +117,10 @@ class Axis:
         """From ``NAME=START:STOP:NUM`` or ``NAME=V1,V2,...`` (exact values, e.g. the paper's
         ``l_lambda=0.008,0.015,0.023``); without ``NAME=`` when ``name`` is given."""
         if name is None:
+            given = text
             name, sep, text = text.partition("=")
             if not sep or not name.strip():
-                raise SweepError(f"axis {text!r}: expected NAME=START:STOP:NUM or NAME=V1,V2,...")
+                raise SweepError(f"axis {given!r}: expected NAME=START:STOP:NUM or NAME=V1,V2,...")
             name = name.strip()
         if ":" not in text:
             try:

@@ -80,3 +80,10 @@ def test_ensemble_params_as_a_dict_says_what_to_do():
     """A dict for params gets simulate's TypeError (use Params(**d)), not an AttributeError."""
     with pytest.raises(TypeError, match=r"use Params\(\*\*d\)"):
         simulate_ensemble({"omega": 30.0}, [0], duration=0.01)
+
+
+def test_an_ensemble_that_cannot_fit_in_memory_is_refused_at_once():
+    """range(10**10) members is refused by its memory estimate before the index list is made
+    (it hung building 1e10 ints), as `chaoscam ensemble` refuses it."""
+    with pytest.raises(ParameterError, match=r"an ensemble of 10000000000 members needs about"):
+        simulate_ensemble(Params(), range(10**10), duration=20.0)

@@ -193,3 +193,20 @@ def test_regime_map_with_other_axes_and_plot(tmp_path):
     assert set(cells.columns) >= {"omega", "xi", "dominant", "p_chaotic_lo", "p_chaotic_hi"}
     assert "left_reach" in set(pd.read_parquet(out)["label"])
     assert (tmp_path / "r.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize(
+    "argv, name",
+    [
+        (["regime-map", "--mu", "0.008", "--sigma", "0", "--set", "l_lambda=0.01"], "--mu"),
+        (["regime-map", "--x", "xi=0.2", "--y", "omega=20", "--set", "omega=30"], "--y"),
+        (["bifurcation", "--param", "xi", "--values", "0.2", "--set", "xi=0.3"], "--param"),
+    ],
+)
+def test_setting_a_swept_parameter_is_refused(tmp_path, capsys, argv, name):
+    """--set for a parameter the sweep varies was silently overridden by the axis: exit 2,
+    naming the axis option, before any work."""
+    assert main([*argv, "--out", str(tmp_path / "s.parquet")]) == 2
+    err = capsys.readouterr().err
+    assert f"is swept by {name}" in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []

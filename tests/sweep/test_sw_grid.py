@@ -65,3 +65,9 @@ def test_axes_can_name_exact_values():
     assert Axis.parse("0.42", name="xi").values == (0.42,)
     with pytest.raises(SweepError, match="xi values"):
         Axis.parse("xi=0.1,abc")
+
+
+def test_an_axis_without_its_name_is_named_in_the_message():
+    """'l_lambda' (no '=') is refused with what was given, not an empty axis ''."""
+    with pytest.raises(SweepError, match=r"axis 'l_lambda': expected NAME=START:STOP:NUM"):
+        Axis.parse("l_lambda")
