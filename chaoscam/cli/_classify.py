@@ -115,7 +115,7 @@ def run_classify_series(args: argparse.Namespace) -> int:
             "(section points / map iterates)"
         )
     if args.dt is not None and not (math.isfinite(args.dt) and args.dt > 0):
-        raise UsageError(f"--dt {args.dt}: the sampling interval must be > 0")
+        raise UsageError(f"--dt {args.dt}: the sampling interval must be a finite number > 0")
     if args.forcing_period is not None:
         if args.section:
             raise UsageError(
@@ -123,12 +123,13 @@ def run_classify_series(args: argparse.Namespace) -> int:
                 "already one per forcing period"
             )
         if not (math.isfinite(args.forcing_period) and args.forcing_period > 0):
-            raise UsageError(f"--forcing-period {args.forcing_period}: must be > 0")
+            raise UsageError(f"--forcing-period {args.forcing_period}: must be a finite number > 0")
     if args.dt is not None and len(args.column) != 1:
         raise UsageError("--dt takes one --column (a scalar signal)")
     path = args.file
     if not path.is_file():
-        raise UsageError(f"{path}: no such file")
+        what = "is a directory; give a CSV file" if path.is_dir() else "no such file"
+        raise UsageError(f"{path}: {what}")
     try:
         frame = pd.read_csv(path)
     except (ValueError, OSError, UnicodeDecodeError) as err:

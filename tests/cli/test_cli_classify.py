@@ -130,3 +130,9 @@ def test_classify_uses_the_tangent_exponent_unless_told_not_to(traj_file, capsys
     assert "exponent" in {e["name"] for e in _json(capsys)["evidence"]}
     assert main(["classify", str(traj_file), "--no-tangent", "--no-extend"]) == 0
     assert "exponent" not in {e["name"] for e in _json(capsys)["evidence"]}
+
+
+def test_classify_series_on_a_directory_says_so(tmp_path, capsys):
+    """A directory given as the CSV file is named as a directory (it said "no such file")."""
+    assert main(["classify-series", str(tmp_path), "--column", "x", "--dt", "0.001"]) == 2
+    assert "is a directory; give a CSV file" in capsys.readouterr().err
