@@ -142,8 +142,15 @@ def _run_locked(args: argparse.Namespace) -> int:
     elif not (args.resume and parts.exists()):
         for path in (out, sections_path, impacts_path):
             if path.exists() and not args.force:
+                why = (
+                    " and was made by another configuration (or is not a finished chaoscam "
+                    "ensemble): --resume continues only the same command"
+                    if args.resume
+                    else ""
+                )
                 raise FileExistsError(
-                    f"{path} exists; choose another --out, remove it, or pass --force to replace it"
+                    f"{path} exists{why}; choose another --out, remove it, or pass --force to "
+                    "replace it"
                 )
     if parts.exists():
         if not args.resume:
