@@ -14,13 +14,13 @@ __all__ = ["ignored_sigma_warning", "resolution_warning", "run_warnings"]
 def resolution_warning(p: Params) -> str | None:
     """The warning for a fixed step too coarse for the contact oscillation (fewer than 20
     steps per contact period), or None. The adaptive path's steps follow the contact."""
-    steps = contact_period(p) / p.dt
+    period = contact_period(p)
+    steps = period / p.dt
     if steps >= 20 or p.integrator != "rk4":
         return None
     return (
-        f"dt = {p.dt:g} s resolves the contact oscillation (period "
-        f"{contact_period(p):.3g} s) with only {steps:.1f} steps; use "
-        f"dt <= {contact_period(p) / 40:.2g} s for a converged run"
+        f"dt = {p.dt:g} s resolves the contact oscillation (period {period:.3g} s) with only "
+        f"{steps:.1f} steps; use dt <= {period / 40:.2g} s for a converged run"
     )
 
 

@@ -156,14 +156,13 @@ def simulate_ensemble(
         raise ValueError(f"batch must be >= 1, got {batch!r}")
     batch = int(batch)
     seed = whole("seed", seed)
-    if hasattr(indices, "__len__"):  # before the list is made: range(10**10) would hang there
-        one = params[0] if isinstance(params, list | tuple) and params else params
-        _check_memory(params_arg(one), duration, transient, len(indices))
+    per_member = isinstance(params, list | tuple)
+    plist = [params_arg(q) for q in params] if per_member else [params_arg(params)]
+    if plist and hasattr(indices, "__len__"):  # before the list: range(10**10) would hang there
+        _check_memory(plist[0], duration, transient, len(indices))
     indices = [whole("index", i) for i in indices]
-    if isinstance(params, list | tuple):
-        plist = [params_arg(q) for q in params]
-    else:
-        plist = [params_arg(params)] * len(indices)
+    if not per_member:
+        plist = plist * len(indices)
     if len(plist) != len(indices):
         raise ValueError(f"{len(plist)} parameter sets for {len(indices)} indices")
     if len({(p.dt, p.omega) for p in plist}) > 1:

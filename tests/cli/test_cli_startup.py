@@ -68,19 +68,26 @@ def test_cli_module_loads_nothing_heavy():
     assert _python("-c", code, check=True).stdout.strip() == "[]"
 
 
-@pytest.mark.parametrize("delay", [0.05, 0.1, 0.2, 0.4])
-def test_ctrl_c_during_start_up_is_one_line(delay):
-    """SIGINT `delay` s after the interpreter is up (while chaoscam imports its layers, or
-    just after): exit 130 and the one line "chaoscam: interrupted", no traceback."""
+def _cli_up(*argv: str) -> subprocess.Popen:
+    """The CLI on ``argv`` in a fresh interpreter, returned once it prints its "up" mark (just
+    before chaoscam is imported)."""
     proc = subprocess.Popen(
-        [sys.executable, "-c", CODE, "simulate", "--duration", "20"],
+        [sys.executable, "-c", CODE, *argv],
         cwd=ROOT,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
     )
+    assert proc.stdout.readline() == "up\n"
+    return proc
+
+
+@pytest.mark.parametrize("delay", [0.05, 0.1, 0.2, 0.4])
+def test_ctrl_c_during_start_up_is_one_line(delay):
+    """SIGINT `delay` s after the interpreter is up (while chaoscam imports its layers, or
+    just after): exit 130 and the one line "chaoscam: interrupted", no traceback."""
+    proc = _cli_up("simulate", "--duration", "20")
     try:
-        assert proc.stdout.readline() == "up\n"
         time.sleep(delay)
         proc.send_signal(signal.SIGINT)
         _, err = proc.communicate(timeout=60)
@@ -154,16 +161,8 @@ def test_sigterm_stops_a_single_run_whose_cam_period_holds_many_steps():
     dt = 2e-8 s a cam period holds 3e8 steps, and a compiled call that ran to the next
     section ignored the signal for minutes; with the kernel's step budget per call the run
     ends within seconds, exit 143 and one line."""
-    proc = subprocess.Popen(
-        [sys.executable, "-c", CODE, "simulate", "--duration", "20"]
-        + ["--set", "omega=1", "--set", "dt=2e-8"],
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    proc = _cli_up("simulate", "--duration", "20", "--set", "omega=1", "--set", "dt=2e-8")
     try:
-        assert proc.stdout.readline() == "up\n"
         time.sleep(10.0)  # imported and compiled (or still compiling): inside the run
         assert proc.poll() is None
         sent = time.monotonic()
