@@ -7,6 +7,7 @@ point of a grid and asks :func:`chaoscam.simulate` for realizations ``(seed, ind
 from __future__ import annotations
 
 import math
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -104,6 +105,14 @@ class Axis:
             raise SweepError(f"axis {self.name}: no values")
         if not all(math.isfinite(v) for v in vals):
             raise SweepError(f"axis {self.name}: values must be finite")
+        if len(set(vals)) < len(vals):
+            twice = sorted(v for v, n in Counter(vals).items() if n > 1)
+            # A repeated value would be a second grid column of the same parameters: run
+            # again under other realization indices and drawn on top of the first.
+            raise SweepError(
+                f"axis {self.name}: the value {twice[0]!r} appears more than once; give each "
+                "value once"
+            )
         object.__setattr__(self, "values", vals)
 
     @classmethod

@@ -71,3 +71,13 @@ def test_an_axis_without_its_name_is_named_in_the_message():
     """'l_lambda' (no '=') is refused with what was given, not an empty axis ''."""
     with pytest.raises(SweepError, match=r"axis 'l_lambda': expected NAME=START:STOP:NUM"):
         Axis.parse("l_lambda")
+
+
+def test_a_value_given_twice_is_refused():
+    """A repeated value would be a second column of the same parameters, simulated again
+    under other indices and drawn over the first: refused, naming the axis and the value."""
+    with pytest.raises(SweepError, match=r"axis l_lambda: the value 0.008 appears more than once"):
+        Axis.parse("l_lambda=0.008,0.015,0.008")
+    with pytest.raises(SweepError, match="xi"):
+        Axis("xi", (0.2, 0.3, 0.2, 0.3))
+    assert Axis("xi", (0.3, 0.2)).values == (0.3, 0.2)  # any order, each value once
