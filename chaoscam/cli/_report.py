@@ -96,18 +96,18 @@ def run_paper(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers {args.workers}: must be >= 1")
     figures = None
-    if args.figures:
+    if args.figures is not None:
         try:
             figures = [int(x) for x in args.figures.split(",")]
         except ValueError:
-            raise UsageError(f"--figures {args.figures}: expected numbers like 3,5,7") from None
+            raise UsageError(f"--figures {args.figures!r}: expected numbers like 3,5,7") from None
         bad = [f for f in figures if f not in FIGURES]
         if bad:
             raise UsageError(f"--figures: no figure {bad}; choose from {sorted(FIGURES)}")
     command = shlex.join(
         ["chaoscam", "paper"]
         + (["--quick"] if args.quick else [])
-        + (["--figures", args.figures] if args.figures else [])
+        + (["--figures", args.figures] if args.figures is not None else [])
         + (["--workers", str(args.workers)] if args.workers else [])
         + ["--out", str(args.out)]
     )

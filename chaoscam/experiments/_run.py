@@ -88,6 +88,14 @@ def run_paper(
         write_report,
     )
 
+    if figures is not None:
+        figures = list(figures)
+        unknown = [f for f in figures if f not in FIGURES]
+        if not figures or unknown:
+            raise ValueError(
+                f"figures = {figures}: choose from {sorted(FIGURES)} (None: every figure and "
+                "the sensitivity sweeps)"
+            )
     out = Path(out)
     outdir = check_paper_outputs(out, figures, force=force)
     outdir.mkdir(exist_ok=True)

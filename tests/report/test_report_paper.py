@@ -29,6 +29,18 @@ def test_paper_rejects_unknown_figure(tmp_path, capsys):
     assert "no figure" in capsys.readouterr().err
 
 
+def test_paper_rejects_an_empty_figure_list(tmp_path, capsys):
+    """--figures '' is a usage error, not every figure (which is what leaving it out means)."""
+    assert main(["paper", "--quick", "--figures", "", "--out", str(tmp_path / "p.html")]) == 2
+    assert "--figures '': expected numbers" in capsys.readouterr().err
+    assert not (tmp_path / "p.html").exists()
+    from chaoscam.experiments import run_paper
+
+    for figures in ([], [2]):  # the API too (it ran every figure for [])
+        with pytest.raises(ValueError, match="choose from"):
+            run_paper(quick=True, out=tmp_path / "p.html", figures=figures)
+
+
 def test_sequence_rule_finds_the_papers_order_and_nothing_else():
     """The Fig. 4 rule: the paper's regimes must appear in order among the label runs."""
     from chaoscam.experiments._paper import _is_subsequence, _runs
