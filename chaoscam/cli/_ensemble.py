@@ -18,7 +18,6 @@ so a second process on the same output is refused.
 from __future__ import annotations
 
 import argparse
-import hashlib
 import json
 import os
 import shutil
@@ -27,7 +26,17 @@ import time
 import warnings
 from pathlib import Path
 
-from .._outputs import OutputError, atomic_path
+from .._outputs import atomic_path
+from ._ensemble_parts import (
+    atomic_text,
+    commit_parts,
+    config_digest,
+    fingerprint,
+    finished_run,
+    manifest,
+    output_paths,
+    part_done,
+)
 from ._options import add_run_options
 
 __all__ = ["register"]
@@ -89,15 +98,10 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"--out {out}: the output must end in .parquet")
     if args.force and args.resume:
         raise UsageError("--force starts over and --resume continues: give one of them")
-    for path in _outputs(out):
+    for path in output_paths(out):
         check_output(path, force=True)  # folder and path now; existence under the lock
     with OutputLock(out):
         return _run_locked(args)
-
-
-def _outputs(out: Path) -> tuple[Path, Path, Path]:
-    """members, sections, impacts."""
-    return out, out.with_suffix(".sections.parquet"), out.with_suffix(".impacts.parquet")
 
 
 def _run_locked(args: argparse.Namespace) -> int:
@@ -114,7 +118,7 @@ def _run_locked(args: argparse.Namespace) -> int:
     whole("--first", args.first)
     params = parse_assignments(args.set)
     duration, transient = run_settings(args.duration, args.transient, args.seed)
-    out, sections_path, impacts_path = _outputs(out)
+    out, sections_path, impacts_path = output_paths(out)
     parts = out.with_suffix(".parts")
     chunk = _chunk(args, parts)
     _check_budget(params, duration, transient, members_n, chunk)
@@ -129,14 +133,14 @@ def _run_locked(args: argparse.Namespace) -> int:
         "classify": args.classify,
         "keep_impacts": args.keep_impacts,
     }
-    digest = _digest(config)
+    digest = config_digest(config)
     # What the finished members file is stamped with: the part size decides where the run is
     # saved on the way, not what it computes, so a finished run is recognised under any.
-    result = _digest({k: v for k, v in config.items() if k != "chunk"})
+    result = config_digest({k: v for k, v in config.items() if k != "chunk"})
     remove_leftovers(parts)  # of a run killed while it created or deleted its parts
     if args.force:
         discard_checkpoint(parts)
-    elif args.resume and not parts.exists() and _finished(out, (result, digest)):
+    elif args.resume and not parts.exists() and finished_run(out, (result, digest)):
         print(f"already finished: {out} (same configuration); nothing to do")
         return 0
     elif not (args.resume and parts.exists()):
@@ -158,7 +162,7 @@ def _run_locked(args: argparse.Namespace) -> int:
                 f"{parts} holds an unfinished run; add --resume to continue it (or --force "
                 "to start over)"
             )
-        if _manifest(parts).get("digest") != digest:
+        if manifest(parts).get("digest") != digest:
             raise UsageError(
                 f"{parts} belongs to another configuration (or has no readable config.json); "
                 "not resumed: use the original command, or --force to start over"
@@ -167,9 +171,7 @@ def _run_locked(args: argparse.Namespace) -> int:
         tmp = parts.with_name(f".tmp-{os.getpid()}-{parts.name}")
         shutil.rmtree(tmp, ignore_errors=True)
         tmp.mkdir()
-        _atomic_text(
-            tmp / "config.json", json.dumps({"digest": digest, "config": config}, indent=1)
-        )
+        atomic_text(tmp / "config.json", json.dumps({"digest": digest, "config": config}, indent=1))
         os.replace(tmp, parts)
     for tmp in parts.glob(".tmp-*"):
         tmp.unlink(missing_ok=True)
@@ -187,7 +189,7 @@ def _run_locked(args: argparse.Namespace) -> int:
     names = ("members", "sections") + (("impacts",) if args.keep_impacts else ())
     for start in starts:
         stop = min(start + chunk, last)
-        if _part_done(parts, start, names):
+        if part_done(parts, start, names):
             done_before += stop - start
             bar.update(stop - start)
             continue
@@ -235,8 +237,8 @@ def _run_locked(args: argparse.Namespace) -> int:
             path = parts / f"{start:012d}.{name}.parquet"
             with atomic_path(path) as tmp:
                 table.to_parquet(tmp, index=False)
-            files[name] = _fingerprint(path)
-        _atomic_text(
+            files[name] = fingerprint(path)
+        atomic_text(
             parts / f"{start:012d}.done",
             json.dumps({"files": files, "settings": ens.settings}, default=str),
         )
@@ -248,7 +250,7 @@ def _run_locked(args: argparse.Namespace) -> int:
             )
     bar.close()
 
-    members = _commit(parts, starts, names, out, result, ours)
+    members = commit_parts(parts, starts, names, out, result, ours, config)
     wall = time.perf_counter() - t0
     counts = members["label" if args.classify else "status"].value_counts().to_dict()
     print(
@@ -268,16 +270,6 @@ runs, so that the progress bar moves (and Ctrl-C is honoured) every few seconds;
 threads' idle tail at the end of each call costs a few per cent."""
 
 
-def _manifest(parts: Path) -> dict:
-    """The ``config.json`` of an unfinished run's parts (digest and configuration), or an
-    empty dict when there is none or it cannot be read."""
-    try:
-        saved = json.loads((parts / "config.json").read_text())
-    except (OSError, ValueError):
-        return {}
-    return saved if isinstance(saved, dict) else {}
-
-
 def _chunk(args: argparse.Namespace, parts: Path) -> int:
     """Members per saved part: ``--chunk``; else, resuming, the part size the interrupted run
     in ``parts`` started with (so that a run begun with another default, or on a GPU, can be
@@ -288,7 +280,7 @@ def _chunk(args: argparse.Namespace, parts: Path) -> int:
     if args.chunk is not None:
         return whole("--chunk", args.chunk, low=1)
     if args.resume and not args.force:
-        saved = _manifest(parts).get("config")
+        saved = manifest(parts).get("config")
         stored = saved.get("chunk") if isinstance(saved, dict) else None
         if isinstance(stored, int) and not isinstance(stored, bool) and stored >= 1:
             return stored
@@ -361,116 +353,3 @@ def _check_budget(params, duration: float, transient: float, members: int, chunk
         reduce="--members or --duration",
         run=dict(params=params, duration=duration, what="each member"),
     )
-
-
-def _atomic_text(path: Path, text: str) -> None:
-    from .._outputs import atomic_write_bytes
-
-    atomic_write_bytes(path, text.encode())
-
-
-def _fingerprint(path: Path) -> dict:
-    data = path.read_bytes()
-    return {"bytes": len(data), "sha256": hashlib.sha256(data).hexdigest()}
-
-
-def _part_done(parts: Path, start: int, names: tuple[str, ...]) -> bool:
-    """True when part ``start`` is whole: its marker lists files that match it."""
-    mark = parts / f"{start:012d}.done"
-    if not mark.exists():
-        return False
-    try:
-        files = json.loads(mark.read_text())["files"]
-        whole = all(
-            _fingerprint(parts / f"{start:012d}.{name}.parquet") == files[name] for name in names
-        )
-    except (OSError, ValueError, KeyError, TypeError):
-        whole = False
-    if not whole:
-        print(
-            f"chaoscam: notice: part {start} in {parts} is damaged or incomplete; it is "
-            "computed again",
-            file=sys.stderr,
-            flush=True,
-        )
-        mark.unlink(missing_ok=True)
-    return whole
-
-
-_META_KEY = b"chaoscam.ensemble"
-
-
-def _digest(config: dict) -> str:
-    return hashlib.sha256(json.dumps(config, sort_keys=True).encode()).hexdigest()[:16]
-
-
-def _finished(out: Path, digests: tuple[str, ...]) -> bool:
-    """True when ``out`` is the members file of a finished run of this configuration: its
-    stamp is one of ``digests`` (that of the configuration without the part size; files
-    finished before that change carry the digest with it)."""
-    import pyarrow.parquet as pq
-
-    try:
-        meta = pq.read_schema(out).metadata or {}
-    except Exception:  # absent, or not a Parquet file: not finished
-        return False
-    return meta.get(_META_KEY) in {d.encode() for d in digests}
-
-
-def _write(frame, path: Path, digest: str | None = None) -> None:
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    table = pa.Table.from_pandas(frame, preserve_index=False)
-    if digest is not None:
-        meta = dict(table.schema.metadata or {})
-        meta[_META_KEY] = digest.encode()
-        table = table.replace_schema_metadata(meta)
-    with atomic_path(path) as tmp:
-        pq.write_table(table, tmp)
-
-
-def _commit(
-    parts: Path, starts: range, names: tuple[str, ...], out: Path, digest: str, ours: set[Path]
-):
-    """Join the parts into the outputs as one commit: every output written to a temporary
-    name, then renamed, the members file last; then the parts are removed (renamed away
-    first). A kill at any point leaves either the parts (``--resume`` joins them again) or
-    the finished outputs. An output not in ``ours`` is put in place only if its name is
-    still free (a hard link): one that another process wrote meanwhile is kept, the outputs
-    placed so far are taken back, and the parts stay for a ``--resume`` once it is moved."""
-    import pandas as pd
-
-    from ..sweep._checkpoint import discard_checkpoint
-
-    targets = dict(zip(("members", "sections", "impacts"), _outputs(out), strict=True))
-    staged = {}
-    members = None
-    for name in names:
-        frame = pd.concat(
-            [pd.read_parquet(parts / f"{s:012d}.{name}.parquet") for s in starts],
-            ignore_index=True,
-        )
-        if name == "members":
-            members = frame
-        staged[name] = parts / f".staged.{name}.parquet"
-        _write(frame, staged[name], digest if name == "members" else None)
-    placed = []
-    for name in sorted(names, key=lambda n: n == "members"):  # members last
-        target = targets[name]
-        if target in ours:
-            os.replace(staged[name], target)
-            continue
-        try:
-            os.link(staged[name], target)
-        except FileExistsError:
-            for p in placed:
-                p.unlink(missing_ok=True)
-            raise OutputError(
-                f"{target} appeared while this run was working (another process wrote it); "
-                f"it was not overwritten. The finished members are kept in {parts}: move "
-                f"{target} away and run the same command with --resume to write them"
-            ) from None
-        placed.append(target)
-    discard_checkpoint(parts)
-    return members

@@ -12,10 +12,11 @@ __all__ = ["register"]
 def register(sub) -> None:
     r = sub.add_parser(
         "report",
-        help="one self-contained HTML report from trajectories, bifurcations, regime maps",
+        help="one self-contained HTML report from trajectories, bifurcations, regime maps, "
+        "ensembles",
         description="Read chaoscam outputs (simulate --out, bifurcation --out, regime-map "
-        "--out; .parquet) and write one HTML file with every figure inline: it opens from "
-        "disk and refers to no network address.",
+        "--out, ensemble --out; .parquet) and write one HTML file with every figure inline: it "
+        "opens from disk and refers to no network address.",
     )
     r.add_argument("inputs", nargs="+", metavar="INPUT", help="chaoscam .parquet outputs")
     r.add_argument("--out", type=Path, required=True, help="the report, FILE.html")

@@ -1,4 +1,5 @@
-"""Reports: figures (seaborn/matplotlib) and HTML for simulations, regime maps and diagrams.
+"""Reports: figures (seaborn/matplotlib) and HTML for simulations, regime maps, diagrams
+and ensembles.
 
 ``chaoscam report INPUT... --out FILE.html`` drives this layer, and ``chaoscam paper``
 (:mod:`chaoscam.experiments`) renders through it; it only renders. In Python::

@@ -19,6 +19,7 @@ from ._figures import png_bytes, png_uri, response_figure
 __all__ = [
     "Comparison",
     "FigureItem",
+    "add_ensemble",
     "build_report",
     "git_commit",
     "render",
@@ -38,6 +39,9 @@ SECTIONS = (
     ("why", "Why the paper differs"),
     ("missing", "What is missing"),
 )
+
+ENSEMBLES = ("ensembles", "Ensembles")
+"""A section shown after the bifurcation diagrams only when the report has an ensemble."""
 
 
 @dataclass
@@ -76,6 +80,7 @@ class ReportParts:
     paper_figures: list[FigureItem] = field(default_factory=list)
     regime_maps: list[dict[str, Any]] = field(default_factory=list)
     bifurcations: list[dict[str, Any]] = field(default_factory=list)
+    ensembles: list[dict[str, Any]] = field(default_factory=list)
     responses: list[FigureItem] = field(default_factory=list)
     evidence: list[dict[str, Any]] = field(default_factory=list)
     comparison: list[Comparison] = field(default_factory=list)
@@ -320,6 +325,18 @@ def add_regime_map(
     parts.summary.append(f"{name}: regime map {x} × {y}, dominant labels {_counts(dom)}.")
 
 
+def add_ensemble(parts: ReportParts, path: str, ens, *, png: bytes | None = None) -> None:
+    """An ensemble's figure, label table, undetermined reasons, record and summary line
+    (:func:`._ensemble.ensemble_entry`; ``png``: its figure already rendered)."""
+    from ._ensemble import ensemble_entry
+
+    entry = ensemble_entry(path, ens, png=png)
+    entry["figure"] = FigureItem(f"ens-{len(parts.ensembles) + 1}", **entry["figure"])
+    parts.ensembles.append(entry)
+    parts.provenance.append(_provenance_rows(path, "ensemble", entry.pop("settings")))
+    parts.summary.append(entry.pop("summary"))
+
+
 def _p_chaotic_text(r: dict[str, Any]) -> str:
     """P(chaotic) with its 95 % Wilson interval; a deterministic cell (one run standing for
     identical realizations, sigma = 0) has no sampling interval and says so instead."""
@@ -369,6 +386,15 @@ def _sweep_settings(cfg: dict[str, Any]) -> dict[str, Any]:
     return rows
 
 
+def _sections(parts: ReportParts) -> tuple[tuple[str, str], ...]:
+    """The table of contents: :data:`SECTIONS`, with :data:`ENSEMBLES` after the
+    bifurcation diagrams when there is an ensemble."""
+    if not parts.ensembles:
+        return SECTIONS
+    at = [sid for sid, _ in SECTIONS].index("bifurcations") + 1
+    return (*SECTIONS[:at], ENSEMBLES, *SECTIONS[at:])
+
+
 def render(parts: ReportParts, *, title: str, command: str | None = None) -> str:
     """The report's HTML text."""
     import jinja2
@@ -391,7 +417,7 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
             commit += f" plus uncommitted changes to {shown}"
     return env.get_template("report.html").render(
         title=title,
-        sections=SECTIONS,
+        sections=_sections(parts),
         parts=parts,
         version=__version__,
         commit=commit or "not available (not run from a git checkout)",
@@ -409,6 +435,8 @@ def build_report(inputs, parts: ReportParts | None = None) -> ReportParts:
         add_regime_map(parts, path, rm)
     for path, bif in inputs.bifurcations:
         add_bifurcation(parts, path, bif)
+    for path, ens in inputs.ensembles:
+        add_ensemble(parts, path, ens)
     for path, traj in inputs.trajectories:
         add_trajectory(parts, path, traj)
     for kind, items, what in (

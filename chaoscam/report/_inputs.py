@@ -1,10 +1,11 @@
 """Read the files a report is built from, and say clearly which file is wrong and why.
 
-Three kinds of input, told apart by the metadata chaoscam writes into its Parquet files:
+Four kinds of input, told apart by the metadata chaoscam writes into its Parquet files:
 a trajectory (``chaoscam simulate --out``, key ``chaoscam.trajectory``), a bifurcation
 diagram and a regime map (``chaoscam bifurcation`` / ``regime-map``, whose sweep record
-says ``kind``). A sweep may be named by its main file or by its companion
-(``.verdicts.parquet``, ``.cells.parquet``).
+says ``kind``), and an ensemble (``chaoscam ensemble --out``, key ``chaoscam.ensemble``).
+A sweep may be named by its main file or by its companion (``.verdicts.parquet``,
+``.cells.parquet``), an ensemble by its members file or its ``.sections.parquet``.
 """
 
 from __future__ import annotations
@@ -14,10 +15,25 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["InputError", "Inputs", "load_inputs", "load_trajectory"]
+__all__ = [
+    "EnsembleOutput",
+    "InputError",
+    "Inputs",
+    "load_ensemble",
+    "load_inputs",
+    "load_trajectory",
+]
 
 _TRAJ_KEY = b"chaoscam.trajectory"
 _COMPANIONS = {".verdicts": "bifurcation", ".cells": "regime_map"}
+
+ENSEMBLE_KEY = b"chaoscam.ensemble"
+"""Members-file metadata: the digest of the run's configuration (what ``--resume`` compares)."""
+
+ENSEMBLE_RECORD_KEY = b"chaoscam.ensemble.record"
+"""Members-file metadata, JSON: kind, package version, backends used, and the configuration
+(params, seed, duration, transient, first, members, classify, keep_impacts). Files written
+before it was kept have the digest only."""
 
 
 class InputError(ValueError):
@@ -31,6 +47,28 @@ class Inputs:
     trajectories: list[tuple[str, Any]] = field(default_factory=list)
     bifurcations: list[tuple[str, Any]] = field(default_factory=list)
     regime_maps: list[tuple[str, Any]] = field(default_factory=list)
+    ensembles: list[tuple[str, Any]] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class EnsembleOutput:
+    """The files of one ``chaoscam ensemble`` run.
+
+    Attributes
+    ----------
+    members : pandas.DataFrame
+        One row per member: member, index, status, n_impacts, contact_fraction, and with
+        ``--classify`` label, period, reasons.
+    sections : pandas.DataFrame or None
+        member, k, t, theta_f, omega_f, l_lambda; None when ``FILE.sections.parquet`` is
+        not beside the members file.
+    record : dict
+        :data:`ENSEMBLE_RECORD_KEY`'s JSON; empty for a file written before it was kept.
+    """
+
+    members: Any
+    sections: Any
+    record: dict
 
 
 def _schema_metadata(path: Path) -> dict[bytes, bytes]:
@@ -57,9 +95,40 @@ def load_trajectory(path: str | Path):
         raise InputError(str(err)) from None
 
 
+def load_ensemble(path: str | Path) -> EnsembleOutput:
+    """An :class:`EnsembleOutput` from a ``chaoscam ensemble`` members file (or its
+    ``.sections.parquet``), with the sections file beside it when there is one."""
+    import pandas as pd
+
+    path = Path(path)
+    if Path(path.stem).suffix == ".sections":
+        path = path.with_name(Path(path.stem).stem + ".parquet")
+    meta = _schema_metadata(path)
+    if ENSEMBLE_KEY not in meta:
+        raise InputError(f"{path}: not the members file of a chaoscam ensemble")
+    try:
+        record = json.loads(meta.get(ENSEMBLE_RECORD_KEY, b"{}"))
+    except ValueError:
+        raise InputError(f"{path}: its ensemble record is not readable JSON") from None
+    sections = path.with_suffix(".sections.parquet")
+    try:
+        members = pd.read_parquet(path)
+        sec = pd.read_parquet(sections) if sections.is_file() else None
+    except Exception as err:  # pyarrow raises several types for damaged files
+        raise InputError(f"{path}: could not read the ensemble ({err})") from None
+    missing = {"member", "status"} - set(members.columns)
+    if missing or (sec is not None and not {"member", "theta_f", "omega_f"} <= set(sec.columns)):
+        raise InputError(f"{path}: the ensemble's tables lack the columns chaoscam writes")
+    return EnsembleOutput(members, sec, record if isinstance(record, dict) else {})
+
+
 def _sweep_kind(path: Path, meta: dict[bytes, bytes]) -> str | None:
     for key, value in meta.items():
-        if key.startswith(b"chaoscam") and key != _TRAJ_KEY:
+        if key.startswith(b"chaoscam") and key not in (
+            _TRAJ_KEY,
+            ENSEMBLE_KEY,
+            ENSEMBLE_RECORD_KEY,
+        ):
             try:
                 return json.loads(value).get("config", {}).get("kind")
             except (ValueError, AttributeError):
@@ -80,11 +149,16 @@ def load_inputs(paths: list[str | Path]) -> Inputs:
         if _TRAJ_KEY in meta:
             out.trajectories.append((str(path), load_trajectory(path)))
             continue
-        kind = _sweep_kind(path, meta)
         stem = Path(path.stem)
         main = path
-        if stem.suffix in _COMPANIONS:  # a companion file: read its main file
+        if stem.suffix in (*_COMPANIONS, ".sections"):  # a companion: read its main file
             main = path.with_name(stem.stem + ".parquet")
+        if ENSEMBLE_KEY in meta or (
+            stem.suffix == ".sections" and main.is_file() and ENSEMBLE_KEY in _schema_metadata(main)
+        ):
+            out.ensembles.append((str(main), load_ensemble(main)))
+            continue
+        kind = _sweep_kind(path, meta)
         try:
             if kind == "bifurcation":
                 out.bifurcations.append((str(main), read_bifurcation(main)))
@@ -92,14 +166,18 @@ def load_inputs(paths: list[str | Path]) -> Inputs:
                 out.regime_maps.append((str(main), read_regime_map(main)))
             else:
                 raise InputError(
-                    f"{path}: a Parquet file but not a chaoscam trajectory, bifurcation or "
-                    "regime map"
+                    f"{path}: a Parquet file but not a chaoscam trajectory, bifurcation, "
+                    "regime map or ensemble"
                 )
         except (OSError, ValueError, KeyError, TypeError) as err:
             if isinstance(err, InputError):
                 raise
             raise InputError(f"{path}: could not read the {kind} ({err})") from None
-    for kind, items in (("bifurcations", out.bifurcations), ("regime_maps", out.regime_maps)):
+    for kind, items in (
+        ("bifurcations", out.bifurcations),
+        ("regime_maps", out.regime_maps),
+        ("ensembles", out.ensembles),
+    ):
         seen: dict[str, Any] = {}
         for p, r in items:
             seen.setdefault(p, r)
