@@ -179,6 +179,7 @@ def _run_locked(args: argparse.Namespace) -> int:
     # while the members run is not replaced at the end.
     ours = {p for p in (out, sections_path, impacts_path) if p.exists()}
 
+    said = _say_before(params, members_n)
     t0 = time.perf_counter()
     done_before = 0
     bar = _bar(args, args.members)
@@ -217,7 +218,7 @@ def _run_locked(args: argparse.Namespace) -> int:
                 if issubclass(w.category, GPUFallbackWarning) and not noticed:
                     print(f"chaoscam: {w.message}", file=sys.stderr, flush=True)
                     noticed = True
-                elif not issubclass(w.category, GPUFallbackWarning):
+                elif not issubclass(w.category, GPUFallbackWarning) and str(w.message) not in said:
                     warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         except KeyboardInterrupt:
             bar.close()
@@ -262,6 +263,24 @@ def _run_locked(args: argparse.Namespace) -> int:
     if args.keep_impacts:
         print(f"impacts: {impacts_path}")
     return 0
+
+
+def _say_before(params, members: int) -> set[str]:
+    """Print, once, the warnings every member would get (each part would repeat them), and
+    say when the members are all the same run; return the warnings' texts."""
+    from .._run_warnings import run_warnings
+    from . import show_warning
+
+    said = run_warnings(params)
+    for text in said:
+        show_warning(text)
+    if members > 1 and params.l_lambda_sigma == 0.0:
+        show_warning(
+            "l_lambda_sigma = 0: every member is the same deterministic run (an index draws "
+            "only line lengths); one member is enough, or --set l_lambda_sigma=... for a "
+            "random line length"
+        )
+    return set(said)
 
 
 PROGRESS_PER_THREAD = 16

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._checks import params_arg, whole
+from .._run_warnings import run_warnings
 from ..model import Params
 from . import _gpu
 from . import _kernel as k
@@ -167,6 +168,9 @@ def simulate_ensemble(
         raise ValueError(f"{len(plist)} parameter sets for {len(indices)} indices")
     if len({(p.dt, p.omega) for p in plist}) > 1:
         raise ValueError("members must share dt and omega")
+    models = {id(q): q for q in plist}.values()  # one model for all members: checked once
+    for text in dict.fromkeys(w for q in models for w in run_warnings(q)):
+        warnings.warn(text, RuntimeWarning, stacklevel=2)  # as simulate() warns
     t0 = time.perf_counter()
     room = _ROOM["gpu" if use_gpu else "cpu"]
     parts = []

@@ -186,3 +186,21 @@ def test_progress_counts_the_extensions_too(tmp_path, capsys):
     assert f"{2 + extended}/{2 + extended}" in err  # the final count is the grown total
     members = pd.read_parquet(out)
     assert "undetermined" not in set(members["label"])
+
+
+def test_a_too_coarse_step_is_warned_once_and_sigma_zero_is_named(tmp_path, capsys):
+    """The warnings every member would get are printed once, not once per part (here 3
+    parts), and a sigma = 0 ensemble says that its members are one run; the API warns as
+    simulate() does, once per distinct warning."""
+    out = tmp_path / "w.parquet"
+    args = ["ensemble", "--members", "3", "--chunk", "1", "--duration", "0.5", "--quiet"]
+    assert main([*args, "--set", "dt=2e-5", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert err.count("resolves the contact oscillation") == 1, err
+    assert err.count("every member is the same deterministic run") == 1
+    with pytest.warns(RuntimeWarning, match="resolves the contact oscillation") as caught:
+        simulate_ensemble(Params(dt=2e-5), range(3), duration=0.2)
+    assert len([w for w in caught if "contact oscillation" in str(w.message)]) == 1
+    two = tmp_path / "s.parquet"
+    assert main([*args, "--set", "l_lambda_sigma=0.002", "--out", str(two)]) == 0
+    assert "deterministic" not in capsys.readouterr().err
