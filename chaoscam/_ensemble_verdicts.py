@@ -33,8 +33,9 @@ _COORDS = ["theta_f", "omega_f"]
 @dataclasses.dataclass(frozen=True)
 class MemberVerdict:
     """One member's label, period and reasons; ``verdict`` is None for a run that did not
-    end normally (labelled by its status: ``left_reach``, ``diverged``) or that has too few
-    section points to judge."""
+    end normally (labelled by its status: ``left_reach``, ``diverged``). A run with too few
+    section points to judge has an undetermined verdict without evidence, and is extended
+    like any undetermined one."""
 
     label: str
     period: int | None
@@ -52,7 +53,9 @@ def _member(status: str, points: pd.DataFrame, jac: np.ndarray, p: Params, trans
             f"{int(keep.sum())} section point(s) after the transient: too few to judge; "
             "run longer than the transient by several cam periods"
         )
-        return MemberVerdict("undetermined", None, why, None)
+        # An undetermined verdict like any other, so that the member is extended as
+        # classify_trajectory extends such a run (the engines' labels agree).
+        return MemberVerdict("undetermined", None, why, Verdict("undetermined", None, (), (why,)))
     v = classify_section_run(points.loc[keep, _COORDS].to_numpy(dtype=float), jac[keep], p)
     return MemberVerdict(v.label, v.period, "; ".join(v.reasons), v)
 

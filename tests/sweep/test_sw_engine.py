@@ -65,6 +65,18 @@ def test_ensemble_labels_are_those_of_classify_ensemble(maps):
     assert rows["ev_exponent"].notna().all()
 
 
+def test_a_window_too_short_to_judge_is_extended_on_both_engines():
+    """Fewer than 2 section points after the transient (0.2 s recorded, under one cam period
+    past the first section): the ensemble engine extended no such member and called it
+    undetermined, while the process engine extends it as classify_trajectory does."""
+    kw = dict(realizations=1, seed=3, duration=0.5, transient=0.3, workers=1)
+    x, y = Axis("l_lambda", (0.008,)), SIGMA
+    a, b = (regime_map(x, y, engine=e, **kw).realizations for e in ("ensemble", "process"))
+    assert (a["n_section"] < 2).all()
+    frames_equal(a[[*SAME, "label", "period"]], b[[*SAME, "label", "period"]])
+    assert "undetermined" not in set(a["label"])
+
+
 def test_threads_and_batches_do_not_change_the_table(maps, monkeypatch):
     """One thread and batches of one member give the two-thread table bit for bit."""
     monkeypatch.setattr(_batch, "batch_size", lambda *a, **k: 1)
