@@ -316,7 +316,10 @@ def run_regime_map(args: argparse.Namespace) -> int:
     if args.plot is not None:
         from ..report._sweep_figures import regime_map_figure
 
-        _save_figure(regime_map_figure(c, x=res.x, y=res.y), args.plot)
+        _save_figure(
+            regime_map_figure(c, x=res.x, y=res.y, confidence=res.config["confidence"]),
+            args.plot,
+        )
         print(f"figure: {args.plot}")
     return 0
 

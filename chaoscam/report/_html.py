@@ -284,14 +284,15 @@ def add_regime_map(
 ) -> None:
     """A regime map's figure, its cell table and its provenance (``png``: its figure already
     rendered, else drawn here)."""
-    from ._sweep_figures import regime_map_figure
+    from ._sweep_figures import percent, regime_map_figure
 
     name = Path(path).name
     cfg = rm.config or {}
     x, y = cfg.get("x", {}).get("name", "x"), cfg.get("y", {}).get("name", "y")
+    confidence = float(cfg.get("confidence", 0.95))
     c = rm.cells
     if png is None:
-        png = png_bytes(regime_map_figure(c, x=x, y=y))
+        png = png_bytes(regime_map_figure(c, x=x, y=y, confidence=confidence))
     rows = []
     for r in c.sort_values([x, y]).to_dict("records"):
         rows.append(
@@ -312,11 +313,12 @@ def add_regime_map(
                 f"Regime map {x} × {y} ({name})",
                 png_uri(png),
                 f"Heatmaps over {x} and {y}: dominant label per cell, probability of chaos "
-                "with its 95% Wilson interval, and the interval width.",
+                f"with its {percent(confidence)} Wilson interval, and the interval width.",
                 caption or f"{len(rm.realizations)} realizations in {len(c)} cells.",
             ),
             "x": x,
             "y": y,
+            "level": percent(confidence),
             "rows": rows,
         }
     )
@@ -338,7 +340,7 @@ def add_ensemble(parts: ReportParts, path: str, ens, *, png: bytes | None = None
 
 
 def _p_chaotic_text(r: dict[str, Any]) -> str:
-    """P(chaotic) with its 95 % Wilson interval; a deterministic cell (one run standing for
+    """P(chaotic) with its Wilson interval; a deterministic cell (one run standing for
     identical realizations, sigma = 0) has no sampling interval and says so instead."""
     p = f"{r.get('p_chaotic', float('nan')):.2f}"
     if bool(r.get("deterministic", False)):
@@ -356,6 +358,10 @@ def _sweep_settings(cfg: dict[str, Any]) -> dict[str, Any]:
         "transient": "transient [s]",
         "realizations": "realizations per cell",
         "classifier": "classifier",
+        "engine": "engine",
+        "device": "device",
+        "confidence": "confidence of the intervals",
+        "adaptive": "adaptive sampling",
         "continuation": "continuation",
     }
     rows = {label: cfg.get(k) for k, label in names.items() if k in cfg}

@@ -14,6 +14,7 @@ __all__ = [
     "LABEL_COLORS",
     "axis_label",
     "plot_dominant",
+    "percent",
     "plot_probability",
     "plot_bifurcation",
     "regime_map_figure",
@@ -150,9 +151,17 @@ def _role(x: str, y: str) -> str | None:
 
 
 def plot_probability(
-    cells: pd.DataFrame, x: str, y: str, ax, *, label: str = "chaotic", annotate=None
+    cells: pd.DataFrame,
+    x: str,
+    y: str,
+    ax,
+    *,
+    label: str = "chaotic",
+    annotate=None,
+    confidence: float = 0.95,
 ) -> None:
-    """Heatmap of P(label) per cell; small grids are annotated with the 95 % interval.
+    """Heatmap of P(label) per cell; small grids are annotated with the Wilson interval (at
+    the map's ``confidence``, which the title names).
 
     ``annotate`` None annotates grids of at most :data:`ANNOTATE_CELLS` cells with ``p``
     and ``[lo, hi]``.
@@ -194,11 +203,19 @@ def plot_probability(
         mask=m.isna(),
     )
     _ticks(ax, m, x, y, _role(x, y))
-    ax.set_title(f"P({label})" + (" with 95% Wilson interval" if annotate else ""))
+    level = percent(confidence)
+    ax.set_title(f"P({label})" + (f" with {level} Wilson interval" if annotate else ""))
 
 
-def plot_interval_width(cells: pd.DataFrame, x: str, y: str, ax, *, label="chaotic") -> None:
-    """Heatmap of the width hi - lo of the 95 % Wilson interval of P(label)."""
+def percent(confidence: float) -> str:
+    """A confidence level as the report writes it: 0.95 -> "95%"."""
+    return f"{100 * confidence:.4g}%"
+
+
+def plot_interval_width(
+    cells: pd.DataFrame, x: str, y: str, ax, *, label="chaotic", confidence: float = 0.95
+) -> None:
+    """Heatmap of the width hi - lo of the Wilson interval of P(label) (at ``confidence``)."""
     import seaborn as sns
 
     width = cells[f"p_{label}_hi"] - cells[f"p_{label}_lo"]
@@ -213,16 +230,19 @@ def plot_interval_width(cells: pd.DataFrame, x: str, y: str, ax, *, label="chaot
         mask=m.isna(),
     )
     _ticks(ax, m, x, y, _role(x, y))
-    ax.set_title(f"95% interval width of P({label})")
+    ax.set_title(f"{percent(confidence)} interval width of P({label})")
 
 
-def regime_map_figure(cells: pd.DataFrame, *, x: str, y: str, label: str = "chaotic"):
+def regime_map_figure(
+    cells: pd.DataFrame, *, x: str, y: str, label: str = "chaotic", confidence: float = 0.95
+):
     """A regime map at the size a report shows it (~1,200 px wide, text >= 10 px there).
 
     Four panels: the dominant label (periodic cells annotated with their period), P(label)
-    and P(periodic) (annotated with the 95 % interval when the grid is small), and the
-    interval width. A map whose cells are all deterministic (sigma = 0: one run each) has
-    no probabilities to show: one panel, the label and period of each cell.
+    and P(periodic) (annotated with the Wilson interval at the map's ``confidence`` when the
+    grid is small), and the interval width. A map whose cells are all deterministic (sigma =
+    0: one run each) has no probabilities to show: one panel, the label and period of each
+    cell.
     """
     from matplotlib.figure import Figure
 
@@ -233,10 +253,10 @@ def regime_map_figure(cells: pd.DataFrame, *, x: str, y: str, label: str = "chao
     fig = Figure(figsize=(13, 10), layout="constrained")
     (a, b), (c, d) = fig.subplots(2, 2)
     plot_dominant(cells, x, y, a)
-    plot_probability(cells, x, y, b, label=label)
-    plot_interval_width(cells, x, y, c, label=label)
+    plot_probability(cells, x, y, b, label=label, confidence=confidence)
+    plot_interval_width(cells, x, y, c, label=label, confidence=confidence)
     if f"p_{label}" in cells and "p_periodic" in cells and label != "periodic":
-        plot_probability(cells, x, y, d, label="periodic")
+        plot_probability(cells, x, y, d, label="periodic", confidence=confidence)
     else:
         d.set_axis_off()
     return fig

@@ -263,12 +263,14 @@ def regime_map(
         Ask the default classifier to re-run each realization with dt / 2 and call it
         undetermined when the verdict changes (twice the cost).
     target_halfwidth : float, optional
-        Adaptive sampling: add ``realizations`` more to a cell while the widest 95 % Wilson
-        half-width of its label fractions exceeds this, up to ``max_realizations``.
+        Adaptive sampling: add ``realizations`` more to a cell while the widest Wilson
+        half-width (at ``confidence``) of its label fractions exceeds this, up to
+        ``max_realizations``.
     max_realizations : int, optional
         Cap of adaptive sampling (default 1000).
     confidence : float
-        Level of the Wilson intervals.
+        Level of the Wilson intervals, in (0, 1) (default 0.95); the report and the figures
+        name it.
     workers : int, optional
         Local worker processes (default: every core; 1 runs in this process), or the worker
         count of a local Dask cluster when ``scheduler="local"``.
@@ -337,6 +339,11 @@ def regime_map(
         }
     elif max_realizations is not None:
         raise SweepError("max realizations applies with a target half-width only")
+    if isinstance(confidence, bool) or not (
+        isinstance(confidence, int | float) and 0.0 < confidence < 1.0
+    ):
+        # before any run: summarize_cells would refuse it only at the end
+        raise SweepError(f"confidence = {confidence!r}: the intervals' level, in (0, 1), e.g. 0.95")
     validate_grid(base, [x, y])
     classify, eng, series = sweep_engine(
         classify,

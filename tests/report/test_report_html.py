@@ -140,3 +140,24 @@ def test_out_must_be_html(outputs, tmp_path, capsys):
     """The report's name must end in .html."""
     code = main(["report", str(outputs / "traj.parquet"), "--out", str(tmp_path / "r.txt")])
     assert code == 2 and "html" in capsys.readouterr().err
+
+
+def test_a_map_at_another_confidence_is_reported_at_that_level(tmp_path, capsys):
+    """A map made with confidence = 0.8 says 80% where it said 95% (its intervals are at
+    80 %), and names its confidence and engine in the provenance; confidence = 95 is refused
+    before any run (it failed at the end, leaving a checkpoint that could not finish)."""
+    from chaoscam.report._classify import ReportClassifier
+    from chaoscam.sweep import Axis, SweepError, regime_map
+
+    x, y = Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.002,))
+    kw = dict(realizations=2, duration=2.0, transient=1.0, workers=1)
+    with pytest.raises(SweepError, match=r"confidence = 95: .*\(0, 1\)"):
+        regime_map(x, y, confidence=95, out=tmp_path / "bad.parquet", **kw)
+    assert not list(tmp_path.iterdir())
+    rm = regime_map(x, y, confidence=0.8, classify=ReportClassifier(), **kw)
+    rm.to_parquet(tmp_path / "m80.parquet")
+    code, text, err = _report([tmp_path / "m80.parquet"], tmp_path, capsys)
+    assert code == 0, err
+    assert "P(chaotic) [80% CI]" in text and "its 80% Wilson interval" in text
+    assert "95%" not in text
+    assert "confidence of the intervals</td><td>0.8" in text and "<td>engine</td>" in text
