@@ -11,6 +11,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "chaoscam"
 # Bottom to top: a module may import from its own layer and those before it, never after.
 LAYERS = (
     "chaoscam._version",
+    "chaoscam._provenance",
     "chaoscam._lazy",
     "chaoscam.model",
     "chaoscam._checks",

@@ -107,9 +107,10 @@ def run(args: argparse.Namespace) -> int:
 def _run_locked(args: argparse.Namespace) -> int:
     from .._checks import whole
     from .._ensemble_verdicts import classify_ensemble
+    from .._provenance import code_identity
     from ..integrate import simulate_ensemble
     from ..integrate._gpu import GPUFallbackWarning
-    from ..sweep._checkpoint import discard_checkpoint, remove_leftovers
+    from ..sweep._checkpoint import differences, discard_checkpoint, remove_leftovers
     from ..sweep._common import run_settings
     from . import UsageError, parse_assignments
 
@@ -132,6 +133,7 @@ def _run_locked(args: argparse.Namespace) -> int:
         "chunk": chunk,
         "classify": args.classify,
         "keep_impacts": args.keep_impacts,
+        "code": code_identity(),
     }
     digest = config_digest(config)
     # What the finished members file is stamped with: the part size decides where the run is
@@ -163,9 +165,10 @@ def _run_locked(args: argparse.Namespace) -> int:
                 "to start over)"
             )
         if manifest(parts).get("digest") != digest:
+            why = differences(manifest(parts).get("config"), config)
             raise UsageError(
-                f"{parts} belongs to another configuration (or has no readable config.json); "
-                "not resumed: use the original command, or --force to start over"
+                f"{parts} belongs to another configuration{why} (or has no readable "
+                "config.json); not resumed: use the original command, or --force to start over"
             )
     else:
         tmp = parts.with_name(f".tmp-{os.getpid()}-{parts.name}")

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from .._provenance import code_rows
 from ._figures import png_bytes, png_uri
 
 __all__ = ["deterministic", "ensemble_entry", "ensemble_figure", "label_shares"]
@@ -141,6 +142,7 @@ def _settings(record: dict, ens) -> dict[str, Any]:
         "transient [s]": record.get("transient"),
         "classified": record.get("classify"),
     }
+    rows.update(code_rows(record.get("code")))
     for k, unit in (
         ("stiffness", ""),
         ("integrator", ""),

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .._provenance import code_rows
 from ._figures import png_bytes, png_uri, response_figure
 
 __all__ = [
@@ -365,6 +366,7 @@ def _sweep_settings(cfg: dict[str, Any]) -> dict[str, Any]:
         "continuation": "continuation",
     }
     rows = {label: cfg.get(k) for k, label in names.items() if k in cfg}
+    rows.update(code_rows(cfg.get("code")))
     for axis, label in (("axis", "swept parameter"), ("x", "x axis"), ("y", "y axis")):
         if axis in cfg:
             a = cfg[axis]

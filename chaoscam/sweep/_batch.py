@@ -218,6 +218,18 @@ def resolve_engine(
     return Engine("ensemble", identity, pack, size, threads)
 
 
+def engine_device(eng: Engine, device: str) -> str:
+    """Where a sweep's realizations run: "gpu" when the ensemble engine was asked for a GPU
+    ("gpu" or "auto") and one can run here (else the CPU path runs them, see
+    :func:`chaoscam.integrate._gpu.gpu_status`), otherwise "cpu". Recorded in the
+    configuration: a GPU's results equal the CPU's only within ``GPU_TOLERANCE``."""
+    if eng.name != "ensemble" or device == "cpu":
+        return "cpu"
+    from ..integrate._gpu import gpu_status
+
+    return "gpu" if gpu_status()[0] else "cpu"
+
+
 def sweep_engine(
     classify,
     lyapunov: bool,

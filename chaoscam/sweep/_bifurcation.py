@@ -19,9 +19,10 @@ import numpy as np
 import pandas as pd
 
 from .._checks import whole
+from .._provenance import code_identity
 from .._version import __version__
 from ..model import Params, contact_angle
-from ._batch import run_sweep, sweep_engine
+from ._batch import engine_device, run_sweep, sweep_engine
 from ._common import (
     check_sweep_budget,
     evidence_columns,
@@ -304,6 +305,8 @@ def bifurcation(
         "continuation": bool(continuation),
         "classifier": eng.identity,
         "engine": eng.name,
+        "device": engine_device(eng, device),
+        "code": code_identity(),
         "index_scheme": "cantor(value_index, ic)",
     }
 

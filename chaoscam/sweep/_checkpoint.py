@@ -51,6 +51,25 @@ def config_hash(config: dict[str, Any]) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
+def differences(saved: Any, config: dict[str, Any]) -> str:
+    """What sets a saved configuration apart from this run's, for the refusal message:
+    " (made by other chaoscam code: ...)" when only the code differs, else the differing
+    settings' names; "" when the saved one cannot be read."""
+    if not isinstance(saved, dict):
+        return ""
+    keys = sorted(k for k in set(saved) | set(config) if saved.get(k) != config.get(k))
+    if keys == ["code"]:
+        old, new = saved.get("code") or {}, config["code"]
+        changed = ", ".join(
+            f"{k} {old.get(k, '?')}, now {new[k]}" for k in new if old.get(k) != new[k]
+        )
+        return (
+            f" (made by other chaoscam code: {changed}; its results may differ from this "
+            "code's, so it is not mixed with them)"
+        )
+    return f" (it differs in: {', '.join(keys)})" if keys else ""
+
+
 def checkpoint_dir(out: Path) -> Path:
     """The checkpoint folder of output ``out``: ``out`` + ``.ckpt``."""
     return out.with_name(out.name + ".ckpt")
@@ -205,10 +224,11 @@ class CheckpointStore:
                     f"{self.path} holds the checkpoint of an interrupted run: run the same "
                     "command with --resume to finish it, or delete the folder to start over"
                 )
+        self._config = config
+        if self.path.exists():
             self._check_manifest()
             for tmp in self.path.glob(".tmp-*"):
                 tmp.unlink(missing_ok=True)
-        self._config = config
         self._seq = 1 + max((int(_PART.fullmatch(p.name)[1]) for p in self._parts()), default=-1)
 
     def open(self) -> None:
@@ -234,8 +254,9 @@ class CheckpointStore:
         if manifest.get("hash") != self.hash:
             raise SweepError(
                 f"{self.path} is the checkpoint of a different configuration (hash "
-                f"{str(manifest.get('hash'))[:12]}, this run {self.hash[:12]}); use the "
-                "original command to resume it, or delete the folder to start over"
+                f"{str(manifest.get('hash'))[:12]}, this run {self.hash[:12]})"
+                f"{differences(manifest.get('config'), self._config)}; use the original "
+                "command to resume it, or delete the folder to start over"
             )
 
     def _parts(self) -> list[Path]:
@@ -344,8 +365,9 @@ def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> 
         )
     meta = read_sweep_metadata(outputs[0]) if outputs[0].exists() else None
     if meta is None or meta.get("hash") != config_hash(config):
+        why = differences(meta.get("config"), config) if meta else ""
         raise SweepError(
-            f"{existing[0]} was made by a different configuration (or is not a chaoscam "
+            f"{existing[0]} was made by a different configuration{why} (or is not a chaoscam "
             "sweep); --resume continues only the same command. Choose another --out"
         )
     return not checkpoint_dir(outputs[0]).exists() and all(p.exists() for p in outputs)

@@ -19,9 +19,10 @@ import numpy as np
 import pandas as pd
 
 from .._checks import whole
+from .._provenance import code_identity
 from .._version import __version__
 from ..model import ParameterError, Params
-from ._batch import run_sweep, sweep_engine
+from ._batch import engine_device, run_sweep, sweep_engine
 from ._common import (
     as_axis,
     check_sweep_budget,
@@ -380,6 +381,8 @@ def regime_map(
         "transient": transient,
         "classifier": eng.identity,
         "engine": eng.name,
+        "device": engine_device(eng, device),
+        "code": code_identity(),
         "adaptive": adaptive,
         "confidence": float(confidence),
         "index_scheme": "cantor(cell, index)",
