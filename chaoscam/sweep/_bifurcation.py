@@ -58,8 +58,10 @@ class Bifurcation:
     verdicts : DataFrame
         One row per (value, initial condition): ``param``, ``value``, ``value_index``,
         ``ic``, ``seed``, ``sim_index``, ``theta_f0``, ``omega_f0`` (NaN = in contact),
-        ``continued``, ``status``, ``label``, ``period``, ``n_points``, ``reasons``,
-        ``warnings`` and ``ev_<name>`` evidence values.
+        ``continued``, ``status``, ``label``, ``period``, ``n_points``, ``recorded_s``
+        (seconds of section recording behind the label: duration - transient, or the
+        extension's when the verdict was extended), ``reasons``, ``warnings`` and
+        ``ev_<name>`` evidence values.
     config : dict
         The settings that fix the result.
     """
@@ -160,6 +162,7 @@ def _tables(records: list[dict], axis: Axis) -> tuple[pd.DataFrame, pd.DataFrame
             "label": [r["label"] for r in records],
             "period": period_column(records),
             "n_points": np.array([r["n_points"] for r in records], dtype=np.int64),
+            "recorded_s": np.array([r["recorded_s"] for r in records], dtype=float),
             "reasons": [r["reasons"] for r in records],
             "warnings": [r["warnings"] for r in records],
         }

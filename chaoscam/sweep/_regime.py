@@ -53,8 +53,10 @@ class RegimeMap:
         realization in its cell), the two axis values (columns named by the parameters),
         ``seed``, ``sim_index`` (the :func:`chaoscam.simulate` index, see
         :func:`realization_index`), ``status``, ``label``, ``period``, ``n_section``,
-        ``n_impacts``, ``contact_fraction``, ``truncated_mass``, ``reasons``, ``warnings``
-        and one ``ev_<name>`` column per evidence value (NaN where a run has none).
+        ``recorded_s`` (seconds of section recording behind the label: duration - transient,
+        or the extension's when the verdict was extended), ``n_impacts``,
+        ``contact_fraction``, ``truncated_mass``, ``reasons``, ``warnings`` and one
+        ``ev_<name>`` column per evidence value (NaN where a run has none).
     cells : DataFrame
         The per-cell summary of :func:`summarize_cells`.
     config : dict
@@ -199,6 +201,7 @@ def _rows(records: list[dict], cells: pd.DataFrame, x: Axis, y: Axis) -> pd.Data
     )
     for name, dtype in (
         ("n_section", np.int64),
+        ("recorded_s", float),
         ("n_impacts", np.int64),
         ("contact_fraction", float),
         ("truncated_mass", float),

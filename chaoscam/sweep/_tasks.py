@@ -127,7 +127,9 @@ def _number(v: Any) -> float:
 
 
 def verdict_fields(verdict: Any) -> dict[str, Any]:
-    """The parts of a verdict a table keeps: label, period, reasons, evidence values.
+    """The parts of a verdict a table keeps: label, period, reasons, evidence values, and
+    ``recorded_s``, the recorded time of the extended run the verdict was made on
+    (``settings["extended"]``; None when made on the run as given).
 
     Works with any object with ``label``, ``period``, ``evidence`` (items with ``name``,
     ``value``) and ``reasons``. Values that are not numbers become NaN; a repeated evidence
@@ -142,7 +144,20 @@ def verdict_fields(verdict: Any) -> dict[str, Any]:
         "period": None if period is None else int(period),
         "reasons": "; ".join(str(r) for r in (getattr(verdict, "reasons", ()) or ())),
         "evidence": evidence,
+        "recorded_s": _extended_to(getattr(verdict, "settings", None)),
     }
+
+
+def _extended_to(settings: Any) -> float | None:
+    ext = settings.get("extended") if isinstance(settings, dict) else None
+    return _number(ext["recorded_s"]) if isinstance(ext, dict) and "recorded_s" in ext else None
+
+
+def recorded_seconds(fields: dict[str, Any], duration: float, transient: float) -> float:
+    """The ``recorded_s`` column: seconds of section recording behind the label, the
+    extension's when the verdict was extended, else the run's own (duration - transient)."""
+    extended = fields.get("recorded_s")
+    return float(extended) if extended is not None else float(duration - transient)
 
 
 OUTPUT_DT = 1e-3
@@ -233,6 +248,7 @@ class RealizationTask:
             "label": fields["label"],
             "period": fields["period"],
             "n_section": int(len(run.section)),
+            "recorded_s": recorded_seconds(fields, self.duration, self.transient),
             "n_impacts": run.n_impacts,
             "contact_fraction": run.contact_fraction,
             "truncated_mass": run.truncated_mass,
@@ -294,6 +310,7 @@ class BranchTask:
             "label": fields["label"],
             "period": fields["period"],
             "n_points": int(len(sec)),
+            "recorded_s": recorded_seconds(fields, self.duration, self.transient),
             "reasons": fields["reasons"],
             "warnings": fields["warnings"],
             "evidence": fields["evidence"],

@@ -32,6 +32,7 @@ def test_points_are_the_section_after_the_transient():
     for val, g in pts.groupby("value"):
         assert np.allclose(g["t"], g["k"] * 2 * np.pi / val, rtol=0, atol=1e-9)
     assert list(v["n_points"]) == [int((pts["value"] == x).sum()) for x in v["value"]]
+    assert (v["recorded_s"] == 1.0).all()  # a classifier that never extends: the run's own
     assert (pts["label"] == pts["value"].map(dict(zip(v["value"], v["label"], strict=True)))).all()
 
 

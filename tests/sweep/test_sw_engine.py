@@ -73,8 +73,10 @@ def test_a_window_too_short_to_judge_is_extended_on_both_engines():
     x, y = Axis("l_lambda", (0.008,)), SIGMA
     a, b = (regime_map(x, y, engine=e, **kw).realizations for e in ("ensemble", "process"))
     assert (a["n_section"] < 2).all()
-    frames_equal(a[[*SAME, "label", "period"]], b[[*SAME, "label", "period"]])
+    same = [*SAME, "label", "period", "recorded_s"]
+    frames_equal(a[same], b[same])
     assert "undetermined" not in set(a["label"])
+    assert (a["recorded_s"] > 0.2 + 1e-9).all()  # the extension's time is what the table says
 
 
 def test_threads_and_batches_do_not_change_the_table(maps, monkeypatch):
@@ -249,3 +251,25 @@ def test_process_engine_forks_after_the_ensemble_engine_ran(first):
     layer = {"regime_map": "unset", "cli_progress_batch": "workqueue"}[first]
     assert run.stdout.split() == [layer, "6"]
     assert "Terminating" not in run.stderr
+
+
+def test_the_table_says_how_long_the_label_was_recorded():
+    """recorded_s is the extended run's recorded time where the default classifier extended
+    an undetermined verdict (here 3 s -> 12 s), else the run's own."""
+    from chaoscam import classify_trajectory, simulate
+
+    m = regime_map(
+        Axis("xi", (0.3,)),
+        Axis("l_lambda_sigma", (0.002,)),
+        engine="process",
+        workers=1,
+        **{**KW, "realizations": 1},
+    )
+    row = m.realizations.iloc[0]
+    p = Params(xi=0.3, l_lambda_sigma=0.002)
+    traj = simulate(
+        p, duration=6.0, transient=3.0, seed=5, index=int(row["sim_index"]), series=False
+    )
+    v = classify_trajectory(traj)
+    extended = v.settings.get("extended")
+    assert extended is not None and row["recorded_s"] == extended["recorded_s"] == 12.0
