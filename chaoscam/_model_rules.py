@@ -15,7 +15,7 @@ import dataclasses
 import numpy as np
 
 from .analysis import Evidence, Verdict
-from .model import Params
+from .model import Params, realizations_identical
 from .tangent import periodic_orbit
 
 __all__ = ["MODEL_ATOL", "ORBIT_REFINE", "REFINE_ITER", "with_model_evidence"]
@@ -64,7 +64,7 @@ def with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, d
         v = Verdict("undetermined", None, v.evidence, v.reasons + (reason,), v.settings)
     if (
         v.label == "periodic"
-        and p.l_lambda_sigma != 0.0
+        and not realizations_identical(p)
         and votes.get("exponent") not in ("not_chaotic", "periodic")
     ):
         # A random line length has no periodic orbit to shoot for: its periodic response is
@@ -82,7 +82,7 @@ def with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, d
     if v.label == "undetermined" and banded is not None:
         return _banded_verdict(v, p, points, banded, extra)
     candidate = v.period if v.label == "periodic" else _disputed_period(v)
-    if candidate is None or p.l_lambda_sigma != 0.0:
+    if candidate is None or not realizations_identical(p):
         return v, extra
     orbit = periodic_orbit(p, points[-1], int(candidate))
     dist = orbit.distance(points[-min(len(points), 4 * orbit.period) :])
@@ -213,7 +213,7 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
     """Resolve "n narrow bands but λ₁ > 0": chaotic when no attracting period-n orbit lies in
     the bands (shooting: unstable or not converged; or a random model, which has none),
     still undetermined when shooting certifies one (a genuine conflict)."""
-    if p.l_lambda_sigma == 0.0:
+    if realizations_identical(p):
         orbit = periodic_orbit(p, points[-1], n)
         mu = float(np.max(np.abs(orbit.multipliers)))
         extra["periodic_orbit"] = _orbit_record(orbit)

@@ -30,7 +30,7 @@ from .integrate import _kernel as k
 from .integrate._constants import initial_counters, initial_state
 from .integrate._driver import Buffers, alone_kernel, drive
 from .integrate._tangent import section_jacobians
-from .model import ParameterError, Params
+from .model import ParameterError, Params, realizations_identical
 
 __all__ = [
     "PeriodicOrbit",
@@ -99,14 +99,15 @@ class _MapRunner:
     """n iterates of the stroboscopic map of a deterministic model, from t = 0, with DP^n."""
 
     def __init__(self, p: Params, n: int) -> None:
-        if p.l_lambda_sigma != 0.0:
+        if not realizations_identical(p):
             raise ParameterError(
                 f"l_lambda_sigma = {p.l_lambda_sigma} m: periodic orbits need the "
-                "deterministic model (l_lambda_sigma = 0)"
+                "deterministic model (l_lambda_sigma = 0, or the fractal stiffness)"
             )
         if p.integrator != "rk4":
             raise ParameterError("periodic orbits are computed on the RK4 grid (integrator='rk4')")
-        self.p = p.replace(integrator="rk4")
+        # The fractal K_n ignores the line length: with sigma = 0 the same motion, no draws.
+        self.p = p.replace(integrator="rk4", l_lambda_sigma=0.0)
         self.n = n
         self.n_stop = int(math.floor(n * p.cam_period / p.dt)) + 2
         self.lam = np.full(4096, p.l_lambda)

@@ -272,16 +272,21 @@ def _say_before(params, members: int) -> set[str]:
     """Print, once, the warnings every member would get (each part would repeat them), and
     say when the members are all the same run; return the warnings' texts."""
     from .._run_warnings import run_warnings
+    from ..model import realizations_identical
     from . import show_warning
 
     said = run_warnings(params)
     for text in said:
         show_warning(text)
-    if members > 1 and params.l_lambda_sigma == 0.0:
+    if members > 1 and realizations_identical(params):
+        why = (
+            "l_lambda_sigma = 0"
+            if params.l_lambda_sigma == 0.0
+            else "the fractal stiffness does not depend on the line length"
+        )
         show_warning(
-            "l_lambda_sigma = 0: every member is the same deterministic run (an index draws "
-            "only line lengths); one member is enough, or --set l_lambda_sigma=... for a "
-            "random line length"
+            f"{why}: every member is the same deterministic run (an index draws only line "
+            "lengths); one member is enough"
         )
     return set(said)
 

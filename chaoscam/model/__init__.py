@@ -13,7 +13,7 @@ from ._geometry import (
     normal_cam_speed,
     slip_speed,
 )
-from ._linelength import LineLengthStream, realization_rng, truncated_mass
+from ._linelength import LineLengthStream, realization_rng, realizations_identical, truncated_mass
 from ._params import FIELD_DOCS, ParameterError, Params, field_names, parse_value
 from ._stiffness import composite_modulus, fractal_areas, fractal_stiffness, hertz_line_stiffness
 
@@ -41,6 +41,7 @@ __all__ = [
     "normal_force",
     "parse_value",
     "realization_rng",
+    "realizations_identical",
     "slip_speed",
     "stiffness_array",
     "truncated_mass",

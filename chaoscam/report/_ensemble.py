@@ -3,9 +3,10 @@ of each label with its 95 % Wilson interval, why members stayed undetermined, an
 record.
 
 A member's label is its verdict (``--classify``) or, unclassified, its run status. With
-``l_lambda_sigma = 0`` every member is the same deterministic run (the members differ only
-in their realization index, which draws nothing), so the shares are those of one run and get
-no sampling interval, as a regime map's σ = 0 cells (:mod:`chaoscam.sweep._regime`).
+``l_lambda_sigma = 0``, or the fractal stiffness, every member is the same deterministic run
+(the members differ only in their realization index, whose draws change nothing), so the
+shares are those of one run and get no sampling interval, as a regime map's deterministic
+cells (:mod:`chaoscam.sweep._regime`).
 """
 
 from __future__ import annotations
@@ -50,8 +51,10 @@ def _order(label: str) -> tuple[int, int, str]:
 
 
 def deterministic(record: dict) -> bool:
-    """True when the record says every member is the same run (``l_lambda_sigma = 0``)."""
-    return (record.get("params") or {}).get("l_lambda_sigma") == 0.0
+    """True when the record says every member is the same run: ``l_lambda_sigma = 0``, or
+    the fractal stiffness (:func:`chaoscam.model.realizations_identical`)."""
+    params = record.get("params") or {}
+    return params.get("l_lambda_sigma") == 0.0 or params.get("stiffness") == "fractal"
 
 
 def label_shares(members, *, confidence: float = 0.95) -> list[dict[str, Any]]:
@@ -185,7 +188,8 @@ def ensemble_entry(path: str, ens, *, png: bytes | None = None) -> dict[str, Any
             + ("." if fixed else " with its 95% Wilson interval."),
             "caption": f"{n} members, {what}"
             + (
-                "; l_lambda_sigma = 0, so every member is the same deterministic run."
+                "; every member is the same deterministic run (l_lambda_sigma = 0 or the fractal "
+                "stiffness)."
                 if fixed
                 else "."
             ),

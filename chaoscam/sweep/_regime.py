@@ -21,7 +21,7 @@ import pandas as pd
 from .._checks import whole
 from .._provenance import code_identity
 from .._version import __version__
-from ..model import ParameterError, Params
+from ..model import ParameterError, Params, realizations_identical
 from ._batch import engine_device, run_sweep, sweep_engine
 from ._common import (
     as_axis,
@@ -389,16 +389,17 @@ def regime_map(
         "adaptive": adaptive,
         "confidence": float(confidence),
         "index_scheme": "cantor(cell, index)",
-        "deterministic_cells": "run once (sigma = 0)",
+        "deterministic_cells": "run once (sigma = 0, or the fractal stiffness)",
     }
     cells = _cells_frame(x, y)
     xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
-    # A cell with sigma = 0 is deterministic: its realizations would all be the same run,
+    # A cell with sigma = 0 (or the fractal stiffness, which the line length does not
+    # change) is deterministic: its realizations would all be the same run,
     # so it is computed once and reported as such (no interval over identical runs).
     once = frozenset(
         c
         for c in range(len(cells))
-        if base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])}).l_lambda_sigma == 0.0
+        if realizations_identical(base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])}))
     )
     cells["deterministic"] = [c in once for c in range(len(cells))]
 
