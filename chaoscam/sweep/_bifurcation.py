@@ -61,7 +61,8 @@ class Bifurcation:
         ``continued``, ``status``, ``label``, ``period``, ``n_points``, ``recorded_s``
         (seconds of section recording behind the label: duration - transient, or the
         extension's when the verdict was extended), ``reasons``, ``warnings`` and
-        ``ev_<name>`` evidence values.
+        ``ev_<name>`` evidence values (``ev_exponent``: the tangent exponent per iterate
+        of the section map, λ₁·T).
     config : dict
         The settings that fix the result.
     """

@@ -135,6 +135,7 @@ def execute(
                 f"({type(err).__name__}: {err}); delete that folder to start over"
             ) from None
     source = plan.start()
+    saved = plan.done  # records restored; each one stored below adds one
     queue: deque = deque()
     inflight: dict[Any, Any] = {}
     retries: Counter = Counter()
@@ -170,6 +171,7 @@ def execute(
                     ) from err
                 for rec in record if isinstance(record, list) else [record]:
                     store.add(rec)
+                    saved += 1
                     queue.extend(plan.on_record(rec))
                     if bar.total != plan.total:
                         bar.total = plan.total
@@ -177,11 +179,13 @@ def execute(
             store.maybe_flush()
     except KeyboardInterrupt:
         backend.cancel(list(inflight))
-        store.flush()
-        raise SweepInterrupted(plan.done, plan.total, store.path) from None
+        store.flush()  # a record stored but not yet counted by the plan is saved too
+        raise SweepInterrupted(max(saved, plan.done), plan.total, store.path) from None
     except BackendLost as err:
         store.flush()
-        raise SweepInterrupted(plan.done, plan.total, store.path, cause=str(err)) from None
+        raise SweepInterrupted(
+            max(saved, plan.done), plan.total, store.path, cause=str(err)
+        ) from None
     except BaseException:
         backend.cancel(list(inflight))
         store.flush()

@@ -56,7 +56,9 @@ class RegimeMap:
         ``recorded_s`` (seconds of section recording behind the label: duration - transient,
         or the extension's when the verdict was extended), ``n_impacts``,
         ``contact_fraction``, ``truncated_mass``, ``reasons``, ``warnings`` and one
-        ``ev_<name>`` column per evidence value (NaN where a run has none).
+        ``ev_<name>`` column per evidence value (NaN where a run has none; ``ev_exponent``
+        is the tangent exponent per iterate of the section map, λ₁·T, and
+        ``ev_lyapunov_model`` is in 1/s).
     cells : DataFrame
         The per-cell summary of :func:`summarize_cells`.
     config : dict

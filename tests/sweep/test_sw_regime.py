@@ -119,6 +119,30 @@ def test_interrupt_then_resume_gives_the_uninterrupted_table(tmp_path, reference
     frames_equal(again.realizations, reference.realizations)
 
 
+def test_a_ctrl_c_between_saving_a_record_and_counting_it_counts_it(tmp_path, monkeypatch):
+    """A Ctrl-C after a record is stored but before the plan counts it: the message gives
+    the records saved (it said one fewer)."""
+    from chaoscam.sweep import _regime
+
+    counted = _regime._RegimePlan.on_record
+    calls = []
+
+    def on_record(self, record):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return counted(self, record)
+
+    monkeypatch.setattr(_regime._RegimePlan, "on_record", on_record)
+    out = tmp_path / "m.parquet"
+    with pytest.raises(SweepInterrupted, match=r"; 2 of \d+ runs are saved") as err:
+        regime_map(MU, SIGMA, **KW, out=out, flush_interval=0)
+    lines = [
+        ln for f in checkpoint_dir(out).glob("part-*.jsonl") for ln in f.read_text().splitlines()
+    ]
+    assert err.value.done == 2 == sum(1 for ln in lines if not ln.startswith("#"))
+
+
 def test_existing_output_or_other_configuration_is_refused(tmp_path):
     """Without resume an existing output is refused untouched; a checkpoint or output of
     another configuration is refused even with resume."""
