@@ -129,10 +129,12 @@ def _step_function(method: int | None):
     """The per-member function a kernel calls: the integrator itself when a batch has one.
 
     A kernel specialised to one integrator spills less than one that can take either
-    (ptxas 12.9 on :func:`kernel_ptx`'s PTX for sm_90, 255 registers a thread in each case:
-    RK4 132 B of spill stores and 464 B of spill loads (48 and 276 B before its steps shared
-    their trigonometry), the adaptive path 8 and 56 B, ``advance``, which holds both, 592
-    and 1,656 B).
+    (ptxas 12.9 on :func:`kernel_ptx`'s PTX for sm_90, 254-255 registers a thread: RK4 164 B
+    of spill stores and 488 B of spill loads, the adaptive path 40 and 280 B, measured
+    2026-11-25 after the per-contact resampling and the step budget added two constants;
+    before them RK4 132 / 464 B and the adaptive path 8 / 56 B, and 48 / 276 B for RK4
+    before its steps shared their trigonometry; ``advance``, which holds both, 592 and
+    1,656 B). Their effect on a device has not been measured.
     """
     if method == k.METHOD_RK4:
         return k.run_chunk
