@@ -104,7 +104,7 @@ def ensemble_figure(ens, *, title: str = ""):
     colors = [LABEL_COLORS.get(r["label"].partition(" ")[0], _OTHER) for r in rows]
     if deterministic(ens.record):
         b.bar(x, share, color=colors)
-        b.set_title("share of members (σ = 0: one deterministic run)")
+        b.set_title("share of members (one deterministic run)")
     else:
         err = np.array([share - [r["lo"] for r in rows], [r["hi"] for r in rows] - share])
         b.bar(x, share, color=colors, yerr=err, capsize=4)
