@@ -226,8 +226,8 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             m = min(m, np.int64((cnt[I_SECTION_K] * c[C_PERIOD] - t) / h))
             if not resample_on_impact:
                 m = min(m, np.int64((cnt[I_RESAMPLE_J] * c[C_RESAMPLE_DT] - t) / h))
-            if m >= 2 and (n + m) * h >= c[C_T_RECORD] > t:
-                m = 0  # do not merge across the start of the recording
+            # A block may straddle the start of the recording: the motion does not depend on
+            # the transient (only what is kept does), so a run is the same bits whatever it.
         if m >= 2:
             th0 = th
             om0 = om
@@ -238,21 +238,25 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             if not (math.isfinite(th) and math.isfinite(om)):
                 return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, NON_FINITE)
             if (n + m) * h >= c[C_T_RECORD]:
-                cnt[I_COUNTED_STEPS] += m
+                first = n + 1  # the block's first grid step ending in the recording
+                while first * h < c[C_T_RECORD]:
+                    first += 1
+                cnt[I_COUNTED_STEPS] += n + m + 1 - first
                 # Series samples inside the block come from a substep off its start, so that
                 # sampling never changes the trajectory.
                 j = n + stride - n % stride if stride > 0 else n + m + 1
                 while j <= n + m:
-                    if j == n + m:
-                        th_j, om_j = th, om
-                    else:
-                        th_j, om_j = rk4_flight(th0, om0, (j - n) * h, c)
-                    i = cnt[I_N_SERIES]
-                    series[i, 0] = j * h
-                    series[i, 1] = th_j
-                    series[i, 2] = om_j
-                    series[i, 3] = lam[cnt[I_LAM_POS]]
-                    cnt[I_N_SERIES] += 1
+                    if j >= first:
+                        if j == n + m:
+                            th_j, om_j = th, om
+                        else:
+                            th_j, om_j = rk4_flight(th0, om0, (j - n) * h, c)
+                        i = cnt[I_N_SERIES]
+                        series[i, 0] = j * h
+                        series[i, 1] = th_j
+                        series[i, 2] = om_j
+                        series[i, 3] = lam[cnt[I_LAM_POS]]
+                        cnt[I_N_SERIES] += 1
                     j += stride
             continue
         t_end = (n + 1) * h
