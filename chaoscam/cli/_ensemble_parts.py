@@ -146,6 +146,10 @@ def commit_parts(
     targets = dict(zip(("members", "sections", "impacts"), output_paths(out), strict=True))
     staged = {}
     members = None
+    stamp = {  # the members file's: what --resume compares, and the run's record
+        _META_KEY: digest.encode(),
+        ENSEMBLE_RECORD_KEY: json.dumps(run_record(parts, starts, config)).encode(),
+    }
     for name in names:
         frame = pd.concat(
             [pd.read_parquet(parts / f"{s:012d}.{name}.parquet") for s in starts],
@@ -154,10 +158,6 @@ def commit_parts(
         if name == "members":
             members = frame
         staged[name] = parts / f".staged.{name}.parquet"
-        stamp = {
-            _META_KEY: digest.encode(),
-            ENSEMBLE_RECORD_KEY: json.dumps(run_record(parts, starts, config)).encode(),
-        }
         write_table(frame, staged[name], stamp if name == "members" else None)
     placed = []
     for name in sorted(names, key=lambda n: n == "members"):  # members last

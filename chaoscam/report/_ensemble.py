@@ -53,8 +53,12 @@ def _order(label: str) -> tuple[int, int, str]:
 def deterministic(record: dict) -> bool:
     """True when the record says every member is the same run: ``l_lambda_sigma = 0``, or
     the fractal stiffness (:func:`chaoscam.model.realizations_identical`)."""
-    params = record.get("params") or {}
-    return params.get("l_lambda_sigma") == 0.0 or params.get("stiffness") == "fractal"
+    from ..model import Params, realizations_identical
+
+    try:
+        return realizations_identical(Params(**record["params"]))
+    except (KeyError, TypeError, ValueError):  # no record, or one this version cannot read
+        return False
 
 
 def label_shares(members, *, confidence: float = 0.95) -> list[dict[str, Any]]:
