@@ -2,44 +2,32 @@
 
 The analysis layer (:mod:`chaoscam.analysis`) judges arrays; these rules add what only the
 model knows: a periodic section of the deterministic model is certified by a periodic orbit
-found by Newton shooting (:func:`chaoscam.tangent.periodic_orbit`), n narrow bands with a
-positive tangent exponent and no attracting orbit inside are n-band chaos, and a periodic
-section is called periodic only with a certificate or a contracting exponent (a random line
-length has no orbit to certify).
+found by Newton shooting (:mod:`chaoscam._certify`), n narrow bands with a positive tangent
+exponent and no attracting orbit inside are n-band chaos, and a periodic section is called
+periodic only with a certificate or a contracting exponent (a random line length has no orbit
+to certify).
 """
 
 from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
-
-from .analysis import Evidence, Verdict
+from ._certify import MODEL_ATOL, ORBIT_REFINE, REFINE_ITER, certify
+from .analysis import Evidence, Verdict, section_period
 from .model import Params, realizations_identical
-from .tangent import periodic_orbit
 
-__all__ = ["MODEL_ATOL", "ORBIT_REFINE", "REFINE_ITER", "with_model_evidence"]
+__all__ = ["BAND_RTOL", "MODEL_ATOL", "ORBIT_REFINE", "REFINE_ITER", "with_model_evidence"]
 
-MODEL_ATOL = 1e-5
-"""Absolute band tolerance [rad] on the model's section, for θ_f and for θ̇_f·T: bands
-narrower than this are jitter (measured: a sticking period-1 orbit at e = 0.02 m keeps
-1.6e-11 rad in θ_f and 6.9e-6 rad/s in θ̇_f from its contact oscillation, whatever the run
-length). The relative tolerance of the analysis layer's Thresholds applies on top."""
-
-REFINE_ITER = 8  # Newton iterations on a refined step (from an orbit or a band point)
-ORBIT_REFINE = (2, 4)
-"""Step divisors at which a periodic orbit that shooting does not certify on the run's grid
-is shot for again (from the same section point): where chattering dominates, the tangent on
-the default grid (dt = 2e-6 s) overstates the dominant multiplier and λ₁ (its error is in
-the Hertz contact phase that ends each chattering sequence, whose closings are near-grazing).
-Measured: ξ = 0.45, period 6: |μ|max = 2.97 at dt, 0.0047 at dt/2, 0.072 at dt/4, 0.026 at
-dt/8 (λ₁ from the run: +0.63 at dt, −2.53 at dt/2, −2.75 on the adaptive path: a sticking
-orbit); ω = 26 rad/s, ξ = 0.3, period 7: 19 (not converged), 2.42, 1.43, 1.30 (unstable: 7-band
-chaos). Only an orbit that converges on the run's grid but is not certified there is shot
-for again (Newton fails in chaotic bands at every step; measured on the default model, 8
-bands: not converged at dt and dt/2). An orbit certified at every refined step decides
-"periodic"; one attracting at some refined steps only leaves the verdict undetermined;
-otherwise the grid's verdict stands."""
+BAND_RTOL = 0.05
+"""Bands narrower than this fraction of the section's extent count as n narrow bands for the
+n-band chaos rule, where the tangent exponent is positive beyond its interval but the section
+is not periodic to its 3e-3 tolerance (bands wider, or band centres closer than it) and the
+0-1 test votes regular. The 0-1 test sees a chaotic component of relative size w on top of a
+periodic sequence only once its mean-square displacement (~w² N) outgrows the periodic part's
+(~1): on N ≲ 1/w² samples it reads regular. Measured at (ω, ξ) = (42.5, 0.15): 4 bands of
+1.4e-2 (8 of 6.7e-4) of the extent, λ₁ = 0.317 ± 0.014 per iterate over 812 periods, K =
+-0.008 on the 812 points and -0.2 on one band's 101; 600 s runs at dt and dt/2 show 8-band
+chaos."""
 
 
 def with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, dict]:
@@ -78,47 +66,27 @@ def with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, d
             "not confirm lambda_1 < 0 within its interval: run longer"
         )
         v = Verdict("undetermined", None, v.evidence, v.reasons + (reason,), v.settings)
-    banded = _banded_period(v)
+    banded = _banded_period(v, p, points)
     if v.label == "undetermined" and banded is not None:
         return _banded_verdict(v, p, points, banded, extra)
     candidate = v.period if v.label == "periodic" else _disputed_period(v)
     if candidate is None or not realizations_identical(p):
         return v, extra
-    orbit = periodic_orbit(p, points[-1], int(candidate))
-    dist = orbit.distance(points[-min(len(points), 4 * orbit.period) :])
-    extent = float(np.ptp(points[:, 0])) or 1.0
-    sits = dist <= max(MODEL_ATOL, 3e-3 * extent)
-    extra["periodic_orbit"] = _orbit_record(orbit, distance=dist)
-    mu = float(np.max(np.abs(orbit.multipliers)))
-    detail = (
-        f"Newton shooting on P^{orbit.period}: residual {orbit.residual:.2g} rad, "
-        f"|mu|max = {mu:.3g}, the run lies within {dist:.2g} rad of the orbit"
-    )
-    certified = orbit.certified and sits and orbit.period == candidate
-    unstable = orbit.converged and not orbit.stable
-    if not certified and orbit.converged:  # the grid's multipliers may be at fault
-        status, better, refined = _refined(p, points, candidate, extent, extra, orbit.points[0])
-        detail += "; " + refined
-        unstable = status in ("unstable", "not converged")
-        if status == "certified":
-            orbit, certified = better, True
-    if certified:
-        e = Evidence("periodic_orbit", orbit.period, "periodic", "certified: " + detail)
-        if v.label == "periodic":
+    cert = certify(p, points, int(candidate), extra)
+    if cert.certified:
+        e = Evidence("periodic_orbit", cert.period, "periodic", "certified: " + cert.detail)
+        if v.label == "periodic" and cert.period == v.period:
             return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
         # The certificate decides what the section and the exponent left open: an attracting
-        # orbit that the run sits on outweighs a spectral or 0-1 vote on a short series.
-        return Verdict("periodic", orbit.period, v.evidence + (e,), (), v.settings), extra
-    if not orbit.converged:
-        why = "not converged"
-    elif not orbit.stable:
-        why = "unstable"
-    else:
-        why = "the run is not on it" if not sits else "its least period differs"
-    e = Evidence("periodic_orbit", orbit.period, None, f"not certified ({why}): " + detail)
-    if unstable:
+        # orbit that the run converges to outweighs a spectral or 0-1 vote on a short series,
+        # and its period (2n after a flip) the section's n bands that hid it.
+        return Verdict("periodic", cert.period, v.evidence + (e,), (), v.settings), extra
+    why = {"off orbit": "the run is not on it", "period differs": "its least period differs"}
+    why = why.get(cert.status, cert.status)
+    e = Evidence("periodic_orbit", cert.orbit.period, None, f"not certified ({why}): {cert.detail}")
+    if cert.status in ("unstable", "not converged") and cert.orbit.converged:
         reason = (
-            f"the section looks periodic but the orbit found is unstable ({detail}): run "
+            f"the section looks periodic but the orbit found is unstable ({cert.detail}): run "
             "longer, to see whether the exponent is positive (chaos near an unstable orbit)"
         )
         return Verdict(
@@ -138,55 +106,6 @@ def with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, d
     return dataclasses.replace(v, evidence=v.evidence + (e,)), extra
 
 
-def _refined(p: Params, points, n: int, extent: float, extra: dict, seed):
-    """Shoot for the period-n orbit again at the steps ``dt / ORBIT_REFINE`` in turn, each
-    from the previous orbit (the first from ``seed``, the grid's orbit point), with at most
-    ``REFINE_ITER`` Newton iterations, stopping at the first step that does not certify it.
-
-    Returns (status, the orbit at the finest step when certified else None, a summary of the
-    multipliers). status: "certified" when every refined orbit is attracting and the run lies
-    on it, "mixed" when only the first ones are, "unstable" when the first converged unstable,
-    else "not converged".
-    """
-    tail = points[-min(len(points), 4 * n) :]
-    x = seed
-    orbits, records, good = [], [], []
-    for f in ORBIT_REFINE:
-        o = periodic_orbit(p.replace(dt=p.dt / f), x, n, max_iter=REFINE_ITER)
-        dist = o.distance(tail)
-        orbits.append(o)
-        records.append(_orbit_record(o, dt=p.dt / f, distance=dist))
-        good.append(o.certified and o.period == n and dist <= max(MODEL_ATOL, 3e-3 * extent))
-        if not good[-1]:
-            break
-        x = o.points[0]
-    extra["periodic_orbit_refined"] = records
-    mus = "|mu|max " + ", ".join(
-        f"{float(np.max(np.abs(o.multipliers))):.3g} at dt/{f}"
-        + ("" if o.converged else " (not converged)")
-        for o, f in zip(orbits, ORBIT_REFINE, strict=False)
-    )
-    if len(good) == len(ORBIT_REFINE):  # none failed: every refined step certifies it
-        return "certified", orbits[-1], f"certified at every refined step: {mus}"
-    if any(good):
-        return "mixed", None, f"mixed on refined steps: {mus}"
-    if orbits[0].converged:
-        return "unstable", None, f"unstable on refined steps, none attracting: {mus}"
-    return "not converged", None, f"not converged on refined steps: {mus}"
-
-
-def _orbit_record(orbit, **more) -> dict:
-    """What a verdict's settings keep of a periodic orbit."""
-    return {
-        "period": orbit.period,
-        "converged": orbit.converged,
-        "residual": orbit.residual,
-        "multipliers_abs": [float(abs(m)) for m in orbit.multipliers],
-        "wall_time_s": orbit.wall_time,
-        **more,
-    }
-
-
 def _disputed_period(v: Verdict) -> int | None:
     """n when an undetermined verdict's section is periodic (n) and the exponent does not say
     chaotic: the case a periodic-orbit certificate settles."""
@@ -199,30 +118,35 @@ def _disputed_period(v: Verdict) -> int | None:
     return int(sp.value)
 
 
-def _banded_period(v: Verdict) -> int | None:
-    """n when the section is periodic to the band tolerance (n narrow bands) while the
-    tangent exponent is positive beyond its confidence interval; else None."""
+def _banded_period(v: Verdict, p: Params, points) -> int | None:
+    """n when the tangent exponent is positive beyond its confidence interval while the
+    section keeps n narrow bands: periodic to the band tolerance, or (for an undetermined
+    verdict) n bands each narrower than ``BAND_RTOL`` of the extent; else None."""
     votes = {e.name: e for e in v.evidence}
     sp, ex = votes.get("section_period"), votes.get("exponent")
-    if sp is None or ex is None or sp.vote != "periodic" or ex.vote != "chaotic":
+    if sp is None or ex is None or ex.vote != "chaotic":
         return None
-    return int(sp.value)
+    if sp.vote == "periodic":
+        return int(sp.value)
+    if v.label != "undetermined":
+        return None
+    atol = (MODEL_ATOL, MODEL_ATOL / p.cam_period)
+    bands = section_period(points, rtol=BAND_RTOL, atol=atol, allow_transient=False, distinct=False)
+    return bands.period
 
 
 def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
     """Resolve "n narrow bands but λ₁ > 0": chaotic when no attracting period-n orbit lies in
-    the bands (shooting: unstable or not converged; or a random model, which has none),
-    still undetermined when shooting certifies one (a genuine conflict)."""
+    the bands that the run converges to (shooting: unstable, not converged, or attracting but
+    not approached by the run; or a random model, which has none), periodic when the orbit is
+    attracting only at refined steps (the grid's exponent is then its error in the chattering
+    phases), still undetermined when the grid certifies one (a genuine conflict) or refined
+    steps disagree."""
     if realizations_identical(p):
-        orbit = periodic_orbit(p, points[-1], n)
-        mu = float(np.max(np.abs(orbit.multipliers)))
-        extra["periodic_orbit"] = _orbit_record(orbit)
-        detail = (
-            f"Newton shooting on P^{n} from the bands: residual {orbit.residual:.2g} rad, "
-            f"converged {orbit.converged}, |mu|max = {mu:.3g}"
-        )
-        if orbit.certified:
-            e = Evidence("periodic_orbit", orbit.period, "periodic", "certified: " + detail)
+        cert = certify(p, points, n, extra)
+        detail = f"from the bands: {cert.detail}"
+        if cert.certified and not cert.refined:
+            e = Evidence("periodic_orbit", cert.period, "periodic", "certified " + detail)
             return dataclasses.replace(
                 v,
                 evidence=v.evidence + (e,),
@@ -232,30 +156,26 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
                     "yet the tangent exponent is positive",
                 ),
             ), extra
-        extent = float(np.ptp(points[:, 0])) or 1.0
-        status, refined = None, ""
-        if orbit.converged:  # an unstable orbit: the grid's multipliers may be at fault
-            status, _, refined = _refined(p, points, n, extent, extra, orbit.points[0])
-        if status == "certified":
-            e = Evidence("periodic_orbit", n, "periodic", f"{detail}; {refined}")
+        if cert.certified:
+            e = Evidence("periodic_orbit", cert.period, "periodic", detail)
             note = (
-                f"the tangent exponent on the run's grid is positive, but the period-{n} orbit "
-                "in the bands is attracting at every refined step: the exponent's sign is the "
-                "grid's error in the chattering phases"
+                f"the tangent exponent on the run's grid is positive, but the period-"
+                f"{cert.period} orbit in the bands is attracting at every refined step: the "
+                "exponent's sign is the grid's error in the chattering phases"
             )
-            return Verdict("periodic", n, v.evidence + (e,), (note,), v.settings), extra
-        if status == "mixed":
-            e = Evidence("periodic_orbit", n, None, f"{detail}; {refined}")
+            return Verdict("periodic", cert.period, v.evidence + (e,), (note,), v.settings), extra
+        if cert.status == "mixed":
+            e = Evidence("periodic_orbit", n, None, detail)
             reason = (
-                f"the period-{n} orbit in the bands changes stability with the step ({refined}):"
-                f" run with dt = {p.dt / ORBIT_REFINE[-1]:.3g} s"
+                f"the period-{n} orbit in the bands changes stability with the step "
+                f"({cert.detail}): run with dt = {p.dt / ORBIT_REFINE[-1]:.3g} s"
             )
             return Verdict(
                 "undetermined", None, v.evidence + (e,), v.reasons + (reason,), v.settings
             ), extra
-        why = "unstable" if orbit.converged else "not converged"
-        detail += f"; {refined}" if refined else ""
-        e = Evidence("periodic_orbit", orbit.period, "not_periodic", f"{why}: {detail}")
+        e = Evidence(
+            "periodic_orbit", cert.orbit.period, "not_periodic", f"{cert.status}: {detail}"
+        )
     else:
         e = Evidence(
             "periodic_orbit", None, None, "random line length: no periodic orbit to shoot for"
@@ -265,8 +185,8 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
         n,
         "chaotic",
         f"the section keeps {n} narrow bands while the tangent exponent is positive beyond "
-        "its confidence interval and no attracting period-n orbit lies in them: chaos "
-        f"confined to {n} bands (n-band chaos)",
+        "its confidence interval and no attracting period-n orbit lies in them that the run "
+        f"converges to: chaos confined to {n} bands (n-band chaos)",
     )
     verdict = Verdict("chaotic", None, v.evidence + (e, band), (), v.settings)
     return verdict, extra

@@ -203,12 +203,17 @@ class PeriodicOrbit:
         """Converged and attracting: decisive evidence of a periodic response."""
         return self.converged and self.stable
 
-    def distance(self, points: np.ndarray, theta_scale: float = 1.0) -> float:
-        """Largest distance [rad, scaled] from each given section point to the orbit."""
-        pts = np.asarray(points, dtype=float)
+    def distances(self, points: np.ndarray, theta_scale: float = 1.0) -> np.ndarray:
+        """Distance [rad, scaled: |(Δθ, T Δθ̇)|] from each given section point to the
+        nearest point of the orbit."""
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
         w = np.array([1.0, self.settings["cam_period"]]) * theta_scale
         d = np.linalg.norm((pts[:, None, :] - self.points[None, :, :]) * w, axis=2)
-        return float(d.min(axis=1).max())
+        return d.min(axis=1)
+
+    def distance(self, points: np.ndarray, theta_scale: float = 1.0) -> float:
+        """Largest distance [rad, scaled] from each given section point to the orbit."""
+        return float(self.distances(points, theta_scale).max())
 
 
 def periodic_orbit(

@@ -26,6 +26,7 @@ LAYERS = (
     "chaoscam.analysis",
     "chaoscam.tangent",
     "chaoscam.lyapunov",
+    "chaoscam._certify",
     "chaoscam._model_rules",
     "chaoscam.classify",
     "chaoscam._ensemble_verdicts",

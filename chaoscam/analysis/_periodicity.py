@@ -152,6 +152,7 @@ def section_period(
     allow_transient: bool = True,
     min_points: int = 8,
     noise_floor: float | None = None,
+    distinct: bool = True,
 ) -> PeriodResult:
     """Period of an orbit of section points: the smallest n whose n bands are all narrow.
 
@@ -198,6 +199,11 @@ def section_period(
     noise_floor : float, optional
         Fraction of the largest coordinate magnitude used as `atol` when none is given;
         default `Thresholds.noise_floor` (1e-6).
+    distinct : bool
+        Refuse a lag whose band centres lie within one tolerance of each other (default).
+        False accepts it: the smallest lag whose bands are all narrow, for asking whether the
+        points are confined to narrow bands visited in order (banded chaos) rather than
+        whether they repeat.
 
     Returns
     -------
@@ -225,6 +231,7 @@ def section_period(
         min_repeats=min_repeats,
         allow_transient=allow_transient,
         min_points=min_points,
+        distinct=distinct,
     )
     d = x.shape[1]
     nan = np.full(d, math.nan)
@@ -273,7 +280,7 @@ def section_period(
             mis = float(np.max(width / tol))
             if mis <= 1.0:
                 sep = _separation(y, p, tol)
-                if sep > 1.0:
+                if sep > 1.0 or not distinct:
                     jitter = width.max(axis=0)
                     return PeriodResult(
                         p, k0, max_p, mis, tol, False, "", settings, jitter, ext, sep

@@ -318,20 +318,20 @@ def test_ensemble_verdicts_on_threads_equal_the_serial_ones(monkeypatch):
     import dataclasses
     import threading
 
-    from chaoscam import Params, _model_rules
+    from chaoscam import Params, _certify
     from chaoscam._ensemble_verdicts import member_verdicts
     from chaoscam.integrate import simulate_ensemble
 
     models = [Params(xi=0.2), Params(xi=0.45), Params(xi=0.24), Params(e=0.03), Params()]
     ens = simulate_ensemble(models, [0] * 5, seed=1, duration=20.0, transient=10.0, tangent=True)
     where = []
-    shoot = _model_rules.periodic_orbit
+    shoot = _certify.periodic_orbit
 
     def spied(*args, **kw):
         where.append(threading.current_thread().name)
         return shoot(*args, **kw)
 
-    monkeypatch.setattr(_model_rules, "periodic_orbit", spied)
+    monkeypatch.setattr(_certify, "periodic_orbit", spied)
     serial = member_verdicts(
         dataclasses.replace(ens, settings={**ens.settings, "threads": 1}), models, extend_to=None
     )

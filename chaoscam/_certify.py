@@ -1,0 +1,282 @@
+"""The periodic-orbit certificate of a run's section (used by chaoscam._model_rules).
+
+A section that repeats with period n is certified periodic when Newton shooting
+(:func:`chaoscam.tangent.periodic_orbit`) finds a period-n orbit of the stroboscopic map that
+is attracting (every Floquet multiplier |μ| < 1) **and the run converges to it**. Three
+things can spoil the first answer, and each has a rule here:
+
+- the default grid's tangent overstates the multipliers where chattering dominates: an orbit
+  that converges (or whose Newton iteration stalls within the band tolerance) without being
+  certified is shot for again at ``dt / ORBIT_REFINE``;
+- "within 3e-3 of the extent" is not "on the orbit": the run must lie within the band
+  tolerance of the grid's orbit, or visibly approach it (:func:`on_orbit`); a refined
+  step's orbit, which the run on the grid cannot converge to, must lie near the run (within
+  the section's period tolerance, :func:`near`);
+- a period-n orbit that lost stability through a flip (a real multiplier < −1) leaves a
+  period-2n orbit near it, whose 2n bands the section reads as n bands: after a flip-unstable
+  n, the period 2n is shot for too (up to ``MAX_DOUBLINGS`` times), and certified only when it
+  is certified at the refined steps as well (a flip moves with the step).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .analysis import Thresholds
+from .model import Params
+from .tangent import PeriodicOrbit, periodic_orbit
+
+__all__ = [
+    "APPROACH",
+    "MAX_DOUBLINGS",
+    "MODEL_ATOL",
+    "ORBIT_REFINE",
+    "REFINE_ITER",
+    "Certificate",
+    "certify",
+    "near",
+    "on_orbit",
+]
+
+MODEL_ATOL = 1e-5
+"""Absolute band tolerance [rad] on the model's section, for θ_f and for θ̇_f·T: bands
+narrower than this are jitter (measured: a sticking period-1 orbit at e = 0.02 m keeps
+1.6e-11 rad in θ_f and 6.9e-6 rad/s in θ̇_f from its contact oscillation, whatever the run
+length). The relative tolerance of the analysis layer's Thresholds applies on top. It is
+also the distance within which a run lies *on* an orbit (:func:`on_orbit`), and the Newton
+residual below which a stalled shooting is refined (a point that P^n maps back within the
+band tolerance)."""
+
+REFINE_ITER = 8  # Newton iterations on a refined step (from an orbit or a band point)
+ORBIT_REFINE = (2, 4)
+"""Step divisors at which a periodic orbit that shooting does not certify on the run's grid
+is shot for again (from the same section point): where chattering dominates, the tangent on
+the default grid (dt = 2e-6 s) overstates the dominant multiplier and λ₁ (its error is in
+the Hertz contact phase that ends each chattering sequence, whose closings are near-grazing).
+Measured: ξ = 0.45, period 6: |μ|max = 2.97 at dt, 0.0047 at dt/2, 0.072 at dt/4, 0.026 at
+dt/8 (λ₁ from the run: +0.63 at dt, −2.53 at dt/2, −2.75 on the adaptive path: a sticking
+orbit); ω = 26 rad/s, ξ = 0.3, period 7: 19 (not converged), 2.42, 1.43, 1.30 (unstable: 7-band
+chaos); (ω, ξ) = (20, 0.6), a sticking period 1: Newton stalls at dt (residual 1.4e-7 rad,
+|μ|max 13), converges at dt/2 and dt/4 with |μ|max 0.0073 and 1.6e-4. Only an orbit that
+converges on the run's grid, or stalls there within ``MODEL_ATOL``, is shot for again (on the
+default model's 8 chaotic bands Newton stalls at 2e-6 rad; its refined orbits are unstable,
+|μ|max 33 and 23). An orbit certified at every refined step decides "periodic"; one
+attracting at some refined steps only leaves the verdict undetermined; otherwise the grid's
+verdict stands."""
+
+APPROACH = 0.5
+"""A run approaches an orbit when its largest distance to it over the last 4n section points
+is at most this fraction of that over its first 4n points (and the run has 8n points or
+more). Measured: at (ω, ξ) = (45, 0.2) shooting certifies a period-11 orbit (|μ|max 0.38)
+that the run stays 2.6e-5 rad from for 600 s (ratio 1.0: the run is not attracted; at dt it
+settles on period 44, at dt/2 on nothing below 2.5e-5 rad); a run converging at |μ| = 0.95
+per orbit period halves its distance within 14 orbit periods."""
+
+MAX_DOUBLINGS = 2
+"""How many times a flip-unstable period-n orbit sends the shooting to period 2n (n → 2n →
+4n). Measured: (ω, ξ) = (37.5, 0.15) and (47.5, 0.1) look like periods 8 and 9 to the section
+(the 2n bands lie within its tolerance), whose orbits are flip-unstable (multipliers −3.2 and
+−2.9); the stable orbits are of periods 16 (|μ|max 0.73 at dt, 0.05 at dt/2, 0.09 at dt/4) and
+18 (0.81, 0.07, 0.05), which 600 s runs settle on. A doubled orbit must be certified at the
+refined steps too: at (45, 0.2) the grid's period-11 orbit is flip-unstable and a period-22
+orbit is attracting at dt (|μ|max 0.16, the run within 4.4e-7 rad of it for 600 s), but at
+dt/2 and dt/4 Newton does not converge on it and 600 s runs keep 11 bands of 3e-5 rad with
+λ₁ = +0.37 ± 0.04 1/s (dt/2): the period 22 is the grid's."""
+
+NEAR_RTOL = Thresholds().period_rtol
+"""A refined step's orbit lies near the run when every one of the run's last 4n points is
+within ``max(MODEL_ATOL, NEAR_RTOL · extent)`` of it (extent: the section's range in θ_f),
+the analysis layer's period tolerance: the run on the grid converges to the grid's orbit,
+which the refined orbit moves by the grid's error (measured: 1.1e-5 rad at (37.5, 0.15),
+period 16, dt/2)."""
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """What the shooting found for one candidate period.
+
+    Attributes
+    ----------
+    status : str
+        "certified" (an attracting orbit the run converges to, on the grid or at every refined
+        step), "mixed" (attracting at some refined steps only), "unstable" (converged, not
+        attracting), "off orbit" (attracting, but the run neither lies on it nor approaches
+        it), "period differs" (its least period is not the one shot for) or "not converged".
+    period : int
+        The period shot for last: n, or 2n, 4n after flip-unstable orbits.
+    orbit : PeriodicOrbit
+        The orbit on the run's grid for that period (the finest refined one when certified
+        on refined steps).
+    detail : str
+        Residual, multipliers and the run's distance, in words, for the evidence.
+    refined : bool
+        Certified only on the refined steps (the grid's multipliers were at fault).
+    """
+
+    status: str
+    period: int
+    orbit: PeriodicOrbit
+    detail: str
+    refined: bool = False
+
+    @property
+    def certified(self) -> bool:
+        return self.status == "certified"
+
+
+def on_orbit(orbit: PeriodicOrbit, points: np.ndarray) -> tuple[bool, float, str]:
+    """Whether the run lies on ``orbit``: (on it, distance of its last 4n points, in words).
+
+    On it when every one of the run's last 4n section points lies within ``MODEL_ATOL`` of
+    the orbit, or when the run approaches it: over its last 4n points at most ``APPROACH``
+    times as far as over its first 4n (with 8n points or more). The distance is in the
+    scaled norm |(Δθ, T Δθ̇)| [rad]. A run that keeps its distance (it circles the orbit at
+    2.6e-5 rad, as at (ω, ξ) = (45, 0.2)) is not on it, whatever the orbit's multipliers:
+    there the map is not smooth near the orbit, and its linear stability says nothing of the
+    run.
+    """
+    d = orbit.distances(points)
+    w = 4 * orbit.period
+    tail = float(d[-w:].max())
+    if tail <= MODEL_ATOL:
+        return True, tail, f"the run lies within {tail:.2g} rad of the orbit"
+    if len(d) < 2 * w:
+        return (
+            False,
+            tail,
+            f"the run lies {tail:.2g} rad from the orbit, too short ({len(d)} points < {2 * w})"
+            " to see it approach",
+        )
+    head = float(d[:w].max())
+    ratio = tail / head if head > 0 else np.inf
+    if ratio <= APPROACH:
+        return True, tail, f"the run approaches the orbit ({head:.2g} -> {tail:.2g} rad)"
+    return (
+        False,
+        tail,
+        f"the run stays {tail:.2g} rad from the orbit ({head:.2g} rad at its start: it does "
+        "not approach it)",
+    )
+
+
+def near(orbit: PeriodicOrbit, points: np.ndarray) -> tuple[bool, float]:
+    """Whether a refined step's ``orbit`` lies near the run (see ``NEAR_RTOL``): (near it,
+    distance of the run's last 4n points)."""
+    dist = orbit.distance(points[-4 * orbit.period :])
+    extent = float(np.ptp(points[:, 0])) or 1.0
+    return dist <= max(MODEL_ATOL, NEAR_RTOL * extent), dist
+
+
+def certify(
+    p: Params, points: np.ndarray, n: int, extra: dict, *, doublings: int = MAX_DOUBLINGS
+) -> Certificate:
+    """Shoot for a period-n orbit from the run's last section point and decide whether it
+    certifies the run's section (see the module docstring for the three rules).
+
+    ``extra`` receives the records: ``periodic_orbit`` (the grid's orbit),
+    ``periodic_orbit_refined`` (the refined steps, when shot for) and
+    ``periodic_orbit_doubled`` (the certificate of the doubled period, when tried).
+    """
+    orbit = periodic_orbit(p, points[-1], n)
+    sits, dist, where = on_orbit(orbit, points)
+    extra["periodic_orbit"] = _orbit_record(orbit, distance=dist)
+    mu = float(np.max(np.abs(orbit.multipliers)))
+    detail = (
+        f"Newton shooting on P^{orbit.period}: residual {orbit.residual:.2g} rad, "
+        f"|mu|max = {mu:.3g}, {where}"
+    )
+    if orbit.certified and sits and orbit.period == n:
+        return Certificate("certified", n, orbit, detail)
+    if orbit.converged and orbit.period != n:
+        return Certificate("period differs", n, orbit, detail)
+    if orbit.converged and orbit.stable:
+        status = "off orbit"
+    elif orbit.converged:
+        status = "unstable"
+    else:
+        status = "not converged"
+    flips = [orbit]
+    if orbit.converged or orbit.residual <= MODEL_ATOL:  # the grid's multipliers may be at fault
+        refined, best, orbits, summary = _refined(p, points, n, extra, orbit.points[0])
+        detail += "; " + summary
+        if refined == "certified":
+            return Certificate("certified", n, best, detail, refined=True)
+        if refined in ("mixed", "off orbit") or not orbit.converged:
+            status = refined
+        flips += orbits
+    if status == "unstable" and doublings > 0 and any(_flip(o) for o in flips):
+        records: dict = {}
+        twice = certify(p, points, 2 * n, records, doublings=doublings - 1)
+        status2, detail2 = twice.status, twice.detail
+        if twice.certified and not twice.refined:  # a flip moves with the step: check it
+            status2, _, _, summary = _refined(
+                p, points, twice.period, records, twice.orbit.points[0]
+            )
+            detail2 += "; " + summary
+        extra["periodic_orbit_doubled"] = records
+        detail += f"; flip-unstable, period {2 * n} shot for: {status2} ({detail2})"
+        if status2 == "certified":
+            return Certificate("certified", twice.period, twice.orbit, detail, True)
+    return Certificate(status, n, orbit, detail)
+
+
+def _flip(orbit: PeriodicOrbit) -> bool:
+    """A converged orbit with a real multiplier below −1 (it lost stability by a flip)."""
+    mu = np.asarray(orbit.multipliers)
+    real = np.abs(mu.imag) <= 1e-9 * np.maximum(1.0, np.abs(mu))
+    return bool(orbit.converged and np.any(real & (mu.real < -1.0)))
+
+
+def _refined(p: Params, points, n: int, extra: dict, seed):
+    """Shoot for the period-n orbit again at the steps ``dt / ORBIT_REFINE`` in turn, each
+    from the previous orbit (the first from ``seed``, the grid's orbit point), with at most
+    ``REFINE_ITER`` Newton iterations, stopping at the first step that does not certify it.
+
+    Returns (status, the orbit at the finest step when certified else None, the orbits shot,
+    a summary of the multipliers). status: "certified" when every refined orbit is attracting
+    and lies near the run (:func:`near`), "mixed" when only the first ones are, "off orbit"
+    when the first is attracting but not near the run, "unstable" when the first converged
+    unstable, else "not converged".
+    """
+    x = seed
+    orbits, records, good, sits = [], [], [], []
+    for f in ORBIT_REFINE:
+        o = periodic_orbit(p.replace(dt=p.dt / f), x, n, max_iter=REFINE_ITER)
+        on, dist = near(o, points)
+        orbits.append(o)
+        sits.append(on)
+        records.append(_orbit_record(o, dt=p.dt / f, distance=dist))
+        good.append(o.certified and o.period == n and on)
+        if not good[-1]:
+            break
+        x = o.points[0]
+    extra["periodic_orbit_refined"] = records
+    mus = "|mu|max " + ", ".join(
+        f"{float(np.max(np.abs(o.multipliers))):.3g} at dt/{f}"
+        + ("" if o.converged else " (not converged)")
+        for o, f in zip(orbits, ORBIT_REFINE, strict=False)
+    )
+    if len(good) == len(ORBIT_REFINE):  # none failed: every refined step certifies it
+        return "certified", orbits[-1], orbits, f"certified at every refined step: {mus}"
+    if any(good):
+        return "mixed", None, orbits, f"mixed on refined steps: {mus}"
+    first = orbits[0]
+    if first.certified and first.period == n and not sits[0]:
+        return "off orbit", None, orbits, f"attracting on refined steps, not near the run: {mus}"
+    if first.converged:
+        return "unstable", None, orbits, f"unstable on refined steps, none attracting: {mus}"
+    return "not converged", None, orbits, f"not converged on refined steps: {mus}"
+
+
+def _orbit_record(orbit: PeriodicOrbit, **more) -> dict:
+    """What a verdict's settings keep of a periodic orbit."""
+    return {
+        "period": orbit.period,
+        "converged": orbit.converged,
+        "residual": orbit.residual,
+        "multipliers_abs": [float(abs(m)) for m in orbit.multipliers],
+        "wall_time_s": orbit.wall_time,
+        **more,
+    }

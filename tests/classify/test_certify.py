@@ -1,0 +1,106 @@
+"""The periodic-orbit certificate (chaoscam._certify) on cells of the (omega, xi) map whose
+truth was settled by 600 s runs, step halving and shooting (README, "The (omega, xi) map
+checked against the model"): each case is one the classifier got wrong before this module."""
+
+import numpy as np
+
+from chaoscam import Params, simulate
+from chaoscam._certify import APPROACH, MODEL_ATOL, on_orbit
+from chaoscam.analysis import section_period
+from chaoscam.classify import classify_trajectory
+from chaoscam.tangent import PeriodicOrbit
+
+
+def _map_cell(omega, xi, **kw):
+    """A regime-map cell's run: 20 s, 10 s transient, section and tangent only."""
+    traj = simulate(
+        Params(omega=omega, xi=xi),
+        duration=20.0,
+        transient=10.0,
+        series=False,
+        tangent=True,
+        resumable=True,
+    )
+    return classify_trajectory(traj, **kw)
+
+
+def _orbit(points, period_s=0.1):
+    pts = np.asarray(points, dtype=float)
+    return PeriodicOrbit(
+        period=len(pts),
+        points=pts,
+        multipliers=np.array([0.5, 0.1]),
+        residual=0.0,
+        converged=True,
+        iterations=1,
+        wall_time=0.0,
+        settings={"cam_period": period_s},
+    )
+
+
+def test_a_run_that_keeps_its_distance_is_not_on_the_orbit():
+    """Points circling an orbit at a fixed 1e-4 rad are not on it; points within the band
+    tolerance are; points whose distance halves over the run approach it."""
+    orbit = _orbit([[0.0, 0.0], [1.0, 0.0]])
+    k = np.arange(64)
+    base = np.column_stack([k % 2, np.zeros(64)]).astype(float)
+    circling = base + np.column_stack([1e-4 * (-1.0) ** (k // 2), np.zeros(64)])
+    assert not on_orbit(orbit, circling)[0]
+    assert on_orbit(orbit, base + 0.3 * MODEL_ATOL)[0]
+    shrinking = base + np.column_stack([1e-3 * 0.97**k, np.zeros(64)])  # to 1.4e-4
+    ok, dist, words = on_orbit(orbit, shrinking)
+    assert ok and "approaches" in words and dist < APPROACH * 1e-3
+    assert not on_orbit(orbit, shrinking[:12])[0]  # too short to see it approach
+
+
+def test_bands_can_be_asked_for_without_distinct_centres():
+    """section_period(distinct=False) accepts a lag whose narrow bands have close centres
+    (a band split in two: 0, 1, 0.5, 1.02, ...), which the default refuses."""
+    rng = np.random.default_rng(0)
+    x = np.tile([0.0, 1.0, 0.5, 1.02], 100) + 1e-4 * rng.standard_normal(400)
+    assert section_period(x, rtol=0.05, allow_transient=False).period is None
+    assert section_period(x, rtol=0.05, allow_transient=False, distinct=False).period == 4
+
+
+def test_a_sticking_orbit_whose_newton_stalls_on_the_grid_is_certified_refined():
+    """(omega, xi) = (20, 0.6): a sticking period 1 whose grid exponent is positive (the
+    chattering artefact) and whose Newton iteration stalls at dt (residual ~1e-7 rad): shot
+    again at dt/2 and dt/4, where it is attracting: periodic 1 (it was called chaotic)."""
+    v = _map_cell(20.0, 0.6, extend_to=None)
+    assert (v.label, v.period) == ("periodic", 1)
+    orbit = next(e for e in v.evidence if e.name == "periodic_orbit")
+    assert "certified at every refined step" in orbit.detail
+    assert all(max(r["multipliers_abs"]) < 1 for r in v.settings["periodic_orbit_refined"])
+
+
+def test_a_flip_unstable_period_sends_the_shooting_to_twice_the_period():
+    """(37.5, 0.15): the section reads 8 bands (the 16 of the attractor lie within its
+    tolerance), the period-8 orbit is flip-unstable; the period-16 orbit is attracting at the
+    refined steps: periodic 16 (it was undetermined)."""
+    v = _map_cell(37.5, 0.15)
+    assert (v.label, v.period) == ("periodic", 16)
+    section = next(e for e in v.evidence if e.name == "section_period")
+    assert section.value == 8
+    doubled = v.settings["periodic_orbit_doubled"]
+    assert doubled["periodic_orbit"]["period"] == 16
+    assert all(max(r["multipliers_abs"]) < 1 for r in doubled["periodic_orbit_refined"])
+
+
+def test_an_attracting_orbit_the_run_does_not_approach_certifies_nothing():
+    """(45, 0.2): shooting finds period-11 orbits near the run, which stays 2.5e-5 rad from
+    them; the period 22 it settles on at dt is not attracting at dt/2 (600 s runs there keep
+    11 bands of 3e-5 rad, lambda_1 > 0): never periodic 11 (it was certified period 11)."""
+    v = _map_cell(45.0, 0.2)
+    assert v.label != "periodic"
+    orbit = next(e for e in v.evidence if e.name == "periodic_orbit")
+    assert orbit.vote is None and "period 22 shot for" in orbit.detail
+
+
+def test_chaos_in_bands_the_zero_one_test_cannot_see_is_banded_chaos():
+    """(42.5, 0.15): lambda_1 > 0 beyond its interval, 4 bands of ~2 % of the extent whose
+    centres are too close for the period test, and a 0-1 test that reads them as regular:
+    n-band chaos (it was undetermined after 120 s)."""
+    v = _map_cell(42.5, 0.15)
+    assert v.label == "chaotic"
+    band = next(e for e in v.evidence if e.name == "banded_chaos")
+    assert band.vote == "chaotic" and band.value == 4
