@@ -258,7 +258,7 @@ def _refined(p: Params, points, n: int, extra: dict, seed):
         + ("" if o.converged else " (not converged)")
         for o, f in zip(orbits, ORBIT_REFINE, strict=False)
     )
-    if len(good) == len(ORBIT_REFINE):  # none failed: every refined step certifies it
+    if len(good) == len(ORBIT_REFINE) and all(good):  # every refined step certifies it
         return "certified", orbits[-1], orbits, f"certified at every refined step: {mus}"
     if any(good):
         return "mixed", None, orbits, f"mixed on refined steps: {mus}"

@@ -2,6 +2,8 @@
 truth was settled by 600 s runs, step halving and shooting (README, "The (omega, xi) map
 checked against the model"): each case is one the classifier got wrong before this module."""
 
+import dataclasses
+
 import numpy as np
 
 from chaoscam import Params, simulate
@@ -104,3 +106,19 @@ def test_chaos_in_bands_the_zero_one_test_cannot_see_is_banded_chaos():
     assert v.label == "chaotic"
     band = next(e for e in v.evidence if e.name == "banded_chaos")
     assert band.vote == "chaotic" and band.value == 4
+
+
+def test_an_orbit_that_fails_at_the_last_refined_step_is_not_certified(monkeypatch):
+    """Attracting at dt/2, unstable at dt/4: "mixed", never "certified" (the loop stopped at
+    the failing last step and counted two steps as two certificates)."""
+    from chaoscam import _certify
+
+    run = np.column_stack([np.zeros(40), np.zeros(40)])
+
+    def shoot(p, x, n, **kw):
+        mu = [0.5, 0.1] if p.dt == Params().dt / 2 else [1.02, 0.1]
+        return dataclasses.replace(_orbit([[0.0, 0.0]]), multipliers=np.array(mu))
+
+    monkeypatch.setattr(_certify, "periodic_orbit", shoot)
+    status, best, orbits, summary = _certify._refined(Params(), run, 1, {}, run[-1])
+    assert status == "mixed" and best is None and len(orbits) == 2, summary
