@@ -35,6 +35,7 @@ from .model import ParameterError, Params, realizations_identical
 __all__ = [
     "PeriodicOrbit",
     "TangentSpectrum",
+    "iterate_map",
     "lyapunov_spectrum",
     "periodic_orbit",
     "spectrum_from_jacobians",
@@ -115,8 +116,8 @@ class _MapRunner:
         self.c = kernel_constants(self.p, tangent=True)
         self.calls = 0
 
-    def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-        """(P^n(x), DP^n(x), status)."""
+    def _rows(self, x: np.ndarray) -> tuple[np.ndarray, int]:
+        """The section rows of n cam periods from x (row 0: x itself), and the status."""
         y = initial_state(self.p)
         y[k.Y_THETA], y[k.Y_OMEGA] = x
         cnt = initial_counters(self.p)
@@ -143,12 +144,33 @@ class _MapRunner:
             run=alone_kernel(self.c),  # this thread: verdicts shoot several members at once
         )
         rows = np.concatenate(kept) if kept else np.empty((0, k.SECTION_COLS))
+        return rows, int(code)
+
+    def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+        """(P^n(x), DP^n(x), status)."""
+        rows, code = self._rows(x)
         if code != k.OK or len(rows) < self.n + 1:
-            return np.full(2, np.nan), np.full((2, 2), np.nan), int(code)
+            return np.full(2, np.nan), np.full((2, 2), np.nan), code
         m = np.eye(2)
         for jac in section_jacobians(rows[1 : self.n + 1]):
             m = jac @ m
-        return rows[self.n, 2:4].copy(), m, int(code)
+        return rows[self.n, 2:4].copy(), m, code
+
+    def points(self, x: np.ndarray) -> np.ndarray:
+        """x, P(x), ..., P^n(x), shape (n + 1, 2); NaN rows after a run that stopped."""
+        rows, _ = self._rows(x)
+        out = np.full((self.n + 1, 2), np.nan)
+        m = min(len(rows), self.n + 1)
+        out[:m] = rows[:m, 2:4]
+        return out
+
+
+def iterate_map(params: Params, x, n: int) -> np.ndarray:
+    """The section points ``x, P(x), ..., P^n(x)`` (shape (n + 1, 2)) of the deterministic
+    model, from the state x = (θ_f, θ̇_f) at t = 0: a direct perturbation test at a chosen
+    step (does a point near an orbit settle on it?). Rows after a run that stopped (left
+    the cam's reach) are NaN."""
+    return _MapRunner(params, int(n)).points(np.asarray(x, dtype=float))
 
 
 def stroboscopic_map(params: Params, x, n: int = 1) -> tuple[np.ndarray, np.ndarray]:

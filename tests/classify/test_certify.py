@@ -120,5 +120,34 @@ def test_an_orbit_that_fails_at_the_last_refined_step_is_not_certified(monkeypat
         return dataclasses.replace(_orbit([[0.0, 0.0]]), multipliers=np.array(mu))
 
     monkeypatch.setattr(_certify, "periodic_orbit", shoot)
+    monkeypatch.setattr(_certify, "iterate_map", lambda p, x, n: np.zeros((n + 1, 2)))
     status, best, orbits, summary = _certify._refined(Params(), run, 1, {}, run[-1])
     assert status == "mixed" and best is None and len(orbits) == 2, summary
+
+
+def test_a_refined_orbit_the_motion_does_not_settle_on_certifies_nothing():
+    """(45, 0.4): a period-18 orbit is attracting at dt/2 and dt/4 and lies within the
+    section's tolerance of the run, but the motion there does not settle on it (600 s runs
+    at dt and dt/2 keep 9 chaotic bands): chaotic, not periodic 18."""
+    v = _map_cell(45.0, 0.4)
+    assert v.label == "chaotic"
+
+
+def test_a_refined_newton_that_stalls_at_the_band_tolerance_still_certifies():
+    """(32.5, 0.5): period 6, unstable on the grid's tangent, attracting at dt/2, and at dt/4
+    Newton stalls at ~4e-7 rad: the motion at both steps settles on it (600 s runs: 6 bands
+    of 4e-7 rad at dt and dt/2): periodic 6."""
+    v = _map_cell(32.5, 0.5)
+    assert (v.label, v.period) == ("periodic", 6)
+    assert all(r["settles"] for r in v.settings["periodic_orbit_refined"])
+
+
+def test_iterate_map_ends_where_the_map_does():
+    """iterate_map's last point is P^n(x), and its first is x."""
+    from chaoscam.tangent import iterate_map, stroboscopic_map
+
+    p = Params(xi=0.2)
+    x = np.array([0.05, -0.3])
+    seq = iterate_map(p, x, 3)
+    assert seq.shape == (4, 2) and np.array_equal(seq[0], x)
+    assert np.array_equal(seq[-1], stroboscopic_map(p, x, 3)[0])
