@@ -260,6 +260,11 @@ def periodic_orbit(
     the classifier resolves. With |μ|max < 1 and a residual r, a fixed point of the smooth
     branch lies within ~r / (1 - |μ|max) of the returned one.
 
+    The least period is the smallest divisor d of n with |P^d(x_0) - x_0| within
+    ``max(10 residual, tol / 100)``: just past a flip the period-2d orbit's halves lie close
+    together (measured: 1.2e-7 rad on a period-16 orbit of the fractal stiffness, D = 1.4,
+    G = 1e-9 m, whose residual was 5.7e-9 rad), so the bound follows the residual, not ``tol``.
+
     Limits: P is piecewise smooth (a grazing impact or the chattering threshold makes it
     jump), so Newton may fail where the orbit grazes; ``converged`` then stays False.
     """
@@ -299,7 +304,7 @@ def periodic_orbit(
     pts = np.array(pts)
     least = n
     for d in range(1, n):
-        if n % d == 0 and np.linalg.norm((pts[d] - pts[0]) * w) <= max(10 * tol, 10 * res):
+        if n % d == 0 and np.linalg.norm((pts[d] - pts[0]) * w) <= max(0.01 * tol, 10 * res):
             least = d
             break
     mult = np.linalg.eigvals(m)

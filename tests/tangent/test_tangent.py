@@ -288,3 +288,14 @@ def test_default_exponent_converges_under_step_halving():
     for x, y in ((a, b), (b, c)):
         gap = abs(x.exponents[0] - y.exponents[0])
         assert gap <= 3.0 * math.hypot(x.stderr[0], y.stderr[0])
+
+
+def test_least_period_keeps_a_freshly_doubled_orbit():
+    """Fractal stiffness, D = 1.4, G = 1e-9 m: a period-16 orbit whose halves lie ~1e-7 rad
+    apart (just past a flip) is period 16, not the period 8 a bound of 10 tol (1e-6 rad)
+    read it as; 160 s runs at dt and dt/2 repeat every 16 periods to 1e-7 rad, every 8 only
+    to 2e-6."""
+    p = Params(stiffness="fractal", G=1e-9, D=1.4, dt=3.9e-7)
+    tr = simulate(p, duration=20.0, transient=10.0, series=False)
+    orbit = periodic_orbit(p, tr.section[["theta_f", "omega_f"]].to_numpy()[-1], 16)
+    assert orbit.converged and orbit.period == 16
