@@ -6,17 +6,19 @@ is attracting (every Floquet multiplier |μ| < 1) **and the run converges to it*
 things can spoil the first answer, and each has a rule here:
 
 - the default grid's tangent overstates the multipliers where chattering dominates: an orbit
-  that converges unstable (or whose Newton iteration stalls within the band tolerance) is
-  shot for again at ``dt / ORBIT_REFINE``, where it must be attracting and the motion at
-  that step, started from the run's last section point, must settle on it (a direct
-  perturbation test, :func:`chaoscam.tangent.iterate_map`); an attracting grid orbit that
-  the run does not approach is not refined (the step is not what keeps the run off it);
+  that converges unstable (or whose Newton iteration stalls within the band tolerance) and
+  that the run lies on (within the band tolerance) is shot for again at ``dt / ORBIT_REFINE``,
+  where it must be attracting and the motion at that step, started from the run's last
+  section point, must settle on it (a direct perturbation test,
+  :func:`chaoscam.tangent.iterate_map`); an attracting grid orbit that the run does not
+  approach is not refined (the step is not what keeps the run off it);
 - "within 3e-3 of the extent" is not "on the orbit": the run must lie within the band
   tolerance of the grid's orbit, or visibly approach it (:func:`on_orbit`);
 - a period-n orbit that lost stability through a flip (a real multiplier < −1) leaves a
   period-2n orbit near it, whose 2n bands the section reads as n bands: after a flip-unstable
-  n, the period 2n is shot for too (up to ``MAX_DOUBLINGS`` times), and certified only when it
-  is certified at the refined steps as well (a flip moves with the step).
+  n whose section shows the doubling, the period 2n is shot for too (``MAX_DOUBLINGS``), and
+  certified only when it is certified at the refined steps as well (a flip moves with the
+  step).
 """
 
 from __future__ import annotations
@@ -61,9 +63,10 @@ chaos); (ω, ξ) = (20, 0.6), a sticking period 1: Newton stalls at dt (residual
 |μ|max 13), converges at dt/2 and dt/4 with |μ|max 0.0073 and 1.6e-4; (32.5, 0.5), period 6:
 |μ|max 1.23 at dt, 0.43 at dt/2, 0.33 at dt/4 where Newton stalls at 4e-7 rad (600 s runs at
 dt and dt/2: 6 bands of 4e-7 rad, λ₁ = −0.32 ± 0.03 1/s at dt/2). Only an orbit that
-converges unstable on the run's grid, or stalls there within ``MODEL_ATOL``, is shot for
-again, and a refined step counts a stalled Newton within ``MODEL_ATOL`` as converged (on the
-default model's 8 chaotic bands Newton stalls at 2e-6 rad; its refined orbits are unstable,
+converges unstable on the run's grid, or stalls there within ``MODEL_ATOL``, and that the
+run lies on within ``MODEL_ATOL``, is shot for again, and a refined step counts a stalled
+Newton within ``MODEL_ATOL`` as converged (on the default model's 8 chaotic bands, 1.4e-4 rad
+from the run, Newton stalls at 2e-6 rad; its refined orbits are unstable,
 |μ|max 33 and 23). An orbit certified at every refined step decides "periodic"; one
 attracting at some refined steps only leaves the verdict undetermined; otherwise the grid's
 verdict stands."""
@@ -76,16 +79,20 @@ that the run stays 2.6e-5 rad from for 600 s (ratio 1.0: the run is not attracte
 settles on period 44, at dt/2 on nothing below 2.5e-5 rad); a run converging at |μ| = 0.95
 per orbit period halves its distance within 14 orbit periods."""
 
-MAX_DOUBLINGS = 2
-"""How many times a flip-unstable period-n orbit sends the shooting to period 2n (n → 2n →
-4n). Measured: (ω, ξ) = (37.5, 0.15) and (47.5, 0.1) look like periods 8 and 9 to the section
-(the 2n bands lie within its tolerance), whose orbits are flip-unstable (multipliers −3.2 and
-−2.9); the stable orbits are of periods 16 (|μ|max 0.73 at dt, 0.05 at dt/2, 0.09 at dt/4) and
-18 (0.81, 0.07, 0.05), which 600 s runs settle on. A doubled orbit must be certified at the
-refined steps too: at (45, 0.2) the grid's period-11 orbit is flip-unstable and a period-22
-orbit is attracting at dt (|μ|max 0.16, the run within 4.4e-7 rad of it for 600 s), but at
-dt/2 and dt/4 Newton does not converge on it and 600 s runs keep 11 bands of 3e-5 rad with
-λ₁ = +0.37 ± 0.04 1/s (dt/2): the period 22 is the grid's."""
+MAX_DOUBLINGS = 1
+"""How many times a flip-unstable period-n orbit sends the shooting to period 2n, when the
+run's section shows the doubling (its bands at lag 2n at most half as wide as at lag n).
+Once: every doubled orbit measured was 2n (7 → 14 → 28 at ξ = 0.325 was certified at dt/2
+only; 600 s runs there give 7 bands at dt and dt/4, period 28 at dt/2), and shooting for 4n
+was the dearest part of the quick report's Fig. 6. Measured: (ω, ξ) = (37.5, 0.15) and
+(47.5, 0.1) look like periods 8 and 9 to the section (the 2n bands lie within its
+tolerance), whose orbits are flip-unstable (multipliers −3.2 and −2.9); the stable orbits are
+of periods 16 (|μ|max 0.73 at dt, 0.05 at dt/2, 0.09 at dt/4) and 18 (0.81, 0.07, 0.05),
+which 600 s runs settle on. A doubled orbit must be certified at the refined steps too: at
+(45, 0.2) the grid's period-11 orbit is flip-unstable and a period-22 orbit is attracting at
+dt (|μ|max 0.16, the run within 4.4e-7 rad of it for 600 s), but at dt/2 and dt/4 Newton
+does not converge on it and 600 s runs keep 11 bands of 3e-5 rad with λ₁ = +0.37 ± 0.04 1/s
+(dt/2): the period 22 is the grid's."""
 
 SETTLE_PERIODS = 8
 """A refined orbit certifies only when the motion at that step, started from the run's last
@@ -193,7 +200,9 @@ def certify(
     else:
         status = "not converged"
     flips = [orbit]
-    if status != "off orbit" and orbit.residual <= MODEL_ATOL:  # the grid's multipliers may err
+    # The grid's multipliers may err: the run lies on an orbit they do not call attracting
+    # (around an orbit the run keeps away from, refined shooting only cost: 8 chaotic bands).
+    if status != "off orbit" and orbit.residual <= MODEL_ATOL and dist <= MODEL_ATOL:
         refined, best, orbits, summary = _refined(p, points, n, extra, orbit.points[0])
         detail += "; " + summary
         if refined == "certified":
@@ -201,7 +210,12 @@ def certify(
         if refined in ("mixed", "off orbit") or not orbit.converged:
             status = refined
         flips += orbits
-    if status == "unstable" and doublings > 0 and any(_flip(o) for o in flips):
+    if (
+        status == "unstable"
+        and doublings > 0
+        and any(_flip(o) for o in flips)
+        and _doubling_seen(points, n)
+    ):
         records: dict = {}
         twice = certify(p, points, 2 * n, records, doublings=doublings - 1)
         status2, detail2 = twice.status, twice.detail
@@ -215,6 +229,20 @@ def certify(
         if status2 == "certified":
             return Certificate("certified", twice.period, twice.orbit, detail, True)
     return Certificate(status, n, orbit, detail)
+
+
+def _doubling_seen(points: np.ndarray, n: int) -> bool:
+    """The run's section shows period 2n more sharply than n: its widest θ_f band at lag 2n
+    is at most ``APPROACH`` times its widest at lag n (and it holds 4n points or more).
+    Measured: 8 → 16 at (37.5, 0.15), 9 → 18 at (47.5, 0.1) and 8 → 16 on the fractal
+    stiffness at D = 1.4 (bands 2e-6 at lag 8, 3e-7 at lag 16); in chaotic bands around a
+    flip-unstable orbit both lags give the same width, and shooting for 2n there only costs."""
+    x = np.asarray(points, dtype=float)[:, 0]
+    if len(x) < 4 * n:
+        return False
+    wide = max(np.ptp(x[r::n]) for r in range(n))
+    sharp = max(np.ptp(x[r :: 2 * n]) for r in range(2 * n))
+    return bool(sharp <= APPROACH * wide)
 
 
 def _flip(orbit: PeriodicOrbit) -> bool:
