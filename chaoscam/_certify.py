@@ -76,7 +76,7 @@ APPROACH = 0.5
 is at most this fraction of that over its first 4n points (and the run has 8n points or
 more). Measured: at (ω, ξ) = (45, 0.2) shooting certifies a period-11 orbit (|μ|max 0.38)
 that the run stays 2.6e-5 rad from for 600 s (ratio 1.0: the run is not attracted; at dt it
-settles on period 44, at dt/2 on nothing below 2.5e-5 rad); a run converging at |μ| = 0.95
+settles on period 22, at dt/2 on nothing below 2.5e-5 rad); a run converging at |μ| = 0.95
 per orbit period halves its distance within 14 orbit periods."""
 
 MAX_DOUBLINGS = 1
@@ -115,7 +115,7 @@ class Certificate:
         attracting), "off orbit" (attracting, but the run neither lies on it nor approaches
         it), "period differs" (its least period is not the one shot for) or "not converged".
     period : int
-        The period shot for last: n, or 2n, 4n after flip-unstable orbits.
+        The period shot for last: n, or 2n after a flip-unstable orbit.
     orbit : PeriodicOrbit
         The orbit on the run's grid for that period (the finest refined one when certified
         on refined steps).
@@ -268,36 +268,35 @@ def _refined(p: Params, points, n: int, extra: dict, seed):
     converged".
     """
     x = seed
-    orbits, records, good, settles = [], [], [], []
+    orbits, records, attracting, settles = [], [], [], []
     for f in ORBIT_REFINE:
         pf = p.replace(dt=p.dt / f)
         o = periodic_orbit(pf, x, n, max_iter=REFINE_ITER)
-        attracting = o.residual <= MODEL_ATOL and o.stable and o.period == n
+        orbits.append(o)
+        attracting.append(o.residual <= MODEL_ATOL and o.stable and o.period == n)
         on, dist = False, float("nan")
-        if attracting:
+        if attracting[-1]:
             motion = iterate_map(pf, points[-1], SETTLE_PERIODS * n)
             if np.all(np.isfinite(motion)):
                 on, dist, _ = on_orbit(o, motion)
-        orbits.append(o)
         settles.append(on)
         records.append(_orbit_record(o, dt=pf.dt, settles=on, distance=dist))
-        good.append(attracting and on)
-        if not good[-1]:
+        if not on:  # on implies attracting: this step does not certify it
             break
         x = o.points[0]
     extra["periodic_orbit_refined"] = records
     mus = "|mu|max " + ", ".join(
         f"{float(np.max(np.abs(o.multipliers))):.3g} at dt/{f}"
         + ("" if o.converged else f" (residual {o.residual:.2g})")
-        + ("" if on or not (o.stable and o.period == n) else ", the motion not settling on it")
-        for o, f, on in zip(orbits, ORBIT_REFINE, settles, strict=False)
+        + (", the motion not settling on it" if a and not on else "")
+        for o, f, a, on in zip(orbits, ORBIT_REFINE, attracting, settles, strict=False)
     )
-    if len(good) == len(ORBIT_REFINE) and all(good):  # every refined step certifies it
+    if len(settles) == len(ORBIT_REFINE) and all(settles):  # every refined step certifies it
         return "certified", orbits[-1], orbits, f"certified at every refined step: {mus}"
-    if any(good):
+    if any(settles):
         return "mixed", None, orbits, f"mixed on refined steps: {mus}"
     first = orbits[0]
-    if first.residual <= MODEL_ATOL and first.stable and first.period == n:
+    if attracting[0]:
         return "off orbit", None, orbits, f"attracting on refined steps, not settled on: {mus}"
     if first.converged:
         return "unstable", None, orbits, f"unstable on refined steps, none attracting: {mus}"
