@@ -76,6 +76,14 @@ def _common(p: argparse.ArgumentParser) -> None:
         metavar="S",
         help="seconds between checkpoint writes (default 1; 0 = after every run)",
     )
+    p.add_argument(
+        "--fate",
+        type=float,
+        default=None,
+        metavar="S",
+        help="continue each run not labelled periodic to S seconds (> --duration) and record "
+        "whether it leaves the cam's reach before (columns fate, left_at): transient chaos",
+    )
     p.add_argument("--plot", type=Path, default=None, help="also draw the figure to FILE.png/pdf")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument(
@@ -194,6 +202,21 @@ def _execution(args) -> dict:
         progress=not args.quiet,
         flush_interval=args.checkpoint_interval,
         force=args.force,
+        fate=args.fate,
+    )
+
+
+def _transient(table) -> str:
+    """The summary line of a sweep with a fate horizon: how many runs left later."""
+    if "fate" not in table or table["fate"].isna().all():
+        return ""
+    left = table[table["fate"].notna() & (table["fate"] != "OK")]
+    if not len(left):
+        return "\nfate: every run not labelled periodic stayed in the cam's reach"
+    return (
+        f"\nfate: {len(left)} run(s) not labelled periodic stopped later "
+        f"({_counts(left['fate'])}; last section at {left['left_at'].min():.4g}–"
+        f"{left['left_at'].max():.4g} s): transient motion"
     )
 
 
@@ -261,7 +284,7 @@ def run_bifurcation(args: argparse.Namespace) -> int:
     print(
         f"bifurcation over {res.param}: {v['value_index'].nunique()} values x "
         f"{v['ic'].nunique()} initial condition(s), {len(res.points)} section points\n"
-        f"verdicts: {_counts(v['label'])}\n"
+        f"verdicts: {_counts(v['label'])}{_transient(v)}\n"
         f"points: {args.out}\nverdicts: {companion(args.out, 'verdicts')}"
     )
     if args.plot is not None:
@@ -310,7 +333,7 @@ def run_regime_map(args: argparse.Namespace) -> int:
     print(
         f"regime map {res.x} x {res.y}: {len(c)} cells, {len(res.realizations)} realizations\n"
         f"labels: {_counts(res.realizations['label'])}\n"
-        f"dominant: {_counts(c['dominant'])}\n"
+        f"dominant: {_counts(c['dominant'])}{_transient(res.realizations)}\n"
         f"realizations: {args.out}\ncells: {companion(args.out, 'cells')}"
     )
     if args.plot is not None:

@@ -23,7 +23,7 @@ from typing import Any
 
 from .._run_warnings import run_warnings
 from ..model import Params, truncated_mass
-from ._tasks import RunSummary, verdict_fields
+from ._tasks import FATE_LABELS, RunSummary, fate_fields, verdict_fields
 
 __all__ = ["ENGINE_CLASSIFIER", "BatchTask", "batch_size", "run_batch", "run_sweep"]
 
@@ -70,7 +70,25 @@ class BatchTask:
 
 def _group_key(task: Any) -> tuple:
     p = task.params
-    return (task.seed, task.duration, task.transient, p.dt, p.omega)
+    return (task.seed, task.duration, task.transient, p.dt, p.omega, task.fate)
+
+
+def _fates(plist, indices, seed: int, fate: float, backend: str) -> list[dict[str, Any]]:
+    """The fate fields of members run again to ``fate`` seconds without the tangent (the
+    same motion, bit for bit): one ensemble call, as the process engine's one run each."""
+    from ..integrate import simulate_ensemble
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the model's warnings came with the first run
+        ens = simulate_ensemble(
+            list(plist), list(indices), seed=seed, duration=fate, transient=0.0, backend=backend
+        )
+    rows_of = ens.sections.groupby("member").indices
+    t = ens.sections["t"].to_numpy()
+    return [
+        fate_fields(str(ens.members["status"].iat[j]), t[rows_of.get(j, [])])
+        for j in range(len(plist))
+    ]
 
 
 def run_batch(
@@ -90,7 +108,7 @@ def run_batch(
     for i, t in enumerate(tasks):
         groups.setdefault(_group_key(t), []).append(i)
     records: list[dict[str, Any] | None] = [None] * len(tasks)
-    for (seed, duration, transient, _, _), picks in groups.items():
+    for (seed, duration, transient, _, _, fate), picks in groups.items():
         plist = [tasks[i].params for i in picks]
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -106,6 +124,26 @@ def run_batch(
             )
             verdicts = member_verdicts(ens, plist, extend_to=extend_to)
         shared = [str(w.message) for w in caught]
+        later = [
+            j
+            for j, v in enumerate(verdicts)
+            if fate is not None and v.verdict is not None and v.label in FATE_LABELS
+        ]
+        fates = dict(
+            zip(
+                later,
+                _fates(
+                    [plist[j] for j in later],
+                    [tasks[picks[j]].sim_index for j in later],
+                    seed,
+                    fate,
+                    ens.settings["backend"],
+                )
+                if later
+                else [],
+                strict=True,
+            )
+        )
         rows_of = ens.sections.groupby("member").indices
         members = ens.members
         for j, i in enumerate(picks):
@@ -124,6 +162,7 @@ def run_batch(
                 if v.verdict is not None
                 else {"label": v.label, "period": None, "reasons": v.reasons, "evidence": {}}
             )
+            fields.update(fates.get(j, {}))
             seen = [w for w in (*run_warnings(plist[j]), *shared) if w]
             fields["status"] = status
             fields["warnings"] = " | ".join(dict.fromkeys(seen))

@@ -24,6 +24,7 @@ from .._version import __version__
 from ..model import Params, contact_angle
 from ._batch import engine_device, run_sweep, sweep_engine
 from ._common import (
+    check_fate,
     check_sweep_budget,
     evidence_columns,
     period_column,
@@ -166,6 +167,8 @@ def _tables(records: list[dict], axis: Axis) -> tuple[pd.DataFrame, pd.DataFrame
             "recorded_s": np.array([r["recorded_s"] for r in records], dtype=float),
             "reasons": [r["reasons"] for r in records],
             "warnings": [r["warnings"] for r in records],
+            "fate": [r.get("fate") for r in records],
+            "left_at": np.array([r.get("left_at", np.nan) for r in records], dtype=float),
         }
     )
     verdicts = pd.concat([verdicts, evidence_columns(records)], axis=1)
@@ -212,6 +215,7 @@ def bifurcation(
     force: bool = False,
     engine: str = "auto",
     device: str = "cpu",
+    fate: float | None = None,
 ) -> Bifurcation:
     """Bifurcation diagram of the stroboscopic section over one parameter (paper Figs. 4, 6).
 
@@ -247,6 +251,10 @@ def bifurcation(
         value (and, without continuation, many values) as one batch of members; a batch
         holds members of one omega and dt, so a sweep over ``omega`` or ``dt`` batches the
         conditions of each value.
+    fate : float, optional
+        As for :func:`regime_map`: runs not labelled periodic are continued to this time
+        [s] to see whether they stay in the cam's reach (verdict columns ``fate`` and
+        ``left_at``); a continued chain still starts its next value from the recorded run.
 
     Returns
     -------
@@ -262,6 +270,7 @@ def bifurcation(
         axis = Axis(param, values)
     base = Params() if base is None else base
     duration, transient = run_settings(duration, transient, seed)
+    fate = check_fate(fate, duration)
     validate_grid(base, [axis])
     if isinstance(initial_conditions, numbers.Integral) and not isinstance(
         initial_conditions, bool
@@ -312,6 +321,7 @@ def bifurcation(
         "device": engine_device(eng, device),
         "code": code_identity(),
         "index_scheme": "cantor(value_index, ic)",
+        "fate": fate,
     }
 
     def make_task(v: int, j: int, state) -> BranchTask:
@@ -337,6 +347,7 @@ def bifurcation(
             classify,
             continued=state is not None,
             series=series,
+            fate=fate,
         )
 
     return run_sweep(

@@ -29,6 +29,7 @@ from ._tasks import DefaultClassifier, classifier_identity
 
 __all__ = [
     "run_settings",
+    "check_fate",
     "resolve_classifier",
     "companion",
     "open_store",
@@ -46,6 +47,20 @@ def run_settings(duration: float, transient: float | None, seed: int) -> tuple[f
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
         raise ParameterError(f"seed = {seed!r} must be an integer >= 0")
     return float(duration), float(transient)
+
+
+def check_fate(fate: float | None, duration: float) -> float | None:
+    """The ``fate`` horizon validated: None, or a finite number of seconds > duration."""
+    if fate is None:
+        return None
+    if isinstance(fate, bool) or not (
+        isinstance(fate, int | float) and math.isfinite(fate) and fate > duration
+    ):
+        raise SweepError(
+            f"fate = {fate!r} s: the time to which runs not labelled periodic are continued "
+            f"must be a finite number > duration = {duration:g} s"
+        )
+    return float(fate)
 
 
 def resolve_classifier(classify, lyapunov: bool, check_step: bool = False):

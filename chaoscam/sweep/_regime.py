@@ -25,6 +25,7 @@ from ..model import ParameterError, Params, realizations_identical
 from ._batch import engine_device, run_sweep, sweep_engine
 from ._common import (
     as_axis,
+    check_fate,
     check_sweep_budget,
     evidence_columns,
     period_column,
@@ -211,6 +212,8 @@ def _rows(records: list[dict], cells: pd.DataFrame, x: Axis, y: Axis) -> pd.Data
         head[name] = np.array([r[name] for r in records], dtype=dtype)
     head["reasons"] = [r["reasons"] for r in records]
     head["warnings"] = [r["warnings"] for r in records]
+    head["fate"] = [r.get("fate") for r in records]
+    head["left_at"] = np.array([r.get("left_at", np.nan) for r in records], dtype=float)
     return pd.concat([head, evidence_columns(records)], axis=1)
 
 
@@ -238,6 +241,7 @@ def regime_map(
     force: bool = False,
     engine: str = "auto",
     device: str = "cpu",
+    fate: float | None = None,
 ) -> RegimeMap:
     """Monte Carlo regime map over two parameters: classify N realizations in every cell.
 
@@ -307,6 +311,17 @@ def regime_map(
         Where the ensemble engine runs its batches: ``"gpu"`` uses an NVIDIA GPU
         (numba-cuda), equal to the CPU only within ``GPU_TOLERANCE`` (chaotic members part
         after a few periods); default ``"cpu"``, bit-identical everywhere.
+    fate : float, optional
+        Horizon [s]: each realization labelled chaotic, quasiperiodic or undetermined is
+        simulated again to this time, without the tangent (the same motion, bit for bit), to
+        see whether it stays in the cam's reach: transient chaos, which a label over
+        ``duration`` cannot see (at (omega, xi) = (42.5 rad/s, 0.40) the motion is chaotic
+        for 229 s and then leaves). Its row gets ``fate`` (the status at the horizon:
+        ``"OK"``, ``"LEFT_REACH"``, ...) and ``left_at`` (the last section time before it
+        stopped, NaN if it stayed), and each cell ``n_transient`` (how many left before the
+        horizon). Labels are not changed: they describe the recorded window. Must exceed
+        ``duration``; None (default) continues nothing. Not in the time estimate (only the
+        runs that are not periodic are continued).
 
     Returns
     -------
@@ -326,6 +341,7 @@ def regime_map(
     x, y = as_axis(x), as_axis(y)
     base = Params() if base is None else base
     duration, transient = run_settings(duration, transient, seed)
+    fate = check_fate(fate, duration)
     realizations = whole("realizations", realizations, low=1)
     adaptive = None
     if target_halfwidth is not None:
@@ -392,6 +408,7 @@ def regime_map(
         "confidence": float(confidence),
         "index_scheme": "cantor(cell, index)",
         "deterministic_cells": "run once (sigma = 0, or the fractal stiffness)",
+        "fate": fate,
     }
     cells = _cells_frame(x, y)
     xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
@@ -408,7 +425,16 @@ def regime_map(
     def make_task(c: int, i: int) -> RealizationTask:
         p = base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])})
         return RealizationTask(
-            c, i, int(seed), realization_index(c, i), p, duration, transient, classify, series
+            c,
+            i,
+            int(seed),
+            realization_index(c, i),
+            p,
+            duration,
+            transient,
+            classify,
+            series,
+            fate,
         )
 
     def build(records: list[dict[str, Any]]) -> RegimeMap:

@@ -123,7 +123,9 @@ def summarize_cells(
         ``lyapunov_n`` over the finite exponents; ``period``, the most frequent period of
         the cell's periodic realizations (the smallest on a tie; NA when none);
         ``truncated_mass``, the probability mass of Normal(mu, sigma^2) below ``l_min``
-        that the truncation removed.
+        that the truncation removed; ``n_transient``, how many of the cell's realizations
+        a ``fate`` horizon found to stop later (leave the cam's reach or diverge; 0 where
+        none was checked, see :func:`chaoscam.sweep.regime_map`).
     """
     labels = _labels(rows["label"].unique() if len(rows) else [])
     out = cells.sort_values("cell").reset_index(drop=True).copy()
@@ -168,4 +170,7 @@ def summarize_cells(
     out["period"] = pd.array(out["cell"].map(mode), dtype="Int64")
     mass = rows.groupby("cell")["truncated_mass"].first() if len(rows) else pd.Series(dtype=float)
     out["truncated_mass"] = out["cell"].map(mass).astype(float)
+    fate = rows["fate"] if "fate" in rows else pd.Series(None, index=rows.index, dtype=object)
+    stopped = rows.loc[fate.notna() & (fate != "OK"), "cell"]
+    out["n_transient"] = out["cell"].map(stopped.value_counts()).fillna(0).astype(np.int64)
     return out

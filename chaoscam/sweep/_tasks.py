@@ -21,7 +21,20 @@ from .._simulate import simulate
 from ..integrate import Status
 from ..model import Params
 
-__all__ = ["DefaultClassifier", "RealizationTask", "BranchTask", "RunSummary", "run_task"]
+__all__ = [
+    "FATE_LABELS",
+    "DefaultClassifier",
+    "RealizationTask",
+    "BranchTask",
+    "RunSummary",
+    "fate_fields",
+    "run_task",
+]
+
+FATE_LABELS = frozenset({"chaotic", "quasiperiodic", "undetermined"})
+"""Labels whose runs a sweep's ``fate`` horizon continues: their motion is not a certified
+attracting orbit, so it may still leave the cam's reach later (transient chaos: at
+(omega, xi) = (42.5 rad/s, 0.40) the motion is chaotic for 229 s and then leaves)."""
 
 
 @dataclass(frozen=True)
@@ -178,6 +191,32 @@ class RunSummary:
     truncated_mass: float
 
 
+def fate_fields(status: str, sections_t) -> dict[str, Any]:
+    """The record's ``fate`` (the status name at the horizon: ``"OK"`` the motion stayed in
+    the cam's reach, ``"LEFT_REACH"``, ``"DIVERGED"``, ...) and ``left_at`` [s], the last
+    section time before a run that stopped (it stopped within the next cam period; NaN for
+    one that stayed), from the fate run's status and section times."""
+    t = pd.Series(sections_t, dtype=float)
+    stopped = status != Status.OK.name and len(t) > 0
+    return {"fate": status, "left_at": float(t.iloc[-1]) if stopped else math.nan}
+
+
+def _fate(params: Params, task: Any) -> dict[str, Any]:
+    """Run the realization again, without the tangent (the same motion, bit for bit), to
+    ``task.fate`` seconds: does it stay in the cam's reach?"""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the model's warnings came with the first run
+        long = simulate(
+            params,
+            duration=task.fate,
+            transient=0.0,
+            seed=task.seed,
+            index=task.sim_index,
+            series=False,
+        )
+    return fate_fields(long.status.name, long.section["t"])
+
+
 def status_fields(status: Status) -> dict[str, Any]:
     """The verdict fields of a run that did not end normally: labelled by its status."""
     return {"label": status.label, "period": None, "reasons": status.message, "evidence": {}}
@@ -200,6 +239,8 @@ def _run(params: Params, task: Any) -> tuple[RunSummary, dict[str, Any]]:
             resumable=tangent,  # an undetermined verdict's extension goes on from it
         )
         fields = verdict_fields(task.classify(traj)) if traj.ok else status_fields(traj.status)
+    if traj.ok and task.fate is not None and fields["label"] in FATE_LABELS:
+        fields.update(_fate(params, task))
     seen = dict.fromkeys(str(w.message) for w in caught)
     fields["status"] = traj.status.name
     fields["warnings"] = " | ".join(seen)
@@ -226,6 +267,7 @@ class RealizationTask:
     transient: float
     classify: Callable
     series: bool = True
+    fate: float | None = None
 
     def key(self) -> tuple[int, int]:
         return (self.cell, self.index)
@@ -255,6 +297,8 @@ class RealizationTask:
             "reasons": fields["reasons"],
             "warnings": fields["warnings"],
             "evidence": fields["evidence"],
+            "fate": fields.get("fate"),
+            "left_at": fields.get("left_at", math.nan),
         }
 
 
@@ -277,6 +321,7 @@ class BranchTask:
     classify: Callable
     continued: bool = False
     series: bool = True
+    fate: float | None = None
 
     def key(self) -> tuple[int, int]:
         return (self.value_index, self.ic)
@@ -314,6 +359,8 @@ class BranchTask:
             "reasons": fields["reasons"],
             "warnings": fields["warnings"],
             "evidence": fields["evidence"],
+            "fate": fields.get("fate"),
+            "left_at": fields.get("left_at", math.nan),
             "section": {c: sec[c].tolist() for c in sec.columns},
             "next_state": nxt,
         }

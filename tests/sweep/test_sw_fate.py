@@ -1,0 +1,129 @@
+"""A sweep's fate horizon: runs not labelled periodic go on, to see whether they stay.
+
+(omega, xi) = (25 rad/s, 0.70) is chaotic over its first 20 s and leaves the cam's reach
+at t = 27.9 s (transient chaos); (25, 0.40) is a certified period 2. Both engines must
+continue exactly the runs not labelled periodic, with the same bits as a direct
+``simulate`` to the horizon, and leave the labels alone.
+"""
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import chaoscam
+from chaoscam import Params
+from chaoscam.sweep import Axis, SweepError, bifurcation, realization_index, regime_map
+
+OMEGA = Axis("omega", (25.0,))
+XI = Axis("xi", (0.4, 0.7))
+KW = dict(duration=20.0, transient=10.0, fate=40.0, workers=2)
+
+
+@pytest.fixture(scope="module")
+def maps():
+    return {e: regime_map(OMEGA, XI, engine=e, **KW) for e in ("ensemble", "process")}
+
+
+def _left_at(p: Params, index: int) -> float:
+    """The last section time of a direct run to the horizon (where it stopped)."""
+    tr = chaoscam.simulate(p, duration=40.0, transient=0.0, index=index, series=False)
+    assert tr.status.name == "LEFT_REACH"
+    return float(tr.section["t"].iloc[-1])
+
+
+def test_chaos_that_leaves_later_is_recorded_and_the_label_kept(maps):
+    for engine, rm in maps.items():
+        rows = rm.realizations.set_index("xi")
+        per, cha = rows.loc[0.4], rows.loc[0.7]
+        assert per["label"] == "periodic" and per["period"] == 2, engine
+        assert pd.isna(per["fate"]) and math.isnan(per["left_at"]), engine  # not continued
+        assert cha["label"] == "chaotic" and cha["status"] == "OK", engine  # label kept
+        assert cha["fate"] == "LEFT_REACH", engine
+        p = Params(omega=25.0, xi=0.7)
+        assert cha["left_at"] == _left_at(p, realization_index(int(cha["cell"]), 0)), engine
+        assert 27.0 < cha["left_at"] < 28.0, engine
+        cells = rm.cells.set_index("xi")
+        assert cells.loc[0.7, "n_transient"] == 1 and cells.loc[0.4, "n_transient"] == 0
+        assert rm.config["fate"] == 40.0
+
+
+def test_the_engines_agree_on_the_fate(maps):
+    cols = ["cell", "label", "fate", "left_at"]
+    a = maps["ensemble"].realizations[cols]
+    b = maps["process"].realizations[cols]
+    pd.testing.assert_frame_equal(a, b)
+
+
+def test_a_run_that_stays_is_recorded_as_staying():
+    """(42.5, 0.40) is chaotic and stays in reach up to 40 s (it leaves at 229 s)."""
+    rm = regime_map(Axis("omega", (42.5,)), Axis("xi", (0.4,)), **KW)
+    row = rm.realizations.iloc[0]
+    assert row["label"] == "chaotic" and row["fate"] == "OK" and math.isnan(row["left_at"])
+    assert rm.cells["n_transient"].iloc[0] == 0
+
+
+def test_without_a_horizon_nothing_is_continued():
+    rm = regime_map(OMEGA, Axis("xi", (0.7,)), duration=20.0, transient=10.0, workers=1)
+    assert rm.realizations["fate"].isna().all() and rm.config["fate"] is None
+    assert rm.cells["n_transient"].tolist() == [0]
+
+
+def test_bifurcation_verdicts_carry_the_fate():
+    b = bifurcation("xi", [0.4, 0.7], base=Params(omega=25.0), **KW)
+    v = b.verdicts.set_index("value")
+    assert v.loc[0.7, "fate"] == "LEFT_REACH" and 27.0 < v.loc[0.7, "left_at"] < 28.0
+    assert pd.isna(v.loc[0.4, "fate"])
+
+
+@pytest.mark.parametrize("fate", [20.0, 5.0, float("inf"), float("nan"), True, "300"])
+def test_a_horizon_not_beyond_the_duration_is_refused(fate):
+    with pytest.raises(SweepError, match=r"fate = .* must be a finite number > duration = 20 s"):
+        regime_map(OMEGA, XI, duration=20.0, fate=fate, workers=1)
+
+
+def test_resuming_with_another_horizon_is_refused(tmp_path):
+    out = tmp_path / "m.parquet"
+    kw = dict(duration=2.0, transient=1.0, workers=1, out=out)
+    regime_map(OMEGA, Axis("xi", (0.4,)), fate=3.0, **kw)
+    with pytest.raises(SweepError, match="different configuration"):
+        regime_map(OMEGA, Axis("xi", (0.4,)), fate=4.0, resume=True, **kw)
+
+
+def test_the_map_figure_marks_transient_cells(maps):
+    from matplotlib.figure import Figure
+
+    from chaoscam.report._sweep_figures import TRANSIENT_MARK, plot_dominant
+
+    ax = Figure().subplots()
+    plot_dominant(maps["ensemble"].cells, "omega", "xi", ax)
+    texts = [t.get_text() for t in ax.texts]
+    assert sorted(texts) == ["P2", TRANSIENT_MARK]
+    assert any("transient" in t.get_text() for t in ax.get_legend().get_texts())
+    ax = Figure().subplots()
+    plot_dominant(maps["ensemble"].cells.assign(n_transient=0), "omega", "xi", ax)
+    assert [t.get_text() for t in ax.texts if t.get_text()] == ["P2"]
+    assert not any("transient" in t.get_text() for t in ax.get_legend().get_texts())
+
+
+def test_the_report_sentence_is_computed_from_the_rows():
+    from chaoscam.experiments._sensitivity import transient_finding
+
+    nan = np.nan
+    rows = pd.DataFrame(
+        {
+            "label": ["chaotic", "chaotic", "undetermined", "periodic"],
+            "fate": ["LEFT_REACH", "OK", "LEFT_REACH", None],
+            "left_at": [27.9, nan, 228.9, nan],
+        }
+    )
+    s = transient_finding(rows, 300.0, "cell")
+    assert "the 3 cells not labelled periodic: 2 leave the cam's reach" in s
+    assert "(last section at 27.9–229 s), 1 labelled chaotic" in s and "transient chaos" in s
+    assert transient_finding(rows.iloc[[1]], 300.0, "value").endswith(
+        "the 1 value not labelled periodic stays in the cam's reach."
+    )
+    assert "none labelled chaotic" in transient_finding(rows.iloc[1:3], 300.0, "cell")
+    assert transient_finding(rows.iloc[[3]], 300.0, "cell") == ""
+    assert transient_finding(rows.drop(columns="fate"), 300.0, "cell") == ""
