@@ -53,6 +53,11 @@ def _runs_text(runs, fmt="{:.3g}") -> str:
     return " → ".join(parts)
 
 
+FATE_S = {True: 100.0, False: 300.0}
+"""The fate horizon [s] of the restitution sweep and the (omega, xi) map, quick and full:
+runs not labelled periodic go on to it, to see whether they stay in the cam's reach (the
+full one covers (42.5 rad/s, 0.40), chaotic for 229 s and then out of reach)."""
+
 XI_WINDOW = 0.05
 """Half-width of the neighbourhood of Table 1's ξ that the restitution finding looks at."""
 
@@ -94,6 +99,35 @@ def restitution_finding(v: pd.DataFrame, xi0: float, stiffness_tags: list[str]) 
         f"({', '.join(tags) or 'none'}), no more than across the paper's stiffness range "
         f"({len(stiffness_tags)}): this sweep does not single the restitution out as the "
         "source of the difference."
+    )
+
+
+def transient_finding(rows: pd.DataFrame, horizon: float, what: str) -> str:
+    """The sentence on transient motion: of the runs not labelled periodic (continued to the
+    fate ``horizon``), how many stop before it, when, and how many of those were labelled
+    chaotic over the recorded window; from ``rows`` with columns label, fate and left_at.
+    ``what`` names one run ("cell", "value"). Empty when no run was continued."""
+    checked = rows[rows["fate"].notna()] if "fate" in rows else rows.iloc[:0]
+    if not len(checked):
+        return ""
+    left = checked[checked["fate"] != "OK"]
+    n = len(checked)
+    head = f" Continued to {horizon:g} s, the {n} {what}{'s' * (n != 1)} not labelled periodic"
+    if not len(left):
+        return head + (" all stay" if n != 1 else " stays") + " in the cam's reach."
+    verb = {"LEFT_REACH": ("leaves the cam's reach", "leave the cam's reach")}
+    how = ", ".join(
+        f"{k} {verb.get(st, (st.lower(), st.lower()))[k != 1]}"
+        for st, k in left["fate"].value_counts().sort_index().items()
+    )
+    t0, t1 = left["left_at"].min(), left["left_at"].max()
+    when = f"{t0:.3g} s" if f"{t0:.3g}" == f"{t1:.3g}" else f"{t0:.3g}–{t1:.3g} s"
+    chaotic = int((left["label"] == "chaotic").sum())
+    if chaotic == 0:
+        return head + f": {how} before it (last section at {when}), none labelled chaotic."
+    return head + (
+        f": {how} before it (last section at {when}), {chaotic} labelled chaotic over the "
+        "recorded window: transient chaos, which that label cannot see."
     )
 
 
@@ -149,7 +183,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     extension of undetermined runs)."""
     from ..model import Params
     from ..report._figures import png_uri
-    from ..report._sweep_figures import bifurcation_figure, regime_map_figure
+    from ..report._sweep_figures import TRANSIENT_MARK, bifurcation_figure, regime_map_figure
     from ..sweep import Axis, bifurcation, regime_map
     from ._paper import FigureResult, _save
 
@@ -190,13 +224,22 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     res.bifurcations.append((str(path_k), bif_k, png_k))
     # 2. restitution
     bif_x = bifurcation(
-        "xi", xi_values(quick), duration=20.0, transient=10.0, classify=classify, workers=workers
+        "xi",
+        xi_values(quick),
+        duration=20.0,
+        transient=10.0,
+        classify=classify,
+        workers=workers,
+        fate=FATE_S[quick],
     )
     path_x = outdir / "sensitivity-xi.parquet"
     bif_x.to_parquet(path_x)
     png_x = _save(bifurcation_figure(bif_x.points), outdir, "sensitivity-xi")
     res.bifurcations.append((str(path_x), bif_x, png_x))
-    res.why.append(restitution_finding(_first_ic(bif_x), Params().xi, flat))
+    res.why.append(
+        restitution_finding(_first_ic(bif_x), Params().xi, flat)
+        + transient_finding(_first_ic(bif_x), FATE_S[quick], "value")
+    )
     # 3. (omega, xi) map
     omegas = (20.0, 50.0, 6) if quick else (10.0, 50.0, 17)
     xis = (0.1, 0.7, 6) if quick else (0.1, 0.7, 13)
@@ -208,6 +251,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         transient=10.0,
         classify=classify,
         workers=workers,
+        fate=FATE_S[quick],
     )
     path_m = outdir / "sensitivity-omega-xi.parquet"
     rm.to_parquet(path_m)
@@ -237,6 +281,9 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
             "fragile, which makes a point-by-point comparison with the paper uncertain."
             if changes
             else "."
+        )
+        + transient_finding(rm.realizations, FATE_S[quick], "cell").replace(
+            "transient chaos,", f"transient chaos (marked {TRANSIENT_MARK}),"
         )
     )
     return res

@@ -45,6 +45,10 @@ ANNOTATE_PERIODS = 400
 """Dominant-label maps with at most this many cells get their periods written in (short
 text, at a smaller size beyond ``ANNOTATE_CELLS``)."""
 
+TRANSIENT_MARK = "↗"
+"""Written in a dominant-label cell where a ``fate`` horizon found runs that leave the cam's
+reach later (transient chaos; see :func:`chaoscam.sweep.regime_map`)."""
+
 _SYMBOLS = {
     "l_lambda": "l_λ",
     "l_lambda_sigma": "σ of l_λ",
@@ -94,9 +98,12 @@ def _ticks(ax, m: pd.DataFrame, x: str, y: str, role: str | None) -> None:
 
 
 def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
-    """Heatmap of each cell's dominant label, with a legend of the labels present."""
+    """Heatmap of each cell's dominant label, with a legend of the labels present; periodic
+    cells carry ``Pn`` (period n), and cells where a fate horizon saw runs leave the cam's
+    reach later carry :data:`TRANSIENT_MARK`."""
     import seaborn as sns
     from matplotlib.colors import ListedColormap
+    from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
     present = [lab for lab in cells["dominant"].unique() if lab]
@@ -108,14 +115,17 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
     m = _grid(coded, x, y, "_code")
     colors = [LABEL_COLORS.get(lab, _OTHER) for lab in order] or ["#FFFFFF"]
     annot = False
-    if "period" in cells and m.size <= ANNOTATE_PERIODS:
-        per = _grid(cells.assign(_p=cells["period"].astype(float)), x, y, "_p").to_numpy()
-        dom = _grid(cells, x, y, "dominant").to_numpy()
-        annot = np.where(
-            (dom == "periodic") & np.isfinite(per),
-            np.char.add("P", np.nan_to_num(per).astype(int).astype(str)),
-            "",
-        )
+    if m.size <= ANNOTATE_PERIODS:
+        text = np.full(m.shape, "", dtype=object)
+        if "period" in cells:
+            per = _grid(cells.assign(_p=cells["period"].astype(float)), x, y, "_p").to_numpy()
+            dom = _grid(cells, x, y, "dominant").to_numpy()
+            periodic = (dom == "periodic") & np.isfinite(per)
+            text[periodic] = ["P" + str(int(v)) for v in per[periodic]]
+        if "n_transient" in cells:
+            later = _grid(cells, x, y, "n_transient").to_numpy(dtype=float) > 0
+            text[later] = [t + TRANSIENT_MARK for t in text[later]]
+        annot = text.astype(str)
     sns.heatmap(
         m,
         ax=ax,
@@ -134,11 +144,28 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
             "fontweight": "bold",
         },
     )
+    for t in ax.texts:  # the arrow glyph is small at the numbers' size
+        if t.get_text() == TRANSIENT_MARK:
+            t.set_fontsize(1.6 * t.get_fontsize())
     _ticks(ax, m, x, y, _role(x, y))
-    shown = annot is not False and bool(np.any(annot != ""))
+    shown = annot is not False and bool(np.any(np.char.startswith(annot, "P")))
+    marked = annot is not False and bool(np.any(np.char.endswith(annot, TRANSIENT_MARK)))
     ax.set_title("dominant label (Pn: periodic, period n)" if shown else "dominant label")
+    handles = [Patch(color=LABEL_COLORS.get(lab, _OTHER), label=lab) for lab in order]
+    if marked:
+        handles.append(
+            Line2D(
+                [],
+                [],
+                ls="",
+                marker=f"${TRANSIENT_MARK}$",
+                color="#000000",
+                markersize=9,
+                label="leaves the cam's reach\nlater (transient)",
+            )
+        )
     ax.legend(
-        handles=[Patch(color=LABEL_COLORS.get(lab, _OTHER), label=lab) for lab in order],
+        handles=handles,
         loc="upper left",
         bbox_to_anchor=(1.01, 1.0),
         frameon=False,
