@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 
 from chaoscam import Params, simulate
-from chaoscam._certify import APPROACH, MODEL_ATOL, on_orbit
+from chaoscam._certify import APPROACH, MODEL_ATOL, _sharp_doubling, on_orbit
 from chaoscam.analysis import section_period
 from chaoscam.classify import classify_trajectory
 from chaoscam.tangent import PeriodicOrbit
@@ -86,6 +86,34 @@ def test_a_flip_unstable_period_sends_the_shooting_to_twice_the_period():
     doubled = v.settings["periodic_orbit_doubled"]
     assert doubled["periodic_orbit"]["period"] == 16
     assert all(max(r["multipliers_abs"]) < 1 for r in doubled["periodic_orbit_refined"])
+
+
+def test_a_section_sharper_at_twice_the_period_is_shot_for_there():
+    """(38, 0.34): 6 bands of 4.7e-6 rad, 12 of 2.7e-7 rad over 10 s; Newton on P^6 stalls
+    2e-6 rad off and the run keeps 1.2e-5 rad from that orbit (no flip to read), while the
+    period-12 orbit is attracting at dt/2 and dt/4 and the run lies on it: periodic 12, as
+    600 s runs at dt show (it was undetermined, and chaotic once extended)."""
+    v = _map_cell(38.0, 0.34, extend_to=None)
+    assert (v.label, v.period) == ("periodic", 12)
+    assert next(e for e in v.evidence if e.name == "section_period").value == 6
+    orbit = next(e for e in v.evidence if e.name == "periodic_orbit")
+    assert "sharper at 2n, period 12 shot for: certified" in orbit.detail
+    doubled = v.settings["periodic_orbit_doubled"]
+    assert all(max(r["multipliers_abs"]) < 1 for r in doubled["periodic_orbit_refined"])
+
+
+def test_only_a_section_periodic_to_the_band_tolerance_at_2n_is_sharp():
+    """Period 2 with halves 1e-6 rad apart: sharp; the same with 1e-4 rad chaotic jitter
+    on top, or a period 1 whose jitter is all there is: not."""
+    p = Params()
+    rng = np.random.default_rng(1)
+    k = np.arange(64)
+    two = np.column_stack([0.3 + 1e-6 * (k % 2), -2.0 + 0 * k]) + 1e-9 * rng.random((64, 2))
+    assert _sharp_doubling(p, two, 1)
+    assert not _sharp_doubling(p, two + 1e-4 * rng.random((64, 2)), 1)
+    one = np.column_stack([0.3 + 0 * k, -2.0 + 0 * k]) + 1e-9 * rng.random((64, 2))
+    assert not _sharp_doubling(p, one, 1)
+    assert not _sharp_doubling(p, two[:3], 1)  # too short to tell
 
 
 def test_an_attracting_orbit_the_run_does_not_approach_certifies_nothing():
