@@ -9,6 +9,11 @@ from pathlib import Path
 __all__ = ["register"]
 
 
+DEFAULT_PAPER = Path("out/paper.html")
+"""Where ``chaoscam paper`` writes without ``--out``: a folder the repository ignores, so
+that the quick report never touches the committed ``reports/paper.html``."""
+
+
 def register(sub) -> None:
     r = sub.add_parser(
         "report",
@@ -40,8 +45,9 @@ def register(sub) -> None:
     p.add_argument(
         "--out",
         type=Path,
-        default=Path("reports/paper.html"),
-        help="the report (default reports/paper.html)",
+        default=None,
+        help=f"the report (default {DEFAULT_PAPER}, created with its folder; git ignores "
+        "it: the committed reports/paper.html is written only when named)",
     )
     p.add_argument(
         "--figures",
@@ -105,6 +111,9 @@ def run_paper(args: argparse.Namespace) -> int:
         bad = [f for f in figures if f not in FIGURES]
         if bad:
             raise UsageError(f"--figures: no figure {bad}; choose from {sorted(FIGURES)}")
+    if args.out is None:  # the default folder is ours to create; a named one is the user's
+        args.out = DEFAULT_PAPER
+        args.out.parent.mkdir(parents=True, exist_ok=True)
     command = shlex.join(
         ["chaoscam", "paper"]
         + (["--quick"] if args.quick else [])

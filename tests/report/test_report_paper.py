@@ -23,6 +23,24 @@ def test_paper_figs_3_and_5_agree_on_their_checkable_claims(tmp_path, capsys):
     assert not re.search(r"https?:", text, re.IGNORECASE)
 
 
+def test_paper_without_out_writes_where_git_does_not_look(tmp_path, monkeypatch, capsys):
+    """No --out: out/paper.html, its folder created; a committed reports/paper.html in the
+    same place is left alone, and .gitignore ignores the default folder."""
+    import subprocess
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "reports").mkdir()
+    (tmp_path / "reports" / "paper.html").write_text("committed")
+    assert main(["paper", "--quick", "--figures", "5"]) == 0
+    assert (tmp_path / "out" / "paper.html").stat().st_size > 0
+    assert (tmp_path / "reports" / "paper.html").read_text() == "committed"
+    assert "report: out/paper.html" in capsys.readouterr().out
+    ignored = subprocess.run(["git", "check-ignore", "-q", "out/paper.html"], cwd=root, check=False)
+    assert ignored.returncode == 0
+
+
 def test_paper_rejects_unknown_figure(tmp_path, capsys):
     """An unknown figure number is a usage error."""
     assert main(["paper", "--figures", "2", "--out", str(tmp_path / "p.html")]) == 2
