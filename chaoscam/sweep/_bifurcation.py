@@ -61,7 +61,8 @@ class Bifurcation:
         ``ic``, ``seed``, ``sim_index``, ``theta_f0``, ``omega_f0`` (NaN = in contact),
         ``continued``, ``status``, ``label``, ``period``, ``n_points``, ``recorded_s``
         (seconds of section recording behind the label: duration - transient, or the
-        extension's when the verdict was extended), ``reasons``, ``warnings`` and
+        extension's when the verdict was extended), ``reasons``, ``warnings``, ``fate``
+        and ``left_at`` (with a ``fate`` horizon, as for :class:`RegimeMap`) and
         ``ev_<name>`` evidence values (``ev_exponent``: the tangent exponent per iterate
         of the section map, λ₁·T).
     config : dict

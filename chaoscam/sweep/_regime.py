@@ -56,9 +56,11 @@ class RegimeMap:
         :func:`realization_index`), ``status``, ``label``, ``period``, ``n_section``,
         ``recorded_s`` (seconds of section recording behind the label: duration - transient,
         or the extension's when the verdict was extended), ``n_impacts``,
-        ``contact_fraction``, ``truncated_mass``, ``reasons``, ``warnings`` and one
-        ``ev_<name>`` column per evidence value (NaN where a run has none; ``ev_exponent``
-        is the tangent exponent per iterate of the section map, λ₁·T, and
+        ``contact_fraction``, ``truncated_mass``, ``reasons``, ``warnings``, ``fate`` and
+        ``left_at`` (with a ``fate`` horizon: the status there and when the run stopped;
+        None / NaN for runs not continued) and one ``ev_<name>`` column per evidence value
+        (NaN where a run has none; ``ev_exponent`` is the tangent exponent per iterate of
+        the section map, λ₁·T, and
         ``ev_lyapunov_model`` is in 1/s).
     cells : DataFrame
         The per-cell summary of :func:`summarize_cells`.
