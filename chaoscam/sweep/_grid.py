@@ -54,6 +54,8 @@ def parse_range(text: str, what: str = "range") -> tuple[float, float, int]:
         raise SweepError(f"{what} {text!r}: NUM must be a whole number") from None
     if not (math.isfinite(start) and math.isfinite(stop)):
         raise SweepError(f"{what} {text!r}: START and STOP must be finite")
+    if not math.isfinite(stop - start):  # before numpy's linspace, which would warn
+        raise SweepError(f"{what} {text!r}: STOP - START overflows a float; narrow the range")
     if num < 1:
         raise SweepError(f"{what} {text!r}: NUM = {num} must be >= 1")
     if num > MAX_AXIS_POINTS:

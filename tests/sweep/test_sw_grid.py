@@ -24,6 +24,14 @@ def test_bad_ranges_are_refused(text):
         parse_range(text)
 
 
+@pytest.mark.filterwarnings("error")
+def test_a_range_too_wide_for_a_float_is_refused_without_numpy_warnings():
+    """STOP - START beyond the largest float: a SweepError naming the range, no overflow
+    warning from numpy first (found by the fuzz test)."""
+    with pytest.raises(SweepError, match="overflows"):
+        Axis.parse("-1.7e308:1.7e308:3", name="xi")
+
+
 def test_single_point_range():
     """START:START:1 is one value."""
     assert parse_range("0.5:0.5:1") == (0.5, 0.5, 1)
