@@ -124,7 +124,8 @@ def main() -> None:
         )
     busy = kernel[times["ensemble"].index(te)]
     print(
-        f"ensemble engine: {busy:.1f} CPU s of its {te:.1f} s inside the compiled kernel; "
+        f"ensemble engine: {busy:.1f} CPU s inside the compiled kernel, of the "
+        f"{cores} x {te:.1f} s its cores had; "
         f"even with every core busy all the time the ratio could not exceed "
         f"{tp / (busy / cores):.2f}"
     )
