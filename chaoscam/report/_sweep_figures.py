@@ -161,7 +161,7 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
                 marker=f"${TRANSIENT_MARK}$",
                 color="#000000",
                 markersize=9,
-                label="leaves the cam's reach\nlater (transient)",
+                label="stops later: leaves the\ncam's reach or diverges\n(transient)",
             )
         )
     ax.legend(
