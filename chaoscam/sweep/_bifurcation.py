@@ -304,7 +304,8 @@ def bifurcation(
         workers=workers,
         keeps_sections=True,
         what="this bifurcation diagram",
-        factor=1 + 2 * lyapunov + check_step,
+        # the fate runs as if every run were continued: an upper bound
+        factor=1 + 2 * lyapunov + check_step + (fate / duration if fate else 0.0),
         reduce="the values, the initial conditions or the duration",
     )
     config = {

@@ -322,8 +322,9 @@ def regime_map(
         ``"OK"``, ``"LEFT_REACH"``, ...) and ``left_at`` (the last section time before it
         stopped, NaN if it stayed), and each cell ``n_transient`` (how many left before the
         horizon). Labels are not changed: they describe the recorded window. Must exceed
-        ``duration``; None (default) continues nothing. Not in the time estimate (only the
-        runs that are not periodic are continued).
+        ``duration``; None (default) continues nothing. The time estimate (a warning
+        beyond an hour) counts it for every run, an upper bound: only the runs not labelled
+        periodic are continued.
 
     Returns
     -------
@@ -389,7 +390,8 @@ def regime_map(
         workers=workers,
         keeps_sections=False,
         what="this regime map",
-        factor=1 + 2 * lyapunov + check_step,
+        # the fate runs as if every run were continued: an upper bound
+        factor=1 + 2 * lyapunov + check_step + (fate / duration if fate else 0.0),
         reduce="the grid, the realizations or the duration",
     )
     config = {

@@ -127,3 +127,25 @@ def test_the_report_sentence_is_computed_from_the_rows():
     assert "none labelled chaotic" in transient_finding(rows.iloc[1:3], 300.0, "cell")
     assert transient_finding(rows.iloc[[3]], 300.0, "cell") == ""
     assert transient_finding(rows.drop(columns="fate"), 300.0, "cell") == ""
+
+
+def test_the_time_estimate_counts_the_horizon_for_every_run(monkeypatch):
+    """The budget check sees the fate runs as an upper bound: factor 1 + fate / duration."""
+    import chaoscam.sweep._regime as regime
+
+    seen = {}
+
+    class Stop(Exception):
+        pass
+
+    def spy(base, **kw):
+        seen.update(kw)
+        raise Stop
+
+    monkeypatch.setattr(regime, "check_sweep_budget", spy)
+    with pytest.raises(Stop):
+        regime_map(OMEGA, XI, duration=20.0, fate=300.0, workers=1)
+    assert seen["factor"] == pytest.approx(1 + 300.0 / 20.0)
+    with pytest.raises(Stop):
+        regime_map(OMEGA, XI, duration=20.0, workers=1)
+    assert seen["factor"] == 1
