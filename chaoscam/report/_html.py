@@ -277,7 +277,11 @@ def add_bifurcation(
         }
     )
     parts.provenance.append(_provenance_rows(path, "bifurcation", _sweep_settings(cfg)))
-    parts.summary.append(f"{name}: bifurcation over {param}, labels {_counts(counts)}.")
+    parts.summary.append(
+        f"{name}: bifurcation over {param}, labels {_counts(counts)}"
+        + _fate_text(v, cfg.get("fate"), "runs")
+        + "."
+    )
 
 
 def add_regime_map(
@@ -325,7 +329,24 @@ def add_regime_map(
     )
     parts.provenance.append(_provenance_rows(path, "regime map", _sweep_settings(cfg)))
     dom = c["dominant"].value_counts().to_dict() if len(c) else {}
-    parts.summary.append(f"{name}: regime map {x} × {y}, dominant labels {_counts(dom)}.")
+    parts.summary.append(
+        f"{name}: regime map {x} × {y}, dominant labels {_counts(dom)}"
+        + _fate_text(rm.realizations, cfg.get("fate"), "realizations")
+        + "."
+    )
+
+
+def _fate_text(rows, fate, what: str) -> str:
+    """The summary's clause on a sweep's fate horizon: how many of the continued runs
+    stopped before it (transient motion); empty without a horizon."""
+    if not fate or "fate" not in rows:
+        return ""
+    checked = rows[rows["fate"].notna()]
+    stopped = checked[checked["fate"] != "OK"]
+    return (
+        f"; continued to {float(fate):g} s, {len(stopped)} of the {len(checked)} {what} "
+        "not labelled periodic stop before it (transient motion)"
+    )
 
 
 def add_ensemble(parts: ReportParts, path: str, ens, *, png: bytes | None = None) -> None:

@@ -149,3 +149,18 @@ def test_the_time_estimate_counts_the_horizon_for_every_run(monkeypatch):
     with pytest.raises(Stop):
         regime_map(OMEGA, XI, duration=20.0, workers=1)
     assert seen["factor"] == 1
+
+
+def test_the_html_report_summary_counts_the_transient_runs(maps, tmp_path):
+    from chaoscam.cli import main
+
+    path = tmp_path / "m.parquet"
+    maps["ensemble"].to_parquet(path)
+    out = tmp_path / "r.html"
+    assert main(["report", str(path), "--out", str(out)]) == 0
+    text = out.read_text()
+    assert "continued to 40 s, 1 of the 1 realizations not labelled periodic stop" in text
+    plain = regime_map(OMEGA, Axis("xi", (0.4,)), duration=2.0, transient=1.0, workers=1)
+    plain.to_parquet(tmp_path / "p.parquet")
+    assert main(["report", str(tmp_path / "p.parquet"), "--out", str(tmp_path / "p.html")]) == 0
+    assert "continued to" not in (tmp_path / "p.html").read_text()
