@@ -85,8 +85,10 @@ def _cli_up(*argv: str) -> subprocess.Popen:
 @pytest.mark.parametrize("delay", [0.05, 0.1, 0.2, 0.4])
 def test_ctrl_c_during_start_up_is_one_line(delay):
     """SIGINT `delay` s after the interpreter is up (while chaoscam imports its layers, or
-    just after): exit 130 and the one line "chaoscam: interrupted", no traceback."""
-    proc = _cli_up("simulate", "--duration", "20")
+    just after): exit 130 and the one line "chaoscam: interrupted", no traceback. The run
+    is long enough (200 s of model time, about a second) to be going at the latest signal:
+    with warm caches a 20 s run ended before 0.4 s, and exited 0."""
+    proc = _cli_up("simulate", "--duration", "200")
     try:
         time.sleep(delay)
         proc.send_signal(signal.SIGINT)
