@@ -222,11 +222,20 @@ def certify(
         if refined in ("mixed", "off orbit") or not orbit.converged:
             status = refined
         flips += orbits
-    flipped = status == "unstable" and flips_double and any(_flip(o) for o in flips)
-    if doublings > 0 and (
-        (flipped and _doubling_seen(points, n))
-        or (status in ("unstable", "not converged", "off orbit") and _sharp_doubling(p, points, n))
-    ):
+    flipped = (
+        doublings > 0
+        and status == "unstable"
+        and flips_double
+        and any(_flip(o) for o in flips)
+        and _doubling_seen(points, n)
+    )
+    sharp = (
+        doublings > 0
+        and not flipped
+        and status in ("unstable", "not converged", "off orbit")
+        and _sharp_doubling(p, points, n)
+    )
+    if flipped or sharp:
         records: dict = {}
         twice = certify(
             p, points, 2 * n, records, doublings=doublings - 1, flips_double=flips_double
@@ -238,7 +247,7 @@ def certify(
             )
             detail2 += "; " + summary
         extra["periodic_orbit_doubled"] = records
-        why = "flip-unstable" if flipped and _doubling_seen(points, n) else "sharper at 2n"
+        why = "flip-unstable" if flipped else "sharper at 2n"
         detail += f"; {why}, period {2 * n} shot for: {status2} ({detail2})"
         if status2 == "certified":
             return Certificate("certified", twice.period, twice.orbit, detail, True)
@@ -254,9 +263,13 @@ def _doubling_seen(points: np.ndarray, n: int) -> bool:
     x = np.asarray(points, dtype=float)[:, 0]
     if len(x) < 4 * n:
         return False
-    wide = max(np.ptp(x[r::n]) for r in range(n))
-    sharp = max(np.ptp(x[r :: 2 * n]) for r in range(2 * n))
-    return bool(sharp <= APPROACH * wide)
+    return _widest_band(x, 2 * n) <= APPROACH * _widest_band(x, n)
+
+
+def _widest_band(x: np.ndarray, lag: int) -> float:
+    """The widest band of the points at this lag: max over r of the range of x[r::lag]
+    (over every coordinate of a 2-D array)."""
+    return max(float(np.ptp(x[r::lag], axis=0).max()) for r in range(lag))
 
 
 def _sharp_doubling(p: Params, points: np.ndarray, n: int) -> bool:
@@ -270,12 +283,10 @@ def _sharp_doubling(p: Params, points: np.ndarray, n: int) -> bool:
     and the run lies within 3e-7 rad of it; 600 s runs stay on period 12 at dt. Chaotic
     bands (1e-4 rad and wider on the default model) are never that sharp, so they cost no
     shooting."""
-    x = np.asarray(points, dtype=float).reshape(len(points), -1)
-    m = 2 * n
-    if len(x) < 2 * m or not _doubling_seen(points, n):
+    if not _doubling_seen(points, n):  # also: 4n points or more
         return False
-    scaled = x[:, :2] * np.array([1.0, p.cam_period])
-    return max(float(np.ptp(scaled[r::m], axis=0).max()) for r in range(m)) <= MODEL_ATOL
+    scaled = np.asarray(points, dtype=float) * np.array([1.0, p.cam_period])
+    return _widest_band(scaled, 2 * n) <= MODEL_ATOL
 
 
 def _flip(orbit: PeriodicOrbit) -> bool:

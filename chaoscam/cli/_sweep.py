@@ -208,9 +208,11 @@ def _execution(args) -> dict:
 
 def _transient(table) -> str:
     """The summary line of a sweep with a fate horizon: how many runs left later."""
-    if "fate" not in table or table["fate"].isna().all():
+    from ..sweep._stats import fate_split
+
+    checked, left = fate_split(table)
+    if not len(checked):
         return ""
-    left = table[table["fate"].notna() & (table["fate"] != "OK")]
     if not len(left):
         return "\nfate: every run not labelled periodic stayed in the cam's reach"
     return (

@@ -107,10 +107,11 @@ def transient_finding(rows: pd.DataFrame, horizon: float, what: str) -> str:
     fate ``horizon``), how many stop before it, when, and how many of those were labelled
     chaotic over the recorded window; from ``rows`` with columns label, fate and left_at.
     ``what`` names one run ("cell", "value"). Empty when no run was continued."""
-    checked = rows[rows["fate"].notna()] if "fate" in rows else rows.iloc[:0]
+    from ..sweep._stats import fate_split
+
+    checked, left = fate_split(rows)
     if not len(checked):
         return ""
-    left = checked[checked["fate"] != "OK"]
     n = len(checked)
     head = f" Continued to {horizon:g} s, the {n} {what}{'s' * (n != 1)} not labelled periodic"
     if not len(left):

@@ -339,10 +339,11 @@ def add_regime_map(
 def _fate_text(rows, fate, what: str) -> str:
     """The summary's clause on a sweep's fate horizon: how many of the continued runs
     stopped before it (transient motion); empty without a horizon."""
-    if not fate or "fate" not in rows:
+    from ..sweep._stats import fate_split
+
+    if not fate:
         return ""
-    checked = rows[rows["fate"].notna()]
-    stopped = checked[checked["fate"] != "OK"]
+    checked, stopped = fate_split(rows)
     return (
         f"; continued to {float(fate):g} s, {len(stopped)} of the {len(checked)} {what} "
         "not labelled periodic stop before it (transient motion)"

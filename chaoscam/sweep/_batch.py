@@ -125,25 +125,15 @@ def run_batch(
             verdicts = member_verdicts(ens, plist, extend_to=extend_to)
         shared = [str(w.message) for w in caught]
         later = [
-            j
-            for j, v in enumerate(verdicts)
-            if fate is not None and v.verdict is not None and v.label in FATE_LABELS
+            j for j, v in enumerate(verdicts) if v.verdict is not None and v.label in FATE_LABELS
         ]
-        fates = dict(
-            zip(
-                later,
-                _fates(
-                    [plist[j] for j in later],
-                    [tasks[picks[j]].sim_index for j in later],
-                    seed,
-                    fate,
-                    ens.settings["backend"],
-                )
-                if later
-                else [],
-                strict=True,
+        fates: dict[int, dict[str, Any]] = {}
+        if fate is not None and later:
+            plater = [plist[j] for j in later]
+            ilater = [tasks[picks[j]].sim_index for j in later]
+            fates = dict(
+                zip(later, _fates(plater, ilater, seed, fate, ens.settings["backend"]), strict=True)
             )
-        )
         rows_of = ens.sections.groupby("member").indices
         members = ens.members
         for j, i in enumerate(picks):

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 from scipy.special import ndtri
 
-__all__ = ["LABEL_ORDER", "wilson_interval", "max_halfwidth", "summarize_cells"]
+__all__ = ["LABEL_ORDER", "fate_split", "wilson_interval", "max_halfwidth", "summarize_cells"]
 
 LABEL_ORDER = (
     "periodic",
@@ -170,7 +170,16 @@ def summarize_cells(
     out["period"] = pd.array(out["cell"].map(mode), dtype="Int64")
     mass = rows.groupby("cell")["truncated_mass"].first() if len(rows) else pd.Series(dtype=float)
     out["truncated_mass"] = out["cell"].map(mass).astype(float)
-    fate = rows["fate"] if "fate" in rows else pd.Series(None, index=rows.index, dtype=object)
-    stopped = rows.loc[fate.notna() & (fate != "OK"), "cell"]
+    stopped = fate_split(rows)[1]["cell"]
     out["n_transient"] = out["cell"].map(stopped.value_counts()).fillna(0).astype(np.int64)
     return out
+
+
+def fate_split(rows: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(the rows a sweep's ``fate`` horizon continued, those of them that stopped before it:
+    left the cam's reach or diverged) from a table with a ``fate`` column (the status at the
+    horizon, None where not continued); both empty without that column."""
+    if "fate" not in rows:
+        return rows.iloc[:0], rows.iloc[:0]
+    checked = rows[rows["fate"].notna()]
+    return checked, checked[checked["fate"] != "OK"]
