@@ -16,6 +16,7 @@ import pandas as pd
 
 from ._paper import (
     FIGURES,
+    FULL_EXTEND_TO,
     QUICK_EXTEND_TO,
     SENSITIVITY,
     _sensitivity_stage,
@@ -160,8 +161,8 @@ def run_paper(
     if quick:
         parts.missing.append(
             "This is a quick run: coarse grids, few realizations, shorter fractal runs, "
-            f"undetermined runs extended to {QUICK_EXTEND_TO:g} s recorded (120 s in the full "
-            "report); "
+            f"undetermined runs extended to {QUICK_EXTEND_TO:g} s recorded "
+            f"({FULL_EXTEND_TO:g} s in the full report); "
             "run `chaoscam paper` without --quick for the full grids."
         )
     title = "chaoscam: the paper's Figs. 3–10 reproduced" + (" (quick run)" if quick else "")
