@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 
     from ..model import Params
 
-__all__ = ["entry", "main", "parse_assignments", "show_warning", "UsageError"]
+__all__ = ["entry", "main", "parse_assignments", "show_warning", "stop_word", "UsageError"]
 
 # Modules that add subcommands, in the order they are listed by --help.
 _COMMAND_MODULES = (
@@ -153,6 +153,11 @@ def entry() -> None:
     sys.exit(code)
 
 
+def stop_word() -> str:
+    """How the run was stopped: "terminated" after a SIGTERM, else "interrupted"."""
+    return "terminated" if _SIGTERM["seen"] else "interrupted"
+
+
 def _interrupted() -> int:
     """Say "interrupted" (or "terminated") once; a second Ctrl-C meanwhile is ignored."""
     import signal
@@ -161,7 +166,7 @@ def _interrupted() -> int:
     main_thread = threading.current_thread() is threading.main_thread()
     before = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
     try:
-        print("chaoscam: " + ("terminated" if _SIGTERM["seen"] else "interrupted"), file=sys.stderr)
+        print(f"chaoscam: {stop_word()}", file=sys.stderr)
     finally:
         if before is not None:
             signal.signal(signal.SIGINT, before)

@@ -112,7 +112,7 @@ def _run_locked(args: argparse.Namespace) -> int:
     from ..integrate._gpu import GPUFallbackWarning
     from ..sweep._checkpoint import differences, discard_checkpoint, remove_leftovers
     from ..sweep._common import run_settings
-    from . import UsageError, parse_assignments
+    from . import UsageError, parse_assignments, stop_word
 
     out: Path = args.out
     members_n = whole("--members", args.members, low=1)
@@ -139,7 +139,9 @@ def _run_locked(args: argparse.Namespace) -> int:
     # What the finished members file is stamped with: the part size decides where the run is
     # saved on the way, not what it computes, so a finished run is recognised under any.
     result = config_digest({k: v for k, v in config.items() if k != "chunk"})
-    remove_leftovers(parts)  # of a run killed while it created or deleted its parts
+    # Of a run killed while it created or deleted its parts, or wrote its outputs.
+    for path in (parts, out, sections_path, impacts_path):
+        remove_leftovers(path)
     if args.force:
         discard_checkpoint(parts)
     elif args.resume and not parts.exists() and finished_run(out, (result, digest)):
@@ -227,7 +229,7 @@ def _run_locked(args: argparse.Namespace) -> int:
             bar.close()
             kept = start - args.first  # the parts before this one, all finished
             print(
-                f"chaoscam: interrupted; {kept} of {args.members} members are finished and "
+                f"chaoscam: {stop_word()}; {kept} of {args.members} members are finished and "
                 f"kept in {parts} (parts of {chunk}): run the same command with --resume to "
                 "continue",
                 file=sys.stderr,

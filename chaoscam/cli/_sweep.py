@@ -228,7 +228,7 @@ def _call(fn, **kwargs):
     resume or reproduce it."""
     from ..sweep._engine import SweepInterrupted, TaskFailed
     from ..sweep._grid import SweepError
-    from . import UsageError
+    from . import UsageError, stop_word
 
     try:
         return fn(**kwargs)
@@ -238,7 +238,7 @@ def _call(fn, **kwargs):
         print(f"chaoscam: error: {err}", file=sys.stderr)
         return 1
     except SweepInterrupted as err:
-        print(f"chaoscam: {err.message}", file=sys.stderr)
+        print(f"chaoscam: {err.describe(stop_word())}", file=sys.stderr)
         return 130 if err.cause is None else 1
 
 

@@ -360,6 +360,7 @@ def run_sweep(
     from the records, write it to ``out`` and remove the checkpoint.
     """
     from ._common import companion, lock_outputs, open_store, reemit_warnings, unique_sorted
+    from ._engine import SweepInterrupted
 
     with lock_outputs(out):
         store, reuse = open_store(out, second, config, resume, flush_interval, force)
@@ -373,10 +374,16 @@ def run_sweep(
         run_plan(
             plan, eng, store, workers=workers, scheduler=scheduler, progress=progress, desc=desc
         )
-        records = unique_sorted(store.records(), keys)
-        reemit_warnings(records)
-        result = build(records)
-        if out is not None:
-            result.to_parquet(out, replace=replace)
-            store.remove()
+        try:
+            records = unique_sorted(store.records(), keys)
+            reemit_warnings(records)
+            result = build(records)
+            if out is not None:
+                result.to_parquet(out, replace=replace)
+                store.remove()
+        except KeyboardInterrupt:
+            # Every record is in the checkpoint; a resume writes the tables from it.
+            if out is None:
+                raise
+            raise SweepInterrupted(plan.total, plan.total, store.path) from None
         return result

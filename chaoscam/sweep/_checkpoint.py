@@ -125,14 +125,18 @@ def decode_part(data: bytes) -> list[dict[str, Any]]:
 def remove_leftovers(path: Path) -> None:
     """Finish what killed runs left beside ``path``: the ``.tmp-PID-NAME`` and
     ``.tmp-PID-removed-NAME`` folders (a checkpoint being created, or being deleted by
-    :func:`discard_checkpoint`) of processes PID that no longer run.
+    :func:`discard_checkpoint`) and files (an output being written,
+    :func:`chaoscam._outputs.atomic_path`) of processes PID that no longer run.
 
-    Call it holding the output's lock; a folder whose process still runs is left alone.
+    Call it holding the output's lock; a leftover whose process still runs is left alone.
     """
     for left in path.parent.glob(f".tmp-*-{path.name}"):
         pid = left.name.split("-", 2)[1]
         if pid.isdigit() and not _running(int(pid)):
-            shutil.rmtree(left, ignore_errors=True)
+            if left.is_dir() and not left.is_symlink():
+                shutil.rmtree(left, ignore_errors=True)
+            else:
+                left.unlink(missing_ok=True)
 
 
 def _running(pid: int) -> bool:
@@ -352,8 +356,10 @@ def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> 
     """Check the output files before any work; True when a finished run can be reused.
 
     Without ``resume`` an existing output is refused (nothing is overwritten). With it, a
-    finished output of the same configuration is reused as is, one of another configuration
-    is refused.
+    finished output of the same configuration is reused as is; one of another configuration
+    is refused, unless the checkpoint beside it is this configuration's: a ``--force`` run
+    over that output was interrupted, and its resume finishes it (replacing the output, as
+    the ``--force`` asked).
     """
     existing = [p for p in outputs if p.exists()]
     if not existing:
@@ -365,9 +371,20 @@ def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> 
         )
     meta = read_sweep_metadata(outputs[0]) if outputs[0].exists() else None
     if meta is None or meta.get("hash") != config_hash(config):
+        if _checkpoint_hash(checkpoint_dir(outputs[0])) == config_hash(config):
+            return False
         why = differences(meta.get("config"), config) if meta else ""
         raise SweepError(
             f"{existing[0]} was made by a different configuration{why} (or is not a chaoscam "
-            "sweep); --resume continues only the same command. Choose another --out"
+            "sweep); --resume continues only the same command. Choose another --out, or pass "
+            "--force without --resume to replace it"
         )
     return not checkpoint_dir(outputs[0]).exists() and all(p.exists() for p in outputs)
+
+
+def _checkpoint_hash(directory: Path) -> str | None:
+    """The configuration hash in a checkpoint's manifest; None without a readable one."""
+    try:
+        return json.loads((directory / "manifest.json").read_text()).get("hash")
+    except (OSError, ValueError, AttributeError):
+        return None

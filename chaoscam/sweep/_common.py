@@ -153,7 +153,9 @@ def open_store(
     for path in (out, companion(out, second)):
         check_output(path, force=True)  # the folder and the path; existence is below
     ckpt = checkpoint_dir(out)
-    remove_leftovers(ckpt)  # of a run killed while it created or deleted its checkpoint
+    # Of a run killed while it created or deleted its checkpoint, or wrote its outputs.
+    for path in (ckpt, out, companion(out, second)):
+        remove_leftovers(path)
     if force and not resume:
         discard_checkpoint(ckpt)
     elif guard_outputs([out, companion(out, second)], config, resume):

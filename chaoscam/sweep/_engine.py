@@ -47,7 +47,12 @@ class SweepInterrupted(KeyboardInterrupt):
 
     @property
     def message(self) -> str:
-        why = "interrupted" if self.cause is None else f"stopped: {self.cause};"
+        return self.describe()
+
+    def describe(self, word: str = "interrupted") -> str:
+        """The message, opening with ``word`` (the command line says "terminated" after a
+        SIGTERM) unless a cause stopped the run."""
+        why = word if self.cause is None else f"stopped: {self.cause};"
         if self.checkpoint is None:
             return (
                 f"{why} after {self.done} of {self.total} runs; nothing was saved "

@@ -83,6 +83,25 @@ def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, ca
     assert a.equals(pd.read_parquet(tmp_path / "whole.sections.parquet"))
 
 
+def test_sigterm_says_terminated_once(tmp_path, monkeypatch, capsys):
+    """SIGTERM during the members (what chaoscam.cli's handler does: a KeyboardInterrupt
+    after noting the signal): one "terminated" line with what is kept and the resume hint,
+    exit 143."""
+    import chaoscam.cli as cli
+    import chaoscam.integrate as integrate
+
+    def terminated(*args, **kwargs):
+        cli._SIGTERM["seen"] = True
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(integrate, "simulate_ensemble", terminated)
+    assert main([*ARGS, "--out", str(tmp_path / "ens.parquet")]) == 143
+    err = capsys.readouterr().err
+    assert "interrupted" not in err
+    said = [line for line in err.splitlines() if "terminated" in line]
+    assert len(said) == 1 and "--resume" in said[0] and "0 of 5 members" in said[0]
+
+
 def test_resuming_a_finished_run_under_another_part_size_does_nothing(tmp_path, capsys):
     """--resume on a finished output says "already finished" whatever the part size (it
     decides where the run is saved, not what it computes); another configuration is still

@@ -17,6 +17,16 @@ def reference():
     return regime_map(X, Y, classify=SpreadClassifier(), **GRID)
 
 
+def _dead_pid() -> str:
+    """The pid of a process that has finished."""
+    import subprocess
+    import sys
+
+    code = "import os; print(os.getpid())"
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return run.stdout.strip()
+
+
 def _interrupted(tmp_path, victim=11):
     """A regime map stopped by Ctrl-C after several one-record parts."""
     out = tmp_path / "m.parquet"
@@ -91,17 +101,10 @@ def test_what_a_killed_deletion_left_is_removed_by_the_next_run(tmp_path, refere
     leaves ``.tmp-PID-removed-NAME``: the next run over that output removes it, also when it
     only finds the output finished; a folder of a process that still runs stays."""
     import os
-    import subprocess
-    import sys
 
     out = tmp_path / "m.parquet"
     regime_map(X, Y, classify=SpreadClassifier(), out=out, **GRID)
-    dead = subprocess.run(
-        [sys.executable, "-c", "import os; print(os.getpid())"],
-        capture_output=True,
-        text=True,
-        check=True,
-    ).stdout.strip()
+    dead = _dead_pid()
     name = checkpoint_dir(out).name
     killed = tmp_path / f".tmp-{dead}-removed-{name}"
     created = tmp_path / f".tmp-{dead}-{name}"  # killed while creating its checkpoint
@@ -113,3 +116,58 @@ def test_what_a_killed_deletion_left_is_removed_by_the_next_run(tmp_path, refere
     frames_equal(again.cells, reference.cells)
     assert not killed.exists() and not created.exists()
     assert mine.exists()  # this process still runs
+
+
+def test_an_interrupted_force_run_over_another_output_resumes(tmp_path, reference):
+    """--force over an output of another configuration, stopped by Ctrl-C, then --resume:
+    the checkpoint is this configuration's, so the resume finishes it and replaces the
+    output (what --force asked); without that checkpoint the foreign output is refused."""
+    out = tmp_path / "m.parquet"
+    regime_map(X, Y, classify=SpreadClassifier(), out=out, **{**GRID, "seed": 4})
+    stop = InterruptOnce(str(tmp_path / "marker"), 11)
+    with pytest.raises(KeyboardInterrupt):
+        regime_map(X, Y, classify=stop, out=out, force=True, flush_interval=0.0, **GRID)
+    assert checkpoint_dir(out).is_dir()
+    res = regime_map(X, Y, classify=stop, out=out, resume=True, **GRID)
+    frames_equal(res.realizations, reference.realizations)
+    frames_equal(regime_map(X, Y, classify=stop, out=out, resume=True, **GRID).cells, res.cells)
+    assert not checkpoint_dir(out).exists()
+    with pytest.raises(SweepError, match="different configuration.*--force"):
+        regime_map(X, Y, classify=stop, out=out, resume=True, **{**GRID, "seed": 4})
+
+
+def test_what_a_run_killed_while_writing_its_tables_left_is_removed(tmp_path, reference):
+    """A SIGKILL while the tables were written leaves ``.tmp-PID-NAME`` files beside them:
+    the next run over that output removes those of processes that no longer run."""
+    import os
+
+    out = tmp_path / "m.parquet"
+    dead = _dead_pid()
+    killed = [tmp_path / f".tmp-{dead}-{name}" for name in ("m.parquet", "m.cells.parquet")]
+    mine = tmp_path / f".tmp-{os.getpid()}-m.parquet.other"
+    for path in (*killed, mine):
+        path.write_bytes(b"PAR1 half a table")
+    res = regime_map(X, Y, classify=SpreadClassifier(), out=out, **GRID)
+    frames_equal(res.cells, reference.cells)
+    assert not any(p.exists() for p in killed)
+    assert mine.exists()  # not a leftover of this output
+
+
+def test_ctrl_c_while_the_tables_are_written_says_how_to_resume(tmp_path, reference):
+    """A Ctrl-C after the last run, while the tables are written: the records are all in
+    the checkpoint, the interruption says so (not a bare KeyboardInterrupt), and --resume
+    writes the tables."""
+    from unittest import mock
+
+    from chaoscam.sweep import SweepInterrupted
+    from chaoscam.sweep._regime import RegimeMap
+
+    out = tmp_path / "m.parquet"
+    with mock.patch.object(RegimeMap, "to_parquet", side_effect=KeyboardInterrupt):
+        with pytest.raises(SweepInterrupted) as stopped:
+            regime_map(X, Y, classify=SpreadClassifier(), out=out, **GRID)
+    total = len(reference.realizations)
+    assert f"{total} of {total} runs are saved" in stopped.value.message
+    assert "--resume" in stopped.value.message and not out.exists()
+    res = regime_map(X, Y, classify=SpreadClassifier(), out=out, resume=True, **GRID)
+    frames_equal(res.realizations, reference.realizations)

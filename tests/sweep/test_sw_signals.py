@@ -70,6 +70,7 @@ def test_sigterm_saves_and_says_how_to_resume(tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 143, err
     assert "--resume" in err and "Traceback" not in err
+    assert "terminated;" in err and "interrupted" not in err
     assert _alive(workers) == []
     proc = _start([*args, "--resume"])
     _, err = proc.communicate(timeout=120)
