@@ -118,6 +118,13 @@ def load_trajectory(path) -> Trajectory:
         series = None
     else:
         raise ValueError(f"{path}: unexpected columns {list(cols)} for a chaoscam trajectory")
+    for name, table_ in (("the table", frame), ("the section metadata", section)):
+        for col in table_.columns:
+            if not pd.api.types.is_numeric_dtype(table_[col]):
+                raise ValueError(
+                    f"{path}: column {col!r} of {name} holds {table_[col].dtype} values, not "
+                    "numbers; not a file chaoscam wrote (or it was edited)"
+                )
     section = section.reindex(columns=list(SECTION_COLUMNS))
     if len(section):
         section["k"] = section["k"].astype(np.int64)

@@ -181,6 +181,15 @@ def _tangent_verdict(
     t0 = s["transient"] + discard
     sec = tr.section
     keep = ((sec["t"] >= t0 - 1e-9 * period) & (sec["k"] > 0)).to_numpy()
+    if not keep.any():
+        # No cam period recorded after the transient: no Jacobian, so no exponent; the
+        # other methods abstain on so little data and say so.
+        v = _evidence_verdict(traj, discard, None, options)
+        reason = (
+            f"no cam period (tau = {period:.4g} s) recorded after t = {t0:g} s, so no "
+            "tangent exponent: simulate longer"
+        )
+        return dataclasses.replace(v, reasons=v.reasons + (reason,)), {}
     points = sec.loc[keep, _SECTION_COORDS].to_numpy(dtype=float)
     if traj.series is None:
         return _section_verdict(points, tr.jacobians[keep], p, options)
@@ -314,6 +323,12 @@ def classify_trajectory(
     """
     if discard < 0 or not math.isfinite(discard):
         raise ValueError(f"discard = {discard!r} s must be >= 0")
+    recorded = traj.settings["duration"] - traj.settings["transient"]
+    if discard >= recorded:
+        raise ValueError(
+            f"discard = {discard!r} s must be in [0, {recorded:g}) s: the run records "
+            f"{recorded:g} s after its transient"
+        )
     settings = {
         "classify": dict(
             tangent=tangent, lyapunov=lyapunov, check_step=check_step, discard=discard, **options

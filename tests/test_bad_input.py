@@ -78,6 +78,20 @@ CLI_CASES = {
     "bifurcation duration 1e9": ([*BIF, "--duration", "1e9", "--out", "OUT.parquet"], "memory"),
     "map seed -1": ([*MAP, "--seed", "-1", "--out", "OUT.parquet"], "seed"),
     "bifurcation seed -1": ([*BIF, "--seed", "-1", "--out", "OUT.parquet"], "seed"),
+    "process workers 99999": (
+        [*BIF[:-3], "--engine", "process", "--workers", "99999", "--out", "OUT.parquet"],
+        "workers",
+    ),
+    "ensemble engine workers 99999": (
+        [*MAP[:-3], "--workers", "99999", "--out", "OUT.parquet"],
+        "workers",
+    ),
+    "initial conditions 1e10": (
+        [*BIF, "--initial-conditions", "10000000000", "--out", "OUT.parquet"],
+        "memory",
+    ),
+    "fate 1e300": ([*BIF, "--fate", "1e300", "--out", "OUT.parquet"], "fate horizon"),
+    "scheduler without port": ([*BIF, "--scheduler", "bogus", "--out", "OUT.parquet"], "scheduler"),
 }
 
 
@@ -257,3 +271,78 @@ def test_failing_classifier_is_one_line_exit_1(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("chaoscam: error: task") and "this classifier has a bug" in err
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    "name, value",
+    [
+        ("NUMBA_THREADING_LAYER", ""),
+        ("NUMBA_THREADING_LAYER", "bogus"),
+        ("NUMBA_NUM_THREADS", "0"),
+        ("NUMBA_NUM_THREADS", "two"),
+    ],
+)
+def test_numba_settings_numba_would_reject_exit_2(monkeypatch, capsys, name, value):
+    """A numba variable numba itself rejects mid-run with a traceback: exit 2 naming it."""
+    monkeypatch.setenv(name, value)
+    assert main(SIM) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"chaoscam: error: {name}=") and "Traceback" not in err
+
+
+def test_negative_values_may_follow_their_option(tmp_path):
+    """``--values -0.5,-0.4`` (and START:STOP:NUM with negative ends) is read as the value,
+    not as an unknown option."""
+    out = tmp_path / "b.parquet"
+    args = ["bifurcation", "--param", "x_O", "--values", "-0.47,-0.46", "--duration", "0.3"]
+    assert main([*args, "--workers", "1", "--quiet", "--out", str(out)]) == 0
+    assert sorted(pd.read_parquet(out)["value"].unique()) == [-0.47, -0.46]
+
+
+def test_classify_a_run_shorter_than_a_cam_period(tmp_path, capsys):
+    """A saved run that records no cam period after its transient: classified undetermined
+    with the reason (the tangent exponent has no Jacobian), not a traceback; a discard
+    beyond the recorded time is refused naming discard and its range."""
+    out = tmp_path / "s.parquet"
+    assert main(["simulate", "--duration", "0.2", "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["classify", "--no-extend", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.err and "no cam period" in captured.out
+    traj = chaoscam.simulate(duration=0.5, transient=0.25)
+    with pytest.raises(ValueError, match=r"discard = 5.0 s must be in \[0, 0.25\)"):
+        chaoscam.classify_trajectory(traj, discard=5.0)
+
+
+@pytest.mark.parametrize("damage", ["output", "manifest"])
+def test_resume_over_a_damaged_output_or_manifest_exits_2(tmp_path, capsys, damage):
+    """--resume where the output is not a parquet file, or the checkpoint's manifest is
+    JSON but not an object: exit 2 with what is wrong, not a pyarrow or attribute error."""
+    out = tmp_path / "b.parquet"
+    if damage == "output":
+        out.write_text("junk")
+    else:
+        ckpt = out.with_suffix(".parquet.ckpt")
+        ckpt.mkdir()
+        (ckpt / "manifest.json").write_text("[]")
+    assert main([*BIF, "--resume", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    said = "not a chaoscam sweep" if damage == "output" else "no readable manifest.json"
+    assert err.startswith("chaoscam: error:") and said in err, err
+
+
+def test_trajectory_file_with_text_in_a_number_column(tmp_path):
+    """A trajectory file whose theta_f column was edited to text: the error names the file
+    and the column, not numpy's "could not convert string to float"."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path, bad = tmp_path / "t.parquet", tmp_path / "bad.parquet"
+    chaoscam.simulate(duration=0.3).to_parquet(path)
+    table = pq.read_table(path)
+    frame = table.to_pandas().assign(theta_f="a")
+    edited = pa.Table.from_pandas(frame, preserve_index=False)
+    pq.write_table(edited.replace_schema_metadata(table.schema.metadata), bad)
+    with pytest.raises(ValueError, match=r"bad.parquet: column 'theta_f' of the table"):
+        chaoscam.load_trajectory(bad)
+    assert chaoscam.load_trajectory(path).series is not None

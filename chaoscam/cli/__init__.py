@@ -178,6 +178,52 @@ def show_warning(message, *args, **kwargs) -> None:
     print(f"chaoscam: warning: {message}", file=sys.stderr, flush=True)
 
 
+NUMBA_LAYERS = ("default", "safe", "threadsafe", "forksafe", "workqueue", "omp", "tbb")
+"""The values numba accepts for ``NUMBA_THREADING_LAYER`` (its documentation, 0.68)."""
+
+
+def check_numba_environment() -> None:
+    """Refuse numba settings in the environment that numba itself would reject with a
+    traceback mid-run (a set but empty or unknown threading layer, a thread count that is
+    not a positive integer): a UsageError naming the variable and what it allows."""
+    import os
+
+    layer = os.environ.get("NUMBA_THREADING_LAYER")
+    if layer is not None and layer not in NUMBA_LAYERS:
+        raise UsageError(
+            f"NUMBA_THREADING_LAYER={layer!r} in the environment: must be one of "
+            f"{', '.join(NUMBA_LAYERS)} (or unset; chaoscam then uses workqueue)"
+        )
+    threads = os.environ.get("NUMBA_NUM_THREADS")
+    if threads is not None and not (threads.strip().isdigit() and int(threads) >= 1):
+        raise UsageError(
+            f"NUMBA_NUM_THREADS={threads!r} in the environment: must be a whole number >= 1 "
+            "(or unset: one thread per core)"
+        )
+
+
+GRID_FLAGS = ("--values", "--mu", "--sigma")
+"""Options whose value may start with a minus sign (``--values -0.5,-0.4``)."""
+
+
+def _negative_values(argv: list[str]) -> list[str]:
+    """``--values -0.5,-0.4`` as ``--values=-0.5,-0.4``: argparse takes a value that starts
+    with "-" and is not a single number for an option, and says "expected one argument"."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        token = argv[i]
+        following = argv[i + 1] if i + 1 < len(argv) else ""
+        if token in GRID_FLAGS and len(following) > 1 and following[0] == "-":
+            if following[1].isdigit() or following[1] == ".":
+                out.append(f"{token}={following}")
+                i += 2
+                continue
+        out.append(token)
+        i += 1
+    return out
+
+
 def _dispatch(argv: list[str] | None) -> int:
     import warnings
 
@@ -185,11 +231,12 @@ def _dispatch(argv: list[str] | None) -> int:
     from ..model import ParameterError
 
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(_negative_values(sys.argv[1:] if argv is None else list(argv)))
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
     try:
+        check_numba_environment()
         with warnings.catch_warnings():
             warnings.showwarning = show_warning  # as they come, not at the end of the run
             code = int(args.func(args) or 0)

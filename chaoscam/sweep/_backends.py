@@ -59,6 +59,25 @@ class BackendLost(RuntimeError):
     no task can run until it is restarted; the finished records are kept."""
 
 
+WORKERS_PER_CORE = 4
+"""Most local workers (processes, or the ensemble engine's batch threads) per core a sweep
+accepts: more only compete for the cores, and each holds a run in memory (a typo such as
+``--workers 99999`` would otherwise start thousands of processes)."""
+
+
+def local_workers(workers: int | None) -> int:
+    """The local worker count: ``workers``, or every core when None; a ValueError naming
+    ``workers`` and its range [1, WORKERS_PER_CORE x cores] otherwise."""
+    n = default_workers() if workers is None else int(workers)
+    most = WORKERS_PER_CORE * default_workers()
+    if not 1 <= n <= most:
+        raise ValueError(
+            f"workers = {n} must be in [1, {most}] ({WORKERS_PER_CORE} per core on this "
+            f"machine's {default_workers()}; more only compete for the cores)"
+        )
+    return n
+
+
 def default_workers() -> int:
     """Cores this process may use."""
     try:
@@ -462,7 +481,5 @@ def make_backend(workers: int | None = None, scheduler: Any = None):
     """
     if scheduler is not None:
         return DaskBackend(scheduler, workers)
-    n = default_workers() if workers is None else int(workers)
-    if n < 1:
-        raise ValueError(f"workers = {n} must be >= 1")
+    n = local_workers(workers)
     return SerialBackend() if n == 1 else ProcessBackend(n)

@@ -196,7 +196,7 @@ def resolve_engine(
     """The engine a sweep runs on (see :data:`ENGINES`) for ``classify`` (identity
     ``identity``), the model ``base`` and ``run`` = (duration, transient) [s]; SweepError
     for a bad choice."""
-    from ._backends import default_workers
+    from ._backends import local_workers
     from ._grid import SweepError
     from ._tasks import DefaultClassifier
 
@@ -228,9 +228,10 @@ def resolve_engine(
         )
     threads = None
     if scheduler is None:
-        threads = default_workers() if workers is None else int(workers)
-        if threads < 1:
-            raise SweepError(f"workers = {threads} must be >= 1")
+        try:
+            threads = local_workers(workers)
+        except ValueError as err:
+            raise SweepError(str(err)) from None
     # Local CPU batches run one per thread, each a batch's work on one core (a GPU batch
     # fills its device; a Dask worker runs numba threads over its own cores).
     by_task = threads if threads is not None and threads > 1 and device == "cpu" else 1

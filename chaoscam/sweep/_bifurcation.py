@@ -273,17 +273,18 @@ def bifurcation(
     duration, transient = run_settings(duration, transient, seed)
     fate = check_fate(fate, duration)
     validate_grid(base, [axis])
-    if isinstance(initial_conditions, numbers.Integral) and not isinstance(
+    counted = isinstance(initial_conditions, numbers.Integral) and not isinstance(
         initial_conditions, bool
-    ):
+    )
+    specs: list[tuple[str, float | None, float | None]] = []
+    if counted:
         initial_conditions = whole("initial conditions", initial_conditions, low=1)
-        specs: list[tuple[str, float | None, float | None]] = [
-            ("base", base.theta_f0, base.omega_f0)
-        ] + [("offset", a, b) for a, b in initial_offsets(initial_conditions)]
+        n_specs = initial_conditions  # built after the budget check: a huge count is refused
     else:
         specs = [("absolute", float(a), float(b)) for a, b in initial_conditions]
         if not specs:
             raise SweepError("initial conditions: the list is empty")
+        n_specs = len(specs)
     classify, eng, series = sweep_engine(
         classify,
         lyapunov,
@@ -297,17 +298,22 @@ def bifurcation(
     )
     check_sweep_budget(
         base,
-        runs=len(axis) * len(specs),
+        runs=len(axis) * n_specs,
         duration=duration,
         transient=transient,
         series=series,
         workers=workers,
         keeps_sections=True,
         what="this bifurcation diagram",
+        fate=fate,
         # the fate runs as if every run were continued: an upper bound
         factor=1 + 2 * lyapunov + check_step + (fate / duration if fate else 0.0),
         reduce="the values, the initial conditions or the duration",
     )
+    if counted:
+        specs = [("base", base.theta_f0, base.omega_f0)] + [
+            ("offset", a, b) for a, b in initial_offsets(initial_conditions)
+        ]
     config = {
         "kind": "bifurcation",
         "version": __version__,

@@ -251,6 +251,8 @@ class CheckpointStore:
     def _check_manifest(self) -> None:
         try:
             manifest = json.loads((self.path / "manifest.json").read_text())
+            if not isinstance(manifest, dict):
+                raise ValueError(f"a JSON {type(manifest).__name__}, not an object")
         except (OSError, ValueError) as err:
             raise SweepError(
                 f"{self.path}: no readable manifest.json ({err}); not a chaoscam checkpoint"
@@ -345,11 +347,17 @@ def write_parquet(
 
 
 def read_sweep_metadata(path: Path) -> dict[str, Any] | None:
-    """The configuration record of a sweep output, or None if it has none."""
+    """The configuration record of a sweep output, or None if it has none (or is not a
+    readable parquet file, or its record is damaged)."""
+    import pyarrow as pa
     import pyarrow.parquet as pq
 
-    meta = pq.read_schema(path).metadata or {}
-    return json.loads(meta[_META_KEY]) if _META_KEY in meta else None
+    try:
+        meta = pq.read_schema(path).metadata or {}
+        record = json.loads(meta[_META_KEY]) if _META_KEY in meta else None
+    except (OSError, pa.ArrowException, ValueError):
+        return None
+    return record if isinstance(record, dict) else None
 
 
 def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> bool:

@@ -179,18 +179,24 @@ def check_sweep_budget(
     what: str,
     reduce: str,
     factor: float = 1.0,
+    fate: float | None = None,
 ) -> None:
     """Refuse a sweep that cannot fit in memory, warn about one that takes hours.
 
     ``runs`` realizations of ``base`` (``factor`` times the cost each: the Lyapunov and
     step checks run more), one per worker in memory at a time, their records (and, with
-    ``keeps_sections``, their section points) all kept by the driver.
+    ``keeps_sections``, their section points) all kept by the driver. With a ``fate``
+    horizon a worker may hold a run continued to it (its section from ``duration`` on).
     """
     from .._budget import JobEstimate, check_budget, estimate
     from ._backends import default_workers
 
     n = default_workers() if workers is None else max(1, int(workers))
     one = estimate(base, duration=duration, transient=transient, series=series)
+    if fate is not None:
+        longer = estimate(base, duration=fate, transient=duration)
+        one = JobEstimate((max(one.bytes, longer.bytes), one.seconds))
+        reduce = f"{reduce}, or the fate horizon"
     kept = estimate(base, duration=duration, transient=transient) if keeps_sections else None
     memory = one.bytes * n + runs * (RECORD_BYTES + (kept.bytes / 3 if kept else 0.0))
     seconds = one.seconds * runs * factor / n
@@ -206,7 +212,8 @@ def backend_for(workers: int | None, scheduler: Any):
     try:
         return make_backend(workers, scheduler)
     except (ValueError, ConnectionError) as err:
-        raise SweepError(str(err)) from None
+        where = "" if scheduler is None or "scheduler" in str(err) else f"scheduler {scheduler!r}: "
+        raise SweepError(f"{where}{err}") from None
 
 
 def unique_sorted(records, key_fields: tuple[str, str]) -> list[dict]:

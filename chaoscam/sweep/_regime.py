@@ -390,6 +390,7 @@ def regime_map(
         workers=workers,
         keeps_sections=False,
         what="this regime map",
+        fate=fate,
         # the fate runs as if every run were continued: an upper bound
         factor=1 + 2 * lyapunov + check_step + (fate / duration if fate else 0.0),
         reduce="the grid, the realizations or the duration",
