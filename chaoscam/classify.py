@@ -323,6 +323,15 @@ def classify_trajectory(
     """
     if discard < 0 or not math.isfinite(discard):
         raise ValueError(f"discard = {discard!r} s must be >= 0")
+    if extend_to is not None and (
+        isinstance(extend_to, bool)
+        or not isinstance(extend_to, int | float)
+        or not math.isfinite(extend_to)
+        or extend_to < 0
+    ):
+        raise ValueError(
+            f"extend_to = {extend_to!r} s must be None (never extend) or a finite number >= 0"
+        )
     recorded = traj.settings["duration"] - traj.settings["transient"]
     if discard >= recorded:
         raise ValueError(

@@ -332,7 +332,12 @@ def lyapunov_model(
     period = p.cam_period
     tau = int(renorm_periods) * period
     n_stop = int(round(duration / dt))
-    wait = max(1, int(0.01 * period / dt)) if max_wait is None else int(max_wait)
+    from ._checks import whole
+
+    n_align = whole("n_align", n_align, low=0)
+    wait = (
+        max(1, int(0.01 * period / dt)) if max_wait is None else whole("max_wait", max_wait, low=1)
+    )
     scale = np.array([theta_scale, om_scale])
     settings = dict(
         method="benettin two-trajectory, kernel-driven",

@@ -269,13 +269,23 @@ def periodic_orbit(
     Limits: P is piecewise smooth (a grazing impact or the chattering threshold makes it
     jump), so Newton may fail where the orbit grazes; ``converged`` then stays False.
     """
+    from ._checks import params_arg, real, whole
+
     t0 = time.perf_counter()
-    n = int(period)
-    if n < 1:
-        raise ParameterError(f"period = {period}: must be an integer >= 1")
+    params = params_arg(params)
+    n = whole("period", period, low=1)
+    tol = real("tol", tol, low=0.0, strict=True, unit="rad")
+    max_iter = whole("max_iter", max_iter, low=0)
+    try:
+        x = np.array(x0, dtype=float)
+    except (TypeError, ValueError):
+        x = np.full(1, np.nan)
+    if x.shape != (2,) or not np.isfinite(x).all():
+        raise ParameterError(
+            f"x0 = {x0!r}: must be two finite numbers (theta_f [rad], omega_f [rad/s])"
+        )
     run = _MapRunner(params, n)
     w = np.array([1.0, params.cam_period])
-    x = np.asarray(x0, dtype=float).copy()
     fx, m, code = run(x)
     res = float(np.linalg.norm((fx - x) * w)) if code == k.OK else math.inf
     it = 0

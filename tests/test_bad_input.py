@@ -178,6 +178,19 @@ API_TYPE_CASES = [
         ParameterError,
         "flush_interval",
     ),
+    (lambda: chaoscam.periodic_orbit(Params(), [0.0, 0.0], 1.5), ParameterError, "period"),
+    (lambda: chaoscam.periodic_orbit(Params(), [0.0], 1), ParameterError, "x0"),
+    (lambda: chaoscam.periodic_orbit(Params(), [0.0, math.nan], 1), ParameterError, "x0"),
+    (lambda: chaoscam.periodic_orbit(Params(), [0.0, 0.0], 1, tol=-1), ParameterError, "tol"),
+    (lambda: chaoscam.contact_period(Params(), -1.0), ParameterError, "l_lambda"),
+    (lambda: chaoscam.contact_period(Params(), math.nan), ParameterError, "l_lambda"),
+    (lambda: chaoscam.lyapunov_model(duration=1.0, n_align=-1), ParameterError, "n_align"),
+    (lambda: chaoscam.lyapunov_model(duration=1.0, max_wait=-1), ParameterError, "max_wait"),
+    (
+        lambda: chaoscam.classify_trajectory(chaoscam.simulate(duration=0.5), extend_to=-1),
+        ValueError,
+        "extend_to",
+    ),
 ]
 
 

@@ -12,10 +12,11 @@ direction ``u = (cos theta_f, sin theta_f)``, upward normal ``n = (-sin theta_f,
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
-from ._params import Params
+from ._params import ParameterError, Params
 
 __all__ = [
     "cam_angle",
@@ -136,6 +137,11 @@ def contact_period(p: Params, l_lambda: float | None = None) -> float:
     more steps, and the adaptive path's cost grows as its inverse square
     (:func:`chaoscam._budget.adaptive_seconds`).
     """
-    lam = p.l_lambda if l_lambda is None else l_lambda
+    if l_lambda is None:
+        lam = p.l_lambda
+    else:
+        lam = float(l_lambda) if isinstance(l_lambda, numbers.Real) else math.nan
+        if isinstance(l_lambda, bool) or not (math.isfinite(lam) and lam > 0):
+            raise ParameterError(f"l_lambda = {l_lambda!r} m must be a finite number > 0")
     l1 = float(lever_arm(p, 0.0, contact_angle(p, 0.0)))
     return 2.0 * math.pi * math.sqrt(p.inertia / (p.stiffness_at(lam) * l1 * l1))
