@@ -483,14 +483,8 @@ def _classifier(quick: bool):
 
 
 def _fig6_classifier(quick: bool):
-    """Fig. 6's classifier: the full report's, extending an undetermined run to 120 s
-    recorded; the quick run does not extend (its fractal runs need dt ~ 2e-7-4e-7 s, ten
-    times the default cost per second).
-
-    Capped at 40 s (the full report at 6c80bc1), 12 of the 42 runs stayed undetermined, and
-    which of them did hung on the last bit of D: at 1.39 and 1.42 (G = 1e-9 m) the linspace
-    values were undetermined at 40 s and the literal 1.39 and 1.42 chaotic. Extended to 120 s,
-    10 of the 12 are chaotic (λ₁ = 0.14-0.25 per iterate) and 2 stay undetermined."""
+    """Fig. 6's classifier: the full report's (capped at 40 s, 12 of 42 runs stayed
+    undetermined, 2 at 120 s: README); the quick run does not extend (dt ~ 2e-7-4e-7 s)."""
     from ..sweep._tasks import DefaultClassifier
 
     return DefaultClassifier(extend_to=None if quick else FULL_EXTEND_TO)
@@ -498,7 +492,6 @@ def _fig6_classifier(quick: bool):
 
 QUICK_EXTEND_TO = 40.0
 """Recorded time [s] the quick report extends an undetermined run to."""
-
 FULL_EXTEND_TO = 120.0
 """Recorded time [s] the full report extends an undetermined run to (Fig. 6 included)."""
 
