@@ -67,6 +67,8 @@ def check_output(
     if path.is_dir():
         raise OutputError(f"{flag} {path}: is a directory; give a file name")
     folder = path.parent if str(path.parent) else Path(".")
+    if folder.exists() and not folder.is_dir():
+        raise OutputError(f"{flag} {path}: {folder} is a file, not a folder")
     if not folder.is_dir():
         raise OutputError(f"{flag} {path}: the folder {folder} does not exist; create it first")
     _probe(folder, f"{flag} {path}")
@@ -76,7 +78,8 @@ def check_output(
                 f"{flag} {path} exists; nothing was overwritten: choose another name, or "
                 "pass --force to replace it"
             )
-        if not os.access(path, os.W_OK):
+        # A dangling link is replaced like a file (os.replace swaps the name, not its target).
+        if path.exists() and not os.access(path, os.W_OK):
             raise OutputError(f"{flag} {path}: exists and is read-only")
     return path
 

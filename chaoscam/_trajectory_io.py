@@ -82,6 +82,8 @@ def load_trajectory(path) -> Trajectory:
     import pyarrow.parquet as pq
 
     path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{path}: is a folder; give a trajectory file (.parquet)")
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
     try:

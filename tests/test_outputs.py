@@ -321,3 +321,21 @@ def test_an_api_sweep_into_a_missing_folder_names_the_folder(tmp_path):
 
     with pytest.raises(OutputError, match=r"the folder .*nodir does not exist; create it first"):
         bifurcation("l_lambda", [0.008], duration=0.1, out=tmp_path / "nodir" / "x.parquet")
+
+
+def test_path_messages_say_what_the_path_is(tmp_path, capsys):
+    """A file where a folder is expected, a folder where a file is read, and a dangling link
+    under --force (replaced like a file): the message describes the actual path."""
+    (tmp_path / "f").write_text("a file")
+    with pytest.raises(OutputError, match="is a file, not a folder"):
+        check_output(tmp_path / "f" / "x.parquet")
+    (tmp_path / "d").mkdir()
+    assert main(["classify", str(tmp_path / "d")]) == 2
+    assert "is a folder" in capsys.readouterr().err
+    link = tmp_path / "l.parquet"
+    link.symlink_to(tmp_path / "missing" / "z.parquet")
+    with pytest.raises(OutputError, match="exists; nothing was overwritten"):
+        check_output(link)
+    assert check_output(link, force=True) == link
+    assert main(["simulate", "--duration", "0.05", "--out", str(link), "--force"]) == 0
+    assert not link.is_symlink() and pd.read_parquet(link).shape[0] > 0
