@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ._checks import real
 from ._extend import extend_trajectory
 from ._model_rules import MODEL_ATOL, with_model_evidence
 from ._simulate import Trajectory, simulate
@@ -323,15 +324,8 @@ def classify_trajectory(
     """
     if discard < 0 or not math.isfinite(discard):
         raise ValueError(f"discard = {discard!r} s must be >= 0")
-    if extend_to is not None and (
-        isinstance(extend_to, bool)
-        or not isinstance(extend_to, int | float)
-        or not math.isfinite(extend_to)
-        or extend_to < 0
-    ):
-        raise ValueError(
-            f"extend_to = {extend_to!r} s must be None (never extend) or a finite number >= 0"
-        )
+    if extend_to is not None:  # None: never extend
+        extend_to = real("extend_to", extend_to, low=0.0, unit="s")
     recorded = traj.settings["duration"] - traj.settings["transient"]
     if discard >= recorded:
         raise ValueError(

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from ._checks import whole
 from ._version import __version__
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
@@ -332,8 +333,6 @@ def lyapunov_model(
     period = p.cam_period
     tau = int(renorm_periods) * period
     n_stop = int(round(duration / dt))
-    from ._checks import whole
-
     n_align = whole("n_align", n_align, low=0)
     wait = (
         max(1, int(0.01 * period / dt)) if max_wait is None else whole("max_wait", max_wait, low=1)

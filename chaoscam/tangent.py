@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from ._checks import params_arg, real, whole
 from .analysis import TangentSpectrum, spectrum_from_jacobians
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
@@ -269,8 +270,6 @@ def periodic_orbit(
     Limits: P is piecewise smooth (a grazing impact or the chattering threshold makes it
     jump), so Newton may fail where the orbit grazes; ``converged`` then stays False.
     """
-    from ._checks import params_arg, real, whole
-
     t0 = time.perf_counter()
     params = params_arg(params)
     n = whole("period", period, low=1)

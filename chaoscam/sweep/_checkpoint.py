@@ -250,9 +250,7 @@ class CheckpointStore:
 
     def _check_manifest(self) -> None:
         try:
-            manifest = json.loads((self.path / "manifest.json").read_text())
-            if not isinstance(manifest, dict):
-                raise ValueError(f"a JSON {type(manifest).__name__}, not an object")
+            manifest = _read_manifest(self.path)
         except (OSError, ValueError) as err:
             raise SweepError(
                 f"{self.path}: no readable manifest.json ({err}); not a chaoscam checkpoint"
@@ -390,9 +388,18 @@ def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> 
     return not checkpoint_dir(outputs[0]).exists() and all(p.exists() for p in outputs)
 
 
+def _read_manifest(directory: Path) -> dict[str, Any]:
+    """A checkpoint's ``manifest.json``; OSError or ValueError when it cannot be read or is
+    not a JSON object."""
+    manifest = json.loads((directory / "manifest.json").read_text())
+    if not isinstance(manifest, dict):
+        raise ValueError(f"a JSON {type(manifest).__name__}, not an object")
+    return manifest
+
+
 def _checkpoint_hash(directory: Path) -> str | None:
     """The configuration hash in a checkpoint's manifest; None without a readable one."""
     try:
-        return json.loads((directory / "manifest.json").read_text()).get("hash")
-    except (OSError, ValueError, AttributeError):
+        return _read_manifest(directory).get("hash")
+    except (OSError, ValueError):
         return None
