@@ -10,6 +10,7 @@ T = 2 pi / omega, and optionally adds the model's own Lyapunov exponent
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import math
 import re
 import time
@@ -99,6 +100,29 @@ def _evidence_verdict(
     x = ser.loc[ser["t"] >= t0 - 1e-9 * period, "theta_f"].to_numpy(dtype=float)
     dt = float(traj.settings["output_dt"])
     return classify_signal(x, dt, period, section=points, lyapunov=lyap, **opts)
+
+
+# What **options may name: the analysis classifiers' settings, not the inputs this module
+# builds from the trajectory (the samples, the section, the exponents).
+_BUILT_HERE = {"x", "dt", "forcing_period", "section", "points", "lyapunov", "exponent"}
+_OPTIONS = sorted(
+    (
+        set(inspect.signature(classify_signal).parameters)
+        | set(inspect.signature(classify_section).parameters)
+    )
+    - _BUILT_HERE
+    - {"exponent_time"}
+)
+
+
+def _check_options(options: dict) -> None:
+    """Refuse an option no analysis classifier takes, naming the ones they do."""
+    unknown = sorted(set(options) - set(_OPTIONS))
+    if unknown:
+        raise TypeError(
+            f"classify_trajectory got an unknown option {unknown[0]!r}; the analysis "
+            f"options are: {', '.join(_OPTIONS)}"
+        )
 
 
 def _model_options(options: dict, period: float) -> dict:
@@ -322,6 +346,7 @@ def classify_trajectory(
         integer status code) and the reason; it is not classified. ``settings`` records the
         trajectory's provenance and these options.
     """
+    _check_options(options)
     if discard < 0 or not math.isfinite(discard):
         raise ValueError(f"discard = {discard!r} s must be >= 0")
     if extend_to is not None:  # None: never extend

@@ -191,6 +191,20 @@ API_TYPE_CASES = [
         ValueError,
         "extend_to",
     ),
+    (
+        lambda: chaoscam.classify_trajectory(chaoscam.simulate(duration=0.5), bogus=1),
+        TypeError,
+        "classify_trajectory got an unknown option 'bogus'.*rtol",
+    ),
+    (lambda: Params(omega=np.array([28.0, 29.0])), ParameterError, "omega"),
+    (lambda: chaoscam.simulate_reference(Params(), -1.0), ParameterError, "duration"),
+    (lambda: chaoscam.simulate_reference(Params(), math.nan), ParameterError, "duration"),
+    (
+        lambda: chaoscam.simulate_reference(Params(), 0.01, max_pieces=0),
+        ParameterError,
+        "max_pieces",
+    ),
+    (lambda: chaoscam.simulate_reference(Params(), 0.01, rtol=0.0), ParameterError, "rtol"),
 ]
 
 

@@ -310,7 +310,12 @@ def test_a_classifier_that_is_not_callable_is_a_usage_error(tmp_path, capsys):
     names it, no traceback, and no checkpoint left behind."""
     assert main(_bif(tmp_path / "b.parquet", "--classifier", "math:pi")) == 2
     err = capsys.readouterr().err
-    assert "--classifier math:pi" in err and "not a function" in err and "Traceback" not in err
+    assert "--classifier math:pi" in err and "cannot be called" in err and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+    # A class whose instances cannot be called: said so, not "int is a int".
+    assert main(_bif(tmp_path / "b.parquet", "--classifier", "builtins:int")) == 2
+    err = capsys.readouterr().err
+    assert "int() makes 0 (type int), which cannot be called" in err
     assert list(tmp_path.iterdir()) == []
 
 

@@ -177,8 +177,16 @@ def simulate_reference(
     max_pieces : int
         Guard on the number of restarts (chattering); a RuntimeError past it.
     """
+    from .._checks import params_arg, real, whole
     from ..model import contact_angle, contact_angle_rate
 
+    p = params_arg(p)
+    duration = real("duration", duration, low=0.0, strict=True, unit="s")
+    seed, index = whole("seed", seed), whole("index", index)
+    # solve_ivp raises rtol below 100 x machine epsilon itself, with a warning.
+    rtol = real("rtol", rtol, low=0.0, strict=True)
+    atol = real("atol", atol, low=0.0, strict=True)
+    max_pieces = whole("max_pieces", max_pieces, low=1)
     stream = LineLengthStream(p, seed, index)
     lam = float(stream.draw(1)[0])
     th = contact_angle(p, 0.0) if p.theta_f0 is None else p.theta_f0

@@ -331,8 +331,8 @@ class Params:
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
-            if type(value).__module__ == "numpy":  # numpy scalars: stored as Python numbers
-                value = value.item()
+            if type(value).__module__ == "numpy" and getattr(value, "size", 0) == 1:
+                value = value.item()  # numpy scalars: stored as Python numbers
                 object.__setattr__(self, f.name, value)
             _validate_field(f, value)
         if self.stiffness == "fractal":

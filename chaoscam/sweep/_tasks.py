@@ -116,15 +116,18 @@ def load_classifier(spec: str) -> Callable:
     if not sep or not module or not name:
         raise ValueError(f"classifier {spec!r}: expected MODULE:NAME")
     obj = getattr(importlib.import_module(module), name)
-    if isinstance(obj, type):
+    made = isinstance(obj, type)
+    if made:
         try:
             obj = obj()
         except TypeError as err:
             raise ValueError(f"the class {name} cannot be made without arguments ({err})") from None
     if not callable(obj):
+        what = f"{name}() makes" if made else f"{name} is"
         raise ValueError(
-            f"{name} is a {type(obj).__name__} ({obj!r}), not a function or a class; a "
-            "classifier takes a trajectory and returns a verdict"
+            f"{what} {obj!r} (type {type(obj).__name__}), which cannot be called; a classifier "
+            "is a function, or a class whose instances are called, taking a trajectory and "
+            "returning a verdict"
         )
     return obj
 
