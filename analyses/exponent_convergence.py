@@ -105,4 +105,10 @@ def main(quick: bool) -> None:
 
 
 if __name__ == "__main__":
-    main("--quick" in sys.argv[1:])
+    import argparse
+
+    ap = argparse.ArgumentParser(
+        prog="analyses/exponent_convergence.py", description=__doc__.splitlines()[0]
+    )
+    ap.add_argument("--quick", action="store_true", help="fewer steps and shorter runs")
+    main(ap.parse_args(sys.argv[1:]).quick)

@@ -1,7 +1,8 @@
 """Paper Fig. 10, reproduced: mu = 0.023 m (regime map shared by Figs. 7-10).
 
 Writes its data and a PNG into OUTDIR; ``chaoscam paper`` runs the same code.
-Usage: python analyses/fig10.py [--quick] [OUTDIR]   (default OUTDIR: reports/paper-data)
+Usage: python analyses/fig10.py [--quick] [--force] [--workers N] [OUTDIR]
+(default OUTDIR: reports/paper-data; its existing files are replaced only with --force)
 """
 
 from chaoscam.experiments import figure_script

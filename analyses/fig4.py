@@ -1,7 +1,8 @@
 """Paper Fig. 4, reproduced: bifurcation of theta_f over l_lambda in [0.001, 0.018] m.
 
 Writes its data and a PNG into OUTDIR; ``chaoscam paper`` runs the same code.
-Usage: python analyses/fig4.py [--quick] [OUTDIR]   (default OUTDIR: reports/paper-data)
+Usage: python analyses/fig4.py [--quick] [--force] [--workers N] [OUTDIR]
+(default OUTDIR: reports/paper-data; its existing files are replaced only with --force)
 """
 
 from chaoscam.experiments import figure_script

@@ -1,7 +1,8 @@
 """Paper Fig. 5, reproduced: fractal stiffness K_n over D for three G.
 
 Writes its data and a PNG into OUTDIR; ``chaoscam paper`` runs the same code.
-Usage: python analyses/fig5.py [--quick] [OUTDIR]   (default OUTDIR: reports/paper-data)
+Usage: python analyses/fig5.py [--quick] [--force] [--workers N] [OUTDIR]
+(default OUTDIR: reports/paper-data; its existing files are replaced only with --force)
 """
 
 from chaoscam.experiments import figure_script

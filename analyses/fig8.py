@@ -1,7 +1,8 @@
 """Paper Fig. 8, reproduced: mu = 0.008 m, sigma up to 0.004 m (regime map shared by Figs. 7-10).
 
 Writes its data and a PNG into OUTDIR; ``chaoscam paper`` runs the same code.
-Usage: python analyses/fig8.py [--quick] [OUTDIR]   (default OUTDIR: reports/paper-data)
+Usage: python analyses/fig8.py [--quick] [--force] [--workers N] [OUTDIR]
+(default OUTDIR: reports/paper-data; its existing files are replaced only with --force)
 """
 
 from chaoscam.experiments import figure_script

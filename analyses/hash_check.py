@@ -104,8 +104,13 @@ def hashes() -> dict[str, str]:
 
 
 def main(argv: list[str]) -> int:
+    import argparse
+
+    ap = argparse.ArgumentParser(prog="analyses/hash_check.py", description=__doc__.splitlines()[0])
+    ap.add_argument("--write", action="store_true", help=f"store the hashes in {STORE.name}")
+    args = ap.parse_args(argv)
     now = hashes()
-    if "--write" in argv:
+    if args.write:
         STORE.write_text(json.dumps(now, indent=1) + "\n")
         print(f"wrote {len(now)} hashes to {STORE}")
         return 0

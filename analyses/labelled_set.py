@@ -258,16 +258,30 @@ def _settle(m: dict) -> tuple[str, int | None, str]:
 
 def main(argv: list[str]) -> None:
     """``[OUT.json]`` measures and settles; ``--from IN.json [OUT.json]`` only re-applies the
-    rules to measurements made before."""
-    old = {}
-    configs, default = CONFIGS, "labelled_set.json"
-    if argv[:1] == ["--holdout"]:
-        configs, default = HOLDOUT, "holdout_set.json"
-        argv = argv[1:]
-    if argv[:1] == ["--from"]:
-        old = json.loads(Path(argv[1]).read_text())
-        argv = argv[2:]
-    out = Path(argv[0]) if argv else Path(__file__).parents[1] / "tests/data" / default
+    rules to measurements made before. OUT is checked before the hours of measurement: an
+    existing file (the default is the tests' truth, ``tests/data/``) is replaced only with
+    ``--force``, and it is written whole or not at all."""
+    import argparse
+
+    from chaoscam._outputs import OutputError, atomic_write_bytes, check_output
+
+    ap = argparse.ArgumentParser(
+        prog="analyses/labelled_set.py", description=__doc__.splitlines()[0]
+    )
+    ap.add_argument("out", nargs="?", metavar="OUT.json", help="default: tests/data/NAME.json")
+    ap.add_argument("--holdout", action="store_true", help="the holdout configurations")
+    ap.add_argument("--from", dest="source", metavar="IN.json", help="re-settle these")
+    ap.add_argument("--force", action="store_true", help="replace an existing OUT.json")
+    args = ap.parse_args(argv)
+    configs, default = (
+        (HOLDOUT, "holdout_set.json") if args.holdout else (CONFIGS, "labelled_set.json")
+    )
+    out = Path(args.out) if args.out else Path(__file__).parents[1] / "tests/data" / default
+    try:
+        check_output(out, flag="OUT.json", force=args.force, suffixes=(".json",))
+        old = json.loads(Path(args.source).read_text()) if args.source else {}
+    except (OutputError, OSError, ValueError) as err:
+        ap.error(str(err))
     table = {}
     for name, overrides in configs.items():
         t0 = time.perf_counter()
@@ -283,8 +297,8 @@ def main(argv: list[str]) -> None:
             f"{name:>22}: {label:<13} {period or '':>3}  {why}  ({m['wall_time_s']:.0f} s)",
             flush=True,
         )
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(table, indent=1, default=float) + "\n")
+    text = json.dumps(table, indent=1, default=float) + "\n"
+    atomic_write_bytes(out, text.encode(), replace=args.force)
     print(f"wrote {out}")
 
 

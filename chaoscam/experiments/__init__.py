@@ -17,6 +17,7 @@ from .._lazy import lazy_face
 _LAZY = {
     "FIGURES": ("._paper", "FIGURES"),
     "FigureResult": ("._paper", "FigureResult"),
+    "SENSITIVITY": ("._paper", "SENSITIVITY"),
     "data_files": ("._paper", "data_files"),
     "figure_script": ("._run", "figure_script"),
     "run_paper": ("._run", "run_paper"),

@@ -169,17 +169,60 @@ def run_paper(
     return write_report(parts, out, title=title, command=command)
 
 
-def figure_script(number: int, argv: list[str] | None = None) -> None:
-    """The body of ``analyses/figN.py``: run Fig. ``number``, print what it found.
+def figure_script(number: int, argv: list[str] | None = None) -> int:
+    """The body of ``analyses/figN.py`` (and, for :data:`SENSITIVITY`,
+    ``analyses/sensitivity.py``): run one stage of ``chaoscam paper``, print what it found.
 
-    Usage: ``python analyses/figN.py [--quick] [OUTDIR]`` (default OUTDIR: reports/paper-data).
+    Usage: ``python analyses/figN.py [--quick] [--force] [--workers N] [OUTDIR]`` (default
+    OUTDIR: reports/paper-data, created when missing). The stage's data files
+    (:func:`data_files`) are checked before any work, as ``chaoscam paper`` checks them: an
+    existing one is replaced only with ``--force`` (the committed ``reports/paper-data``
+    holds the full report's data, which a ``--quick`` run would otherwise overwrite). Bad
+    arguments or outputs: exit 2 with one line; Ctrl-C: exit 130 with one line. Returns the
+    exit code (0) when it finishes.
     """
+    import argparse
     import sys
 
-    argv = sys.argv[1:] if argv is None else argv
-    args = [a for a in argv if a != "--quick"]
-    outdir = Path(args[0] if args else "reports/paper-data")
-    outdir.mkdir(parents=True, exist_ok=True)
-    result = FIGURES[number]("--quick" in argv, outdir)
+    from .._outputs import OutputError, check_output
+
+    name = "sensitivity" if number == SENSITIVITY else f"fig{number}"
+    what = "the sensitivity sweeps" if number == SENSITIVITY else f"Fig. {number}"
+    ap = argparse.ArgumentParser(
+        prog=f"analyses/{name}.py",
+        description=f"Run {what} of the paper report and write its data and PNG into OUTDIR.",
+    )
+    ap.add_argument(
+        "outdir",
+        nargs="?",
+        default="reports/paper-data",
+        metavar="OUTDIR",
+        help="folder for the data and PNG (default: reports/paper-data)",
+    )
+    ap.add_argument("--quick", action="store_true", help="the quick report's grids")
+    ap.add_argument("--force", action="store_true", help="replace this stage's files in OUTDIR")
+    ap.add_argument("--workers", type=int, default=None, help="cores (default: all)")
+    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    outdir = Path(args.outdir)
+    try:
+        if outdir.exists() and not outdir.is_dir():
+            raise OutputError(f"OUTDIR {outdir}: is a file, not a folder")
+        outdir.mkdir(parents=True, exist_ok=True)
+        for file in data_files(number):
+            check_output(outdir / file, flag="OUTDIR", force=args.force)
+    except (OutputError, OSError) as err:
+        ap.error(str(err))  # exit 2
+    fn = _sensitivity_stage if number == SENSITIVITY else FIGURES[number]
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            result = fn(args.quick, outdir, workers=args.workers)
+    except KeyboardInterrupt:
+        print(f"{ap.prog}: interrupted; run it again with --force", file=sys.stderr)
+        raise SystemExit(130) from None
     for c in result.comparisons:
         print(f"{c.figure}: {c.verdict} - {c.found} ({c.reason})")
+    for line in result.why:
+        print(f"Why the paper differs: {line}")
+    print(f"wrote {', '.join(data_files(number))} in {outdir}")
+    return 0

@@ -25,3 +25,55 @@ def test_fig5_script_writes_data_and_figure(tmp_path):
     assert "Fig. 5" in out.stdout
     data = list(tmp_path.glob("*.csv")) + list(tmp_path.glob("*.parquet"))
     assert list(tmp_path.glob("*.png")) and data
+
+
+def _script(name, *args):
+    return subprocess.run(
+        [sys.executable, str(ROOT / "analyses" / name), *args],
+        capture_output=True,
+        text=True,
+    )
+
+
+def test_a_script_replaces_existing_files_only_with_force(tmp_path):
+    """A second run into the same folder is refused (exit 2, one line naming a file, the
+    files kept: the committed reports/paper-data would otherwise be overwritten by a quick
+    run); with --force it replaces them."""
+    assert _script("fig5.py", "--quick", str(tmp_path)).returncode == 0
+    before = {p.name: p.stat().st_mtime_ns for p in tmp_path.iterdir()}
+    again = _script("fig5.py", "--quick", str(tmp_path))
+    assert again.returncode == 2 and "Traceback" not in again.stderr
+    assert "--force" in again.stderr and "fig5" in again.stderr
+    assert {p.name: p.stat().st_mtime_ns for p in tmp_path.iterdir()} == before
+    forced = _script("fig5.py", "--quick", "--force", str(tmp_path))
+    assert forced.returncode == 0
+    assert all(p.stat().st_mtime_ns != before[p.name] for p in tmp_path.iterdir())
+
+
+def test_a_script_explains_itself_and_refuses_what_it_does_not_know(tmp_path):
+    """--help prints the usage and creates nothing (it used to make a folder named
+    '--help'); an unknown option and an OUTDIR that is a file: exit 2 without a traceback."""
+    helped = subprocess.run(
+        [sys.executable, str(ROOT / "analyses" / "sensitivity.py"), "--help"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert helped.returncode == 0 and "--force" in helped.stdout and "OUTDIR" in helped.stdout
+    assert list(tmp_path.iterdir()) == []
+    wrong = _script("fig4.py", "--quik", str(tmp_path))
+    assert wrong.returncode == 2 and "--quik" in wrong.stderr and "Traceback" not in wrong.stderr
+    (tmp_path / "file").write_text("x")
+    onto_file = _script("fig3.py", "--quick", str(tmp_path / "file"))
+    assert onto_file.returncode == 2 and "is a file" in onto_file.stderr
+    assert list(tmp_path.iterdir()) == [tmp_path / "file"]
+
+
+def test_labelled_set_refuses_to_overwrite_the_truth_before_measuring(tmp_path):
+    """analyses/labelled_set.py checks OUT.json before hours of measurement: an existing
+    file (by default the tests' truth) is refused without --force, at once, and kept."""
+    out = tmp_path / "truth.json"
+    out.write_text("{}")
+    run = _script("labelled_set.py", str(out))
+    assert run.returncode == 2 and "--force" in run.stderr and "Traceback" not in run.stderr
+    assert out.read_text() == "{}"
