@@ -306,7 +306,11 @@ def classify_trajectory(
         converged, attracting (|μ| < 1) and with the run on it, it is recorded as the
         decisive evidence ``periodic_orbit``; a converged *unstable* orbit makes the
         verdict "undetermined". ``settings["tangent"]`` and ``settings["periodic_orbit"]``
-        record the numbers. False: the series-based evidence below.
+        record the numbers. False: the series-based evidence below, which has no exponent
+        through the impacts and so cannot tell n narrow chaotic bands from a period n
+        (measured: l_lambda = 11 mm, sigma = 1.5 mm, seed 1, 20 s: periodic 8 with
+        tangent=False; the tangent path finds lambda_1 = +0.69 +- 0.05 per iterate and
+        calls the same run 8-band chaos).
     lyapunov : bool
         Also compute the model's largest Lyapunov exponent through the impacts
         (:func:`chaoscam.lyapunov.lyapunov_model`, same params, duration, transient, seed,
