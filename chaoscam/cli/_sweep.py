@@ -81,8 +81,9 @@ def _common(p: argparse.ArgumentParser) -> None:
         type=float,
         default=None,
         metavar="S",
-        help="continue each run not labelled periodic to S seconds (> --duration) and record "
-        "whether it leaves the cam's reach before (columns fate, left_at): transient chaos",
+        help="continue each run labelled chaotic, quasiperiodic or undetermined to S seconds "
+        "(> --duration) and record whether it leaves the cam's reach before (columns fate, "
+        "left_at): transient chaos",
     )
     p.add_argument("--plot", type=Path, default=None, help="also draw the figure to FILE.png/pdf")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -208,17 +209,18 @@ def _execution(args) -> dict:
 
 def _transient(table) -> str:
     """The summary line of a sweep with a fate horizon: how many runs left later."""
-    from ..sweep._stats import fate_split
+    from ..sweep._stats import continued_labels, fate_split
 
     checked, left = fate_split(table)
     if not len(checked):
         return ""
     if not len(left):
-        return "\nfate: every run not labelled periodic stayed in the cam's reach"
+        return f"\nfate: every run {continued_labels(checked)} stayed in the cam's reach"
+    t0, t1 = f"{left['left_at'].min():.4g}", f"{left['left_at'].max():.4g}"
     return (
-        f"\nfate: {len(left)} run(s) not labelled periodic stopped later "
-        f"({_counts(left['fate'])}; last section at {left['left_at'].min():.4g}–"
-        f"{left['left_at'].max():.4g} s): transient motion"
+        f"\nfate: {len(left)} of the {len(checked)} run(s) {continued_labels(checked)} "
+        f"stopped later ({_counts(left['fate'])}; last section at "
+        f"{t0 if t0 == t1 else f'{t0}–{t1}'} s): transient motion"
     )
 
 

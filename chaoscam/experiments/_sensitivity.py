@@ -55,8 +55,9 @@ def _runs_text(runs, fmt="{:.3g}") -> str:
 
 FATE_S = {True: 100.0, False: 300.0}
 """The fate horizon [s] of the restitution sweep and the (omega, xi) map, quick and full:
-runs not labelled periodic go on to it, to see whether they stay in the cam's reach (the
-full one covers (42.5 rad/s, 0.40), chaotic for 229 s and then out of reach)."""
+runs labelled chaotic, quasiperiodic or undetermined go on to it, to see whether they stay in
+the cam's reach (the full one covers (42.5 rad/s, 0.40), chaotic for 229 s and then out of
+reach)."""
 
 XI_WINDOW = 0.05
 """Half-width of the neighbourhood of Table 1's ξ that the restitution finding looks at."""
@@ -103,17 +104,20 @@ def restitution_finding(v: pd.DataFrame, xi0: float, stiffness_tags: list[str]) 
 
 
 def transient_finding(rows: pd.DataFrame, horizon: float, what: str) -> str:
-    """The sentence on transient motion: of the runs not labelled periodic (continued to the
-    fate ``horizon``), how many stop before it, when, and how many of those were labelled
-    chaotic over the recorded window; from ``rows`` with columns label, fate and left_at.
+    """The sentence on transient motion: of the runs labelled chaotic, quasiperiodic or
+    undetermined (continued to the fate ``horizon``), how many stop before it, when, and how
+    many of those were labelled chaotic over the recorded window; from ``rows`` with columns
+    label, fate and left_at.
     ``what`` names one run ("cell", "value"). Empty when no run was continued."""
-    from ..sweep._stats import fate_split
+    from ..sweep._stats import continued_labels, fate_split
 
     checked, left = fate_split(rows)
     if not len(checked):
         return ""
     n = len(checked)
-    head = f" Continued to {horizon:g} s, the {n} {what}{'s' * (n != 1)} not labelled periodic"
+    head = (
+        f" Continued to {horizon:g} s, the {n} {what}{'s' * (n != 1)} {continued_labels(checked)}"
+    )
     if not len(left):
         return head + (" all stay" if n != 1 else " stays") + " in the cam's reach."
     verb = {"LEFT_REACH": ("leaves the cam's reach", "leave the cam's reach")}

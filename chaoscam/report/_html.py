@@ -339,14 +339,14 @@ def add_regime_map(
 def _fate_text(rows, fate, what: str) -> str:
     """The summary's clause on a sweep's fate horizon: how many of the continued runs
     stopped before it (transient motion); empty without a horizon."""
-    from ..sweep._stats import fate_split
+    from ..sweep._stats import continued_labels, fate_split
 
     if not fate:
         return ""
     checked, stopped = fate_split(rows)
     return (
         f"; continued to {float(fate):g} s, {len(stopped)} of the {len(checked)} {what} "
-        "not labelled periodic stop before it (transient motion)"
+        f"{continued_labels(checked)} stop before it (transient motion)"
     )
 
 

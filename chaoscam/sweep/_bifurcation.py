@@ -253,9 +253,10 @@ def bifurcation(
         holds members of one omega and dt, so a sweep over ``omega`` or ``dt`` batches the
         conditions of each value.
     fate : float, optional
-        As for :func:`regime_map`: runs not labelled periodic are continued to this time
-        [s] to see whether they stay in the cam's reach (verdict columns ``fate`` and
-        ``left_at``); a continued chain still starts its next value from the recorded run.
+        As for :func:`regime_map`: runs labelled chaotic, quasiperiodic or undetermined are
+        continued to this time [s] to see whether they stay in the cam's reach (verdict
+        columns ``fate`` and ``left_at``); a continued chain still starts its next value
+        from the recorded run.
 
     Returns
     -------

@@ -57,8 +57,8 @@ def check_fate(fate: float | None, duration: float) -> float | None:
         isinstance(fate, int | float) and math.isfinite(fate) and fate > duration
     ):
         raise SweepError(
-            f"fate = {fate!r} s: the time to which runs not labelled periodic are continued "
-            f"must be a finite number > duration = {duration:g} s"
+            f"fate = {fate!r} s: the time to which runs labelled chaotic, quasiperiodic or "
+            f"undetermined are continued must be a finite number > duration = {duration:g} s"
         )
     return float(fate)
 

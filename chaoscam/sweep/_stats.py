@@ -183,3 +183,14 @@ def fate_split(rows: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
         return rows.iloc[:0], rows.iloc[:0]
     checked = rows[rows["fate"].notna()]
     return checked, checked[checked["fate"] != "OK"]
+
+
+def continued_labels(checked: pd.DataFrame) -> str:
+    """How the continued rows were labelled, for a sentence: "labelled chaotic or
+    undetermined" (runs that already left the cam's reach are not continued, so "not
+    labelled periodic" would overcount)."""
+    labels = [x for x in ("chaotic", "quasiperiodic", "undetermined") if x in set(checked["label"])]
+    if not labels:
+        return "continued"
+    head = ", ".join(labels[:-1])
+    return "labelled " + (f"{head} or {labels[-1]}" if head else labels[-1])

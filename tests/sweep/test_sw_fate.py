@@ -119,10 +119,12 @@ def test_the_report_sentence_is_computed_from_the_rows():
         }
     )
     s = transient_finding(rows, 300.0, "cell")
-    assert "the 3 cells not labelled periodic: 2 leave the cam's reach" in s
+    # Named by their labels: the runs that already left the cam's reach are not continued,
+    # so "not labelled periodic" overcounted them (the committed report said 51 of 98).
+    assert "the 3 cells labelled chaotic or undetermined: 2 leave the cam's reach" in s
     assert "(last section at 27.9–229 s), 1 labelled chaotic" in s and "transient chaos" in s
     assert transient_finding(rows.iloc[[1]], 300.0, "value").endswith(
-        "the 1 value not labelled periodic stays in the cam's reach."
+        "the 1 value labelled chaotic stays in the cam's reach."
     )
     assert "none labelled chaotic" in transient_finding(rows.iloc[1:3], 300.0, "cell")
     assert transient_finding(rows.iloc[[3]], 300.0, "cell") == ""
@@ -159,8 +161,23 @@ def test_the_html_report_summary_counts_the_transient_runs(maps, tmp_path):
     out = tmp_path / "r.html"
     assert main(["report", str(path), "--out", str(out)]) == 0
     text = out.read_text()
-    assert "continued to 40 s, 1 of the 1 realizations not labelled periodic stop" in text
+    assert "continued to 40 s, 1 of the 1 realizations labelled chaotic stop" in text
     plain = regime_map(OMEGA, Axis("xi", (0.4,)), duration=2.0, transient=1.0, workers=1)
     plain.to_parquet(tmp_path / "p.parquet")
     assert main(["report", str(tmp_path / "p.parquet"), "--out", str(tmp_path / "p.html")]) == 0
     assert "continued to" not in (tmp_path / "p.html").read_text()
+
+
+def test_the_command_line_summary_names_the_continued_runs(tmp_path, capsys):
+    """`regime-map --fate`: the summary counts the continued runs by their labels (the run
+    that left the cam's reach within the recorded window is not one of them) and gives a
+    single time as one number. (25 rad/s, 0.70): chaotic over 2 s, out of reach at 27.9 s."""
+    from chaoscam.cli import main
+
+    argv = ["regime-map", "--x", "omega=25,42.5", "--y", "xi=0.7", "--duration", "4"]
+    argv += ["--transient", "2", "--fate", "40", "--workers", "1", "--quiet"]
+    assert main([*argv, "--out", str(tmp_path / "f.parquet")]) == 0
+    out = capsys.readouterr().out
+    assert "labels: chaotic 1, left_reach 1" in out
+    assert "fate: 1 of the 1 run(s) labelled chaotic stopped later (LEFT_REACH 1; " in out
+    assert "last section at 27.9 s): transient motion" in out
