@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import shlex
+import sys
 from pathlib import Path
 
 __all__ = ["register"]
@@ -98,10 +99,14 @@ def run_report(args: argparse.Namespace) -> int:
 def run_paper(args: argparse.Namespace) -> int:
     from ..experiments import FIGURES
     from ..experiments import run_paper as _run
+    from ..sweep._backends import local_workers
     from . import UsageError
 
-    if args.workers is not None and args.workers < 1:
-        raise UsageError(f"--workers {args.workers}: must be >= 1")
+    if args.workers is not None:
+        try:
+            local_workers(args.workers)  # what every sweep of the report would refuse
+        except ValueError as err:
+            raise UsageError(f"--workers {args.workers}: {err}") from None
     figures = None
     if args.figures is not None:
         try:
@@ -121,7 +126,7 @@ def run_paper(args: argparse.Namespace) -> int:
         + (["--workers", str(args.workers)] if args.workers else [])
         + ["--out", str(args.out)]
     )
-    _run(
+    run = _run(
         quick=args.quick,
         out=args.out,
         figures=figures,
@@ -131,4 +136,11 @@ def run_paper(args: argparse.Namespace) -> int:
         force=args.force,
     )
     print(f"report: {args.out}")
+    if run.failed:
+        print(
+            f"chaoscam: {len(run.failed)} stage(s) failed, the report says what is missing:\n  "
+            + "\n  ".join(run.failed),
+            file=sys.stderr,
+        )
+        return 1
     return 0

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import time
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -23,17 +24,28 @@ from ._paper import (
     data_files,
 )
 
-__all__ = ["check_paper_outputs", "figure_script", "run_paper"]
+__all__ = ["PaperRun", "check_paper_outputs", "figure_script", "run_paper"]
+
+
+@dataclass(frozen=True)
+class PaperRun:
+    """What :func:`run_paper` did: the report's path and the stages that failed (each
+    "title: failed with Error: message", as the report's "What is missing" names them; a
+    failed stage does not stop the others)."""
+
+    path: Path
+    failed: tuple[str, ...] = ()
+
 
 STAGE_TITLES = {
-    FIGURES[3]: "Fig. 3: line-length draws",
-    FIGURES[4]: "Fig. 4: bifurcation over l_λ",
-    FIGURES[5]: "Fig. 5: fractal stiffness",
-    FIGURES[6]: "Fig. 6: bifurcation over D",
-    FIGURES[7]: "Figs. 7–10: random line length",
-    _sensitivity_stage: "why the paper differs: sensitivity sweeps",
+    3: "Fig. 3: line-length draws",
+    4: "Fig. 4: bifurcation over l_λ",
+    5: "Fig. 5: fractal stiffness",
+    6: "Fig. 6: bifurcation over D",
+    7: "Figs. 7–10: random line length",
+    SENSITIVITY: "why the paper differs: sensitivity sweeps",
 }
-"""What ``chaoscam paper`` calls each stage on the terminal."""
+"""What ``chaoscam paper`` calls each stage (by its first figure number) on the terminal."""
 
 
 def check_paper_outputs(out: str | Path, figures=None, *, force: bool = False) -> Path:
@@ -68,14 +80,19 @@ def run_paper(
     command=None,
     echo=False,
     force: bool = False,
-) -> Path:
+) -> PaperRun:
     """Run the figure scripts and write the report (data and PNGs in ``OUT_DIR/paper-data``).
 
-    Every output is checked first (:func:`check_paper_outputs`): existing files are replaced
-    only with ``force``. With ``echo`` (the command line), each stage's start and duration
-    go to stderr and the findings, figure by figure, to stdout.
+    Every output is checked first (:func:`check_paper_outputs`), and ``workers`` too
+    (:func:`chaoscam.sweep.local_workers`, a ValueError naming it): existing files are
+    replaced only with ``force``. With ``echo`` (the command line), each stage's start and
+    duration go to stderr and the findings, figure by figure, to stdout. A stage that raises
+    is reported in the report's "What is missing" and in :attr:`PaperRun.failed`; the
+    others still run.
     """
     import sys
+
+    from ..sweep._backends import local_workers
 
     def say(text: str) -> None:
         if echo:
@@ -97,38 +114,53 @@ def run_paper(
                 f"figures = {figures}: choose from {sorted(FIGURES)} (None: every figure and "
                 "the sensitivity sweeps)"
             )
+    if workers is not None:
+        local_workers(workers)  # before any work: every sweep would refuse it
     out = Path(out)
     outdir = check_paper_outputs(out, figures, force=force)
     outdir.mkdir(exist_ok=True)
     wanted = sorted(set(figures or FIGURES))
-    funcs = []
+    stages: dict = {}  # function -> its first figure number (Figs. 7-10 share one)
     for number in wanted:
-        if FIGURES[number] not in funcs:
-            funcs.append(FIGURES[number])
+        stages.setdefault(FIGURES[number], number)
     if figures is None:  # the whole report: also the sweeps that explain the differences
-        funcs.append(_sensitivity_stage)
+        stages[_sensitivity_stage] = SENSITIVITY
+    funcs = list(stages)
     parts = ReportParts()
     t_all = time.perf_counter()
     results = []
+    failed: list[str] = []
+    ran = set()
     for stage, fn in enumerate(funcs, 1):
         t0 = time.perf_counter()
-        title = STAGE_TITLES.get(fn, fn.__name__)
+        title = STAGE_TITLES.get(stages[fn], fn.__name__)
         say(f"[{stage}/{len(funcs)}] {title} ...")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             try:
                 r = fn(quick, outdir, workers=workers)
             except Exception as err:  # a figure that fails is reported, not hidden
-                parts.missing.append(f"{title}: failed with {type(err).__name__}: {err}")
+                failed.append(f"{title}: failed with {type(err).__name__}: {err}")
+                parts.missing.append(failed[-1])
+                say(f"[{stage}/{len(funcs)}] {failed[-1]}")
                 continue
         r.seconds = time.perf_counter() - t0
+        ran.add(fn)
         say(f"[{stage}/{len(funcs)}] {title}: {r.seconds:.0f} s")
         results.append(r)
     total = time.perf_counter() - t_all
+    done = [n for n in wanted if FIGURES[n] in ran]
+    if done == sorted(FIGURES):
+        done_text = "Figs. 3–10"
+    else:
+        done_text = (
+            f"{'Fig.' if len(done) == 1 else 'Figs.'} {', '.join(map(str, done)) or '(none)'}"
+        )
     parts.summary.append(
-        f"{'Quick' if quick else 'Full'} reproduction of the paper's Figs. "
-        f"{', '.join(map(str, wanted))} in {total:.0f} s "
+        f"{'Quick' if quick else 'Full'} reproduction of the paper's {done_text} "
+        f"in {total:.0f} s "
         f"({', '.join(f'{r.name}: {r.seconds:.0f} s' for r in results)})."
+        + (f" {len(failed)} of {len(funcs)} stages failed (see What is missing)." if failed else "")
     )
     for r in results:
         before = (len(parts.paper_figures), len(parts.regime_maps), len(parts.bifurcations))
@@ -165,8 +197,10 @@ def run_paper(
             f"({FULL_EXTEND_TO:g} s in the full report); "
             "run `chaoscam paper` without --quick for the full grids."
         )
-    title = "chaoscam: the paper's Figs. 3–10 reproduced" + (" (quick run)" if quick else "")
-    return write_report(parts, out, title=title, command=command)
+    title = f"chaoscam: the paper's {done_text} reproduced" + (" (quick run)" if quick else "")
+    if failed:
+        title += f" (incomplete: {len(failed)} of {len(funcs)} stages failed)"
+    return PaperRun(write_report(parts, out, title=title, command=command), tuple(failed))
 
 
 def figure_script(number: int, argv: list[str] | None = None) -> int:

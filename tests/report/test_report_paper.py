@@ -71,7 +71,8 @@ def test_sequence_rule_finds_the_papers_order_and_nothing_else():
 
 
 def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch, capsys):
-    """A figure script that raises leaves a report that names the failure."""
+    """A figure script that raises leaves a report that names the failure, does not claim
+    the figure in its summary or title, and the command exits 1 (it exited 0)."""
     from chaoscam.experiments import _paper
 
     def boom(quick, outdir, workers=None):
@@ -80,13 +81,32 @@ def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch, capsys):
     monkeypatch.setitem(_paper.FIGURES, 3, boom)
     from chaoscam.experiments import run_paper
 
-    out = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 5], echo=True)
-    text = out.read_text()
-    assert "boom: failed with RuntimeError: no luck" in text
+    run = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 5], echo=True)
+    fail = "Fig. 3: line-length draws: failed with RuntimeError: no luck"
+    assert run.failed == (fail,)
+    text = run.path.read_text()
+    assert fail in text
     assert "Fig. 5 — fractal stiffness against D" in text
+    assert "Fig. 5 in " in text and "Figs. 3" not in text and "1 of 2 stages failed" in text
+    assert "(incomplete: 1 of 2 stages failed)" in text
     err = capsys.readouterr().err  # the stages by their titles, not function names
-    assert "[1/2] boom ...\n[2/2] Fig. 5: fractal stiffness ...\n" in err
+    assert f"[1/2] Fig. 3: line-length draws ...\n[1/2] {fail}\n" in err
+    assert "[2/2] Fig. 5: fractal stiffness ...\n" in err
     assert "[2/2] Fig. 5: fractal stiffness: " in err
+    out = tmp_path / "c" / "p.html"
+    out.parent.mkdir()
+    assert main(["paper", "--quick", "--figures", "3,5", "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "1 stage(s) failed" in err and "no luck" in err and out.exists()
+
+
+def test_paper_refuses_a_worker_count_before_any_work(tmp_path, capsys):
+    """--workers past the sweeps' limit: exit 2 at once, nothing written (every sweep of
+    the report failed on it, and the command still exited 0)."""
+    out = tmp_path / "p.html"
+    assert main(["paper", "--quick", "--workers", "99999", "--out", str(out)]) == 2
+    assert "--workers 99999: workers = 99999 must be in [1, " in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
 
 
 def _shrink_the_runs(monkeypatch):
@@ -182,7 +202,7 @@ def test_each_figure_is_rendered_once_and_the_report_embeds_its_file(tmp_path, m
 
     for module in (_paper, _html, _figures):
         monkeypatch.setattr(module, "png_bytes", stub)
-    out = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 4, 5, 7])
+    out = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 4, 5, 7]).path
     files = {p.name: p.read_bytes() for p in (tmp_path / "paper-data").glob("*.png")}
     assert len(files) == 10  # figs 3, 4, 5, the map and six responses
     assert sorted(rendered) == sorted(files.values())  # once each, nothing else drawn
