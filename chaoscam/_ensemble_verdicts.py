@@ -20,6 +20,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pandas as pd
 
+from ._model_rules import extensible
 from .analysis import Verdict
 from .classify import EXTEND_TO, _with_settings, classify_section_run
 from .integrate import Ensemble, Status, extend_ensemble, simulate_ensemble
@@ -134,7 +135,7 @@ def member_verdicts(
 
 
 def _unsettled(v: MemberVerdict) -> bool:
-    return v.label == "undetermined" and v.verdict is not None
+    return v.verdict is not None and extensible(v.verdict)
 
 
 def _verdicts(ens: Ensemble, plist: list[Params]) -> list[MemberVerdict]:

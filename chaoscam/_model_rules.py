@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
+
 from ._certify import MODEL_ATOL, ORBIT_REFINE, REFINE_ITER, certify
 from .analysis import Evidence, Verdict, section_period
 from .model import Params, realizations_identical
@@ -193,3 +195,32 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
     )
     verdict = Verdict("chaotic", None, v.evidence + (e, band), (), v.settings)
     return verdict, extra
+
+
+OVERFLOW = "tangent_overflow"
+"""The evidence of a verdict whose Jacobians are not finite (:func:`overflow_evidence`)."""
+
+
+def overflow_evidence(jacobians, p: Params) -> Evidence | None:
+    """The evidence (abstaining, with the reason) that the tangent overflowed: a Jacobian
+    that is not finite, RK4 past its stability limit in the contact (``l_lambda`` given in
+    mm: K_n 1000 times the intended one); None when every Jacobian is finite. A verdict
+    holding it is undetermined and not extended (:func:`extensible`): a longer run
+    overflows too."""
+    from ._run_warnings import resolution_warning
+
+    jac = np.asarray(jacobians, dtype=float)
+    bad = ~np.isfinite(jac).reshape(len(jac), -1).all(axis=1)
+    if not bad.any():
+        return None
+    cause = resolution_warning(p) or f"dt = {p.dt:g} s; try a smaller dt"
+    why = (
+        f"the tangent overflowed: {int(bad.sum())} of {len(bad)} cam periods' Jacobians are "
+        f"not finite, so there is no exponent ({cause})"
+    )
+    return Evidence(OVERFLOW, int(bad.sum()), None, why)
+
+
+def extensible(v: Verdict) -> bool:
+    """Whether an undetermined verdict may settle on a longer run (not after an overflow)."""
+    return v.label == "undetermined" and not any(e.name == OVERFLOW for e in v.evidence)

@@ -10,7 +10,6 @@ T = 2 pi / omega, and optionally adds the model's own Lyapunov exponent
 from __future__ import annotations
 
 import dataclasses
-import inspect
 import math
 import re
 import time
@@ -20,10 +19,11 @@ import numpy as np
 
 from ._checks import real
 from ._extend import extend_trajectory
-from ._model_rules import MODEL_ATOL, with_model_evidence
+from ._model_rules import MODEL_ATOL, extensible, overflow_evidence, with_model_evidence
 from ._simulate import Trajectory, simulate
 from ._trajectory_io import load_trajectory
 from .analysis import Evidence, Verdict, classify_section, classify_signal
+from .analysis._options import check_options
 from .integrate import Status
 from .model import Params
 from .tangent import spectrum_from_jacobians
@@ -102,29 +102,6 @@ def _evidence_verdict(
     return classify_signal(x, dt, period, section=points, lyapunov=lyap, **opts)
 
 
-# What **options may name: the analysis classifiers' settings, not the inputs this module
-# builds from the trajectory (the samples, the section, the exponents).
-_BUILT_HERE = {"x", "dt", "forcing_period", "section", "points", "lyapunov", "exponent"}
-_OPTIONS = sorted(
-    (
-        set(inspect.signature(classify_signal).parameters)
-        | set(inspect.signature(classify_section).parameters)
-    )
-    - _BUILT_HERE
-    - {"exponent_time"}
-)
-
-
-def _check_options(options: dict) -> None:
-    """Refuse an option no analysis classifier takes, naming the ones they do."""
-    unknown = sorted(set(options) - set(_OPTIONS))
-    if unknown:
-        raise TypeError(
-            f"classify_trajectory got an unknown option {unknown[0]!r}; the analysis "
-            f"options are: {', '.join(_OPTIONS)}"
-        )
-
-
 def _model_options(options: dict, period: float) -> dict:
     """Analysis options for the model's section: the absolute band tolerance by default."""
     opts = {k_: v_ for k_, v_ in options.items() if k_ not in ("lyapunov_tol",)}
@@ -154,6 +131,8 @@ def classify_section_run(points, jacobians, params: Params, **options: Any) -> V
 def _section_verdict(points, jacobians, p: Params, options: dict) -> tuple[Verdict, dict]:
     """Section with the tangent exponent, then the model-level rules; (verdict, settings)."""
     period = p.cam_period
+    if (overflow := _overflow_verdict(points, jacobians, p, options)) is not None:
+        return overflow, {}
     spec = spectrum_from_jacobians(jacobians, period)
     v = classify_section(
         points,
@@ -162,6 +141,17 @@ def _section_verdict(points, jacobians, p: Params, options: dict) -> tuple[Verdi
         **_model_options(options, period),
     )
     return with_model_evidence(v, p, points, spec)
+
+
+def _overflow_verdict(points, jacobians, p: Params, options: dict) -> Verdict | None:
+    """Undetermined from the section alone, with the reason, when the tangent overflowed
+    (:func:`chaoscam._model_rules.overflow_evidence`); else None."""
+    ev = overflow_evidence(jacobians, p)
+    if ev is None:
+        return None
+    v = classify_section(points, **_model_options(options, p.cam_period))
+    # Its reasons alone: the section's own ("run longer", "pass the exponent") do not apply.
+    return Verdict("undetermined", None, v.evidence + (ev,), (ev.detail,))
 
 
 def _exponent_of(spec) -> tuple[float, float, int]:
@@ -216,7 +206,7 @@ def _tangent_verdict(
         )
         return dataclasses.replace(v, reasons=v.reasons + (reason,)), {}
     points = sec.loc[keep, _SECTION_COORDS].to_numpy(dtype=float)
-    if traj.series is None:
+    if traj.series is None or not np.isfinite(tr.jacobians[keep]).all():
         return _section_verdict(points, tr.jacobians[keep], p, options)
     # the run's own series and section, with the exponent of the same realization
     spec = spectrum_from_jacobians(tr.jacobians[keep], period)
@@ -253,7 +243,7 @@ def _extended(tr, verdict, extra, discard, options, cap) -> tuple[Verdict, dict]
     recorded = s["duration"] - start
     t_wall = time.perf_counter()
     base = tr if tr.params.integrator == "rk4" else None
-    while verdict.label == "undetermined" and recorded < cap:
+    while extensible(verdict) and recorded < cap:
         recorded = min(cap, 4.0 * recorded)
         if base is None:
             longer = _rk4_tangent_run(tr, start + recorded)
@@ -350,7 +340,7 @@ def classify_trajectory(
         integer status code) and the reason; it is not classified. ``settings`` records the
         trajectory's provenance and these options.
     """
-    _check_options(options)
+    check_options(options, "classify_trajectory")
     if discard < 0 or not math.isfinite(discard):
         raise ValueError(f"discard = {discard!r} s must be >= 0")
     if extend_to is not None:  # None: never extend
@@ -376,7 +366,7 @@ def classify_trajectory(
 
     tr = _tangent_run(traj) if tangent and not lyapunov else None
     verdict, extra = _verdict_of(traj, lyapunov, discard, options, tangent, tr)
-    if tr is not None and extend_to and verdict.label == "undetermined":
+    if tr is not None and extend_to and extensible(verdict):
         verdict, extra = _extended(tr, verdict, extra, discard, options, float(extend_to))
     verdict = _with_settings(verdict, **settings, **extra)
     if not check_step:

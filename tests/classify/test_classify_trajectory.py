@@ -373,3 +373,30 @@ def test_threaded_calls_keep_order_and_stop_on_an_error():
     with pytest.raises(RuntimeError, match="member 0"):
         _threaded(fail_first, list(range(40)), 2)
     assert len(started) < 40
+
+
+def test_an_overflowed_tangent_is_undetermined_with_its_cause_and_not_extended():
+    """l_lambda = 8 m (a length meant in mm): K_n is 1000x the intended one, RK4 at the
+    default dt is past its stability limit in the contact, and the tangent overflows while
+    the motion stays finite. The verdict (both engines) is undetermined, says why and what
+    step would do, and is not extended (a longer run overflows too); it raised
+    "jacobians hold NaN or inf" with a traceback from classify, report, ensemble and sweeps."""
+    import warnings
+
+    from chaoscam import classify_ensemble
+    from chaoscam.integrate import simulate_ensemble
+
+    p = Params(l_lambda=8.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # the step warning, tested elsewhere
+        tr = chaoscam.simulate(p, duration=3.0, series=False, tangent=True)
+        ens = simulate_ensemble(p, [0], duration=3.0, tangent=True)
+    assert tr.ok
+    v = classify_trajectory(tr)
+    assert v.label == "undetermined" and "extended" not in v.settings
+    (why,) = v.reasons
+    assert why.startswith("the tangent overflowed: ") and "use dt <= 7.2e-08 s" in why
+    assert [e.name for e in v.evidence][-1] == "tangent_overflow"
+    members = classify_ensemble(ens, p).members
+    assert list(members["label"]) == ["undetermined"]
+    assert members["reasons"][0] == why
