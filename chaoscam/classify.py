@@ -302,13 +302,15 @@ def classify_trajectory(
         tangent=False; the tangent path finds lambda_1 = +0.69 +- 0.05 per iterate and
         calls the same run 8-band chaos).
     lyapunov : bool
-        Also compute the model's largest Lyapunov exponent through the impacts
+        Instead of the tangent verdict (``tangent`` is then not used: no tangent exponent,
+        no periodic-orbit certificate, no extension), the series-based evidence with the
+        model's largest Lyapunov exponent from two trajectories through the impacts
         (:func:`chaoscam.lyapunov.lyapunov_model`, same params, duration, transient, seed,
-        index; about twice the cost of the simulation) and add it as evidence
-        ``lyapunov_model``: λ₁ > `lyapunov_tol` (default 0.02 / T) votes chaotic, else not
-        chaotic. A NaN exponent (a companion that failed) abstains with its reason.
-        Weak for contact-dominated responses, where the estimate depends on the separation
-        d0 (see its Limits): a period-1 orbit that chatters onto the cam every period
+        index; about twice the cost of the simulation), as evidence ``lyapunov_model``:
+        λ₁ > `lyapunov_tol` (default 0.02 / T) votes chaotic, else not chaotic. Kept to
+        compare the two exponents. A NaN exponent (a companion that failed) abstains with
+        its reason. Weak for contact-dominated responses, where the estimate depends on the
+        separation d0 (see its Limits): a period-1 orbit that chatters onto the cam every period
         (omega = 22 rad/s) gets λ₁ ≈ +0.4 1/s, and the verdict is then "undetermined".
     check_step : bool
         Re-simulate the same realization (params, duration, transient, seed, index, output

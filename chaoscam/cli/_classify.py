@@ -34,8 +34,9 @@ def register(sub) -> None:
     p.add_argument(
         "--lyapunov",
         action="store_true",
-        help="use the two-trajectory exponent instead of the tangent one (kept for "
-        "comparison; about twice the run's cost)",
+        help="use the two-trajectory exponent and the series-based evidence instead of the "
+        "tangent verdict (no orbit certificate, no extension; kept for comparison, about "
+        "twice the run's cost)",
     )
     p.add_argument(
         "--check-step",

@@ -19,7 +19,9 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--lyapunov",
         action="store_true",
-        help="also compute the model's largest Lyapunov exponent (slower)",
+        help="classify with the model's two-trajectory Lyapunov exponent and the "
+        "series-based evidence instead of the default tangent verdict (no orbit certificate, "
+        "no extension; kept for comparison, about twice the cost)",
     )
     p.add_argument(
         "--check-step",

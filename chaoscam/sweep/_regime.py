@@ -269,8 +269,10 @@ def regime_map(
         ``chaoscam.classify.classify_trajectory``. Runs that did not end normally are not
         classified: their label is the status's (``left_reach``, ``diverged``).
     lyapunov : bool
-        Ask the default classifier for the model's largest Lyapunov exponent (evidence
-        ``lyapunov_model`` [1/s], about twice the cost of a run).
+        Classify with the model's two-trajectory Lyapunov exponent (evidence
+        ``lyapunov_model`` [1/s], about twice the cost of a run) and the series-based
+        evidence, instead of the default tangent verdict (no orbit certificate, no
+        extension), as :func:`chaoscam.classify_trajectory` does with ``lyapunov=True``.
     check_step : bool
         Ask the default classifier to re-run each realization with dt / 2 and call it
         undetermined when the verdict changes (twice the cost).
