@@ -298,6 +298,11 @@ def test_failing_classifier_is_one_line_exit_1(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("chaoscam: error: task") and "this classifier has a bug" in err
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    # The call that reproduces it names the run's parameters and window (it said
+    # "chaoscam.simulate(params, ...)" without them).
+    call = err.split("reproduce it with ")[1].split(", then the classifier")[0]
+    run = eval(call, {"chaoscam": chaoscam})
+    assert run.params.l_lambda in (0.006, 0.008) and run.settings["duration"] == 0.5
 
 
 @pytest.mark.parametrize(

@@ -172,7 +172,7 @@ def execute(
                 except Exception as err:
                     raise TaskFailed(
                         f"task {task.key()} failed ({type(err).__name__}: {err}); reproduce "
-                        f"it with {task.hint()} and the classifier"
+                        f"it with {task.hint()}, then the classifier on that run"
                     ) from err
                 for rec in record if isinstance(record, list) else [record]:
                     store.add(rec)

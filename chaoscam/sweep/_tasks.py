@@ -257,6 +257,18 @@ def _run(params: Params, task: Any) -> tuple[RunSummary, dict[str, Any]]:
     return summary, fields
 
 
+def simulate_call(task: Any) -> str:
+    """The ``chaoscam.simulate`` call that reproduces ``task``'s run alone: its parameters
+    (those that differ from the defaults), window, seed and index."""
+    base = Params().to_dict()
+    changed = {k: v for k, v in task.params.to_dict().items() if v != base[k]}
+    args = ", ".join(f"{k}={v!r}" for k, v in changed.items())
+    return (
+        f"chaoscam.simulate(chaoscam.Params({args}), duration={task.duration!r}, "
+        f"transient={task.transient!r}, seed={task.seed}, index={task.sim_index})"
+    )
+
+
 @dataclass(frozen=True)
 class RealizationTask:
     """Realization ``index`` of regime-map cell ``cell`` (simulate index ``sim_index``)."""
@@ -277,7 +289,7 @@ class RealizationTask:
 
     def hint(self) -> str:
         """How to reproduce the run alone."""
-        return f"chaoscam.simulate(params, seed={self.seed}, index={self.sim_index})"
+        return simulate_call(self)
 
     def run(self) -> dict[str, Any]:
         return self.record(*_run(self.params, self))
@@ -331,7 +343,7 @@ class BranchTask:
 
     def hint(self) -> str:
         """How to reproduce the run alone."""
-        return f"chaoscam.simulate(params, seed={self.seed}, index={self.sim_index})"
+        return simulate_call(self)
 
     def run(self) -> dict[str, Any]:
         return self.record(*_run(self.params, self))
