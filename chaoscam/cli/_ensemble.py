@@ -110,7 +110,12 @@ def _run_locked(args: argparse.Namespace) -> int:
     from .._provenance import code_identity
     from ..integrate import simulate_ensemble
     from ..integrate._gpu import GPUFallbackWarning
-    from ..sweep._checkpoint import differences, discard_checkpoint, remove_leftovers
+    from ..sweep._checkpoint import (
+        differences,
+        discard_checkpoint,
+        not_a_folder,
+        remove_leftovers,
+    )
     from ..sweep._common import run_settings
     from . import UsageError, parse_assignments, stop_word
 
@@ -160,6 +165,11 @@ def _run_locked(args: argparse.Namespace) -> int:
                     f"{path} exists{why}; choose another --out, remove it, or pass --force to "
                     "replace it"
                 )
+    if not_a_folder(parts):
+        raise FileExistsError(
+            f"{parts} is a file where this run keeps its parts folder: move it away, or pass "
+            "--force to replace it"
+        )
     if parts.exists():
         if not args.resume:
             raise FileExistsError(

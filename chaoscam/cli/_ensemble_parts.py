@@ -138,7 +138,9 @@ def commit_parts(
     first). A kill at any point leaves either the parts (``--resume`` joins them again) or
     the finished outputs. An output not in ``ours`` is put in place only if its name is
     still free (a hard link): one that another process wrote meanwhile is kept, the outputs
-    placed so far are taken back, and the parts stay for a ``--resume`` once it is moved."""
+    placed so far are taken back, and the parts stay for a ``--resume`` once it is moved.
+    An output in ``ours`` that this run does not write (the impacts of the output a
+    ``--force`` run replaces, without ``--keep-impacts``) is removed."""
     import pandas as pd
 
     from ..sweep._checkpoint import discard_checkpoint
@@ -159,6 +161,11 @@ def commit_parts(
             members = frame
         staged[name] = parts / f".staged.{name}.parquet"
         write_table(frame, staged[name], stamp if name == "members" else None)
+    for name, target in targets.items():
+        if name not in names and target in ours:
+            # The replaced (--force) output's companion that this run does not write (its
+            # impacts, without --keep-impacts): left, it would pass for this run's.
+            target.unlink(missing_ok=True)
     placed = []
     for name in sorted(names, key=lambda n: n == "members"):  # members last
         target = targets[name]

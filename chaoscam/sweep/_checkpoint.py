@@ -151,11 +151,20 @@ def _running(pid: int) -> bool:
     return True
 
 
+def not_a_folder(path: Path) -> bool:
+    """Whether something other than a folder (a file, a dangling link) holds ``path``."""
+    return (path.is_symlink() and not path.exists()) or (path.exists() and not path.is_dir())
+
+
 def discard_checkpoint(path: Path) -> None:
     """Delete a checkpoint folder: renamed away first, in one step, so a kill during the
     deletion never leaves a half-deleted checkpoint that a later --resume would trip over
-    (the renamed folder it leaves is removed by the next run, :func:`remove_leftovers`)."""
-    if not path.exists():
+    (the renamed folder it leaves is removed by the next run, :func:`remove_leftovers`).
+    A file or link where the folder belongs is removed as such."""
+    if not (path.exists() or path.is_symlink()):
+        return
+    if path.is_symlink() or not path.is_dir():
+        path.unlink()
         return
     gone = path.with_name(f".tmp-{os.getpid()}-removed-{path.name}")
     os.replace(path, gone)
@@ -222,11 +231,17 @@ class CheckpointStore:
         self.flush_interval = float(flush_interval)
         self._pending: list[dict[str, Any]] = []
         self._last = time.monotonic()
+        if not_a_folder(self.path):
+            raise FileExistsError(
+                f"{self.path} is a file where this run keeps its checkpoint folder: move it "
+                "away, or pass --force (force=True in Python) to replace it"
+            )
         if self.path.exists():
             if not resume:
                 raise FileExistsError(
                     f"{self.path} holds the checkpoint of an interrupted run: run the same "
-                    "command with --resume to finish it, or delete the folder to start over"
+                    "command with --resume to finish it, or pass --force (force=True in Python) to "
+                    "start over"
                 )
         self._config = config
         if self.path.exists():

@@ -223,3 +223,26 @@ def test_a_too_coarse_step_is_warned_once_and_sigma_zero_is_named(tmp_path, caps
     two = tmp_path / "s.parquet"
     assert main([*args, "--set", "l_lambda_sigma=0.002", "--out", str(two)]) == 0
     assert "deterministic" not in capsys.readouterr().err
+
+
+def test_force_removes_the_replaced_runs_impacts(tmp_path):
+    """--force over a run kept with --keep-impacts, now without it: the old impacts file
+    goes with the output it belonged to (it stayed, passing for the new run's)."""
+    out = tmp_path / "e.parquet"
+    base = ["ensemble", "--members", "2", "--duration", "0.5", "--quiet", "--out", str(out)]
+    assert main([*base, "--keep-impacts"]) == 0
+    assert (tmp_path / "e.impacts.parquet").exists()
+    assert main([*base, "--force"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["e.parquet", "e.sections.parquet"]
+
+
+def test_a_file_where_the_parts_folder_goes(tmp_path, capsys):
+    """A file at FILE.parts: exit 2 saying so (it said the file held an unfinished run);
+    --force replaces it and leaves only the outputs."""
+    out = tmp_path / "e.parquet"
+    (tmp_path / "e.parts").write_text("not mine")
+    base = ["ensemble", "--members", "2", "--duration", "0.5", "--quiet", "--out", str(out)]
+    assert main(base) == 2
+    assert "e.parts is a file where this run keeps its parts folder" in capsys.readouterr().err
+    assert main([*base, "--force"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["e.parquet", "e.sections.parquet"]

@@ -171,3 +171,18 @@ def test_ctrl_c_while_the_tables_are_written_says_how_to_resume(tmp_path, refere
     assert "--resume" in stopped.value.message and not out.exists()
     res = regime_map(X, Y, classify=SpreadClassifier(), out=out, resume=True, **GRID)
     frames_equal(res.realizations, reference.realizations)
+
+
+def test_a_file_where_the_checkpoint_folder_goes(tmp_path):
+    """A file at FILE.ckpt: refused before any work, saying it is a file (it said it held
+    the checkpoint of an interrupted run); force=True replaces it and leaves nothing behind
+    (it ran the whole map, then failed with 'Not a directory' leaving a .tmp-...-removed file)."""
+    out = tmp_path / "m.parquet"
+    ckpt = checkpoint_dir(out)
+    ckpt.write_text("not mine")
+    kw = dict(GRID, classify=SpreadClassifier(), out=out)
+    with pytest.raises(FileExistsError, match="is a file where this run keeps its checkpoint"):
+        regime_map(X, Y, **kw)
+    assert ckpt.read_text() == "not mine" and not out.exists()
+    regime_map(X, Y, force=True, **kw)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.cells.parquet", "m.parquet"]
