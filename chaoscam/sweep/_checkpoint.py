@@ -385,14 +385,23 @@ def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> 
     existing = [p for p in outputs if p.exists()]
     if not existing:
         return False
+    ours = _checkpoint_hash(checkpoint_dir(outputs[0])) == config_hash(config)
+    if not outputs[0].exists() and not ours:
+        # A companion without its main table: nothing to finish or reuse.
+        raise FileExistsError(
+            f"{existing[0]} exists without {outputs[0].name}, a leftover of another run: "
+            "remove it, choose another --out, or pass --force (force=True in Python) to "
+            "replace it (nothing was overwritten)"
+        )
     if not resume:
         raise FileExistsError(
             f"{existing[0]} exists: pass --resume (resume=True in Python) to finish or reuse "
-            "that run, or choose another --out (nothing was overwritten)"
+            "that run, --force to replace it, or choose another --out (nothing was "
+            "overwritten)"
         )
     meta = read_sweep_metadata(outputs[0]) if outputs[0].exists() else None
     if meta is None or meta.get("hash") != config_hash(config):
-        if _checkpoint_hash(checkpoint_dir(outputs[0])) == config_hash(config):
+        if ours:
             return False
         why = differences(meta.get("config"), config) if meta else ""
         raise SweepError(

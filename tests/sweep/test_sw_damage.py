@@ -186,3 +186,18 @@ def test_a_file_where_the_checkpoint_folder_goes(tmp_path):
     assert ckpt.read_text() == "not mine" and not out.exists()
     regime_map(X, Y, force=True, **kw)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.cells.parquet", "m.parquet"]
+
+
+def test_a_companion_without_its_main_table_is_named_a_leftover(tmp_path):
+    """FILE.cells.parquet without FILE.parquet (and no checkpoint): refused as a leftover,
+    with or without resume, naming --force (without resume it advised --resume, which then
+    called it another configuration's); force=True replaces it."""
+    out = tmp_path / "m.parquet"
+    kw = dict(GRID, classify=SpreadClassifier(), out=out)
+    regime_map(X, Y, **kw)
+    out.unlink()
+    for resume in (False, True):
+        with pytest.raises(FileExistsError, match="exists without m.parquet, a leftover.*--force"):
+            regime_map(X, Y, resume=resume, **kw)
+    regime_map(X, Y, force=True, **kw)
+    assert out.exists()
