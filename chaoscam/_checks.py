@@ -12,7 +12,7 @@ from typing import Any
 
 from .model import ParameterError
 
-__all__ = ["whole", "real", "params_arg"]
+__all__ = ["whole", "real", "params_arg", "with_overrides"]
 
 
 def whole(name: str, value: Any, *, low: int = 0, high: int | None = None) -> int:
@@ -67,3 +67,28 @@ def params_arg(params: Any):
     raise TypeError(
         f"params must be a chaoscam.Params or None, got {type(params).__name__} {params!r}"
     )
+
+
+def with_overrides(p, overrides: dict, caller) -> Any:
+    """``p.replace(**overrides)`` for an API function's ``**overrides``: a keyword that is
+    neither one of ``caller``'s settings nor a model parameter is refused naming both lists
+    and what it was probably meant to be (``simulate(duraton=1)`` -> duration)."""
+    import inspect
+
+    from .model._params import close_names, field_names
+
+    unknown = [k for k in overrides if k not in field_names()]
+    if unknown:
+        own = [
+            n
+            for n, a in inspect.signature(caller).parameters.items()
+            if a.kind is inspect.Parameter.KEYWORD_ONLY
+        ]
+        close = close_names(unknown[0], own + list(field_names()))
+        hint = f" Did you mean {', '.join(close)}?" if close else ""
+        raise ParameterError(
+            f"{caller.__name__}() got an unknown keyword {unknown[0]!r}: neither one of its "
+            f"settings nor a model parameter.{hint} Its settings: {', '.join(own)}; the "
+            f"parameters: {', '.join(field_names())}"
+        )
+    return p.replace(**overrides)

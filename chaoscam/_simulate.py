@@ -298,11 +298,11 @@ def raw_run(
     **overrides: Any,
 ) -> RawRun:
     """:func:`simulate` up to its arrays (same arguments, same checks and warnings)."""
-    from ._checks import params_arg, real
+    from ._checks import params_arg, real, with_overrides
 
     p = params_arg(params)
     if overrides:
-        p = p.replace(**overrides)
+        p = with_overrides(p, overrides, simulate)
     # output_dt is checked even without a series: a bad value is a mistake either way.
     output_dt = real("output_dt", output_dt, low=0.0, strict=True, unit="s")
     seed, index = _check_run(p, duration, transient, output_dt if series else None, seed, index)

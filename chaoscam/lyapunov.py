@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import whole
+from ._checks import whole, with_overrides
 from ._version import __version__
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
@@ -313,7 +313,7 @@ def lyapunov_model(
     """
     p = Params() if params is None else params
     if overrides:
-        p = p.replace(**overrides)
+        p = with_overrides(p, overrides, lyapunov_model)
     asked = p.integrator
     # Decision: both trajectories on the fixed-step RK4 grid, whatever the integrator asked
     # for. Adaptive steps differ between reference and companion, and that step-sequence

@@ -55,6 +55,8 @@ CLI_CASES = {
         "max_events_per_step",
     ),
     "theta_f0 1e308": ([*SIM, "--set", "theta_f0=1e308"], "theta_f0"),
+    "set twice": ([*SIM, "--set", "omega=30", "--set", "omega=40"], "omega is given twice"),
+    "set in capitals": ([*SIM, "--set", "OMEGA=30"], "Did you mean omega"),
     "x_O 1e308": ([*SIM, "--set", "x_O=1e308"], "x_O"),
     "duration 1e9": (["simulate", "--duration", "1e9", "--out", "OUT.parquet"], "memory"),
     "dt above duration": (["simulate", "--duration", "0.4", "--set", "dt=1"], "dt"),
@@ -205,6 +207,15 @@ API_TYPE_CASES = [
         "max_pieces",
     ),
     (lambda: chaoscam.simulate_reference(Params(), 0.01, rtol=0.0), ParameterError, "rtol"),
+    # A misspelt setting is named as such, with what was meant (it listed only the model's
+    # parameters); a parameter in the wrong case is found too.
+    (
+        lambda: chaoscam.simulate(duraton=1.0),
+        ParameterError,
+        "simulate.. got an unknown keyword 'duraton'.*Did you mean duration",
+    ),
+    (lambda: chaoscam.simulate(OMEGA=30.0), ParameterError, "Did you mean omega"),
+    (lambda: chaoscam.lyapunov_model(d_0=1e-8), ParameterError, "Did you mean d0"),
 ]
 
 

@@ -48,6 +48,11 @@ def parse_assignments(items: list[str] | None, base: Params | None = None) -> Pa
         name, sep, value = item.partition("=")
         if not sep or not name.strip():
             raise UsageError(f"--set expects NAME=VALUE, got {item!r}")
+        if name.strip() in pairs:
+            raise UsageError(
+                f"--set {name.strip()} is given twice ({pairs[name.strip()]!r} and {value!r}): "
+                "give each parameter once"
+            )
         pairs[name.strip()] = value
     return Params.from_strings(pairs, base=base)
 
