@@ -389,3 +389,14 @@ def test_trajectory_file_with_text_in_a_number_column(tmp_path):
     with pytest.raises(ValueError, match=r"bad.parquet: column 'theta_f' of the table"):
         chaoscam.load_trajectory(bad)
     assert chaoscam.load_trajectory(path).series is not None
+
+
+def test_an_unknown_option_shows_its_commands_usage(capsys):
+    """`chaoscam simulate --bogus`: the simulate usage and its name (it showed the top-level
+    `usage: chaoscam [-h] [--version] COMMAND ...`); exit 2."""
+    with pytest.raises(SystemExit) as stop:
+        main(["simulate", "--bogus"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("usage: chaoscam simulate ")
+    assert "chaoscam simulate: error: unrecognized arguments: --bogus" in err

@@ -229,6 +229,16 @@ def _negative_values(argv: list[str]) -> list[str]:
     return out
 
 
+def _command_parser(parser, args):
+    """The subcommand's parser of ``args`` (the top-level one when there is none)."""
+    import argparse
+
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return action.choices.get(getattr(args, "command", None), parser)
+    return parser
+
+
 def _dispatch(argv: list[str] | None) -> int:
     import warnings
 
@@ -236,7 +246,11 @@ def _dispatch(argv: list[str] | None) -> int:
     from ..model import ParameterError
 
     parser = build_parser()
-    args = parser.parse_args(_negative_values(sys.argv[1:] if argv is None else list(argv)))
+    args, extra = parser.parse_known_args(
+        _negative_values(sys.argv[1:] if argv is None else list(argv))
+    )
+    if extra:  # with the command's own usage, not the top level's (argparse's default)
+        _command_parser(parser, args).error(f"unrecognized arguments: {' '.join(extra)}")
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
