@@ -147,7 +147,10 @@ def _check_run(
     seed, index = whole("seed", seed), whole("index", index)
     duration, transient = check_window(duration, transient, dt=p.dt)
     if output_dt is not None and not (output_dt >= p.dt and math.isfinite(output_dt)):
-        raise ParameterError(f"output_dt = {output_dt!r} s must be >= dt = {p.dt} s")
+        raise ParameterError(
+            f"output_dt = {output_dt!r} s (the series' sampling step, --output-dt) must be "
+            f">= dt = {p.dt} s: raise output_dt or lower dt"
+        )
     series_rows = (duration - transient) / output_dt if output_dt is not None else 0.0
     job = estimate(
         p,

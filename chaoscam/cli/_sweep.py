@@ -87,7 +87,9 @@ def _common(p: argparse.ArgumentParser) -> None:
         "(> --duration) and record whether it leaves the cam's reach before (columns fate, "
         "left_at): transient chaos",
     )
-    p.add_argument("--plot", type=Path, default=None, help="also draw the figure to FILE.png/pdf")
+    p.add_argument(
+        "--plot", type=Path, default=None, help="also draw the figure to FILE (.png, .pdf or .svg)"
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument(
         "--force",

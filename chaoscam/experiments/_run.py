@@ -67,6 +67,13 @@ def check_paper_outputs(out: str | Path, figures=None, *, force: bool = False) -
         stages = sorted(set(figures or FIGURES)) + ([] if figures else [SENSITIVITY])
         names = dict.fromkeys(n for f in stages for n in data_files(f))
         for name in names:
+            if (outdir / name).exists() and not force:
+                raise OutputError(
+                    f"{outdir} already holds {name} (the data of an earlier report); nothing "
+                    "was overwritten: write the report into another folder (--out "
+                    "OTHER/paper.html, its data go to OTHER/paper-data), or pass --force to "
+                    "replace them"
+                )
             check_output(outdir / name, flag="paper data", force=force)
     return outdir
 

@@ -213,18 +213,21 @@ def resolve_engine(
         engine = "ensemble" if default and base.integrator == "rk4" else "process"
     if engine == "process":
         if device != "cpu":
-            raise SweepError("device applies to engine='ensemble' only")
+            raise SweepError(
+                "device (--device) applies to engine='ensemble' (--engine ensemble) only"
+            )
         return Engine("process", identity)
     if not default:
         raise SweepError(
-            "engine='ensemble' labels members from their sections and tangent exponents "
-            "(chaoscam.classify_ensemble): it takes the default classifier, without lyapunov "
-            "or check_step; use engine='process' for another classifier"
+            "engine='ensemble' (--engine ensemble) labels members from their sections and "
+            "tangent exponents (chaoscam.classify_ensemble): it takes the default classifier, "
+            "without lyapunov or check_step (--lyapunov, --check-step); use engine='process' "
+            "(--engine process) for another classifier"
         )
     if base.integrator != "rk4":
         raise SweepError(
-            "engine='ensemble' runs the fixed-step RK4 integrator (integrator = 'rk4'); use "
-            "engine='process' for the adaptive one"
+            "engine='ensemble' (--engine ensemble) runs the fixed-step RK4 integrator "
+            "(integrator = 'rk4'); use engine='process' (--engine process) for the adaptive one"
         )
     threads = None
     if scheduler is None:

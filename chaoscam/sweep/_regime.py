@@ -365,7 +365,10 @@ def regime_map(
             "batch": realizations,
         }
     elif max_realizations is not None:
-        raise SweepError("max realizations applies with a target half-width only")
+        raise SweepError(
+            "max_realizations (--max-realizations) applies only with target_halfwidth "
+            "(--target-halfwidth)"
+        )
     if isinstance(confidence, bool) or not (
         isinstance(confidence, int | float) and 0.0 < confidence < 1.0
     ):

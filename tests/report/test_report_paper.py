@@ -161,8 +161,8 @@ def test_paper_refuses_any_existing_output_before_the_work(tmp_path, capsys):
     args = ["paper", "--quick", "--figures", "3,5", "--out", str(tmp_path / "p.html")]
     assert main(args) == 2
     err = capsys.readouterr().err
-    assert err.startswith("chaoscam: error: paper data") and str(data / "fig5.png") in err
-    assert "--force" in err
+    assert err.startswith(f"chaoscam: error: {data} already holds fig5.png")
+    assert "--force" in err and "another folder" in err  # not "choose another name"
     assert [p.name for p in data.iterdir()] == ["fig5.png"]  # fig3 did not run
     assert not (tmp_path / "p.html").exists()
     assert main([*args, "--force"]) == 0

@@ -180,7 +180,7 @@ def test_bifurcation_points_are_the_same_on_both_engines():
         (dict(engine="ensemble", classify=SpreadClassifier()), "use engine='process'"),
         (dict(engine="ensemble", lyapunov=True), "without lyapunov"),
         (dict(engine="ensemble", base=Params(integrator="adaptive")), "RK4"),
-        (dict(engine="process", device="gpu"), "device applies to engine='ensemble'"),
+        (dict(engine="process", device="gpu"), r"device \(--device\) applies to engine='ensemble'"),
         (dict(device="tpu"), "device = 'tpu'"),
     ],
 )
