@@ -10,7 +10,6 @@ T = 2 pi / omega, and optionally adds the model's own Lyapunov exponent
 from __future__ import annotations
 
 import dataclasses
-import math
 import re
 import time
 from typing import Any
@@ -25,7 +24,7 @@ from ._trajectory_io import load_trajectory
 from .analysis import Evidence, Verdict, classify_section, classify_signal
 from .analysis._options import check_options
 from .integrate import Status
-from .model import Params
+from .model import ParameterError, Params
 from .tangent import spectrum_from_jacobians
 
 __all__ = ["classify_file", "classify_section_run", "classify_trajectory", "load_trajectory"]
@@ -343,13 +342,12 @@ def classify_trajectory(
         trajectory's provenance and these options.
     """
     check_options(options, "classify_trajectory")
-    if discard < 0 or not math.isfinite(discard):
-        raise ValueError(f"discard = {discard!r} s must be >= 0")
+    discard = real("discard", discard, low=0.0, unit="s")
     if extend_to is not None:  # None: never extend
         extend_to = real("extend_to", extend_to, low=0.0, unit="s")
     recorded = traj.settings["duration"] - traj.settings["transient"]
     if discard >= recorded:
-        raise ValueError(
+        raise ParameterError(
             f"discard = {discard!r} s must be in [0, {recorded:g}) s: the run records "
             f"{recorded:g} s after its transient"
         )

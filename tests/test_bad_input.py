@@ -400,3 +400,25 @@ def test_an_unknown_option_shows_its_commands_usage(capsys):
     err = capsys.readouterr().err
     assert err.startswith("usage: chaoscam simulate ")
     assert "chaoscam simulate: error: unrecognized arguments: --bogus" in err
+
+
+def test_classify_discard_on_the_command_line(tmp_path, capsys):
+    """classify --discard S: the verdict leaves out S s (its evidence differs from the whole
+    run's, as the API's does); beyond the record, exit 2 naming discard and the range (no
+    traceback)."""
+    import json
+
+    traj = chaoscam.simulate(duration=2.0)
+    path = tmp_path / "r.parquet"
+    traj.to_parquet(path)
+    for discard in (0.0, 1.0):
+        assert main(["classify", str(path), "--discard", str(discard), "--no-extend"]) == 0
+        out = json.loads(capsys.readouterr().out)
+        api = chaoscam.classify_trajectory(traj, discard=discard, extend_to=None).to_dict()
+        assert out == json.loads(json.dumps(api))
+    assert out != json.loads(
+        json.dumps(chaoscam.classify_trajectory(traj, extend_to=None).to_dict())
+    )
+    assert main(["classify", str(path), "--discard", "3"]) == 2
+    err = capsys.readouterr().err
+    assert "discard = 3.0 s must be in [0, 2) s" in err and "Traceback" not in err

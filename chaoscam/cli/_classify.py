@@ -43,6 +43,14 @@ def register(sub) -> None:
         action="store_true",
         help="re-simulate with dt/2 and report undetermined if the verdict changes",
     )
+    p.add_argument(
+        "--discard",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="leave out the first S seconds after the run's transient (default 0: a run "
+        "simulated without --transient is classified from t = 0, start-up included)",
+    )
     p.set_defaults(func=run_classify)
 
     q = sub.add_parser(
@@ -94,6 +102,7 @@ def run_classify(args: argparse.Namespace) -> int:
         extend_to=None if args.no_extend else 120.0,
         lyapunov=args.lyapunov,
         check_step=args.check_step,
+        discard=args.discard,
     )
     out = verdict.to_dict()
     extended = verdict.settings.get("extended")
