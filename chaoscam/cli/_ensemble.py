@@ -65,9 +65,19 @@ def register(sub) -> None:
     add_run_options(p, transient=None)
     p.add_argument(
         "--backend",
+        "--device",
+        dest="backend",
         choices=("cpu", "gpu", "auto"),
         default="cpu",
-        help="cpu (default), gpu (falls back to the CPU with a notice), or auto",
+        help="cpu (default), gpu (falls back to the CPU with a notice), or auto (--device, "
+        "as the sweeps call it, is the same option)",
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="CPU threads (default: every core numba may use, NUMBA_NUM_THREADS)",
     )
     p.add_argument("--classify", action="store_true", help="label each member from its section")
     p.add_argument("--keep-impacts", action="store_true", help="also write every impact")
@@ -98,6 +108,16 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"--out {out}: the output must end in .parquet")
     if args.force and args.resume:
         raise UsageError("--force starts over and --resume continues: give one of them")
+    if args.workers is not None:
+        import numba
+
+        most = numba.config.NUMBA_NUM_THREADS
+        if not 1 <= args.workers <= most:
+            raise UsageError(
+                f"--workers {args.workers}: must be in [1, {most}] (the threads numba may "
+                "use here: NUMBA_NUM_THREADS)"
+            )
+        numba.set_num_threads(args.workers)
     for path in output_paths(out):
         check_output(path, force=True)  # folder and path now; existence under the lock
     with OutputLock(out):
@@ -127,7 +147,7 @@ def _run_locked(args: argparse.Namespace) -> int:
     out, sections_path, impacts_path = output_paths(out)
     parts = out.with_suffix(".parts")
     chunk = _chunk(args, parts)
-    _check_budget(params, duration, transient, members_n, chunk)
+    _check_budget(params, duration, transient, members_n, chunk, args.workers)
     config = {
         "params": params.to_dict(),
         "seed": args.seed,
@@ -377,15 +397,16 @@ def _extending(bar):
     return progress
 
 
-def _check_budget(params, duration: float, transient: float, members: int, chunk: int) -> None:
+def _check_budget(
+    params, duration: float, transient: float, members: int, chunk: int, workers=None
+) -> None:
     """Refuse an ensemble whose joined tables cannot fit in memory; warn about hours."""
     from .._budget import JobEstimate, check_budget, estimate
     from ..sweep._backends import default_workers
 
     one = estimate(params, duration=duration, transient=transient)
-    job = JobEstimate(
-        (one.bytes * (members + min(chunk, members)), one.seconds * members / default_workers())
-    )
+    cores = workers or default_workers()
+    job = JobEstimate((one.bytes * (members + min(chunk, members)), one.seconds * members / cores))
     check_budget(
         job,
         what="this ensemble",

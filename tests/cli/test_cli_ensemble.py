@@ -246,3 +246,27 @@ def test_a_file_where_the_parts_folder_goes(tmp_path, capsys):
     assert "e.parts is a file where this run keeps its parts folder" in capsys.readouterr().err
     assert main([*base, "--force"]) == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["e.parquet", "e.sections.parquet"]
+
+
+def test_workers_and_device_on_the_ensemble_command(tmp_path, capsys):
+    """--workers N sets the CPU threads (the same members as with every core) and is checked
+    against the threads numba may use; --device is the sweeps' name for --backend (both were
+    'unrecognized arguments')."""
+    import numba
+
+    base = ["ensemble", "--members", "3", "--duration", "0.5", "--quiet"]
+    threads = numba.get_num_threads()
+    try:
+        assert (
+            main([*base, "--workers", "1", "--device", "cpu", "--out", str(tmp_path / "a.parquet")])
+            == 0
+        )
+        assert numba.get_num_threads() == 1
+    finally:
+        numba.set_num_threads(threads)
+    assert main([*base, "--out", str(tmp_path / "b.parquet")]) == 0
+    a, b = (pd.read_parquet(tmp_path / f"{n}.parquet") for n in "ab")
+    assert a.equals(b)
+    assert main([*base, "--workers", "0", "--out", str(tmp_path / "c.parquet")]) == 2
+    assert "--workers 0: must be in [1, " in capsys.readouterr().err
+    assert not (tmp_path / "c.parquet").exists()
