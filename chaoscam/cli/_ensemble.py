@@ -36,6 +36,7 @@ from ._ensemble_parts import (
     manifest,
     output_paths,
     part_done,
+    recorded_config,
 )
 from ._options import add_run_options
 
@@ -175,9 +176,15 @@ def _run_locked(args: argparse.Namespace) -> int:
     elif not (args.resume and parts.exists()):
         for path in (out, sections_path, impacts_path):
             if path.exists() and not args.force:
+                # The part size is not recorded: it decides where a run is saved, not what
+                # it computes.
+                what = differences(
+                    recorded_config(out), {k: v for k, v in config.items() if k != "chunk"}
+                )
                 why = (
-                    " and was made by another configuration (or is not a finished chaoscam "
-                    "ensemble): --resume continues only the same command"
+                    " and was made by another configuration"
+                    + (what or " (or is not a finished chaoscam ensemble)")
+                    + ": --resume continues only the same command"
                     if args.resume
                     else ""
                 )

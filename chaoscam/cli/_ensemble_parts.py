@@ -97,6 +97,21 @@ def finished_run(out: Path, digests: tuple[str, ...]) -> bool:
     return meta.get(_META_KEY) in {d.encode() for d in digests}
 
 
+def recorded_config(out: Path) -> dict | None:
+    """The configuration a finished members file records (:func:`run_record`), for saying
+    what differs; None when it has none (not a chaoscam ensemble, or unreadable)."""
+    import pyarrow.parquet as pq
+
+    try:
+        meta = pq.read_schema(out).metadata or {}
+        record = json.loads(meta[ENSEMBLE_RECORD_KEY])
+    except Exception:  # absent, not Parquet, no record: nothing to compare
+        return None
+    if not isinstance(record, dict):
+        return None
+    return {k: v for k, v in record.items() if k not in ("kind", "version", "backends")}
+
+
 def write_table(frame, path: Path, stamp: dict[bytes, bytes] | None = None) -> None:
     import pyarrow as pa
     import pyarrow.parquet as pq
