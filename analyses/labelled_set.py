@@ -298,7 +298,10 @@ def main(argv: list[str]) -> None:
             flush=True,
         )
     text = json.dumps(table, indent=1, default=float) + "\n"
-    atomic_write_bytes(out, text.encode(), replace=args.force)
+    try:
+        atomic_write_bytes(out, text.encode(), replace=args.force)
+    except OutputError as err:  # OUT.json appeared meanwhile: the table went beside it
+        raise SystemExit(f"{ap.prog}: {err}") from None
     print(f"wrote {out}")
 
 

@@ -75,7 +75,8 @@ def with_overrides(p, overrides: dict, caller) -> Any:
     and what it was probably meant to be (``simulate(duraton=1)`` -> duration)."""
     import inspect
 
-    from .model._params import close_names, field_names
+    from .model._names import close_names
+    from .model._params import field_names
 
     unknown = [k for k in overrides if k not in field_names()]
     if unknown:

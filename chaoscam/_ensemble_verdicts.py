@@ -72,13 +72,13 @@ def member_verdicts(
 
     ``params`` is the model of the run (one for all members, or one per member, as given to
     ``simulate_ensemble``). As :func:`chaoscam.classify_trajectory` does, an undetermined
-    member is run again longer (4x the recorded time each round, at most ``extend_to``
-    seconds recorded; None: never), all such members in one ensemble call on the backend
-    of ``ens``, until its verdict settles; its verdict's ``settings["extended"]`` records
-    the time used. A run made with ``resumable=True`` is continued from where it stopped
-    (:func:`chaoscam.integrate.extend_ensemble`: the same bits as running it again from
-    t = 0, without repeating the transient and the time already recorded). Raises
-    ValueError when ``ens`` was run without ``tangent=True``.
+    member (but not one whose tangent overflowed) is run again longer (4x the recorded time
+    each round, at most ``extend_to`` seconds recorded; None: never), all such members in
+    one ensemble call on the backend of ``ens``, until its verdict settles; its verdict's
+    ``settings["extended"]`` records the time used. A run made with ``resumable=True`` is
+    continued from where it stopped (:func:`chaoscam.integrate.extend_ensemble`: the same
+    bits as running it again from t = 0, without repeating the transient and the time
+    already recorded). Raises ValueError when ``ens`` was run without ``tangent=True``.
 
     ``progress``, optional, is called as ``progress(0, extending=m, recorded_s=r)`` before
     each extension round (m members, to r seconds recorded) and as ``progress(n)`` after

@@ -210,7 +210,9 @@ def overflow_evidence(jacobians, p: Params) -> Evidence | None:
     from ._run_warnings import resolution_warning
 
     jac = np.asarray(jacobians, dtype=float)
-    bad = ~np.isfinite(jac).reshape(len(jac), -1).all(axis=1)
+    if jac.ndim != 3 or not len(jac):
+        return None  # a malformed shape: spectrum_from_jacobians says what it expects
+    bad = ~np.isfinite(jac).all(axis=(1, 2))
     if not bad.any():
         return None
     cause = resolution_warning(p) or f"dt = {p.dt:g} s; try a smaller dt"

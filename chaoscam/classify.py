@@ -22,7 +22,7 @@ from ._model_rules import MODEL_ATOL, extensible, overflow_evidence, with_model_
 from ._simulate import Trajectory, simulate
 from ._trajectory_io import load_trajectory
 from .analysis import Evidence, Verdict, classify_section, classify_signal
-from .analysis._options import check_options
+from .analysis._options import check_options, section_options
 from .integrate import Status
 from .model import ParameterError, Params
 from .tangent import spectrum_from_jacobians
@@ -128,8 +128,10 @@ def classify_section_run(points, jacobians, params: Params, **options: Any) -> V
 
 
 def _section_verdict(points, jacobians, p: Params, options: dict) -> tuple[Verdict, dict]:
-    """Section with the tangent exponent, then the model-level rules; (verdict, settings)."""
+    """Section with the tangent exponent, then the model-level rules; (verdict, settings).
+    A series run's signal options have no use here (its extension, an overflow)."""
     period = p.cam_period
+    options = section_options(options)
     if (overflow := _overflow_verdict(points, jacobians, p, options)) is not None:
         return overflow, {}
     spec = spectrum_from_jacobians(jacobians, period)
@@ -143,8 +145,9 @@ def _section_verdict(points, jacobians, p: Params, options: dict) -> tuple[Verdi
 
 
 def _overflow_verdict(points, jacobians, p: Params, options: dict) -> Verdict | None:
-    """Undetermined from the section alone, with the reason, when the tangent overflowed
-    (:func:`chaoscam._model_rules.overflow_evidence`); else None."""
+    """Undetermined from the section alone (``options``: classify_section's), with the
+    reason, when the tangent overflowed (:func:`chaoscam._model_rules.overflow_evidence`);
+    else None."""
     ev = overflow_evidence(jacobians, p)
     if ev is None:
         return None
@@ -322,9 +325,10 @@ def classify_trajectory(
     discard : float
         Extra time after the run's transient left out of the classification [s].
     extend_to : float or None
-        With ``tangent``: when the verdict is "undetermined", the same realization is run
-        longer (4x the recorded time each round, section and tangent only, at most
-        ``extend_to`` seconds recorded; a realization's prefix does not depend on its
+        With ``tangent``: when the verdict is "undetermined" (but not for a tangent that
+        overflowed, evidence ``tangent_overflow``: a longer run overflows too), the same
+        realization is run longer (4x the recorded time each round, section and tangent
+        only, at most ``extend_to`` seconds recorded; a realization's prefix does not depend on its
         duration) and classified again, until it settles; ``settings["extended"]`` records
         the recorded time and wall time used. A round goes on from the run before it
         (:func:`chaoscam.extend_trajectory`) when that run was kept resumable (the sweeps'
@@ -341,7 +345,7 @@ def classify_trajectory(
         integer status code) and the reason; it is not classified. ``settings`` records the
         trajectory's provenance and these options.
     """
-    check_options(options, "classify_trajectory")
+    check_options(options, "classify_trajectory", series=traj.series is not None)
     discard = real("discard", discard, low=0.0, unit="s")
     if extend_to is not None:  # None: never extend
         extend_to = real("extend_to", extend_to, low=0.0, unit="s")

@@ -13,7 +13,7 @@ import inspect
 from ._classify import classify_signal
 from ._classify_section import classify_section
 
-__all__ = ["ANALYSIS_OPTIONS", "check_options"]
+__all__ = ["SECTION_OPTIONS", "SIGNAL_OPTIONS", "check_options", "section_options"]
 
 _BUILT_BY_THE_CALLER = {
     "x",
@@ -26,23 +26,40 @@ _BUILT_BY_THE_CALLER = {
     "exponent_time",
 }
 
-ANALYSIS_OPTIONS = tuple(
-    sorted(
-        (
-            set(inspect.signature(classify_signal).parameters)
-            | set(inspect.signature(classify_section).parameters)
+
+def _settings(fn) -> frozenset[str]:
+    return frozenset(inspect.signature(fn).parameters) - _BUILT_BY_THE_CALLER
+
+
+SIGNAL_OPTIONS = _settings(classify_signal)
+"""What a run with a series may pass through (to :func:`classify_signal`)."""
+
+SECTION_OPTIONS = _settings(classify_section)
+"""What a run with its section alone may pass through (to :func:`classify_section`)."""
+
+
+def check_options(options: dict, caller: str, *, series: bool) -> None:
+    """Refuse (TypeError) an option the classifier of this run does not take, naming the
+    ones it does: :func:`classify_signal`'s for a run with a series, else
+    :func:`classify_section`'s."""
+    allowed, fn = (
+        (SIGNAL_OPTIONS, "classify_signal")
+        if series
+        else (
+            SECTION_OPTIONS,
+            "classify_section",
         )
-        - _BUILT_BY_THE_CALLER
     )
-)
-"""The keyword settings of the analysis classifiers a caller may pass through."""
-
-
-def check_options(options: dict, caller: str) -> None:
-    """Refuse (TypeError) an option no analysis classifier takes, naming the ones they do."""
-    unknown = sorted(set(options) - set(ANALYSIS_OPTIONS))
+    unknown = sorted(set(options) - allowed)
     if unknown:
+        what = "a run with a series" if series else "a run kept without its series"
         raise TypeError(
-            f"{caller} got an unknown option {unknown[0]!r}; the analysis options are: "
-            f"{', '.join(ANALYSIS_OPTIONS)}"
+            f"{caller} got an unknown option {unknown[0]!r}; for {what} the options are "
+            f"{fn}'s: {', '.join(sorted(allowed))}"
         )
+
+
+def section_options(options: dict) -> dict:
+    """``options`` less those :func:`classify_section` does not take (for a run with a
+    series judged from its section alone, where its signal options have no use)."""
+    return {k: v for k, v in options.items() if k in SECTION_OPTIONS}

@@ -118,10 +118,12 @@ def run(args: argparse.Namespace) -> int:
                 f"--workers {args.workers}: must be in [1, {most}] (the threads numba may "
                 "use here: NUMBA_NUM_THREADS)"
             )
-        numba.set_num_threads(args.workers)
     for path in output_paths(out):
         check_output(path, force=True)  # folder and path now; existence under the lock
-    with OutputLock(out):
+    from ..sweep._batch import numba_threads
+
+    # The thread count for this run only (fork-safe layer first), restored after.
+    with OutputLock(out), numba_threads(args.workers):
         return _run_locked(args)
 
 

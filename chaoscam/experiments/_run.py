@@ -129,7 +129,7 @@ def run_paper(
     wanted = sorted(set(figures or FIGURES))
     stages: dict = {}  # function -> its first figure number (Figs. 7-10 share one)
     for number in wanted:
-        stages.setdefault(FIGURES[number], number)
+        stages.setdefault(FIGURES[number], min(n for n in FIGURES if FIGURES[n] is FIGURES[number]))
     if figures is None:  # the whole report: also the sweeps that explain the differences
         stages[_sensitivity_stage] = SENSITIVITY
     funcs = list(stages)
@@ -245,13 +245,22 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     ap.add_argument("--workers", type=int, default=None, help="cores (default: all)")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     outdir = Path(args.outdir)
+    from ..sweep._backends import local_workers
+
     try:
+        if args.workers is not None:
+            local_workers(args.workers)  # every sweep of the stage would refuse it
         if outdir.exists() and not outdir.is_dir():
             raise OutputError(f"OUTDIR {outdir}: is a file, not a folder")
         outdir.mkdir(parents=True, exist_ok=True)
         for file in data_files(number):
+            if (outdir / file).exists() and not args.force:
+                raise OutputError(
+                    f"OUTDIR {outdir} already holds {file}; nothing was overwritten: give "
+                    "another OUTDIR, or pass --force to replace this stage's files"
+                )
             check_output(outdir / file, flag="OUTDIR", force=args.force)
-    except (OutputError, OSError) as err:
+    except (OutputError, OSError, ValueError) as err:
         ap.error(str(err))  # exit 2
     fn = _sensitivity_stage if number == SENSITIVITY else FIGURES[number]
     try:

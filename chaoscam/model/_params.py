@@ -435,17 +435,9 @@ def field_names() -> tuple[str, ...]:
 FIELD_DOCS: dict[str, dict] = {f.name: dict(f.metadata) for f in fields(Params)}
 
 
-def close_names(name: str, names) -> list[str]:
-    """Up to three of ``names`` close to ``name``: the same but for case first (OMEGA ->
-    omega), then by difflib's similarity."""
-    import difflib
-
-    same = [n for n in names if n.lower() == name.lower() and n != name]
-    close = difflib.get_close_matches(name, list(names), n=3)
-    return list(dict.fromkeys(same + close))[:3]
-
-
 def _unknown_message(name: str) -> str:
+    from ._names import close_names
+
     close = close_names(name, field_names())
     hint = f" Did you mean {', '.join(close)}?" if close else ""
     return f"unknown parameter {name!r}.{hint} Known: {', '.join(field_names())}"

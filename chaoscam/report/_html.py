@@ -344,6 +344,8 @@ def _fate_text(rows, fate, what: str) -> str:
     if not fate:
         return ""
     checked, stopped = fate_split(rows)
+    if not len(checked):
+        return ""  # a horizon, but no run to continue (all periodic or out of reach)
     return (
         f"; continued to {float(fate):g} s, {len(stopped)} of the {len(checked)} {what} "
         f"{continued_labels(checked)} stop before it (transient motion)"

@@ -263,9 +263,14 @@ def simulate_call(task: Any) -> str:
     base = Params().to_dict()
     changed = {k: v for k, v in task.params.to_dict().items() if v != base[k]}
     args = ", ".join(f"{k}={v!r}" for k, v in changed.items())
+    extra = ""
+    if not task.series:
+        extra = ", series=False"
+    elif task.params.dt > OUTPUT_DT:  # as the task ran it (:func:`_run`)
+        extra = f", output_dt={task.params.dt!r}"
     return (
         f"chaoscam.simulate(chaoscam.Params({args}), duration={task.duration!r}, "
-        f"transient={task.transient!r}, seed={task.seed}, index={task.sim_index})"
+        f"transient={task.transient!r}, seed={task.seed}, index={task.sim_index}{extra})"
     )
 
 

@@ -400,3 +400,15 @@ def test_an_overflowed_tangent_is_undetermined_with_its_cause_and_not_extended()
     members = classify_ensemble(ens, p).members
     assert list(members["label"]) == ["undetermined"]
     assert members["reasons"][0] == why
+
+
+def test_analysis_options_go_where_they_apply():
+    """An option of the series classifier on a run with a series is also fine when the run
+    is extended (the extension has no series: it raised classify_section's TypeError);
+    on a run kept without its series it is refused naming classify_section's options."""
+    run = chaoscam.simulate(duration=2.0)
+    v = classify_trajectory(run, spectrum_options={}, extend_to=40.0)
+    assert v.settings["extended"]["recorded_s"] > 1.0
+    bare = chaoscam.simulate(duration=2.0, series=False)
+    with pytest.raises(TypeError, match="options are classify_section's: .*zero_one"):
+        classify_trajectory(bare, spectrum_options={})

@@ -250,23 +250,29 @@ def test_a_file_where_the_parts_folder_goes(tmp_path, capsys):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["e.parquet", "e.sections.parquet"]
 
 
-def test_workers_and_device_on_the_ensemble_command(tmp_path, capsys):
-    """--workers N sets the CPU threads (the same members as with every core) and is checked
-    against the threads numba may use; --device is the sweeps' name for --backend (both were
-    'unrecognized arguments')."""
+def test_workers_and_device_on_the_ensemble_command(tmp_path, capsys, monkeypatch):
+    """--workers N sets the CPU threads for the run only (restored after; the same members
+    as with every core) and is checked against the threads numba may use; --device is the
+    sweeps' name for --backend (both were 'unrecognized arguments')."""
     import numba
+
+    import chaoscam.cli._ensemble as ens_cli
 
     base = ["ensemble", "--members", "3", "--duration", "0.5", "--quiet"]
     threads = numba.get_num_threads()
-    try:
-        assert (
-            main([*base, "--workers", "1", "--device", "cpu", "--out", str(tmp_path / "a.parquet")])
-            == 0
-        )
-        assert numba.get_num_threads() == 1
-    finally:
-        numba.set_num_threads(threads)
+    seen = []
+    run = ens_cli._run_locked
+
+    def spy(args):
+        seen.append(numba.get_num_threads())
+        return run(args)
+
+    monkeypatch.setattr(ens_cli, "_run_locked", spy)
+    a_out = str(tmp_path / "a.parquet")
+    assert main([*base, "--workers", "1", "--device", "cpu", "--out", a_out]) == 0
+    assert seen == [1] and numba.get_num_threads() == threads
     assert main([*base, "--out", str(tmp_path / "b.parquet")]) == 0
+    assert seen == [1, threads]
     a, b = (pd.read_parquet(tmp_path / f"{n}.parquet") for n in "ab")
     assert a.equals(b)
     assert main([*base, "--workers", "0", "--out", str(tmp_path / "c.parquet")]) == 2

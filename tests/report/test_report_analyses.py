@@ -43,7 +43,7 @@ def test_a_script_replaces_existing_files_only_with_force(tmp_path):
     before = {p.name: p.stat().st_mtime_ns for p in tmp_path.iterdir()}
     again = _script("fig5.py", "--quick", str(tmp_path))
     assert again.returncode == 2 and "Traceback" not in again.stderr
-    assert "--force" in again.stderr and "fig5" in again.stderr
+    assert "--force" in again.stderr and "already holds fig5" in again.stderr
     assert {p.name: p.stat().st_mtime_ns for p in tmp_path.iterdir()} == before
     forced = _script("fig5.py", "--quick", "--force", str(tmp_path))
     assert forced.returncode == 0
@@ -61,6 +61,9 @@ def test_a_script_explains_itself_and_refuses_what_it_does_not_know(tmp_path):
     )
     assert helped.returncode == 0 and "--force" in helped.stdout and "OUTDIR" in helped.stdout
     assert list(tmp_path.iterdir()) == []
+    workers = _script("fig4.py", "--workers", "0", str(tmp_path / "w"))
+    assert workers.returncode == 2 and "workers = 0 must be in [1, " in workers.stderr
+    assert "Traceback" not in workers.stderr and not (tmp_path / "w").exists()
     wrong = _script("fig4.py", "--quik", str(tmp_path))
     assert wrong.returncode == 2 and "--quik" in wrong.stderr and "Traceback" not in wrong.stderr
     (tmp_path / "file").write_text("x")

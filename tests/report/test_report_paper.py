@@ -100,6 +100,20 @@ def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch, capsys):
     assert "1 stage(s) failed" in err and "no luck" in err and out.exists()
 
 
+def test_a_stage_asked_for_by_a_later_figure_keeps_its_title(tmp_path, monkeypatch):
+    """figures=[8]: the shared stage of Figs. 7-10 is titled as such (it fell back to the
+    function's name, fig7_10)."""
+    from chaoscam.experiments import _paper, run_paper
+
+    def boom(quick, outdir, workers=None):
+        raise RuntimeError("no luck")
+
+    for n in (7, 8, 9, 10):
+        monkeypatch.setitem(_paper.FIGURES, n, boom)
+    run = run_paper(quick=True, out=tmp_path / "p.html", figures=[8])
+    assert run.failed == ("Figs. 7–10: random line length: failed with RuntimeError: no luck",)
+
+
 def test_paper_refuses_a_worker_count_before_any_work(tmp_path, capsys):
     """--workers past the sweeps' limit: exit 2 at once, nothing written (every sweep of
     the report failed on it, and the command still exited 0)."""

@@ -181,3 +181,13 @@ def test_the_command_line_summary_names_the_continued_runs(tmp_path, capsys):
     assert "labels: chaotic 1, left_reach 1" in out
     assert "fate: 1 of the 1 run(s) labelled chaotic stopped later (LEFT_REACH 1; " in out
     assert "last section at 27.9 s): transient motion" in out
+
+
+def test_the_report_clause_is_empty_when_no_run_was_continued():
+    """A horizon, but every run periodic (or out of reach): no "0 of the 0 cells" clause."""
+    from chaoscam.report._html import _fate_text
+
+    rows = pd.DataFrame({"label": ["periodic", "left_reach"], "fate": [None, None]})
+    assert _fate_text(rows, 300.0, "cells") == ""
+    rows.loc[0, ["label", "fate"]] = ["chaotic", "OK"]
+    assert _fate_text(rows, 300.0, "cells").startswith("; continued to 300 s, 0 of the 1 cells")
