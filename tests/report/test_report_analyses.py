@@ -14,19 +14,6 @@ def test_there_is_one_script_per_paper_figure():
     )
 
 
-def test_fig5_script_writes_data_and_figure(tmp_path):
-    """Running a script writes a PNG and a data file into OUTDIR and prints the comparison."""
-    out = subprocess.run(
-        [sys.executable, str(ROOT / "analyses" / "fig5.py"), "--quick", str(tmp_path)],
-        check=True,
-        capture_output=True,
-        text=True,
-    )
-    assert "Fig. 5" in out.stdout
-    data = list(tmp_path.glob("*.csv")) + list(tmp_path.glob("*.parquet"))
-    assert list(tmp_path.glob("*.png")) and data
-
-
 def _script(name, *args):
     return subprocess.run(
         [sys.executable, str(ROOT / "analyses" / name), *args],
@@ -36,10 +23,14 @@ def _script(name, *args):
 
 
 def test_a_script_replaces_existing_files_only_with_force(tmp_path):
-    """A second run into the same folder is refused (exit 2, one line naming a file, the
-    files kept: the committed reports/paper-data would otherwise be overwritten by a quick
-    run); with --force it replaces them."""
-    assert _script("fig5.py", "--quick", str(tmp_path)).returncode == 0
+    """A script writes a PNG and a data file into OUTDIR and prints the comparison; a second
+    run into the same folder is refused (exit 2, one line naming a file, the files kept: the
+    committed reports/paper-data would otherwise be overwritten by a quick run); with
+    --force it replaces them."""
+    first = _script("fig5.py", "--quick", str(tmp_path))
+    assert first.returncode == 0 and "Fig. 5" in first.stdout
+    data = list(tmp_path.glob("*.csv")) + list(tmp_path.glob("*.parquet"))
+    assert list(tmp_path.glob("*.png")) and data
     before = {p.name: p.stat().st_mtime_ns for p in tmp_path.iterdir()}
     again = _script("fig5.py", "--quick", str(tmp_path))
     assert again.returncode == 2 and "Traceback" not in again.stderr
