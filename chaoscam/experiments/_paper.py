@@ -219,13 +219,8 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     wanted = ["chaotic", "periodic-2", "quasiperiodic", "chaotic"]
     found = [lab for lab, _ in runs if lab != "undetermined"]
     if undetermined > 0.5:
-        verdict, why = (
-            "not comparable",
-            (
-                f"{undetermined:.0%} of the values are undetermined by the classifier: too "
-                "little evidence to place the transitions"
-            ),
-        )
+        why = f"{undetermined:.0%} of the values are undetermined by the classifier: too "
+        verdict, why = "not comparable", why + "little evidence to place the transitions"
     elif _is_subsequence(wanted, found):
         verdict, why = "agrees", "the paper's sequence appears, in order, along l_λ"
     else:
@@ -241,7 +236,9 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
         Comparison(
             "Fig. 4",
             "over l_λ ∈ [0.001, 0.018] m: chaos → period 2 → quasiperiod 2 → chaos",
-            f"{len(v)} values: {seq}",
+            f"{len(v)} values from initial condition 0: {seq} (all {len(bif.verdicts)} runs: "
+            + ", ".join(f"{k} {n}" for k, n in bif.verdicts["label"].value_counts().items())
+            + ")",
             verdict,
             why + ("; quick run: one initial condition per value, 25 values" if quick else ""),
         )

@@ -97,6 +97,9 @@ def test_full_report_has_every_section_and_valid_images(outputs, tmp_path, capsy
         assert raw.startswith(PNG_SIGNATURE)
         assert mpimg.imread(io.BytesIO(raw), format="png").shape[0] > 50
     assert not re.search(r"https?:", text, re.IGNORECASE), "no network reference"
+    # The evidence section defines the labels and the tables' columns it points readers to.
+    for term in ("periodic n", "chaotic", "undetermined", "left_reach", "exponent"):
+        assert f"<dt>{term}" in text
     assert "Nothing: every part of the report has its inputs." in text
     assert "chaoscam report " in text and "package version" in text and "git commit" in text
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 
+import pandas as pd
 import pytest
 
 from chaoscam.cli import main
@@ -225,3 +226,31 @@ def test_each_figure_is_rendered_once_and_the_report_embeds_its_file(tmp_path, m
         base64.b64decode(u) for u in re.findall(r'src="data:image/png;base64,([^"]+)"', text)
     }
     assert embedded == set(files.values())
+
+
+def test_the_summary_opens_with_the_labels_counted_from_the_tables():
+    """The first line of the summary answers the question from the runs themselves: label
+    counts of the paper's figures and, apart, of the sensitivity sweeps (with the periods)."""
+    from types import SimpleNamespace
+
+    from chaoscam.experiments._run import _in_short
+
+    def sweep(number, labels, periods):
+        table = pd.DataFrame({"label": labels, "period": periods})
+        return SimpleNamespace(
+            number=number,
+            bifurcations=[("b", SimpleNamespace(verdicts=table), b"")],
+            regime_maps=[],
+        )
+
+    nan = float("nan")
+    fig = sweep(4, ["chaotic", "chaotic", "undetermined"], [nan, nan, nan])
+    sens = sweep(0, ["periodic", "periodic", "left_reach", "chaotic"], [1, 3, nan, nan])
+    assert _in_short([fig, sens]) == (
+        "In short: the 3 runs of the paper's figures are 0 periodic, 2 chaotic, 0 "
+        "quasiperiodic, 1 undetermined, 0 out of reach or diverged. The 4 runs of the "
+        "sensitivity sweeps, which move the stiffness, ξ and ω away from Table 1, are 2 "
+        "periodic, 1 chaotic, 0 quasiperiodic, 0 undetermined, 1 out of reach or diverged "
+        "(periods 1, 3)."
+    )
+    assert _in_short([sens]) == ""
