@@ -12,7 +12,7 @@ from typing import Any
 
 from .model import ParameterError
 
-__all__ = ["whole", "real", "params_arg", "with_overrides"]
+__all__ = ["flag", "whole", "real", "params_arg", "with_overrides"]
 
 
 def whole(name: str, value: Any, *, low: int = 0, high: int | None = None) -> int:
@@ -25,6 +25,16 @@ def whole(name: str, value: Any, *, low: int = 0, high: int | None = None) -> in
     if value < low or (high is not None and value > high):
         top = "" if high is None else f" and <= {high}"
         raise ParameterError(f"{name} = {value} must be an integer >= {low}{top}")
+    return value
+
+
+def flag(name: str, value: Any) -> bool:
+    """``value`` as a bool: True or False (numpy's too); "no", 1 or None refused (a string
+    is truthy, so "no" would have switched the option on)."""
+    if type(value).__module__ == "numpy" and type(value).__name__ in ("bool_", "bool"):
+        value = bool(value)
+    if not isinstance(value, bool):
+        raise ParameterError(f"{name} = {value!r} must be True or False")
     return value
 
 

@@ -301,8 +301,10 @@ def raw_run(
     **overrides: Any,
 ) -> RawRun:
     """:func:`simulate` up to its arrays (same arguments, same checks and warnings)."""
-    from ._checks import params_arg, real, with_overrides
+    from ._checks import flag, params_arg, real, with_overrides
 
+    series, tangent = flag("series", series), flag("tangent", tangent)
+    resumable = flag("resumable", resumable)
     p = params_arg(params)
     if overrides:
         p = with_overrides(p, overrides, simulate)

@@ -321,8 +321,8 @@ def lyapunov_model(
     # came out at +0.29 1/s against -0.75 1/s on the grid.
     p = p.replace(integrator="rk4")
     duration, transient = check_window(duration, transient, dt=p.dt)
-    if not (int(renorm_periods) == renorm_periods and renorm_periods >= 1):
-        raise ParameterError(f"renorm_periods = {renorm_periods!r} must be an integer >= 1")
+    renorm_periods = whole("renorm_periods", renorm_periods, low=1)
+    seed, index = whole("seed", seed), whole("index", index)
     if not (math.isfinite(d0) and d0 > 0):
         raise ParameterError(f"d0 = {d0!r} must be > 0")
     om_scale = p.omega if omega_scale is None else float(omega_scale)

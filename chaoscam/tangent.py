@@ -283,6 +283,12 @@ def periodic_orbit(
         raise ParameterError(
             f"x0 = {x0!r}: must be two finite numbers (theta_f [rad], omega_f [rad/s])"
         )
+    from ._budget import check_run
+
+    # Each Newton iteration runs n cam periods: at most max_iter + 1 of them, judged as one
+    # run (refused past the run limit, as simulate is; a warning past a minute).
+    most = (max_iter + 1) * n
+    check_run(params, most * params.cam_period, what=f"the shooting (up to {most} periods)")
     run = _MapRunner(params, n)
     w = np.array([1.0, params.cam_period])
     fx, m, code = run(x)

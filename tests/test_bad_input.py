@@ -422,3 +422,70 @@ def test_classify_discard_on_the_command_line(tmp_path, capsys):
     assert main(["classify", str(path), "--discard", "3"]) == 2
     err = capsys.readouterr().err
     assert "discard = 3.0 s must be in [0, 2) s" in err and "Traceback" not in err
+
+
+def _tiny_ensemble():
+    from chaoscam.integrate import simulate_ensemble
+
+    return simulate_ensemble(Params(), range(2), duration=0.3, tangent=True, resumable=True)
+
+
+# A review's API mistakes, each refused naming the argument (they were accepted, or failed
+# deep inside with numpy's, Python's or a TaskFailed's words).
+API_REVIEW_CASES = [
+    (lambda: chaoscam.simulate(duration=0.05, series="no"), "series = 'no' must be True or False"),
+    (lambda: chaoscam.simulate(duration=0.05, tangent=1), "tangent = 1 must be True or False"),
+    (
+        lambda: chaoscam.classify_trajectory(chaoscam.simulate(duration=0.5), check_step="no"),
+        "check_step",
+    ),
+    (lambda: regime_map(("xi", [0.4]), ("omega", [30.0]), lyapunov="no"), "lyapunov"),
+    (lambda: bifurcation("xi", [0.4], duration=0.3, workers=1.5), "workers = 1.5"),
+    (lambda: bifurcation("xi", [0.4], duration=0.3, workers=True), "workers = True"),
+    (lambda: chaoscam.lyapunov_model(duration=0.5, seed=True), "seed = True"),
+    (lambda: chaoscam.lyapunov_model(duration=0.5, renorm_periods=1.5), "renorm_periods"),
+    (
+        lambda: chaoscam.integrate.extend_ensemble(_tiny_ensemble(), Params(), 0.6, members=[-1]),
+        "members = -1",
+    ),
+    (
+        lambda: chaoscam.integrate.extend_ensemble(_tiny_ensemble(), Params(), 0.6, members=[True]),
+        "members = True",
+    ),
+    (
+        lambda: chaoscam.integrate.simulate_ensemble(Params(), range(1), duration=0.2, batch=1.5),
+        "batch = 1.5",
+    ),
+    (
+        lambda: chaoscam.integrate.simulate_ensemble(
+            Params(), range(1), duration=0.2, keep_impacts="no"
+        ),
+        "keep_impacts",
+    ),
+    (lambda: chaoscam.periodic_orbit(Params(), [0.0, 0.0], 10**6), "the shooting .up to"),
+]
+
+
+@pytest.mark.parametrize("i", range(len(API_REVIEW_CASES)))
+def test_api_review_mistakes_are_named(i):
+    call, named = API_REVIEW_CASES[i]
+    with pytest.raises((ParameterError, ValueError), match=named):
+        call()
+
+
+def test_whole_number_floats_in_integer_fields_are_stored_as_integers():
+    """flight_merge = 2.0 (what START:STOP:NUM gives) is 2: an ensemble and a sweep over it
+    run (they failed in numpy: 'expected a sequence of integers')."""
+    from chaoscam.integrate import simulate_ensemble
+
+    p = Params(flight_merge=2.0, max_events_per_step=4.0)
+    assert (p.flight_merge, p.max_events_per_step) == (2, 4) and type(p.flight_merge) is int
+    assert simulate_ensemble(p, range(1), duration=0.2).members["status"].tolist() == ["OK"]
+    res = bifurcation("flight_merge", "2:4:2", duration=0.3, workers=1)
+    assert len(res.verdicts) == 2
+
+
+def test_axis_linspace_takes_numpy_scalars():
+    from chaoscam.sweep import Axis
+
+    assert Axis.linspace("xi", np.float64(0.1), np.float32(0.5), np.int64(2)).values == (0.1, 0.5)

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._checks import params_arg, whole
+from .._checks import flag, params_arg, whole
 from .._run_warnings import run_warnings
 from ..model import Params
 from . import _gpu
@@ -150,12 +150,11 @@ def simulate_ensemble(
     them do, and only their statistics compare.
     """
     duration, transient = check_window(duration, transient)
+    keep_impacts, tangent = flag("keep_impacts", keep_impacts), flag("tangent", tangent)
     use_gpu, device = _pick_backend(backend)
     if batch is None:
         batch = _gpu.GPU_BATCH if use_gpu else _CPU_BATCH
-    if int(batch) < 1:
-        raise ValueError(f"batch must be >= 1, got {batch!r}")
-    batch = int(batch)
+    batch = whole("batch", batch, low=1)
     seed = whole("seed", seed)
     per_member = isinstance(params, list | tuple)
     plist = [params_arg(q) for q in params] if per_member else [params_arg(params)]
@@ -263,7 +262,12 @@ def extend_ensemble(
     duration, transient = check_window(duration, s["transient"])
     if duration < s["duration"]:
         raise ValueError(f"duration = {duration!r} s is shorter than the run's {s['duration']} s")
-    picks = list(range(len(res))) if members is None else [int(m) for m in members]
+    last = len(res) - 1
+    picks = (
+        list(range(len(res)))
+        if members is None
+        else [whole("members", m, low=0, high=last) for m in members]  # not -1, 1.9, True
+    )
     plist = list(params) if isinstance(params, list | tuple) else [params] * len(res)
     if len(plist) != len(res):
         raise ValueError(f"{len(plist)} parameter sets for {len(res)} members")

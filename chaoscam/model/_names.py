@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-__all__ = ["close_names"]
+__all__ = ["close_names", "unknown_message"]
 
 
 def close_names(name: str, names) -> list[str]:
@@ -13,3 +13,10 @@ def close_names(name: str, names) -> list[str]:
     same = [n for n in names if n.lower() == name.lower() and n != name]
     close = difflib.get_close_matches(name, list(names), n=3)
     return list(dict.fromkeys(same + close))[:3]
+
+
+def unknown_message(name: str, names) -> str:
+    """The refusal of an unknown parameter name, with what it was probably meant to be."""
+    close = close_names(name, names)
+    hint = f" Did you mean {', '.join(close)}?" if close else ""
+    return f"unknown parameter {name!r}.{hint} Known: {', '.join(names)}"

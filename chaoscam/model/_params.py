@@ -335,6 +335,8 @@ class Params:
                 value = value.item()  # numpy scalars: stored as Python numbers
                 object.__setattr__(self, f.name, value)
             _validate_field(f, value)
+            if f.type == "int" and isinstance(value, float):  # 4.0 -> 4 (4.5 refused above)
+                object.__setattr__(self, f.name, int(value))
         if self.stiffness == "fractal":
             # Raises a ParameterError naming D or G when (15)/(17) do not apply.
             from ._stiffness import fractal_stiffness
@@ -436,11 +438,9 @@ FIELD_DOCS: dict[str, dict] = {f.name: dict(f.metadata) for f in fields(Params)}
 
 
 def _unknown_message(name: str) -> str:
-    from ._names import close_names
+    from ._names import unknown_message
 
-    close = close_names(name, field_names())
-    hint = f" Did you mean {', '.join(close)}?" if close else ""
-    return f"unknown parameter {name!r}.{hint} Known: {', '.join(field_names())}"
+    return unknown_message(name, field_names())
 
 
 def parse_value(name: str, text: str) -> Any:

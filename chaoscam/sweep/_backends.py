@@ -68,7 +68,9 @@ accepts: more only compete for the cores, and each holds a run in memory (a typo
 def local_workers(workers: int | None) -> int:
     """The local worker count: ``workers``, or every core when None; a ValueError naming
     ``workers`` and its range [1, WORKERS_PER_CORE x cores] otherwise."""
-    n = default_workers() if workers is None else int(workers)
+    from .._checks import whole
+
+    n = default_workers() if workers is None else whole("workers", workers, low=1)
     most = WORKERS_PER_CORE * default_workers()
     if not 1 <= n <= most:
         raise ValueError(

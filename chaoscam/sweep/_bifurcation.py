@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .._checks import whole
+from .._checks import flag, whole
 from .._provenance import code_identity
 from .._version import __version__
 from ..model import Params, contact_angle
@@ -273,6 +273,7 @@ def bifurcation(
     base = Params() if base is None else base
     duration, transient = run_settings(duration, transient, seed)
     fate = check_fate(fate, duration)
+    lyapunov, check_step = flag("lyapunov", lyapunov), flag("check_step", check_step)
     validate_grid(base, [axis])
     counted = isinstance(initial_conditions, numbers.Integral) and not isinstance(
         initial_conditions, bool

@@ -120,6 +120,7 @@ class Axis:
     @classmethod
     def linspace(cls, name: str, start: float, stop: float, num: int) -> Axis:
         """``num`` evenly spaced values from ``start`` to ``stop``, both included."""
+        start, stop = (v.item() if type(v).__module__ == "numpy" else v for v in (start, stop))
         parse_range(f"{start!r}:{stop!r}:{num}", what=name)
         return cls(name, tuple(np.linspace(start, stop, num).tolist()))
 

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .._checks import whole
+from .._checks import flag, whole
 from .._provenance import code_identity
 from .._version import __version__
 from ..model import ParameterError, Params, realizations_identical
@@ -347,6 +347,7 @@ def regime_map(
     base = Params() if base is None else base
     duration, transient = run_settings(duration, transient, seed)
     fate = check_fate(fate, duration)
+    lyapunov, check_step = flag("lyapunov", lyapunov), flag("check_step", check_step)
     realizations = whole("realizations", realizations, low=1)
     adaptive = None
     if target_halfwidth is not None:
