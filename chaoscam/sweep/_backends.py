@@ -68,10 +68,14 @@ accepts: more only compete for the cores, and each holds a run in memory (a typo
 def local_workers(workers: int | None) -> int:
     """The local worker count: ``workers``, or every core when None; a ValueError naming
     ``workers`` and its range [1, WORKERS_PER_CORE x cores] otherwise."""
-    from .._checks import whole
+    import numbers
 
-    n = default_workers() if workers is None else whole("workers", workers, low=1)
     most = WORKERS_PER_CORE * default_workers()
+    if workers is not None and (
+        isinstance(workers, bool) or not isinstance(workers, numbers.Integral)
+    ):  # 1.5, True and "2" were taken as 1, 1 and 2
+        raise ValueError(f"workers = {workers!r} must be a whole number in [1, {most}]")
+    n = default_workers() if workers is None else int(workers)
     if not 1 <= n <= most:
         raise ValueError(
             f"workers = {n} must be in [1, {most}] ({WORKERS_PER_CORE} per core on this "
