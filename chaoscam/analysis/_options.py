@@ -42,14 +42,8 @@ def check_options(options: dict, caller: str, *, series: bool) -> None:
     """Refuse (TypeError) an option the classifier of this run does not take, naming the
     ones it does: :func:`classify_signal`'s for a run with a series, else
     :func:`classify_section`'s."""
-    allowed, fn = (
-        (SIGNAL_OPTIONS, "classify_signal")
-        if series
-        else (
-            SECTION_OPTIONS,
-            "classify_section",
-        )
-    )
+    allowed = SIGNAL_OPTIONS if series else SECTION_OPTIONS
+    fn = "classify_signal" if series else "classify_section"
     unknown = sorted(set(options) - allowed)
     if unknown:
         what = "a run with a series" if series else "a run kept without its series"

@@ -67,16 +67,33 @@ def check_paper_outputs(out: str | Path, figures=None, *, force: bool = False) -
     if outdir.is_dir():
         stages = sorted(set(figures or FIGURES)) + ([] if figures else [SENSITIVITY])
         names = dict.fromkeys(n for f in stages for n in data_files(f))
+        elsewhere = (
+            "write the report into another folder (--out OTHER/paper.html, its data go to "
+            "OTHER/paper-data), or pass --force to replace them"
+        )
         for name in names:
-            if (outdir / name).exists() and not force:
-                raise OutputError(
-                    f"{outdir} already holds {name} (the data of an earlier report); nothing "
-                    "was overwritten: write the report into another folder (--out "
-                    "OTHER/paper.html, its data go to OTHER/paper-data), or pass --force to "
-                    "replace them"
-                )
-            check_output(outdir / name, flag="paper data", force=force)
+            _check_data_file(
+                outdir,
+                name,
+                force,
+                f"{outdir} already holds",
+                elsewhere,
+                " (the data of an earlier report)",
+            )
     return outdir
+
+
+def _check_data_file(
+    outdir: Path, name: str, force: bool, holds: str, elsewhere: str, what: str = ""
+) -> None:
+    """:func:`chaoscam._outputs.check_output` for a figure's data file, whose name the user
+    cannot choose: an existing one is refused saying where else to write (``elsewhere``),
+    not "choose another name"."""
+    from .._outputs import OutputError, check_output
+
+    if (outdir / name).exists() and not force:
+        raise OutputError(f"{holds} {name}{what}; nothing was overwritten: {elsewhere}")
+    check_output(outdir / name, flag="paper data", force=force)
 
 
 def run_paper(
@@ -271,7 +288,7 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     import argparse
     import sys
 
-    from .._outputs import OutputError, check_output
+    from .._outputs import OutputError
 
     name = "sensitivity" if number == SENSITIVITY else f"fig{number}"
     what = "the sensitivity sweeps" if number == SENSITIVITY else f"Fig. {number}"
@@ -300,12 +317,13 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
             raise OutputError(f"OUTDIR {outdir}: is a file, not a folder")
         outdir.mkdir(parents=True, exist_ok=True)
         for file in data_files(number):
-            if (outdir / file).exists() and not args.force:
-                raise OutputError(
-                    f"OUTDIR {outdir} already holds {file}; nothing was overwritten: give "
-                    "another OUTDIR, or pass --force to replace this stage's files"
-                )
-            check_output(outdir / file, flag="OUTDIR", force=args.force)
+            _check_data_file(
+                outdir,
+                file,
+                args.force,
+                f"OUTDIR {outdir} already holds",
+                "give another OUTDIR, or pass --force to replace this stage's files",
+            )
     except (OutputError, OSError, ValueError) as err:
         ap.error(str(err))  # exit 2
     fn = _sensitivity_stage if number == SENSITIVITY else FIGURES[number]
