@@ -91,7 +91,7 @@ def run_report(args: argparse.Namespace) -> int:
         ["chaoscam", "report", *map(str, args.inputs), "--out", str(args.out)]
         + (["--title", args.title] if args.title != "chaoscam report" else [])
     )
-    write_report(parts, args.out, title=args.title, command=command)
+    write_report(parts, args.out, title=args.title, command=command, replace=args.force)
     print(f"report: {args.out}")
     return 0
 

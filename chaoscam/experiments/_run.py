@@ -114,10 +114,37 @@ def run_paper(
     duration go to stderr and the findings, figure by figure, to stdout. A stage that raises
     is reported in the report's "What is missing" and in :attr:`PaperRun.failed`; the
     others still run.
-    """
-    import sys
 
+    A second run into the same folder (the same ``paper-data``) is refused while this one
+    works (:class:`chaoscam._outputs.OutputLock`), and without ``force`` the report is put in
+    place only if its name is still free: a file that appeared there meanwhile is kept, and
+    this run's report goes beside it with an ``OutputError`` naming both.
+    """
+    from .._outputs import OutputLock
     from ..sweep._backends import local_workers
+
+    if figures is not None:
+        figures = list(figures)
+        unknown = [f for f in figures if f not in FIGURES]
+        if not figures or unknown:
+            raise ValueError(
+                f"figures = {figures}: choose from {sorted(FIGURES)} (None: every figure and "
+                "the sensitivity sweeps)"
+            )
+    if workers is not None:
+        local_workers(workers)  # before any work: every sweep would refuse it
+    out = Path(out)
+    check_paper_outputs(out, figures, force=force)  # the messages, before taking the lock
+    # One run at a time per report folder: reports beside each other share paper-data.
+    with OutputLock(out.parent / "paper-data", "folder (--out OTHER/paper.html)"):
+        outdir = check_paper_outputs(out, figures, force=force)  # again, under the lock
+        outdir.mkdir(exist_ok=True)
+        return _run_stages(quick, out, outdir, figures, workers, command, echo, force)
+
+
+def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> PaperRun:
+    """The body of :func:`run_paper`, holding the report folder's lock."""
+    import sys
 
     def say(text: str) -> None:
         if echo:
@@ -131,19 +158,6 @@ def run_paper(
         write_report,
     )
 
-    if figures is not None:
-        figures = list(figures)
-        unknown = [f for f in figures if f not in FIGURES]
-        if not figures or unknown:
-            raise ValueError(
-                f"figures = {figures}: choose from {sorted(FIGURES)} (None: every figure and "
-                "the sensitivity sweeps)"
-            )
-    if workers is not None:
-        local_workers(workers)  # before any work: every sweep would refuse it
-    out = Path(out)
-    outdir = check_paper_outputs(out, figures, force=force)
-    outdir.mkdir(exist_ok=True)
     wanted = sorted(set(figures or FIGURES))
     stages: dict = {}  # function -> its first figure number (Figs. 7-10 share one)
     for number in wanted:
@@ -229,7 +243,8 @@ def run_paper(
     title = f"chaoscam: the paper's {done_text} reproduced" + (" (quick run)" if quick else "")
     if failed:
         title += f" (incomplete: {len(failed)} of {len(funcs)} stages failed)"
-    return PaperRun(write_report(parts, out, title=title, command=command), tuple(failed))
+    written = write_report(parts, out, title=title, command=command, replace=force)
+    return PaperRun(written, tuple(failed))
 
 
 _LABELS = ("periodic", "chaotic", "quasiperiodic", "undetermined")

@@ -484,11 +484,17 @@ def build_report(inputs, parts: ReportParts | None = None) -> ReportParts:
     return parts
 
 
-def write_report(parts: ReportParts, out: str | Path, *, title: str, command=None) -> Path:
-    """Render and write the report; returns the path."""
-    from .._outputs import atomic_write_bytes
+def write_report(
+    parts: ReportParts, out: str | Path, *, title: str, command=None, replace: bool = True
+) -> Path:
+    """Render and write the report atomically into an existing folder; returns the path.
 
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(out, render(parts, title=title, command=command).encode("utf-8"))
+    ``replace=False`` never writes over an existing file: the report then goes beside it
+    (``NAME.PID.html``) with an :class:`chaoscam._outputs.OutputError` naming both.
+    """
+    from .._outputs import atomic_write_bytes, check_output
+
+    out = check_output(out, flag="out", force=True, suffixes=(".html", ".htm"))
+    data = render(parts, title=title, command=command).encode("utf-8")
+    atomic_write_bytes(out, data, replace=replace)
     return out

@@ -85,7 +85,7 @@ class Bifurcation:
 
 def read_bifurcation(path: str | Path) -> Bifurcation:
     """Read a diagram written by :func:`bifurcation`."""
-    return Bifurcation(*read_tables(path, "verdicts"))
+    return Bifurcation(*read_tables(path, "verdicts", "bifurcation"))
 
 
 def initial_offsets(n: int) -> list[tuple[float, float]]:

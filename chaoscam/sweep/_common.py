@@ -110,12 +110,39 @@ def write_tables(
     write_parquet(other, companion(path, second), config, replace=replace)
 
 
-def read_tables(path: str | Path, second: str) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
-    """(main table, ``second`` table, configuration) of a sweep written by
-    :func:`write_tables`."""
+_READERS = {"bifurcation": "read_bifurcation", "regime_map": "read_regime_map"}
+_KIND_NAMES = {"bifurcation": "bifurcation diagram", "regime_map": "regime map"}
+
+
+def read_tables(
+    path: str | Path, second: str, kind: str
+) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
+    """(main table, ``second`` table, configuration) of a sweep of ``kind`` written by
+    :func:`write_tables`. The main file may be named by its companion too.
+
+    Raises FileNotFoundError for a missing table and :class:`SweepError` for a file that is
+    not such a sweep (another kind, another chaoscam output, not Parquet), naming it."""
     path = Path(path)
-    meta = read_sweep_metadata(path) or {}
-    return pd.read_parquet(path), pd.read_parquet(companion(path, second)), meta.get("config", {})
+    tail = f".{second}.parquet"
+    if path.name.endswith(tail):  # the companion named: read its main file
+        path = path.with_name(path.name[: -len(tail)] + ".parquet")
+    what, other = _KIND_NAMES[kind], companion(path, second)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    meta = read_sweep_metadata(path)
+    if meta is None:
+        raise SweepError(f"{path}: not a chaoscam {what} (no sweep record in its metadata)")
+    config = meta.get("config", {})
+    found = config.get("kind", kind)  # files without a kind predate it
+    if found != kind:
+        reader = _READERS.get(found)
+        raise SweepError(
+            f"{path}: a {_KIND_NAMES.get(found, found)}, not a {what}"
+            + (f"; read it with chaoscam.sweep.{reader}" if reader else "")
+        )
+    if not other.is_file():
+        raise FileNotFoundError(f"{other}: no such file; a {what} is {path.name} and {other.name}")
+    return pd.read_parquet(path), pd.read_parquet(other), config
 
 
 def lock_outputs(out: Path | None):

@@ -89,7 +89,7 @@ class RegimeMap:
 
 def read_regime_map(path: str | Path) -> RegimeMap:
     """Read a map written by :func:`regime_map` (``FILE.parquet`` and ``FILE.cells.parquet``)."""
-    return RegimeMap(*read_tables(path, "cells"))
+    return RegimeMap(*read_tables(path, "cells", "regime_map"))
 
 
 class _RegimePlan:

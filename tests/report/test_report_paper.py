@@ -254,3 +254,45 @@ def test_the_summary_opens_with_the_labels_counted_from_the_tables():
         "(periods 1, 3)."
     )
     assert _in_short([sens]) == ""
+
+
+def test_a_second_run_into_the_same_folder_is_refused(tmp_path, capsys):
+    """While another process runs a report into this folder (it holds paper-data's lock),
+    another report there is refused at once naming the holder, even with --force and under
+    another name: they share paper-data (a second run started within the first's first
+    seconds passed every check, and both wrote the same files)."""
+    from tests.test_outputs import _hold_lock
+
+    holder = _hold_lock(tmp_path / "paper-data")
+    try:
+        args = ["paper", "--quick", "--figures", "3", "--out", str(tmp_path / "q.html")]
+        assert main([*args, "--force"]) == 2
+        err = capsys.readouterr().err
+        assert f"paper-data is in use by another chaoscam process (pid {holder.pid})" in err
+        assert not (tmp_path / "q.html").exists() and not (tmp_path / "paper-data").exists()
+    finally:
+        holder.kill()
+        holder.wait()
+    assert main(args) == 0
+
+
+def test_a_report_that_appeared_meanwhile_is_kept(tmp_path, monkeypatch):
+    """Without force, a report file written by someone else during the run is not replaced:
+    this run's report goes beside it, and the error names both."""
+    from chaoscam._outputs import OutputError
+    from chaoscam.experiments import _paper, run_paper
+
+    out = tmp_path / "p.html"
+    fig3 = _paper.FIGURES[3]
+
+    def meanwhile(quick, outdir, workers=None):
+        out.write_text("theirs")
+        return fig3(quick, outdir, workers=workers)
+
+    monkeypatch.setitem(_paper.FIGURES, 3, meanwhile)
+    with pytest.raises(OutputError, match="appeared while this run was working") as err:
+        run_paper(quick=True, out=out, figures=[3])
+    assert out.read_text() == "theirs"
+    kept = [p for p in tmp_path.glob("p.*.html")]
+    assert len(kept) == 1 and str(kept[0]) in str(err.value)
+    assert "Fig. 3 reproduced (quick run)" in kept[0].read_text()

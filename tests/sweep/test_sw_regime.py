@@ -162,3 +162,29 @@ def test_existing_output_or_other_configuration_is_refused(tmp_path):
         regime_map(MU, SIGMA, **{**KW, "classify": cls}, out=out2)
     with pytest.raises(SweepError, match="different configuration"):
         regime_map(MU, SIGMA, **{**KW, "classify": cls, "seed": 5}, out=out2, resume=True)
+
+
+def test_readers_name_a_file_of_another_kind(tmp_path, reference):
+    """read_regime_map round-trips a map (named by either file) and refuses a bifurcation
+    diagram, a plain Parquet file and a missing companion, each naming the file."""
+    import pandas as pd
+
+    from chaoscam.sweep import bifurcation, read_bifurcation, read_regime_map
+
+    out = tmp_path / "m.parquet"
+    reference.to_parquet(out)
+    for name in (out, tmp_path / "m.cells.parquet"):
+        frames_equal(read_regime_map(name).cells, reference.cells)
+    with pytest.raises(SweepError, match="m.parquet: a regime map, not a bifurcation diagram"):
+        read_bifurcation(out)
+    bif = tmp_path / "b.parquet"
+    bifurcation("omega", [28.7], **{k: v for k, v in KW.items() if k != "realizations"}, out=bif)
+    with pytest.raises(SweepError, match="a bifurcation diagram, not a regime map; read it"):
+        read_regime_map(bif)
+    plain = tmp_path / "p.parquet"
+    pd.DataFrame({"x": [1]}).to_parquet(plain)
+    with pytest.raises(SweepError, match="p.parquet: not a chaoscam regime map"):
+        read_regime_map(plain)
+    (tmp_path / "m.cells.parquet").unlink()
+    with pytest.raises(FileNotFoundError, match="m.cells.parquet: no such file"):
+        read_regime_map(out)
