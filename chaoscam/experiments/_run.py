@@ -296,14 +296,16 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     OUTDIR: reports/paper-data, created when missing). The stage's data files
     (:func:`data_files`) are checked before any work, as ``chaoscam paper`` checks them: an
     existing one is replaced only with ``--force`` (the committed ``reports/paper-data``
-    holds the full report's data, which a ``--quick`` run would otherwise overwrite). Bad
-    arguments or outputs: exit 2 with one line; Ctrl-C: exit 130 with one line. Returns the
+    holds the full report's data, which a ``--quick`` run would otherwise overwrite), and
+    OUTDIR is locked for the run, as ``chaoscam paper`` locks its data folder. Bad
+    arguments or outputs (OUTDIR in use included): exit 2 with one line; Ctrl-C: exit 130 with one line. Returns the
     exit code (0) when it finishes.
     """
     import argparse
+    import contextlib
     import sys
 
-    from .._outputs import OutputError
+    from .._outputs import OutputError, OutputLock
 
     name = "sensitivity" if number == SENSITIVITY else f"fig{number}"
     what = "the sensitivity sweeps" if number == SENSITIVITY else f"Fig. {number}"
@@ -325,12 +327,14 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     outdir = Path(args.outdir)
     from ..sweep._backends import local_workers
 
+    held = contextlib.ExitStack()  # OUTDIR's lock, as chaoscam paper takes it
     try:
         if args.workers is not None:
             local_workers(args.workers)  # every sweep of the stage would refuse it
         if outdir.exists() and not outdir.is_dir():
             raise OutputError(f"OUTDIR {outdir}: is a file, not a folder")
         outdir.mkdir(parents=True, exist_ok=True)
+        held.enter_context(OutputLock(outdir, "OUTDIR"))
         for file in data_files(number):
             _check_data_file(
                 outdir,
@@ -340,10 +344,11 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
                 "give another OUTDIR, or pass --force to replace this stage's files",
             )
     except (OutputError, OSError, ValueError) as err:
+        held.close()
         ap.error(str(err))  # exit 2
     fn = _sensitivity_stage if number == SENSITIVITY else FIGURES[number]
     try:
-        with warnings.catch_warnings():
+        with held, warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             result = fn(args.quick, outdir, workers=args.workers)
     except KeyboardInterrupt:

@@ -71,3 +71,21 @@ def test_labelled_set_refuses_to_overwrite_the_truth_before_measuring(tmp_path):
     run = _script("labelled_set.py", str(out))
     assert run.returncode == 2 and "--force" in run.stderr and "Traceback" not in run.stderr
     assert out.read_text() == "{}"
+
+
+def test_a_script_into_a_folder_in_use_is_refused(tmp_path):
+    """While another process writes into OUTDIR (chaoscam paper into its paper-data, or
+    another script), a script there is refused at once, naming the holder."""
+    from tests.test_outputs import _hold_lock
+
+    outdir = tmp_path / "paper-data"
+    outdir.mkdir()
+    holder = _hold_lock(outdir)
+    try:
+        busy = _script("fig3.py", "--quick", "--force", str(outdir))
+    finally:
+        holder.kill()
+        holder.wait()
+    assert busy.returncode == 2 and "Traceback" not in busy.stderr
+    assert f"in use by another chaoscam process (pid {holder.pid})" in busy.stderr
+    assert list(outdir.iterdir()) == []
