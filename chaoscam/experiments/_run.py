@@ -298,8 +298,8 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     existing one is replaced only with ``--force`` (the committed ``reports/paper-data``
     holds the full report's data, which a ``--quick`` run would otherwise overwrite), and
     OUTDIR is locked for the run, as ``chaoscam paper`` locks its data folder. Bad
-    arguments or outputs (OUTDIR in use included): exit 2 with one line; Ctrl-C: exit 130 with one line. Returns the
-    exit code (0) when it finishes.
+    arguments or outputs (OUTDIR in use included): exit 2 with one line; Ctrl-C: exit 130
+    with one line. Returns the exit code (0) when it finishes.
     """
     import argparse
     import contextlib
