@@ -71,7 +71,8 @@ def member_verdicts(
     """The verdict of every member of ``ens``, in the order of ``ens.members``.
 
     ``params`` is the model of the run (one for all members, or one per member, as given to
-    ``simulate_ensemble``). As :func:`chaoscam.classify_trajectory` does, an undetermined
+    ``simulate_ensemble``); other models are refused (ValueError), as the verdicts would
+    judge the members with them. As :func:`chaoscam.classify_trajectory` does, an undetermined
     member (but not one whose tangent overflowed) is run again longer (4x the recorded time
     each round, at most ``extend_to`` seconds recorded; None: never), all such members in
     one ensemble call on the backend of ``ens``, until its verdict settles; its verdict's
@@ -88,6 +89,7 @@ def member_verdicts(
         raise ValueError("classify_ensemble needs an ensemble run with tangent=True")
     members = ens.members
     plist = list(params) if isinstance(params, list | tuple) else [params] * len(members)
+    _check_models(ens, plist)
     verdicts = _verdicts(ens, plist)
     s = ens.settings
     recorded = s["duration"] - s["transient"]
@@ -132,6 +134,27 @@ def member_verdicts(
                 verdicts[j] = dataclasses.replace(v, verdict=extended)
         pending = [j for j in pending if _unsettled(verdicts[j])]
     return verdicts
+
+
+def _check_models(ens: Ensemble, plist: list) -> None:
+    """``params`` must be the models the members ran with: each verdict judges its member
+    with them (the certificate of a periodic orbit runs the model again)."""
+    from .integrate._ensemble import models_digest
+
+    if len(plist) != len(ens.members):
+        raise ValueError(
+            f"params: {len(plist)} parameter sets for an ensemble of {len(ens.members)} "
+            "members; give one Params for all, or one per member"
+        )
+    bad = next((q for q in plist if not isinstance(q, Params)), None)
+    if bad is not None:
+        raise ValueError(f"params: expected chaoscam.Params, got {type(bad).__name__}")
+    ran = ens.settings.get("models")
+    if ran is not None and models_digest(plist) != ran:
+        raise ValueError(
+            "params are not the models this ensemble was run with; pass the Params (or the "
+            "list) given to simulate_ensemble"
+        )
 
 
 def _unsettled(v: MemberVerdict) -> bool:

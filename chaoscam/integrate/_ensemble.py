@@ -200,8 +200,24 @@ def simulate_ensemble(
         "batch": batch,
         "integrators": sorted({p.integrator for p in plist}),
         "tangent": bool(tangent),
+        "models": models_digest(plist),
     }
     return _assemble(parts, settings, keep_impacts, t0)
+
+
+def models_digest(plist: list[Params]) -> str:
+    """A fingerprint of the members' models, in order (``settings["models"]``): the sha256
+    of each one's fields (its ``repr``, exact for floats), 16 hex digits. What
+    :func:`chaoscam.classify.classify_ensemble` compares its ``params`` with."""
+    import hashlib
+
+    whole_run, seen = hashlib.sha256(), {}
+    for p in plist:
+        one = seen.get(id(p))
+        if one is None:  # members that share a model are hashed once
+            one = seen[id(p)] = hashlib.sha256(repr(p).encode()).digest()
+        whole_run.update(one)
+    return whole_run.hexdigest()[:16]
 
 
 def _check_memory(p: Params, duration: float, transient: float, members: int) -> None:
@@ -299,7 +315,8 @@ def extend_ensemble(
         )
         if progress is not None:
             progress(len(parts[-1][1]))
-    return _assemble(parts, {**s, "duration": duration, "continued_from": res.step}, False, t0)
+    more = {"duration": duration, "continued_from": res.step, "models": models_digest(plist)}
+    return _assemble(parts, {**s, **more}, False, t0)
 
 
 def _assemble(parts, settings: dict, keep_impacts: bool, t0: float) -> Ensemble:

@@ -60,6 +60,25 @@ def test_ensemble_keeps_impacts_and_labels_members():
     assert list(ens.members.label) == ["periodic"] * 2 and list(ens.members.period) == [1, 1]
 
 
+def test_classify_ensemble_refuses_other_models():
+    """The verdicts judge each member with the params given (the certificate runs the model
+    again), so params that are not the run's, a list of the wrong length or not Params are
+    refused; the same models, as one Params or a list of equal ones, are taken."""
+    p = Params(omega=10.0)
+    ens = simulate_ensemble(p, [0, 1], duration=2.0, transient=1.0, tangent=True)
+    with pytest.raises(ValueError, match="not the models this ensemble was run with"):
+        classify_ensemble(ens, Params(omega=10.0, xi=0.3))
+    with pytest.raises(ValueError, match="not the models"):
+        classify_ensemble(ens, [p, Params(omega=10.0, l_lambda=0.009)])
+    with pytest.raises(ValueError, match="params: 3 parameter sets for an ensemble of 2"):
+        classify_ensemble(ens, [p] * 3)
+    with pytest.raises(ValueError, match="params: expected chaoscam.Params, got dict"):
+        classify_ensemble(ens, [p, {"omega": 10.0}])
+    for same in (Params(omega=10.0), [Params(omega=10.0), Params(omega=10.0)]):
+        labelled = classify_ensemble(ens, same, extend_to=None)
+        assert len(labelled.members["label"]) == 2
+
+
 @pytest.mark.parametrize(
     "kwargs, message",
     [
