@@ -17,18 +17,10 @@ from ._lyapunov import (
     lyapunov_spectrum_map,
 )
 from ._lyapunov_series import DoubtfulEstimateWarning, SeriesLyapunovResult, lyapunov_from_series
-from ._periodicity import (
-    PeriodResult,
-    RotationResult,
-    correlation_dimension,
-    embed_angles,
-    neighbour_expansion,
-    rotation_order,
-    section_period,
-    stationarity_ratio,
-)
+from ._periodicity import PeriodResult, RotationResult, embed_angles, rotation_order, section_period
 from ._saltation import saltation_matrix
 from ._sections import crossing_section, local_maxima
+from ._set_measures import correlation_dimension, neighbour_expansion, stationarity_ratio
 from ._spectrum import SpectrumResult, power_spectrum, spectrum_analysis
 from ._tangent_spectrum import TangentSpectrum, spectrum_from_jacobians
 from ._thresholds import Thresholds

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._validate import as_points
+from ._validate import as_points, check_settings
 
 __all__ = ["BirkhoffResult", "birkhoff_weights", "weighted_birkhoff"]
 
@@ -23,8 +23,7 @@ def birkhoff_weights(n: int) -> np.ndarray:
     average of a smooth function on a quasiperiodic orbit converge faster than any power
     of 1/n (instead of as 1/n for the plain average).
     """
-    if n < 1:
-        raise ValueError(f"need n >= 1 weights, got {n}")
+    check_settings("birkhoff_weights", n=(n, "int>=1"))
     t = np.arange(1, n + 1) / (n + 1.0)
     w = np.exp(-1.0 / (t * (1.0 - t)))
     return w / w.sum()

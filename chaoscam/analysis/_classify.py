@@ -16,9 +16,9 @@ from ._evidence import (
 from ._exponent import as_exponent, exponent_evidence
 from ._lyapunov_series import lyapunov_from_series
 from ._sections import local_maxima
-from ._spectrum import spectrum_analysis
+from ._spectrum import check_spectrum_options, spectrum_analysis
 from ._thresholds import Thresholds, resolve
-from ._validate import MIN_SERIES, as_points, as_series
+from ._validate import MIN_SERIES, as_points, as_series, check_settings
 from ._verdict import Evidence, Verdict, combine
 
 __all__ = ["classify_section", "classify_signal"]
@@ -72,6 +72,40 @@ def _zero_one_signal(x, dt, forcing_period, seed, per_period, line_freq, thr):
                 "its periods (a long period then mimics diffusion)",
             )
     return e
+
+
+def _check_signal_settings(given: dict) -> None:
+    """classify_signal's settings in their ranges, before any evidence is gathered (an
+    evidence function that raises is reported as failed evidence, not as an error)."""
+    check_settings(
+        "classify_signal",
+        **{
+            name: (given[name], rule)
+            for name, rule in (
+                ("dt", "real>0"),
+                ("forcing_period", "real>0?"),
+                ("lyapunov", "real?"),
+                ("lyapunov_tol", "real>=0?"),
+                ("max_period", "int>=1?"),
+                ("min_points_aperiodic", "int>=1?"),
+                ("zero_one_per_period", "int>=1"),
+                ("seed", "int>=0"),
+                ("exponent_time", "real>0"),
+            )
+        },
+    )
+    per_period, forcing_period = given["zero_one_per_period"], given["forcing_period"]
+    if forcing_period is not None and per_period > max(1, round(forcing_period / given["dt"])):
+        raise ValueError(
+            f"classify_signal: zero_one_per_period = {per_period} must be <= "
+            f"{max(1, round(forcing_period / given['dt']))}, the samples per forcing period"
+        )
+    options = given["spectrum_options"]
+    if options is not None and not isinstance(options, dict):
+        raise TypeError(f"classify_signal: spectrum_options must be a dict, got {options!r}")
+    if "forcing_frequency" in (options or {}):
+        raise TypeError("classify_signal: the spectrum's forcing_frequency is 1 / forcing_period")
+    check_spectrum_options("classify_signal: spectrum_options", options or {})
 
 
 def classify_signal(
@@ -187,10 +221,7 @@ def classify_signal(
     quasiperiodic versus chaotic call rests on the spectrum and the 0–1 test agreeing.
     """
     x = as_series(x, min_size=MIN_SERIES)
-    if not dt > 0:
-        raise ValueError(f"dt must be positive, got {dt}")
-    if forcing_period is not None and not forcing_period > 0:
-        raise ValueError(f"forcing_period must be positive, got {forcing_period}")
+    _check_signal_settings(locals())
     if section is not None:
         section = as_points(section, "section")
     thr = resolve(thresholds, rtol, min_points_aperiodic)

@@ -8,7 +8,7 @@ from collections.abc import Sequence
 from ._evidence import lyapunov_evidence, section_evidence
 from ._exponent import as_exponent, exponent_evidence
 from ._thresholds import Thresholds, resolve
-from ._validate import as_points
+from ._validate import as_points, check_settings
 from ._verdict import Verdict, combine
 
 __all__ = ["classify_section"]
@@ -165,6 +165,15 @@ def classify_section(
     quasiperiodic from chaotic.
     """
     x = as_points(points)
+    check_settings(
+        "classify_section",
+        lyapunov=(lyapunov, "real?"),
+        lyapunov_tol=(lyapunov_tol, "real>=0"),
+        exponent_time=(exponent_time, "real>0"),
+        max_period=(max_period, "int>=1?"),
+        min_points_aperiodic=(min_points_aperiodic, "int>=1?"),
+        seed=(seed, "int>=0"),
+    )
     thr = resolve(thresholds, rtol, min_points_aperiodic)
     settings = dict(
         rtol=thr.period_rtol,

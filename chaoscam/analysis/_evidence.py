@@ -7,15 +7,8 @@ import math
 import numpy as np
 
 from ._birkhoff import weighted_birkhoff
-from ._periodicity import (
-    _floor,
-    correlation_dimension,
-    embed_angles,
-    neighbour_expansion,
-    rotation_order,
-    section_period,
-    stationarity_ratio,
-)
+from ._periodicity import _floor, embed_angles, rotation_order, section_period
+from ._set_measures import correlation_dimension, neighbour_expansion, stationarity_ratio
 from ._thresholds import Thresholds
 from ._validate import as_points
 from ._verdict import Evidence

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from ._thresholds import Thresholds
+from ._validate import check_settings
 from ._verdict import Evidence
 
 __all__ = ["as_exponent", "exponent_evidence"]
@@ -19,6 +20,7 @@ def as_exponent(exponent, time_per_iterate: float = 1.0) -> tuple[float, float, 
     λ and stderr are multiplied by `time_per_iterate` (the forcing period T for an
     exponent in 1/s and a stroboscopic section).
     """
+    check_settings("as_exponent", time_per_iterate=(time_per_iterate, "real>0"))
     n = None
     if hasattr(exponent, "exponent"):
         lam = exponent.exponent

@@ -9,6 +9,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._validate import check_settings
+
 __all__ = [
     "LyapunovResult",
     "LyapunovSpectrum",
@@ -162,6 +164,15 @@ def lyapunov_benettin(
     compare `max_log_growth` with λ₁ τ). Grazing impacts make the flow's derivative
     unbounded and the exponent ill-defined.
     """
+    check_settings(
+        "lyapunov_benettin",
+        renorm_time=(renorm_time, "real>0"),
+        n_renorm=(n_renorm, "int>=1"),
+        d0=(d0, "real>0"),
+        transient_time=(transient_time, "real>=0"),
+        n_align=(n_align, "int>=0"),
+        seed=(seed, "int>=0"),
+    )
     x = np.array(x0, dtype=float)
     comps = np.arange(x.size) if components is None else np.asarray(components, dtype=int)
     settings = dict(
@@ -252,6 +263,16 @@ def lyapunov_benettin_map(
     See `lyapunov_benettin` for the parameters, the zero-exponent conventions and the limits.
     """
 
+    check_settings(
+        "lyapunov_benettin_map",
+        n=(n, "int>=1"),
+        d0=(d0, "real>0"),
+        transient=(transient, "int>=0"),
+        n_align=(n_align, "int>=0"),
+        seed=(seed, "int>=0"),
+        time_per_iterate=(time_per_iterate, "real>0"),
+    )
+
     def advance(state, k):
         for _ in range(int(round(k))):
             state = step(state)
@@ -329,7 +350,18 @@ def lyapunov_spectrum_map(
     """
     x = np.array(x0, dtype=float).reshape(-1)
     d = x.size
+    check_settings(
+        "lyapunov_spectrum_map",
+        n=(n, "int>=1"),
+        transient=(transient, "int>=0"),
+        n_exponents=(n_exponents, "int>=1?"),
+        time_per_iterate=(time_per_iterate, "real>0"),
+    )
     m = d if n_exponents is None else int(n_exponents)
+    if m > d:
+        raise ValueError(
+            f"lyapunov_spectrum_map: n_exponents = {m} must be <= {d}, the state's dimension"
+        )
     for _ in range(int(transient)):
         x = np.asarray(step(x), dtype=float).reshape(-1)
     q = np.eye(d)[:, :m]

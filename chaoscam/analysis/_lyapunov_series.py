@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._validate import as_series
+from ._validate import as_series, check_settings
 
 __all__ = ["DoubtfulEstimateWarning", "SeriesLyapunovResult", "lyapunov_from_series"]
 
@@ -132,6 +132,17 @@ def lyapunov_from_series(
     x = as_series(x)
     if method not in ("rosenstein", "eckmann"):
         raise ValueError(f"method must be 'rosenstein' or 'eckmann', got {method!r}")
+    check_settings(
+        "lyapunov_from_series",
+        dt=(dt, "real>0"),
+        max_points=(max_points, "int>=1"),
+        emb_dim=(emb_dim, "int>=1"),
+        lag=(lag, "int>=1?"),
+        min_tsep=(min_tsep, "int>=0?"),
+        trajectory_len=(trajectory_len, "int>=2"),
+        matrix_dim=(matrix_dim, "int>=1"),
+        min_points=(min_points, "int>=1"),
+    )
     stride = max(1, math.ceil(x.size / max_points))
     y = x[::stride]
     tau = dt * stride

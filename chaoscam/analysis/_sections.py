@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import as_points, as_series
+from ._validate import as_points, as_series, check_settings
 
 __all__ = ["crossing_section", "local_maxima"]
 
@@ -31,6 +31,7 @@ def local_maxima(x, dt: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
         O(dt³) per maximum (O(dt²) in time); at a kink (an impact) it is O(dt).
     """
     x = as_series(x)
+    check_settings("local_maxima", dt=(dt, "real>0"))
     if x.size < 3:
         return np.array([]), np.array([])
     i = np.nonzero((x[1:-1] > x[:-2]) & (x[1:-1] >= x[2:]))[0] + 1
@@ -79,6 +80,14 @@ def crossing_section(
     """
     t = as_series(t, "t")
     y = as_points(states, "states")
+    check_settings("crossing_section", index=(index, "int>=0"), level=(level, "real"))
+    if index >= y.shape[1] or direction not in (-1, 0, 1):
+        raise ValueError(
+            f"crossing_section: index = {index} must be < {y.shape[1]} (the states' "
+            f"components) and direction = {direction!r} one of +1, -1, 0"
+        )
+    if t.size != y.shape[0]:
+        raise ValueError(f"crossing_section: {t.size} times for {y.shape[0]} states")
     g = y[:, index] - level
     s = np.sign(g)
     idx = np.nonzero(s[:-1] * s[1:] < 0)[0]

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._validate import as_series
+from ._validate import as_series, check_settings
 
 __all__ = ["SpectrumResult", "power_spectrum", "spectrum_analysis"]
 
@@ -33,6 +33,7 @@ def power_spectrum(x, dt: float) -> tuple[np.ndarray, np.ndarray]:
         Periodogram.
     """
     x = as_series(x)
+    check_settings("power_spectrum", dt=(dt, "real>0"))
     n = x.size
     j = np.arange(n) - 0.5 * (n - 1)
     slope = float(j @ x) / float(j @ j) if n > 1 else 0.0
@@ -134,6 +135,32 @@ def _refine_fundamental(f0: float, fk: np.ndarray, pk: np.ndarray, tol: float) -
     return float(np.sum(w * m[on] * fk[on]) / np.sum(w * m[on] ** 2))
 
 
+SPECTRUM_RULES = {
+    "forcing_frequency": "real>0?",
+    "max_period": "int>=1?",
+    "half_width": "int>=0",
+    "line_tol": "real>0",
+    "broadband_tol": "real>0",
+    "max_order": "int>=1",
+    "n_peaks": "int>=0",
+    "min_cycles": "real>0",
+    "peak_tol": "real>0",
+}
+"""The settings of :func:`spectrum_analysis` and their ranges (see ``check_settings``)."""
+
+
+def check_spectrum_options(fn: str, options: dict) -> None:
+    """Refuse a setting :func:`spectrum_analysis` does not take (TypeError) or one out of
+    its range (ValueError), naming ``fn``."""
+    unknown = sorted(set(options) - set(SPECTRUM_RULES))
+    if unknown:
+        raise TypeError(
+            f"{fn}: unknown spectrum option {unknown[0]!r}; spectrum_analysis takes "
+            f"{', '.join(SPECTRUM_RULES)}"
+        )
+    check_settings(fn, **{k: (v, SPECTRUM_RULES[k]) for k, v in options.items()})
+
+
 def spectrum_analysis(
     x,
     dt: float,
@@ -223,6 +250,25 @@ def spectrum_analysis(
     """
     x = as_series(x)
     n = x.size
+    check_settings("spectrum_analysis", dt=(dt, "real>0"))
+    check_spectrum_options(
+        "spectrum_analysis",
+        dict(
+            forcing_frequency=forcing_frequency,
+            max_period=max_period,
+            half_width=half_width,
+            line_tol=line_tol,
+            broadband_tol=broadband_tol,
+            max_order=max_order,
+            n_peaks=n_peaks,
+            min_cycles=min_cycles,
+            peak_tol=peak_tol,
+        ),
+    )
+    if half_width > n:
+        raise ValueError(
+            f"spectrum_analysis: half_width = {half_width} bins must be <= the {n} samples of x"
+        )
     settings = dict(
         dt=dt,
         forcing_frequency=forcing_frequency,

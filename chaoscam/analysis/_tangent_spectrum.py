@@ -12,6 +12,8 @@ from typing import Any
 
 import numpy as np
 
+from ._validate import check_settings
+
 __all__ = ["TangentSpectrum", "spectrum_from_jacobians"]
 
 
@@ -69,8 +71,11 @@ def spectrum_from_jacobians(
     period : float
         Time per map iterate [s].
     n_batches : int
-        Batches for the standard error of the mean of the per-period growths.
+        Batches (at least 2) for the standard error of the mean of the per-period growths.
     """
+    check_settings(
+        "spectrum_from_jacobians", period=(period, "real>0"), n_batches=(n_batches, "int>=2")
+    )
     jac = np.asarray(jacobians, dtype=float)
     if jac.ndim != 3 or jac.shape[1:] != (2, 2) or len(jac) == 0:
         raise ValueError(f"jacobians must have shape (n >= 1, 2, 2), got {jac.shape}")

@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import math
+import numbers
+import re
+from typing import Any
+
 import numpy as np
 
 MIN_SERIES = 16  # fewer samples than this cannot show an oscillation: too little data
@@ -45,3 +50,27 @@ def as_points(points, name: str = "points", min_size: int = 1) -> np.ndarray:
             f"{name} contains NaN or infinite values; remove or interpolate them first"
         )
     return arr
+
+
+def check_settings(fn: str, **settings: tuple[Any, str]) -> None:
+    """Refuse a setting outside its range: ValueError naming ``fn``, the setting and the
+    range. Each setting is ``(value, rule)``, the rule one of ``"real"`` (finite),
+    ``"real>0"``, ``"real>=0"``, ``"int>=N"`` (an integer, not a bool or a float); a
+    trailing ``?`` lets None pass (the setting's "not given")."""
+    for name, (value, rule) in settings.items():
+        if value is None and rule.endswith("?"):
+            continue
+        base = rule.rstrip("?")
+        kind, op, low = re.fullmatch(r"(int|real)(>=|>)?([0-9.]+)?", base).groups()
+        number = numbers.Integral if kind == "int" else numbers.Real
+        ok = isinstance(value, number) and not isinstance(value, bool)
+        if ok:
+            v = float(value)
+            ok = math.isfinite(v) and (
+                op is None or v > float(low) or (op == ">=" and v == float(low))
+            )
+        if not ok:
+            what = "an integer" if kind == "int" else "a finite number"
+            bound = f" {op} {low}" if op else ""
+            none = " or None" if rule.endswith("?") else ""
+            raise ValueError(f"{fn}: {name} = {value!r} must be {what}{bound}{none}")

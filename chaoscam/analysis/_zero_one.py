@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._validate import as_series
+from ._validate import as_series, check_settings
 
 __all__ = ["ZeroOneResult", "zero_one_test"]
 
@@ -86,7 +86,8 @@ def zero_one_test(
     seed : int
         Seed of the c draws (results are reproducible).
     min_length : int
-        Below this many samples the test is not run (K is NaN and `message` says why).
+        Below this many samples (at least 4) the test is not run (K is NaN and `message`
+        says why).
 
     Returns
     -------
@@ -106,6 +107,19 @@ def zero_one_test(
     is O(n_c N log N).
     """
     phi = as_series(x)
+    check_settings(
+        "zero_one_test",
+        n_c=(n_c, "int>=1"),
+        n_cut=(n_cut, "int>=2?"),
+        seed=(seed, "int>=0"),
+        min_length=(min_length, "int>=4"),
+    )
+    low, high = np.asarray(c_range, dtype=float) if np.size(c_range) == 2 else (0.0, 0.0)
+    if not 0.0 < low < high < math.pi:
+        raise ValueError(
+            f"zero_one_test: c_range = {c_range!r} must be two numbers 0 < low < high < π "
+            "(c = 0 and c = π are resonant)"
+        )
     n_total = phi.size
     settings = dict(n_c=n_c, c_range=tuple(c_range), seed=seed, n_cut=n_cut, min_length=min_length)
     empty = np.array([])
