@@ -197,6 +197,7 @@ def section_evidence(
         atol=atol,
         max_period=max_period,
         noise_floor=thr.noise_floor,
+        band_separation=thr.band_separation,
     )
     if failed:
         return [failed], {}, reasons

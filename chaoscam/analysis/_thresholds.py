@@ -32,6 +32,13 @@ class Thresholds:
         differences below ``noise_floor · max|x|`` are round-off or integration error.
         1e-6 is far above double round-off and below any dynamics worth resolving. It is
         what makes a fixed point (period 1, no extent to speak of) detectable.
+    band_separation : float
+        Two bands of a period n are distinct (the period is not a repeat of a shorter one
+        or noise around it) when their centres lie more than this many widths of the
+        widest band apart, and beyond the absolute floor, in some coordinate: 4 widths
+        leave a gap of at least 3 between them. The tolerance itself is not the measure: a
+        period-12 orbit of the cam model (Y_f = 3.16e5 Pa) repeats to 1e-9 rad while two of
+        its points lie 9e-6 rad (θ) and 2.2e-4 rad (θ̇·T) apart, within 3e-3 of the extent.
     stationary_low, stationary_high : float
         Spread of the second half of the points over that of the first half: outside
         [0.5, 2] the points are still converging or escaping and the section abstains.
@@ -98,6 +105,7 @@ class Thresholds:
 
     period_rtol: float = 3e-3
     noise_floor: float = 1e-6
+    band_separation: float = 4.0
     stationary_low: float = 0.5
     stationary_high: float = 2.0
     min_points_aperiodic: int = 100
