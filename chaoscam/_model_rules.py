@@ -86,6 +86,8 @@ def with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, d
     why = {"off orbit": "the run is not on it", "period differs": "its least period differs"}
     why = why.get(cert.status, cert.status)
     e = Evidence("periodic_orbit", cert.orbit.period, None, f"not certified ({why}): {cert.detail}")
+    if cert.status == "step-dependent":
+        return _step_dependent(v, p, cert, e), extra
     if cert.status in ("unstable", "not converged") and cert.orbit.converged:
         reason = (
             f"the section looks periodic but the orbit found is unstable ({cert.detail}): run "
@@ -169,6 +171,9 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
                 "exponent's sign is the grid's error in the chattering phases"
             )
             return Verdict("periodic", cert.period, v.evidence + (e,), (note,), v.settings), extra
+        if cert.status == "step-dependent":
+            e = Evidence("periodic_orbit", n, None, detail)
+            return _step_dependent(v, p, cert, e), extra
         if cert.status == "mixed":
             e = Evidence("periodic_orbit", n, None, detail)
             reason = (
@@ -195,6 +200,23 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
     )
     verdict = Verdict("chaotic", None, v.evidence + (e, band), (), v.settings)
     return verdict, extra
+
+
+STEP_DEPENDENT = "step_dependent"
+"""The evidence of a verdict whose periodic orbit is the grid's (:func:`_step_dependent`)."""
+
+
+def _step_dependent(v: Verdict, p: Params, cert, e: Evidence) -> Verdict:
+    """Undetermined, not extended: the run's grid certifies a period-n orbit that is not
+    attracting at half the step, so the answer is the step's, and a longer run at this step
+    gives it again."""
+    why = (
+        f"the period-{cert.period} orbit is attracting on the run's grid (dt = {p.dt:g} s) "
+        f"but not at dt/2 ({cert.detail}): the period is the step's; rerun with dt = "
+        f"{p.dt / ORBIT_REFINE[-1]:.3g} s"
+    )
+    step = Evidence(STEP_DEPENDENT, cert.period, None, why)
+    return Verdict("undetermined", None, v.evidence + (e, step), v.reasons + (why,), v.settings)
 
 
 OVERFLOW = "tangent_overflow"
@@ -224,5 +246,8 @@ def overflow_evidence(jacobians, p: Params) -> Evidence | None:
 
 
 def extensible(v: Verdict) -> bool:
-    """Whether an undetermined verdict may settle on a longer run (not after an overflow)."""
-    return v.label == "undetermined" and not any(e.name == OVERFLOW for e in v.evidence)
+    """Whether an undetermined verdict may settle on a longer run (not after an overflow,
+    nor when its periodic orbit is the step's)."""
+    return v.label == "undetermined" and not any(
+        e.name in (OVERFLOW, STEP_DEPENDENT) for e in v.evidence
+    )

@@ -217,6 +217,15 @@ def simulate(
     Trajectory
         Frozen; ``status`` says how the run ended (it never raises for a run that leaves the
         cam or diverges).
+
+    Notes
+    -----
+    The follower starts in contact with the cam (``theta_f0``, ``omega_f0`` None). To start
+    from another state, e.g. a section point ``(theta_f, omega_f)`` of an earlier run (its
+    rows lie at t = k 2π/ω, where the cam is back at ``theta_c0``), pass
+    ``simulate(theta_f0=theta_f, omega_f0=omega_f)``: a new run from there, not the earlier
+    run's continuation to the bit (its contact state and line-length draws start afresh;
+    :func:`chaoscam.extend_trajectory` continues a run exactly).
     """
     return raw_run(
         params,

@@ -56,12 +56,17 @@ def test_a_run_that_keeps_its_distance_is_not_on_the_orbit():
 
 
 def test_bands_can_be_asked_for_without_distinct_centres():
-    """section_period(distinct=False) accepts a lag whose narrow bands have close centres
-    (a band split in two: 0, 1, 0.5, 1.02, ...), which the default refuses."""
+    """section_period(distinct=False) accepts a lag two of whose narrow bands overlap (0, 1,
+    0.5, 1.0002, ... with noise 1e-4: the two bands near 1 are one band split in two),
+    which the default refuses; two bands 0.02 apart, 30 noise widths, are distinct (the
+    tolerance, 0.05 of the extent, is not the measure of distinct): period 4."""
     rng = np.random.default_rng(0)
-    x = np.tile([0.0, 1.0, 0.5, 1.02], 100) + 1e-4 * rng.standard_normal(400)
+    noise = 1e-4 * rng.standard_normal(400)
+    x = np.tile([0.0, 1.0, 0.5, 1.0002], 100) + noise
     assert section_period(x, rtol=0.05, allow_transient=False).period is None
     assert section_period(x, rtol=0.05, allow_transient=False, distinct=False).period == 4
+    apart = np.tile([0.0, 1.0, 0.5, 1.02], 100) + noise
+    assert section_period(apart, rtol=0.05, allow_transient=False).period == 4
 
 
 def test_a_sticking_orbit_whose_newton_stalls_on_the_grid_is_certified_refined():
@@ -179,3 +184,36 @@ def test_iterate_map_ends_where_the_map_does():
     seq = iterate_map(p, x, 3)
     assert seq.shape == (4, 2) and np.array_equal(seq[0], x)
     assert np.array_equal(seq[-1], stroboscopic_map(p, x, 3)[0])
+
+
+def test_a_period_12_with_two_close_points_is_periodic():
+    """Y_f = 3.16e5 Pa (K_n ~ 2.2e3 N/m), the stiffness sweep's run: an exact, attracting
+    period 12 (bands of 1e-9 rad; 300 s runs at dt and dt/2 and a 1e-8 kick agree) two of
+    whose points lie 9e-6 rad and 2.2e-4 rad/s·T apart, within the band tolerance: it was
+    "undetermined" ("no period found") after 120 s, the tolerance taken as the measure of
+    distinct bands."""
+    from chaoscam.sweep import bifurcation
+
+    b = bifurcation("Y_f", [3.16e5], duration=20.0, transient=10.0, workers=1)
+    row = b.verdicts.iloc[0]
+    assert (row["label"], row["period"]) == ("periodic", 12), row["reasons"]
+
+
+def test_an_orbit_of_the_grid_alone_is_step_dependent_and_not_extended():
+    """xi = 0.525: Newton certifies an attracting period 8 on the default grid (|mu|max
+    0.05, the run on it), but at dt/2 it is unstable (|mu|max 3.7; 300 s runs at dt/2 and
+    dt/4 keep 8 bands whose twins separate at +0.17 1/s): undetermined, with the reason and
+    the step to use, and not extended (a longer run at this step says the same). It was
+    "periodic 8"."""
+    from chaoscam import Params, classify_trajectory, simulate
+
+    traj = simulate(Params(xi=0.525), duration=130.0, transient=10.0, tangent=True)
+    v = classify_trajectory(traj)
+    assert v.label == "undetermined"
+    step = {e.name: e for e in v.evidence}["step_dependent"]
+    assert (
+        step.value == 8
+        and "not at dt/2" in step.detail
+        and "rerun with dt = 5e-07 s" in step.detail
+    )
+    assert "extended" not in v.settings
