@@ -61,6 +61,17 @@ def real(
     return value
 
 
+def of_type(name: str, value: Any, cls: type, made_by: str) -> Any:
+    """``value`` when it is a ``cls``; else a TypeError naming ``name``, what it got and
+    what makes one (a trajectory passed where a file name goes, or None, gave an
+    AttributeError from deep inside)."""
+    if not isinstance(value, cls):
+        raise TypeError(
+            f"{name} must be a chaoscam {cls.__name__} ({made_by}), got {type(value).__name__}"
+        )
+    return value
+
+
 def params_arg(params: Any):
     """The ``params`` argument of an API function: a :class:`Params`, or None for defaults."""
     from .model import Params

@@ -20,6 +20,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pandas as pd
 
+from ._checks import of_type
 from ._model_rules import extensible
 from .analysis import Verdict
 from .classify import EXTEND_TO, _with_settings, classify_section_run
@@ -85,6 +86,7 @@ def member_verdicts(
     each extension round (m members, to r seconds recorded) and as ``progress(n)`` after
     each batch of it (n members just run), so that a progress bar can grow its total.
     """
+    of_type("ens", ens, Ensemble, "from chaoscam.integrate.simulate_ensemble")
     if ens.jacobians is None:
         raise ValueError("classify_ensemble needs an ensemble run with tangent=True")
     members = ens.members

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 
-from ._checks import real
+from ._checks import of_type, real
 from ._simulate import KernelRun, RawRun, Trajectory, _check_run, output_block, simulate
 from .integrate import _kernel as k
 from .model import ParameterError
@@ -56,7 +56,7 @@ def extend_trajectory(
     >>> len(longer.section) > len(short.section)
     True
     """
-    s = traj.settings
+    s = of_type("traj", traj, Trajectory, "from chaoscam.simulate or load_trajectory").settings
     duration = real("duration", duration, low=0.0, strict=True, unit="s")
     if duration < s["duration"]:
         raise ParameterError(

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import flag, real
+from ._checks import flag, of_type, real
 from ._extend import extend_trajectory
 from ._model_rules import MODEL_ATOL, extensible, overflow_evidence, with_model_evidence
 from ._simulate import Trajectory, simulate
@@ -345,6 +345,7 @@ def classify_trajectory(
         integer status code) and the reason; it is not classified. ``settings`` records the
         trajectory's provenance and these options.
     """
+    of_type("traj", traj, Trajectory, "from chaoscam.simulate or load_trajectory")
     tangent, lyapunov = flag("tangent", tangent), flag("lyapunov", lyapunov)
     check_step = flag("check_step", check_step)
     check_options(options, "classify_trajectory", series=traj.series is not None)

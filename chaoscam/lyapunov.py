@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import whole, with_overrides
+from ._checks import params_arg, whole, with_overrides
 from ._version import __version__
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
@@ -311,7 +311,7 @@ def lyapunov_model(
     responses it biases the estimate (omega = 45 rad/s, period 7: +0.29 1/s adaptive,
     -0.75 1/s on the grid).
     """
-    p = Params() if params is None else params
+    p = params_arg(params)
     if overrides:
         p = with_overrides(p, overrides, lyapunov_model)
     asked = p.integrator

@@ -489,3 +489,22 @@ def test_axis_linspace_takes_numpy_scalars():
     from chaoscam.sweep import Axis
 
     assert Axis.linspace("xi", np.float64(0.1), np.float32(0.5), np.int64(2)).values == (0.1, 0.5)
+
+
+# The wrong kind of object where a run, an ensemble or a model goes: a TypeError naming the
+# argument and what makes one (they failed with an AttributeError from deep inside).
+WRONG_KIND_CASES = [
+    (lambda: chaoscam.classify_trajectory("run.parquet"), "traj must be a chaoscam Trajectory"),
+    (lambda: chaoscam.classify_trajectory(None), "traj must be a chaoscam Trajectory"),
+    (lambda: chaoscam.extend_trajectory(None, 10.0), "traj must be a chaoscam Trajectory"),
+    (lambda: chaoscam.lyapunov_model("x"), "params must be a chaoscam.Params"),
+    (lambda: chaoscam.contact_period({"omega": 30.0}), "p must be a chaoscam Params"),
+    (lambda: chaoscam.classify_ensemble(None, Params()), "ens must be a chaoscam Ensemble"),
+]
+
+
+@pytest.mark.parametrize("i", range(len(WRONG_KIND_CASES)))
+def test_the_wrong_kind_of_object_is_named(i):
+    call, named = WRONG_KIND_CASES[i]
+    with pytest.raises(TypeError, match=named):
+        call()

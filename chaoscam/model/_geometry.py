@@ -137,6 +137,8 @@ def contact_period(p: Params, l_lambda: float | None = None) -> float:
     more steps, and the adaptive path's cost grows as its inverse square
     (:func:`chaoscam._budget.adaptive_seconds`).
     """
+    if not isinstance(p, Params):
+        raise TypeError(f"p must be a chaoscam Params, got {type(p).__name__}")
     if l_lambda is None:
         lam = p.l_lambda
     else:
