@@ -124,12 +124,12 @@ class Certificate:
     Attributes
     ----------
     status : str
-        "certified" (an attracting orbit the run converges to, on the grid or at every refined
-        step), "step-dependent" (certified on the run's grid but not at ``dt / 2``,
-        :data:`CONFIRM_REFINE`), "mixed" (attracting at some refined steps only), "unstable"
-        (converged, not attracting), "off orbit" (attracting, but the run neither lies on it
-        nor approaches it), "period differs" (its least period is not the one shot for) or
-        "not converged".
+        "certified" (an attracting orbit the run converges to, on the grid and at dt/2, or at
+        every refined step when the grid's multipliers err), "step-dependent" (certified on
+        the run's grid but not at ``dt / 2``, :data:`CONFIRM_REFINE`), "mixed" (attracting at
+        some refined steps only), "unstable" (converged, not attracting), "off orbit"
+        (attracting, but the run neither lies on it nor approaches it), "period differs"
+        (its least period is not the one shot for) or "not converged".
     period : int
         The period shot for last: n, or 2n after a flip-unstable orbit.
     orbit : PeriodicOrbit

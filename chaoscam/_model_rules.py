@@ -211,7 +211,7 @@ def _step_dependent(v: Verdict, p: Params, cert, e: Evidence) -> Verdict:
     attracting at half the step, so the answer is the step's, and a longer run at this step
     gives it again."""
     why = (
-        f"the period-{cert.period} orbit is attracting on the run's grid (dt = {p.dt:g} s) "
+        f"the period-{cert.period} orbit is certified on the run's grid (dt = {p.dt:g} s) "
         f"but not at dt/2 ({cert.detail}): the period is the step's; rerun with dt = "
         f"{p.dt / ORBIT_REFINE[-1]:.3g} s"
     )

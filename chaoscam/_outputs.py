@@ -163,7 +163,10 @@ class OutputLock:
 
     def __init__(self, path: str | Path, what: str = "output") -> None:
         self.target = Path(path)
-        self.path = self.target.with_name(f".{self.target.name}.lock")
+        named = self.target if self.target.name not in ("", "..") else self.target.resolve()
+        if not named.name:
+            raise OutputError(f"{path}: the root folder cannot be locked; choose a folder in it")
+        self.path = named.with_name(f".{named.name}.lock")
         self.what = what
         self._fd: int | None = None
         self._nested = False

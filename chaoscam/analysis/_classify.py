@@ -84,22 +84,24 @@ def _check_signal_settings(given: dict) -> None:
             for name, rule in (
                 ("dt", "real>0"),
                 ("forcing_period", "real>0?"),
-                ("lyapunov", "real?"),
+                ("lyapunov", "number?"),
                 ("lyapunov_tol", "real>=0?"),
                 ("max_period", "int>=1?"),
                 ("min_points_aperiodic", "int>=1?"),
-                ("zero_one_per_period", "int>=1"),
+                ("zero_one_per_period", "int>=1?"),
                 ("seed", "int>=0"),
                 ("exponent_time", "real>0"),
             )
         },
     )
     per_period, forcing_period = given["zero_one_per_period"], given["forcing_period"]
-    if forcing_period is not None and per_period > max(1, round(forcing_period / given["dt"])):
-        raise ValueError(
-            f"classify_signal: zero_one_per_period = {per_period} must be <= "
-            f"{max(1, round(forcing_period / given['dt']))}, the samples per forcing period"
-        )
+    if per_period is not None and forcing_period is not None:
+        most = max(1, round(forcing_period / given["dt"]))
+        if per_period > most:
+            raise ValueError(
+                f"classify_signal: zero_one_per_period = {per_period} must be <= {most}, "
+                "the samples per forcing period"
+            )
     options = given["spectrum_options"]
     if options is not None and not isinstance(options, dict):
         raise TypeError(f"classify_signal: spectrum_options must be a dict, got {options!r}")
@@ -122,7 +124,7 @@ def classify_signal(
     max_period: int | None = None,
     min_points_aperiodic: int | None = None,
     series_lyapunov: bool = False,
-    zero_one_per_period: int = 4,
+    zero_one_per_period: int | None = None,
     spectrum_options: dict | None = None,
     seed: int = 0,
     thresholds: Thresholds | None = None,
@@ -187,8 +189,9 @@ def classify_signal(
         Passed to the section analysis (see `classify_section`).
     series_lyapunov : bool
         Also estimate λ₁ from the signal with nolds (slower: ~0.2–0.5 s).
-    zero_one_per_period : int
-        Samples per forcing period fed to the 0–1 test of a forced signal.
+    zero_one_per_period : int, optional
+        Samples per forcing period fed to the 0–1 test of a forced signal, at most the
+        signal's own; default 4, or the signal's own when it has fewer.
     spectrum_options : dict, optional
         Extra keyword arguments of `spectrum_analysis`.
     seed : int
@@ -222,6 +225,9 @@ def classify_signal(
     """
     x = as_series(x, min_size=MIN_SERIES)
     _check_signal_settings(locals())
+    if zero_one_per_period is None:
+        most = max(1, round(forcing_period / dt)) if forcing_period is not None else 4
+        zero_one_per_period = min(4, most)
     if section is not None:
         section = as_points(section, "section")
     thr = resolve(thresholds, rtol, min_points_aperiodic)

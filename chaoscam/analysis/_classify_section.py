@@ -167,7 +167,7 @@ def classify_section(
     x = as_points(points)
     check_settings(
         "classify_section",
-        lyapunov=(lyapunov, "real?"),
+        lyapunov=(lyapunov, "number?"),
         lyapunov_tol=(lyapunov_tol, "real>=0"),
         exponent_time=(exponent_time, "real>0"),
         max_period=(max_period, "int>=1?"),

@@ -105,7 +105,6 @@ class Thresholds:
 
     period_rtol: float = 3e-3
     noise_floor: float = 1e-6
-    band_separation: float = 4.0
     stationary_low: float = 0.5
     stationary_high: float = 2.0
     min_points_aperiodic: int = 100
@@ -128,6 +127,7 @@ class Thresholds:
     series_chaotic: float = 0.05
     series_regular: float = 0.01
     constant_signal: float = 1e-12
+    band_separation: float = 4.0  # last: positional tables of earlier versions keep their meaning
 
     def __post_init__(self):
         for f in fields(self):
@@ -138,6 +138,10 @@ class Thresholds:
             raise ValueError("Thresholds: need stationary_low <= 1 <= stationary_high")
         if not self.zero_one_regular < self.zero_one_chaotic:
             raise ValueError("Thresholds: need zero_one_regular < zero_one_chaotic")
+        if not self.band_separation > 0:
+            raise ValueError(
+                f"Thresholds.band_separation must be > 0, got {self.band_separation!r}"
+            )
 
     def to_dict(self) -> dict:
         """The table as a plain dict (recorded in ``Verdict.settings["thresholds"]``)."""

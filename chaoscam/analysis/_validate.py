@@ -54,13 +54,19 @@ def as_points(points, name: str = "points", min_size: int = 1) -> np.ndarray:
 
 def check_settings(fn: str, **settings: tuple[Any, str]) -> None:
     """Refuse a setting outside its range: ValueError naming ``fn``, the setting and the
-    range. Each setting is ``(value, rule)``, the rule one of ``"real"`` (finite),
-    ``"real>0"``, ``"real>=0"``, ``"int>=N"`` (an integer, not a bool or a float); a
-    trailing ``?`` lets None pass (the setting's "not given")."""
+    range. Each setting is ``(value, rule)``, the rule one of ``"number"`` (any real, NaN
+    and ±inf included: an estimate's value), ``"real"`` (finite), ``"real>0"``,
+    ``"real>=0"``, ``"int>=N"`` (an integer, not a bool or a float, as for the package's
+    other counts); a trailing ``?`` lets None pass (the setting's "not given")."""
     for name, (value, rule) in settings.items():
         if value is None and rule.endswith("?"):
             continue
         base = rule.rstrip("?")
+        if base == "number":
+            if isinstance(value, numbers.Real) and not isinstance(value, bool):
+                continue
+            none = " or None" if rule.endswith("?") else ""
+            raise ValueError(f"{fn}: {name} = {value!r} must be a number{none}")
         kind, op, low = re.fullmatch(r"(int|real)(>=|>)?([0-9.]+)?", base).groups()
         number = numbers.Integral if kind == "int" else numbers.Real
         ok = isinstance(value, number) and not isinstance(value, bool)
@@ -73,4 +79,5 @@ def check_settings(fn: str, **settings: tuple[Any, str]) -> None:
             what = "an integer" if kind == "int" else "a finite number"
             bound = f" {op} {low}" if op else ""
             none = " or None" if rule.endswith("?") else ""
-            raise ValueError(f"{fn}: {name} = {value!r} must be {what}{bound}{none}")
+            got = "" if isinstance(value, number) else f" (got {type(value).__name__})"
+            raise ValueError(f"{fn}: {name} = {value!r} must be {what}{bound}{none}{got}")

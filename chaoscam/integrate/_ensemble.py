@@ -207,15 +207,22 @@ def simulate_ensemble(
 
 def models_digest(plist: list[Params]) -> str:
     """A fingerprint of the members' models, in order (``settings["models"]``): the sha256
-    of each one's fields (its ``repr``, exact for floats), 16 hex digits. What
+    of each one's fields, numbers as floats (``repr``, exact; ``omega=10`` and ``10.0`` are
+    one model, as ``==`` says), 16 hex digits. What
     :func:`chaoscam.classify.classify_ensemble` compares its ``params`` with."""
+    import dataclasses
     import hashlib
+    import numbers
+
+    def canonical(v):
+        return float(v) if isinstance(v, numbers.Real) and not isinstance(v, bool) else v
 
     whole_run, seen = hashlib.sha256(), {}
     for p in plist:
         one = seen.get(id(p))
         if one is None:  # members that share a model are hashed once
-            one = seen[id(p)] = hashlib.sha256(repr(p).encode()).digest()
+            fields = [(f.name, canonical(getattr(p, f.name))) for f in dataclasses.fields(p)]
+            one = seen[id(p)] = hashlib.sha256(repr(fields).encode()).digest()
         whole_run.update(one)
     return whole_run.hexdigest()[:16]
 

@@ -88,3 +88,17 @@ def test_the_limits_themselves_are_taken():
     an.lyapunov_benettin_map(_logistic, [0.3], 1, transient=0, n_align=0)
     an.classify_signal(X, 0.01, 0.2, zero_one_per_period=20, seed=0)
     an.neighbour_expansion(PTS, min_distance=0.0)
+
+
+def test_a_coarse_series_and_an_estimate_of_minus_infinity_are_taken():
+    """A review's findings: a series sampled 3 times per forcing period is classified with
+    the 0-1 test at its own rate (the default 4 refused it); lyapunov = -inf (two
+    trajectories that merged) and NaN are an estimate's values, not bad settings; a band
+    separation of 0 is refused by Thresholds itself (it became a 'failed' evidence)."""
+    coarse = np.sin(2 * np.pi * np.arange(300) / 3.0)
+    v = an.classify_signal(coarse, 0.1, 0.3)
+    assert v.settings["zero_one_per_period"] == 3
+    assert an.classify_section(PTS, lyapunov=-math.inf).label == "periodic"
+    an.classify_section(PTS, lyapunov=math.nan)
+    with pytest.raises(ValueError, match="band_separation must be > 0"):
+        an.Thresholds(band_separation=0.0)

@@ -106,3 +106,10 @@ def test_an_ensemble_that_cannot_fit_in_memory_is_refused_at_once():
     (it hung building 1e10 ints), as `chaoscam ensemble` refuses it."""
     with pytest.raises(ParameterError, match=r"an ensemble of 10000000000 members needs about"):
         simulate_ensemble(Params(), range(10**10), duration=20.0)
+
+
+def test_equal_models_written_differently_are_the_same_models():
+    """Params(omega=10) == Params(omega=10.0): classify_ensemble takes either (the
+    fingerprint hashed their repr, which differs)."""
+    ens = simulate_ensemble(Params(omega=10), [0], duration=1.0, transient=0.5, tangent=True)
+    assert len(classify_ensemble(ens, Params(omega=10.0), extend_to=None).members) == 1

@@ -89,3 +89,17 @@ def test_a_script_into_a_folder_in_use_is_refused(tmp_path):
     assert busy.returncode == 2 and "Traceback" not in busy.stderr
     assert f"in use by another chaoscam process (pid {holder.pid})" in busy.stderr
     assert list(outdir.iterdir()) == []
+
+
+def test_a_script_into_the_current_folder_runs(tmp_path):
+    """OUTDIR '.' (the current folder): its lock goes beside it, as chaoscam paper's does
+    (the lock refused a path without a name)."""
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "analyses" / "fig3.py"), "--quick", "."],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+    )
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "fig3.csv").exists()
+    assert not list(tmp_path.parent.glob(f".{tmp_path.name}.lock"))  # released

@@ -296,3 +296,22 @@ def test_a_report_that_appeared_meanwhile_is_kept(tmp_path, monkeypatch):
     kept = [p for p in tmp_path.glob("p.*.html")]
     assert len(kept) == 1 and str(kept[0]) in str(err.value)
     assert "Fig. 3 reproduced (quick run)" in kept[0].read_text()
+
+
+def test_write_report_keeps_an_existing_file_and_needs_its_folder(tmp_path):
+    """write_report(replace=False) never writes over a file (its report goes beside it,
+    named in the error); a missing folder is refused (it was created)."""
+    from chaoscam._outputs import OutputError
+    from chaoscam.report import write_report
+    from chaoscam.report._html import ReportParts
+
+    out = tmp_path / "r.html"
+    out.write_text("theirs")
+    with pytest.raises(OutputError, match="appeared while this run was working"):
+        write_report(ReportParts(), out, title="t", replace=False)
+    assert out.read_text() == "theirs" and len(list(tmp_path.glob("r.*.html"))) == 1
+    write_report(ReportParts(), out, title="t")
+    assert "<html" in out.read_text()
+    with pytest.raises(OutputError, match="does not exist"):
+        write_report(ReportParts(), tmp_path / "no" / "r.html", title="t")
+    assert not (tmp_path / "no").exists()
