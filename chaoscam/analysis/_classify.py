@@ -74,9 +74,10 @@ def _zero_one_signal(x, dt, forcing_period, seed, per_period, line_freq, thr):
     return e
 
 
-def _check_signal_settings(given: dict) -> None:
+def _check_signal_settings(given: dict) -> int:
     """classify_signal's settings in their ranges, before any evidence is gathered (an
-    evidence function that raises is reported as failed evidence, not as an error)."""
+    evidence function that raises is reported as failed evidence, not as an error); returns
+    the 0-1 test's samples per forcing period (default 4, at most the signal's own)."""
     check_settings(
         "classify_signal",
         **{
@@ -95,19 +96,19 @@ def _check_signal_settings(given: dict) -> None:
         },
     )
     per_period, forcing_period = given["zero_one_per_period"], given["forcing_period"]
-    if per_period is not None and forcing_period is not None:
-        most = max(1, round(forcing_period / given["dt"]))
-        if per_period > most:
-            raise ValueError(
-                f"classify_signal: zero_one_per_period = {per_period} must be <= {most}, "
-                "the samples per forcing period"
-            )
+    most = 4 if forcing_period is None else max(1, round(forcing_period / given["dt"]))
+    if per_period is not None and forcing_period is not None and per_period > most:
+        raise ValueError(
+            f"classify_signal: zero_one_per_period = {per_period} must be <= {most}, "
+            "the samples per forcing period"
+        )
     options = given["spectrum_options"]
     if options is not None and not isinstance(options, dict):
         raise TypeError(f"classify_signal: spectrum_options must be a dict, got {options!r}")
     if "forcing_frequency" in (options or {}):
         raise TypeError("classify_signal: the spectrum's forcing_frequency is 1 / forcing_period")
     check_spectrum_options("classify_signal: spectrum_options", options or {})
+    return min(4, most) if per_period is None else per_period
 
 
 def classify_signal(
@@ -224,10 +225,7 @@ def classify_signal(
     quasiperiodic versus chaotic call rests on the spectrum and the 0–1 test agreeing.
     """
     x = as_series(x, min_size=MIN_SERIES)
-    _check_signal_settings(locals())
-    if zero_one_per_period is None:
-        most = max(1, round(forcing_period / dt)) if forcing_period is not None else 4
-        zero_one_per_period = min(4, most)
+    zero_one_per_period = _check_signal_settings(locals())
     if section is not None:
         section = as_points(section, "section")
     thr = resolve(thresholds, rtol, min_points_aperiodic)

@@ -250,25 +250,6 @@ def spectrum_analysis(
     """
     x = as_series(x)
     n = x.size
-    check_settings("spectrum_analysis", dt=(dt, "real>0"))
-    check_spectrum_options(
-        "spectrum_analysis",
-        dict(
-            forcing_frequency=forcing_frequency,
-            max_period=max_period,
-            half_width=half_width,
-            line_tol=line_tol,
-            broadband_tol=broadband_tol,
-            max_order=max_order,
-            n_peaks=n_peaks,
-            min_cycles=min_cycles,
-            peak_tol=peak_tol,
-        ),
-    )
-    if half_width > n:
-        raise ValueError(
-            f"spectrum_analysis: half_width = {half_width} bins must be <= the {n} samples of x"
-        )
     settings = dict(
         dt=dt,
         forcing_frequency=forcing_frequency,
@@ -280,6 +261,13 @@ def spectrum_analysis(
         min_cycles=min_cycles,
         peak_tol=peak_tol,
     )
+    check_settings("spectrum_analysis", dt=(dt, "real>0"))
+    options = {k: v for k, v in settings.items() if k != "dt"}
+    check_spectrum_options("spectrum_analysis", {**options, "n_peaks": n_peaks})
+    if half_width > n:
+        raise ValueError(
+            f"spectrum_analysis: half_width = {half_width} bins must be <= the {n} samples of x"
+        )
     nan = math.nan
     df = 1.0 / (n * dt) if n > 0 else nan
 

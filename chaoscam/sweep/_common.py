@@ -110,7 +110,6 @@ def write_tables(
     write_parquet(other, companion(path, second), config, replace=replace)
 
 
-_READERS = {"bifurcation": "read_bifurcation", "regime_map": "read_regime_map"}
 _KIND_NAMES = {"bifurcation": "bifurcation diagram", "regime_map": "regime map"}
 
 
@@ -135,10 +134,9 @@ def read_tables(
     config = meta.get("config", {})
     found = config.get("kind", kind)  # files without a kind predate it
     if found != kind:
-        reader = _READERS.get(found)
         raise SweepError(
             f"{path}: a {_KIND_NAMES.get(found, found)}, not a {what}"
-            + (f"; read it with chaoscam.sweep.{reader}" if reader else "")
+            + (f"; read it with chaoscam.sweep.read_{found}" if found in _KIND_NAMES else "")
         )
     if not other.is_file():
         raise FileNotFoundError(f"{other}: no such file; a {what} is {path.name} and {other.name}")
