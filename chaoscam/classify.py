@@ -317,11 +317,13 @@ def classify_trajectory(
     check_step : bool
         Re-simulate the same realization (params, duration, transient, seed, index, output
         step) with dt / 2 (adaptive integrator: tolerances / 32, see ``Params.refined``) and
-        classify it the same way (Lyapunov included when asked); if
+        classify it the same way (Lyapunov included when asked; on the tangent path with the
+        same extension to ``extend_to`` when undetermined); if
         the label or the period changes, the verdict becomes "undetermined" with that reason
         (MODEL.md: a result must not change when the step is halved). Evidence
         ``step_check`` (value 1 unchanged, 0 changed; the half-step verdict in its detail)
-        does not vote.
+        does not vote. An undetermined verdict is not re-run (a half step cannot change
+        it): ``step_check`` then has no value and says so.
     discard : float
         Extra time after the run's transient left out of the classification [s].
     extend_to : float or None
@@ -378,14 +380,10 @@ def classify_trajectory(
     verdict = _with_settings(verdict, **settings, **extra)
     if not check_step:
         return verdict
-
-    half = _resimulate_half_step(traj)
-    hv, _ = (
-        (_status_verdict(half, {}), {})
-        if half.status is not Status.OK
-        else _verdict_of(half, lyapunov, discard, options, tangent)
-    )
     fine = traj.params.refined()
+    if verdict.label == "undetermined":
+        return _step_check_skipped(verdict, fine)
+    hv = _half_step_verdict(traj, lyapunov, discard, options, tangent, extend_to)
     same = hv.label == verdict.label and hv.period == verdict.period
     what = (
         f"{traj.params.describe_step()}: {_describe(verdict)}; "
@@ -471,17 +469,57 @@ def _verdict_of(
     return _rename_lyapunov(v, prefix, res.exponent), extra
 
 
-def _resimulate_half_step(traj: Trajectory) -> Trajectory:
+def _step_check_skipped(verdict: Verdict, fine) -> Verdict:
+    """``check_step`` on an undetermined verdict: nothing a half step finds can change it,
+    so the realization is not re-simulated; evidence ``step_check`` says so (no value)."""
+    check = Evidence(
+        "step_check",
+        None,
+        None,
+        f"not re-run at {fine.describe_step()}: the verdict is undetermined already, "
+        "which a half step cannot change",
+    )
+    return dataclasses.replace(
+        verdict,
+        evidence=verdict.evidence + (check,),
+        settings={**verdict.settings, "step_check": {"dt_half": fine.dt, "skipped": True}},
+    )
+
+
+def _half_step_verdict(traj, lyapunov, discard, options, tangent, extend_to) -> Verdict:
+    """The verdict on ``traj``'s realization at half the step, reached the way the run's own
+    was: the same evidence and, on the tangent path, the same extension of an undetermined
+    verdict up to ``extend_to`` (else a grid verdict settled on an extended run would be
+    compared with an unextended, undetermined one)."""
+    with_tangent = tangent and not lyapunov
+    half = _resimulate_half_step(traj, tangent=with_tangent)
+    if half.status is not Status.OK:
+        return _status_verdict(half, {})
+    tr = _tangent_run(half) if with_tangent else None
+    hv, extra = _verdict_of(half, lyapunov, discard, options, tangent, tr)
+    if tr is not None and extend_to and extensible(hv):
+        hv, _ = _extended(tr, hv, extra, discard, options, float(extend_to))
+    return hv
+
+
+def _resimulate_half_step(traj: Trajectory, *, tangent: bool = False) -> Trajectory:
+    """The realization of ``traj`` with the step halved (:meth:`Params.refined`); with
+    ``tangent`` on the RK4 grid also its Jacobians, kept resumable (what the tangent verdict
+    and its extension read), else without."""
     s = traj.settings
     keep_series = traj.series is not None
+    fine = traj.params.refined()
+    tangent = tangent and fine.integrator == "rk4"
     return simulate(
-        traj.params.refined(),
+        fine,
         duration=s["duration"],
         transient=s["transient"],
         seed=s["seed"],
         index=s["index"],
         series=keep_series,
         output_dt=s["output_dt"] if keep_series else 1e-3,
+        tangent=tangent,
+        resumable=tangent,
     )
 
 

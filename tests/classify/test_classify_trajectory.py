@@ -97,7 +97,7 @@ def test_step_check_failure_makes_the_verdict_undetermined(periodic, default3, m
     """If the half-step run gives another label, the verdict is undetermined with the reason."""
     seen = {}
 
-    def fake_half(traj):
+    def fake_half(traj, **kw):
         seen["dt"] = traj.params.dt
         return default3  # stands in for a half-step run that came out irregular
 
@@ -106,6 +106,36 @@ def test_step_check_failure_makes_the_verdict_undetermined(periodic, default3, m
     assert v.label == "undetermined" and v.period is None
     assert any("halving the step" in r for r in v.reasons)
     assert v.evidence[-1].name == "step_check" and v.evidence[-1].value == 0
+
+
+def test_step_check_extends_the_half_step_run_as_the_grid_run():
+    """Table 1's point is undetermined on its 10 s recorded and chaotic once extended to 40 s;
+    its half-step run must be extended the same way before the two are compared (it was
+    not: "chaotic" against an unextended "undetermined" read as a changed verdict)."""
+    tr = chaoscam.simulate(duration=20.0, transient=10.0)
+    v = classify_trajectory(tr, check_step=True)
+    assert v.label == "chaotic", v.reasons
+    assert v.settings["extended"]["recorded_s"] == 40.0
+    assert v.evidence[-1].name == "step_check" and v.evidence[-1].value == 1
+    assert v.settings["step_check"]["label"] == "chaotic"
+
+
+def test_step_check_does_not_rerun_an_undetermined_verdict(monkeypatch):
+    """An undetermined verdict cannot change with the step: no half-step run, and the
+    step_check evidence says why it has no value."""
+    tr = chaoscam.simulate(duration=3.0, transient=2.0)
+    plain = classify_trajectory(tr, extend_to=None)
+    assert plain.label == "undetermined"
+
+    def no_rerun(traj, **kw):
+        raise AssertionError("re-simulated an undetermined verdict")
+
+    monkeypatch.setattr(cl, "_resimulate_half_step", no_rerun)
+    v = classify_trajectory(tr, extend_to=None, check_step=True)
+    assert (v.label, v.reasons) == (plain.label, plain.reasons)
+    e = v.evidence[-1]
+    assert e.name == "step_check" and e.value is None and "cannot change" in e.detail
+    assert v.settings["step_check"]["skipped"] is True
 
 
 def test_half_step_run_is_the_same_realization(periodic):
