@@ -465,10 +465,12 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
 
 def _sensitivity_stage(quick: bool, outdir: Path, workers=None) -> FigureResult:
-    """The sweeps that explain the differences (:mod:`._sensitivity`)."""
-    from ._sensitivity import sensitivity
+    """The sweeps that explain the differences (:mod:`._sensitivity`; the full run checks
+    their verdicts at half the step)."""
+    from ._sensitivity import sensitivity, step_checked
 
-    return sensitivity(quick, outdir, workers=workers, classify=_classifier(quick))
+    classify = step_checked(_classifier(quick), quick)
+    return sensitivity(quick, outdir, workers=workers, classify=classify)
 
 
 def _classifier(quick: bool):

@@ -2,7 +2,14 @@
 
 import pandas as pd
 
-from chaoscam.experiments._sensitivity import XI_WINDOW, restitution_finding, xi_values
+from chaoscam.experiments._paper import _classifier
+from chaoscam.experiments._sensitivity import (
+    XI_WINDOW,
+    restitution_finding,
+    step_checked,
+    step_finding,
+    xi_values,
+)
 from chaoscam.model import Params
 
 
@@ -46,3 +53,27 @@ def test_restitution_equal_to_a_rich_stiffness_range_is_not_called_more_sensitiv
     text = restitution_finding(v, 0.42, ["chaotic", "periodic 3"])
     assert "more sensitive" not in text
     assert "no more than across the paper's stiffness range (2)" in text
+
+
+def test_full_sweeps_check_the_step_and_quick_ones_do_not():
+    """The full report's sensitivity sweeps re-run their verdicts at dt/2; the quick one
+    keeps its time; the rest of the classifier is the report's."""
+    for quick in (True, False):
+        c = step_checked(_classifier(quick), quick)
+        assert c.check_step is (not quick)
+        assert c.extend_to == _classifier(quick).extend_to
+
+
+def test_step_finding_counts_checked_verdicts_and_names_the_changed():
+    """Checked = a step_check value (1 held, 0 changed); undetermined and escaped runs have
+    none and are not counted; no column or no value: no sentence."""
+    rows = pd.DataFrame({"value": [0.1, 0.2, 0.3, 0.4], "ev_step_check": [1.0, 0.0, None, 1.0]})
+    text = step_finding(rows, lambda r: f"ξ = {r.value:g}")
+    assert "2 of 3 verdicts hold; 1 changes there and is undetermined (ξ = 0.2)." in text
+    rows.loc[0, "ev_step_check"] = 0.0
+    assert "1 of 3 verdicts hold; 2 change there and are undetermined (ξ = 0.1, ξ = 0.2)." in (
+        step_finding(rows, lambda r: f"ξ = {r.value:g}")
+    )
+    assert step_finding(rows.assign(ev_step_check=1.0), str).endswith("4 of 4 verdicts hold.")
+    assert step_finding(rows.drop(columns="ev_step_check"), str) == ""
+    assert step_finding(rows.assign(ev_step_check=None), str) == ""
