@@ -16,10 +16,12 @@ from typing import Any
 
 import numpy as np
 
+from . import _step_check as step_check
 from ._checks import flag, of_type, real
 from ._extend import extend_trajectory
 from ._model_rules import MODEL_ATOL, extensible, overflow_evidence, with_model_evidence
 from ._simulate import Trajectory, simulate
+from ._step_check import resimulate_half_step as _resimulate_half_step
 from ._trajectory_io import load_trajectory
 from .analysis import Evidence, Verdict, classify_section, classify_signal
 from .analysis._options import check_options, section_options
@@ -382,46 +384,9 @@ def classify_trajectory(
         return verdict
     fine = traj.params.refined()
     if verdict.label == "undetermined":
-        return _step_check_skipped(verdict, fine)
+        return step_check.skipped(verdict, fine)
     hv = _half_step_verdict(traj, lyapunov, discard, options, tangent, extend_to)
-    same = hv.label == verdict.label and hv.period == verdict.period
-    what = (
-        f"{traj.params.describe_step()}: {_describe(verdict)}; "
-        f"{fine.describe_step()}: {_describe(hv)}"
-    )
-    check = Evidence(
-        "step_check",
-        int(same),
-        None,
-        ("unchanged when the step is halved (" if same else "changed when the step is halved (")
-        + what
-        + ")",
-    )
-    settings_h = {
-        **verdict.settings,
-        "step_check": {
-            "dt_half": fine.dt,
-            "refined": fine.describe_step(),
-            "label": hv.label,
-            "period": hv.period,
-            "reasons": list(hv.reasons),
-        },
-    }
-    if same:
-        return dataclasses.replace(
-            verdict, evidence=verdict.evidence + (check,), settings=settings_h
-        )
-    return Verdict(
-        "undetermined",
-        None,
-        verdict.evidence + (check,),
-        verdict.reasons + (f"halving the step changes the verdict ({what})",),
-        settings_h,
-    )
-
-
-def _describe(v: Verdict) -> str:
-    return f"{v.label}" + (f" (period {v.period})" if v.period is not None else "")
+    return step_check.compared(verdict, hv, traj.params, fine)
 
 
 def _verdict_of(
@@ -469,23 +434,6 @@ def _verdict_of(
     return _rename_lyapunov(v, prefix, res.exponent), extra
 
 
-def _step_check_skipped(verdict: Verdict, fine) -> Verdict:
-    """``check_step`` on an undetermined verdict: nothing a half step finds can change it,
-    so the realization is not re-simulated; evidence ``step_check`` says so (no value)."""
-    check = Evidence(
-        "step_check",
-        None,
-        None,
-        f"not re-run at {fine.describe_step()}: the verdict is undetermined already, "
-        "which a half step cannot change",
-    )
-    return dataclasses.replace(
-        verdict,
-        evidence=verdict.evidence + (check,),
-        settings={**verdict.settings, "step_check": {"dt_half": fine.dt, "skipped": True}},
-    )
-
-
 def _half_step_verdict(traj, lyapunov, discard, options, tangent, extend_to) -> Verdict:
     """The verdict on ``traj``'s realization at half the step, reached the way the run's own
     was: the same evidence and, on the tangent path, the same extension of an undetermined
@@ -500,27 +448,6 @@ def _half_step_verdict(traj, lyapunov, discard, options, tangent, extend_to) -> 
     if tr is not None and extend_to and extensible(hv):
         hv, _ = _extended(tr, hv, extra, discard, options, float(extend_to))
     return hv
-
-
-def _resimulate_half_step(traj: Trajectory, *, tangent: bool = False) -> Trajectory:
-    """The realization of ``traj`` with the step halved (:meth:`Params.refined`); with
-    ``tangent`` on the RK4 grid also its Jacobians, kept resumable (what the tangent verdict
-    and its extension read), else without."""
-    s = traj.settings
-    keep_series = traj.series is not None
-    fine = traj.params.refined()
-    tangent = tangent and fine.integrator == "rk4"
-    return simulate(
-        fine,
-        duration=s["duration"],
-        transient=s["transient"],
-        seed=s["seed"],
-        index=s["index"],
-        series=keep_series,
-        output_dt=s["output_dt"] if keep_series else 1e-3,
-        tangent=tangent,
-        resumable=tangent,
-    )
 
 
 def classify_file(

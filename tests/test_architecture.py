@@ -28,6 +28,7 @@ LAYERS = (
     "chaoscam.lyapunov",
     "chaoscam._certify",
     "chaoscam._model_rules",
+    "chaoscam._step_check",
     "chaoscam.classify",
     "chaoscam._ensemble_verdicts",
     "chaoscam.sweep",

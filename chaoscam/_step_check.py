@@ -1,0 +1,100 @@
+"""The step check of a verdict (``classify_trajectory(..., check_step=True)``).
+
+MODEL.md: a result must not change when the step is halved. The realization is simulated
+again with dt / 2 (:meth:`Params.refined`; the adaptive integrator's tolerances / 32) and
+classified the same way (:mod:`chaoscam.classify` does that); here, the re-simulation and what
+the comparison makes of the two verdicts: the grid verdict with evidence ``step_check`` (1:
+unchanged), or "undetermined" with the reason (0: changed). An undetermined verdict is not
+re-run, since no half-step verdict can change it (``step_check`` without a value).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from ._simulate import Trajectory, simulate
+from .analysis import Evidence, Verdict
+from .model import Params
+
+__all__ = ["resimulate_half_step", "skipped", "compared"]
+
+
+def resimulate_half_step(traj: Trajectory, *, tangent: bool = False) -> Trajectory:
+    """The realization of ``traj`` with the step halved (:meth:`Params.refined`): the same
+    params otherwise, duration, transient, seed, index and output step; with ``tangent``, on
+    the RK4 grid, also its Jacobians, kept resumable (what the tangent verdict and its
+    extension read)."""
+    s = traj.settings
+    keep_series = traj.series is not None
+    fine = traj.params.refined()
+    tangent = tangent and fine.integrator == "rk4"
+    return simulate(
+        fine,
+        duration=s["duration"],
+        transient=s["transient"],
+        seed=s["seed"],
+        index=s["index"],
+        series=keep_series,
+        output_dt=s["output_dt"] if keep_series else 1e-3,
+        tangent=tangent,
+        resumable=tangent,
+    )
+
+
+def skipped(verdict: Verdict, fine: Params) -> Verdict:
+    """An undetermined ``verdict`` with evidence ``step_check`` (no value) saying why the
+    realization was not re-run at ``fine``'s step."""
+    check = Evidence(
+        "step_check",
+        None,
+        None,
+        f"not re-run at {fine.describe_step()}: the verdict is undetermined already, "
+        "which a half step cannot change",
+    )
+    return dataclasses.replace(
+        verdict,
+        evidence=verdict.evidence + (check,),
+        settings={**verdict.settings, "step_check": {"dt_half": fine.dt, "skipped": True}},
+    )
+
+
+def _describe(v: Verdict) -> str:
+    return f"{v.label}" + (f" (period {v.period})" if v.period is not None else "")
+
+
+def compared(verdict: Verdict, half: Verdict, coarse: Params, fine: Params) -> Verdict:
+    """The grid ``verdict`` (at ``coarse``'s step) checked against ``half``, the same
+    realization's at ``fine``'s: unchanged (label and period), it is kept with evidence
+    ``step_check`` = 1; else "undetermined" with the reason, ``step_check`` = 0.
+    ``settings["step_check"]`` records both verdicts."""
+    same = half.label == verdict.label and half.period == verdict.period
+    what = (
+        f"{coarse.describe_step()}: {_describe(verdict)}; {fine.describe_step()}: {_describe(half)}"
+    )
+    check = Evidence(
+        "step_check",
+        int(same),
+        None,
+        f"{'unchanged' if same else 'changed'} when the step is halved ({what})",
+    )
+    settings = {
+        **verdict.settings,
+        "step_check": {
+            "dt_half": fine.dt,
+            "refined": fine.describe_step(),
+            "label": half.label,
+            "period": half.period,
+            "reasons": list(half.reasons),
+            "grid_label": verdict.label,
+            "grid_period": verdict.period,
+        },
+    }
+    if same:
+        return dataclasses.replace(verdict, evidence=verdict.evidence + (check,), settings=settings)
+    return Verdict(
+        "undetermined",
+        None,
+        verdict.evidence + (check,),
+        verdict.reasons + (f"halving the step changes the verdict ({what})",),
+        settings,
+    )
