@@ -1,0 +1,87 @@
+"""replay: one realization of a finished sweep, run alone, is the run the sweep classified."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from chaoscam import Params, classify_trajectory
+from chaoscam.sweep import (
+    Axis,
+    DefaultClassifier,
+    bifurcation,
+    read_regime_map,
+    regime_map,
+    replay,
+    replay_params,
+)
+
+BASE = Params(l_lambda_sigma=0.002)
+
+
+@pytest.fixture(scope="module")
+def rmap():
+    """Two cells, two realizations each (sigma > 0: different realizations), on the
+    ensemble engine (batch members), classified by the default classifier (not extended)."""
+    return regime_map(
+        Axis("omega", (20.0, 30.0)),
+        Axis("xi", (0.42,)),
+        base=BASE,
+        realizations=2,
+        duration=3.0,
+        transient=2.0,
+        classify=DefaultClassifier(extend_to=None),  # no extension: a cheap test
+        workers=1,
+        progress=False,
+    )
+
+
+def test_regime_map_row_replays_its_own_run(rmap):
+    """Every realization replayed alone has the sweep's section count, impact count and
+    label; the two realizations of a cell are different runs."""
+    assert rmap.config["engine"] == "ensemble"
+    impacts = []
+    for row in rmap.realizations.itertuples():
+        p = replay_params(rmap, row)
+        assert (p.omega, p.xi, p.l_lambda_sigma) == (row.omega, row.xi, 0.002)
+        tr = replay(rmap, row)
+        assert len(tr.section) == row.n_section
+        assert tr.stats["n_impacts"] == row.n_impacts
+        assert classify_trajectory(tr, extend_to=None).label == row.label
+        impacts.append(tr.stats["n_impacts"])
+    assert len(set(impacts)) > 1
+
+
+def test_bifurcation_row_replays_its_section_points():
+    """A continued branch (the second value starts from the first's end state) replays to
+    the diagram's own section points, bit for bit, for each initial condition."""
+    bif = bifurcation(
+        "xi",
+        [0.2, 0.25],
+        initial_conditions=2,
+        duration=3.0,
+        transient=1.0,
+        continuation=True,
+        workers=1,
+        progress=False,
+    )
+    assert bif.verdicts["continued"].any()
+    for _, row in bif.verdicts.iterrows():  # pandas rows too
+        tr = replay(bif, row, tangent=False)
+        mine = bif.points[(bif.points["value_index"] == row["value_index"])
+                          & (bif.points["ic"] == row["ic"])]  # fmt: skip
+        np.testing.assert_array_equal(
+            tr.section["theta_f"].to_numpy()[-len(mine) :], mine["theta_f"].to_numpy()
+        )
+
+
+def test_replay_reads_a_written_map_and_names_what_it_needs(tmp_path, rmap):
+    """From a file it replays the same; a row without the fields, or something not a sweep,
+    is refused with what to pass."""
+    rmap.to_parquet(tmp_path / "m.parquet")
+    back = read_regime_map(tmp_path / "m.parquet")
+    row = back.realizations.iloc[0]
+    assert len(replay(back, row, tangent=False).section) == row["n_section"]
+    with pytest.raises(KeyError, match="realizations"):
+        replay(back, {"omega": 20.0, "xi": 0.42})
+    with pytest.raises(TypeError, match="RegimeMap or a Bifurcation"):
+        replay(pd.DataFrame(), row)
