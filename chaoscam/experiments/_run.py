@@ -24,6 +24,7 @@ from ._paper import (
     data_files,
 )
 from ._sensitivity import FATE_S
+from ._step_audit import PER_SWEEP, audit_sentence, step_audit
 
 __all__ = ["PaperRun", "check_paper_outputs", "figure_script", "run_paper"]
 
@@ -187,6 +188,7 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
         ran.add(fn)
         say(f"[{stage}/{len(funcs)}] {title}: {r.seconds:.0f} s")
         results.append(r)
+    audit, audit_s = _audit_stage(results, quick, workers, say, parts)
     total = time.perf_counter() - t_all
     done = [n for n in wanted if FIGURES[n] in ran]
     if done == sorted(FIGURES):
@@ -198,7 +200,9 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
     parts.summary.append(
         f"{'Quick' if quick else 'Full'} reproduction of the paper's {done_text} "
         f"in {total:.0f} s "
-        f"({', '.join(f'{r.name}: {r.seconds:.0f} s' for r in results)})."
+        f"({', '.join(f'{r.name}: {r.seconds:.0f} s' for r in results)}"
+        + (f", step audit: {audit_s:.0f} s" if audit else "")
+        + ")."
         + (f" {len(failed)} of {len(funcs)} stages failed (see What is missing)." if failed else "")
     )
     for r in results:
@@ -223,7 +227,7 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
         parts.why_figures.extend(r.why_figures)
     tally = pd.Series([c.verdict for c in parts.comparison]).value_counts()
     counted = ", ".join(f"{k}: {v}" for k, v in tally.items())
-    head = [line for line in (_in_short(results),) if line]
+    head = [line for line in (_in_short(results), audit_sentence(audit)) if line]
     head += [f"Against the paper, figure by figure: {counted} (see the last table)."]
     head += [f"{c.figure}: {c.verdict} — {c.found}" for c in parts.comparison]
     head += [f"Why the paper differs: {line}" for line in parts.why]
@@ -245,6 +249,32 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
         title += f" (incomplete: {len(failed)} of {len(funcs)} stages failed)"
     written = write_report(parts, out, title=title, command=command, replace=force)
     return PaperRun(written, tuple(failed))
+
+
+def _audit_stage(results, quick, workers, say, parts):
+    """The step audit of the paper figures' sweeps (:mod:`._step_audit`; the full run only):
+    its rows and seconds. A failure goes to "What is missing" (the figures stand without it,
+    so the report is not marked incomplete)."""
+    sweeps = []
+    for r in results:
+        if r.number == SENSITIVITY:  # every verdict of these is checked at half the step
+            continue
+        found = [(p, s) for p, s, _ in r.bifurcations] + [(p, s) for p, s, _ in r.regime_maps]
+        for path, sweep in found:
+            sweeps.append((r.name + (f" ({Path(path).stem})" if len(found) > 1 else ""), sweep))
+    if not sweeps or not PER_SWEEP[quick]:
+        return [], 0.0
+    t0 = time.perf_counter()
+    say("step audit: the figures' sampled runs at half the step ...")
+    try:
+        rows = step_audit(sweeps, quick, FULL_EXTEND_TO, workers=workers)
+    except Exception as err:  # reported, not hidden
+        parts.missing.append(f"Step audit: failed with {type(err).__name__}: {err}")
+        say(parts.missing[-1])
+        return [], 0.0
+    seconds = time.perf_counter() - t0
+    say(f"step audit: {seconds:.0f} s")
+    return rows, seconds
 
 
 _LABELS = ("periodic", "chaotic", "quasiperiodic", "undetermined")

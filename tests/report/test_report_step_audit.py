@@ -1,0 +1,69 @@
+"""The step audit: sampled runs of the paper figures' sweeps, replayed and checked at dt/2."""
+
+import pandas as pd
+import pytest
+
+from chaoscam.experiments import _step_audit as sa
+from chaoscam.experiments._step_audit import AuditRow, audit_sample, audit_sentence, step_audit
+from chaoscam.sweep import DefaultClassifier, bifurcation
+
+
+def test_sample_is_seeded_and_draws_decided_labels_only():
+    """Only periodic, quasiperiodic or chaotic rows; the same seed draws the same rows (in
+    table order); asking for more than there are gives all of them."""
+    labels = ["chaotic", "undetermined", "periodic", "left_reach", "quasiperiodic"] * 8
+    table = pd.DataFrame({"label": labels, "n": range(len(labels))})
+    a, b = audit_sample(table, 5), audit_sample(table, 5)
+    assert a.equals(b) and len(a) == 5 and list(a["n"]) == sorted(a["n"])
+    assert set(a["label"]) <= {"periodic", "quasiperiodic", "chaotic"}
+    assert not audit_sample(table, 5, seed=1)["n"].equals(a["n"].reset_index(drop=True))
+    assert len(audit_sample(table, 100)) == 24
+
+
+def _row(where, recorded, replayed, half, held):
+    return AuditRow("Fig. 4", where, recorded, replayed, half, held, 1.5)
+
+
+def test_sentence_counts_and_names_what_did_not_hold():
+    """Kept, undetermined at dt/2, another label and not reproduced are told apart; the
+    last three are named."""
+    rows = [
+        _row("a", "chaotic", "chaotic", "chaotic", True),
+        _row("b", "chaotic", "chaotic", "undetermined", False),
+        _row("c", "chaotic", "chaotic", "periodic 8", False),
+        _row("d", "periodic 2", "chaotic", "chaotic", True),
+    ]
+    text = audit_sentence(rows)
+    assert "4 runs" in text and "(6 s of work)" in text
+    assert (
+        "3 reproduce their label; at half the step 1 keep it, 1 are undetermined and 1 get" in text
+    )
+    assert "Undetermined at half the step: Fig. 4 at b: chaotic → undetermined" in text
+    assert "Another label: Fig. 4 at c: chaotic → periodic 8" in text
+    assert "Not reproduced: Fig. 4 at d (recorded periodic 2, replayed chaotic)" in text
+    assert audit_sentence([]) == ""
+
+
+def test_audit_replays_a_diagrams_runs_in_worker_processes(monkeypatch):
+    """A small diagram: two of its decided runs replayed in a process pool come back with
+    the recorded label, with their step check."""
+    bif = bifurcation(
+        "e",
+        [0.02, 0.021, 0.022],  # period 1 after ~2 s
+        duration=4.0,
+        transient=2.0,
+        classify=DefaultClassifier(extend_to=None),
+        workers=1,
+        progress=False,
+    )
+    assert bif.verdicts["label"].isin(sa.LABELS).sum() >= 2
+    monkeypatch.setitem(sa.PER_SWEEP, False, 2)
+    rows = step_audit([("Fig. X", bif)], quick=False, extend_to=None, workers=2)
+    assert len(rows) == 2 and all(r.reproduced for r in rows)
+    assert all(r.where.startswith("e = ") and r.half != "not re-run" for r in rows)
+    assert step_audit([("Fig. X", bif)], quick=True, extend_to=None) == []
+
+
+@pytest.mark.parametrize("quick", [True, False])
+def test_quick_report_audits_nothing_and_full_audits_every_sweep(quick):
+    assert (sa.PER_SWEEP[quick] == 0) is quick
