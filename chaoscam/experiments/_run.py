@@ -242,6 +242,8 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
             "extended (its labels are those of 8 s runs, 4 s recorded), and the ξ sweep's and "
             f"(ω, ξ) map's chaotic or undetermined runs continued to {FATE_S[True]:g} s "
             f"({FATE_S[False]:g} s) to see whether they stay in the cam's reach; "
+            "the sensitivity sweeps' verdicts not checked at half the step and no step "
+            "audit of the figures (both in the full report); "
             "run `chaoscam paper` without --quick for the full grids."
         )
     title = f"chaoscam: the paper's {done_text} reproduced" + (" (quick run)" if quick else "")
@@ -249,6 +251,20 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
         title += f" (incomplete: {len(failed)} of {len(funcs)} stages failed)"
     written = write_report(parts, out, title=title, command=command, replace=force)
     return PaperRun(written, tuple(failed))
+
+
+def _sweep_names(name: str, sweeps: list) -> list[str]:
+    """``name`` for a figure's one sweep; for several, each with the base parameters in which
+    they differ (Fig. 6: "Fig. 6 (G = 1e-09, dt = 3.9e-07)")."""
+    if len(sweeps) == 1:
+        return [name]
+    bases = [s.config["base"] for s in sweeps]
+    keys = [k for k in bases[0] if len({repr(b.get(k)) for b in bases}) > 1]
+
+    def text(v) -> str:
+        return f"{v:g}" if isinstance(v, float) else str(v)
+
+    return [f"{name} ({', '.join(f'{k} = {text(b.get(k))}' for k in keys)})" for b in bases]
 
 
 def _audit_stage(results, quick, workers, say, parts):
@@ -259,9 +275,8 @@ def _audit_stage(results, quick, workers, say, parts):
     for r in results:
         if r.number == SENSITIVITY:  # every verdict of these is checked at half the step
             continue
-        found = [(p, s) for p, s, _ in r.bifurcations] + [(p, s) for p, s, _ in r.regime_maps]
-        for path, sweep in found:
-            sweeps.append((r.name + (f" ({Path(path).stem})" if len(found) > 1 else ""), sweep))
+        found = [s for _, s, _ in r.bifurcations] + [s for _, s, _ in r.regime_maps]
+        sweeps += zip(_sweep_names(r.name, found), found, strict=True)
     if not sweeps or not PER_SWEEP[quick]:
         return [], 0.0
     t0 = time.perf_counter()

@@ -142,6 +142,10 @@ def step_audit(
     return rows
 
 
+def _count(n: int, one: str, many: str) -> str:
+    return f"{n} {one if n == 1 else many}"
+
+
 def audit_sentence(rows: list[AuditRow]) -> str:
     """The summary's sentence on the audit: how many runs were reproduced, kept their label
     at half the step, are undetermined there, or got another label (those two named)."""
@@ -157,8 +161,9 @@ def audit_sentence(rows: list[AuditRow]) -> str:
         f"Step audit: {n} runs labelled periodic, quasiperiodic or chaotic, drawn from "
         f"{', '.join(figures)}, were replayed alone and classified again with the step halved "
         f"({sum(r.seconds for r in rows):.0f} s of work): {len(same)} reproduce their label; "
-        f"at half the step {sum(r.held for r in same)} keep it, {len(undecided)} are "
-        f"undetermined and {len(other)} get another label"
+        f"at half the step {_count(sum(r.held for r in same), 'keeps', 'keep')} it, "
+        f"{_count(len(undecided), 'is', 'are')} undetermined and "
+        f"{_count(len(other), 'gets', 'get')} another label"
     )
 
     def named(what: str, group: list[AuditRow]) -> str:

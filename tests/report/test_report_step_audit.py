@@ -36,7 +36,7 @@ def test_sentence_counts_and_names_what_did_not_hold():
     text = audit_sentence(rows)
     assert "4 runs" in text and "(6 s of work)" in text
     assert (
-        "3 reproduce their label; at half the step 1 keep it, 1 are undetermined and 1 get" in text
+        "3 reproduce their label; at half the step 1 keeps it, 1 is undetermined and 1 gets" in text
     )
     assert "Undetermined at half the step: Fig. 4 at b: chaotic → undetermined" in text
     assert "Another label: Fig. 4 at c: chaotic → periodic 8" in text
@@ -67,3 +67,21 @@ def test_audit_replays_a_diagrams_runs_in_worker_processes(monkeypatch):
 @pytest.mark.parametrize("quick", [True, False])
 def test_quick_report_audits_nothing_and_full_audits_every_sweep(quick):
     assert (sa.PER_SWEEP[quick] == 0) is quick
+
+
+def test_a_figures_sweeps_are_named_by_what_differs():
+    """Fig. 6's two diagrams differ in G (and dt): each audited run names its sweep so."""
+    from types import SimpleNamespace
+
+    from chaoscam.experiments._run import _sweep_names
+
+    def sweep(**base):
+        return SimpleNamespace(config={"base": {"xi": 0.42, "integrator": "rk4", **base}})
+
+    one = [sweep(G=1e-9, dt=3.9e-7)]
+    assert _sweep_names("Fig. 6", one) == ["Fig. 6"]
+    two = [*one, sweep(G=1e-10, dt=2e-7)]
+    assert _sweep_names("Fig. 6", two) == [
+        "Fig. 6 (G = 1e-09, dt = 3.9e-07)",
+        "Fig. 6 (G = 1e-10, dt = 2e-07)",
+    ]
