@@ -256,8 +256,8 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
 def _sweep_names(name: str, sweeps: list) -> list[str]:
     """``name`` for a figure's one sweep; for several, each with the base parameters in which
     they differ (Fig. 6: "Fig. 6 (G = 1e-09, dt = 3.9e-07)")."""
-    if len(sweeps) == 1:
-        return [name]
+    if len(sweeps) <= 1:  # none (Figs. 3 and 5 have no sweep) or one
+        return [name] * len(sweeps)
     bases = [s.config["base"] for s in sweeps]
     keys = [k for k in bases[0] if len({repr(b.get(k)) for b in bases}) > 1]
 
@@ -271,17 +271,19 @@ def _audit_stage(results, quick, workers, say, parts):
     """The step audit of the paper figures' sweeps (:mod:`._step_audit`; the full run only):
     its rows and seconds. A failure goes to "What is missing" (the figures stand without it,
     so the report is not marked incomplete)."""
-    sweeps = []
-    for r in results:
-        if r.number == SENSITIVITY:  # every verdict of these is checked at half the step
-            continue
-        found = [s for _, s, _ in r.bifurcations] + [s for _, s, _ in r.regime_maps]
-        sweeps += zip(_sweep_names(r.name, found), found, strict=True)
-    if not sweeps or not PER_SWEEP[quick]:
+    if not PER_SWEEP[quick]:
         return [], 0.0
     t0 = time.perf_counter()
-    say("step audit: the figures' sampled runs at half the step ...")
     try:
+        sweeps = []
+        for r in results:
+            if r.number == SENSITIVITY:  # every verdict of these is checked at half the step
+                continue
+            found = [s for _, s, _ in r.bifurcations] + [s for _, s, _ in r.regime_maps]
+            sweeps += zip(_sweep_names(r.name, found), found, strict=True)
+        if not sweeps:
+            return [], 0.0
+        say("step audit: the figures' sampled runs at half the step ...")
         rows = step_audit(sweeps, quick, FULL_EXTEND_TO, workers=workers)
     except Exception as err:  # reported, not hidden
         parts.missing.append(f"Step audit: failed with {type(err).__name__}: {err}")

@@ -78,6 +78,7 @@ def test_a_figures_sweeps_are_named_by_what_differs():
     def sweep(**base):
         return SimpleNamespace(config={"base": {"xi": 0.42, "integrator": "rk4", **base}})
 
+    assert _sweep_names("Fig. 3", []) == []  # a figure without a sweep
     one = [sweep(G=1e-9, dt=3.9e-7)]
     assert _sweep_names("Fig. 6", one) == ["Fig. 6"]
     two = [*one, sweep(G=1e-10, dt=2e-7)]
@@ -85,3 +86,39 @@ def test_a_figures_sweeps_are_named_by_what_differs():
         "Fig. 6 (G = 1e-09, dt = 3.9e-07)",
         "Fig. 6 (G = 1e-10, dt = 2e-07)",
     ]
+
+
+def test_audit_stage_skips_figures_without_sweeps_and_reports_a_failure(monkeypatch):
+    """The full report's audit stage over its stages' results: a figure without a sweep
+    (Fig. 3, Fig. 5) and the sensitivity stage are passed over, a figure's sweep is audited;
+    a failure goes to "What is missing" and the report goes on."""
+    from chaoscam.experiments import _run
+    from chaoscam.experiments._paper import SENSITIVITY, FigureResult
+    from chaoscam.report._html import ReportParts
+
+    bif = bifurcation(
+        "e",
+        [0.02, 0.021],
+        duration=4.0,
+        transient=2.0,
+        classify=DefaultClassifier(extend_to=None),
+        workers=1,
+        progress=False,
+    )
+    results = [
+        FigureResult(3),
+        FigureResult(4, bifurcations=[("fig4.parquet", bif, b"")]),
+        FigureResult(SENSITIVITY, bifurcations=[("s.parquet", bif, b"")]),
+    ]
+    monkeypatch.setitem(sa.PER_SWEEP, False, 1)
+    said, parts = [], ReportParts()
+    rows, seconds = _run._audit_stage(results, False, 1, said.append, parts)
+    assert [r.figure for r in rows] == ["Fig. 4"] and rows[0].reproduced and seconds > 0
+    assert _run._audit_stage(results, True, 1, said.append, parts) == ([], 0.0)
+
+    def broken(*a, **k):
+        raise RuntimeError("no pool")
+
+    monkeypatch.setattr(_run, "step_audit", broken)
+    assert _run._audit_stage(results, False, 1, said.append, parts) == ([], 0.0)
+    assert parts.missing == ["Step audit: failed with RuntimeError: no pool"]
