@@ -24,7 +24,7 @@ from ._paper import (
     data_files,
 )
 from ._sensitivity import FATE_S
-from ._step_audit import PER_SWEEP, audit_sentence, step_audit
+from ._step_audit import PER_SWEEP, audit_sentence, step_audit, sweep_names
 
 __all__ = ["PaperRun", "check_paper_outputs", "figure_script", "run_paper"]
 
@@ -253,20 +253,6 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
     return PaperRun(written, tuple(failed))
 
 
-def _sweep_names(name: str, sweeps: list) -> list[str]:
-    """``name`` for a figure's one sweep; for several, each with the base parameters in which
-    they differ (Fig. 6: "Fig. 6 (G = 1e-09, dt = 3.9e-07)")."""
-    if len(sweeps) <= 1:  # none (Figs. 3 and 5 have no sweep) or one
-        return [name] * len(sweeps)
-    bases = [s.config["base"] for s in sweeps]
-    keys = [k for k in bases[0] if len({repr(b.get(k)) for b in bases}) > 1]
-
-    def text(v) -> str:
-        return f"{v:g}" if isinstance(v, float) else str(v)
-
-    return [f"{name} ({', '.join(f'{k} = {text(b.get(k))}' for k in keys)})" for b in bases]
-
-
 def _audit_stage(results, quick, workers, say, parts):
     """The step audit of the paper figures' sweeps (:mod:`._step_audit`; the full run only):
     its rows and seconds. A failure goes to "What is missing" (the figures stand without it,
@@ -280,7 +266,7 @@ def _audit_stage(results, quick, workers, say, parts):
             if r.number == SENSITIVITY:  # every verdict of these is checked at half the step
                 continue
             found = [s for _, s, _ in r.bifurcations] + [s for _, s, _ in r.regime_maps]
-            sweeps += zip(_sweep_names(r.name, found), found, strict=True)
+            sweeps += zip(sweep_names(r.name, found), found, strict=True)
         if not sweeps:
             return [], 0.0
         say("step audit: the figures' sampled runs at half the step ...")

@@ -27,7 +27,14 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-__all__ = ["PER_SWEEP", "AuditRow", "audit_sample", "step_audit", "audit_sentence"]
+__all__ = [
+    "PER_SWEEP",
+    "AuditRow",
+    "audit_sample",
+    "audit_sentence",
+    "step_audit",
+    "sweep_names",
+]
 
 PER_SWEEP = {True: 0, False: 5}
 """Runs audited per sweep of the paper's figures (quick, full): the full report's four sweeps
@@ -62,6 +69,20 @@ class AuditRow:
 def _tag(label: Any, period: Any) -> str:
     ok = label == "periodic" and period is not None and not pd.isna(period)
     return f"periodic {int(period)}" if ok else str(label)
+
+
+def sweep_names(name: str, sweeps: list) -> list[str]:
+    """``name`` for a figure's one sweep; for several, each with the base parameters in which
+    they differ (Fig. 6: "Fig. 6 (G = 1e-09, dt = 3.9e-07)")."""
+    if len(sweeps) <= 1:  # none (Figs. 3 and 5 have no sweep) or one
+        return [name] * len(sweeps)
+    bases = [s.config["base"] for s in sweeps]
+    keys = [k for k in bases[0] if len({repr(b.get(k)) for b in bases}) > 1]
+
+    def text(v) -> str:
+        return f"{v:g}" if isinstance(v, float) else str(v)
+
+    return [f"{name} ({', '.join(f'{k} = {text(b.get(k))}' for k in keys)})" for b in bases]
 
 
 def audit_sample(table: pd.DataFrame, k: int, seed: int = AUDIT_SEED) -> pd.DataFrame:
@@ -114,19 +135,26 @@ def _audit_one(job: tuple) -> AuditRow:
 
 
 def step_audit(
-    sweeps: list[tuple[str, Any]], quick: bool, extend_to: float | None, workers=None
+    sweeps: list[tuple[str, Any]],
+    quick: bool,
+    extend_to: float | None,
+    workers=None,
+    *,
+    per_sweep: int | None = None,
+    seed: int = AUDIT_SEED,
 ) -> list[AuditRow]:
-    """Audit :data:`PER_SWEEP` runs of each ``(figure name, sweep)`` (a RegimeMap or a
-    Bifurcation): each replayed and checked at half the step, an undetermined verdict
-    extended up to ``extend_to`` seconds recorded (the sweeps' own cap), on ``workers`` local
-    processes (:func:`chaoscam.sweep.local_workers`)."""
+    """Audit :data:`PER_SWEEP` runs (or ``per_sweep``) of each ``(figure name, sweep)`` (a
+    RegimeMap or a Bifurcation), drawn with ``seed``: each replayed and checked at half the
+    step, an undetermined verdict extended up to ``extend_to`` seconds recorded (the sweeps'
+    own cap), on ``workers`` local processes (:func:`chaoscam.sweep.local_workers`)."""
     from ..sweep._backends import ProcessBackend, local_workers
 
     jobs = []
     for figure, sweep in sweeps:
         table = sweep.realizations if sweep.config["kind"] == "regime_map" else sweep.verdicts
         settings = _Settings(sweep.config)
-        for row in audit_sample(table, PER_SWEEP[quick]).to_dict("records"):
+        k = PER_SWEEP[quick] if per_sweep is None else per_sweep
+        for row in audit_sample(table, k, seed).to_dict("records"):
             jobs.append((figure, settings, row, extend_to))
     if not jobs:
         return []
@@ -158,8 +186,10 @@ def audit_sentence(rows: list[AuditRow]) -> str:
     other = [r for r in same if not r.held and r not in undecided]
     lost = [r for r in rows if not r.reproduced]
     text = (
-        f"Step audit: {n} runs labelled periodic, quasiperiodic or chaotic, drawn from "
-        f"{', '.join(figures)}, were replayed alone and classified again with the step halved "
+        f"Step audit: {n} run{'s' * (n != 1)} labelled periodic, quasiperiodic or chaotic, "
+        "drawn from "
+        f"{', '.join(figures)}, {'was' if n == 1 else 'were'} replayed alone and classified "
+        "again with the step halved "
         f"({sum(r.seconds for r in rows):.0f} s of work): {len(same)} reproduce their label; "
         f"at half the step {_count(sum(r.held for r in same), 'keeps', 'keep')} it, "
         f"{_count(len(undecided), 'is', 'are')} undetermined and "

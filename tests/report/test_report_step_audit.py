@@ -8,6 +8,20 @@ from chaoscam.experiments._step_audit import AuditRow, audit_sample, audit_sente
 from chaoscam.sweep import DefaultClassifier, bifurcation
 
 
+@pytest.fixture(scope="module")
+def small_diagram():
+    """Three values of e with a period-1 response after ~2 s, not extended (cheap)."""
+    return bifurcation(
+        "e",
+        [0.02, 0.021, 0.022],
+        duration=4.0,
+        transient=2.0,
+        classify=DefaultClassifier(extend_to=None),
+        workers=1,
+        progress=False,
+    )
+
+
 def test_sample_is_seeded_and_draws_decided_labels_only():
     """Only periodic, quasiperiodic or chaotic rows; the same seed draws the same rows (in
     table order); asking for more than there are gives all of them."""
@@ -44,18 +58,10 @@ def test_sentence_counts_and_names_what_did_not_hold():
     assert audit_sentence([]) == ""
 
 
-def test_audit_replays_a_diagrams_runs_in_worker_processes(monkeypatch):
+def test_audit_replays_a_diagrams_runs_in_worker_processes(monkeypatch, small_diagram):
     """A small diagram: two of its decided runs replayed in a process pool come back with
     the recorded label, with their step check."""
-    bif = bifurcation(
-        "e",
-        [0.02, 0.021, 0.022],  # period 1 after ~2 s
-        duration=4.0,
-        transient=2.0,
-        classify=DefaultClassifier(extend_to=None),
-        workers=1,
-        progress=False,
-    )
+    bif = small_diagram
     assert bif.verdicts["label"].isin(sa.LABELS).sum() >= 2
     monkeypatch.setitem(sa.PER_SWEEP, False, 2)
     rows = step_audit([("Fig. X", bif)], quick=False, extend_to=None, workers=2)
@@ -73,38 +79,28 @@ def test_a_figures_sweeps_are_named_by_what_differs():
     """Fig. 6's two diagrams differ in G (and dt): each audited run names its sweep so."""
     from types import SimpleNamespace
 
-    from chaoscam.experiments._run import _sweep_names
-
     def sweep(**base):
         return SimpleNamespace(config={"base": {"xi": 0.42, "integrator": "rk4", **base}})
 
-    assert _sweep_names("Fig. 3", []) == []  # a figure without a sweep
+    assert sa.sweep_names("Fig. 3", []) == []  # a figure without a sweep
     one = [sweep(G=1e-9, dt=3.9e-7)]
-    assert _sweep_names("Fig. 6", one) == ["Fig. 6"]
+    assert sa.sweep_names("Fig. 6", one) == ["Fig. 6"]
     two = [*one, sweep(G=1e-10, dt=2e-7)]
-    assert _sweep_names("Fig. 6", two) == [
+    assert sa.sweep_names("Fig. 6", two) == [
         "Fig. 6 (G = 1e-09, dt = 3.9e-07)",
         "Fig. 6 (G = 1e-10, dt = 2e-07)",
     ]
 
 
-def test_audit_stage_skips_figures_without_sweeps_and_reports_a_failure(monkeypatch):
+def test_audit_stage_skips_figures_without_sweeps_and_reports_a_failure(monkeypatch, small_diagram):
     """The full report's audit stage over its stages' results: a figure without a sweep
     (Fig. 3, Fig. 5) and the sensitivity stage are passed over, a figure's sweep is audited;
     a failure goes to "What is missing" and the report goes on."""
+    bif = small_diagram
     from chaoscam.experiments import _run
     from chaoscam.experiments._paper import SENSITIVITY, FigureResult
     from chaoscam.report._html import ReportParts
 
-    bif = bifurcation(
-        "e",
-        [0.02, 0.021],
-        duration=4.0,
-        transient=2.0,
-        classify=DefaultClassifier(extend_to=None),
-        workers=1,
-        progress=False,
-    )
     results = [
         FigureResult(3),
         FigureResult(4, bifurcations=[("fig4.parquet", bif, b"")]),
@@ -122,3 +118,26 @@ def test_audit_stage_skips_figures_without_sweeps_and_reports_a_failure(monkeypa
     monkeypatch.setattr(_run, "step_audit", broken)
     assert _run._audit_stage(results, False, 1, said.append, parts) == ([], 0.0)
     assert parts.missing == ["Step audit: failed with RuntimeError: no pool"]
+
+
+def test_audit_script_reads_a_reports_data_and_refuses_bad_input(tmp_path, capsys, small_diagram):
+    """analyses/step_audit.py over a data folder holding a Fig. 4 diagram: one line per
+    audited run and the sentence; a missing file, K < 1 or S <= 0: exit 2 naming it."""
+    bif = small_diagram
+    from chaoscam.experiments._audit_script import audit_script
+
+    bif.to_parquet(tmp_path / "fig4.parquet")
+    args = ["--figures", "4", "--per-sweep", "1", "--workers", "1", "--extend-to", "4"]
+    assert audit_script([*args, str(tmp_path)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("Fig. 4 | e = 0.02") and "| holds |" in out[0]
+    assert out[1].startswith("Step audit: 1 run labelled") and "1 reproduce" in out[1]
+    for bad, says in (
+        ([*args, str(tmp_path / "none")], "fig4.parquet is missing"),
+        (["--per-sweep", "0", str(tmp_path)], "--per-sweep 0: must be at least 1"),
+        (["--extend-to", "-1", str(tmp_path)], "--extend-to -1.0: must be"),
+        (["--figures", "4,5", str(tmp_path)], "--figures 4,5: choose among 4, 6, 7"),
+    ):
+        with pytest.raises(SystemExit) as stop:
+            audit_script(bad)
+        assert stop.value.code == 2 and says in capsys.readouterr().err

@@ -1,0 +1,15 @@
+"""Step audit of a report's figure sweeps: do their labels hold when the step is halved?
+
+Reads the sweeps that ``chaoscam paper`` wrote into DATA (Fig. 4, Fig. 6's two diagrams,
+Figs. 7-10's map), draws K decided runs from each (seeded), replays each alone
+(``chaoscam.sweep.replay``) and classifies it with ``check_step=True``; prints one line per
+run and the report's sentence. The full report runs the same audit with K = 5. Writes nothing.
+
+Usage: python analyses/step_audit.py [--figures 4,6,7] [--per-sweep K] [--seed N]
+       [--extend-to S] [--workers N] [DATA]   (default DATA: reports/paper-data)
+"""
+
+from chaoscam.experiments._audit_script import audit_script
+
+if __name__ == "__main__":
+    raise SystemExit(audit_script())

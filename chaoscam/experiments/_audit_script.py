@@ -1,0 +1,124 @@
+"""``python analyses/step_audit.py``: the step audit of a finished report's figure sweeps.
+
+The full report audits 5 runs per sweep (:mod:`._step_audit`); this reads the sweeps a report
+wrote into its data folder and audits as many as asked (``--per-sweep``, every decided run of
+a sweep with a large number), printing one line per run and the report's sentence. It writes
+nothing.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ._paper import FULL_EXTEND_TO, G_FIG6, _fig6_tag
+from ._step_audit import AUDIT_SEED, PER_SWEEP, step_audit, sweep_names
+
+__all__ = ["SWEEP_FILES", "read_sweeps", "audit_script"]
+
+SWEEP_FILES = {
+    4: ("Fig. 4", ["fig4.parquet"]),
+    6: ("Fig. 6", [f"{_fig6_tag(g)}.parquet" for g in G_FIG6]),
+    7: ("Figs. 7–10", ["fig7-10.parquet"]),
+}
+"""The paper figures that are sweeps: number -> (name, their files in the data folder)."""
+
+
+def read_sweeps(folder: Path, figures) -> list[tuple[str, object]]:
+    """``(name, sweep)`` for each sweep of ``figures`` in the report's data ``folder``; a
+    missing file is a FileNotFoundError that names it and the command that writes it."""
+    from ..sweep import read_bifurcation, read_regime_map
+
+    out = []
+    for number in figures:
+        name, files = SWEEP_FILES[number]
+        found = []
+        for file in files:
+            path = folder / file
+            if not path.is_file():
+                raise FileNotFoundError(
+                    f"{path} is missing: write it with `chaoscam paper --out "
+                    f"{folder.parent}/paper.html` or `python analyses/fig{number}.py {folder}`"
+                )
+            found.append(read_regime_map(path) if number == 7 else read_bifurcation(path))
+        out += zip(sweep_names(name, found), found, strict=True)
+    return out
+
+
+def audit_script(argv: list[str] | None = None) -> int:
+    """The body of ``analyses/step_audit.py``. Bad arguments or a missing data file: exit 2
+    with one line; Ctrl-C: exit 130 with one line. Returns 0 when it finishes."""
+    import argparse
+    import sys
+
+    ap = argparse.ArgumentParser(
+        prog="analyses/step_audit.py",
+        description="Replay sampled runs of a report's figure sweeps and classify them again "
+        "with the step halved (the full report's step audit, at any size).",
+    )
+    ap.add_argument(
+        "folder",
+        nargs="?",
+        default="reports/paper-data",
+        metavar="DATA",
+        help="the report's data folder (default: reports/paper-data)",
+    )
+    ap.add_argument(
+        "--figures",
+        default=",".join(map(str, SWEEP_FILES)),
+        metavar="N,N",
+        help="which figures' sweeps, comma-separated (default: 4,6,7; 7 stands for Figs. 7-10)",
+    )
+    ap.add_argument(
+        "--per-sweep",
+        type=int,
+        default=PER_SWEEP[False],
+        metavar="K",
+        help=f"decided runs drawn per sweep, K >= 1 (default {PER_SWEEP[False]}, the full "
+        "report's; more than a sweep holds: all of them)",
+    )
+    ap.add_argument("--seed", type=int, default=AUDIT_SEED, help="seed of the draw")
+    ap.add_argument(
+        "--extend-to",
+        type=float,
+        default=FULL_EXTEND_TO,
+        metavar="S",
+        help=f"longest recorded time of an extended verdict, S > 0 (default {FULL_EXTEND_TO:g} "
+        "s, the full report's)",
+    )
+    ap.add_argument("--workers", type=int, default=None, help="cores (default: all)")
+    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    from ..sweep._backends import local_workers
+
+    figures = [f.strip() for f in args.figures.split(",")]
+    if not all(f in map(str, SWEEP_FILES) for f in figures):
+        ap.error(f"--figures {args.figures}: choose among {', '.join(map(str, SWEEP_FILES))}")
+    if args.per_sweep < 1:
+        ap.error(f"--per-sweep {args.per_sweep}: must be at least 1")
+    if not args.extend_to > 0:
+        ap.error(f"--extend-to {args.extend_to}: must be a number of seconds > 0")
+    try:
+        if args.workers is not None:
+            local_workers(args.workers)
+        sweeps = read_sweeps(Path(args.folder), dict.fromkeys(map(int, figures)))
+    except (OSError, ValueError) as err:
+        ap.error(str(err))  # exit 2
+    try:
+        rows = step_audit(
+            sweeps,
+            False,
+            args.extend_to,
+            workers=args.workers,
+            per_sweep=args.per_sweep,
+            seed=args.seed,
+        )
+    except KeyboardInterrupt:
+        print(f"{ap.prog}: interrupted; nothing was written", file=sys.stderr)
+        raise SystemExit(130) from None
+    from ._step_audit import audit_sentence
+
+    for r in rows:
+        mark = "holds" if r.held else "CHANGES"
+        print(f"{r.figure} | {r.where} | recorded {r.recorded} | dt: {r.replayed} | "
+              f"dt/2: {r.half} | {mark} | {r.seconds:.1f} s")  # fmt: skip
+    print(audit_sentence(rows) or "no decided run to audit")
+    return 0
