@@ -54,7 +54,15 @@ def skipped(verdict: Verdict, fine: Params) -> Verdict:
     return dataclasses.replace(
         verdict,
         evidence=verdict.evidence + (check,),
-        settings={**verdict.settings, "step_check": {"dt_half": fine.dt, "skipped": True}},
+        settings={
+            **verdict.settings,
+            "step_check": {
+                "dt_half": fine.dt,
+                "skipped": True,
+                "grid_label": verdict.label,
+                "grid_period": verdict.period,
+            },
+        },
     )
 
 
@@ -62,11 +70,19 @@ def _describe(v: Verdict) -> str:
     return f"{v.label}" + (f" (period {v.period})" if v.period is not None else "")
 
 
-def compared(verdict: Verdict, half: Verdict, coarse: Params, fine: Params) -> Verdict:
+def compared(
+    verdict: Verdict,
+    half: Verdict,
+    coarse: Params,
+    fine: Params,
+    *,
+    half_recorded_s: float | None = None,
+) -> Verdict:
     """The grid ``verdict`` (at ``coarse``'s step) checked against ``half``, the same
-    realization's at ``fine``'s: unchanged (label and period), it is kept with evidence
-    ``step_check`` = 1; else "undetermined" with the reason, ``step_check`` = 0.
-    ``settings["step_check"]`` records both verdicts."""
+    realization's at ``fine``'s (made on ``half_recorded_s`` seconds of recording):
+    unchanged (label and period), it is kept with evidence ``step_check`` = 1; else
+    "undetermined" with the reason, ``step_check`` = 0. ``settings["step_check"]`` records
+    both verdicts."""
     same = half.label == verdict.label and half.period == verdict.period
     what = (
         f"{coarse.describe_step()}: {_describe(verdict)}; {fine.describe_step()}: {_describe(half)}"
@@ -85,6 +101,7 @@ def compared(verdict: Verdict, half: Verdict, coarse: Params, fine: Params) -> V
             "label": half.label,
             "period": half.period,
             "reasons": list(half.reasons),
+            "recorded_s": half_recorded_s,
             "grid_label": verdict.label,
             "grid_period": verdict.period,
         },

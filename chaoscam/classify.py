@@ -21,6 +21,8 @@ from ._checks import flag, of_type, real
 from ._extend import extend_trajectory
 from ._model_rules import MODEL_ATOL, extensible, overflow_evidence, with_model_evidence
 from ._simulate import Trajectory, simulate
+
+# the step check's re-simulation under this module's name, which tests replace
 from ._step_check import resimulate_half_step as _resimulate_half_step
 from ._trajectory_io import load_trajectory
 from .analysis import Evidence, Verdict, classify_section, classify_signal
@@ -385,8 +387,8 @@ def classify_trajectory(
     fine = traj.params.refined()
     if verdict.label == "undetermined":
         return step_check.skipped(verdict, fine)
-    hv = _half_step_verdict(traj, lyapunov, discard, options, tangent, extend_to)
-    return step_check.compared(verdict, hv, traj.params, fine)
+    hv, recorded = _half_step_verdict(traj, lyapunov, discard, options, tangent, extend_to)
+    return step_check.compared(verdict, hv, traj.params, fine, half_recorded_s=recorded)
 
 
 def _verdict_of(
@@ -434,20 +436,23 @@ def _verdict_of(
     return _rename_lyapunov(v, prefix, res.exponent), extra
 
 
-def _half_step_verdict(traj, lyapunov, discard, options, tangent, extend_to) -> Verdict:
+def _half_step_verdict(
+    traj, lyapunov, discard, options, tangent, extend_to
+) -> tuple[Verdict, float]:
     """The verdict on ``traj``'s realization at half the step, reached the way the run's own
     was: the same evidence and, on the tangent path, the same extension of an undetermined
     verdict up to ``extend_to`` (else a grid verdict settled on an extended run would be
-    compared with an unextended, undetermined one)."""
+    compared with an unextended, undetermined one); with the seconds recorded behind it."""
     with_tangent = tangent and not lyapunov
     half = _resimulate_half_step(traj, tangent=with_tangent)
+    recorded = half.settings["duration"] - half.settings["transient"] - discard
     if half.status is not Status.OK:
-        return _status_verdict(half, {})
+        return _status_verdict(half, {}), recorded
     tr = _tangent_run(half) if with_tangent else None
     hv, extra = _verdict_of(half, lyapunov, discard, options, tangent, tr)
     if tr is not None and extend_to and extensible(hv):
-        hv, _ = _extended(tr, hv, extra, discard, options, float(extend_to))
-    return hv
+        hv, extra = _extended(tr, hv, extra, discard, options, float(extend_to))
+    return hv, extra.get("extended", {}).get("recorded_s", recorded)
 
 
 def classify_file(

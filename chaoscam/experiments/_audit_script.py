@@ -94,8 +94,10 @@ def audit_script(argv: list[str] | None = None) -> int:
         ap.error(f"--figures {args.figures}: choose among {', '.join(map(str, SWEEP_FILES))}")
     if args.per_sweep < 1:
         ap.error(f"--per-sweep {args.per_sweep}: must be at least 1")
-    if not args.extend_to > 0:
-        ap.error(f"--extend-to {args.extend_to}: must be a number of seconds > 0")
+    if not 0 < args.extend_to < float("inf"):
+        ap.error(f"--extend-to {args.extend_to}: must be a finite number of seconds > 0")
+    if args.seed < 0:
+        ap.error(f"--seed {args.seed}: must be an integer >= 0")
     try:
         if args.workers is not None:
             local_workers(args.workers)

@@ -83,8 +83,9 @@ def step_finding(rows: pd.DataFrame, where) -> str:
         return ""
     checked = rows[rows["ev_step_check"].notna()]
     changed = checked[checked["ev_step_check"] == 0]
-    head = (
-        f" Checked at half the step, {len(checked) - len(changed)} of {len(checked)} verdicts hold"
+    held = len(checked) - len(changed)
+    head = f" Checked at half the step, {held} of {len(checked)} " + (
+        "verdict holds" if len(checked) == 1 else "verdicts hold"
     )
     if not len(changed):
         return head + "."

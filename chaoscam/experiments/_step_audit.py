@@ -21,6 +21,7 @@ changes is not relabelled in the figure: the audit samples, it does not correct.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -41,7 +42,10 @@ PER_SWEEP = {True: 0, False: 5}
 (Fig. 4, Fig. 6's two, Figs. 7-10's map) give 20 runs; the quick report audits none."""
 
 AUDIT_SEED = 20261126
-"""Seed of the draw of audited runs (fixed: the same report audits the same runs)."""
+"""Seed of the draw of audited runs (fixed: the same report audits the same runs). Every
+sweep is drawn with it, so sweeps with as many decided runs are audited at the same rows:
+Fig. 6's two diagrams (one D grid) at the same values of D, a paired comparison of the two
+roughnesses."""
 
 LABELS = ("periodic", "quasiperiodic", "chaotic")
 """Labels the audit draws from (undetermined ones have nothing a half step could change)."""
@@ -49,9 +53,10 @@ LABELS = ("periodic", "quasiperiodic", "chaotic")
 
 @dataclass(frozen=True)
 class AuditRow:
-    """One audited run: ``figure`` and ``where`` name it; ``label`` / ``period`` as the
-    figure recorded them; ``replayed`` the replay's verdict on the grid, ``half`` at dt / 2
-    (each "label" or "periodic N"); ``held`` whether the check kept the verdict."""
+    """One audited run: ``figure`` and ``where`` name it; ``recorded`` is its verdict as the
+    figure has it, ``replayed`` the replay's on the grid, ``half`` the one at dt / 2 ("not
+    re-run" when the replay came back undetermined), each "label" or "periodic N"; ``held``
+    whether the check kept the verdict; ``seconds`` the work it took."""
 
     figure: str
     where: str
@@ -82,6 +87,8 @@ def sweep_names(name: str, sweeps: list) -> list[str]:
     def text(v) -> str:
         return f"{v:g}" if isinstance(v, float) else str(v)
 
+    if not keys:  # the same base: they differ in their axes or windows only
+        return [f"{name} (sweep {i})" for i in range(1, len(sweeps) + 1)]
     return [f"{name} ({', '.join(f'{k} = {text(b.get(k))}' for k in keys)})" for b in bases]
 
 
@@ -118,8 +125,10 @@ def _audit_one(job: tuple) -> AuditRow:
 
     figure, settings, row, extend_to = job
     t0 = time.perf_counter()
-    traj = replay(settings, row)
-    v = classify_trajectory(traj, check_step=True, extend_to=extend_to)
+    with warnings.catch_warnings():  # the model's warnings came with the sweep's own run
+        warnings.simplefilter("ignore", RuntimeWarning)
+        traj = replay(settings, row)
+        v = classify_trajectory(traj, check_step=True, extend_to=extend_to)
     check = v.settings.get("step_check", {})
     grid = _tag(check.get("grid_label", v.label), check.get("grid_period", v.period))
     half = _tag(check["label"], check["period"]) if "label" in check else "not re-run"
@@ -190,7 +199,8 @@ def audit_sentence(rows: list[AuditRow]) -> str:
         "drawn from "
         f"{', '.join(figures)}, {'was' if n == 1 else 'were'} replayed alone and classified "
         "again with the step halved "
-        f"({sum(r.seconds for r in rows):.0f} s of work): {len(same)} reproduce their label; "
+        f"({sum(r.seconds for r in rows):.0f} s of work): "
+        f"{_count(len(same), 'reproduces its', 'reproduce their')} label; "
         f"at half the step {_count(sum(r.held for r in same), 'keeps', 'keep')} it, "
         f"{_count(len(undecided), 'is', 'are')} undetermined and "
         f"{_count(len(other), 'gets', 'get')} another label"

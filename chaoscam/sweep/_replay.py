@@ -40,13 +40,21 @@ def _field(row: Any, name: str) -> Any:
 
 
 def _sweep_config(sweep: Any) -> dict[str, Any]:
+    """The sweep's ``config`` with its ``kind``: recorded, or for files written before
+    sweeps recorded it (which ``read_*`` still accept), told by its axes ("x" and "y": a
+    regime map; "axis": a diagram)."""
     cfg = getattr(sweep, "config", None)
-    if not isinstance(cfg, dict) or cfg.get("kind") not in ("regime_map", "bifurcation"):
+    kind = None
+    if isinstance(cfg, dict):
+        kind = cfg.get("kind") or (
+            "regime_map" if {"x", "y"} <= cfg.keys() else "bifurcation" if "axis" in cfg else None
+        )
+    if kind not in ("regime_map", "bifurcation") or "base" not in cfg:
         raise TypeError(
             f"sweep must be a RegimeMap or a Bifurcation (from regime_map, bifurcation or "
             f"their read_* functions), got {type(sweep).__name__}"
         )
-    return cfg
+    return {**cfg, "kind": kind}
 
 
 def replay_params(sweep: Any, row: Any) -> Params:
@@ -84,7 +92,9 @@ def replay(sweep: Any, row: Any, *, tangent: bool = True) -> Trajectory:
     -------
     Trajectory
         Duration, transient, seed and index of the sweep; the series sampled every 1 ms (or
-        every dt where dt is coarser), as in the sweep's own run.
+        every dt where dt is coarser), as in the default classifier's runs. The motion does
+        not depend on it (asking for a series never changes a run), but a sweep run with a
+        classifier that declared ``needs_series = False`` classified its runs without one.
     """
     cfg = _sweep_config(sweep)
     p = replay_params(sweep, row)

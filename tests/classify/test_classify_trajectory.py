@@ -118,6 +118,7 @@ def test_step_check_extends_the_half_step_run_as_the_grid_run():
     assert v.settings["extended"]["recorded_s"] == 40.0
     assert v.evidence[-1].name == "step_check" and v.evidence[-1].value == 1
     assert v.settings["step_check"]["label"] == "chaotic"
+    assert v.settings["step_check"]["recorded_s"] == 40.0  # extended as the grid run was
 
 
 def test_step_check_does_not_rerun_an_undetermined_verdict(monkeypatch):
@@ -136,6 +137,7 @@ def test_step_check_does_not_rerun_an_undetermined_verdict(monkeypatch):
     e = v.evidence[-1]
     assert e.name == "step_check" and e.value is None and "cannot change" in e.detail
     assert v.settings["step_check"]["skipped"] is True
+    assert v.settings["step_check"]["grid_label"] == "undetermined"
 
 
 def test_half_step_run_is_the_same_realization(periodic):

@@ -75,5 +75,8 @@ def test_step_finding_counts_checked_verdicts_and_names_the_changed():
         step_finding(rows, lambda r: f"ξ = {r.value:g}")
     )
     assert step_finding(rows.assign(ev_step_check=1.0), str).endswith("4 of 4 verdicts hold.")
+    assert step_finding(rows.iloc[:1].assign(ev_step_check=1.0), str).endswith(
+        "1 of 1 verdict holds."
+    )
     assert step_finding(rows.drop(columns="ev_step_check"), str) == ""
     assert step_finding(rows.assign(ev_step_check=None), str) == ""

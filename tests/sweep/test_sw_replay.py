@@ -85,3 +85,13 @@ def test_replay_reads_a_written_map_and_names_what_it_needs(tmp_path, rmap):
         replay(back, {"omega": 20.0, "xi": 0.42})
     with pytest.raises(TypeError, match="RegimeMap or a Bifurcation"):
         replay(pd.DataFrame(), row)
+
+
+def test_replay_tells_the_kind_of_a_sweep_written_before_kinds(rmap):
+    """Files written before sweeps recorded their kind (which read_regime_map accepts) are
+    told by their axes."""
+    import dataclasses
+
+    old = dataclasses.replace(rmap, config={k: v for k, v in rmap.config.items() if k != "kind"})
+    row = old.realizations.iloc[0]
+    assert replay_params(old, row) == replay_params(rmap, row)
