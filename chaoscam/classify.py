@@ -377,10 +377,7 @@ def classify_trajectory(
     if traj.status is not Status.OK:
         return _status_verdict(traj, settings)
 
-    tr = _tangent_run(traj) if tangent and not lyapunov else None
-    verdict, extra = _verdict_of(traj, lyapunov, discard, options, tangent, tr)
-    if tr is not None and extend_to and extensible(verdict):
-        verdict, extra = _extended(tr, verdict, extra, discard, options, float(extend_to))
+    verdict, extra = _classified(traj, lyapunov, discard, options, tangent, extend_to)
     verdict = _with_settings(verdict, **settings, **extra)
     if not check_step:
         return verdict
@@ -436,6 +433,16 @@ def _verdict_of(
     return _rename_lyapunov(v, prefix, res.exponent), extra
 
 
+def _classified(traj, lyapunov, discard, options, tangent, extend_to) -> tuple[Verdict, dict]:
+    """The verdict on a run that ended normally, and its settings: the tangent verdict
+    (extended up to ``extend_to`` while undetermined) or the series evidence."""
+    tr = _tangent_run(traj) if tangent and not lyapunov else None
+    verdict, extra = _verdict_of(traj, lyapunov, discard, options, tangent, tr)
+    if tr is not None and extend_to and extensible(verdict):
+        verdict, extra = _extended(tr, verdict, extra, discard, options, float(extend_to))
+    return verdict, extra
+
+
 def _half_step_verdict(
     traj, lyapunov, discard, options, tangent, extend_to
 ) -> tuple[Verdict, float]:
@@ -443,15 +450,11 @@ def _half_step_verdict(
     was: the same evidence and, on the tangent path, the same extension of an undetermined
     verdict up to ``extend_to`` (else a grid verdict settled on an extended run would be
     compared with an unextended, undetermined one); with the seconds recorded behind it."""
-    with_tangent = tangent and not lyapunov
-    half = _resimulate_half_step(traj, tangent=with_tangent)
+    half = _resimulate_half_step(traj, tangent=tangent and not lyapunov)
     recorded = half.settings["duration"] - half.settings["transient"] - discard
     if half.status is not Status.OK:
         return _status_verdict(half, {}), recorded
-    tr = _tangent_run(half) if with_tangent else None
-    hv, extra = _verdict_of(half, lyapunov, discard, options, tangent, tr)
-    if tr is not None and extend_to and extensible(hv):
-        hv, extra = _extended(tr, hv, extra, discard, options, float(extend_to))
+    hv, extra = _classified(half, lyapunov, discard, options, tangent, extend_to)
     return hv, extra.get("extended", {}).get("recorded_s", recorded)
 
 
