@@ -31,15 +31,18 @@ PAPER_K_N = (8.9e7, 1.6e9)
 """The paper's Hertz line stiffness range [N/m] (its l_λ range with Table 1's materials)."""
 
 
-def _tag(label: str, period) -> str:
-    return f"period {int(period)}" if label == "periodic" and pd.notna(period) else label
+def verdict_tag(label, period) -> str:
+    """A verdict in a finding's words: "period 8" for a periodic one with its period, else the
+    label ("chaotic", "undetermined", "left_reach", ...)."""
+    ok = label == "periodic" and period is not None and pd.notna(period)
+    return f"period {int(period)}" if ok else str(label)
 
 
 def label_runs(values, labels, periods) -> list[tuple[str, float, float]]:
     """Consecutive equal (label, period) along sorted values: [(text, first, last), ...]."""
     out: list[tuple[str, float, float]] = []
     for v, lab, per in zip(values, labels, periods, strict=True):
-        t = _tag(lab, per)
+        t = verdict_tag(lab, per)
         if out and out[-1][0] == t:
             out[-1] = (t, out[-1][1], float(v))
         else:
@@ -119,7 +122,7 @@ def restitution_finding(v: pd.DataFrame, xi0: float, stiffness_tags: list[str]) 
     the neighbourhood of Table 1's ξ holds more regimes than that stiffness range."""
     near = v[(v["value"] - xi0).abs() <= XI_WINDOW + 1e-9]
     tags = list(
-        dict.fromkeys(_tag(a, b) for a, b in zip(near["label"], near["period"], strict=True))
+        dict.fromkeys(verdict_tag(a, b) for a, b in zip(near["label"], near["period"], strict=True))
     )
     head = (
         f"Restitution ξ (Table 1: {xi0:g}): "
@@ -239,7 +242,9 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     kv = v["value"].map(k_n).to_numpy()
     runs = label_runs(kv, v["label"], v["period"])
     inside = v[(kv >= PAPER_K_N[0] / 10) & (kv <= PAPER_K_N[1])]
-    flat = sorted({_tag(a, b) for a, b in zip(inside["label"], inside["period"], strict=True)})
+    flat = sorted(
+        {verdict_tag(a, b) for a, b in zip(inside["label"], inside["period"], strict=True)}
+    )
     decades = np.log10(kv.max() / kv.min())
     res.why.append(
         f"Contact stiffness: K_n from {kv.min():.3g} to {kv.max():.3g} N/m ({decades:.1f} "
@@ -305,12 +310,14 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     png_m = _save(regime_map_figure(rm.cells, x="omega", y="xi"), outdir, "sensitivity-omega-xi")
     res.regime_maps.append((str(path_m), rm, png_m))
     cells = rm.cells
-    tags = pd.Series([_tag(a, b) for a, b in zip(cells["dominant"], cells["period"], strict=True)])
+    tags = pd.Series(
+        [verdict_tag(a, b) for a, b in zip(cells["dominant"], cells["period"], strict=True)]
+    )
     periods = sorted({int(p) for p in cells["period"].dropna()})
     escape = cells[cells["dominant"] == "left_reach"]
     row_xi = float(cells["xi"].iloc[(cells["xi"] - Params().xi).abs().argmin()])
     row = cells[cells["xi"] == row_xi].sort_values("omega")
-    row_tags = [_tag(a, b) for a, b in zip(row["dominant"], row["period"], strict=True)]
+    row_tags = [verdict_tag(a, b) for a, b in zip(row["dominant"], row["period"], strict=True)]
     changes = sum(a != b for a, b in zip(row_tags, row_tags[1:], strict=False))
     res.why.append(
         f"(ω, ξ) map, {len(cells)} deterministic cells (one run each): "

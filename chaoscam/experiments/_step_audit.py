@@ -28,6 +28,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ._sensitivity import verdict_tag
+
 __all__ = [
     "PER_SWEEP",
     "AuditRow",
@@ -69,11 +71,6 @@ class AuditRow:
     @property
     def reproduced(self) -> bool:
         return self.replayed == self.recorded
-
-
-def _tag(label: Any, period: Any) -> str:
-    ok = label == "periodic" and period is not None and not pd.isna(period)
-    return f"periodic {int(period)}" if ok else str(label)
 
 
 def sweep_names(name: str, sweeps: list) -> list[str]:
@@ -130,12 +127,12 @@ def _audit_one(job: tuple) -> AuditRow:
         traj = replay(settings, row)
         v = classify_trajectory(traj, check_step=True, extend_to=extend_to)
     check = v.settings.get("step_check", {})
-    grid = _tag(check.get("grid_label", v.label), check.get("grid_period", v.period))
-    half = _tag(check["label"], check["period"]) if "label" in check else "not re-run"
+    grid = verdict_tag(check.get("grid_label", v.label), check.get("grid_period", v.period))
+    half = verdict_tag(check["label"], check["period"]) if "label" in check else "not re-run"
     return AuditRow(
         figure,
         _where(settings.config, row),
-        _tag(row["label"], row["period"]),
+        verdict_tag(row["label"], row["period"]),
         grid,
         half,
         v.label != "undetermined" and grid == half,
