@@ -106,12 +106,7 @@ def audit_script(argv: list[str] | None = None) -> int:
         ap.error(str(err))  # exit 2
     try:
         rows = step_audit(
-            sweeps,
-            False,
-            args.extend_to,
-            workers=args.workers,
-            per_sweep=args.per_sweep,
-            seed=args.seed,
+            sweeps, args.per_sweep, args.extend_to, workers=args.workers, seed=args.seed
         )
     except KeyboardInterrupt:
         print(f"{ap.prog}: interrupted; nothing was written", file=sys.stderr)

@@ -270,7 +270,7 @@ def _audit_stage(results, quick, workers, say, parts):
         if not sweeps:
             return [], 0.0
         say("step audit: the figures' sampled runs at half the step ...")
-        rows = step_audit(sweeps, quick, FULL_EXTEND_TO, workers=workers)
+        rows = step_audit(sweeps, PER_SWEEP[quick], FULL_EXTEND_TO, workers=workers)
     except Exception as err:  # reported, not hidden
         parts.missing.append(f"Step audit: failed with {type(err).__name__}: {err}")
         say(parts.missing[-1])

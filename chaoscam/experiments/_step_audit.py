@@ -142,25 +142,23 @@ def _audit_one(job: tuple) -> AuditRow:
 
 def step_audit(
     sweeps: list[tuple[str, Any]],
-    quick: bool,
+    per_sweep: int,
     extend_to: float | None,
     workers=None,
     *,
-    per_sweep: int | None = None,
     seed: int = AUDIT_SEED,
 ) -> list[AuditRow]:
-    """Audit :data:`PER_SWEEP` runs (or ``per_sweep``) of each ``(figure name, sweep)`` (a
-    RegimeMap or a Bifurcation), drawn with ``seed``: each replayed and checked at half the
-    step, an undetermined verdict extended up to ``extend_to`` seconds recorded (the sweeps'
-    own cap), on ``workers`` local processes (:func:`chaoscam.sweep.local_workers`)."""
+    """Audit ``per_sweep`` runs (the report: :data:`PER_SWEEP`) of each ``(figure name,
+    sweep)`` (a RegimeMap or a Bifurcation), drawn with ``seed``: each replayed and checked at
+    half the step, an undetermined verdict extended up to ``extend_to`` seconds recorded (the
+    sweeps' own cap), on ``workers`` local processes (:func:`chaoscam.sweep.local_workers`)."""
     from ..sweep._backends import ProcessBackend, local_workers
 
     jobs = []
     for figure, sweep in sweeps:
         table = sweep.realizations if sweep.config["kind"] == "regime_map" else sweep.verdicts
         settings = _Settings(sweep.config)
-        k = PER_SWEEP[quick] if per_sweep is None else per_sweep
-        for row in audit_sample(table, k, seed).to_dict("records"):
+        for row in audit_sample(table, per_sweep, seed).to_dict("records"):
             jobs.append((figure, settings, row, extend_to))
     if not jobs:
         return []

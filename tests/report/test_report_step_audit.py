@@ -58,16 +58,15 @@ def test_sentence_counts_and_names_what_did_not_hold():
     assert audit_sentence([]) == ""
 
 
-def test_audit_replays_a_diagrams_runs_in_worker_processes(monkeypatch, small_diagram):
+def test_audit_replays_a_diagrams_runs_in_worker_processes(small_diagram):
     """A small diagram: two of its decided runs replayed in a process pool come back with
     the recorded label, with their step check."""
     bif = small_diagram
     assert bif.verdicts["label"].isin(sa.LABELS).sum() >= 2
-    monkeypatch.setitem(sa.PER_SWEEP, False, 2)
-    rows = step_audit([("Fig. X", bif)], quick=False, extend_to=None, workers=2)
+    rows = step_audit([("Fig. X", bif)], 2, extend_to=None, workers=2)
     assert len(rows) == 2 and all(r.reproduced for r in rows)
     assert all(r.where.startswith("e = ") and r.half != "not re-run" for r in rows)
-    assert step_audit([("Fig. X", bif)], quick=True, extend_to=None) == []
+    assert step_audit([("Fig. X", bif)], 0, extend_to=None) == []
 
 
 @pytest.mark.parametrize("quick", [True, False])
