@@ -20,7 +20,9 @@ def resolution_warning(p: Params) -> str | None:
         return None
     return (
         f"dt = {p.dt:g} s resolves the contact oscillation (period {period:.3g} s) with only "
-        f"{steps:.1f} steps; use dt <= {period / 40:.2g} s for a converged run"
+        f"{steps:.1f} steps; use dt <= {period / 40:.2g} s (40 steps), and check the verdict "
+        "at half the step (classify_trajectory(..., check_step=True)): where chattering "
+        "dominates, 40 steps can still overstate the exponent (README)"
     )
 
 
