@@ -2,8 +2,9 @@
 
 The full report audits 5 runs per sweep (:mod:`._step_audit`); this reads the sweeps a report
 wrote into its data folder and audits as many as asked (``--per-sweep``, every decided run of
-a sweep with a large number), printing one line per run and the report's sentence. It writes
-nothing.
+a sweep with a large number), printing one line per run and the report's sentence. With
+``--ladder 2,4,8`` it follows the drawn runs (any label) down several halvings of the step
+instead (:mod:`._ladder`). It writes nothing.
 """
 
 from __future__ import annotations
@@ -73,8 +74,8 @@ def audit_script(argv: list[str] | None = None) -> int:
         type=int,
         default=PER_SWEEP[False],
         metavar="K",
-        help=f"decided runs drawn per sweep, K >= 1 (default {PER_SWEEP[False]}, the full "
-        "report's; more than a sweep holds: all of them)",
+        help="runs drawn per sweep (decided ones; any with --ladder), K >= 1 (default "
+        f"{PER_SWEEP[False]}, the full report's; more than a sweep holds: all of them)",
     )
     ap.add_argument("--seed", type=int, default=AUDIT_SEED, help="seed of the draw")
     ap.add_argument(
@@ -84,6 +85,14 @@ def audit_script(argv: list[str] | None = None) -> int:
         metavar="S",
         help=f"longest recorded time of an extended verdict, S > 0 (default {FULL_EXTEND_TO:g} "
         "s, the full report's)",
+    )
+    ap.add_argument(
+        "--ladder",
+        default=None,
+        metavar="K,K",
+        help="a step ladder instead: each drawn run (any label) classified at dt and at dt/K "
+        "for each K, powers of two >= 2 in increasing order (e.g. 2,4,8), and compared with "
+        "the finest",
     )
     ap.add_argument("--workers", type=int, default=None, help="cores (default: all)")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
@@ -98,6 +107,9 @@ def audit_script(argv: list[str] | None = None) -> int:
         ap.error(f"--extend-to {args.extend_to}: must be a finite number of seconds > 0")
     if args.seed < 0:
         ap.error(f"--seed {args.seed}: must be an integer >= 0")
+    halvings = _halvings(args.ladder) if args.ladder is not None else None
+    if halvings == ():
+        ap.error(f"--ladder {args.ladder}: give powers of two >= 2 in increasing order, e.g. 2,4,8")
     try:
         if args.workers is not None:
             local_workers(args.workers)
@@ -105,6 +117,8 @@ def audit_script(argv: list[str] | None = None) -> int:
     except (OSError, ValueError) as err:
         ap.error(str(err))  # exit 2
     try:
+        if halvings:
+            return _ladder(sweeps, halvings, args)
         rows = step_audit(
             sweeps, args.per_sweep, args.extend_to, workers=args.workers, seed=args.seed
         )
@@ -118,4 +132,33 @@ def audit_script(argv: list[str] | None = None) -> int:
         print(f"{r.figure} | {r.where} | recorded {r.recorded} | dt: {r.replayed} | "
               f"dt/2: {r.half} | {mark} | {r.seconds:.1f} s")  # fmt: skip
     print(audit_sentence(rows) or "no decided run to audit")
+    return 0
+
+
+def _halvings(text: str) -> tuple[int, ...]:
+    """ "2,4,8" -> (1, 2, 3); () when a value is not a power of two >= 2 or the values do not
+    increase."""
+    try:
+        ks = [int(k) for k in text.split(",")]
+    except ValueError:
+        return ()
+    if not ks or any(k < 2 or k & (k - 1) for k in ks) or ks != sorted(set(ks)):
+        return ()
+    return tuple(k.bit_length() - 1 for k in ks)
+
+
+def _ladder(sweeps, halvings: tuple[int, ...], args) -> int:
+    """The ladder's lines (one per run: its verdict and exponent at every step) and its
+    sentence."""
+    from ._ladder import ladder_sentence, step_ladder
+
+    rows = step_ladder(
+        sweeps, halvings, args.per_sweep, args.extend_to, workers=args.workers, seed=args.seed
+    )
+    for r in rows:
+        rungs = " | ".join(
+            f"{'dt' if h == 0 else f'dt/{2**h}'}: {tag} ({lam:+.3f})" for h, tag, lam in r.rungs
+        )
+        print(f"{r.figure} | {r.where} | recorded {r.recorded} | {rungs} | {r.seconds:.1f} s")
+    print(ladder_sentence(rows) or "no run to follow")
     return 0

@@ -73,7 +73,7 @@ def replay_params(sweep: Any, row: Any) -> Params:
     )
 
 
-def replay(sweep: Any, row: Any, *, tangent: bool = True) -> Trajectory:
+def replay(sweep: Any, row: Any, *, tangent: bool = True, refine: int = 0) -> Trajectory:
     """Simulate ``row``'s realization alone, as the sweep ran it.
 
     Parameters
@@ -87,6 +87,10 @@ def replay(sweep: Any, row: Any, *, tangent: bool = True) -> Trajectory:
         Also integrate the tangent dynamics, and keep the run resumable, as the sweeps do for
         the default classifier (RK4 only): ``classify_trajectory`` then reads its Jacobians
         and extends it without simulating it again.
+    refine : int
+        Halve the step this many times (:meth:`Params.refined`: RK4's ``dt / 2**refine``;
+        the adaptive path's tolerances / 32 each time), the same realization otherwise: the
+        rungs of a step ladder (``analyses/step_audit.py --ladder``). 0: the sweep's run.
 
     Returns
     -------
@@ -98,6 +102,10 @@ def replay(sweep: Any, row: Any, *, tangent: bool = True) -> Trajectory:
     """
     cfg = _sweep_config(sweep)
     p = replay_params(sweep, row)
+    if isinstance(refine, bool) or not isinstance(refine, int) or refine < 0:
+        raise ValueError(f"refine = {refine!r}: must be an integer >= 0 (step halvings)")
+    for _ in range(refine):
+        p = p.refined()
     tangent = bool(tangent) and p.integrator == "rk4"
     return simulate(
         p,

@@ -139,7 +139,36 @@ def test_audit_script_reads_a_reports_data_and_refuses_bad_input(tmp_path, capsy
         (["--extend-to", "inf", str(tmp_path)], "--extend-to inf: must be a finite"),
         (["--seed", "-1", str(tmp_path)], "--seed -1: must be an integer >= 0"),
         (["--figures", "4,5", str(tmp_path)], "--figures 4,5: choose among 4, 6, 7"),
+        (["--ladder", "3", str(tmp_path)], "--ladder 3: give powers of two >= 2"),
+        (["--ladder", "4,2", str(tmp_path)], "--ladder 4,2: give powers of two >= 2"),
+        (["--ladder", "1,2", str(tmp_path)], "--ladder 1,2: give powers of two >= 2"),
+        (["--ladder", "x", str(tmp_path)], "--ladder x: give powers of two >= 2"),
     ):
         with pytest.raises(SystemExit) as stop:
             audit_script(bad)
         assert stop.value.code == 2 and says in capsys.readouterr().err
+
+
+def test_ladder_follows_every_drawn_run_down_the_step(tmp_path, capsys, small_diagram):
+    """--ladder 2,4: two runs of any label, each classified at dt, dt/2 and dt/4; the first
+    rung is the recorded verdict (the replay is the sweep's run); the sentence compares dt
+    and dt/2 with dt/4."""
+    from chaoscam.experiments._audit_script import audit_script
+    from chaoscam.experiments._ladder import ladder_sample, ladder_sentence, step_ladder
+
+    table = pd.DataFrame({"label": ["chaotic", "undetermined"] * 5})
+    assert "undetermined" in set(ladder_sample(table, 6)["label"])  # any label: 6 > 5 chaotic
+    bif = small_diagram
+    rows = step_ladder([("Fig. X", bif)], (1, 2), 2, None, workers=2)
+    assert len(rows) == 2
+    for r in rows:
+        assert [h for h, _, _ in r.rungs] == [0, 1, 2] and r.rungs[0][1] == r.recorded
+    text = ladder_sentence(rows)
+    assert text.startswith("Step ladder: 2 runs of Fig. X classified at dt, dt/2, dt/4")
+    assert "Against dt/4: at dt " in text and "; at dt/2 " in text
+    bif.to_parquet(tmp_path / "fig4.parquet")
+    args = ["--figures", "4", "--per-sweep", "1", "--workers", "1", "--ladder", "2"]
+    assert audit_script([*args, str(tmp_path)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("Fig. 4 | e = ") and " | dt: " in out[0] and " | dt/2: " in out[0]
+    assert out[1].startswith("Step ladder: 1 run")

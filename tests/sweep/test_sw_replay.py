@@ -95,3 +95,25 @@ def test_replay_tells_the_kind_of_a_sweep_written_before_kinds(rmap):
     old = dataclasses.replace(rmap, config={k: v for k, v in rmap.config.items() if k != "kind"})
     row = old.realizations.iloc[0]
     assert replay_params(old, row) == replay_params(rmap, row)
+
+
+def test_replay_refined_is_the_same_realization_at_a_finer_step(rmap):
+    """refine = 2 runs the row's realization at dt / 4: the same draws and window as
+    simulating the refined parameters directly, with a different step; refine < 0, a float or
+    a bool is refused by name."""
+    from chaoscam import simulate
+
+    row = rmap.realizations.iloc[0]
+    fine = replay(rmap, row, tangent=False, refine=2)
+    assert fine.params.dt == BASE.dt / 4
+    p = replay_params(rmap, row).refined().refined()
+    direct = simulate(p, duration=3.0, transient=2.0, seed=int(row["seed"]),
+                      index=int(row["sim_index"]), output_dt=1e-3)  # fmt: skip
+    np.testing.assert_array_equal(fine.section["theta_f"], direct.section["theta_f"])
+    assert (
+        fine.section["theta_f"].to_numpy()[-1]
+        != replay(rmap, row, tangent=False).section["theta_f"].to_numpy()[-1]
+    )
+    for bad in (-1, 1.0, True):
+        with pytest.raises(ValueError, match="refine"):
+            replay(rmap, row, refine=bad)
