@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from ._sensitivity import verdict_tag
-from ._step_audit import AUDIT_SEED, _Settings, _where
+from ._step_audit import AUDIT_SEED, _Settings, _where, run_jobs
 
 __all__ = ["LadderRow", "ladder_sample", "ladder_sentence", "step_ladder"]
 
@@ -90,26 +90,13 @@ def step_ladder(
     (:func:`ladder_sample`), each classified at the sweep's step and at ``dt / 2**h`` for
     each ``h`` in ``halvings`` (increasing, >= 1), an undetermined verdict extended up to
     ``extend_to`` seconds recorded, on ``workers`` local processes."""
-    from ..sweep._backends import ProcessBackend, local_workers
-
     jobs = []
     for figure, sweep in sweeps:
         table = sweep.realizations if sweep.config["kind"] == "regime_map" else sweep.verdicts
         settings = _Settings(sweep.config)
         for row in ladder_sample(table, per_sweep, seed).to_dict("records"):
             jobs.append((figure, settings, row, tuple(halvings), extend_to))
-    if not jobs:
-        return []
-    pool = ProcessBackend(min(local_workers(workers), len(jobs)))
-    futures = []
-    try:
-        futures = [pool.submit(_ladder_one, job) for job in jobs]
-        rows = [pool.result(f) for f in futures]
-    except BaseException:  # Ctrl-C or a failed run: stop the workers now
-        pool.cancel(futures)
-        raise
-    pool.close()
-    return rows
+    return run_jobs(_ladder_one, jobs, workers)
 
 
 def _step(h: int) -> str:

@@ -35,6 +35,7 @@ __all__ = [
     "AuditRow",
     "audit_sample",
     "audit_sentence",
+    "run_jobs",
     "step_audit",
     "sweep_names",
 ]
@@ -152,22 +153,28 @@ def step_audit(
     sweep)`` (a RegimeMap or a Bifurcation), drawn with ``seed``: each replayed and checked at
     half the step, an undetermined verdict extended up to ``extend_to`` seconds recorded (the
     sweeps' own cap), on ``workers`` local processes (:func:`chaoscam.sweep.local_workers`)."""
-    from ..sweep._backends import ProcessBackend, local_workers
-
     jobs = []
     for figure, sweep in sweeps:
         table = sweep.realizations if sweep.config["kind"] == "regime_map" else sweep.verdicts
         settings = _Settings(sweep.config)
         for row in audit_sample(table, per_sweep, seed).to_dict("records"):
             jobs.append((figure, settings, row, extend_to))
+    return run_jobs(_audit_one, jobs, workers)
+
+
+def run_jobs(task, jobs: list, workers=None) -> list:
+    """``[task(job) for job in jobs]`` on ``workers`` local processes (no more than jobs),
+    in order; Ctrl-C or a failed job stops the workers at once, not after their runs."""
+    from ..sweep._backends import ProcessBackend, local_workers
+
     if not jobs:
         return []
     pool = ProcessBackend(min(local_workers(workers), len(jobs)))
     futures = []
     try:
-        futures = [pool.submit(_audit_one, job) for job in jobs]
+        futures = [pool.submit(task, job) for job in jobs]
         rows = [pool.result(f) for f in futures]
-    except BaseException:  # Ctrl-C or a failed run: stop the workers now, not after their runs
+    except BaseException:
         pool.cancel(futures)
         raise
     pool.close()
