@@ -150,15 +150,13 @@ def _halvings(text: str) -> tuple[int, ...]:
 def _ladder(sweeps, halvings: tuple[int, ...], args) -> int:
     """The ladder's lines (one per run: its verdict and exponent at every step) and its
     sentence."""
-    from ._ladder import ladder_sentence, step_ladder
+    from ._ladder import ladder_sentence, step_ladder, step_name
 
     rows = step_ladder(
         sweeps, halvings, args.per_sweep, args.extend_to, workers=args.workers, seed=args.seed
     )
     for r in rows:
-        rungs = " | ".join(
-            f"{'dt' if h == 0 else f'dt/{2**h}'}: {tag} ({lam:+.3f})" for h, tag, lam in r.rungs
-        )
+        rungs = " | ".join(f"{step_name(h)}: {tag} ({lam:+.3f})" for h, tag, lam in r.rungs)
         print(f"{r.figure} | {r.where} | recorded {r.recorded} | {rungs} | {r.seconds:.1f} s")
     print(ladder_sentence(rows) or "no run to follow")
     return 0

@@ -22,9 +22,9 @@ from typing import Any
 import numpy as np
 
 from ._sensitivity import verdict_tag
-from ._step_audit import AUDIT_SEED, _Settings, _where, run_jobs
+from ._step_audit import AUDIT_SEED, _where, draw_rows, run_jobs, sampled_rows
 
-__all__ = ["LadderRow", "ladder_sample", "ladder_sentence", "step_ladder"]
+__all__ = ["LadderRow", "ladder_sample", "ladder_sentence", "step_ladder", "step_name"]
 
 
 @dataclass(frozen=True)
@@ -41,18 +41,15 @@ class LadderRow:
     seconds: float
 
 
-def ladder_sample(table, k: int, seed: int = AUDIT_SEED):
-    """Up to ``k`` rows of a sweep's table, whatever their label, drawn without replacement
-    with ``seed`` (all of them when there are fewer), in table order."""
-    if len(table) <= k:
-        return table
-    pick = np.random.default_rng(seed).choice(len(table), size=k, replace=False)
-    return table.iloc[np.sort(pick)]
+ladder_sample = draw_rows
+"""Up to ``k`` rows of a sweep's table, whatever their label (:func:`._step_audit.draw_rows`)."""
 
 
 def _exponent(verdict) -> float:
-    value = next((e.value for e in verdict.evidence if e.name == "exponent"), None)
-    return float(value) if isinstance(value, int | float) else math.nan
+    """The tangent exponent as a sweep's table keeps it (``ev_exponent``; NaN without one)."""
+    from ..sweep._tasks import verdict_fields
+
+    return verdict_fields(verdict)["evidence"].get("exponent", math.nan)
 
 
 def _ladder_one(job: tuple) -> LadderRow:
@@ -90,16 +87,15 @@ def step_ladder(
     (:func:`ladder_sample`), each classified at the sweep's step and at ``dt / 2**h`` for
     each ``h`` in ``halvings`` (increasing, >= 1), an undetermined verdict extended up to
     ``extend_to`` seconds recorded, on ``workers`` local processes."""
-    jobs = []
-    for figure, sweep in sweeps:
-        table = sweep.realizations if sweep.config["kind"] == "regime_map" else sweep.verdicts
-        settings = _Settings(sweep.config)
-        for row in ladder_sample(table, per_sweep, seed).to_dict("records"):
-            jobs.append((figure, settings, row, tuple(halvings), extend_to))
+    jobs = [
+        (*job, tuple(halvings), extend_to)
+        for job in sampled_rows(sweeps, ladder_sample, per_sweep, seed)
+    ]
     return run_jobs(_ladder_one, jobs, workers)
 
 
-def _step(h: int) -> str:
+def step_name(h: int) -> str:
+    """The step after ``h`` halvings: "dt", "dt/2", "dt/4", ..."""
     return "dt" if h == 0 else f"dt/{2**h}"
 
 
@@ -121,12 +117,12 @@ def ladder_sentence(rows: list[LadderRow]) -> str:
             if moved
             else ""
         )
-        parts.append(f"at {_step(h)} {same} of {len(rows)} labels agree{size}")
+        parts.append(f"at {step_name(h)} {same} of {len(rows)} labels agree{size}")
     figures = ", ".join(dict.fromkeys(r.figure for r in rows))
     work = sum(r.seconds for r in rows)
     return (
         f"Step ladder: {len(rows)} runs of {figures} classified at "
-        f"{', '.join(map(_step, steps))} ({work:.0f} s of work). Against {_step(finest)}: "
+        f"{', '.join(map(step_name, steps))} ({work:.0f} s of work). Against {step_name(finest)}: "
         + "; ".join(parts)
         + "."
     )

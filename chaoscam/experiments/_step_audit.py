@@ -35,7 +35,9 @@ __all__ = [
     "AuditRow",
     "audit_sample",
     "audit_sentence",
+    "draw_rows",
     "run_jobs",
+    "sampled_rows",
     "step_audit",
     "sweep_names",
 ]
@@ -90,14 +92,30 @@ def sweep_names(name: str, sweeps: list) -> list[str]:
     return [f"{name} ({', '.join(f'{k} = {text(b.get(k))}' for k in keys)})" for b in bases]
 
 
+def draw_rows(table: pd.DataFrame, k: int, seed: int = AUDIT_SEED) -> pd.DataFrame:
+    """Up to ``k`` rows of ``table``, drawn without replacement with ``seed`` (all of them
+    when there are fewer), in table order."""
+    if len(table) <= k:
+        return table
+    pick = np.random.default_rng(seed).choice(len(table), size=k, replace=False)
+    return table.iloc[np.sort(pick)]
+
+
 def audit_sample(table: pd.DataFrame, k: int, seed: int = AUDIT_SEED) -> pd.DataFrame:
-    """Up to ``k`` rows of a sweep's table labelled as in :data:`LABELS`, drawn without
-    replacement with ``seed`` (all of them when there are fewer), in table order."""
-    pool = table[table["label"].isin(LABELS)]
-    if len(pool) <= k:
-        return pool
-    pick = np.random.default_rng(seed).choice(len(pool), size=k, replace=False)
-    return pool.iloc[np.sort(pick)]
+    """Up to ``k`` rows of a sweep's table labelled as in :data:`LABELS`, drawn with
+    :func:`draw_rows`."""
+    return draw_rows(table[table["label"].isin(LABELS)], k, seed)
+
+
+def sampled_rows(sweeps: list[tuple[str, Any]], sample, k: int, seed: int):
+    """``(figure name, settings, row)`` for the rows ``sample(table, k, seed)`` draws from
+    each ``(figure name, sweep)``'s table (a map's realizations, a diagram's verdicts): what
+    a pool task of the audit or the ladder starts from."""
+    for figure, sweep in sweeps:
+        table = sweep.realizations if sweep.config["kind"] == "regime_map" else sweep.verdicts
+        settings = _Settings(sweep.config)
+        for row in sample(table, k, seed).to_dict("records"):
+            yield figure, settings, row
 
 
 @dataclass(frozen=True)
@@ -153,12 +171,7 @@ def step_audit(
     sweep)`` (a RegimeMap or a Bifurcation), drawn with ``seed``: each replayed and checked at
     half the step, an undetermined verdict extended up to ``extend_to`` seconds recorded (the
     sweeps' own cap), on ``workers`` local processes (:func:`chaoscam.sweep.local_workers`)."""
-    jobs = []
-    for figure, sweep in sweeps:
-        table = sweep.realizations if sweep.config["kind"] == "regime_map" else sweep.verdicts
-        settings = _Settings(sweep.config)
-        for row in audit_sample(table, per_sweep, seed).to_dict("records"):
-            jobs.append((figure, settings, row, extend_to))
+    jobs = [(*job, extend_to) for job in sampled_rows(sweeps, audit_sample, per_sweep, seed)]
     return run_jobs(_audit_one, jobs, workers)
 
 
