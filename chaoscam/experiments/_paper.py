@@ -19,6 +19,7 @@ import pandas as pd
 
 from ..report._figures import png_bytes, png_uri, response_figure
 from ..report._html import Comparison, FigureItem
+from . import _steps
 
 __all__ = ["FIGURES", "FigureResult", "data_files"]
 
@@ -30,10 +31,6 @@ SIGMA_MAX = 0.004
 
 G_FIG6 = (1e-9, 1e-10)
 """The fractal roughnesses of Fig. 6 [m]."""
-FIG6_STEPS = {True: 40, False: 160}
-"""RK4 steps per contact period at D = 1.56 (the stiffest) for Fig. 6, quick and full. At 40
-(the default Hertz step's resolution) the exponent is overstated up to 5x and 20 of 42 labels
-differ from dt/8's; at 160, 9 of 42 (README "Fig. 6 and the step"). The quick run keeps 40."""
 
 
 def _fig6_tag(g: float) -> str:
@@ -194,14 +191,18 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
 def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 4: bifurcation of θ_f over l_λ ∈ [0.001, 0.018] m (Hertz line stiffness)."""
+    from ..model import Params
     from ..report._sweep_figures import bifurcation_figure
     from ..sweep import bifurcation
 
     res = FigureResult(4)
     values = "0.001:0.018:25" if quick else "0.001:0.018:69"  # the paper's step, 0.00025 m
+    stiffest = Params(l_lambda=0.018)
+    dt = _steps.figure_dt(stiffest, _steps.FIG4_STEPS[quick])
     bif = bifurcation(
         "l_lambda",
         values,
+        base=Params(dt=dt),
         duration=20.0,
         transient=10.0,
         initial_conditions=1 if quick else 3,
@@ -244,7 +245,9 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
             + ", ".join(f"{k} {n}" for k, n in bif.verdicts["label"].value_counts().items())
             + ")",
             verdict,
-            why + ("; quick run: one initial condition per value, 25 values" if quick else ""),
+            why
+            + ("; quick run: one initial condition per value, 25 values" if quick else "")
+            + _steps.fig4_step_note(stiffest, dt),
         )
     )
     return res
@@ -319,7 +322,6 @@ def fig5(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
 def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 6: bifurcation over D with the fractal stiffness, G = 1e-9 and 1e-10 m."""
-    from .._simulate import contact_period
     from ..model import Params
     from ..report._sweep_figures import bifurcation_figure
     from ..sweep import bifurcation
@@ -331,7 +333,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     found = []
     for g in G_FIG6:
         stiffest = Params(stiffness="fractal", D=1.56, G=g)
-        dt = float(f"{contact_period(stiffest) / FIG6_STEPS[quick]:.1e}")
+        dt = _steps.figure_dt(stiffest, _steps.FIG6_STEPS[quick])
         base = Params(stiffness="fractal", G=g, dt=dt)
         bif = bifurcation(
             "D",
@@ -357,15 +359,12 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
             "not comparable",
             "the paper's statement for Fig. 6 that we hold (MODEL.md) names the sweep, not a "
             "sequence of regimes, so there is no claim to test; the diagrams are shown for reading"
-            + f"; {FIG6_STEPS[quick]} RK4 steps per contact period at D = 1.56"
+            + _steps.fig6_step_note(quick)
             + (
                 f"; quick run: {duration:g} s runs ({transient:g} s transient), 6 values of D, no "
-                "extension of undetermined runs and a step at which labels are not converged "
-                f"(the full report takes {FIG6_STEPS[False]} steps: README)"
+                "extension of undetermined runs"
                 if quick
-                else ", because at 40 the exponent is overstated up to 5x and 20 of 42 labels "
-                f"differ from dt/8's (9 of 42 at {FIG6_STEPS[False]}: README); undetermined runs "
-                f"extended to {FULL_EXTEND_TO:g} s recorded at most"
+                else f"; undetermined runs extended to {FULL_EXTEND_TO:g} s recorded at most"
             ),
         )
     )
@@ -464,6 +463,7 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
             else ""
         )
         why += "; at σ = 0 the realizations are identical (the deterministic system)"
+        why += _steps.FIGS7_10_STEP_NOTE
         if quick:
             why += f"; quick run: {n} realizations per cell, wide intervals"
         res.comparisons.append(Comparison(figname, paper, f"{t0}; {t1}", verdict, why))

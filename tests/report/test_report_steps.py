@@ -1,0 +1,44 @@
+"""The step of the paper's bifurcation figures: steps per contact period at the stiffest point."""
+
+import math
+
+import pytest
+
+from chaoscam import contact_period
+from chaoscam.experiments import _steps
+from chaoscam.model import Params
+
+FIG4_STIFFEST = Params(l_lambda=0.018)
+FIG6_STIFFEST = Params(stiffness="fractal", D=1.56, G=1e-9)
+
+
+@pytest.mark.parametrize("stiffest", [FIG4_STIFFEST, FIG6_STIFFEST])
+@pytest.mark.parametrize("steps", [40, 160])
+def test_the_step_resolves_the_stiffest_contact_with_the_asked_steps(stiffest, steps):
+    """dt spans 1/steps of the stiffest point's contact period, to its two significant
+    digits (so within 5 % of the asked count), and is what steps_per_period reads back."""
+    dt = _steps.figure_dt(stiffest, steps)
+    assert dt == float(f"{dt:.1e}")
+    assert math.isclose(dt, contact_period(stiffest) / steps, rel_tol=0.05)
+    assert math.isclose(_steps.steps_per_period(stiffest, dt), steps, rel_tol=0.05)
+
+
+def test_the_full_report_refines_both_figures_and_the_quick_one_keeps_its_step():
+    """Full: 160 steps for Figs. 4 and 6 (Fig. 4's dt 3.8e-7 s, about 5x finer than the
+    default); quick: the model's default dt for Fig. 4 and 40 steps for Fig. 6."""
+    assert _steps.FIG4_STEPS[False] == _steps.FIG6_STEPS[False] == _steps.FULL_STEPS == 160
+    assert _steps.figure_dt(FIG4_STIFFEST, _steps.FIG4_STEPS[True]) == Params().dt
+    assert _steps.figure_dt(FIG4_STIFFEST, _steps.FIG4_STEPS[False]) == 3.8e-7
+    assert _steps.FIG6_STEPS[True] == 40
+
+
+def test_the_notes_state_the_step_the_figure_ran_at():
+    """Fig. 4's note counts the steps of the dt it ran at (30 at the default, 160 refined)
+    and says the coarse one misses the period-8 windows; Fig. 6's names its step count."""
+    coarse = _steps.fig4_step_note(FIG4_STIFFEST, Params().dt)
+    fine = _steps.fig4_step_note(FIG4_STIFFEST, 3.8e-7)
+    assert "(30 RK4 steps per contact period" in coarse and "full report takes 160" in coarse
+    assert "(160 RK4 steps per contact period" in fine and "at the default 2e-06 s (30" in fine
+    assert "40 RK4 steps" in _steps.fig6_step_note(True)
+    assert "not converged" in _steps.fig6_step_note(True)
+    assert "160 RK4 steps" in _steps.fig6_step_note(False)
