@@ -25,6 +25,7 @@ from ._paper import (
 )
 from ._sensitivity import FATE_S
 from ._step_audit import PER_SWEEP, audit_sentence, step_audit, sweep_names
+from ._steps import FIG6_STEPS, FULL_STEPS
 
 __all__ = ["PaperRun", "check_paper_outputs", "figure_script", "run_paper"]
 
@@ -239,7 +240,10 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
             "This is a quick run: coarse grids, few realizations, shorter fractal runs, "
             f"undetermined runs extended to {QUICK_EXTEND_TO:g} s recorded "
             f"({FULL_EXTEND_TO:g} s in the full report) except Fig. 6's, which are not "
-            "extended (its labels are those of 8 s runs, 4 s recorded), and the ξ sweep's and "
+            "extended (its labels are those of 8 s runs, 4 s recorded); Figs. 4 and 6 at coarser "
+            "steps, at which their labels are not converged (the default dt and "
+            f"{FIG6_STEPS[True]} RK4 steps per contact period, {FULL_STEPS} in the full report); "
+            "the ξ sweep's and "
             f"(ω, ξ) map's chaotic or undetermined runs continued to {FATE_S[True]:g} s "
             f"({FATE_S[False]:g} s) to see whether they stay in the cam's reach; "
             "the sensitivity sweeps' verdicts not checked at half the step and no step "
