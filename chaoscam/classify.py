@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import re
 import time
+import warnings
 from typing import Any
 
 import numpy as np
@@ -175,8 +176,19 @@ def _tangent_run(traj: Trajectory) -> Trajectory:
 
 def _rk4_tangent_run(traj: Trajectory, duration: float) -> Trajectory:
     """The realization of ``traj`` simulated ``duration`` seconds on the RK4 grid (where the
-    tangent lives) with the tangent, without series, kept resumable."""
+    tangent lives) with the tangent, without series, kept resumable. For a run of the
+    adaptive path a RuntimeWarning says so: the verdict then rests on the grid's ``dt``,
+    which the adaptive tolerances do not refine."""
     s = traj.settings
+    if traj.params.integrator != "rk4":
+        warnings.warn(
+            f"the verdict of this {traj.params.describe_step()} run takes its tangent exponent "
+            f"(and any extension) on the RK4 grid at dt = {traj.params.dt:g} s, which the "
+            "adaptive tolerances do not refine: to converge the verdict, refine dt "
+            '(README "The figures\' step")',
+            RuntimeWarning,
+            stacklevel=2,
+        )
     return simulate(
         traj.params.replace(integrator="rk4"),
         duration=duration,
@@ -297,7 +309,8 @@ def classify_trajectory(
         Default True: the verdict comes from the section with the tangent exponent of the
         model through its impacts (:func:`chaoscam.tangent.lyapunov_spectrum`: λ₁ with its
         standard error; taken from ``traj.jacobians`` or from a re-simulation with
-        ``tangent=True``, ~1.1x a simulation, always on the RK4 grid) and, when the section
+        ``tangent=True``, ~1.1x a simulation, always on the RK4 grid at ``params.dt``, also
+        for a run of the adaptive path, which a RuntimeWarning then says) and, when the section
         is periodic and the model deterministic, a periodic orbit found by Newton shooting:
         converged, attracting (|μ| < 1) and with the run on it, it is recorded as the
         decisive evidence ``periodic_orbit``; a converged *unstable* orbit makes the

@@ -1,6 +1,7 @@
 """classify_trajectory / classify_file: the verdict of a simulated run of the model."""
 
 import json
+import warnings
 
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -52,6 +53,21 @@ def test_without_tangent_the_section_alone_decides():
     v = classify_trajectory(tr, tangent=False)
     assert (v.label, v.period) == ("periodic", 1)
     assert all(e.name.startswith("section_") for e in v.evidence)
+
+
+def test_an_adaptive_run_is_told_its_verdict_rests_on_the_rk4_grid(periodic):
+    """An adaptive run without its tangent gets its exponent on the RK4 grid at its dt: a
+    RuntimeWarning names that dt (the adaptive tolerances do not refine it); an RK4 run
+    without its tangent, on its own grid, gets no such warning."""
+    adaptive = chaoscam.simulate(
+        PERIODIC.replace(integrator="adaptive"), duration=4.0, transient=2.0, series=False
+    )
+    with pytest.warns(RuntimeWarning, match=r"RK4 grid at dt = 2e-06 s.*refine dt"):
+        v = classify_trajectory(adaptive)
+    assert (v.label, v.period) == ("periodic", 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        classify_trajectory(periodic)
 
 
 def test_lyapunov_evidence_is_named_lyapunov_model(default3):
