@@ -182,9 +182,11 @@ def _rk4_tangent_run(traj: Trajectory, duration: float) -> Trajectory:
     s = traj.settings
     if traj.params.integrator != "rk4":
         warnings.warn(
-            f"the verdict of this {traj.params.describe_step()} run takes its tangent exponent "
-            f"(and any extension) on the RK4 grid at dt = {traj.params.dt:g} s, which the "
-            "adaptive tolerances do not refine: to converge the verdict, refine dt "
+            f"the verdict of this {traj.params.describe_step()} run is taken on the same "
+            f"realization on the RK4 grid at dt = {traj.params.dt:g} s (its tangent exponent "
+            "unless the run carried one, the orbit certificate, any extension, and the section "
+            "unless the run kept a series), which the adaptive tolerances do not refine: to "
+            "converge the verdict, refine dt "
             '(README "The figures\' step")',
             RuntimeWarning,
             stacklevel=2,
@@ -309,8 +311,9 @@ def classify_trajectory(
         Default True: the verdict comes from the section with the tangent exponent of the
         model through its impacts (:func:`chaoscam.tangent.lyapunov_spectrum`: λ₁ with its
         standard error; taken from ``traj.jacobians`` or from a re-simulation with
-        ``tangent=True``, ~1.1x a simulation, always on the RK4 grid at ``params.dt``, also
-        for a run of the adaptive path, which a RuntimeWarning then says) and, when the section
+        ``tangent=True``, ~1.1x a simulation, on the RK4 grid at ``params.dt``: for a run of
+        the adaptive path without its tangent, a RuntimeWarning says so; the orbit
+        certificate and any extension are always on that grid) and, when the section
         is periodic and the model deterministic, a periodic orbit found by Newton shooting:
         converged, attracting (|μ| < 1) and with the run on it, it is recorded as the
         decisive evidence ``periodic_orbit``; a converged *unstable* orbit makes the

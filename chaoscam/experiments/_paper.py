@@ -197,7 +197,7 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
     res = FigureResult(4)
     values = "0.001:0.018:25" if quick else "0.001:0.018:69"  # the paper's step, 0.00025 m
-    stiffest = Params(l_lambda=0.018)
+    stiffest = Params(l_lambda=float(values.split(":")[1]))  # the largest l_λ: stiffest
     dt = _steps.figure_dt(stiffest, _steps.FIG4_STEPS[quick])
     bif = bifurcation(
         "l_lambda",
@@ -332,7 +332,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     values = "1.36:1.56:6" if quick else "1.36:1.56:21"
     found = []
     for g in G_FIG6:
-        stiffest = Params(stiffness="fractal", D=1.56, G=g)
+        stiffest = Params(stiffness="fractal", D=float(values.split(":")[1]), G=g)
         dt = _steps.figure_dt(stiffest, _steps.FIG6_STEPS[quick])
         base = Params(stiffness="fractal", G=g, dt=dt)
         bif = bifurcation(
@@ -359,7 +359,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
             "not comparable",
             "the paper's statement for Fig. 6 that we hold (MODEL.md) names the sweep, not a "
             "sequence of regimes, so there is no claim to test; the diagrams are shown for reading"
-            + _steps.fig6_step_note(quick)
+            + _steps.fig6_step_note(stiffest, quick)
             + (
                 f"; quick run: {duration:g} s runs ({transient:g} s transient), 6 values of D, no "
                 "extension of undetermined runs"

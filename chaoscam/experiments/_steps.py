@@ -26,10 +26,10 @@ from ..model import Params
 __all__ = [
     "FIG4_STEPS",
     "FIG6_STEPS",
+    "FIGS7_10_STEP_NOTE",
     "FULL_STEPS",
     "fig4_step_note",
     "fig6_step_note",
-    "FIGS7_10_STEP_NOTE",
     "figure_dt",
     "steps_per_period",
 ]
@@ -38,16 +38,16 @@ FULL_STEPS = 160
 """RK4 steps per contact period at the stiffest point of a bifurcation figure, full report."""
 
 FIG4_STEPS = {True: None, False: FULL_STEPS}
-"""Fig. 4's steps per contact period at l_λ = 0.018 m, quick and full (None: the model's
-default dt, 30 steps there): dt = 3.8e-7 s in the full report."""
+"""Fig. 4's steps per contact period at its largest l_λ, 0.018 m, quick and full (None: the
+model's default dt, 30 steps there): dt = 3.8e-7 s in the full report."""
 
 FIG6_STEPS = {True: 40, False: FULL_STEPS}
-"""Fig. 6's steps per contact period at D = 1.56, quick and full: dt = 9.6e-8 and 5e-8 s
-(G = 1e-9, 1e-10 m) in the full report."""
+"""Fig. 6's steps per contact period at its largest D, 1.56, quick and full: dt = 9.6e-8 and
+5e-8 s (G = 1e-9, 1e-10 m) in the full report."""
 
 FIGS7_10_STEP_NOTE = (
-    "; the model's default dt: the labels hold when it is refined (100 of 100 runs at dt/2, "
-    "39 of 39 at dt/4: README), though the exponent at dt is about 2.5x its value at dt/4"
+    "; the model's default dt, whose labels hold when it is refined (measured: 100 of 100 runs "
+    "at dt/2, 39 of 39 at dt/4: README), though its exponent is about 2.5x dt/4's"
 )
 """Figs. 7-10's comparison, on their step (the default)."""
 
@@ -60,11 +60,9 @@ def figure_dt(stiffest: Params, steps: int | None) -> float:
     Examples: Fig. 4 at l_λ = 0.018 m and 160 steps, 3.8e-7 s; Fig. 6 at D = 1.56,
     G = 1e-9 m and 160 steps, 9.6e-8 s.
     """
-    from .._simulate import contact_period
-
     if steps is None:
         return stiffest.dt
-    return float(f"{contact_period(stiffest) / steps:.1e}")
+    return float(f"{steps_per_period(stiffest, 1.0) / steps:.1e}")
 
 
 def steps_per_period(p: Params, dt: float) -> float:
@@ -75,32 +73,28 @@ def steps_per_period(p: Params, dt: float) -> float:
 
 
 def fig4_step_note(stiffest: Params, dt: float) -> str:
-    """Fig. 4's comparison, on its step ``dt`` [s] (``stiffest``: l_λ = 0.018 m)."""
+    """Fig. 4's comparison, on its step ``dt`` [s] (``stiffest``: its largest l_λ)."""
     steps = steps_per_period(stiffest, dt)
+    at = f"at l_λ = {stiffest.l_lambda:g} m"
+    here = f"; dt = {dt:g} s ({steps:.0f} RK4 steps per contact period {at}"
+    measured = (
+        "measured at the default 2e-6 s (30 steps), the period-8 windows at 8.75, 13.5 and "
+        "15.25 mm read chaotic and the exponent is about twice dt/8's (README)"
+    )
     if steps < FULL_STEPS * 0.9:
-        return (
-            f"; dt = {dt:g} s ({steps:.0f} RK4 steps per contact period at l_λ = 0.018 m), at "
-            f"which narrow period-8 windows read chaotic (the full report takes {FULL_STEPS}: "
-            "README)"
-        )
-    default = Params().dt
-    return (
-        f"; dt = {dt:g} s ({steps:.0f} RK4 steps per contact period at l_λ = 0.018 m): at the "
-        f"default {default:g} s ({steps_per_period(stiffest, default):.0f} steps) the period-8 "
-        "windows at 8.75, 13.5 and 15.25 mm read chaotic and the exponent is about twice its "
-        "converged value (README)"
+        coarse = "a step at which labels are not converged"
+        return f"{here}, {coarse}: {measured}; the full report takes {FULL_STEPS})"
+    return f"{here}; {measured})"
+
+
+def fig6_step_note(stiffest: Params, quick: bool) -> str:
+    """Fig. 6's comparison, on its step, quick or full (``stiffest``: its largest D)."""
+    here = f"; {FIG6_STEPS[quick]} RK4 steps per contact period at D = {stiffest.D:g}"
+    measured = (
+        "measured: at 40 the exponent is overstated up to 5x and 20 of 42 labels differ from "
+        "dt/8's, at 160 9 of 42 (README)"
     )
-
-
-def fig6_step_note(quick: bool) -> str:
-    """Fig. 6's comparison, on its step (quick or full)."""
-    steps = FIG6_STEPS[quick]
     if quick:
-        return (
-            f"; {steps} RK4 steps per contact period at D = 1.56, a step at which labels are "
-            f"not converged (the full report takes {FIG6_STEPS[False]}: README)"
-        )
-    return (
-        f"; {steps} RK4 steps per contact period at D = 1.56, because at 40 the exponent is "
-        f"overstated up to 5x and 20 of 42 labels differ from dt/8's (9 of 42 at {steps}: README)"
-    )
+        coarse = "a step at which labels are not converged"
+        return f"{here}, {coarse} ({measured}; the full report takes {FIG6_STEPS[False]})"
+    return f"{here} ({measured})"

@@ -15,12 +15,41 @@ FIG6_STIFFEST = Params(stiffness="fractal", D=1.56, G=1e-9)
 @pytest.mark.parametrize("stiffest", [FIG4_STIFFEST, FIG6_STIFFEST])
 @pytest.mark.parametrize("steps", [40, 160])
 def test_the_step_resolves_the_stiffest_contact_with_the_asked_steps(stiffest, steps):
-    """dt spans 1/steps of the stiffest point's contact period, to its two significant
-    digits (so within 5 % of the asked count), and is what steps_per_period reads back."""
+    """dt spans 1/steps of the stiffest point's contact period, to two significant digits
+    (so within 5 % of the asked count)."""
     dt = _steps.figure_dt(stiffest, steps)
     assert dt == float(f"{dt:.1e}")
     assert math.isclose(dt, contact_period(stiffest) / steps, rel_tol=0.05)
-    assert math.isclose(_steps.steps_per_period(stiffest, dt), steps, rel_tol=0.05)
+
+
+class _Stop(Exception):
+    pass
+
+
+@pytest.mark.parametrize("quick", [True, False])
+@pytest.mark.parametrize("number", [4, 6])
+def test_the_figures_run_their_sweeps_at_the_rule_s_step(number, quick, monkeypatch, tmp_path):
+    """Figs. 4 and 6 hand their bifurcation sweep a base whose dt is the rule's at the sweep's
+    largest value (l_λ = 0.018 m, D = 1.56): caught at the call, before any run."""
+    import chaoscam.sweep
+    from chaoscam.experiments._paper import FIGURES
+
+    seen = []
+
+    def caught(param, values, *, base=None, **kwargs):
+        seen.append((param, base))
+        raise _Stop
+
+    monkeypatch.setattr(chaoscam.sweep, "bifurcation", caught)
+    with pytest.raises(_Stop):
+        FIGURES[number](quick, tmp_path)
+    param, base = seen[0]
+    if number == 4:
+        steps, stiffest = _steps.FIG4_STEPS[quick], FIG4_STIFFEST
+    else:
+        steps, stiffest = _steps.FIG6_STEPS[quick], FIG6_STIFFEST
+    assert base.dt == _steps.figure_dt(stiffest, steps)
+    assert param == ("l_lambda" if number == 4 else "D")
 
 
 def test_the_full_report_refines_both_figures_and_the_quick_one_keeps_its_step():
@@ -37,8 +66,11 @@ def test_the_notes_state_the_step_the_figure_ran_at():
     and says the coarse one misses the period-8 windows; Fig. 6's names its step count."""
     coarse = _steps.fig4_step_note(FIG4_STIFFEST, Params().dt)
     fine = _steps.fig4_step_note(FIG4_STIFFEST, 3.8e-7)
-    assert "(30 RK4 steps per contact period" in coarse and "full report takes 160" in coarse
-    assert "(160 RK4 steps per contact period" in fine and "at the default 2e-06 s (30" in fine
-    assert "40 RK4 steps" in _steps.fig6_step_note(True)
-    assert "not converged" in _steps.fig6_step_note(True)
-    assert "160 RK4 steps" in _steps.fig6_step_note(False)
+    assert "(30 RK4 steps per contact period at l_λ = 0.018 m, a step at which" in coarse
+    assert coarse.endswith("the full report takes 160)")
+    assert "(160 RK4 steps per contact period at l_λ = 0.018 m; measured at" in fine
+    assert "not converged" not in fine
+    quick, full = (_steps.fig6_step_note(FIG6_STIFFEST, q) for q in (True, False))
+    assert "; 40 RK4 steps per contact period at D = 1.56, a step at which" in quick
+    assert "not converged" in quick and "not converged" not in full
+    assert full.startswith("; 160 RK4 steps per contact period at D = 1.56 (measured")
