@@ -194,10 +194,11 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     from ..model import Params
     from ..report._sweep_figures import bifurcation_figure
     from ..sweep import bifurcation
+    from ..sweep._grid import parse_range
 
     res = FigureResult(4)
     values = "0.001:0.018:25" if quick else "0.001:0.018:69"  # the paper's step, 0.00025 m
-    stiffest = Params(l_lambda=float(values.split(":")[1]))  # the largest l_λ: stiffest
+    stiffest = Params(l_lambda=parse_range(values)[1])  # the largest l_λ: the stiffest
     dt = _steps.figure_dt(stiffest, _steps.FIG4_STEPS[quick])
     bif = bifurcation(
         "l_lambda",
@@ -325,6 +326,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     from ..model import Params
     from ..report._sweep_figures import bifurcation_figure
     from ..sweep import bifurcation
+    from ..sweep._grid import parse_range
     from ..sweep._tasks import DefaultClassifier
 
     res = FigureResult(6)
@@ -332,7 +334,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     values = "1.36:1.56:6" if quick else "1.36:1.56:21"
     found = []
     for g in G_FIG6:
-        stiffest = Params(stiffness="fractal", D=float(values.split(":")[1]), G=g)
+        stiffest = Params(stiffness="fractal", D=parse_range(values)[1], G=g)
         dt = _steps.figure_dt(stiffest, _steps.FIG6_STEPS[quick])
         base = Params(stiffness="fractal", G=g, dt=dt)
         bif = bifurcation(

@@ -60,9 +60,11 @@ def figure_dt(stiffest: Params, steps: int | None) -> float:
     Examples: Fig. 4 at l_λ = 0.018 m and 160 steps, 3.8e-7 s; Fig. 6 at D = 1.56,
     G = 1e-9 m and 160 steps, 9.6e-8 s.
     """
+    from .._simulate import contact_period
+
     if steps is None:
         return stiffest.dt
-    return float(f"{steps_per_period(stiffest, 1.0) / steps:.1e}")
+    return float(f"{contact_period(stiffest) / steps:.1e}")
 
 
 def steps_per_period(p: Params, dt: float) -> float:
