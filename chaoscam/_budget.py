@@ -25,8 +25,8 @@ from __future__ import annotations
 
 import math
 import os
-import warnings
 
+from ._warn import warn
 from .model import ParameterError
 
 __all__ = [
@@ -239,7 +239,7 @@ def check_run(params, duration: float, *, what: str = "one run", series_rows: fl
             remedy += " or output_dt"
     if seconds > RUN_REFUSE_SECONDS:
         raise ParameterError(f"{text}: refused; {remedy}")
-    warnings.warn(f"{text}; {remedy} for a shorter run", RuntimeWarning, stacklevel=3)
+    warn(f"{text}; {remedy} for a shorter run")
     return True
 
 
@@ -287,10 +287,8 @@ def check_budget(job: JobEstimate, *, what: str, reduce: str, run: tuple | None 
     if run is not None and check_run(**run):
         return
     if job.seconds > WARN_SECONDS:
-        warnings.warn(
+        warn(
             f"{what} will take about {_human_seconds(job.seconds)} (a coarse estimate: "
             f"{NS_PER_STEP:g} ns per step of dt, more on the adaptive path in contact); "
-            f"reduce {reduce} for a shorter run",
-            RuntimeWarning,
-            stacklevel=3,
+            f"reduce {reduce} for a shorter run"
         )

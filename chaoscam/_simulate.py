@@ -13,7 +13,6 @@ import dataclasses
 import json
 import math
 import time
-import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -21,6 +20,7 @@ import numpy as np
 
 from ._run_warnings import run_warnings
 from ._version import __version__
+from ._warn import warn
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
 from .integrate._constants import initial_counters, initial_state
@@ -324,7 +324,7 @@ def raw_run(
     n_stop = int(round(duration / p.dt))
     stride = max(1, int(round(output_dt / p.dt))) if series else 0
     for text in run_warnings(p):
-        warnings.warn(text, RuntimeWarning, stacklevel=3)  # simulate's caller
+        warn(text)
 
     stream = LineLengthStream(p, seed, index)
     lam = stream.draw(output_block(p))

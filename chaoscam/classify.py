@@ -12,7 +12,6 @@ from __future__ import annotations
 import dataclasses
 import re
 import time
-import warnings
 from typing import Any
 
 import numpy as np
@@ -26,6 +25,7 @@ from ._simulate import Trajectory, simulate
 # the step check's re-simulation under this module's name, which tests replace
 from ._step_check import resimulate_half_step as _resimulate_half_step
 from ._trajectory_io import load_trajectory
+from ._warn import warn
 from .analysis import Evidence, Verdict, classify_section, classify_signal
 from .analysis._options import check_options, section_options
 from .integrate import Status
@@ -181,15 +181,13 @@ def _rk4_tangent_run(traj: Trajectory, duration: float) -> Trajectory:
     which the adaptive tolerances do not refine."""
     s = traj.settings
     if traj.params.integrator != "rk4":
-        warnings.warn(
+        warn(
             f"the verdict of this {traj.params.describe_step()} run is taken on the same "
             f"realization on the RK4 grid at dt = {traj.params.dt:g} s (its tangent exponent "
             "unless the run carried one, the orbit certificate, any extension, and the section "
             "unless the run kept a series), which the adaptive tolerances do not refine: to "
             "converge the verdict, refine dt "
             '(README "The figures\' step")',
-            RuntimeWarning,
-            stacklevel=2,
         )
     return simulate(
         traj.params.replace(integrator="rk4"),

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._warn import warn as warn_user
 from ._validate import as_series, check_settings
 
 __all__ = ["DoubtfulEstimateWarning", "SeriesLyapunovResult", "lyapunov_from_series"]
@@ -163,10 +164,9 @@ def lyapunov_from_series(
     def result(exponent, exponents, r2):
         doubtful = bool(reasons)
         if doubtful and warn:
-            warnings.warn(
+            warn_user(
                 f"Lyapunov estimate from the series is doubtful: {'; '.join(reasons)}",
                 DoubtfulEstimateWarning,
-                stacklevel=3,
             )
         return SeriesLyapunovResult(
             float(exponent),

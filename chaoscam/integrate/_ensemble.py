@@ -15,7 +15,6 @@ runs.
 from __future__ import annotations
 
 import time
-import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -23,6 +22,7 @@ import numpy as np
 
 from .._checks import flag, params_arg, whole
 from .._run_warnings import run_warnings
+from .._warn import warn
 from ..model import Params
 from . import _gpu
 from . import _kernel as k
@@ -169,7 +169,7 @@ def simulate_ensemble(
         raise ValueError("members must share dt and omega")
     models = {id(q): q for q in plist}.values()  # one model for all members: checked once
     for text in dict.fromkeys(w for q in models for w in run_warnings(q)):
-        warnings.warn(text, RuntimeWarning, stacklevel=2)  # as simulate() warns
+        warn(text)  # as simulate() warns
     t0 = time.perf_counter()
     room = _ROOM["gpu" if use_gpu else "cpu"]
     parts = []
@@ -377,9 +377,5 @@ def _pick_backend(backend: str) -> tuple[bool, str]:
     if ok:
         return True, reason
     if backend == "gpu":
-        warnings.warn(
-            f"GPU backend unavailable: {reason}; falling back to the CPU",
-            _gpu.GPUFallbackWarning,
-            stacklevel=3,
-        )
+        warn(f"GPU backend unavailable: {reason}; falling back to the CPU", _gpu.GPUFallbackWarning)
     return False, "cpu"

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import warnings
 from collections import Counter
 from pathlib import Path
 from typing import Any
@@ -11,6 +10,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .._warn import warn
 from ..integrate._driver import check_window
 from ..model import ParameterError
 from ._backends import make_backend
@@ -289,4 +289,4 @@ def reemit_warnings(records: list[dict]) -> None:
         for msg in filter(None, r["warnings"].split(" | ")):
             counts[msg] += 1
     for msg, n in counts.items():
-        warnings.warn(f"{n} of {len(records)} runs: {msg}", RuntimeWarning, stacklevel=4)
+        warn(f"{n} of {len(records)} runs: {msg}")
