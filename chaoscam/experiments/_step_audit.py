@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..model import Params
 from ._sensitivity import verdict_tag
 
 __all__ = [
@@ -77,19 +78,28 @@ class AuditRow:
 
 
 def sweep_names(name: str, sweeps: list) -> list[str]:
-    """``name`` for a figure's one sweep; for several, each with the base parameters in which
-    they differ (Fig. 6: "Fig. 6 (G = 1e-09, dt = 3.9e-07)")."""
-    if len(sweeps) <= 1:  # none (Figs. 3 and 5 have no sweep) or one
-        return [name] * len(sweeps)
+    """``name`` for each of a figure's sweeps, with the base parameters in which they differ
+    when there are several (Fig. 6: "Fig. 6 (G = 1e-09, dt = 3.9e-07)") and with their step
+    when it is not the model's default (Fig. 4: "Fig. 4 (dt = 3.8e-07)"): what the audit
+    halves is that step."""
+    if not sweeps:  # Figs. 3 and 5 have no sweep
+        return []
+    default_dt = Params().dt
     bases = [s.config["base"] for s in sweeps]
     keys = [k for k in bases[0] if len({repr(b.get(k)) for b in bases}) > 1]
+    if "dt" not in keys and bases[0].get("dt", default_dt) != default_dt:
+        keys.append("dt")  # the same step for all, not the default
 
     def text(v) -> str:
         return f"{v:g}" if isinstance(v, float) else str(v)
 
-    if not keys:  # the same base: they differ in their axes or windows only
-        return [f"{name} (sweep {i})" for i in range(1, len(sweeps) + 1)]
-    return [f"{name} ({', '.join(f'{k} = {text(b.get(k))}' for k in keys)})" for b in bases]
+    names = []
+    for i, b in enumerate(bases, start=1):
+        parts = [f"{k} = {text(b.get(k, default_dt if k == 'dt' else None))}" for k in keys]
+        if len(sweeps) > 1 and len({repr(b) for b in bases}) == 1:
+            parts.append(f"sweep {i}")  # the same base: they differ in axes or windows only
+        names.append(f"{name} ({', '.join(parts)})" if parts else name)
+    return names
 
 
 def draw_rows(table: pd.DataFrame, k: int, seed: int = AUDIT_SEED) -> pd.DataFrame:

@@ -75,7 +75,8 @@ def test_quick_report_audits_nothing_and_full_audits_every_sweep(quick):
 
 
 def test_a_figures_sweeps_are_named_by_what_differs():
-    """Fig. 6's two diagrams differ in G (and dt): each audited run names its sweep so."""
+    """Fig. 6's two diagrams differ in G (and dt): each audited run names its sweep so; a
+    sweep at a step other than the default names its step (the audit halves it)."""
     from types import SimpleNamespace
 
     def sweep(**base):
@@ -83,9 +84,15 @@ def test_a_figures_sweeps_are_named_by_what_differs():
 
     assert sa.sweep_names("Fig. 3", []) == []  # a figure without a sweep
     one = [sweep(G=1e-9, dt=3.9e-7)]
-    assert sa.sweep_names("Fig. 6", one) == ["Fig. 6"]
+    assert sa.sweep_names("Fig. 4", one) == ["Fig. 4 (dt = 3.9e-07)"]  # not the default step
+    assert sa.sweep_names("Fig. 7", [sweep(dt=2e-6)]) == ["Fig. 7"]  # the default step
+    assert sa.sweep_names("Fig. 7", [sweep()]) == ["Fig. 7"]
     two = [*one, sweep(G=1e-10, dt=2e-7)]
-    assert sa.sweep_names("Fig. 9", [one[0], one[0]]) == ["Fig. 9 (sweep 1)", "Fig. 9 (sweep 2)"]
+    assert sa.sweep_names("Fig. 9", [sweep(), sweep()]) == ["Fig. 9 (sweep 1)", "Fig. 9 (sweep 2)"]
+    assert sa.sweep_names("Fig. 9", [one[0], one[0]]) == [
+        "Fig. 9 (dt = 3.9e-07, sweep 1)",
+        "Fig. 9 (dt = 3.9e-07, sweep 2)",
+    ]
     assert sa.sweep_names("Fig. 6", two) == [
         "Fig. 6 (G = 1e-09, dt = 3.9e-07)",
         "Fig. 6 (G = 1e-10, dt = 2e-07)",
