@@ -25,6 +25,7 @@ def first_impacts(dt, n=3):
     return tr.impacts.iloc[:n]
 
 
+@pytest.mark.slow  # 11-17 s on 2 cores: a check of the check, run with -m slow
 def test_reference_is_converged_at_its_default_tolerance(reference):
     """The reference moves < 2e-8 s, 1e-8 rad when its rtol is cut fourfold, to 2.5e-14 (near
     solve_ivp's floor of 100 eps): it is a reference."""
