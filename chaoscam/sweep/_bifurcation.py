@@ -194,6 +194,28 @@ def _tables(records: list[dict], axis: Axis) -> tuple[pd.DataFrame, pd.DataFrame
     return points, verdicts
 
 
+STATE_FIELDS = ("theta_f0", "omega_f0")
+"""Fields of the initial state: a diagram over one of them is a slice of the basins."""
+
+
+def _check_state_axis(name: str, counted: int | None, continuation) -> None:
+    """Refuse what would overwrite a swept initial state: the other initial conditions
+    (they set the state themselves) and continuation (it carries the state over)."""
+    if name not in STATE_FIELDS:
+        return
+    if counted != 1:
+        raise SweepError(
+            f"the swept {name} is the initial state: initial_conditions must be 1 "
+            "(the other conditions set the state themselves); sweep the other field with "
+            "regime_map for a two-dimensional slice"
+        )
+    if continuation:
+        raise SweepError(
+            f"the swept {name} is the initial state: continuation (which starts each value "
+            "from the last one's state) cannot be used with it"
+        )
+
+
 def bifurcation(
     param: str | Axis,
     values: Sequence[float] | str | None = None,
@@ -239,7 +261,8 @@ def bifurcation(
     initial_conditions : int or sequence of (theta_f0, omega_f0)
         An int n: condition 0 is the base's initial state (in contact by default) and
         1 .. n-1 are spread over `IC_BOX` by :func:`initial_offsets`; or explicit states
-        [rad, rad/s].
+        [rad, rad/s]. A diagram over ``theta_f0`` or ``omega_f0`` (a slice of the basins)
+        sets that part of the state itself: it takes 1 condition and no continuation.
     continuation : bool
         Start value v+1 of each condition from the last section point of value v (at cam
         phase theta_c0, so the cam phase carries over); a run that did not end normally
@@ -278,6 +301,7 @@ def bifurcation(
     counted = isinstance(initial_conditions, numbers.Integral) and not isinstance(
         initial_conditions, bool
     )
+    _check_state_axis(axis.name, initial_conditions if counted else None, continuation)
     specs: list[tuple[str, float | None, float | None]] = []
     if counted:
         initial_conditions = whole("initial conditions", initial_conditions, low=1)
@@ -342,6 +366,8 @@ def bifurcation(
             th, om = state
         elif kind == "offset":
             th, om = float(contact_angle(p, 0.0)) + a, b
+        elif kind == "base":  # the base's state, with the swept value if the axis is one
+            th, om = p.theta_f0, p.omega_f0
         else:
             th, om = a, b
         p = p.replace(theta_f0=th, omega_f0=om)

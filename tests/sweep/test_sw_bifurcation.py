@@ -97,3 +97,36 @@ def test_paper_figure_grids_validate():
     """Fig. 6's D in [1.36, 1.56] with fractal stiffness is valid for G = 1e-9 and 1e-10 m."""
     for g in (1e-9, 1e-10):
         validate_grid(Params(stiffness="fractal", G=g), [Axis.parse("D=1.36:1.56:41")])
+
+
+@pytest.mark.parametrize("engine", ["process", "ensemble"])
+@pytest.mark.parametrize("name, values", [("theta_f0", [0.1, 0.2]), ("omega_f0", [-1.0, 1.0])])
+def test_a_diagram_over_the_initial_state_starts_each_run_there(engine, name, values):
+    """A diagram over theta_f0 or omega_f0 (a slice of the basins) starts each run at the
+    swept value: its section is the one simulate gives from there, not the default start's
+    (the base state used to overwrite it)."""
+    from chaoscam import simulate
+
+    kw = dict(duration=1.0, transient=0.5, workers=1)
+    b = bifurcation(name, values, engine=engine, **kw)
+    assert list(b.verdicts[name]) == values
+    for value in values:
+        want = simulate(Params(**{name: value}), duration=1.0, transient=0.5, series=False)
+        got = b.points[b.points["value"] == value]
+        assert np.array_equal(got["theta_f"].to_numpy(), want.section["theta_f"].to_numpy())
+
+
+@pytest.mark.parametrize(
+    "kw, what",
+    [
+        (dict(initial_conditions=2), "initial_conditions must be 1"),
+        (dict(initial_conditions=[(0.1, 0.0)]), "initial_conditions must be 1"),
+        (dict(continuation=True), "continuation"),
+    ],
+)
+def test_a_diagram_over_the_initial_state_refuses_what_would_overwrite_it(kw, what):
+    """Other initial conditions and continuation set the state themselves: refused by name."""
+    from chaoscam.sweep import SweepError
+
+    with pytest.raises(SweepError, match=what):
+        bifurcation("theta_f0", [0.1, 0.2], duration=1.0, workers=1, **kw)
