@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from ._checks import of_type
-from ._model_rules import extensible
+from ._model_rules import extensible, extension_stopped
 from .analysis import Verdict
 from .classify import EXTEND_TO, _with_settings, classify_section_run
 from .integrate import Ensemble, Status, extend_ensemble, simulate_ensemble
@@ -130,10 +130,19 @@ def member_verdicts(
             "wall_time_s": time.perf_counter() - t_wall,
             "why": "the verdict on the run as given was undetermined",
         }
-        for j, v in zip(pending, _verdicts(longer, sub), strict=True):
-            if v.verdict is not None:  # a longer run that ended early keeps the first verdict
+        last_t = longer.sections.groupby("member")["t"].max()
+        for i, (j, v) in enumerate(zip(pending, _verdicts(longer, sub), strict=True)):
+            if v.verdict is not None:
                 extended = _with_settings(v.verdict, extended=note)
                 verdicts[j] = dataclasses.replace(v, verdict=extended)
+            else:  # the longer run ended early: the first verdict stays, and says so
+                m, status = longer.members["member"].iat[i], longer.members["status"].iat[i]
+                kept = extension_stopped(
+                    verdicts[j].verdict, Status[status], float(last_t.get(m, np.nan)), recorded
+                )
+                verdicts[j] = dataclasses.replace(
+                    verdicts[j], reasons="; ".join(kept.reasons), verdict=kept
+                )
         pending = [j for j in pending if _unsettled(verdicts[j])]
     return verdicts
 

@@ -247,7 +247,34 @@ def overflow_evidence(jacobians, p: Params) -> Evidence | None:
 
 def extensible(v: Verdict) -> bool:
     """Whether an undetermined verdict may settle on a longer run (not after an overflow,
-    nor when its periodic orbit is the step's)."""
-    return v.label == "undetermined" and not any(
-        e.name in (OVERFLOW, STEP_DEPENDENT) for e in v.evidence
+    nor when its periodic orbit is the step's, nor when a longer run stopped early:
+    :func:`extension_stopped`)."""
+    return (
+        v.label == "undetermined"
+        and EXTENSION_STOPPED not in v.settings
+        and not any(e.name in (OVERFLOW, STEP_DEPENDENT) for e in v.evidence)
     )
+
+
+EXTENSION_STOPPED = "extension_stopped"
+"""``Verdict.settings`` key of :func:`extension_stopped`."""
+
+
+def extension_stopped(v: Verdict, status, stopped_at: float, wanted_s: float) -> Verdict:
+    """``v``, the verdict of the recorded window, kept when the longer run that was to
+    settle it ended early (the motion left the cam's reach at ``stopped_at`` [s], its last
+    section time, or diverged): its advice to run longer goes, since no longer window
+    exists, and a reason says so. ``settings["extension_stopped"]`` records the status, the
+    time and the recorded seconds that were wanted; the extension is not tried again."""
+    what = status.message.split(":")[0].split(". ")[0]  # "The follower left the cam's reach"
+    why = (
+        f"no longer window exists: extended to {wanted_s:g} s recorded, the run stopped "
+        f"after t = {stopped_at:.4g} s ({status.name}: {what[0].lower() + what[1:]}), so "
+        "the verdict is the recorded window's"
+    )
+    reasons = tuple(r for r in v.reasons if not r.startswith("to decide:"))
+    settings = {
+        **v.settings,
+        EXTENSION_STOPPED: {"status": status.name, "at_s": stopped_at, "wanted_s": wanted_s},
+    }
+    return dataclasses.replace(v, reasons=(*reasons, why), settings=settings)

@@ -10,6 +10,7 @@ T = 2 pi / omega, and optionally adds the model's own Lyapunov exponent
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 import time
 from typing import Any
@@ -19,7 +20,13 @@ import numpy as np
 from . import _step_check as step_check
 from ._checks import flag, of_type, real
 from ._extend import extend_trajectory
-from ._model_rules import MODEL_ATOL, extensible, overflow_evidence, with_model_evidence
+from ._model_rules import (
+    MODEL_ATOL,
+    extensible,
+    extension_stopped,
+    overflow_evidence,
+    with_model_evidence,
+)
 from ._simulate import Trajectory, simulate
 
 # the step check's re-simulation under this module's name, which tests replace
@@ -268,8 +275,9 @@ def _extended(tr, verdict, extra, discard, options, cap) -> tuple[Verdict, dict]
         else:
             longer = extend_trajectory(base, start + recorded, series=False)
         base = longer
-        if longer.status is not Status.OK:
-            break
+        if longer.status is not Status.OK:  # no longer window: say so, keep the verdict
+            at = float(longer.section["t"].iloc[-1]) if len(longer.section) else math.nan
+            return extension_stopped(verdict, longer.status, at, recorded), extra
         verdict, extra = _tangent_verdict(longer, discard, options)
         extra["extended"] = {
             "recorded_s": recorded,
