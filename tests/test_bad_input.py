@@ -508,3 +508,12 @@ def test_the_wrong_kind_of_object_is_named(i):
     call, named = WRONG_KIND_CASES[i]
     with pytest.raises(TypeError, match=named):
         call()
+
+
+def test_a_step_longer_than_the_contact_period_is_said_so():
+    """dt = 1 s against a contact period of 9.14e-5 s: a step 1.09e4 times the period, not
+    "0.0 steps"."""
+    from chaoscam._run_warnings import resolution_warning
+
+    assert "with a step 1.09e+04x the period;" in resolution_warning(Params(dt=1.0))
+    assert "with only 1.8 steps" in resolution_warning(Params(dt=5e-5))

@@ -122,7 +122,8 @@ def exponent_evidence(
     gap = abs(lam - eps)
     factor = math.inf if gap == 0 else (z * se / gap) ** 2
     if math.isfinite(factor) and factor <= 1e4:
-        more = f"run the exponent ~{math.ceil(factor)}x longer"
+        times = f"{factor:.3g}" if factor < 10 else f"{math.ceil(factor)}"  # not ~2x for 1.13x
+        more = f"run the exponent ~{times}x longer"
         if n_intervals is not None:
             more += f" ({n_intervals} -> {math.ceil(factor * n_intervals)} intervals)"
         more += " to decide"

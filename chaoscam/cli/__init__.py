@@ -114,7 +114,8 @@ def main(argv: list[str] | None = None) -> int:
 
     0 success, 1 a run that could not do what was asked (its cause printed), 2 bad input
     (a message naming the field or path, never a traceback), 130 Ctrl-C and 143 SIGTERM
-    (both after saving finished work and saying how to resume). A Ctrl-C at any point of
+    (both after saving finished work and saying how to resume), 141 when the reader of
+    stdout left (``| head``: no message, as a shell reports SIGPIPE). A Ctrl-C at any point of
     this function, the imports of start-up included, gives one line and 130.
     """
     previous = None
@@ -239,6 +240,18 @@ def _command_parser(parser, args):
     return parser
 
 
+def _mute_stdout() -> None:
+    """Point stdout at /dev/null, so that the interpreter's flush of what is left at exit
+    does not fail again on the closed pipe (the Python documentation's recipe for SIGPIPE)."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):  # no real stdout (captured in tests)
+        pass
+
+
 def _dispatch(argv: list[str] | None) -> int:
     import warnings
 
@@ -262,6 +275,9 @@ def _dispatch(argv: list[str] | None) -> int:
     except (ParameterError, UsageError, OutputError, FileExistsError) as err:
         print(f"chaoscam: error: {err}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # the reader of stdout left (`chaoscam classify ... | head`)
+        _mute_stdout()
+        return 141  # as a shell reports a command stopped by SIGPIPE
     except OSError as err:  # a file the command reads or writes: never a traceback
         print(f"chaoscam: error: {err}", file=sys.stderr)
         return 2

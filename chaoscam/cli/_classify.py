@@ -136,6 +136,11 @@ def run_classify_series(args: argparse.Namespace) -> int:
             raise UsageError(f"--forcing-period {args.forcing_period}: must be a finite number > 0")
     if args.dt is not None and len(args.column) != 1:
         raise UsageError("--dt takes one --column (a scalar signal)")
+    twice = sorted({c for c in args.column if args.column.count(c) > 1})
+    if twice:  # a repeated coordinate would weigh twice in the section's distances
+        raise UsageError(
+            f"--column {', '.join(map(repr, twice))} given more than once: name each once"
+        )
     path = args.file
     if not path.is_file():
         what = "is a directory; give a CSV file" if path.is_dir() else "no such file"

@@ -36,10 +36,10 @@ def read_sweeps(folder: Path, figures) -> list[tuple[str, object]]:
         for file in files:
             path = folder / file
             if not path.is_file():
-                raise FileNotFoundError(
-                    f"{path} is missing: write it with `chaoscam paper --out "
-                    f"{folder.parent}/paper.html` or `python analyses/fig{number}.py {folder}`"
-                )
+                how = f"`python analyses/fig{number}.py {folder}`"
+                if folder.name == "paper-data":  # where chaoscam paper writes its data
+                    how = f"`chaoscam paper --out {folder.parent}/paper.html` or {how}"
+                raise FileNotFoundError(f"{path} is missing: write it with {how}")
             found.append(read_regime_map(path) if number == 7 else read_bifurcation(path))
         out += zip(sweep_names(name, found), found, strict=True)
     return out

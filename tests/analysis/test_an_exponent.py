@@ -26,10 +26,16 @@ def test_minus_infinity_is_decisively_not_chaotic():
 
 
 def test_straddling_interval_abstains_and_says_how_much_longer():
-    """λ = 0.05 ± 0.02 over 100 intervals: the interval contains 0.01: abstain, run 2.25x (3x)."""
+    """λ = 0.05 ± 0.02 over 100 intervals: the interval contains 0.01: abstain, run 2.25x
+    longer (225 intervals); a factor of 10 and more is rounded up to a whole one, and a
+    factor near 1 is not (it read "~2x longer (46 -> 52 intervals)")."""
     e = exponent_evidence(0.05, 0.02, 100)
     assert e.vote is None
-    assert "3x longer" in e.detail and "225 intervals" in e.detail
+    assert "~2.25x longer" in e.detail and "225 intervals" in e.detail
+    e = exponent_evidence(0.02, 0.02, 46)  # (3 x 0.02 / 0.01)^2 = 36
+    assert "~36x longer" in e.detail and "(46 -> 1656 intervals)" in e.detail
+    e = exponent_evidence(0.05, 0.01417, 46)  # (3 x 0.01417 / 0.04)^2 = 1.13
+    assert "~1.13x longer" in e.detail and "(46 -> 52 intervals)" in e.detail
 
 
 def test_missing_stderr_or_nan_abstains():

@@ -112,8 +112,18 @@ def test_series_with_section_points(tmp_path, capsys):
         (["--column", "x", "--dt", "0"], "x\n1\n2\n", "--dt"),
         (["--column", "x", "--section", "--forcing-period", "1"], "x\n1\n2\n", "forcing"),
         (["--column", "x", "--dt", "0.1"], "x\n1\nfoo\n", "not numbers"),
+        (["--column", "x", "--column", "x", "--section"], "x\n1\n2\n", "'x' given more than once"),
     ],
-    ids=["missing-file", "missing-column", "nan", "no-mode", "bad-dt", "section-forcing", "text"],
+    ids=[
+        "missing-file",
+        "missing-column",
+        "nan",
+        "no-mode",
+        "bad-dt",
+        "section-forcing",
+        "text",
+        "column-twice",
+    ],
 )
 def test_series_bad_input_exits_2(tmp_path, capsys, extra, content, message):
     """Bad input to classify-series: a clear message on stderr and exit code 2."""
@@ -136,3 +146,21 @@ def test_classify_series_on_a_directory_says_so(tmp_path, capsys):
     """A directory given as the CSV file is named as a directory (it said "no such file")."""
     assert main(["classify-series", str(tmp_path), "--column", "x", "--dt", "0.001"]) == 2
     assert "is a directory; give a CSV file" in capsys.readouterr().err
+
+
+def test_a_closed_pipe_ends_quietly(traj_file):
+    """`chaoscam classify RUN | head -c 10`: the reader leaves before the verdict is written;
+    no "Broken pipe" error and no traceback, exit 141 as a shell reports SIGPIPE."""
+    import subprocess
+    import sys
+
+    code = "import sys; from chaoscam.cli import main; sys.exit(main(sys.argv[1:]))"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code, "classify", str(traj_file), "--no-extend"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    proc.stdout.close()  # the reader is gone before anything is written
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 141, err
+    assert "Broken pipe" not in err and "Traceback" not in err

@@ -141,6 +141,9 @@ def test_audit_script_reads_a_reports_data_and_refuses_bad_input(tmp_path, capsy
     assert out[1].startswith("Step audit: 1 run labelled") and "1 reproduces its label" in out[1]
     for bad, says in (
         ([*args, str(tmp_path / "none")], "fig4.parquet is missing"),
+        # chaoscam paper writes a paper-data folder: named only for one
+        ([*args, str(tmp_path / "none")], f"with `python analyses/fig4.py {tmp_path}/none`"),
+        ([*args, str(tmp_path / "paper-data")], f"`chaoscam paper --out {tmp_path}/paper.html`"),
         (["--per-sweep", "0", str(tmp_path)], "--per-sweep 0: must be at least 1"),
         (["--extend-to", "-1", str(tmp_path)], "--extend-to -1.0: must be"),
         (["--extend-to", "inf", str(tmp_path)], "--extend-to inf: must be a finite"),
