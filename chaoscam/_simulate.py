@@ -125,7 +125,8 @@ class Trajectory:
     def to_parquet(self, path) -> None:
         """Write the time series (or, without one, the section) with provenance metadata."""
         import pyarrow as pa
-        import pyarrow.parquet as pq
+
+        from ._parquet import write_table
 
         frame = self.series if self.series is not None else self.section
         table = pa.Table.from_pandas(frame, preserve_index=False)
@@ -134,7 +135,7 @@ class Trajectory:
         for name in ("section", "impacts"):
             frame_json = getattr(self, name).to_json(orient="split", double_precision=15)
             meta[f"chaoscam.{name}".encode()] = frame_json.encode()
-        pq.write_table(table.replace_schema_metadata(meta), path)
+        write_table(table.replace_schema_metadata(meta), path)
 
 
 def _check_run(

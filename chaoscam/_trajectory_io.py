@@ -79,7 +79,8 @@ def load_trajectory(path) -> Trajectory:
         Not a Parquet file, or not one written by chaoscam (the message names the file).
     """
     import pyarrow as pa
-    import pyarrow.parquet as pq
+
+    from ._parquet import DamagedFileError, read_table
 
     path = Path(path)
     if path.is_dir():
@@ -87,7 +88,9 @@ def load_trajectory(path) -> Trajectory:
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
     try:
-        table = pq.read_table(path)
+        table = read_table(path)
+    except DamagedFileError as err:
+        raise ValueError(str(err)) from None
     except (pa.ArrowException, OSError) as err:
         raise ValueError(f"{path}: not a Parquet file ({err})") from err
     meta = table.schema.metadata or {}

@@ -13,6 +13,8 @@ LAYERS = (
     "chaoscam._version",
     "chaoscam._provenance",
     "chaoscam._lazy",
+    "chaoscam._warn",
+    "chaoscam._parquet",
     "chaoscam.model",
     "chaoscam._checks",
     "chaoscam._outputs",

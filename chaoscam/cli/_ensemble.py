@@ -281,7 +281,7 @@ def _run_locked(args: argparse.Namespace) -> int:
             table = tables[name].assign(member=tables[name]["member"] + offset)
             path = parts / f"{start:012d}.{name}.parquet"
             with atomic_path(path) as tmp:
-                table.to_parquet(tmp, index=False)
+                table.to_parquet(tmp, index=False, write_page_checksum=True)
             files[name] = fingerprint(path)
         atomic_text(
             parts / f"{start:012d}.done",

@@ -16,6 +16,8 @@ import sys
 from pathlib import Path
 
 from .._outputs import OutputError, atomic_path
+from .._parquet import read_frame
+from .._parquet import write_table as parquet_table
 from ..report._inputs import ENSEMBLE_KEY as _META_KEY
 from ..report._inputs import ENSEMBLE_RECORD_KEY
 
@@ -114,13 +116,12 @@ def recorded_config(out: Path) -> dict | None:
 
 def write_table(frame, path: Path, stamp: dict[bytes, bytes] | None = None) -> None:
     import pyarrow as pa
-    import pyarrow.parquet as pq
 
     table = pa.Table.from_pandas(frame, preserve_index=False)
     if stamp:
         table = table.replace_schema_metadata({**(table.schema.metadata or {}), **stamp})
     with atomic_path(path) as tmp:
-        pq.write_table(table, tmp)
+        parquet_table(table, tmp)
 
 
 def run_record(parts: Path, starts: range, config: dict) -> dict:
@@ -169,7 +170,7 @@ def commit_parts(
     }
     for name in names:
         frame = pd.concat(
-            [pd.read_parquet(parts / f"{s:012d}.{name}.parquet") for s in starts],
+            [read_frame(parts / f"{s:012d}.{name}.parquet") for s in starts],
             ignore_index=True,
         )
         if name == "members":

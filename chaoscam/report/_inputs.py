@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .._parquet import read_frame
+
 __all__ = [
     "EnsembleOutput",
     "InputError",
@@ -98,7 +100,6 @@ def load_trajectory(path: str | Path):
 def load_ensemble(path: str | Path) -> EnsembleOutput:
     """An :class:`EnsembleOutput` from a ``chaoscam ensemble`` members file (or its
     ``.sections.parquet``), with the sections file beside it when there is one."""
-    import pandas as pd
 
     path = Path(path)
     if Path(path.stem).suffix == ".sections":
@@ -112,8 +113,8 @@ def load_ensemble(path: str | Path) -> EnsembleOutput:
         raise InputError(f"{path}: its ensemble record is not readable JSON") from None
     sections = path.with_suffix(".sections.parquet")
     try:
-        members = pd.read_parquet(path)
-        sec = pd.read_parquet(sections) if sections.is_file() else None
+        members = read_frame(path)
+        sec = read_frame(sections) if sections.is_file() else None
     except Exception as err:  # pyarrow raises several types for damaged files
         raise InputError(f"{path}: could not read the ensemble ({err})") from None
     missing = {"member", "status"} - set(members.columns)

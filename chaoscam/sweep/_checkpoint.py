@@ -348,7 +348,8 @@ def write_parquet(
     """Write ``frame`` atomically, with the configuration and its hash as file metadata
     (``replace=False``: never over a file that exists; :func:`chaoscam._outputs.atomic_path`)."""
     import pyarrow as pa
-    import pyarrow.parquet as pq
+
+    from .._parquet import write_table
 
     table = pa.Table.from_pandas(frame, preserve_index=False)
     meta = dict(table.schema.metadata or {})
@@ -356,7 +357,7 @@ def write_parquet(
     from .._outputs import atomic_path
 
     with atomic_path(path, replace=replace) as tmp:
-        pq.write_table(table.replace_schema_metadata(meta), tmp)
+        write_table(table.replace_schema_metadata(meta), tmp)
 
 
 def read_sweep_metadata(path: Path) -> dict[str, Any] | None:

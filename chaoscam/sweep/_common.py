@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .._parquet import read_frame
 from .._warn import warn
 from ..integrate._driver import check_window
 from ..model import ParameterError
@@ -140,7 +141,7 @@ def read_tables(
         )
     if not other.is_file():
         raise FileNotFoundError(f"{other}: no such file; a {what} is {path.name} and {other.name}")
-    return pd.read_parquet(path), pd.read_parquet(other), config
+    return read_frame(path), read_frame(other), config
 
 
 def lock_outputs(out: Path | None):
