@@ -177,10 +177,38 @@ def run_classify_series(args: argparse.Namespace) -> int:
     try:
         if args.section:
             points = data[:, 0] if data.shape[1] == 1 else data
-            verdict = classify_section(points)
+            verdict = _uncertified(classify_section(points), points)
         else:
             verdict = classify_signal(data[:, 0], args.dt, args.forcing_period)
     except ValueError as err:
         raise UsageError(f"{path}: {err}") from None
     _print(verdict)
     return 0
+
+
+def _uncertified(verdict, points):
+    """A periodic section verdict whose bands have a measurable width (over 1e-6 of the
+    orbit's extent) gets a reason saying what it rests on: data alone cannot tell a period
+    from chaos confined to bands narrower than the tolerance, as chaoscam's own runs show
+    (the default model's section: 8 bands up to 8e-4 of the extent wide, chaotic by its
+    tangent exponent). ``chaoscam classify`` has the model, and decides such runs."""
+    import dataclasses
+
+    import numpy as np
+
+    from ..analysis import section_period
+
+    if verdict.label != "periodic":
+        return verdict
+    pr = section_period(points, rtol=verdict.settings.get("rtol"))
+    extent = np.where(pr.extent > 0, pr.extent, np.inf)
+    widest = float(np.max(pr.jitter / extent)) if pr.period else 0.0
+    if not widest > 1e-6:
+        return verdict
+    why = (
+        f"periodic to the tolerance, not certified: its {verdict.period} band(s) are up to "
+        f"{widest:.2g} of the orbit's extent wide, and chaos confined to bands that narrow "
+        "looks the same on points alone; for a chaoscam run, `chaoscam classify RUN` decides "
+        "it with the tangent exponent and a certified orbit"
+    )
+    return dataclasses.replace(verdict, reasons=(*verdict.reasons, why))

@@ -100,6 +100,23 @@ def test_series_with_section_points(tmp_path, capsys):
     assert main(argv) == 0
     out = _json(capsys)
     assert (out["label"], out["period"]) == ("periodic", 3)
+    assert out["reasons"] == []  # exact points: nothing to add
+
+
+def test_series_section_with_wide_bands_says_it_is_not_certified(tmp_path, capsys):
+    """The default model's section (8 bands up to 8e-4 of the extent, chaotic by its
+    tangent exponent) is periodic 8 to the tolerance on points alone: the verdict says it
+    is not certified and how to decide it."""
+    import chaoscam
+
+    tr = chaoscam.simulate(chaoscam.Params(), duration=20)
+    tr.section[["theta_f", "omega_f"]].to_csv(tmp_path / "s.csv", index=False)
+    argv = ["classify-series", str(tmp_path / "s.csv"), "--section"]
+    assert main([*argv, "--column", "theta_f", "--column", "omega_f"]) == 0
+    out = _json(capsys)
+    assert (out["label"], out["period"]) == ("periodic", 8)
+    assert out["reasons"][-1].startswith("periodic to the tolerance, not certified: its 8 band")
+    assert "`chaoscam classify RUN`" in out["reasons"][-1]
 
 
 @pytest.mark.parametrize(
