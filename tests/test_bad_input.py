@@ -518,3 +518,24 @@ def test_a_step_longer_than_the_contact_period_is_said_so():
 
     assert "with a step 1.09e+04x the period;" in resolution_warning(Params(dt=1.0))
     assert "with only 1.8 steps" in resolution_warning(Params(dt=5e-5))
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["simulate", "--out", ""],
+        ["simulate", "--section", " "],
+        ["ensemble", "--members", "2", "--out", ""],
+        ["regime-map", "--x", "omega=20:30:2", "--y", "xi=0.2:0.3:2", "--out", ""],
+        ["classify", ""],
+        ["report", "--out", ""],
+    ],
+    ids=["simulate", "section", "ensemble", "regime-map", "classify", "report"],
+)
+def test_an_empty_path_is_refused_as_such(argv, capsys):
+    """`--out ''` read as the current folder ("--out .: the file must end in .parquet"): now
+    every file argument refuses an empty path by name, exit 2."""
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2
+    assert "an empty path: give a file name" in capsys.readouterr().err

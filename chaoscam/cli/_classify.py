@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from pathlib import Path
+
+from ._options import path_arg
 
 __all__ = ["register"]
 
@@ -19,7 +20,7 @@ def register(sub) -> None:
         "(label, period, evidence, reasons; and, when an undetermined verdict was settled "
         "by running the realization longer, extended: the recorded time it took).",
     )
-    p.add_argument("trajectory", type=Path, metavar="TRAJ.parquet")
+    p.add_argument("trajectory", type=path_arg, metavar="TRAJ.parquet")
     p.add_argument(
         "--no-tangent",
         action="store_true",
@@ -60,7 +61,7 @@ def register(sub) -> None:
         "evidence, reasons). With --dt the rows are a uniformly sampled signal of a flow; "
         "with --section they are already Poincaré-section points (map iterates).",
     )
-    q.add_argument("file", type=Path, metavar="FILE.csv")
+    q.add_argument("file", type=path_arg, metavar="FILE.csv")
     q.add_argument(
         "--column",
         action="append",

@@ -38,7 +38,7 @@ from ._ensemble_parts import (
     part_done,
     recorded_config,
 )
-from ._options import add_run_options
+from ._options import add_run_options, path_arg
 
 __all__ = ["register"]
 
@@ -96,7 +96,7 @@ def register(sub) -> None:
         help="start over: replace existing outputs and discard unfinished parts",
     )
     p.add_argument("--quiet", action="store_true", help="no progress lines")
-    p.add_argument("--out", type=Path, required=True, help="members to FILE.parquet")
+    p.add_argument("--out", type=path_arg, required=True, help="members to FILE.parquet")
     p.set_defaults(func=run)
 
 

@@ -6,7 +6,19 @@ the same on ``simulate``, ``ensemble``, ``bifurcation`` and ``regime-map``.
 
 from __future__ import annotations
 
-__all__ = ["add_run_options"]
+import argparse
+from pathlib import Path
+
+__all__ = ["add_run_options", "path_arg"]
+
+
+def path_arg(text: str) -> Path:
+    """The argparse type of every file argument: ``Path(text)``, but an empty text is refused
+    (``Path("")`` is the current folder, and ``--out ''`` read as "--out .: the file must
+    end in .parquet")."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path: give a file name")
+    return Path(text)
 
 
 def add_run_options(p, *, transient: float | None) -> None:

@@ -7,6 +7,8 @@ import shlex
 import sys
 from pathlib import Path
 
+from ._options import path_arg
+
 __all__ = ["register"]
 
 
@@ -25,7 +27,7 @@ def register(sub) -> None:
         "opens from disk and refers to no network address.",
     )
     r.add_argument("inputs", nargs="+", metavar="INPUT", help="chaoscam .parquet outputs")
-    r.add_argument("--out", type=Path, required=True, help="the report, FILE.html")
+    r.add_argument("--out", type=path_arg, required=True, help="the report, FILE.html")
     r.add_argument("--title", default="chaoscam report", help="the report's title")
     r.add_argument("--force", action="store_true", help="replace an existing report")
     r.set_defaults(func=run_report)
@@ -45,7 +47,7 @@ def register(sub) -> None:
     )
     p.add_argument(
         "--out",
-        type=Path,
+        type=path_arg,
         default=None,
         help=f"the report (default {DEFAULT_PAPER}, created with its folder; git ignores "
         "it: the committed reports/paper.html is written only when named)",

@@ -5,9 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 import warnings
-from pathlib import Path
 
-from ._options import add_run_options
+from ._options import add_run_options, path_arg
 
 __all__ = ["register"]
 
@@ -22,9 +21,9 @@ def register(sub) -> None:
     add_run_options(p, transient=0.0)
     p.add_argument("--index", type=int, default=0, help="realization index under the seed")
     p.add_argument("--output-dt", type=float, default=1e-3, help="series sampling [s]")
-    p.add_argument("--out", type=Path, help="time series to FILE.parquet or FILE.csv")
-    p.add_argument("--section", type=Path, help="stroboscopic section to FILE.csv")
-    p.add_argument("--impacts", type=Path, help="impact list to FILE.csv")
+    p.add_argument("--out", type=path_arg, help="time series to FILE.parquet or FILE.csv")
+    p.add_argument("--section", type=path_arg, help="stroboscopic section to FILE.csv")
+    p.add_argument("--impacts", type=path_arg, help="impact list to FILE.csv")
     p.add_argument("--force", action="store_true", help="replace existing output files")
     p.set_defaults(func=run)
 

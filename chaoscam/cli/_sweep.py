@@ -7,7 +7,7 @@ import math
 import sys
 from pathlib import Path
 
-from ._options import add_run_options
+from ._options import add_run_options, path_arg
 
 __all__ = ["register"]
 
@@ -88,7 +88,10 @@ def _common(p: argparse.ArgumentParser) -> None:
         "left_at): transient chaos",
     )
     p.add_argument(
-        "--plot", type=Path, default=None, help="also draw the figure to FILE (.png, .pdf or .svg)"
+        "--plot",
+        type=path_arg,
+        default=None,
+        help="also draw the figure to FILE (.png, .pdf or .svg)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument(
@@ -96,7 +99,7 @@ def _common(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="start over: replace existing outputs and discard an existing checkpoint",
     )
-    p.add_argument("--out", type=Path, required=True, help="output FILE.parquet")
+    p.add_argument("--out", type=path_arg, required=True, help="output FILE.parquet")
 
 
 def register(sub) -> None:
