@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._simulate import SECTION_COLUMNS, SERIES_COLUMNS, Trajectory
+from ._simulate import IMPACT_COLUMNS, IMPACT_KINDS, SECTION_COLUMNS, SERIES_COLUMNS, Trajectory
 from .integrate import Status
 from .model import Params
 
@@ -109,8 +109,10 @@ def load_trajectory(path) -> Trajectory:
         prov = json.loads(meta[b"chaoscam.trajectory"])
         params = Params(**prov["params"])
         status = Status[prov["status"]]
-        section = pd.read_json(StringIO(meta[b"chaoscam.section"].decode()), orient="split")
-        impacts = pd.read_json(StringIO(meta[b"chaoscam.impacts"].decode()), orient="split")
+        section, impacts = (
+            pd.read_json(StringIO(meta[key].decode()), orient="split", precise_float=True)
+            for key in (b"chaoscam.section", b"chaoscam.impacts")
+        )
         settings = dict(prov["settings"])
         stats = dict(prov.get("stats", {}))
     except (KeyError, TypeError, ValueError) as err:
@@ -131,8 +133,12 @@ def load_trajectory(path) -> Trajectory:
                     "numbers; not a file chaoscam wrote (or it was edited)"
                 )
     section = section.reindex(columns=list(SECTION_COLUMNS))
-    if len(section):
-        section["k"] = section["k"].astype(np.int64)
+    if len(section):  # JSON does not keep dtypes: 0.0 alone reads back as an integer
+        section = section.astype({c: np.int64 if c == "k" else np.float64 for c in section})
+    if len(impacts) and set(impacts.columns) == set(IMPACT_COLUMNS):  # as simulate gives them
+        floats = {c: np.float64 for c in impacts.columns if c != "kind"}
+        impacts = impacts.astype(floats)
+        impacts["kind"] = pd.Categorical(impacts["kind"], categories=list(IMPACT_KINDS))
     last = frame.iloc[-1] if len(frame) else None
     final = (
         (float(last["t"]), float(last["theta_f"]), float(last["omega_f"]))
