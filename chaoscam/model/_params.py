@@ -333,12 +333,12 @@ class Params:
             value = getattr(self, f.name)
             if type(value).__module__ == "numpy" and getattr(value, "size", 0) == 1:
                 value = value.item()  # numpy scalars: stored as Python numbers
-                object.__setattr__(self, f.name, value)
             _validate_field(f, value)
-            if f.type == "int" and isinstance(value, float):  # 4.0 -> 4 (4.5 refused above)
-                object.__setattr__(self, f.name, int(value))
-        if self.stiffness == "fractal":
-            # Raises a ParameterError naming D or G when (15)/(17) do not apply.
+            kind = {"int": int, "float": float, "float | None": float}.get(f.type)  # 30 -> 30.0
+            if kind and value is not None and type(value) is not kind:  # equal Params, records
+                value = kind(value)
+            object.__setattr__(self, f.name, value)
+        if self.stiffness == "fractal":  # a ParameterError naming D or G where (15)/(17) fail
             from ._stiffness import fractal_stiffness
 
             fractal_stiffness(self.E, self.D, self.G, self.k, self.phi, self.A_r)
