@@ -72,8 +72,9 @@ def of_type(name: str, value: Any, cls: type, made_by: str) -> Any:
     return value
 
 
-def params_arg(params: Any):
-    """The ``params`` argument of an API function: a :class:`Params`, or None for defaults."""
+def params_arg(params: Any, name: str = "params"):
+    """The ``params`` argument of an API function (or another argument ``name`` holding a
+    model, a sweep's ``base``): a :class:`Params`, or None for defaults."""
     from .model import Params
 
     if params is None:
@@ -81,12 +82,13 @@ def params_arg(params: Any):
     if isinstance(params, Params):
         return params
     if isinstance(params, dict):
+        keywords = ", or pass the fields as keywords, e.g. simulate(omega=30.0)"
         raise TypeError(
-            "params must be a chaoscam.Params, got a dict: use Params(**d), or pass the "
-            "fields as keywords, e.g. simulate(omega=30.0)"
+            f"{name} must be a chaoscam.Params, got a dict: use Params(**d)"
+            + (keywords if name == "params" else "")
         )
     raise TypeError(
-        f"params must be a chaoscam.Params or None, got {type(params).__name__} {params!r}"
+        f"{name} must be a chaoscam.Params or None, got {type(params).__name__} {params!r}"
     )
 
 

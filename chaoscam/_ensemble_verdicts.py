@@ -20,7 +20,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pandas as pd
 
-from ._checks import of_type
+from ._checks import of_type, real
 from ._model_rules import extensible, extension_stopped
 from .analysis import Verdict
 from .classify import EXTEND_TO, _with_settings, classify_section_run
@@ -87,6 +87,8 @@ def member_verdicts(
     each batch of it (n members just run), so that a progress bar can grow its total.
     """
     of_type("ens", ens, Ensemble, "from chaoscam.integrate.simulate_ensemble")
+    if extend_to is not None:  # as classify_trajectory checks it
+        extend_to = real("extend_to", extend_to, low=0.0, unit="s")
     if ens.jacobians is None:
         raise ValueError("classify_ensemble needs an ensemble run with tangent=True")
     members = ens.members

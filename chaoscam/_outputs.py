@@ -139,8 +139,9 @@ def _place_new(tmp: Path, path: Path) -> None:
         kept = conflict_name(path)
         os.replace(tmp, kept)
         raise OutputError(
-            f"{path} appeared while this run was working (another process wrote it); it was "
-            f"not overwritten, and this run's result is in {kept}"
+            f"{path} exists: another process wrote it while this run worked, or (a call with "
+            "replace=False) it was there before; it was not overwritten, and this run's "
+            f"result is in {kept}"
         ) from None
 
 

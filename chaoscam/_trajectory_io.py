@@ -68,8 +68,11 @@ def load_trajectory(path) -> Trajectory:
 
     The table holds the series (or, for a run without one, the section); the metadata keys
     ``chaoscam.trajectory`` (params, settings, status, stats), ``chaoscam.section`` and
-    ``chaoscam.impacts`` (JSON, pandas "split" orientation, 10 decimals) hold the rest.
-    ``final_state`` is not stored: it is taken from the last row of the table.
+    ``chaoscam.impacts`` (JSON, pandas "split" orientation, floats exact; files written
+    before 2026-11-26 kept 15 significant digits) hold the rest, read back with their dtypes.
+    Not stored: the Jacobians of a ``tangent=True`` run (``lyapunov_spectrum`` says so;
+    ``classify_trajectory`` simulates the tangent again) and ``final_state``, taken from the
+    last row of the table (with ``series=False``, the last section point, not the run's end).
 
     Raises
     ------

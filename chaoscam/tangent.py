@@ -62,7 +62,24 @@ def lyapunov_spectrum(
     random line length (σ > 0) the exponents are those of the realization's random map
     sequence.
     """
-    if trajectory is None:
+    if trajectory is not None:
+        given = {
+            k_: v
+            for k_, v, default in (
+                ("params", params, None),
+                ("duration", duration, 120.0),
+                ("transient", transient, 60.0),
+                ("seed", seed, 0),
+                ("index", index, 0),
+            )
+            if v is not default and v != default
+        }
+        if given:  # they would be silently ignored: the trajectory's own are used
+            raise ParameterError(
+                f"give a trajectory or the run's settings, not both: {', '.join(given)} "
+                "would be ignored (the trajectory's own are used)"
+            )
+    else:
         from ._simulate import simulate
 
         trajectory = simulate(
@@ -75,11 +92,22 @@ def lyapunov_spectrum(
             tangent=True,
         )
     if trajectory.jacobians is None:
+        if trajectory.settings.get("tangent"):  # simulated with it, the Jacobians not kept
+            raise ValueError(
+                "the trajectory's Jacobians were not kept (a trajectory read from a file "
+                "has none): simulate it again with tangent=True"
+            )
         raise ValueError("the trajectory was simulated without tangent=True")
     if trajectory.status is not Status.OK:
         raise ValueError(f"the run ended {trajectory.status.name}: {trajectory.message}")
     jac = trajectory.jacobians
     keep = trajectory.section["k"].to_numpy() > 0  # the k = 0 row is the initial state
+    if not keep.any():
+        raise ValueError(
+            f"the run records no section point after its start (duration "
+            f"{trajectory.settings['duration']:g} s, cam period "
+            f"{trajectory.params.cam_period:.3g} s): nothing to take exponents from"
+        )
     spec = spectrum_from_jacobians(jac[keep], trajectory.params.cam_period)
     return TangentSpectrum(
         exponents=spec.exponents,
@@ -206,6 +234,10 @@ class PeriodicOrbit:
         Newton iterations used.
     wall_time : float
         Seconds spent.
+    settings : dict
+        tol, max_iter, map_calls, cam_period, seed_period, and seed_status: how the map
+        from ``x0`` ended (``LEFT_REACH`` or a divergence: no orbit was found from there,
+        the multipliers are NaN).
     """
 
     period: int
@@ -292,6 +324,7 @@ def periodic_orbit(
     run = _MapRunner(params, n)
     w = np.array([1.0, params.cam_period])
     fx, m, code = run(x)
+    first = Status(code)  # how the map from the seed ended (not OK: no orbit from there)
     res = float(np.linalg.norm((fx - x) * w)) if code == k.OK else math.inf
     it = 0
     while it < max_iter and res > tol and math.isfinite(res):
@@ -323,10 +356,11 @@ def periodic_orbit(
         if n % d == 0 and np.linalg.norm((pts[d] - pts[0]) * w) <= max(0.01 * tol, 10 * res):
             least = d
             break
-    mult = np.linalg.eigvals(m)
     if least < n:
-        mult = np.linalg.eigvals(stroboscopic_map(params, x, least)[1])
+        m = stroboscopic_map(params, x, least)[1]
         pts = pts[:least]
+    # A map that left the model (the seed off the cam's reach) has no Jacobian: NaN.
+    mult = np.linalg.eigvals(m) if np.isfinite(m).all() else np.full(2, np.nan + 0j)
     return PeriodicOrbit(
         period=least,
         points=pts,
@@ -341,5 +375,6 @@ def periodic_orbit(
             "map_calls": run.calls + one.calls,
             "cam_period": params.cam_period,
             "seed_period": n,
+            "seed_status": first.name,  # e.g. LEFT_REACH: the map from x0 left the model
         },
     )

@@ -234,6 +234,18 @@ def test_two_writers_started_together(tmp_path):
     assert len(pd.read_parquet(out)) == 3 * 4 + 3
 
 
+def test_atomic_path_without_replace_says_when_the_file_was_there_before(tmp_path):
+    """replace=False over a file that existed before the call: kept, and the error allows
+    that it was there before (it said only "another process wrote it")."""
+    out = tmp_path / "pre.html"
+    out.write_text("old")
+    said = r"pre.html exists: .* or \(a call with replace=False\) it was there before"
+    with pytest.raises(OutputError, match=said):
+        with atomic_path(out, replace=False) as tmp:
+            tmp.write_text("ours")
+    assert out.read_text() == "old"
+
+
 def test_atomic_path_without_replace_keeps_a_file_that_appeared_meanwhile(tmp_path):
     """replace=False (an output checked absent, no --force): a file another process wrote
     while this one worked is kept as it is, this one's result goes beside it as NAME.PID.SUFFIX,
@@ -241,7 +253,7 @@ def test_atomic_path_without_replace_keeps_a_file_that_appeared_meanwhile(tmp_pa
     from chaoscam._outputs import conflict_name
 
     out = tmp_path / "x.csv"
-    with pytest.raises(OutputError, match="appeared while this run was working") as err:
+    with pytest.raises(OutputError, match="another process wrote it while this run worked") as err:
         with atomic_path(out, replace=False) as tmp:
             tmp.write_text("ours")
             out.write_text("theirs")  # another process, meanwhile
@@ -269,7 +281,7 @@ def test_a_sweep_does_not_replace_an_output_written_during_its_run(tmp_path, mon
 
     monkeypatch.setattr(_batch, "run_plan", meanwhile)
     assert main(_bif(out)) == 2
-    assert "appeared while this run was working" in capsys.readouterr().err
+    assert "another process wrote it while this run worked" in capsys.readouterr().err
     assert out.read_text() == "theirs"
     assert len(pd.read_parquet(tmp_path / f"b.{os.getpid()}.parquet")) > 0
     assert (tmp_path / "b.parquet.ckpt").is_dir()

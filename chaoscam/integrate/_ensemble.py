@@ -156,6 +156,13 @@ def simulate_ensemble(
         batch = _gpu.GPU_BATCH if use_gpu else _CPU_BATCH
     batch = whole("batch", batch, low=1)
     seed = whole("seed", seed)
+    if isinstance(indices, str | bytes) or not hasattr(indices, "__iter__"):
+        raise TypeError(
+            f"indices must be a sequence of realization indices (e.g. range(5)), got "
+            f"{type(indices).__name__} {indices!r}"
+        )
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be callable (or None), got {type(progress).__name__}")
     per_member = isinstance(params, list | tuple)
     plist = [params_arg(q) for q in params] if per_member else [params_arg(params)]
     if plist and hasattr(indices, "__len__"):  # before the list: range(10**10) would hang there

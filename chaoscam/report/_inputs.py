@@ -137,10 +137,13 @@ def _sweep_kind(path: Path, meta: dict[bytes, bytes]) -> str | None:
     return None
 
 
-def load_inputs(paths: list[str | Path]) -> Inputs:
-    """Read every input; an :class:`InputError` names the first bad file."""
+def load_inputs(paths: list[str | Path] | str | Path) -> Inputs:
+    """Read every input (one path, or a list of them); an :class:`InputError` names the
+    first bad file."""
     from ..sweep import read_bifurcation, read_regime_map
 
+    if isinstance(paths, str | Path):  # one file, not the characters of its name
+        paths = [paths]
     out = Inputs()
     for raw in paths:
         path = Path(raw)

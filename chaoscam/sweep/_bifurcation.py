@@ -9,6 +9,7 @@ last section point, following one branch.
 
 from __future__ import annotations
 
+import math
 import numbers
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -18,7 +19,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .._checks import flag, whole
+from .._checks import flag, params_arg, whole
 from .._provenance import code_identity
 from .._version import __version__
 from ..model import Params, contact_angle
@@ -194,6 +195,30 @@ def _tables(records: list[dict], axis: Axis) -> tuple[pd.DataFrame, pd.DataFrame
     return points, verdicts
 
 
+def _states(given) -> list:
+    """``initial_conditions`` when it is not a count: a list of states, else a SweepError."""
+    if isinstance(given, str | bytes | dict) or not hasattr(given, "__iter__"):
+        raise SweepError(
+            "initial_conditions must be a count (an int >= 1) or a list of (theta_f0, "
+            f"omega_f0) states [rad, rad/s], got {type(given).__name__} {given!r}"
+        )
+    return list(given)
+
+
+def _state(given) -> tuple[float, float]:
+    """One explicit initial state: two finite numbers, else a SweepError naming it."""
+    try:
+        th, om = (float(x) for x in given)
+    except (TypeError, ValueError):
+        th = om = math.nan
+    if not (math.isfinite(th) and math.isfinite(om)):
+        raise SweepError(
+            f"initial_conditions: each state is (theta_f0 [rad], omega_f0 [rad/s]), two "
+            f"finite numbers, got {given!r}"
+        )
+    return th, om
+
+
 STATE_FIELDS = ("theta_f0", "omega_f0")
 """Fields of the initial state: a diagram over one of them is a slice of the basins."""
 
@@ -293,7 +318,7 @@ def bifurcation(
         axis = Axis.parse(values, name=param)
     else:
         axis = Axis(param, values)
-    base = Params() if base is None else base
+    base = params_arg(base, "base")
     duration, transient = run_settings(duration, transient, seed)
     fate = check_fate(fate, duration)
     lyapunov, check_step = flag("lyapunov", lyapunov), flag("check_step", check_step)
@@ -307,7 +332,7 @@ def bifurcation(
         initial_conditions = whole("initial conditions", initial_conditions, low=1)
         n_specs = initial_conditions  # built after the budget check: a huge count is refused
     else:
-        specs = [("absolute", float(a), float(b)) for a, b in initial_conditions]
+        specs = [("absolute", *_state(s)) for s in _states(initial_conditions)]
         if not specs:
             raise SweepError("initial conditions: the list is empty")
         n_specs = len(specs)

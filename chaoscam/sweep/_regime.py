@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .._checks import flag, whole
+from .._checks import flag, params_arg, whole
 from .._provenance import code_identity
 from .._version import __version__
 from ..model import ParameterError, Params, realizations_identical
@@ -344,7 +344,7 @@ def regime_map(
         Ctrl-C; the message says how to resume.
     """
     x, y = as_axis(x), as_axis(y)
-    base = Params() if base is None else base
+    base = params_arg(base, "base")
     duration, transient = run_settings(duration, transient, seed)
     fate = check_fate(fate, duration)
     lyapunov, check_step = flag("lyapunov", lyapunov), flag("check_step", check_step)

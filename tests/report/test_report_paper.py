@@ -290,7 +290,7 @@ def test_a_report_that_appeared_meanwhile_is_kept(tmp_path, monkeypatch):
         return fig3(quick, outdir, workers=workers)
 
     monkeypatch.setitem(_paper.FIGURES, 3, meanwhile)
-    with pytest.raises(OutputError, match="appeared while this run was working") as err:
+    with pytest.raises(OutputError, match="another process wrote it while this run worked") as err:
         run_paper(quick=True, out=out, figures=[3])
     assert out.read_text() == "theirs"
     kept = [p for p in tmp_path.glob("p.*.html")]
@@ -307,7 +307,7 @@ def test_write_report_keeps_an_existing_file_and_needs_its_folder(tmp_path):
 
     out = tmp_path / "r.html"
     out.write_text("theirs")
-    with pytest.raises(OutputError, match="appeared while this run was working"):
+    with pytest.raises(OutputError, match="another process wrote it while this run worked"):
         write_report(ReportParts(), out, title="t", replace=False)
     assert out.read_text() == "theirs" and len(list(tmp_path.glob("r.*.html"))) == 1
     write_report(ReportParts(), out, title="t")

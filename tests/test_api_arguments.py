@@ -1,0 +1,79 @@
+"""Arguments of the Python API that were accepted and ignored, or failed deep inside numpy
+or pandas (found by an API review): each now gives an error naming the argument, or does
+what it says."""
+
+import math
+
+import numpy as np
+import pytest
+
+import chaoscam
+from chaoscam import ParameterError, Params
+from chaoscam.integrate import simulate_ensemble
+from chaoscam.sweep import SweepError, bifurcation, regime_map
+
+
+@pytest.mark.parametrize(
+    "ic",
+    [[(1, 2, 3)], [(0.1,)], [0.1, 0.2], [("a", 1)], [(math.nan, 0.0)], "abc", 2.5, True],
+)
+def test_a_malformed_initial_condition_is_named(ic):
+    with pytest.raises(SweepError, match="initial_conditions"):
+        bifurcation("xi", [0.2], initial_conditions=ic, duration=1.0, workers=1)
+
+
+@pytest.mark.parametrize("sweep", ["bifurcation", "regime_map"])
+def test_a_sweeps_base_must_be_params(sweep):
+    run = {
+        "bifurcation": lambda base: bifurcation("xi", [0.2], base=base, duration=1.0),
+        "regime_map": lambda base: regime_map("xi=0.2:0.3:2", "omega=25:30:2", base=base),
+    }[sweep]
+    with pytest.raises(TypeError, match=r"base must be a chaoscam.Params, got a dict: use Params"):
+        run({"omega": 30.0})
+    with pytest.raises(TypeError, match="base must be a chaoscam.Params or None, got str"):
+        run("x")
+
+
+@pytest.mark.parametrize("extend_to", [-1, math.nan, True, "x"])
+def test_classify_ensemble_checks_extend_to_as_classify_trajectory_does(extend_to):
+    p = Params()
+    ens = simulate_ensemble(p, [0], duration=1.0, tangent=True)
+    with pytest.raises(ParameterError, match="extend_to"):
+        chaoscam.classify_ensemble(ens, p, extend_to=extend_to)
+
+
+def test_simulate_ensemble_names_bad_indices_and_progress_before_running():
+    with pytest.raises(TypeError, match=r"indices must be a sequence .* got int 5"):
+        simulate_ensemble(Params(), 5, duration=0.5)
+    with pytest.raises(TypeError, match="progress must be callable"):
+        simulate_ensemble(Params(), [0], duration=0.5, progress=5)
+
+
+def test_periodic_orbit_from_a_seed_off_the_model_is_not_a_crash():
+    """A seed whose map leaves the cam's reach (or penetrates): not converged, NaN
+    multipliers and the status, instead of numpy's LinAlgError."""
+    for x0, status in (((3.0, 100.0), "LEFT_REACH"), ((-1.0, 0.0), "PENETRATION")):
+        orbit = chaoscam.periodic_orbit(Params(), x0, 1)
+        assert not orbit.converged and np.isnan(orbit.multipliers).all()
+        assert orbit.settings["seed_status"] == status
+
+
+def test_lyapunov_spectrum_refuses_settings_it_would_ignore(tmp_path):
+    tr = chaoscam.simulate(Params(xi=0.2), duration=4.0, transient=2.0, tangent=True)
+    assert chaoscam.lyapunov_spectrum(trajectory=tr).exponents[0] < 0
+    for kw in (dict(params=Params(xi=0.3)), dict(duration=5.0), dict(seed=1)):
+        with pytest.raises(ParameterError, match="would be ignored"):
+            chaoscam.lyapunov_spectrum(trajectory=tr, **kw)
+    tr.to_parquet(tmp_path / "t.parquet")  # a file keeps no Jacobians: said so
+    with pytest.raises(ValueError, match="Jacobians were not kept"):
+        chaoscam.lyapunov_spectrum(trajectory=chaoscam.load_trajectory(tmp_path / "t.parquet"))
+    short = chaoscam.simulate(duration=0.1, tangent=True)
+    with pytest.raises(ValueError, match="no section point after its start"):
+        chaoscam.lyapunov_spectrum(trajectory=short)
+
+
+def test_load_inputs_takes_one_path(tmp_path):
+    from chaoscam.report import load_inputs
+
+    chaoscam.simulate(duration=0.3).to_parquet(tmp_path / "run.parquet")
+    assert len(load_inputs(str(tmp_path / "run.parquet")).trajectories) == 1
