@@ -410,7 +410,7 @@ class Params:
 
     @classmethod
     def from_strings(cls, assignments: dict[str, str], base: Params | None = None) -> Params:
-        """Build from ``NAME=VALUE`` strings as given on the command line."""
+        """Build from a dict ``{NAME: "VALUE"}``, as ``--set NAME=VALUE`` gives them."""
         base = cls() if base is None else base
         return base.replace(**{k: parse_value(k, v) for k, v in assignments.items()})
 

@@ -43,3 +43,10 @@ def test_a_threshold_changes_the_decision():
     assert classify_section(pts).period == 2
     v = classify_section(pts, thresholds=Thresholds(period_rtol=1e-4))
     assert v.label != "periodic"
+
+
+@pytest.mark.parametrize("rtol", [-1.0, "x", float("nan")])
+def test_a_bad_rtol_keyword_is_named_as_given(rtol):
+    """rtol (the keyword) in the message, not Thresholds.period_rtol (the table's entry)."""
+    with pytest.raises(ValueError, match=r"^rtol must be a finite number >= 0"):
+        classify_section(np.random.default_rng(0).normal(size=(200, 2)), rtol=rtol)
