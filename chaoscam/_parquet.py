@@ -18,11 +18,13 @@ The pyarrow imports are inside the functions: a run that writes nothing does not
 from __future__ import annotations
 
 import hashlib
+import json
 from pathlib import Path
 
 __all__ = [
     "DIGEST_KEY",
     "DamagedFileError",
+    "exact_json",
     "read_frame",
     "read_metadata",
     "read_table",
@@ -105,3 +107,18 @@ def read_metadata(path: str | Path) -> dict:
     meta = dict(pq.read_schema(path).metadata or {})
     _verify(path, meta)
     return meta
+
+
+def exact_json(frame) -> str:
+    """``frame`` as pandas' "split" JSON with every float written exactly (Python's shortest
+    round-trip repr): ``DataFrame.to_json`` keeps at most 15 significant digits, so a section
+    read back differed from the run's in the last bits (up to 5.6e-16 rad, 91 of 92 points of
+    a default 20 s run). NaN is written as null, as ``to_json`` writes it."""
+    cells = frame.astype(object).where(frame.notna(), None)
+    return json.dumps(
+        {
+            "columns": list(frame.columns),
+            "index": list(range(len(frame))),
+            "data": cells.values.tolist(),
+        }
+    )
