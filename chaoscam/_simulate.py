@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._frozen import FrozenDict
 from ._run_warnings import run_warnings
 from ._version import __version__
 from ._warn import warn
@@ -59,12 +60,12 @@ class Trajectory:
     params : Params
         The model used.
     settings : dict
-        duration, transient, seed, index, output_dt, solver, package version, wall time.
+        duration, transient, seed, index, output_dt, solver, package version, wall time;
+        read-only, as ``stats`` (a record of the run: :class:`chaoscam._frozen.FrozenDict`).
     status : Status
         How the run ended; ``message`` says what to do about it.
     series : pandas.DataFrame or None
-        Time series sampled every ``output_dt`` (columns ``SERIES_COLUMNS``), or None when
-        not kept.
+        Time series sampled every ``output_dt`` (``SERIES_COLUMNS``), or None when not kept.
     section : pandas.DataFrame
         Stroboscopic Poincaré section at t = k 2 pi / omega: k, t, theta_f, omega_f, l_lambda.
     impacts : pandas.DataFrame
@@ -72,9 +73,8 @@ class Trajectory:
         gap_rate_before, lever_arm, l_lambda, kind ("macro", "micro": slower than
         ``v_micro``, "chatter_end": the plastic closure ending a complete chattering).
     stats : dict
-        contact_fraction, n_impacts (and of them n_macro_impacts, n_micro_impacts,
-        n_chatter_ends), slow_closings, chatter_handovers, truncated_mass,
-        steps_per_contact_period.
+        contact_fraction, n_impacts (of them n_macro_impacts, n_micro_impacts, n_chatter_ends),
+        slow_closings, chatter_handovers, truncated_mass, steps_per_contact_period.
     final_state : tuple
         (t, theta_f, omega_f) where the run stopped.
     jacobians : ndarray or None
@@ -100,6 +100,10 @@ class Trajectory:
     jacobians: np.ndarray | None = field(default=None, repr=False)
     divergence: np.ndarray | None = field(default=None, repr=False)
     resume: RunCopy | None = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        for name in ("settings", "stats"):
+            object.__setattr__(self, name, FrozenDict(getattr(self, name)))
 
     @property
     def message(self) -> str:

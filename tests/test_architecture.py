@@ -15,6 +15,7 @@ LAYERS = (
     "chaoscam._lazy",
     "chaoscam._warn",
     "chaoscam._parquet",
+    "chaoscam._frozen",
     "chaoscam.model",
     "chaoscam._checks",
     "chaoscam._outputs",

@@ -49,13 +49,23 @@ def test_a_damaged_trajectory_is_refused_by_name(run_file, tmp_path, capsys):
 
 
 def test_a_damaged_sweep_table_is_refused_by_name(tmp_path):
-    rm = regime_map("omega=25:30:3", "xi=0.2:0.3:3", duration=2.0, workers=1)
+    from tests.sweep._helpers import SpreadClassifier  # cheap: the file is what is tested
+
+    rm = regime_map(
+        "omega=25:30:2", "xi=0.2:0.3:2", duration=1.0, workers=1, classify=SpreadClassifier()
+    )
     out = tmp_path / "map.parquet"
     rm.to_parquet(out)
     assert read_regime_map(out).realizations["label"].tolist() == rm.realizations["label"].tolist()
     cells = out.with_name("map.cells.parquet")
-    data = bytearray(cells.read_bytes())  # the cells table is small: flip in its first page
-    for i in range(60, 160):
+    # the last bytes of its largest column chunk: inside a data page's values, not a header
+    group = pq.ParquetFile(cells).metadata.row_group(0)
+    chunk = max(
+        (group.column(i) for i in range(group.num_columns)), key=lambda c: c.total_compressed_size
+    )
+    end = chunk.data_page_offset + chunk.total_compressed_size
+    data = bytearray(cells.read_bytes())
+    for i in range(end - 9, end - 1):
         data[i] ^= 0x5A
     cells.write_bytes(bytes(data))
     with pytest.raises(DamagedFileError, match=r"map.cells.parquet: damaged"):

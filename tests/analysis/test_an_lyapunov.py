@@ -81,6 +81,7 @@ def test_rossler_exponent():
     assert abs(res.exponent / 0.0714 - 1) < 0.10
 
 
+@pytest.mark.slow  # 6-8 s: a textbook system; the model's exponents are tested by default
 def test_ueda_exponent():
     """Ueda (k = 0.05, B = 7.5): λ₁ ≈ 0.0999 within 5 % for the (x, x') directions.
 

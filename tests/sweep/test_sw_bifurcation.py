@@ -99,8 +99,10 @@ def test_paper_figure_grids_validate():
         validate_grid(Params(stiffness="fractal", G=g), [Axis.parse("D=1.36:1.56:41")])
 
 
-@pytest.mark.parametrize("engine", ["process", "ensemble"])
-@pytest.mark.parametrize("name, values", [("theta_f0", [0.1, 0.2]), ("omega_f0", [-1.0, 1.0])])
+@pytest.mark.parametrize(
+    "engine, name, values",
+    [("process", "theta_f0", [0.1, 0.2]), ("ensemble", "omega_f0", [-1.0, 1.0])],
+)
 def test_a_diagram_over_the_initial_state_starts_each_run_there(engine, name, values):
     """A diagram over theta_f0 or omega_f0 (a slice of the basins) starts each run at the
     swept value: its section is the one simulate gives from there, not the default start's
