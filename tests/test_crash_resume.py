@@ -1,6 +1,7 @@
 """Crash test: SIGKILL of the driver at random moments (start-up, mid-run, while writing the
 outputs), then --resume, gives the table of a run never killed; no worker outlives its
-driver. A few kills per sweep kind by default, 20 per kind marked slow."""
+driver. Two kills for two kinds by default, for all four with -m slow, and 20 per kind marked
+slow."""
 
 import os
 import random
@@ -163,7 +164,14 @@ def _crash_and_resume(tmp_path, kind, kills, rng, reference):
     assert not [p for p in tmp_path.iterdir() if p.suffix in (".ckpt", ".parts")]
 
 
-@pytest.mark.parametrize("kind", list(COMMANDS))
+# Two kinds by default; the default engine's map (18 s) and the diagram (9 s) are killed
+# twenty times each in the slow variant below, and test_sw_cli kills the default engine's map.
+QUICK = ["regime-map", "ensemble"]
+
+
+@pytest.mark.parametrize(
+    "kind", [k if k in QUICK else pytest.param(k, marks=pytest.mark.slow) for k in COMMANDS]
+)
 def test_kills_then_resume_identical(tmp_path, kind, references):
     """Two SIGKILLs at random moments, then --resume: the uninterrupted tables."""
     _crash_and_resume(tmp_path, kind, 2, random.Random(f"{kind}-quick"), references(kind))

@@ -8,6 +8,10 @@ import pytest
 from chaoscam.analysis import classify_section
 from chaoscam.testsystems import ball_period_one_theory, bouncing_ball, period_one_thresholds
 
+# A textbook system (9-10 s for the window's runs): with -m slow. The classifier's verdicts
+# on the model itself are tested by default (tests/test_labelled_set.py).
+pytestmark = pytest.mark.slow
+
 E = 0.5
 
 

@@ -159,6 +159,7 @@ def test_audit_script_reads_a_reports_data_and_refuses_bad_input(tmp_path, capsy
         assert stop.value.code == 2 and says in capsys.readouterr().err
 
 
+@pytest.mark.slow  # 9 s: the ladder (an analysis tool); the audit is tested by default
 def test_ladder_follows_every_drawn_run_down_the_step(tmp_path, capsys, small_diagram):
     """--ladder 2,4: two runs of any label, each classified at dt, dt/2 and dt/4; the first
     rung is the recorded verdict (the replay is the sweep's run); the sentence compares dt
