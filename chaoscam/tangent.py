@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ._checks import params_arg, real, whole
+from ._warn import warn
 from .analysis import TangentSpectrum, spectrum_from_jacobians
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
@@ -109,6 +110,12 @@ def lyapunov_spectrum(
             f"{trajectory.params.cam_period:.3g} s): nothing to take exponents from"
         )
     spec = spectrum_from_jacobians(jac[keep], trajectory.params.cam_period)
+    if not math.isfinite(float(spec.stderr[0])):  # too few periods for the batch means
+        warn(
+            f"lambda_1 = {spec.exponents[0]:.3g} 1/s rests on {spec.n_periods} cam period(s), "
+            "too few for its standard error (NaN): lengthen the recorded time "
+            "(duration - transient)"
+        )
     return TangentSpectrum(
         exponents=spec.exponents,
         stderr=spec.stderr,

@@ -60,7 +60,8 @@ def test_periodic_orbit_from_a_seed_off_the_model_is_not_a_crash():
 
 def test_lyapunov_spectrum_refuses_settings_it_would_ignore(tmp_path):
     tr = chaoscam.simulate(Params(xi=0.2), duration=4.0, transient=2.0, tangent=True)
-    assert chaoscam.lyapunov_spectrum(trajectory=tr).exponents[0] < 0
+    with pytest.warns(RuntimeWarning, match="too few for its standard error"):  # 9 periods
+        assert chaoscam.lyapunov_spectrum(trajectory=tr).exponents[0] < 0
     for kw in (dict(params=Params(xi=0.3)), dict(duration=5.0), dict(seed=1)):
         with pytest.raises(ParameterError, match="would be ignored"):
             chaoscam.lyapunov_spectrum(trajectory=tr, **kw)
@@ -77,3 +78,15 @@ def test_load_inputs_takes_one_path(tmp_path):
 
     chaoscam.simulate(duration=0.3).to_parquet(tmp_path / "run.parquet")
     assert len(load_inputs(str(tmp_path / "run.parquet")).trajectories) == 1
+
+
+def test_an_exponent_without_a_standard_error_is_warned():
+    """Two periods recorded give exponents with a NaN standard error: a warning naming the
+    number of periods (they came without a word); a run long enough gets none."""
+    import warnings
+
+    with pytest.warns(RuntimeWarning, match=r"rests on 4 cam period\(s\), too few"):
+        chaoscam.lyapunov_spectrum(duration=1.0, transient=0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        chaoscam.lyapunov_spectrum(duration=10.0, transient=0.0)
