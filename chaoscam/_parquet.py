@@ -26,7 +26,6 @@ __all__ = [
     "DamagedFileError",
     "exact_json",
     "read_frame",
-    "read_metadata",
     "read_table",
     "write_table",
 ]
@@ -98,15 +97,6 @@ def read_frame(path: str | Path):
     frame = _checked(path, lambda: pd.read_parquet(path, page_checksum_verification=True))
     _verify(path, pq.read_schema(path).metadata)
     return frame
-
-
-def read_metadata(path: str | Path) -> dict:
-    """The file's key-value metadata (its footer only), verified against its digest."""
-    import pyarrow.parquet as pq
-
-    meta = dict(pq.read_schema(path).metadata or {})
-    _verify(path, meta)
-    return meta
 
 
 def exact_json(frame) -> str:

@@ -155,14 +155,11 @@ def resolve(
     that the classifiers also take as keywords (`rtol`, `min_points_aperiodic`) replaced
     when given."""
     thr = thresholds or Thresholds()
-    for name, field_, value in (
-        ("rtol", "period_rtol", rtol),
-        ("min_points_aperiodic", "min_points_aperiodic", min_points_aperiodic),
-    ):
-        if value is None:
-            continue
+    if rtol is not None:
         try:  # the keyword's own name in the message, not the table's entry
-            thr = replace(thr, **{field_: float(value) if name == "rtol" else int(value)})
+            thr = replace(thr, period_rtol=float(rtol))
         except (TypeError, ValueError):
-            raise ValueError(f"{name} must be a finite number >= 0, got {value!r}") from None
+            raise ValueError(f"rtol must be a finite number >= 0, got {rtol!r}") from None
+    if min_points_aperiodic is not None:
+        thr = replace(thr, min_points_aperiodic=int(min_points_aperiodic))
     return thr

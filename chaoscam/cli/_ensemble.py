@@ -26,7 +26,6 @@ import time
 import warnings
 from pathlib import Path
 
-from .._outputs import atomic_path
 from ._ensemble_parts import (
     atomic_text,
     commit_parts,
@@ -37,6 +36,7 @@ from ._ensemble_parts import (
     output_paths,
     part_done,
     recorded_config,
+    write_table,
 )
 from ._options import add_run_options, path_arg
 
@@ -280,8 +280,7 @@ def _run_locked(args: argparse.Namespace) -> int:
         for name in names:
             table = tables[name].assign(member=tables[name]["member"] + offset)
             path = parts / f"{start:012d}.{name}.parquet"
-            with atomic_path(path) as tmp:
-                table.to_parquet(tmp, index=False, write_page_checksum=True)
+            write_table(table, path)  # atomic, with the checksums of chaoscam._parquet
             files[name] = fingerprint(path)
         atomic_text(
             parts / f"{start:012d}.done",

@@ -93,11 +93,11 @@ def sweep_names(name: str, sweeps: list) -> list[str]:
     def text(v) -> str:
         return f"{v:g}" if isinstance(v, float) else str(v)
 
+    same_base = len(sweeps) > 1 and len({repr(b) for b in bases}) == 1  # axes or windows differ
     names = []
-    for i, b in enumerate(bases, start=1):
-        parts = [f"{k} = {text(b.get(k, default_dt if k == 'dt' else None))}" for k in keys]
-        if len(sweeps) > 1 and len({repr(b) for b in bases}) == 1:
-            parts.append(f"sweep {i}")  # the same base: they differ in axes or windows only
+    for i, base in enumerate(bases, start=1):
+        parts = [f"{k} = {text(base.get(k, default_dt if k == 'dt' else None))}" for k in keys]
+        parts += [f"sweep {i}"] if same_base else []
         names.append(f"{name} ({', '.join(parts)})" if parts else name)
     return names
 
