@@ -80,6 +80,15 @@ def test_load_inputs_takes_one_path(tmp_path):
     assert len(load_inputs(str(tmp_path / "run.parquet")).trajectories) == 1
 
 
+def test_build_report_names_what_it_takes():
+    """A list of paths given to build_report is refused by name (it failed with an
+    AttributeError on 'regime_maps')."""
+    from chaoscam.report import build_report
+
+    with pytest.raises(TypeError, match=r"not a list: build_report\(load_inputs\(paths\)\)"):
+        build_report(["run.parquet"])
+
+
 def test_an_exponent_without_a_standard_error_is_warned():
     """Two periods recorded give exponents with a NaN standard error: a warning naming the
     number of periods (they came without a word); a run long enough gets none."""

@@ -16,6 +16,7 @@ from typing import Any
 
 from .._provenance import code_rows
 from ._figures import png_bytes, png_uri, response_figure
+from ._inputs import require_inputs
 
 __all__ = [
     "Comparison",
@@ -443,9 +444,7 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
     if commit:
         changed = uncommitted_sources()
         if changed:
-            shown = ", ".join(changed[:5]) + (
-                f" and {len(changed) - 5} more" if len(changed) > 5 else ""
-            )
+            shown = ", ".join(changed[:5]) + (f" and {len(changed) - 5} more" * (len(changed) > 5))
             commit += f" plus uncommitted changes to {shown}"
     return env.get_template("report.html").render(
         title=title,
@@ -462,7 +461,7 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
 
 def build_report(inputs, parts: ReportParts | None = None) -> ReportParts:
     """Add every input (an :class:`~chaoscam.report._inputs.Inputs`) to the report parts."""
-    parts = parts or ReportParts()
+    inputs, parts = require_inputs(inputs), parts or ReportParts()
     for path, rm in inputs.regime_maps:
         add_regime_map(parts, path, rm)
     for path, bif in inputs.bifurcations:

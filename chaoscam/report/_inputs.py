@@ -137,6 +137,17 @@ def _sweep_kind(path: Path, meta: dict[bytes, bytes]) -> str | None:
     return None
 
 
+def require_inputs(inputs) -> Inputs:
+    """``inputs`` itself when it is an :class:`Inputs`; otherwise a TypeError saying how to
+    make one (``build_report(["run.parquet"])`` failed deep inside with an AttributeError)."""
+    if not isinstance(inputs, Inputs):
+        raise TypeError(
+            f"build_report takes what load_inputs returns, not a {type(inputs).__name__}: "
+            "build_report(load_inputs(paths))"
+        )
+    return inputs
+
+
 def load_inputs(paths: list[str | Path] | str | Path) -> Inputs:
     """Read every input (one path, or a list of them); an :class:`InputError` names the
     first bad file."""
