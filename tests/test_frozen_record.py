@@ -41,3 +41,15 @@ def test_the_record_reads_like_a_dict(run):
     longer = chaoscam.extend_trajectory(run, 2.0)
     want = chaoscam.simulate(Params(l_lambda_sigma=0.002), duration=2.0, seed=1, series=False)
     assert longer.section.equals(want.section)
+
+
+def test_a_verdicts_settings_are_read_only():
+    """A Verdict's settings (its thresholds and each method's settings) are its record too;
+    they were a plain dict on a frozen dataclass."""
+    from chaoscam.analysis import Evidence, combine
+
+    verdict = combine([Evidence("section", 3, "periodic", "3 points")], settings={"n": 5})
+    with pytest.raises(TypeError, match="read-only"):
+        verdict.settings["n"] = 6
+    assert verdict.settings == {"n": 5}
+    assert pickle.loads(pickle.dumps(verdict)).settings == {"n": 5}

@@ -7,6 +7,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._frozen import FrozenDict
+
 __all__ = ["LABELS", "VOTES", "Evidence", "Verdict", "combine"]
 
 LABELS = ("periodic", "quasiperiodic", "chaotic", "undetermined")
@@ -87,7 +89,8 @@ class Verdict:
         Why the label is "undetermined" (disagreement, too little data), or what limits it.
     settings : dict
         The settings used by each method; ``settings["thresholds"]`` is the
-        `Thresholds` table the classifier used (as a dict).
+        `Thresholds` table the classifier used (as a dict). Read-only at its top level
+        (:class:`chaoscam._frozen.FrozenDict`), as a Trajectory's settings are.
     """
 
     label: str
@@ -99,6 +102,7 @@ class Verdict:
     def __post_init__(self):
         if self.label not in LABELS:
             raise ValueError(f"unknown label {self.label!r}; expected one of {LABELS}")
+        object.__setattr__(self, "settings", FrozenDict(self.settings))
 
     @property
     def used(self) -> tuple[str, ...]:
