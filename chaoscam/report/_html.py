@@ -18,16 +18,8 @@ from .._provenance import code_rows
 from ._figures import png_bytes, png_uri, response_figure
 from ._inputs import require_inputs
 
-__all__ = [
-    "Comparison",
-    "FigureItem",
-    "add_ensemble",
-    "build_report",
-    "git_commit",
-    "render",
-    "uncommitted_sources",
-    "write_report",
-]
+__all__ = ["Comparison", "FigureItem", "add_ensemble", "build_report", "git_commit", "render"]
+__all__ += ["uncommitted_sources", "write_report"]
 
 SECTIONS = (
     ("summary", "Summary of findings"),
@@ -401,22 +393,23 @@ def _sweep_settings(cfg: dict[str, Any]) -> dict[str, Any]:
                 if vals
                 else a.get("name")
             )
-    base = cfg.get("base", {})
-    units = {"dt": "s", "l_lambda": "m", "l_lambda_sigma": "m", "G": "m", "D": "-"}
-    for k in (
-        "integrator",
-        "stiffness",
-        "dt",
-        "rtol",
-        "l_lambda",
-        "l_lambda_sigma",
-        "D",
-        "G",
-        "resample",
-    ):
-        if k in base:
-            rows[f"base {k}" + (f" [{units[k]}]" if k in units else "")] = base[k]
+    from ..model import FIELD_DOCS, Params
+
+    base, default = cfg.get("base", {}), Params().to_dict()
+    for k, v in base.items():  # the integrator and step always, else what differs from Params()
+        if k in ("integrator", "dt") or v != default.get(k, v):
+            unit = "" if isinstance(v, str) else FIELD_DOCS.get(k, {}).get("unit", "")
+            rows[f"base {k}" + (f" [{unit}]" if unit else "")] = v
     return rows
+
+
+def model_rows() -> list[tuple[str, Any, str, str]]:
+    """(name, value, unit, meaning) of each field of ``Params()``, where every run starts."""
+    from ..model import FIELD_DOCS, Params
+
+    short = lambda doc: doc if len(doc) < 160 else doc[:150].rsplit(" ", 1)[0] + " …"  # noqa: E731
+    docs = {k: (d.get("unit") or "", short(d.get("doc") or "")) for k, d in FIELD_DOCS.items()}
+    return [(k, v, *docs.get(k, ("", ""))) for k, v in Params().to_dict().items()]
 
 
 def _sections(parts: ReportParts) -> tuple[tuple[str, str], ...]:
@@ -456,6 +449,7 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
         command=command or " ".join(["chaoscam", *sys.argv[1:]]),
         python=sys.version.split()[0],
         classifier=classifier_fingerprint(),
+        model=model_rows(),
     )
 
 

@@ -299,12 +299,15 @@ def plot_bifurcation(
 ) -> None:
     """Section points over the swept value, rasterised (tens of thousands stay light).
 
-    ``color_by`` = "label" (the verdict), "ic" (the initial condition) or None.
+    ``color_by`` = "label" (the verdict), "ic" (the initial condition) or None. Several
+    initial conditions per value are drawn side by side on a linear axis (each shifted by at
+    most a third of the values' spacing), so that one's label does not hide another's.
     """
     param = str(points["param"].iloc[0]) if len(points) else "value"
+    x = _dodged(points) if len(points) else points.get("value")
     groups = [(None, points)] if color_by is None else list(points.groupby(color_by, sort=True))
     if size is None:  # dots that stay visible for a few points and do not merge for 1e5
-        size = float(np.clip(3e4 / max(len(points), 1), 0.3, 6.0))
+        size = float(np.clip(6e4 / max(len(points), 1), 0.5, 10.0))
     for key, g in groups:
         if color_by == "label":
             color = LABEL_COLORS.get(key, _OTHER)
@@ -313,7 +316,7 @@ def plot_bifurcation(
         else:
             color = None
         ax.scatter(
-            g["value"],
+            x[g.index],
             g[coordinate],
             s=size,
             c=color,
@@ -328,18 +331,36 @@ def plot_bifurcation(
     if v.size and v.min() > 0 and v.max() / v.min() > LOG_AXIS_SPAN:
         ax.set_xscale("log")  # values over several decades (a stiffness sweep)
     if color_by is not None and groups:
-        ax.legend(markerscale=6, frameon=False, fontsize="small", title=color_by)
+        scale = float(np.sqrt(40.0 / size))  # legend dots of ~40 pt² whatever the size
+        ax.legend(markerscale=scale, frameon=False, fontsize="small", title=color_by)
+
+
+def _dodged(points: pd.DataFrame) -> pd.Series:
+    """The x of each point: its value, shifted by initial condition when there are several
+    and the values are evenly enough spaced for a linear axis."""
+    values = np.unique(points["value"].to_numpy(dtype=float))
+    ics = np.unique(points["ic"]) if "ic" in points else []
+    logx = values.min() > 0 and values.max() / values.min() > LOG_AXIS_SPAN if len(values) else 0
+    if len(ics) < 2 or len(values) < 2 or logx:
+        return points["value"].astype(float)
+    rank = pd.Series(np.arange(len(ics)), index=ics)[points["ic"]].to_numpy()
+    width = np.diff(values).min() / 3.0
+    return points["value"] + (rank / (len(ics) - 1) - 0.5) * width
 
 
 def bifurcation_figure(
-    points: pd.DataFrame, *, coordinate: str = "theta_f", color_by: str = "label"
+    points: pd.DataFrame, *, coordinate: str = "theta_f", color_by: str = "label", note: str = ""
 ):
-    """One panel: the bifurcation diagram of ``coordinate`` over the swept parameter."""
+    """One panel: the bifurcation diagram of ``coordinate`` over the swept parameter;
+    ``note`` (e.g. "G = 1e-10 m") goes into the title, to tell panels of one figure apart."""
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(9, 5), layout="constrained")
     ax = fig.subplots()
     plot_bifurcation(points, ax, coordinate=coordinate, color_by=color_by)
     param = str(points["param"].iloc[0]) if len(points) else ""
-    ax.set_title(f"bifurcation diagram over {param}: stroboscopic section after the transient")
+    note = f" ({note})" if note else ""
+    ax.set_title(
+        f"bifurcation diagram over {param}{note}: stroboscopic section after the transient"
+    )
     return fig

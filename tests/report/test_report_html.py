@@ -102,6 +102,24 @@ def test_full_report_has_every_section_and_valid_images(outputs, tmp_path, capsy
         assert f"<dt>{term}" in text
     assert "Nothing: every part of the report has its inputs." in text
     assert "chaoscam report " in text and "package version" in text and "git commit" in text
+    # The parameter set every run starts from, with units; a sweep's settings list the base
+    # fields it changes (here none but the integrator and step, always shown).
+    assert "<td>omega</td><td>28.7</td><td>rad/s</td>" in text
+    assert "<td>xi</td><td>0.42</td>" in text
+    assert "<td>base dt [s]</td>" in text and "<td>base xi" not in text
+
+
+def test_a_sweep_lists_every_base_field_it_changes():
+    """Settings rows: every base field that differs from Params(), with its unit (a fixed
+    list of nine fields hid a changed ω, ξ or e)."""
+    from chaoscam.model import Params
+    from chaoscam.report._html import _sweep_settings
+
+    base = Params(xi=0.3, omega=40.0, dt=1e-6).to_dict()
+    rows = _sweep_settings({"kind": "bifurcation", "base": base})
+    assert rows["base xi [-]"] == 0.3 and rows["base omega [rad/s]"] == 40.0
+    assert rows["base dt [s]"] == 1e-6 and rows["base integrator"] == "rk4"
+    assert not any("base e " in k or k == "base e [m]" for k in rows)
 
 
 def test_partial_inputs_say_what_is_missing(outputs, tmp_path, capsys):
