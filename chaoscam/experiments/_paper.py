@@ -59,9 +59,9 @@ def data_files(number: int) -> list[str]:
     if number == 6:
         return [f"{_fig6_tag(g)}{ext}" for g in G_FIG6 for ext in bif]
     if number == SENSITIVITY:
-        return [f"sensitivity-{name}{ext}" for name in ("stiffness", "xi") for ext in bif] + [
-            f"sensitivity-omega-xi{ext}" for ext in (".parquet", ".cells.parquet", ".png")
-        ]
+        sweeps = [f"sensitivity-{n}{ext}" for n in ("stiffness", "hertz", "xi") for ext in bif]
+        sweeps.append("sensitivity-yf.png")  # the Y_f sweep's own diagram
+        return sweeps + [f"sensitivity-omega-xi{e}" for e in (".parquet", ".cells.parquet", ".png")]
     names = [f"fig7-10{ext}" for ext in (".parquet", ".cells.parquet", ".png")]
     for mu in MU_PAPER:
         for sigma in (0.0, SIGMA_MAX):
@@ -349,7 +349,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
         tag = _fig6_tag(g)
         path = outdir / f"{tag}.parquet"
         bif.to_parquet(path)
-        png = _save(bifurcation_figure(bif.points), outdir, tag)
+        png = _save(bifurcation_figure(bif.points, note=f"G = {g:g} m"), outdir, tag)
         res.bifurcations.append((str(path), bif, png))
         counts = bif.verdicts["label"].value_counts().to_dict()
         found.append(f"G = {g:g} m (dt = {dt:g} s): " + _counts(counts))

@@ -303,6 +303,11 @@ def _in_short(results) -> str:
             return 0, "", ""
         labels = pd.concat([f["label"] for f in frames], ignore_index=True)
         found = [f"{int((labels == k).sum())} {k}" for k in _LABELS]
+        chaos = [f.loc[f["label"] == "chaotic"] for f in frames if "ev_banded_chaos" in f]
+        bands = pd.concat([c["ev_banded_chaos"] for c in chaos]).dropna() if chaos else []
+        if len(bands):  # chaos on n narrow bands: almost a period n, say so
+            kinds = "/".join(f"{int(n)}" for n in sorted(set(bands)))
+            found[_LABELS.index("chaotic")] += f" ({len(bands)} of them {kinds}-band chaos)"
         stopped = int((~labels.isin(_LABELS)).sum())
         periods = pd.concat([f.loc[f["label"] == "periodic", "period"] for f in frames])
         shown = sorted({int(p) for p in periods.dropna()})

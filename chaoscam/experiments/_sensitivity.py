@@ -4,9 +4,10 @@
 (Table 1 otherwise) on the package's default classifier and states what they show:
 
 * the contact stiffness K_n over more than eight decades (through the follower's Young's
-  modulus Y_f: K_n = (pi/4) E l_lambda with 1/E = (1 - nu_f^2)/Y_f + (1 - nu_c^2)/Y_c), to see
-  whether the paper's Hertz range can explain the difference (it cannot when the label is
-  flat there);
+  modulus Y_f: K_n = (pi/4) E l_lambda with 1/E = (1 - nu_f^2)/Y_f + (1 - nu_c^2)/Y_c), and
+  across the paper's Hertz range itself through l_lambda (:data:`PAPER_L_LAMBDA`, as the paper
+  varies it), to see whether that range can explain the difference (it cannot when the motion
+  keeps one regime there);
 * the restitution coefficient ξ, sampled densely around Table 1's value, to compare how many
   regimes its neighbourhood holds with how many the paper's stiffness range holds;
 * a regime map over (ω, ξ): periodic windows, sticking, chaos and escape from the cam's reach.
@@ -25,24 +26,48 @@ import pandas as pd
 
 from ..report._html import FigureItem
 
-__all__ = ["PAPER_K_N", "sensitivity", "label_runs"]
+__all__ = ["PAPER_K_N", "PAPER_L_LAMBDA", "label_runs", "sensitivity", "stiffness_finding"]
 
 PAPER_K_N = (8.9e7, 1.6e9)
 """The paper's Hertz line stiffness range [N/m] (its l_λ range with Table 1's materials)."""
 
+PAPER_L_LAMBDA = (0.001, 0.018)
+"""The paper's l_λ range [m] (Fig. 4): through K_n = (π/4) E l_λ it spans :data:`PAPER_K_N`."""
 
-def verdict_tag(label, period) -> str:
-    """A verdict in a finding's words: "period 8" for a periodic one with its period, else the
-    label ("chaotic", "undetermined", "left_reach", ...)."""
-    ok = label == "periodic" and period is not None and pd.notna(period)
-    return f"period {int(period)}" if ok else str(label)
+HERTZ_VALUES = {True: 6, False: 18}
+"""How many l_λ the stiffness finding samples across :data:`PAPER_L_LAMBDA` (quick, full), at
+the ξ sweep's step and classifier, so that the two ranges are compared on equal terms (Fig. 4
+samples the same range at a finer step)."""
 
 
-def label_runs(values, labels, periods) -> list[tuple[str, float, float]]:
-    """Consecutive equal (label, period) along sorted values: [(text, first, last), ...]."""
+def verdict_tag(label, period, bands=None) -> str:
+    """A verdict in a finding's words: "period 8" for a periodic one with its period, "8-band
+    chaos" for a chaotic one whose section lies on 8 narrow bands (``ev_banded_chaos``), else
+    the label ("chaotic", "undetermined", "left_reach", ...)."""
+    if label == "periodic" and period is not None and pd.notna(period):
+        return f"period {int(period)}"
+    if label == "chaotic" and bands is not None and pd.notna(bands) and bands > 1:
+        return f"{int(bands)}-band chaos"
+    return str(label)
+
+
+def _bands(v: pd.DataFrame):
+    """The band counts of a verdict table (None where it has no ``ev_banded_chaos``)."""
+    return v["ev_banded_chaos"] if "ev_banded_chaos" in v else [None] * len(v)
+
+
+def frame_tags(v: pd.DataFrame) -> list[str]:
+    """:func:`verdict_tag` of every row of a verdict table (label, period, bands)."""
+    return [verdict_tag(*t) for t in zip(v["label"], v["period"], _bands(v), strict=True)]
+
+
+def label_runs(values, labels, periods, bands=None) -> list[tuple[str, float, float]]:
+    """Consecutive equal tags (:func:`verdict_tag`) along sorted values:
+    [(text, first, last), ...]."""
     out: list[tuple[str, float, float]] = []
-    for v, lab, per in zip(values, labels, periods, strict=True):
-        t = verdict_tag(lab, per)
+    bands = [None] * len(labels) if bands is None else bands
+    for v, lab, per, nb in zip(values, labels, periods, bands, strict=True):
+        t = verdict_tag(lab, per, nb)
         if out and out[-1][0] == t:
             out[-1] = (t, out[-1][1], float(v))
         else:
@@ -115,33 +140,90 @@ def xi_values(quick: bool) -> list[float]:
     return sorted({round(float(v), 10) for v in (*coarse, *near)})
 
 
-def restitution_finding(v: pd.DataFrame, xi0: float, stiffness_tags: list[str]) -> str:
+def _regimes(tags) -> list[str]:
+    """The distinct regimes among tags, in order, leaving "undetermined" out (it is no
+    regime: the evidence did not decide)."""
+    return [t for t in dict.fromkeys(tags) if t != "undetermined"]
+
+
+def restitution_finding(v: pd.DataFrame, xi0: float, hertz_tags: list[str]) -> str:
     """The restitution sentence of the findings, from the ξ sweep's verdicts ``v`` (columns
-    value, label, period; sorted by value) and the labels the stiffness sweep found around
-    the paper's Hertz range. It calls the restitution the more sensitive parameter only when
-    the neighbourhood of Table 1's ξ holds more regimes than that stiffness range."""
+    value, label, period, optionally ev_banded_chaos; sorted by value) and the tags of the
+    runs across the paper's Hertz range (:func:`stiffness_finding`). It calls the restitution
+    the more sensitive parameter only when the neighbourhood of Table 1's ξ holds more regimes
+    than that range; undetermined runs count on neither side."""
     near = v[(v["value"] - xi0).abs() <= XI_WINDOW + 1e-9]
-    tags = list(
-        dict.fromkeys(verdict_tag(a, b) for a, b in zip(near["label"], near["period"], strict=True))
-    )
+    tags, hertz = _regimes(frame_tags(near)), _regimes(hertz_tags)
+    n_und = int((near["label"] == "undetermined").sum())
     head = (
         f"Restitution ξ (Table 1: {xi0:g}): "
-        + _runs_text(label_runs(v["value"], v["label"], v["period"]), "{:.3g}")
-        + f". Within ±{XI_WINDOW:g} of Table 1's value ({len(near)} values sampled) "
+        + _runs_text(label_runs(v["value"], v["label"], v["period"], _bands(v)), "{:.3g}")
+        + f". Within ±{XI_WINDOW:g} of Table 1's value ({len(near)} values sampled"
+        + (f", {n_und} undetermined" if n_und else "")
+        + ") "
     )
-    if len(tags) > max(len(stiffness_tags), 1):
+    across = f"across the paper's Hertz range ({', '.join(hertz) or 'none'})"
+    if len(tags) > max(len(hertz), 1):
         return head + (
-            f"the label takes {len(tags)} different values ({', '.join(tags)}), against "
-            f"{len(stiffness_tags)} across the paper's stiffness range: the regime is more "
-            "sensitive to the restitution (and so to how the restitution law is applied at the "
-            "oblique impact) than to the stiffness, a plausible source of the difference."
+            f"the motion takes {len(tags)} regimes ({', '.join(tags)}), against {len(hertz)} "
+            f"{across}: the regime is more sensitive to the restitution (and so to how the "
+            "restitution law is applied at the oblique impact) than to the stiffness, a "
+            "plausible source of the difference."
         )
     return head + (
-        f"the label takes {len(tags)} value{'s' if len(tags) != 1 else ''} "
-        f"({', '.join(tags) or 'none'}), no more than across the paper's stiffness range "
-        f"({len(stiffness_tags)}): this sweep does not single the restitution out as the "
-        "source of the difference."
+        f"the motion takes {len(tags)} regime{'s' if len(tags) != 1 else ''} "
+        f"({', '.join(tags) or 'none'}), no more than the {len(hertz)} {across}: this sweep "
+        "does not single the restitution out as the source of the difference."
     )
+
+
+def stiffness_finding(yf: pd.DataFrame, hertz: pd.DataFrame) -> tuple[str, list[str]]:
+    """The stiffness sentence of the findings and the tags across the paper's Hertz range.
+
+    ``yf``: the Y_f sweep's verdicts, ``hertz``: the l_λ sweep's (:data:`PAPER_L_LAMBDA`),
+    each with a ``K_n`` column [N/m] and sorted by it. The range is judged from the l_λ runs
+    and the Y_f runs inside :data:`PAPER_K_N`: one regime there (undetermined aside) means
+    the paper's stiffness model cannot explain the difference; periods n and n-band chaos of
+    one n are the same motion on n narrow bands, where the stiffness decides the label only.
+    """
+    kv = yf["K_n"].to_numpy()
+    runs = label_runs(kv, yf["label"], yf["period"], _bands(yf))
+    in_yf = yf[(yf["K_n"] >= PAPER_K_N[0]) & (yf["K_n"] <= PAPER_K_N[1])]
+    inside = pd.concat([hertz, in_yf]).sort_values("K_n")
+    tags = frame_tags(inside)
+    regimes = _regimes(tags)
+    text = (
+        f"Contact stiffness: K_n from {kv.min():.3g} to {kv.max():.3g} N/m "
+        f"({np.log10(kv.max() / kv.min()):.1f} decades, through Y_f): {_runs_text(runs)}. "
+        f"Across the paper's Hertz range {PAPER_K_N[0]:.2g}–{PAPER_K_N[1]:.2g} N/m, sampled "
+        f"through l_λ = {PAPER_L_LAMBDA[0] * 1e3:g}–{PAPER_L_LAMBDA[1] * 1e3:g} mm as the paper "
+        f"does ({len(hertz)} values) and by {len(in_yf)} of the Y_f values: "
+        + _runs_text(label_runs(inside["K_n"], inside["label"], inside["period"], _bands(inside)))
+        + ": "
+    )
+    bands = {int(t.split()[1]) for t in regimes if t.startswith("period ")}
+    bands |= {int(t.split("-")[0]) for t in regimes if t.endswith("-band chaos")}
+    family = len(bands) == 1 and all(t.startswith("period ") or "-band" in t for t in regimes)
+    if len(regimes) <= 1:
+        text += (
+            "one regime there, so the paper's stiffness model cannot explain why its regimes "
+            "differ from ours"
+        )
+    elif family:
+        text += (
+            f"the label moves between {' and '.join(regimes)}, the same motion on {bands.pop()} "
+            "narrow bands: the stiffness decides which label, not the kind of motion, so it "
+            "cannot explain why the paper's regimes differ from ours"
+        )
+    else:
+        text += "the response changes inside that range, so the stiffness model matters"
+    paper = [t for t in ("period 2", "quasiperiodic") if t in regimes]
+    text += (
+        f"; the paper's {' and '.join(paper)} appear{'s' * (len(paper) == 1)} there."
+        if paper
+        else "; neither the paper's period 2 nor a quasiperiodic motion appears there."
+    )
+    return text, tags
 
 
 def transient_finding(rows: pd.DataFrame, horizon: float, what: str) -> str:
@@ -182,44 +264,57 @@ def _first_ic(bif) -> pd.DataFrame:
 
 
 def _stiffness(quick: bool, outdir: Path, workers, classify):
+    """The two stiffness sweeps: Y_f over nine decades and l_λ across the paper's range;
+    each returns (bifurcation, path, {value: K_n})."""
     from ..model import Params
     from ..sweep import bifurcation
 
+    base = Params()
     step = 1.0 if quick else 0.5
     y_f = [float(f"{v:.3g}") for v in 10 ** np.arange(2.0, 11.01, step)] + [2.07e11]
-    bif = bifurcation("Y_f", y_f, duration=20.0, transient=10.0, classify=classify, workers=workers)
-    path = outdir / "sensitivity-stiffness.parquet"
-    bif.to_parquet(path)
-    base = Params()
-    k_n = {v: base.replace(Y_f=v).stiffness_at(base.l_lambda) for v in y_f}
-    return bif, path, k_n
+    l_lambda = np.linspace(*PAPER_L_LAMBDA, HERTZ_VALUES[quick]).round(6).tolist()
+    out = []
+    for name, values, k_of in (
+        ("Y_f", y_f, lambda v: base.replace(Y_f=v).stiffness_at(base.l_lambda)),
+        ("l_lambda", l_lambda, base.stiffness_at),
+    ):
+        bif = bifurcation(
+            name, values, duration=20.0, transient=10.0, classify=classify, workers=workers
+        )
+        path = outdir / f"sensitivity-{'stiffness' if name == 'Y_f' else 'hertz'}.parquet"
+        bif.to_parquet(path)
+        out.append((bif, path, {v: k_of(v) for v in values}))
+    return out
 
 
-def _stiffness_figure(bif, k_n: dict):
+def _stiffness_figure(sweeps):
+    """Section points of both stiffness sweeps against K_n, coloured by verdict; a run that
+    left no section point (diverged, out of reach) is an x on the top edge."""
     from matplotlib.figure import Figure
 
     from ..report._sweep_figures import LABEL_COLORS
 
-    pts = bif.points.assign(K_n=bif.points["value"].map(k_n))
     fig = Figure(figsize=(10, 5.5), layout="constrained")
     ax = fig.subplots()
+    pts = pd.concat([b.points.assign(K_n=b.points["value"].map(k)) for b, _, k in sweeps])
     for lab, g in pts.groupby("label"):
-        ax.scatter(
-            g["K_n"],
-            g["theta_f"],
-            s=4,
-            color=LABEL_COLORS.get(lab, "#E69F00"),
-            label=lab,
-            rasterized=True,
-        )
+        color = LABEL_COLORS.get(lab, "#E69F00")
+        ax.scatter(g["K_n"], g["theta_f"], s=9, color=color, label=lab, rasterized=True)
     ax.axvspan(*PAPER_K_N, color="#999999", alpha=0.25, lw=0, label="the paper's Hertz range")
+    gone = pd.concat([b.verdicts.assign(K_n=b.verdicts["value"].map(k)) for b, _, k in sweeps])
+    gone = gone[~gone["label"].isin(["periodic", "quasiperiodic", "chaotic", "undetermined"])]
+    if len(gone):
+        what = ", ".join(sorted(set(gone["label"])))
+        y = [ax.get_ylim()[1]] * len(gone)
+        ax.scatter(gone["K_n"], y, marker="x", s=40, color="black", clip_on=False,
+                   label=f"no section point ({what})")  # fmt: skip
     ax.set_xscale("log")
     ax.set(
-        xlabel="contact stiffness K_n [N/m] (through Y_f)",
+        xlabel="contact stiffness K_n [N/m] (through Y_f, and through l_λ in the shaded range)",
         ylabel="θ_f at the section [rad]",
         title="Section points against the contact stiffness (the rest as in Table 1)",
     )
-    ax.legend(frameon=False, fontsize="medium", markerscale=3)
+    ax.legend(frameon=False, fontsize="medium", markerscale=2.5)
     return fig
 
 
@@ -235,30 +330,15 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
 
     res = FigureResult(0, title="Sensitivity (why the paper differs)")
     # 1. stiffness
-    bif_k, path_k, k_n = _stiffness(quick, outdir, workers, classify)
-    fig = _stiffness_figure(bif_k, k_n)
-    png_k = _save(fig, outdir, "sensitivity-stiffness")
-    v = _first_ic(bif_k)
-    kv = v["value"].map(k_n).to_numpy()
-    runs = label_runs(kv, v["label"], v["period"])
-    inside = v[(kv >= PAPER_K_N[0] / 10) & (kv <= PAPER_K_N[1])]
-    flat = sorted(
-        {verdict_tag(a, b) for a, b in zip(inside["label"], inside["period"], strict=True)}
+    sweeps = _stiffness(quick, outdir, workers, classify)
+    png_k = _save(_stiffness_figure(sweeps), outdir, "sensitivity-stiffness")
+    (bif_k, path_k, k_yf), (bif_h, path_h, k_h) = sweeps
+    yf, hertz = (
+        _first_ic(b).assign(K_n=lambda f, k=k: f["value"].map(k)).sort_values("K_n")
+        for b, _, k in sweeps
     )
-    decades = np.log10(kv.max() / kv.min())
-    res.why.append(
-        f"Contact stiffness: K_n from {kv.min():.3g} to {kv.max():.3g} N/m ({decades:.1f} "
-        f"decades, through Y_f): {_runs_text(runs)}. Around and below the paper's Hertz range "
-        f"{PAPER_K_N[0]:.2g}–{PAPER_K_N[1]:.2g} N/m (from a tenth of its low end) the labels "
-        f"are {', '.join(flat) or 'none'}: "
-        + (
-            "the response does not change there, so the paper's stiffness model cannot "
-            "explain why its regimes differ from ours."
-            if len(flat) == 1
-            else "the response changes inside that range, so the stiffness model matters."
-        )
-        + step_finding(v, lambda r: f"K_n = {k_n[r.value]:.3g} N/m")
-    )
+    text, hertz_tags = stiffness_finding(yf, hertz)
+    res.why.append(text + step_finding(pd.concat([yf, hertz]), lambda r: f"K_n = {r.K_n:.3g} N/m"))
     res.why_figures.append(
         FigureItem(
             "sensitivity-stiffness",
@@ -266,13 +346,18 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
             png_uri(png_k),
             "Section angle against contact stiffness on a log axis, coloured by verdict, "
             "with the paper's stiffness range shaded.",
-            f"{len(v)} stiffnesses, 20 s runs (10 s transient), one initial condition; "
-            f"labels from the default classifier"
+            f"{len(yf)} stiffnesses through Y_f and {len(hertz)} through l_λ across the "
+            "paper's range, 20 s runs (10 s transient), one initial condition; labels from "
+            "the default classifier"
             + (", each checked at half the step" if getattr(classify, "check_step", False) else "")
-            + f". Data: {path_k.name}.",
+            + f". Data: {path_k.name}, {path_h.name}.",
         )
     )
-    res.bifurcations.append((str(path_k), bif_k, png_k))
+    res.bifurcations.append(
+        (str(path_k), bif_k, _save(bifurcation_figure(bif_k.points), outdir, "sensitivity-yf"))
+    )
+    png_h = _save(bifurcation_figure(bif_h.points), outdir, "sensitivity-hertz")
+    res.bifurcations.append((str(path_h), bif_h, png_h))
     # 2. restitution
     bif_x = bifurcation(
         "xi",
@@ -288,7 +373,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     png_x = _save(bifurcation_figure(bif_x.points), outdir, "sensitivity-xi")
     res.bifurcations.append((str(path_x), bif_x, png_x))
     res.why.append(
-        restitution_finding(_first_ic(bif_x), Params().xi, flat)
+        restitution_finding(_first_ic(bif_x), Params().xi, hertz_tags)
         + transient_finding(_first_ic(bif_x), FATE_S[quick], "value")
         + step_finding(_first_ic(bif_x), lambda r: f"ξ = {r.value:.3g}")
     )

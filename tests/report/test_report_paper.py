@@ -254,6 +254,11 @@ def test_the_summary_opens_with_the_labels_counted_from_the_tables():
         "(periods 1, 3)."
     )
     assert _in_short([sens]) == ""
+    banded = sweep(4, ["chaotic", "chaotic", "periodic"], [nan, nan, 8])
+    banded.bifurcations[0][1].verdicts["ev_banded_chaos"] = [8.0, nan, nan]
+    assert "are 1 periodic, 2 chaotic (1 of them 8-band chaos), 0 quasiperiodic" in (
+        _in_short([banded])
+    )
 
 
 def test_a_second_run_into_the_same_folder_is_refused(tmp_path, capsys):

@@ -4,10 +4,12 @@ import pandas as pd
 
 from chaoscam.experiments._paper import _classifier
 from chaoscam.experiments._sensitivity import (
+    PAPER_K_N,
     XI_WINDOW,
     restitution_finding,
     step_checked,
     step_finding,
+    stiffness_finding,
     xi_values,
 )
 from chaoscam.model import Params
@@ -36,23 +38,23 @@ def test_restitution_is_called_more_sensitive_only_when_it_is():
          (0.45, "periodic", 6), (0.7, "left_reach", None)]
     )  # fmt: skip
     text = restitution_finding(rich, 0.42, ["chaotic"])
-    assert "takes 3 different values (period 5, chaotic, period 6)" in text
+    assert "takes 3 regimes (period 5, chaotic, period 6), against 1 across" in text
     assert "more sensitive to the restitution" in text
     assert "(3 values sampled)" in text
 
     flat = _verdicts([(0.1, "periodic", 1), (0.4, "chaotic", None), (0.45, "chaotic", None)])
     text = restitution_finding(flat, 0.42, ["chaotic"])
     assert "more sensitive" not in text
-    assert "takes 1 value (chaotic)" in text
+    assert "takes 1 regime (chaotic)" in text
     assert "does not single the restitution out" in text
 
 
 def test_restitution_equal_to_a_rich_stiffness_range_is_not_called_more_sensitive():
     """Two regimes near ξ0 and two across the stiffness range: no claim either way."""
     v = _verdicts([(0.4, "periodic", 5), (0.42, "chaotic", None)])
-    text = restitution_finding(v, 0.42, ["chaotic", "periodic 3"])
+    text = restitution_finding(v, 0.42, ["chaotic", "period 3"])
     assert "more sensitive" not in text
-    assert "no more than across the paper's stiffness range (2)" in text
+    assert "no more than the 2 across the paper's Hertz range (chaotic, period 3)" in text
 
 
 def test_full_sweeps_check_the_step_and_quick_ones_do_not():
@@ -80,3 +82,50 @@ def test_step_finding_counts_checked_verdicts_and_names_the_changed():
     )
     assert step_finding(rows.drop(columns="ev_step_check"), str) == ""
     assert step_finding(rows.assign(ev_step_check=None), str) == ""
+
+
+def test_undetermined_is_no_regime_on_either_side():
+    """Undetermined runs near ξ0 are counted as such, not as a regime; an undetermined tag
+    across the Hertz range does not make it richer."""
+    v = _verdicts(
+        [(0.4, "periodic", 5), (0.41, "undetermined", None), (0.42, "chaotic", None)]
+    )  # fmt: skip
+    text = restitution_finding(v, 0.42, ["chaotic", "undetermined"])
+    assert "(3 values sampled, 1 undetermined) the motion takes 2 regimes" in text
+    assert "against 1 across the paper's Hertz range (chaotic)" in text
+
+
+def test_banded_chaos_is_named_by_its_bands():
+    """A chaotic run on 8 narrow bands reads "8-band chaos" in the sentences."""
+    v = _verdicts([(0.4, "periodic", 8), (0.42, "chaotic", None)]).assign(
+        ev_banded_chaos=[None, 8.0]
+    )
+    assert "period 8 (0.4) → 8-band chaos (0.42)" in restitution_finding(v, 0.42, [])
+
+
+def _stiff(rows):
+    frame = pd.DataFrame(rows, columns=["K_n", "label", "period", "ev_banded_chaos"])
+    return frame.assign(value=frame["K_n"]).sort_values("K_n")
+
+
+def test_stiffness_finding_judges_the_hertz_range_from_both_sweeps():
+    """One regime across the range: the stiffness cannot explain the difference; period 8 and
+    8-band chaos: the same motion, the label only; another regime: the stiffness matters.
+    Y_f runs outside the range do not count; the paper's regimes are looked for."""
+    lo, hi = PAPER_K_N
+    yf = _stiff([(10.0, "periodic", 3, None), (hi / 2, "chaotic", None, 8.0)])
+    one = _stiff([(lo, "chaotic", None, 8.0), (hi, "undetermined", None, None)])
+    text, tags = stiffness_finding(yf, one)
+    assert "(2 values) and by 1 of the Y_f values" in text
+    assert "one regime there, so the paper's stiffness model cannot explain" in text
+    assert "neither the paper's period 2 nor a quasiperiodic motion appears there" in text
+    assert tags == ["8-band chaos", "8-band chaos", "undetermined"]
+
+    family = _stiff([(lo, "periodic", 8, None), (hi, "chaotic", None, 8.0)])
+    text, _ = stiffness_finding(yf, family)
+    assert "moves between period 8 and 8-band chaos, the same motion on 8 narrow bands" in text
+
+    other = _stiff([(lo, "periodic", 2, None), (hi, "chaotic", None, None)])
+    text, _ = stiffness_finding(yf, other)
+    assert "the response changes inside that range, so the stiffness model matters" in text
+    assert "the paper's period 2 appears there" in text
