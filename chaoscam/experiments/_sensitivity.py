@@ -226,12 +226,13 @@ def stiffness_finding(yf: pd.DataFrame, hertz: pd.DataFrame) -> tuple[str, list[
     return text, tags
 
 
-def transient_finding(rows: pd.DataFrame, horizon: float, what: str) -> str:
+def transient_finding(rows: pd.DataFrame, horizon: float, what: str, where=None) -> str:
     """The sentence on transient motion: of the runs labelled chaotic, quasiperiodic or
     undetermined (continued to the fate ``horizon``), how many stop before it, when, and how
     many of those were labelled chaotic over the recorded window; from ``rows`` with columns
     label, fate and left_at.
-    ``what`` names one run ("cell", "value"). Empty when no run was continued."""
+    ``what`` names one run ("cell", "value"); ``where(row)``, when given, names the runs
+    labelled chaotic that left. Empty when no run was continued."""
     from ..sweep._stats import continued_labels, fate_split
 
     checked, left = fate_split(rows)
@@ -250,12 +251,33 @@ def transient_finding(rows: pd.DataFrame, horizon: float, what: str) -> str:
     )
     t0, t1 = left["left_at"].min(), left["left_at"].max()
     when = f"{t0:.3g} s" if f"{t0:.3g}" == f"{t1:.3g}" else f"{t0:.3g}–{t1:.3g} s"
-    chaotic = int((left["label"] == "chaotic").sum())
-    if chaotic == 0:
+    gone = left[left["label"] == "chaotic"]
+    if not len(gone):
         return head + f": {how} before it (last section at {when}), none labelled chaotic."
+    named = f" ({', '.join(map(where, gone.itertuples()))})" if where else ""
     return head + (
-        f": {how} before it (last section at {when}), {chaotic} labelled chaotic over the "
-        "recorded window: transient chaos, which that label cannot see."
+        f": {how} before it (last section at {when}), {len(gone)} labelled chaotic over the "
+        f"recorded window{named}: transient chaos, which that label cannot see."
+    )
+
+
+def open_choices() -> str:
+    """The sentence naming what the paper leaves open and this model decided (README,
+    "decisions"), with the values every run here uses, none of them swept: where a reader
+    would look next. Computed from ``Params()``, so it says what the runs used."""
+    from ..model import Params
+
+    p = Params()
+    return (
+        "Not swept here: what the paper leaves open and this model had to decide (README, "
+        f"decisions): the rod's inertia J = {p.inertia:.4g} kg m², the pivot "
+        f"({p.pivot[0]:g}, {p.pivot[1]:g}) m, the damping law ({p.damping}), the friction "
+        f"torque's arm {p.arm:g} m, the chattering limit (v_min = {p.v_min:g}, v_chatter = "
+        f"{p.v_chatter:g} m/s) and when a line length is drawn (resample = {p.resample}). "
+        "Each is a parameter: a bifurcation sweeps the numbers (--param J, x_O, y_O, "
+        "friction_arm, v_chatter), --set damping=paper_literal or resample=impact the choices; "
+        "whether one of them brings back the paper's period 2 and quasiperiod 2 is not "
+        "measured here."
     )
 
 
@@ -374,7 +396,12 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     res.bifurcations.append((str(path_x), bif_x, png_x))
     res.why.append(
         restitution_finding(_first_ic(bif_x), Params().xi, hertz_tags)
-        + transient_finding(_first_ic(bif_x), FATE_S[quick], "value")
+        + transient_finding(
+            _first_ic(bif_x),
+            FATE_S[quick],
+            "value",
+            lambda r: f"ξ = {r.value:.3g}, left at {r.left_at:.3g} s",
+        )
         + step_finding(_first_ic(bif_x), lambda r: f"ξ = {r.value:.3g}")
     )
     # 3. (omega, xi) map
@@ -421,9 +448,10 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
             if changes
             else "."
         )
-        + transient_finding(rm.realizations, FATE_S[quick], "cell").replace(
-            "transient chaos,", f"transient chaos (marked {TRANSIENT_MARK}),"
-        )
+        + transient_finding(
+            rm.realizations, FATE_S[quick], "cell", lambda r: f"({r.omega:.3g}, {r.xi:.3g})"
+        ).replace("transient chaos,", f"transient chaos (marked {TRANSIENT_MARK}),")
         + step_finding(rm.realizations, lambda r: f"(ω, ξ) = ({r.omega:.3g}, {r.xi:.3g})")
     )
+    res.why.append(open_choices())
     return res

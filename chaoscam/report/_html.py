@@ -310,7 +310,9 @@ def add_regime_map(
                 f"map-{len(parts.regime_maps) + 1}",
                 f"Regime map {x} × {y} ({name})",
                 png_uri(png),
-                f"Heatmaps over {x} and {y}: dominant label per cell, probability of chaos "
+                f"Heatmap over {x} and {y}: the label and period of each deterministic cell."
+                if "deterministic" in c and c["deterministic"].astype(bool).all()
+                else f"Heatmaps over {x} and {y}: dominant label per cell, probability of chaos "
                 f"with its {percent(confidence)} Wilson interval, and the interval width.",
                 caption or f"{len(rm.realizations)} realizations in {len(c)} cells.",
             ),

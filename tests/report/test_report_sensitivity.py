@@ -129,3 +129,14 @@ def test_stiffness_finding_judges_the_hertz_range_from_both_sweeps():
     text, _ = stiffness_finding(yf, other)
     assert "the response changes inside that range, so the stiffness model matters" in text
     assert "the paper's period 2 appears there" in text
+
+
+def test_the_open_choices_are_named_with_the_values_the_runs_used():
+    """The sentence on what the paper leaves open is computed from Params(): a changed
+    default would show in it."""
+    from chaoscam.experiments._sensitivity import open_choices
+
+    p = Params()
+    text = open_choices()
+    assert f"J = {p.inertia:.4g} kg m²" in text and f"({p.damping})" in text
+    assert f"v_chatter = {p.v_chatter:g} m/s" in text and "is not measured here" in text
