@@ -1,6 +1,6 @@
 """Why our reconstruction differs from the paper: the response against K_n, ξ and (ω, ξ).
 
-``sensitivity(quick, outdir) -> FigureResult`` runs three sweeps of the deterministic model
+``sensitivity(quick, outdir) -> FigureResult`` runs sweeps of the deterministic model
 (Table 1 otherwise) on the package's default classifier and states what they show:
 
 * the contact stiffness K_n over more than eight decades (through the follower's Young's
@@ -10,7 +10,9 @@
   keeps one regime there);
 * the restitution coefficient ξ, sampled densely around Table 1's value, to compare how many
   regimes its neighbourhood holds with how many the paper's stiffness range holds;
-* a regime map over (ω, ξ): periodic windows, sticking, chaos and escape from the cam's reach.
+* a regime map over (ω, ξ): periodic windows, sticking, chaos and escape from the cam's reach;
+* what the paper leaves open and this model decided (:mod:`._choices`: the inertia J, the
+  pivot height, the damping signs), against the same Hertz range.
 
 Every sentence of the findings is computed from the sweeps; nothing is written in advance.
 The full run checks every verdict at half the step (:data:`CHECK_STEP`).
@@ -25,6 +27,17 @@ import numpy as np
 import pandas as pd
 
 from ..report._html import FigureItem
+from ._choices import open_choices
+from ._findings import (
+    band_counts,
+    first_ic,
+    frame_tags,
+    label_runs,
+    regimes,
+    runs_text,
+    step_finding,
+    verdict_tag,
+)
 
 __all__ = ["PAPER_K_N", "PAPER_L_LAMBDA", "label_runs", "sensitivity", "stiffness_finding"]
 
@@ -38,49 +51,6 @@ HERTZ_VALUES = {True: 6, False: 18}
 """How many l_λ the stiffness finding samples across :data:`PAPER_L_LAMBDA` (quick, full), at
 the ξ sweep's step and classifier, so that the two ranges are compared on equal terms (Fig. 4
 samples the same range at a finer step)."""
-
-
-def verdict_tag(label, period, bands=None) -> str:
-    """A verdict in a finding's words: "period 8" for a periodic one with its period, "8-band
-    chaos" for a chaotic one whose section lies on 8 narrow bands (``ev_banded_chaos``), else
-    the label ("chaotic", "undetermined", "left_reach", ...)."""
-    if label == "periodic" and period is not None and pd.notna(period):
-        return f"period {int(period)}"
-    if label == "chaotic" and bands is not None and pd.notna(bands) and bands > 1:
-        return f"{int(bands)}-band chaos"
-    return str(label)
-
-
-def _bands(v: pd.DataFrame):
-    """The band counts of a verdict table (None where it has no ``ev_banded_chaos``)."""
-    return v["ev_banded_chaos"] if "ev_banded_chaos" in v else [None] * len(v)
-
-
-def frame_tags(v: pd.DataFrame) -> list[str]:
-    """:func:`verdict_tag` of every row of a verdict table (label, period, bands)."""
-    return [verdict_tag(*t) for t in zip(v["label"], v["period"], _bands(v), strict=True)]
-
-
-def label_runs(values, labels, periods, bands=None) -> list[tuple[str, float, float]]:
-    """Consecutive equal tags (:func:`verdict_tag`) along sorted values:
-    [(text, first, last), ...]."""
-    out: list[tuple[str, float, float]] = []
-    bands = [None] * len(labels) if bands is None else bands
-    for v, lab, per, nb in zip(values, labels, periods, bands, strict=True):
-        t = verdict_tag(lab, per, nb)
-        if out and out[-1][0] == t:
-            out[-1] = (t, out[-1][1], float(v))
-        else:
-            out.append((t, float(v), float(v)))
-    return out
-
-
-def _runs_text(runs, fmt="{:.3g}") -> str:
-    parts = []
-    for t, a, b in runs:
-        span = fmt.format(a) if a == b else f"{fmt.format(a)}–{fmt.format(b)}"
-        parts.append(f"{t} ({span})")
-    return " → ".join(parts)
 
 
 FATE_S = {True: 100.0, False: 300.0}
@@ -103,28 +73,6 @@ def step_checked(classify, quick: bool):
     return dataclasses.replace(classify, check_step=CHECK_STEP[quick])
 
 
-def step_finding(rows: pd.DataFrame, where) -> str:
-    """The sentence on the step check of one sweep's runs (``rows`` with ``ev_step_check``:
-    1 kept, 0 changed, empty when not checked): how many verdicts were checked, and where
-    they changed (``where(row)`` names a run). Empty when no run was checked."""
-    if "ev_step_check" not in rows or not rows["ev_step_check"].notna().any():
-        return ""
-    checked = rows[rows["ev_step_check"].notna()]
-    changed = checked[checked["ev_step_check"] == 0]
-    held = len(checked) - len(changed)
-    head = f" Checked at half the step, {held} of {len(checked)} " + (
-        "verdict holds" if len(checked) == 1 else "verdicts hold"
-    )
-    if not len(changed):
-        return head + "."
-    one = len(changed) == 1
-    runs = ", ".join(map(where, changed.itertuples()))
-    return head + (
-        f"; {len(changed)} change{'s' * one} there and {'is' if one else 'are'} undetermined "
-        f"({runs})."
-    )
-
-
 XI_WINDOW = 0.05
 """Half-width of the neighbourhood of Table 1's ξ that the restitution finding looks at."""
 
@@ -140,12 +88,6 @@ def xi_values(quick: bool) -> list[float]:
     return sorted({round(float(v), 10) for v in (*coarse, *near)})
 
 
-def _regimes(tags) -> list[str]:
-    """The distinct regimes among tags, in order, leaving "undetermined" out (it is no
-    regime: the evidence did not decide)."""
-    return [t for t in dict.fromkeys(tags) if t != "undetermined"]
-
-
 def restitution_finding(v: pd.DataFrame, xi0: float, hertz_tags: list[str]) -> str:
     """The restitution sentence of the findings, from the ξ sweep's verdicts ``v`` (columns
     value, label, period, optionally ev_banded_chaos; sorted by value) and the tags of the
@@ -153,11 +95,11 @@ def restitution_finding(v: pd.DataFrame, xi0: float, hertz_tags: list[str]) -> s
     the more sensitive parameter only when the neighbourhood of Table 1's ξ holds more regimes
     than that range; undetermined runs count on neither side."""
     near = v[(v["value"] - xi0).abs() <= XI_WINDOW + 1e-9]
-    tags, hertz = _regimes(frame_tags(near)), _regimes(hertz_tags)
+    tags, hertz = regimes(frame_tags(near)), regimes(hertz_tags)
     n_und = int((near["label"] == "undetermined").sum())
     head = (
         f"Restitution ξ (Table 1: {xi0:g}): "
-        + _runs_text(label_runs(v["value"], v["label"], v["period"], _bands(v)), "{:.3g}")
+        + runs_text(label_runs(v["value"], v["label"], v["period"], band_counts(v)), "{:.3g}")
         + f". Within ±{XI_WINDOW:g} of Table 1's value ({len(near)} values sampled"
         + (f", {n_und} undetermined" if n_und else "")
         + ") "
@@ -187,37 +129,39 @@ def stiffness_finding(yf: pd.DataFrame, hertz: pd.DataFrame) -> tuple[str, list[
     one n are the same motion on n narrow bands, where the stiffness decides the label only.
     """
     kv = yf["K_n"].to_numpy()
-    runs = label_runs(kv, yf["label"], yf["period"], _bands(yf))
+    runs = label_runs(kv, yf["label"], yf["period"], band_counts(yf))
     in_yf = yf[(yf["K_n"] >= PAPER_K_N[0]) & (yf["K_n"] <= PAPER_K_N[1])]
     inside = pd.concat([hertz, in_yf]).sort_values("K_n")
     tags = frame_tags(inside)
-    regimes = _regimes(tags)
+    found = regimes(tags)
     text = (
         f"Contact stiffness: K_n from {kv.min():.3g} to {kv.max():.3g} N/m "
-        f"({np.log10(kv.max() / kv.min()):.1f} decades, through Y_f): {_runs_text(runs)}. "
+        f"({np.log10(kv.max() / kv.min()):.1f} decades, through Y_f): {runs_text(runs)}. "
         f"Across the paper's Hertz range {PAPER_K_N[0]:.2g}–{PAPER_K_N[1]:.2g} N/m, sampled "
         f"through l_λ = {PAPER_L_LAMBDA[0] * 1e3:g}–{PAPER_L_LAMBDA[1] * 1e3:g} mm as the paper "
         f"does ({len(hertz)} values) and by {len(in_yf)} of the Y_f values: "
-        + _runs_text(label_runs(inside["K_n"], inside["label"], inside["period"], _bands(inside)))
+        + runs_text(
+            label_runs(inside["K_n"], inside["label"], inside["period"], band_counts(inside))
+        )
         + ": "
     )
-    bands = {int(t.split()[1]) for t in regimes if t.startswith("period ")}
-    bands |= {int(t.split("-")[0]) for t in regimes if t.endswith("-band chaos")}
-    family = len(bands) == 1 and all(t.startswith("period ") or "-band" in t for t in regimes)
-    if len(regimes) <= 1:
+    bands = {int(t.split()[1]) for t in found if t.startswith("period ")}
+    bands |= {int(t.split("-")[0]) for t in found if t.endswith("-band chaos")}
+    family = len(bands) == 1 and all(t.startswith("period ") or "-band" in t for t in found)
+    if len(found) <= 1:
         text += (
             "one regime there, so the paper's stiffness model cannot explain why its regimes "
             "differ from ours"
         )
     elif family:
         text += (
-            f"the label moves between {' and '.join(regimes)}, the same motion on {bands.pop()} "
+            f"the label moves between {' and '.join(found)}, the same motion on {bands.pop()} "
             "narrow bands: the stiffness decides which label, not the kind of motion, so it "
             "cannot explain why the paper's regimes differ from ours"
         )
     else:
         text += "the response changes inside that range, so the stiffness model matters"
-    paper = [t for t in ("period 2", "quasiperiodic") if t in regimes]
+    paper = [t for t in ("period 2", "quasiperiodic") if t in found]
     text += (
         f"; the paper's {' and '.join(paper)} appear{'s' * (len(paper) == 1)} there."
         if paper
@@ -254,35 +198,11 @@ def transient_finding(rows: pd.DataFrame, horizon: float, what: str, where=None)
     gone = left[left["label"] == "chaotic"]
     if not len(gone):
         return head + f": {how} before it (last section at {when}), none labelled chaotic."
-    named = f" ({', '.join(map(where, gone.itertuples()))})" if where else ""
+    named = f", at {'; '.join(map(where, gone.itertuples()))}" if where else ""
     return head + (
         f": {how} before it (last section at {when}), {len(gone)} labelled chaotic over the "
         f"recorded window{named}: transient chaos, which that label cannot see."
     )
-
-
-def open_choices() -> str:
-    """The sentence naming what the paper leaves open and this model decided (README,
-    "decisions"), with the values every run here uses, none of them swept: where a reader
-    would look next. Computed from ``Params()``, so it says what the runs used."""
-    from ..model import Params
-
-    p = Params()
-    return (
-        "Not swept here: what the paper leaves open and this model had to decide (README, "
-        f"decisions): the rod's inertia J = {p.inertia:.4g} kg m², the pivot "
-        f"({p.pivot[0]:g}, {p.pivot[1]:g}) m, the damping law ({p.damping}), the friction "
-        f"torque's arm {p.arm:g} m, the chattering limit (v_min = {p.v_min:g}, v_chatter = "
-        f"{p.v_chatter:g} m/s) and when a line length is drawn (resample = {p.resample}). "
-        "Each is a parameter: a bifurcation sweeps the numbers (--param J, x_O, y_O, "
-        "friction_arm, v_chatter), --set damping=paper_literal or resample=impact the choices; "
-        "whether one of them brings back the paper's period 2 and quasiperiod 2 is not "
-        "measured here."
-    )
-
-
-def _first_ic(bif) -> pd.DataFrame:
-    return bif.verdicts[bif.verdicts["ic"] == 0].sort_values("value")
 
 
 def _stiffness(quick: bool, outdir: Path, workers, classify):
@@ -356,7 +276,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     png_k = _save(_stiffness_figure(sweeps), outdir, "sensitivity-stiffness")
     (bif_k, path_k, k_yf), (bif_h, path_h, k_h) = sweeps
     yf, hertz = (
-        _first_ic(b).assign(K_n=lambda f, k=k: f["value"].map(k)).sort_values("K_n")
+        first_ic(b).assign(K_n=lambda f, k=k: f["value"].map(k)).sort_values("K_n")
         for b, _, k in sweeps
     )
     text, hertz_tags = stiffness_finding(yf, hertz)
@@ -395,14 +315,14 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     png_x = _save(bifurcation_figure(bif_x.points), outdir, "sensitivity-xi")
     res.bifurcations.append((str(path_x), bif_x, png_x))
     res.why.append(
-        restitution_finding(_first_ic(bif_x), Params().xi, hertz_tags)
+        restitution_finding(first_ic(bif_x), Params().xi, hertz_tags)
         + transient_finding(
-            _first_ic(bif_x),
+            first_ic(bif_x),
             FATE_S[quick],
             "value",
-            lambda r: f"ξ = {r.value:.3g}, left at {r.left_at:.3g} s",
+            lambda r: f"ξ = {r.value:.3g} (left at {r.left_at:.3g} s)",
         )
-        + step_finding(_first_ic(bif_x), lambda r: f"ξ = {r.value:.3g}")
+        + step_finding(first_ic(bif_x), lambda r: f"ξ = {r.value:.3g}")
     )
     # 3. (omega, xi) map
     omegas = (20.0, 50.0, 6) if quick else (10.0, 50.0, 17)
@@ -453,5 +373,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         ).replace("transient chaos,", f"transient chaos (marked {TRANSIENT_MARK}),")
         + step_finding(rm.realizations, lambda r: f"(ω, ξ) = ({r.omega:.3g}, {r.xi:.3g})")
     )
-    res.why.append(open_choices())
+    choices, bifs = open_choices(quick, outdir, workers, classify, hertz_tags)
+    res.why.append(choices)
+    res.bifurcations.extend(bifs)
     return res

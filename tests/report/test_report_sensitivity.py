@@ -131,12 +131,29 @@ def test_stiffness_finding_judges_the_hertz_range_from_both_sweeps():
     assert "the paper's period 2 appears there" in text
 
 
-def test_the_open_choices_are_named_with_the_values_the_runs_used():
-    """The sentence on what the paper leaves open is computed from Params(): a changed
-    default would show in it."""
-    from chaoscam.experiments._sensitivity import open_choices
+def test_the_open_choices_sentence_is_computed_from_the_sweeps():
+    """J and pivot sweeps and the literal damping: regimes counted together against the
+    Hertz range (undetermined on neither side), the paper's period 2 looked for, and the
+    choices not swept named with the values the runs used (from Params())."""
+    from chaoscam.experiments._choices import choices_finding
 
     p = Params()
-    text = open_choices()
-    assert f"J = {p.inertia:.4g} kg m²" in text and f"({p.damping})" in text
-    assert f"v_chatter = {p.v_chatter:g} m/s" in text and "is not measured here" in text
+    inertia = _verdicts(
+        [(0.02, "periodic", 1), (0.044, "chaotic", None), (0.08, "undetermined", None)]
+    )
+    pivot = _verdicts([(0.085, "periodic", 2), (0.105, "periodic", 5)])
+    damping = _verdicts([(0.42, "chaotic", None)]).assign(ev_banded_chaos=[8.0])
+    text = choices_finding(inertia, pivot, damping, ["8-band chaos", "undetermined"])
+    assert "J from 0.02 to 0.08 kg m²" in text and f"(the solid rod's {p.inertia:.3g})" in text
+    assert "period 1 (0.02) → chaotic (0.044) → undetermined (0.08)" in text
+    assert "the paper's literal damping signs: 8-band chaos." in text
+    assert (
+        "Together 5 regimes (period 1, chaotic, period 2, period 5, 8-band chaos), against 1"
+        in text
+    )
+    assert "move the motion more than the paper's stiffness does" in text
+    assert "the paper's period 2 appears among them" in text
+    assert f"v_chatter = {p.v_chatter:g} m/s" in text and f"resample = {p.resample}" in text
+
+    one = choices_finding(inertia.iloc[[1]], pivot.iloc[:0], damping.iloc[:0], ["chaotic"])
+    assert "no more than the paper's stiffness does" in one

@@ -126,8 +126,8 @@ def test_the_report_sentence_is_computed_from_the_rows():
     assert transient_finding(rows.iloc[[1]], 300.0, "value").endswith(
         "the 1 value labelled chaotic stays in the cam's reach."
     )
-    named = transient_finding(rows, 300.0, "cell", lambda r: f"left at {r.left_at:g} s")
-    assert "1 labelled chaotic over the recorded window (left at 27.9 s): transient" in named
+    named = transient_finding(rows, 300.0, "cell", lambda r: f"ω = 1 (left at {r.left_at:g} s)")
+    assert "recorded window, at ω = 1 (left at 27.9 s): transient" in named
     assert "none labelled chaotic" in transient_finding(rows.iloc[1:3], 300.0, "cell")
     assert transient_finding(rows.iloc[[3]], 300.0, "cell") == ""
     assert transient_finding(rows.drop(columns="fate"), 300.0, "cell") == ""

@@ -1,0 +1,115 @@
+"""What the paper leaves open, swept: does a choice this model had to make move the motion
+more than the paper's whole stiffness range does?
+
+At Table 1 otherwise: the rod's inertia J over 0.5–2 times the solid steel rod's (the paper
+gives the mass, not J), the pivot height y_O over R + r ± 1 cm (the paper draws the rod but
+gives no pivot), and one run with the paper's literal damping signs (``damping =
+"paper_literal"``; docs/model.md and the README's decisions table give the reasons for the
+defaults). The sentence is computed from the verdicts, on the sensitivity sweeps' step and
+classifier; the choices not swept are named with the values the runs used.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ._findings import (
+    band_counts,
+    first_ic,
+    frame_tags,
+    label_runs,
+    regimes,
+    runs_text,
+    step_finding,
+)
+
+__all__ = ["J_FACTORS", "PIVOT_SPAN", "choices_finding", "open_choices"]
+
+J_FACTORS = {True: (0.5, 0.75, 1.0, 1.5, 2.0), False: tuple(np.linspace(0.5, 2.0, 13))}
+"""The inertias swept, as factors of the solid rod's m (l²/3 + r²/4) (quick, full)."""
+
+PIVOT_SPAN = 0.01
+"""Half-width [m] of the pivot heights swept around the default R + r."""
+
+
+def _pivots(quick: bool) -> list[float]:
+    from ..model import Params
+
+    y0 = Params().pivot[1]
+    return np.linspace(y0 - PIVOT_SPAN, y0 + PIVOT_SPAN, 5 if quick else 11).round(6).tolist()
+
+
+def choices_finding(
+    inertia: pd.DataFrame, pivot: pd.DataFrame, damping: pd.DataFrame, hertz_tags: list[str]
+) -> str:
+    """The sentence: the labels along J and y_O (verdict tables with value, label, period and
+    optionally ev_banded_chaos, sorted), the literal damping's label, and how many regimes
+    they hold together against the paper's Hertz range (undetermined counts on neither side).
+    """
+    from ..model import Params
+
+    p = Params()
+    tags = frame_tags(inertia) + frame_tags(pivot) + frame_tags(damping)
+    found, hertz = regimes(tags), regimes(hertz_tags)
+
+    def along(v):
+        return runs_text(label_runs(v["value"], v["label"], v["period"], band_counts(v)))
+
+    text = (
+        f"What the paper leaves open, at Table 1 otherwise: the rod's inertia J from "
+        f"{inertia['value'].min():.3g} to {inertia['value'].max():.3g} kg m² (the solid rod's "
+        f"{p.inertia:.3g}): {along(inertia)}; the pivot height y_O from "
+        f"{pivot['value'].min():.3g} to {pivot['value'].max():.3g} m (default {p.pivot[1]:g}): "
+        f"{along(pivot)}; the paper's literal damping signs: {', '.join(frame_tags(damping))}. "
+        f"Together {len(found)} regime{'s' * (len(found) != 1)} ({', '.join(found) or 'none'}), "
+        f"against {len(hertz)} across the paper's Hertz range: "
+    )
+    if len(found) > max(len(hertz), 1):
+        text += "these unreported choices move the motion more than the paper's stiffness does"
+    else:
+        text += "these choices move the motion no more than the paper's stiffness does"
+    paper = [t for t in ("period 2", "quasiperiodic") if t in found]
+    text += (
+        f"; the paper's {' and '.join(paper)} appear{'s' * (len(paper) == 1)} among them."
+        if paper
+        else "; neither the paper's period 2 nor a quasiperiodic motion appears among them."
+    )
+    return text + (
+        f" Not swept: the friction torque's arm ({p.arm:g} m), the chattering limit (v_min = "
+        f"{p.v_min:g}, v_chatter = {p.v_chatter:g} m/s) and when a line length is drawn "
+        f"(resample = {p.resample})."
+    )
+
+
+def open_choices(quick: bool, outdir: Path, workers, classify, hertz_tags: list[str]):
+    """Run the sweeps; returns (the sentence, [(data file, bifurcation, its figure)] for the
+    J and y_O diagrams). The literal-damping run is kept as data only."""
+    from ..model import Params
+    from ..report._sweep_figures import bifurcation_figure
+    from ._paper import _save
+
+    p = Params()
+    runs, figures = {}, []
+    plan = (
+        ("J", [round(p.inertia * f, 8) for f in J_FACTORS[quick]], p, "sensitivity-J"),
+        ("y_O", _pivots(quick), p, "sensitivity-pivot"),
+        ("xi", [p.xi], p.replace(damping="paper_literal"), "sensitivity-damping"),
+    )
+    from ..sweep import bifurcation
+
+    for name, values, base, stem in plan:
+        bif = bifurcation(
+            name, values, base=base, duration=20.0, transient=10.0, classify=classify,
+            workers=workers,
+        )  # fmt: skip
+        path = outdir / f"{stem}.parquet"
+        bif.to_parquet(path)
+        runs[name] = first_ic(bif)
+        if name != "xi":
+            figures.append((str(path), bif, _save(bifurcation_figure(bif.points), outdir, stem)))
+    text = choices_finding(runs["J"], runs["y_O"], runs["xi"], hertz_tags)
+    rows = pd.concat([runs["J"].assign(what="J"), runs["y_O"].assign(what="y_O")])
+    return text + step_finding(rows, lambda r: f"{r.what} = {r.value:.3g}"), figures
