@@ -58,6 +58,10 @@ MAPS_AND_SWEEPS = (
     "Regime map l_lambda × l_lambda_sigma (fig7-10.parquet)",
     "Bifurcation diagram over Y_f (sensitivity-stiffness.parquet)",
     "Bifurcation diagram over xi (sensitivity-xi.parquet)",
+    "Bifurcation diagram over l_lambda (sensitivity-hertz.parquet)",
+    "Bifurcation diagram over J (sensitivity-J.parquet)",
+    "Bifurcation diagram over y_O (sensitivity-pivot.parquet)",
+    "Model parameters every run starts from",
     'id="sensitivity-stiffness"',
     'id="why"',
 )
