@@ -89,6 +89,7 @@ def open_choices(quick: bool, outdir: Path, workers, classify, hertz_tags: list[
     J and y_O diagrams). The literal-damping run is kept as data only."""
     from ..model import Params
     from ..report._sweep_figures import bifurcation_figure
+    from ..sweep import bifurcation
     from ._paper import _save
 
     p = Params()
@@ -98,8 +99,6 @@ def open_choices(quick: bool, outdir: Path, workers, classify, hertz_tags: list[
         ("y_O", _pivots(quick), p, "sensitivity-pivot"),
         ("xi", [p.xi], p.replace(damping="paper_literal"), "sensitivity-damping"),
     )
-    from ..sweep import bifurcation
-
     for name, values, base, stem in plan:
         bif = bifurcation(
             name, values, base=base, duration=20.0, transient=10.0, classify=classify,
