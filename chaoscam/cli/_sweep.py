@@ -299,9 +299,9 @@ def run_bifurcation(args: argparse.Namespace) -> int:
         f"points: {args.out}\nverdicts: {companion(args.out, 'verdicts')}"
     )
     if args.plot is not None:
-        from ..report._sweep_figures import bifurcation_figure
+        from ..report._sweep_figures import sweep_diagram
 
-        _save_figure(bifurcation_figure(res.points), args.plot)
+        _save_figure(sweep_diagram(res), args.plot)
         print(f"figure: {args.plot}")
     return 0
 

@@ -88,7 +88,7 @@ def open_choices(quick: bool, outdir: Path, workers, classify, hertz_tags: list[
     """Run the sweeps; returns (the sentence, [(data file, bifurcation, its figure)] for the
     J and y_O diagrams). The literal-damping run is kept as data only."""
     from ..model import Params
-    from ..report._sweep_figures import bifurcation_figure
+    from ..report._sweep_figures import sweep_diagram
     from ..sweep import bifurcation
     from ._paper import _save
 
@@ -108,7 +108,7 @@ def open_choices(quick: bool, outdir: Path, workers, classify, hertz_tags: list[
         bif.to_parquet(path)
         runs[name] = first_ic(bif)
         if name != "xi":
-            figures.append((str(path), bif, _save(bifurcation_figure(bif.points), outdir, stem)))
+            figures.append((str(path), bif, _save(sweep_diagram(bif), outdir, stem)))
     text = choices_finding(runs["J"], runs["y_O"], runs["xi"], hertz_tags)
     rows = pd.concat([runs["J"].assign(what="J"), runs["y_O"].assign(what="y_O")])
     return text + step_finding(rows, lambda r: f"{r.what} = {r.value:.3g}"), figures

@@ -193,7 +193,7 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
 def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 4: bifurcation of θ_f over l_λ ∈ [0.001, 0.018] m (Hertz line stiffness)."""
     from ..model import Params
-    from ..report._sweep_figures import bifurcation_figure
+    from ..report._sweep_figures import sweep_diagram
     from ..sweep import bifurcation
     from ..sweep._grid import parse_range
 
@@ -213,7 +213,7 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     )
     path = outdir / "fig4.parquet"
     bif.to_parquet(path)
-    png = _save(bifurcation_figure(bif.points), outdir, "fig4")
+    png = _save(sweep_diagram(bif), outdir, "fig4")
     res.bifurcations.append((str(path), bif, png))
     v = bif.verdicts[bif.verdicts["ic"] == 0].sort_values("value")
     labels = [
@@ -325,7 +325,7 @@ def fig5(quick: bool, outdir: Path, workers=None) -> FigureResult:
 def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 6: bifurcation over D with the fractal stiffness, G = 1e-9 and 1e-10 m."""
     from ..model import Params
-    from ..report._sweep_figures import bifurcation_figure
+    from ..report._sweep_figures import sweep_diagram
     from ..sweep import bifurcation
     from ..sweep._grid import parse_range
     from ..sweep._tasks import DefaultClassifier
@@ -350,7 +350,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
         tag = _fig6_tag(g)
         path = outdir / f"{tag}.parquet"
         bif.to_parquet(path)
-        png = _save(bifurcation_figure(bif.points, note=f"G = {g:g} m"), outdir, tag)
+        png = _save(sweep_diagram(bif, note=f"G = {g:g} m"), outdir, tag)
         res.bifurcations.append((str(path), bif, png))
         counts = bif.verdicts["label"].value_counts().to_dict()
         found.append(f"G = {g:g} m (dt = {dt:g} s): " + _counts(counts))

@@ -266,7 +266,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     extension of undetermined runs)."""
     from ..model import Params
     from ..report._figures import png_uri
-    from ..report._sweep_figures import TRANSIENT_MARK, bifurcation_figure, regime_map_figure
+    from ..report._sweep_figures import TRANSIENT_MARK, regime_map_figure, sweep_diagram
     from ..sweep import Axis, bifurcation, regime_map
     from ._paper import FigureResult, _save
 
@@ -296,9 +296,9 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         )
     )
     res.bifurcations.append(
-        (str(path_k), bif_k, _save(bifurcation_figure(bif_k.points), outdir, "sensitivity-yf"))
+        (str(path_k), bif_k, _save(sweep_diagram(bif_k), outdir, "sensitivity-yf"))
     )
-    png_h = _save(bifurcation_figure(bif_h.points), outdir, "sensitivity-hertz")
+    png_h = _save(sweep_diagram(bif_h), outdir, "sensitivity-hertz")
     res.bifurcations.append((str(path_h), bif_h, png_h))
     # 2. restitution
     bif_x = bifurcation(
@@ -312,7 +312,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     )
     path_x = outdir / "sensitivity-xi.parquet"
     bif_x.to_parquet(path_x)
-    png_x = _save(bifurcation_figure(bif_x.points), outdir, "sensitivity-xi")
+    png_x = _save(sweep_diagram(bif_x), outdir, "sensitivity-xi")
     res.bifurcations.append((str(path_x), bif_x, png_x))
     res.why.append(
         restitution_finding(first_ic(bif_x), Params().xi, hertz_tags)

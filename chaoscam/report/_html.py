@@ -233,7 +233,7 @@ def add_bifurcation(
 ) -> None:
     """A bifurcation diagram, its verdicts per value and its provenance (``png``: its figure
     already rendered, else drawn here)."""
-    from ._sweep_figures import bifurcation_figure
+    from ._sweep_figures import sweep_diagram
 
     name = Path(path).name
     cfg = bif.config or {}
@@ -241,7 +241,7 @@ def add_bifurcation(
     v = bif.verdicts
     counts = v["label"].value_counts().to_dict() if len(v) else {}
     if png is None:
-        png = png_bytes(bifurcation_figure(bif.points))
+        png = png_bytes(sweep_diagram(bif))
     ev_cols = [c for c in v.columns if c.startswith("ev_")]
     parts.bifurcations.append(
         {

@@ -242,10 +242,15 @@ def percent(confidence: float) -> str:
 def plot_interval_width(
     cells: pd.DataFrame, x: str, y: str, ax, *, label="chaotic", confidence: float = 0.95
 ) -> None:
-    """Heatmap of the width hi - lo of the Wilson interval of P(label) (at ``confidence``)."""
+    """Heatmap of the width hi - lo of the Wilson interval of P(label) (at ``confidence``).
+
+    A deterministic cell (sigma = 0: one run) has no interval: it is left blank and marked
+    "one run", not coloured as a width (it was drawn as a width of ~0, the narrowest)."""
     import seaborn as sns
 
+    det = cells["deterministic"].fillna(False).astype(bool) if "deterministic" in cells else None
     width = cells[f"p_{label}_hi"] - cells[f"p_{label}_lo"]
+    width = width if det is None else width.mask(det)
     m = _grid(cells.assign(_w=width), x, y, "_w")
     sns.heatmap(
         m,
@@ -256,6 +261,10 @@ def plot_interval_width(
         cbar_kws={"label": "interval width"},
         mask=m.isna(),
     )
+    if det is not None and det.any():
+        one = _grid(cells.assign(_d=det), x, y, "_d").fillna(False).to_numpy(dtype=bool)
+        for i, j in zip(*np.nonzero(one), strict=True):
+            ax.text(j + 0.5, i + 0.5, "one run", ha="center", va="center", fontsize=ANNOTATION_PT)
     _ticks(ax, m, x, y, _role(x, y))
     ax.set_title(f"{percent(confidence)} interval width of P({label})")
 
@@ -348,19 +357,49 @@ def _dodged(points: pd.DataFrame) -> pd.Series:
     return points["value"] + (rank / (len(ics) - 1) - 0.5) * width
 
 
+def _mark_without_points(ax, points: pd.DataFrame, verdicts: pd.DataFrame, color_by) -> None:
+    """An x on the top edge at each run of ``verdicts`` (value, ic, label) without a point."""
+    drawn = set(zip(points["value"], points["ic"], strict=True)) if len(points) else set()
+    keys = zip(verdicts["value"], verdicts["ic"], strict=True)
+    gone = verdicts[[k not in drawn for k in keys]]
+    if not len(gone):
+        return
+    what = ", ".join(sorted(set(map(str, gone["label"]))))
+    top = [ax.get_ylim()[1]] * len(gone)
+    ax.scatter(gone["value"], top, marker="x", s=40, color="black", clip_on=False,
+               label=f"no section point ({what})")  # fmt: skip
+    scale = ax.get_legend().markerscale if ax.get_legend() else 1.0  # the diagram's dots
+    ax.legend(markerscale=scale, frameon=False, fontsize="small", title=color_by)
+
+
 def bifurcation_figure(
-    points: pd.DataFrame, *, coordinate: str = "theta_f", color_by: str = "label", note: str = ""
+    points: pd.DataFrame,
+    *,
+    coordinate: str = "theta_f",
+    color_by: str = "label",
+    note: str = "",
+    verdicts: pd.DataFrame | None = None,
 ):
     """One panel: the bifurcation diagram of ``coordinate`` over the swept parameter;
-    ``note`` (e.g. "G = 1e-10 m") goes into the title, to tell panels of one figure apart."""
+    ``note`` (e.g. "G = 1e-10 m") goes into the title, to tell panels of one figure apart.
+    With the sweep's ``verdicts``, a run that left no section point after the transient (out
+    of the cam's reach, diverged) is an x on the top edge, named in the legend."""
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(9, 5), layout="constrained")
     ax = fig.subplots()
     plot_bifurcation(points, ax, coordinate=coordinate, color_by=color_by)
+    if verdicts is not None and len(verdicts):
+        _mark_without_points(ax, points, verdicts, color_by)
     param = str(points["param"].iloc[0]) if len(points) else ""
     note = f" ({note})" if note else ""
     ax.set_title(
         f"bifurcation diagram over {param}{note}: stroboscopic section after the transient"
     )
     return fig
+
+
+def sweep_diagram(bif, *, note: str = ""):
+    """:func:`bifurcation_figure` of a finished bifurcation sweep: its points, and its
+    verdicts to mark the runs without a section point."""
+    return bifurcation_figure(bif.points, note=note, verdicts=bif.verdicts)

@@ -78,3 +78,37 @@ def test_deterministic_cells_show_one_run_not_an_interval():
     for r, s in zip(rows, shown, strict=True):
         assert ("deterministic: one run" in s) == r["deterministic"]
         assert ("[" in s) != r["deterministic"]
+
+
+def test_deterministic_cells_have_no_interval_width():
+    """The width panel leaves a sigma = 0 cell blank and marks it "one run" (it was coloured
+    as the narrowest width); the other cells keep their widths."""
+    from matplotlib.figure import Figure
+
+    from chaoscam.report._sweep_figures import plot_interval_width
+
+    cells = _cells().assign(deterministic=lambda c: c["l_lambda_sigma"] == 0.0)
+    ax = Figure().subplots()
+    plot_interval_width(cells, "l_lambda", "l_lambda_sigma", ax)
+    assert [t.get_text() for t in ax.texts] == ["one run"] * 3
+    shown = ax.collections[0].get_array()
+    assert np.ma.count(shown) == 6  # the three sigma = 0 cells are masked
+
+
+def test_runs_without_section_points_are_marked():
+    """A run that left no point after the transient (left_reach, diverged) is an x on the top
+    edge, named in the legend; a sweep whose runs all have points gets no x."""
+    pts = pd.DataFrame(
+        {"param": "xi", "value": [0.1, 0.1, 0.2], "ic": 0, "theta_f": [0.0, 0.1, 0.2],
+         "label": "periodic", "period": 1}
+    )  # fmt: skip
+    verdicts = pd.DataFrame(
+        {"value": [0.1, 0.2, 0.7], "ic": 0, "label": ["periodic", "periodic", "left_reach"]}
+    )
+    ax = bifurcation_figure(pts, verdicts=verdicts).axes[0]
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "no section point (left_reach)" in legend
+    xs = [c for c in ax.collections if c.get_offsets().shape[0] and c.get_label().startswith("no")]
+    assert xs[0].get_offsets()[:, 0].tolist() == [0.7]
+    ax = bifurcation_figure(pts, verdicts=verdicts.iloc[:2]).axes[0]
+    assert not any("no section" in t.get_text() for t in ax.get_legend().get_texts())
