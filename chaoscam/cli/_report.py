@@ -69,6 +69,12 @@ def register(sub) -> None:
         action="store_true",
         help="replace an existing report (and its paper-data folder's files)",
     )
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="continue an interrupted report in the same folder: finished sweeps are read "
+        "back, the one under way finishes from its checkpoint",
+    )
     p.set_defaults(func=run_paper)
 
 
@@ -127,16 +133,25 @@ def run_paper(args: argparse.Namespace) -> int:
         + (["--figures", args.figures] if args.figures is not None else [])
         + (["--workers", str(args.workers)] if args.workers else [])
         + ["--out", str(args.out)]
+        + (["--resume"] if args.resume else [])
     )
-    run = _run(
-        quick=args.quick,
-        out=args.out,
-        figures=figures,
-        workers=args.workers,
-        command=command,
-        echo=True,
-        force=args.force,
-    )
+    try:
+        run = _run(
+            quick=args.quick,
+            out=args.out,
+            figures=figures,
+            workers=args.workers,
+            command=command,
+            echo=True,
+            force=args.force,
+            resume=args.resume,
+        )
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM: say what is kept and how to go on, once
+        from ..experiments._run import RESUME_HINT
+        from . import stop_word
+
+        print(f"chaoscam: {stop_word()}; {RESUME_HINT}", file=sys.stderr)
+        return 130
     print(f"report: {args.out}")
     if run.failed:
         print(

@@ -25,6 +25,7 @@ from ._findings import (
     runs_text,
     step_finding,
 )
+from ._store import stored
 
 __all__ = ["J_FACTORS", "PIVOT_SPAN", "choices_finding", "open_choices"]
 
@@ -100,12 +101,11 @@ def open_choices(quick: bool, outdir: Path, workers, classify, hertz_tags: list[
         ("xi", [p.xi], p.replace(damping="paper_literal"), "sensitivity-damping"),
     )
     for name, values, base, stem in plan:
+        path = outdir / f"{stem}.parquet"
         bif = bifurcation(
             name, values, base=base, duration=20.0, transient=10.0, classify=classify,
-            workers=workers,
+            workers=workers, **stored(path),
         )  # fmt: skip
-        path = outdir / f"{stem}.parquet"
-        bif.to_parquet(path)
         runs[name] = first_ic(bif)
         if name != "xi":
             figures.append((str(path), bif, _save(sweep_diagram(bif), outdir, stem)))

@@ -20,6 +20,7 @@ import pandas as pd
 from ..report._figures import png_bytes, png_uri, response_figure
 from ..report._html import Comparison, FigureItem
 from . import _steps
+from ._store import stored
 
 __all__ = ["FIGURES", "FigureResult", "data_files"]
 
@@ -210,9 +211,8 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
         initial_conditions=1 if quick else 3,
         classify=_classifier(quick),
         workers=workers,
+        **stored(path := outdir / "fig4.parquet"),
     )
-    path = outdir / "fig4.parquet"
-    bif.to_parquet(path)
     png = _save(sweep_diagram(bif), outdir, "fig4")
     res.bifurcations.append((str(path), bif, png))
     v = bif.verdicts[bif.verdicts["ic"] == 0].sort_values("value")
@@ -338,6 +338,8 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
         stiffest = Params(stiffness="fractal", D=parse_range(values)[1], G=g)
         dt = _steps.figure_dt(stiffest, _steps.FIG6_STEPS[quick])
         base = Params(stiffness="fractal", G=g, dt=dt)
+        tag = _fig6_tag(g)
+        path = outdir / f"{tag}.parquet"
         bif = bifurcation(
             "D",
             values,
@@ -346,10 +348,8 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
             transient=transient,
             classify=DefaultClassifier(extend_to=None if quick else FULL_EXTEND_TO),
             workers=workers,
+            **stored(path),
         )
-        tag = _fig6_tag(g)
-        path = outdir / f"{tag}.parquet"
-        bif.to_parquet(path)
         png = _save(sweep_diagram(bif, note=f"G = {g:g} m"), outdir, tag)
         res.bifurcations.append((str(path), bif, png))
         counts = bif.verdicts["label"].value_counts().to_dict()
@@ -395,9 +395,8 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
         transient=10.0,
         classify=_classifier(quick),
         workers=workers,
+        **stored(path := outdir / "fig7-10.parquet"),
     )
-    path = outdir / "fig7-10.parquet"
-    rm.to_parquet(path)
     png = _save(regime_map_figure(rm.cells, x="l_lambda", y="l_lambda_sigma"), outdir, "fig7-10")
     res.regime_maps.append((str(path), rm, png))
     for mu in MU_PAPER:

@@ -71,7 +71,8 @@ def check_paper_outputs(out: str | Path, figures=None, *, force: bool = False) -
         names = dict.fromkeys(n for f in stages for n in data_files(f))
         elsewhere = (
             "write the report into another folder (--out OTHER/paper.html, its data go to "
-            "OTHER/paper-data), or pass --force to replace them"
+            "OTHER/paper-data), pass --resume to continue an interrupted report with them, or "
+            "--force to replace them"
         )
         for name in names:
             _check_data_file(
@@ -80,7 +81,7 @@ def check_paper_outputs(out: str | Path, figures=None, *, force: bool = False) -
                 force,
                 f"{outdir} already holds",
                 elsewhere,
-                " (the data of an earlier report)",
+                " (the data of an earlier or an interrupted report)",
             )
     return outdir
 
@@ -107,6 +108,7 @@ def run_paper(
     command=None,
     echo=False,
     force: bool = False,
+    resume: bool = False,
 ) -> PaperRun:
     """Run the figure scripts and write the report (data and PNGs in ``OUT_DIR/paper-data``).
 
@@ -117,13 +119,17 @@ def run_paper(
     is reported in the report's "What is missing" and in :attr:`PaperRun.failed`; the
     others still run.
 
-    A second run into the same folder (the same ``paper-data``) is refused while this one
-    works (:class:`chaoscam._outputs.OutputLock`), and without ``force`` the report is put in
-    place only if its name is still free: a file that appeared there meanwhile is kept, and
-    this run's report goes beside it with an ``OutputError`` naming both.
+    ``resume`` continues an interrupted report in the same folder: each sweep whose output
+    is there and finished (same configuration) is read back, the one under way finishes from
+    its checkpoint, the rest run (:mod:`._store`); the report is then written over the old
+    one, if any. A second run into the same folder (the same ``paper-data``) is refused while
+    this one works (:class:`chaoscam._outputs.OutputLock`), and without ``force`` the report
+    is put in place only if its name is still free: a file that appeared there meanwhile is
+    kept, and this run's report goes beside it with an ``OutputError`` naming both.
     """
     from .._outputs import OutputLock
     from ..sweep._backends import local_workers
+    from ._store import store_mode
 
     if figures is not None:
         figures = list(figures)
@@ -136,12 +142,14 @@ def run_paper(
     if workers is not None:
         local_workers(workers)  # before any work: every sweep would refuse it
     out = Path(out)
+    force = force or resume  # a resumed report finishes, and replaces, the same files
     check_paper_outputs(out, figures, force=force)  # the messages, before taking the lock
     # One run at a time per report folder: reports beside each other share paper-data.
     with OutputLock(out.parent / "paper-data", "folder (--out OTHER/paper.html)"):
         outdir = check_paper_outputs(out, figures, force=force)  # again, under the lock
         outdir.mkdir(exist_ok=True)
-        return _run_stages(quick, out, outdir, figures, workers, command, echo, force)
+        with store_mode(force=force, resume=resume):
+            return _run_stages(quick, out, outdir, figures, workers, command, echo, force)
 
 
 def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> PaperRun:
@@ -330,11 +338,19 @@ def _in_short(results) -> str:
     return text
 
 
+RESUME_HINT = (
+    "the finished sweeps are kept (a sweep under way in its .ckpt folder): run the same "
+    "command with --resume to continue"
+)
+"""What an interrupted report or figure script says it kept and how to go on."""
+
+
 def figure_script(number: int, argv: list[str] | None = None) -> int:
     """The body of ``analyses/figN.py`` (and, for :data:`SENSITIVITY`,
     ``analyses/sensitivity.py``): run one stage of ``chaoscam paper``, print what it found.
 
-    Usage: ``python analyses/figN.py [--quick] [--force] [--workers N] [OUTDIR]`` (default
+    Usage: ``python analyses/figN.py [--quick] [--force | --resume] [--workers N] [OUTDIR]``
+    (default
     OUTDIR: reports/paper-data, created when missing). The stage's data files
     (:func:`data_files`) are checked before any work, as ``chaoscam paper`` checks them: an
     existing one is replaced only with ``--force`` (the committed ``reports/paper-data``
@@ -348,6 +364,7 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     import sys
 
     from .._outputs import OutputError, OutputLock
+    from ._store import store_mode
 
     name = "sensitivity" if number == SENSITIVITY else f"fig{number}"
     what = "the sensitivity sweeps" if number == SENSITIVITY else f"Fig. {number}"
@@ -364,6 +381,7 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     )
     ap.add_argument("--quick", action="store_true", help="the quick report's grids")
     ap.add_argument("--force", action="store_true", help="replace this stage's files in OUTDIR")
+    ap.add_argument("--resume", action="store_true", help="continue an interrupted run")
     ap.add_argument("--workers", type=int, default=None, help="cores (default: all)")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     outdir = Path(args.outdir)
@@ -381,20 +399,21 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
             _check_data_file(
                 outdir,
                 file,
-                args.force,
+                args.force or args.resume,
                 f"OUTDIR {outdir} already holds",
-                "give another OUTDIR, or pass --force to replace this stage's files",
+                "give another OUTDIR, pass --resume to continue an interrupted run, or "
+                "--force to replace this stage's files",
             )
     except (OutputError, OSError, ValueError) as err:
         held.close()
         ap.error(str(err))  # exit 2
     fn = _sensitivity_stage if number == SENSITIVITY else FIGURES[number]
     try:
-        with held, warnings.catch_warnings():
+        with held, store_mode(force=args.force, resume=args.resume), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             result = fn(args.quick, outdir, workers=args.workers)
     except KeyboardInterrupt:
-        print(f"{ap.prog}: interrupted; run it again with --force", file=sys.stderr)
+        print(f"{ap.prog}: interrupted; {RESUME_HINT}", file=sys.stderr)
         raise SystemExit(130) from None
     for c in result.comparisons:
         print(f"{c.figure}: {c.verdict} - {c.found} ({c.reason})")

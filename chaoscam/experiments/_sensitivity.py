@@ -38,6 +38,7 @@ from ._findings import (
     step_finding,
     verdict_tag,
 )
+from ._store import stored
 
 __all__ = ["PAPER_K_N", "PAPER_L_LAMBDA", "label_runs", "sensitivity", "stiffness_finding"]
 
@@ -220,11 +221,11 @@ def _stiffness(quick: bool, outdir: Path, workers, classify):
         ("Y_f", y_f, lambda v: base.replace(Y_f=v).stiffness_at(base.l_lambda)),
         ("l_lambda", l_lambda, base.stiffness_at),
     ):
-        bif = bifurcation(
-            name, values, duration=20.0, transient=10.0, classify=classify, workers=workers
-        )
         path = outdir / f"sensitivity-{'stiffness' if name == 'Y_f' else 'hertz'}.parquet"
-        bif.to_parquet(path)
+        bif = bifurcation(
+            name, values, duration=20.0, transient=10.0, classify=classify, workers=workers,
+            **stored(path),
+        )  # fmt: skip
         out.append((bif, path, {v: k_of(v) for v in values}))
     return out
 
@@ -309,9 +310,8 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         classify=classify,
         workers=workers,
         fate=FATE_S[quick],
+        **stored(path_x := outdir / "sensitivity-xi.parquet"),
     )
-    path_x = outdir / "sensitivity-xi.parquet"
-    bif_x.to_parquet(path_x)
     png_x = _save(sweep_diagram(bif_x), outdir, "sensitivity-xi")
     res.bifurcations.append((str(path_x), bif_x, png_x))
     res.why.append(
@@ -336,9 +336,8 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         classify=classify,
         workers=workers,
         fate=FATE_S[quick],
+        **stored(path_m := outdir / "sensitivity-omega-xi.parquet"),
     )
-    path_m = outdir / "sensitivity-omega-xi.parquet"
-    rm.to_parquet(path_m)
     png_m = _save(regime_map_figure(rm.cells, x="omega", y="xi"), outdir, "sensitivity-omega-xi")
     res.regime_maps.append((str(path_m), rm, png_m))
     cells = rm.cells

@@ -184,6 +184,49 @@ def test_paper_refuses_any_existing_output_before_the_work(tmp_path, capsys):
     assert (data / "fig5.png").read_bytes()[:4] == b"\x89PNG"
 
 
+def test_an_interrupted_report_resumes_without_redoing_its_finished_sweeps(
+    tmp_path, monkeypatch, capsys
+):
+    """Ctrl-C during Fig. 6's sweeps: exit 130 and one line saying what is kept and how to go
+    on; a plain rerun is refused; --resume reads Fig. 4's finished sweep back (its file is
+    not written again), runs the rest, and its findings equal an uninterrupted run's."""
+    import chaoscam.sweep
+
+    _shrink_the_runs(monkeypatch)
+    small = chaoscam.sweep.bifurcation
+
+    def stopped_at_fig6(param, values, **kw):
+        if param == "D":
+            raise KeyboardInterrupt
+        return small(param, values, **kw)
+
+    monkeypatch.setattr(chaoscam.sweep, "bifurcation", stopped_at_fig6)
+    args = ["paper", "--quick", "--figures", "4,6", "--out", str(tmp_path / "p.html")]
+    assert main(args) == 130
+    err = capsys.readouterr().err
+    last = err.splitlines()[-1]  # after the stages' progress lines
+    assert (
+        last.startswith("chaoscam: interrupted; the finished sweeps are kept")
+        and "--resume" in last
+    )
+    assert err.count("interrupted") == 1
+    fig4 = tmp_path / "paper-data" / "fig4.parquet"
+    stamp = fig4.stat().st_mtime_ns
+    assert main(args) == 2 and "pass --resume to continue" in capsys.readouterr().err
+    monkeypatch.setattr(chaoscam.sweep, "bifurcation", small)
+    assert main([*args, "--resume"]) == 0
+    assert fig4.stat().st_mtime_ns == stamp  # read back, not run again
+    resumed = capsys.readouterr().out
+    (tmp_path / "fresh").mkdir()
+    assert main([*args[:-1], str(tmp_path / "fresh" / "p.html")]) == 0
+    fresh = capsys.readouterr().out
+
+    def findings(text):
+        return [line for line in text.splitlines() if not line.startswith(("Quick", "report:"))]
+
+    assert findings(resumed) == findings(fresh) and len(findings(fresh)) > 3
+
+
 def test_paper_unwritable_places_are_refused(tmp_path, capsys):
     """A paper-data that is a file, or a report folder that does not exist: exit 2 with a
     message, nothing run."""
