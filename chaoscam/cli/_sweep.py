@@ -341,8 +341,11 @@ def run_regime_map(args: argparse.Namespace) -> int:
     if isinstance(res, int):
         return res
     c = res.cells
+    det = int(c["deterministic"].astype(bool).sum()) if "deterministic" in c else 0
+    once = f" ({det} deterministic cell(s), sigma = 0: one run each)" if det else ""
     print(
-        f"regime map {res.x} x {res.y}: {len(c)} cells, {len(res.realizations)} realizations\n"
+        f"regime map {res.x} x {res.y}: {len(c)} cells, {len(res.realizations)} realizations"
+        f"{once}\n"
         f"labels: {_counts(res.realizations['label'])}\n"
         f"dominant: {_counts(c['dominant'])}{_transient(res.realizations)}\n"
         f"realizations: {args.out}\ncells: {companion(args.out, 'cells')}"

@@ -357,10 +357,11 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     holds the full report's data, which a ``--quick`` run would otherwise overwrite), and
     OUTDIR is locked for the run, as ``chaoscam paper`` locks its data folder. Bad
     arguments or outputs (OUTDIR in use included): exit 2 with one line; Ctrl-C: exit 130
-    with one line. Returns the exit code (0) when it finishes.
+    with one line (SIGTERM: 143), saying how to resume. Returns the exit code (0) when it finishes.
     """
     import argparse
     import contextlib
+    import signal
     import sys
 
     from .._outputs import OutputError, OutputLock
@@ -408,13 +409,23 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
         held.close()
         ap.error(str(err))  # exit 2
     fn = _sensitivity_stage if number == SENSITIVITY else FIGURES[number]
+    stopped = {}  # SIGTERM is handled as Ctrl-C, as the chaoscam command handles it
+
+    def on_term(signum, frame):
+        stopped["term"] = True
+        raise KeyboardInterrupt
+
+    before = signal.signal(signal.SIGTERM, on_term)
     try:
         with held, store_mode(force=args.force, resume=args.resume), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             result = fn(args.quick, outdir, workers=args.workers)
     except KeyboardInterrupt:
-        print(f"{ap.prog}: interrupted; {RESUME_HINT}", file=sys.stderr)
-        raise SystemExit(130) from None
+        word = "terminated" if stopped else "interrupted"
+        print(f"{ap.prog}: {word}; {RESUME_HINT}", file=sys.stderr)
+        raise SystemExit(143 if stopped else 130) from None
+    finally:
+        signal.signal(signal.SIGTERM, before)
     for c in result.comparisons:
         print(f"{c.figure}: {c.verdict} - {c.found} ({c.reason})")
     for line in result.why:

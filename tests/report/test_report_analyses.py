@@ -4,6 +4,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -103,3 +105,28 @@ def test_a_script_into_the_current_folder_runs(tmp_path):
     assert done.returncode == 0, done.stderr
     assert (tmp_path / "fig3.csv").exists()
     assert not list(tmp_path.parent.glob(f".{tmp_path.name}.lock"))  # released
+
+
+@pytest.mark.slow
+def test_a_script_stopped_by_sigterm_says_so_and_resumes(tmp_path):
+    """SIGTERM during the sensitivity sweeps (~20 s quick): exit 143 with one line saying what
+    is kept and --resume (it exited silently); --resume then finishes, with no checkpoint
+    left."""
+    import signal
+    import time
+
+    proc = subprocess.Popen(
+        [sys.executable, str(ROOT / "analyses" / "sensitivity.py"), "--quick", str(tmp_path)],
+        stderr=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    time.sleep(8.0)  # imports done, a sweep under way
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 143, err
+    assert err.strip().endswith("run the same command with --resume to continue")
+    assert "terminated; the finished sweeps are kept" in err and "Traceback" not in err
+    done = _script("sensitivity.py", "--quick", "--resume", str(tmp_path))
+    assert done.returncode == 0, done.stderr
+    assert not list(tmp_path.glob("*.ckpt"))

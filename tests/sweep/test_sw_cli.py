@@ -165,8 +165,9 @@ def test_existing_output_and_foreign_checkpoint_exit_2(tmp_path, capsys):
     assert main([*base[:-1], str(tmp_path / "c.parquet")]) == 2
 
 
-def test_regime_map_with_other_axes_and_plot(tmp_path):
-    """--x/--y over omega x xi writes both tables and a figure."""
+def test_regime_map_with_other_axes_and_plot(tmp_path, capsys):
+    """--x/--y over omega x xi writes both tables and a figure; the summary says that its
+    deterministic cells (sigma = 0) ran once each, whatever --realizations asked."""
     out = tmp_path / "r.parquet"
     args = [
         "regime-map",
@@ -193,6 +194,9 @@ def test_regime_map_with_other_axes_and_plot(tmp_path):
     assert set(cells.columns) >= {"omega", "xi", "dominant", "p_chaotic_lo", "p_chaotic_hi"}
     assert "left_reach" in set(pd.read_parquet(out)["label"])
     assert (tmp_path / "r.png").stat().st_size > 0
+    assert "4 cells, 4 realizations (4 deterministic cell(s), sigma = 0: one run each)" in (
+        capsys.readouterr().out
+    )
 
 
 @pytest.mark.parametrize(
