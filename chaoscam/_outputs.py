@@ -62,10 +62,14 @@ def check_output(
     if path is None:
         return None
     path = Path(path)
-    if suffixes is not None and path.suffix.lower() not in suffixes:
-        raise OutputError(f"{flag} {path}: the file must end in {' or '.join(suffixes)}")
-    if path.is_dir():
+    if path.is_dir():  # first: "bad/" is a folder, whatever its suffix
         raise OutputError(f"{flag} {path}: is a directory; give a file name")
+    if suffixes is not None and path.suffix.lower() not in suffixes:
+        bare = path.name.lower() in suffixes  # ".html": a suffix without a name
+        raise OutputError(
+            f"{flag} {path}: the file must end in {' or '.join(suffixes)}"
+            + (f" after a name (NAME{path.name})" if bare else "")
+        )
     folder = path.parent if str(path.parent) else Path(".")
     if folder.exists() and not folder.is_dir():
         raise OutputError(f"{flag} {path}: {folder} is a file, not a folder")

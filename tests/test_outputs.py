@@ -143,6 +143,11 @@ def test_check_output_unwritable_location_and_suffix(tmp_path):
     with pytest.raises(OutputError, match=r"\.html"):
         check_output(tmp_path / "r.txt", suffixes=(".html",))
     assert check_output(None) is None
+    # A folder is named as one whatever its suffix; a bare suffix asks for a name before it.
+    with pytest.raises(OutputError, match="is a directory"):
+        check_output(f"{tmp_path}/", suffixes=(".html",))
+    with pytest.raises(OutputError, match=r"after a name \(NAME\.html\)"):
+        check_output(tmp_path / ".html", suffixes=(".html",))
 
 
 def test_atomic_path_keeps_the_old_file_on_failure(tmp_path):
