@@ -21,6 +21,7 @@ from ._findings import (
     first_ic,
     frame_tags,
     label_runs,
+    paper_regimes,
     regimes,
     runs_text,
     step_finding,
@@ -72,16 +73,14 @@ def choices_finding(
         text += "these unreported choices move the motion more than the paper's stiffness does"
     else:
         text += "these choices move the motion no more than the paper's stiffness does"
-    paper = [t for t in ("period 2", "quasiperiodic") if t in found]
-    text += (
-        f"; the paper's {' and '.join(paper)} appear{'s' * (len(paper) == 1)} among them."
-        if paper
-        else "; neither the paper's period 2 nor a quasiperiodic motion appears among them."
-    )
-    return text + (
-        f" Not swept: the friction torque's arm ({p.arm:g} m), the chattering limit (v_min = "
-        f"{p.v_min:g}, v_chatter = {p.v_chatter:g} m/s) and when a line length is drawn "
-        f"(resample = {p.resample})."
+    return (
+        text
+        + paper_regimes(found, "among them")
+        + (
+            f" Not swept: the friction torque's arm ({p.arm:g} m), the chattering limit (v_min = "
+            f"{p.v_min:g}, v_chatter = {p.v_chatter:g} m/s) and when a line length is drawn "
+            f"(resample = {p.resample})."
+        )
     )
 
 

@@ -10,9 +10,11 @@ import pandas as pd
 
 __all__ = [
     "band_counts",
+    "band_number",
     "first_ic",
     "frame_tags",
     "label_runs",
+    "paper_regimes",
     "regimes",
     "runs_text",
     "step_finding",
@@ -20,15 +22,24 @@ __all__ = [
 ]
 
 
+def band_number(label, period, bands=None) -> int | None:
+    """n of a motion on n narrow bands: a periodic verdict's period, or the band count of a
+    chaotic one on narrow bands (``ev_banded_chaos``); None for any other verdict."""
+    if label == "periodic" and period is not None and pd.notna(period):
+        return int(period)
+    if label == "chaotic" and bands is not None and pd.notna(bands) and bands > 1:
+        return int(bands)
+    return None
+
+
 def verdict_tag(label, period, bands=None) -> str:
     """A verdict in a finding's words: "period 8" for a periodic one with its period, "8-band
     chaos" for a chaotic one whose section lies on 8 narrow bands (``ev_banded_chaos``), else
     the label ("chaotic", "undetermined", "left_reach", ...)."""
-    if label == "periodic" and period is not None and pd.notna(period):
-        return f"period {int(period)}"
-    if label == "chaotic" and bands is not None and pd.notna(bands) and bands > 1:
-        return f"{int(bands)}-band chaos"
-    return str(label)
+    n = band_number(label, period, bands)
+    if n is None:
+        return str(label)
+    return f"period {n}" if label == "periodic" else f"{n}-band chaos"
 
 
 def band_counts(v: pd.DataFrame):
@@ -67,6 +78,15 @@ def regimes(tags) -> list[str]:
     """The distinct regimes among tags, in order, leaving "undetermined" out (it is no
     regime: the evidence did not decide)."""
     return [t for t in dict.fromkeys(tags) if t != "undetermined"]
+
+
+def paper_regimes(found: list[str], where: str) -> str:
+    """The clause saying whether the paper's period 2 or a quasiperiodic motion is among the
+    regimes ``found`` (``where``: "there", "among them")."""
+    paper = [t for t in ("period 2", "quasiperiodic") if t in found]
+    if not paper:
+        return f"; neither the paper's period 2 nor a quasiperiodic motion appears {where}."
+    return f"; the paper's {' and '.join(paper)} appear{'s' * (len(paper) == 1)} {where}."
 
 
 def step_finding(rows: pd.DataFrame, where) -> str:

@@ -350,14 +350,14 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     ``analyses/sensitivity.py``): run one stage of ``chaoscam paper``, print what it found.
 
     Usage: ``python analyses/figN.py [--quick] [--force | --resume] [--workers N] [OUTDIR]``
-    (default
-    OUTDIR: reports/paper-data, created when missing). The stage's data files
+    (default OUTDIR: reports/paper-data, created when missing). The stage's data files
     (:func:`data_files`) are checked before any work, as ``chaoscam paper`` checks them: an
     existing one is replaced only with ``--force`` (the committed ``reports/paper-data``
     holds the full report's data, which a ``--quick`` run would otherwise overwrite), and
     OUTDIR is locked for the run, as ``chaoscam paper`` locks its data folder. Bad
     arguments or outputs (OUTDIR in use included): exit 2 with one line; Ctrl-C: exit 130
-    with one line (SIGTERM: 143), saying how to resume. Returns the exit code (0) when it finishes.
+    with one line (SIGTERM: 143), saying how to resume. Returns the exit code (0) when it
+    finishes.
     """
     import argparse
     import contextlib

@@ -30,9 +30,11 @@ from ..report._html import FigureItem
 from ._choices import open_choices
 from ._findings import (
     band_counts,
+    band_number,
     first_ic,
     frame_tags,
     label_runs,
+    paper_regimes,
     regimes,
     runs_text,
     step_finding,
@@ -146,9 +148,10 @@ def stiffness_finding(yf: pd.DataFrame, hertz: pd.DataFrame) -> tuple[str, list[
         )
         + ": "
     )
-    bands = {int(t.split()[1]) for t in found if t.startswith("period ")}
-    bands |= {int(t.split("-")[0]) for t in found if t.endswith("-band chaos")}
-    family = len(bands) == 1 and all(t.startswith("period ") or "-band" in t for t in found)
+    decided = inside[inside["label"] != "undetermined"]
+    rows = zip(decided["label"], decided["period"], band_counts(decided), strict=True)
+    bands = {band_number(*r) for r in rows}
+    family = len(bands) == 1 and None not in bands  # period n and n-band chaos of one n
     if len(found) <= 1:
         text += (
             "one regime there, so the paper's stiffness model cannot explain why its regimes "
@@ -162,13 +165,7 @@ def stiffness_finding(yf: pd.DataFrame, hertz: pd.DataFrame) -> tuple[str, list[
         )
     else:
         text += "the response changes inside that range, so the stiffness model matters"
-    paper = [t for t in ("period 2", "quasiperiodic") if t in found]
-    text += (
-        f"; the paper's {' and '.join(paper)} appear{'s' * (len(paper) == 1)} there."
-        if paper
-        else "; neither the paper's period 2 nor a quasiperiodic motion appears there."
-    )
-    return text, tags
+    return text + paper_regimes(found, "there"), tags
 
 
 def transient_finding(rows: pd.DataFrame, horizon: float, what: str, where=None) -> str:
@@ -235,7 +232,7 @@ def _stiffness_figure(sweeps):
     left no section point (diverged, out of reach) is an x on the top edge."""
     from matplotlib.figure import Figure
 
-    from ..report._sweep_figures import LABEL_COLORS
+    from ..report._sweep_figures import LABEL_COLORS, mark_without_points
 
     fig = Figure(figsize=(10, 5.5), layout="constrained")
     ax = fig.subplots()
@@ -244,13 +241,8 @@ def _stiffness_figure(sweeps):
         color = LABEL_COLORS.get(lab, "#E69F00")
         ax.scatter(g["K_n"], g["theta_f"], s=9, color=color, label=lab, rasterized=True)
     ax.axvspan(*PAPER_K_N, color="#999999", alpha=0.25, lw=0, label="the paper's Hertz range")
-    gone = pd.concat([b.verdicts.assign(K_n=b.verdicts["value"].map(k)) for b, _, k in sweeps])
-    gone = gone[~gone["label"].isin(["periodic", "quasiperiodic", "chaotic", "undetermined"])]
-    if len(gone):
-        what = ", ".join(sorted(set(gone["label"])))
-        y = [ax.get_ylim()[1]] * len(gone)
-        ax.scatter(gone["K_n"], y, marker="x", s=40, color="black", clip_on=False,
-                   label=f"no section point ({what})")  # fmt: skip
+    runs = pd.concat([b.verdicts.assign(K_n=b.verdicts["value"].map(k)) for b, _, k in sweeps])
+    mark_without_points(ax, pts, runs, x="K_n")
     ax.set_xscale("log")
     ax.set(
         xlabel="contact stiffness K_n [N/m] (through Y_f, and through l_λ in the shaded range)",
@@ -314,15 +306,13 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     )
     png_x = _save(sweep_diagram(bif_x), outdir, "sensitivity-xi")
     res.bifurcations.append((str(path_x), bif_x, png_x))
+    v_x = first_ic(bif_x)
     res.why.append(
-        restitution_finding(first_ic(bif_x), Params().xi, hertz_tags)
+        restitution_finding(v_x, Params().xi, hertz_tags)
         + transient_finding(
-            first_ic(bif_x),
-            FATE_S[quick],
-            "value",
-            lambda r: f"ξ = {r.value:.3g} (left at {r.left_at:.3g} s)",
+            v_x, FATE_S[quick], "value", lambda r: f"ξ = {r.value:.3g} (left at {r.left_at:.3g} s)"
         )
-        + step_finding(first_ic(bif_x), lambda r: f"ξ = {r.value:.3g}")
+        + step_finding(v_x, lambda r: f"ξ = {r.value:.3g}")
     )
     # 3. (omega, xi) map
     omegas = (20.0, 50.0, 6) if quick else (10.0, 50.0, 17)

@@ -282,7 +282,7 @@ def add_regime_map(
 ) -> None:
     """A regime map's figure, its cell table and its provenance (``png``: its figure already
     rendered, else drawn here)."""
-    from ._sweep_figures import percent, regime_map_figure
+    from ._sweep_figures import all_deterministic, percent, regime_map_figure
 
     name = Path(path).name
     cfg = rm.config or {}
@@ -311,7 +311,7 @@ def add_regime_map(
                 f"Regime map {x} × {y} ({name})",
                 png_uri(png),
                 f"Heatmap over {x} and {y}: the label and period of each deterministic cell."
-                if "deterministic" in c and c["deterministic"].astype(bool).all()
+                if all_deterministic(c)
                 else f"Heatmaps over {x} and {y}: dominant label per cell, probability of chaos "
                 f"with its {percent(confidence)} Wilson interval, and the interval width.",
                 caption or f"{len(rm.realizations)} realizations in {len(c)} cells.",
@@ -409,7 +409,9 @@ def model_rows() -> list[tuple[str, Any, str, str]]:
     """(name, value, unit, meaning) of each field of ``Params()``, where every run starts."""
     from ..model import FIELD_DOCS, Params
 
-    short = lambda doc: doc if len(doc) < 160 else doc[:150].rsplit(" ", 1)[0] + " …"  # noqa: E731
+    def short(doc: str) -> str:  # the first ~150 characters of a long field doc
+        return doc if len(doc) < 160 else doc[:150].rsplit(" ", 1)[0] + " …"
+
     docs = {k: (d.get("unit") or "", short(d.get("doc") or "")) for k, d in FIELD_DOCS.items()}
     return [(k, v, *docs.get(k, ("", ""))) for k, v in Params().to_dict().items()]
 
@@ -439,7 +441,8 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
     if commit:
         changed = uncommitted_sources()
         if changed:
-            shown = ", ".join(changed[:5]) + (f" and {len(changed) - 5} more" * (len(changed) > 5))
+            more = f" and {len(changed) - 5} more" if len(changed) > 5 else ""
+            shown = ", ".join(changed[:5]) + more
             commit += f" plus uncommitted changes to {shown}"
     return env.get_template("report.html").render(
         title=title,

@@ -269,6 +269,11 @@ def plot_interval_width(
     ax.set_title(f"{percent(confidence)} interval width of P({label})")
 
 
+def all_deterministic(cells: pd.DataFrame) -> bool:
+    """Whether every cell of a map is deterministic (sigma = 0: one run, no probabilities)."""
+    return "deterministic" in cells and bool(cells["deterministic"].astype(bool).all())
+
+
 def regime_map_figure(
     cells: pd.DataFrame, *, x: str, y: str, label: str = "chaotic", confidence: float = 0.95
 ):
@@ -282,7 +287,7 @@ def regime_map_figure(
     """
     from matplotlib.figure import Figure
 
-    if "deterministic" in cells and cells["deterministic"].astype(bool).all():
+    if all_deterministic(cells):
         fig = Figure(figsize=(9.5, 6.5), layout="constrained")
         plot_dominant(cells, x, y, fig.subplots())
         return fig
@@ -336,12 +341,17 @@ def plot_bifurcation(
         )
     ax.set_xlabel(axis_label(param) if len(points) else "value")
     ax.set_ylabel(axis_label(coordinate))
-    v = points["value"].to_numpy(dtype=float) if len(points) else np.empty(0)
-    if v.size and v.min() > 0 and v.max() / v.min() > LOG_AXIS_SPAN:
+    if _log_axis(points):
         ax.set_xscale("log")  # values over several decades (a stiffness sweep)
     if color_by is not None and groups:
         scale = float(np.sqrt(40.0 / size))  # legend dots of ~40 pt² whatever the size
         ax.legend(markerscale=scale, frameon=False, fontsize="small", title=color_by)
+
+
+def _log_axis(points: pd.DataFrame) -> bool:
+    """Whether the swept values span more than :data:`LOG_AXIS_SPAN` (a log axis)."""
+    v = points["value"].to_numpy(dtype=float) if len(points) else np.empty(0)
+    return bool(v.size and v.min() > 0 and v.max() / v.min() > LOG_AXIS_SPAN)
 
 
 def _dodged(points: pd.DataFrame) -> pd.Series:
@@ -349,27 +359,24 @@ def _dodged(points: pd.DataFrame) -> pd.Series:
     and the values are evenly enough spaced for a linear axis."""
     values = np.unique(points["value"].to_numpy(dtype=float))
     ics = np.unique(points["ic"]) if "ic" in points else []
-    logx = values.min() > 0 and values.max() / values.min() > LOG_AXIS_SPAN if len(values) else 0
-    if len(ics) < 2 or len(values) < 2 or logx:
+    if len(ics) < 2 or len(values) < 2 or _log_axis(points):
         return points["value"].astype(float)
     rank = pd.Series(np.arange(len(ics)), index=ics)[points["ic"]].to_numpy()
     width = np.diff(values).min() / 3.0
     return points["value"] + (rank / (len(ics) - 1) - 0.5) * width
 
 
-def _mark_without_points(ax, points: pd.DataFrame, verdicts: pd.DataFrame, color_by) -> None:
-    """An x on the top edge at each run of ``verdicts`` (value, ic, label) without a point."""
-    drawn = set(zip(points["value"], points["ic"], strict=True)) if len(points) else set()
-    keys = zip(verdicts["value"], verdicts["ic"], strict=True)
-    gone = verdicts[[k not in drawn for k in keys]]
-    if not len(gone):
-        return
-    what = ", ".join(sorted(set(map(str, gone["label"]))))
-    top = [ax.get_ylim()[1]] * len(gone)
-    ax.scatter(gone["value"], top, marker="x", s=40, color="black", clip_on=False,
-               label=f"no section point ({what})")  # fmt: skip
-    scale = ax.get_legend().markerscale if ax.get_legend() else 1.0  # the diagram's dots
-    ax.legend(markerscale=scale, frameon=False, fontsize="small", title=color_by)
+def mark_without_points(ax, points: pd.DataFrame, verdicts: pd.DataFrame, x="value") -> bool:
+    """An x on the top edge at each run of ``verdicts`` (``x``, ic, label) that left no
+    section point (out of the cam's reach, diverged), labelled for the legend; True when
+    there was one (the caller then draws its legend again)."""
+    drawn = set(zip(points[x], points["ic"], strict=True)) if len(points) else set()
+    gone = verdicts[[k not in drawn for k in zip(verdicts[x], verdicts["ic"], strict=True)]]
+    if len(gone):
+        what = ", ".join(sorted(set(map(str, gone["label"]))))
+        ax.scatter(gone[x], [ax.get_ylim()[1]] * len(gone), marker="x", s=40, color="black",
+                   clip_on=False, label=f"no section point ({what})")  # fmt: skip
+    return bool(len(gone))
 
 
 def bifurcation_figure(
@@ -389,8 +396,9 @@ def bifurcation_figure(
     fig = Figure(figsize=(9, 5), layout="constrained")
     ax = fig.subplots()
     plot_bifurcation(points, ax, coordinate=coordinate, color_by=color_by)
-    if verdicts is not None and len(verdicts):
-        _mark_without_points(ax, points, verdicts, color_by)
+    if verdicts is not None and mark_without_points(ax, points, verdicts):
+        scale = ax.get_legend().markerscale if ax.get_legend() else 1.0  # the diagram's dots
+        ax.legend(markerscale=scale, frameon=False, fontsize="small", title=color_by)
     param = str(points["param"].iloc[0]) if len(points) else ""
     note = f" ({note})" if note else ""
     ax.set_title(
