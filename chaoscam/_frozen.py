@@ -5,13 +5,15 @@ A :class:`chaoscam.Trajectory` is frozen, but its ``settings`` and ``stats`` wer
 simulated seed 99 as if it were the same run (found by an API review). :class:`FrozenDict`
 reads like a dict (``json.dumps``, ``{**d}``, ``d.get``, pickling across processes) and
 refuses every change with a TypeError saying how to make a changed copy.
+:func:`freeze_fields` does the same for a frozen result's arrays (read-only views: a
+result's exponents or Jacobians cannot be changed in place either).
 
 Imports only the standard library, so any module may use it.
 """
 
 from __future__ import annotations
 
-__all__ = ["FrozenDict"]
+__all__ = ["FrozenDict", "freeze_fields"]
 
 
 class FrozenDict(dict):
@@ -31,3 +33,16 @@ class FrozenDict(dict):
 
     def __repr__(self) -> str:
         return dict.__repr__(self)
+
+
+def freeze_fields(result, *names: str) -> None:
+    """In a frozen dataclass's ``__post_init__``: make the named fields read-only, a dict as a
+    :class:`FrozenDict`, an array as a read-only view of itself (None stays None)."""
+    for name in names:
+        value = getattr(result, name)
+        if isinstance(value, dict):
+            value = FrozenDict(value)
+        elif hasattr(value, "flags"):  # a numpy array, without importing numpy here
+            value = value.view()
+            value.flags.writeable = False
+        object.__setattr__(result, name, value)

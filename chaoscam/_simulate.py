@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._frozen import FrozenDict
+from ._frozen import freeze_fields
 from ._run_warnings import run_warnings
 from ._version import __version__
 from ._warn import warn
@@ -83,7 +83,7 @@ class Trajectory:
         ends at each section point (through the impacts' saltation matrices).
     divergence : ndarray or None
         With ``tangent=True``: the integral of the flow's divergence over each such period
-        (Liouville: ln|det J_k| = divergence_k + 2 ln(xi) per restitution jump).
+        (Liouville: ln|det J_k| = divergence_k + 2 ln(xi) per restitution jump). Read-only.
     resume : RunCopy or None
         With ``resumable=True`` (RK4): the copy :func:`chaoscam.extend_trajectory`
         continues the run from; None otherwise, and for a run read from a file.
@@ -102,8 +102,7 @@ class Trajectory:
     resume: RunCopy | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name in ("settings", "stats"):
-            object.__setattr__(self, name, FrozenDict(getattr(self, name)))
+        freeze_fields(self, "settings", "stats", "jacobians", "divergence")
 
     @property
     def message(self) -> str:

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ._checks import params_arg, whole, with_overrides
+from ._frozen import freeze_fields
 from ._version import __version__
 from .integrate import Status, kernel_constants
 from .integrate import _kernel as k
@@ -82,6 +83,9 @@ class ModelLyapunov:
     status: Status
     message: str = ""
     settings: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "running", "settings")
 
     @property
     def ok(self) -> bool:
@@ -176,19 +180,9 @@ def _batch_stderr(values: np.ndarray, n_batches: int = 20) -> float:
 
 
 def _no_exponent(msg, status, postponed, unsynced, settings) -> ModelLyapunov:
+    nan = math.nan
     return ModelLyapunov(
-        math.nan,
-        math.nan,
-        math.nan,
-        np.array([]),
-        0.0,
-        0,
-        math.nan,
-        postponed,
-        unsynced,
-        status,
-        msg,
-        settings,
+        nan, nan, nan, np.array([]), 0.0, 0, nan, postponed, unsynced, status, msg, settings
     )
 
 

@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ._checks import params_arg, real, whole
+from ._frozen import freeze_fields
 from ._warn import warn
 from .analysis import TangentSpectrum, spectrum_from_jacobians
 from .integrate import Status, kernel_constants
@@ -255,6 +256,9 @@ class PeriodicOrbit:
     iterations: int
     wall_time: float
     settings: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "points", "multipliers", "settings")
 
     @property
     def stable(self) -> bool:

@@ -6,6 +6,7 @@ import copy
 import json
 import pickle
 
+import numpy as np
 import pytest
 
 import chaoscam
@@ -53,3 +54,30 @@ def test_a_verdicts_settings_are_read_only():
         verdict.settings["n"] = 6
     assert verdict.settings == {"n": 5}
     assert pickle.loads(pickle.dumps(verdict)).settings == {"n": 5}
+
+
+@pytest.mark.filterwarnings("ignore:lambda_1.*too few")  # 2 s: enough to hold arrays
+def test_a_results_arrays_are_read_only():
+    """A result's arrays are read-only views (chaoscam._frozen.freeze_fields): a Trajectory's
+    Jacobians, the spectrum from them and the 0-1 test's K_c could be changed in place on a
+    frozen result, and a later spectrum or report would read the changed numbers."""
+    from chaoscam.analysis import section_period, zero_one_test
+
+    run = chaoscam.simulate(duration=2.0, series=False, tangent=True)
+    spectrum = chaoscam.lyapunov_spectrum(trajectory=run)
+    zero_one = zero_one_test(np.sin(0.3 * np.arange(400)))
+    period = section_period(np.tile([[0.1, 0.2], [0.3, 0.4]], (20, 1)))
+    arrays = {
+        "jacobians": run.jacobians,
+        "divergence": run.divergence,
+        "exponents": spectrum.exponents,
+        "k_c": zero_one.k_c,
+        "tolerance": period.tolerance,
+    }
+    for name, a in arrays.items():
+        with pytest.raises(ValueError, match="read-only"):
+            a[0] = 0.0
+        assert not a.flags.writeable, name
+    with pytest.raises(TypeError, match="read-only"):
+        spectrum.settings["n"] = 1
+    assert np.isfinite(chaoscam.lyapunov_spectrum(trajectory=run).exponents).all()  # still readable

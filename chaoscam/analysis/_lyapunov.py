@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._frozen import freeze_fields
 from ._validate import check_settings
 
 __all__ = [
@@ -54,6 +55,9 @@ class LyapunovResult:
     message: str = ""
     settings: dict = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        freeze_fields(self, "running", "settings")
+
 
 @dataclass(frozen=True)
 class LyapunovSpectrum:
@@ -72,6 +76,9 @@ class LyapunovSpectrum:
     exponents: np.ndarray
     stderr: np.ndarray
     settings: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "exponents", "stderr", "settings")
 
     @property
     def largest(self) -> float:

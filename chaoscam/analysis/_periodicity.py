@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._frozen import freeze_fields
 from ._thresholds import Thresholds
 from ._validate import as_points, check_settings
 
@@ -128,6 +129,9 @@ class PeriodResult:
     jitter: np.ndarray = field(default_factory=lambda: np.array([]))
     extent: np.ndarray = field(default_factory=lambda: np.array([]))
     separation: float = math.inf
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "tolerance", "settings", "jitter", "extent")
 
 
 def _separation(y: np.ndarray, p: int, scale: np.ndarray) -> float:

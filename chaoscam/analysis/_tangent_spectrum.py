@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from .._frozen import freeze_fields
 from ._validate import check_settings
 
 __all__ = ["TangentSpectrum", "spectrum_from_jacobians"]
@@ -45,6 +46,9 @@ class TangentSpectrum:
     local: np.ndarray = field(repr=False)
     det_log: float
     settings: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "exponents", "stderr", "local", "settings")
 
     @property
     def exponent(self) -> float:

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._frozen import freeze_fields
 from ._validate import as_series, check_settings
 
 __all__ = ["ZeroOneResult", "zero_one_test"]
@@ -46,6 +47,9 @@ class ZeroOneResult:
     oversampled: bool
     message: str = ""
     settings: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "k_c", "c", "settings")
 
 
 def zero_one_test(

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._checks import flag, params_arg, whole
+from .._frozen import freeze_fields
 from .._run_warnings import run_warnings
 from .._warn import warn
 from ..model import Params
@@ -82,6 +83,9 @@ class Ensemble:
     impacts: pd.DataFrame | None = None
     jacobians: np.ndarray | None = None
     resume: Resume | None = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "settings", "jacobians")
 
 
 def simulate_ensemble(

@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from .._checks import flag, params_arg, whole
+from .._frozen import freeze_fields
 from .._provenance import code_identity
 from .._version import __version__
 from ..model import Params, contact_angle
@@ -73,6 +74,9 @@ class Bifurcation:
     points: pd.DataFrame
     verdicts: pd.DataFrame
     config: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "config")
 
     @property
     def param(self) -> str:

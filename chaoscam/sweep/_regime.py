@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from .._checks import flag, params_arg, whole
+from .._frozen import freeze_fields
 from .._provenance import code_identity
 from .._version import __version__
 from ..model import ParameterError, Params, realizations_identical
@@ -72,6 +73,9 @@ class RegimeMap:
     realizations: pd.DataFrame
     cells: pd.DataFrame
     config: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "config")
 
     @property
     def x(self) -> str:
