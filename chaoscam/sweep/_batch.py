@@ -15,6 +15,7 @@ batch it ran in, the thread count or an interruption.
 
 from __future__ import annotations
 
+import sys
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -369,6 +370,11 @@ def run_sweep(
     with lock_outputs(out):
         store, reuse = open_store(out, second, config, resume, flush_interval, force)
         if reuse:
+            if progress:
+                print(
+                    f"already finished: {out} (same configuration); read, nothing run",
+                    file=sys.stderr,
+                )
             return read(out)
         # Outputs there now are this configuration's (a resumed run's) or --force's; any
         # other that appears while the plan runs is not replaced at the end.

@@ -155,6 +155,8 @@ def test_existing_output_and_foreign_checkpoint_exit_2(tmp_path, capsys):
     assert main(base) == 2
     assert "--resume" in capsys.readouterr().err
     assert main([*base, "--resume"]) == 0  # the same run: reused as is
+    assert main([a for a in base if a != "--quiet"] + ["--resume"]) == 0
+    assert "already finished" in capsys.readouterr().err  # and says so
     assert main([*base[:4], "0.3:0.6:2", *base[5:], "--resume"]) == 2
     assert out.read_bytes() == before
     ckpt = checkpoint_dir(tmp_path / "c.parquet")
