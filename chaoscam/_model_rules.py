@@ -196,10 +196,23 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
         "chaotic",
         f"the section keeps {n} narrow bands while the tangent exponent is positive beyond "
         "its confidence interval and no attracting period-n orbit lies in them that the run "
-        f"converges to: chaos confined to {n} bands (n-band chaos)",
+        f"converges to: chaos confined to {n} bands (n-band chaos){_outweighed(v)}",
     )
     verdict = Verdict("chaotic", None, v.evidence + (e, band), (), v.settings)
     return verdict, extra
+
+
+def _outweighed(v: Verdict) -> str:
+    """The clause naming the votes n-band chaos outweighs (periodic or quasiperiodic, cast
+    without the exponent), or ""."""
+    names = [e.name for e in v.evidence if e.vote in ("periodic", "quasiperiodic")]
+    if not names:
+        return ""
+    return (
+        f"; it outweighs the {', '.join(names)} vote(s), which see the narrow bands (a "
+        "recurrence to the band tolerance, or the lines of a spectrum) but not the "
+        "stretching inside them"
+    )
 
 
 STEP_DEPENDENT = "step_dependent"
