@@ -60,7 +60,7 @@ def data_files(number: int) -> list[str]:
     if number == 6:
         return [f"{_fig6_tag(g)}{ext}" for g in G_FIG6 for ext in bif]
     if number == SENSITIVITY:
-        names = ("stiffness", "hertz", "xi", "J", "pivot")  # and the Y_f sweep's own diagram
+        names = ("stiffness", "hertz", "xi", "J", "pivot", "arm")  # and the Y_f sweep's own diagram
         sweeps = [f"sensitivity-{n}{ext}" for n in names for ext in bif] + ["sensitivity-yf.png"]
         sweeps += ["sensitivity-damping.parquet", "sensitivity-damping.verdicts.parquet"]
         return sweeps + [f"sensitivity-omega-xi{e}" for e in (".parquet", ".cells.parquet", ".png")]

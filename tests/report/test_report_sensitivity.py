@@ -132,9 +132,9 @@ def test_stiffness_finding_judges_the_hertz_range_from_both_sweeps():
 
 
 def test_the_open_choices_sentence_is_computed_from_the_sweeps():
-    """J and pivot sweeps and the literal damping: regimes counted together against the
-    Hertz range (undetermined on neither side), the paper's period 2 looked for, and the
-    choices not swept named with the values the runs used (from Params())."""
+    """J, pivot and friction-arm sweeps and the literal damping: regimes counted together
+    against the Hertz range (undetermined on neither side), the paper's period 2 looked for,
+    and the choices not swept named with the values the runs used (from Params())."""
     from chaoscam.experiments._choices import choices_finding
 
     p = Params()
@@ -142,18 +142,21 @@ def test_the_open_choices_sentence_is_computed_from_the_sweeps():
         [(0.02, "periodic", 1), (0.044, "chaotic", None), (0.08, "undetermined", None)]
     )
     pivot = _verdicts([(0.085, "periodic", 2), (0.105, "periodic", 5)])
+    arm = _verdicts([(0.0, "periodic", 5), (0.02, "periodic", 3)])
     damping = _verdicts([(0.42, "chaotic", None)]).assign(ev_banded_chaos=[8.0])
-    text = choices_finding(inertia, pivot, damping, ["8-band chaos", "undetermined"])
+    text = choices_finding(inertia, pivot, arm, damping, ["8-band chaos", "undetermined"])
     assert "J from 0.02 to 0.08 kg m²" in text and f"(the solid rod's {p.inertia:.3g})" in text
     assert "period 1 (0.02) → chaotic (0.044) → undetermined (0.08)" in text
+    assert f"arm from 0 to 0.02 m (default r = {p.arm:g}): period 5 (0) → period 3 (0.02)" in text
     assert "the paper's literal damping signs: 8-band chaos." in text
     assert (
-        "Together 5 regimes (period 1, chaotic, period 2, period 5, 8-band chaos), against 1"
-        in text
+        "Together 6 regimes (period 1, chaotic, period 2, period 5, period 3, 8-band chaos), "
+        "against 1" in text
     )
     assert "move the motion more than the paper's stiffness does" in text
     assert "the paper's period 2 appears among them" in text
     assert f"v_chatter = {p.v_chatter:g} m/s" in text and f"resample = {p.resample}" in text
 
-    one = choices_finding(inertia.iloc[[1]], pivot.iloc[:0], damping.iloc[:0], ["chaotic"])
+    none = pivot.iloc[:0]
+    one = choices_finding(inertia.iloc[[1]], none, none, none, ["chaotic"])
     assert "no more than the paper's stiffness does" in one
