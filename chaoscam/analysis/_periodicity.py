@@ -207,10 +207,14 @@ def section_period(
         See `distinct`; default `Thresholds.band_separation` (4).
     distinct : bool
         Refuse a lag two of whose bands overlap (default): their centres lie within
-        `band_separation` widths of the widest band, or within the absolute floor (`atol`),
-        in every coordinate. Two points of a period-n orbit may lie much closer together
-        than the tolerance (a period-12 orbit on the cam with two points 9e-6 rad and
-        2.2e-4 rad/s·T apart, bands of 1e-9 rad); it is still period n. False accepts
+        `band_separation` widths of the widest band (or within round-off, 64 ulps of the
+        coordinate's magnitude) in every coordinate. Two points of a period-n orbit may lie
+        much closer together than the tolerance or the absolute floor `atol`, which bound
+        the jitter a band may carry, not the distance between distinct points: a period-12
+        orbit on the cam with two points 9e-6 rad and 2.2e-4 rad/s·T apart, and a period-30
+        orbit (ξ = 0.30) with two points 2.8e-6 rad and 1.6e-5 rad/s apart, both with bands
+        of 1e-9 rad, are still period 12 and 30 (with the floor in this test the period 30
+        was refused at every lag). False accepts
         it: the smallest lag whose bands are all narrow, for asking whether the points are
         confined to narrow bands visited in order (banded chaos) rather than whether they
         repeat.
@@ -277,7 +281,7 @@ def section_period(
     best = math.inf
     max_p_used = 0
     tol_out = _tolerance(x, rtol, atol, noise_floor)
-    floor = np.maximum(_floor(x, atol, noise_floor), 1e-300)
+    round_off = np.maximum(64 * np.finfo(float).eps * np.max(np.abs(x), axis=0), 1e-300)
     for k0 in starts:
         y = x[k0:]
         m = y.shape[0]
@@ -303,7 +307,7 @@ def section_period(
             mis = float(np.max(width / tol))
             if mis <= 1.0:
                 jitter = width.max(axis=0)
-                sep = _separation(y, p, np.maximum(band_separation * jitter, floor))
+                sep = _separation(y, p, np.maximum(band_separation * jitter, round_off))
                 if sep > 1.0 or not distinct:
                     return PeriodResult(
                         p, k0, max_p, mis, tol, False, "", settings, jitter, ext, sep

@@ -199,6 +199,20 @@ def test_a_period_12_with_two_close_points_is_periodic():
     assert (row["label"], row["period"]) == ("periodic", 12), row["reasons"]
 
 
+def test_a_period_30_with_two_points_closer_than_the_floor_is_periodic():
+    """xi = 0.30 after its chaotic start-up (it settles at t ~ 53 s at dt, 165 s at dt/2,
+    310 s at dt/4, on the same orbit): an attracting period 30 (bands of 1e-8 rad) two of
+    whose points lie 2.8e-6 rad and 1.6e-5 rad/s apart, closer than the model's absolute
+    floor (1e-5 rad, 1e-5/T rad/s). With the floor in the distinct-band test every lag was
+    refused and the run was "undetermined", its Birkhoff average voting a torus on the
+    rotation number 3/5 (found by an independent referee)."""
+    run = simulate(Params(xi=0.30), duration=300.0, transient=280.0, series=False, tangent=True)
+    v = classify_trajectory(run)
+    assert (v.label, v.period) == ("periodic", 30), v.reasons
+    orbit = next(e for e in v.evidence if e.name == "periodic_orbit")
+    assert orbit.vote == "periodic" and orbit.detail.startswith("certified")
+
+
 def test_an_orbit_of_the_grid_alone_is_step_dependent_and_not_extended():
     """xi = 0.525: Newton certifies an attracting period 8 on the default grid (|mu|max
     0.05, the run on it), but at dt/2 it is unstable (|mu|max 3.7; 300 s runs at dt/2 and
