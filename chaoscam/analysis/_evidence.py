@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 
 import numpy as np
 
@@ -129,6 +130,11 @@ def birkhoff_evidence(name: str, z: np.ndarray, thr: Thresholds) -> Evidence:
         f"weighted Birkhoff averages converged to {res.digits:.1f} digits over 2 x "
         f"{res.n // 2} points" + (f", rotation number {rho:.10f}" if value is not None else "")
     )
+    near = _rational_near(rho, n // 2, thr.birkhoff_rational_tol)
+    if res.digits >= thr.birkhoff_quasi_digits and near:
+        return Evidence(name, value, None, txt + f" = {near} to within "
+                        f"{thr.birkhoff_rational_tol:g}: a periodic orbit's rotation number "
+                        "as much as a torus's at resonance, not a vote")  # fmt: skip
     if res.digits >= thr.birkhoff_quasi_digits:
         return Evidence(
             name,
@@ -143,6 +149,14 @@ def birkhoff_evidence(name: str, z: np.ndarray, thr: Thresholds) -> Evidence:
         txt + f" < {thr.birkhoff_quasi_digits:g}: slow convergence (chaos, noise or a "
         "non-smooth set), not a vote",
     )
+
+
+def _rational_near(rho: float, q_max: int, tol: float) -> str:
+    """ "p/q" when ``rho`` lies within ``tol`` of a rational with 1 <= q <= ``q_max``, else ""."""
+    if not math.isfinite(rho) or q_max < 1:
+        return ""
+    f = Fraction(rho).limit_denominator(q_max)
+    return f"{f.numerator}/{f.denominator}" if abs(rho - f) <= tol else ""
 
 
 def _periodic_evidence(prefix, pr, rtol, thr, zero_one):

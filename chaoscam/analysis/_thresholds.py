@@ -35,10 +35,11 @@ class Thresholds:
     band_separation : float
         Two bands of a period n are distinct (the period is not a repeat of a shorter one
         or noise around it) when their centres lie more than this many widths of the
-        widest band apart, and beyond the absolute floor, in some coordinate: 4 widths
-        leave a gap of at least 3 between them. The tolerance itself is not the measure: a
-        period-12 orbit of the cam model (Y_f = 3.16e5 Pa) repeats to 1e-9 rad while two of
-        its points lie 9e-6 rad (θ) and 2.2e-4 rad (θ̇·T) apart, within 3e-3 of the extent.
+        widest band apart in some coordinate: 4 widths leave a gap of at least 3 between
+        them. Neither the tolerance nor the absolute floor is the measure: a period-12 orbit
+        of the cam model (Y_f = 3.16e5 Pa) repeats to 1e-9 rad while two of its points lie
+        9e-6 rad (θ) and 2.2e-4 rad (θ̇·T) apart, within 3e-3 of the extent, and a period 30
+        (ξ = 0.30) has two points 2.8e-6 rad and 1.6e-5 rad/s apart, below the model's floor.
     stationary_low, stationary_high : float
         Spread of the second half of the points over that of the first half: outside
         [0.5, 2] the points are still converging or escaping and the section abstains.
@@ -101,6 +102,12 @@ class Thresholds:
     constant_signal : float
         `classify_signal`: a signal whose range is below this fraction of its magnitude is
         constant (an equilibrium).
+    birkhoff_rational_tol : float
+        A converged rotation number within this of a rational p/q with q <= N/2 is not a
+        torus vote: a period-q orbit the period test did not resolve has one too (the cam
+        model at ξ = 0.30, period 30: 0.6000000004 = 3/5 + 4e-10). 1e-8 sits far below the
+        1/Q² spacing of the rationals tried (Q = N/2, 2e-5 at N = 450), so a torus is
+        mistaken for one with probability ~1e-8 Q² (5e-4).
     """
 
     period_rtol: float = 3e-3
@@ -127,7 +134,9 @@ class Thresholds:
     series_chaotic: float = 0.05
     series_regular: float = 0.01
     constant_signal: float = 1e-12
-    band_separation: float = 4.0  # last: positional tables of earlier versions keep their meaning
+    # last: positional tables of earlier versions keep their meaning
+    band_separation: float = 4.0
+    birkhoff_rational_tol: float = 1e-8
 
     def __post_init__(self):
         for f in fields(self):

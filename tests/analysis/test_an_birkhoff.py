@@ -70,3 +70,22 @@ def test_too_few_points_give_a_message():
     """Fewer than 17 points: digits NaN and a message, not an exception."""
     res = weighted_birkhoff(rotation(10))
     assert math.isnan(res.digits) and "need" in res.message
+
+
+def test_a_rational_rotation_number_is_not_a_torus_vote():
+    """The Birkhoff evidence abstains on a converged rotation number within 1e-8 of p/q
+    (q <= N/2): a periodic orbit has one too (the cam model at xi = 0.30, period 30, gave
+    0.6000000004 and a torus vote); the golden rotation still votes quasiperiodic."""
+    from chaoscam.analysis import Thresholds
+    from chaoscam.analysis._evidence import birkhoff_evidence
+
+    thr = Thresholds()
+    for rho, vote in (
+        (0.6 + 4e-10, None),
+        (GOLDEN, "quasiperiodic"),
+        (0.6 + 1e-6, "quasiperiodic"),
+    ):
+        e = birkhoff_evidence("section_birkhoff", rotation(450, rho), thr)
+        assert e.vote == vote, (rho, e.detail)
+    e = birkhoff_evidence("section_birkhoff", rotation(450, 0.6 + 4e-10), thr)
+    assert "= 3/5 to within 1e-08" in e.detail
