@@ -85,7 +85,8 @@ def _common(p: argparse.ArgumentParser) -> None:
         metavar="S",
         help="continue each run labelled chaotic, quasiperiodic or undetermined to S seconds "
         "(> --duration) and record whether it leaves the cam's reach before (columns fate, "
-        "left_at): transient chaos",
+        "left_at) and, if it stays, its verdict on the continued run's last half (columns "
+        "fate_label, fate_period): transient chaos",
     )
     p.add_argument(
         "--plot",
@@ -215,19 +216,27 @@ def _execution(args) -> dict:
 
 
 def _transient(table) -> str:
-    """The summary line of a sweep with a fate horizon: how many runs left later."""
-    from ..sweep._stats import continued_labels, fate_split
+    """The summary line of a sweep with a fate horizon: how many runs left later, and how
+    many settled on a periodic orbit."""
+    from ..sweep._stats import continued_labels, fate_settled, fate_split
 
     checked, left = fate_split(table)
     if not len(checked):
         return ""
+    settled = fate_settled(table)
+    late = (
+        f"; {len(settled)} periodic at the horizon (period(s) "
+        f"{_counts(settled['fate_period'].astype(int))}): transient motion that settles"
+        if len(settled)
+        else ""
+    )
     if not len(left):
-        return f"\nfate: every run {continued_labels(checked)} stayed in the cam's reach"
+        return f"\nfate: every run {continued_labels(checked)} stayed in the cam's reach{late}"
     t0, t1 = f"{left['left_at'].min():.4g}", f"{left['left_at'].max():.4g}"
     return (
         f"\nfate: {len(left)} of the {len(checked)} run(s) {continued_labels(checked)} "
         f"stopped later ({_counts(left['fate'])}; last section at "
-        f"{t0 if t0 == t1 else f'{t0}–{t1}'} s): transient motion"
+        f"{t0 if t0 == t1 else f'{t0}–{t1}'} s): transient motion{late}"
     )
 
 

@@ -168,13 +168,37 @@ def stiffness_finding(yf: pd.DataFrame, hertz: pd.DataFrame) -> tuple[str, list[
     return text + paper_regimes(found, "there"), tags
 
 
-def transient_finding(rows: pd.DataFrame, horizon: float, what: str, where=None) -> str:
+def transient_finding(rows: pd.DataFrame, horizon: float, what: str, where=None, name=None) -> str:
     """The sentence on transient motion: of the runs labelled chaotic, quasiperiodic or
     undetermined (continued to the fate ``horizon``), how many stop before it, when, and how
-    many of those were labelled chaotic over the recorded window; from ``rows`` with columns
-    label, fate and left_at.
+    many of those were labelled chaotic over the recorded window, then how many settle on a
+    periodic orbit (:func:`_settled_finding`); from ``rows`` with columns label, fate,
+    left_at, fate_label and fate_period.
     ``what`` names one run ("cell", "value"); ``where(row)``, when given, names the runs
-    labelled chaotic that left. Empty when no run was continued."""
+    labelled chaotic that left, ``name(row)`` those that settle. Empty when no run was
+    continued."""
+    return _left_finding(rows, horizon, what, where) + _settled_finding(rows, name)
+
+
+def _settled_finding(rows: pd.DataFrame, name=None) -> str:
+    """The clause on the continued runs found periodic at the fate horizon."""
+    from ..sweep._stats import fate_settled
+
+    settled = fate_settled(rows)
+    if not len(settled):
+        return ""
+    k = len(settled)
+    named = f" ({'; '.join(map(name, settled.itertuples()))})" if name else ""
+    periods = ", ".join(str(p) for p in sorted(set(settled["fate_period"].dropna().astype(int))))
+    return (
+        f" {k} of them settle{'s' * (k == 1)} on a periodic orbit by then (period "
+        f"{periods}, on the run's last half, certified where the model is deterministic)"
+        f"{named}: a transient over the recorded window, which the label describes."
+    )
+
+
+def _left_finding(rows: pd.DataFrame, horizon: float, what: str, where=None) -> str:
+    """The sentence's part on the continued runs that stop before the horizon."""
     from ..sweep._stats import continued_labels, fate_split
 
     checked, left = fate_split(rows)
@@ -259,7 +283,12 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     extension of undetermined runs)."""
     from ..model import Params
     from ..report._figures import png_uri
-    from ..report._sweep_figures import TRANSIENT_MARK, regime_map_figure, sweep_diagram
+    from ..report._sweep_figures import (
+        SETTLED_MARK,
+        TRANSIENT_MARK,
+        regime_map_figure,
+        sweep_diagram,
+    )
     from ..sweep import Axis, bifurcation, regime_map
     from ._paper import FigureResult, _save
 
@@ -310,7 +339,11 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     res.why.append(
         restitution_finding(v_x, Params().xi, hertz_tags)
         + transient_finding(
-            v_x, FATE_S[quick], "value", lambda r: f"ξ = {r.value:.3g} (left at {r.left_at:.3g} s)"
+            v_x,
+            FATE_S[quick],
+            "value",
+            lambda r: f"ξ = {r.value:.3g} (left at {r.left_at:.3g} s)",
+            lambda r: f"ξ = {r.value:.3g}",
         )
         + step_finding(v_x, lambda r: f"ξ = {r.value:.3g}")
     )
@@ -340,6 +373,10 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     row = cells[cells["xi"] == row_xi].sort_values("omega")
     row_tags = [verdict_tag(a, b) for a, b in zip(row["dominant"], row["period"], strict=True)]
     changes = sum(a != b for a, b in zip(row_tags, row_tags[1:], strict=False))
+
+    def cell_name(r) -> str:
+        return f"({r.omega:.3g}, {r.xi:.3g})"
+
     res.why.append(
         f"(ω, ξ) map, {len(cells)} deterministic cells (one run each): "
         + ", ".join(f"{k} {n}" for k, n in tags.value_counts().sort_index().items())
@@ -357,9 +394,9 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
             if changes
             else "."
         )
-        + transient_finding(
-            rm.realizations, FATE_S[quick], "cell", lambda r: f"({r.omega:.3g}, {r.xi:.3g})"
-        ).replace("transient chaos,", f"transient chaos (marked {TRANSIENT_MARK}),")
+        + transient_finding(rm.realizations, FATE_S[quick], "cell", cell_name, cell_name)
+        .replace("transient chaos,", f"transient chaos (marked {TRANSIENT_MARK}),")
+        .replace("a transient over", f"a transient (marked {SETTLED_MARK}Pn) over")
         + step_finding(rm.realizations, lambda r: f"(ω, ξ) = ({r.omega:.3g}, {r.xi:.3g})")
     )
     choices, bifs = open_choices(quick, outdir, workers, classify, hertz_tags)

@@ -333,8 +333,9 @@ def add_regime_map(
 
 def _fate_text(rows, fate, what: str) -> str:
     """The summary's clause on a sweep's fate horizon: how many of the continued runs
-    stopped before it (transient motion); empty without a horizon."""
-    from ..sweep._stats import continued_labels, fate_split
+    stopped before it, and how many settled on a periodic orbit (transient motion); empty
+    without a horizon."""
+    from ..sweep._stats import continued_labels, fate_settled, fate_split
 
     if not fate:
         return ""
@@ -343,7 +344,8 @@ def _fate_text(rows, fate, what: str) -> str:
         return ""  # a horizon, but no run to continue (all periodic or out of reach)
     return (
         f"; continued to {float(fate):g} s, {len(stopped)} of the {len(checked)} {what} "
-        f"{continued_labels(checked)} stop before it (transient motion)"
+        f"{continued_labels(checked)} stop before it and {len(fate_settled(rows))} settle "
+        "on a periodic orbit (transient motion)"
     )
 
 

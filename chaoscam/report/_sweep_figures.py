@@ -46,6 +46,9 @@ ANNOTATE_PERIODS = 400
 text, at a smaller size beyond ``ANNOTATE_CELLS``)."""
 
 TRANSIENT_MARK = "↗"
+SETTLED_MARK = "→"
+"""Before Pn in a cell whose runs settle on period n after the recorded window (a fate
+horizon's verdict), the cell's label describing a transient."""
 """Written in a dominant-label cell where a ``fate`` horizon found runs that leave the cam's
 reach later (transient chaos; see :func:`chaoscam.sweep.regime_map`)."""
 
@@ -117,14 +120,24 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
     annot = False
     if m.size <= ANNOTATE_PERIODS:
         text = np.full(m.shape, "", dtype=object)
+        dom = _grid(cells, x, y, "dominant").to_numpy()
+
+        def grid_of(name: str) -> np.ndarray:  # a cell column on the map's grid, as floats
+            return _grid(cells.assign(_v=cells[name].astype(float)), x, y, "_v").to_numpy()
+
         if "period" in cells:
-            per = _grid(cells.assign(_p=cells["period"].astype(float)), x, y, "_p").to_numpy()
-            dom = _grid(cells, x, y, "dominant").to_numpy()
+            per = grid_of("period")
             periodic = (dom == "periodic") & np.isfinite(per)
             text[periodic] = ["P" + str(int(v)) for v in per[periodic]]
         if "n_transient" in cells:
-            later = _grid(cells, x, y, "n_transient").to_numpy(dtype=float) > 0
+            later = grid_of("n_transient") > 0
             text[later] = [t + TRANSIENT_MARK for t in text[later]]
+        if "settled_period" in cells:  # a transient that settles: the period it settles on
+            per = grid_of("settled_period")
+            late = np.isfinite(per) & (dom != "periodic")
+            text[late] = [
+                f"{t}{SETTLED_MARK}P{int(v)}" for t, v in zip(text[late], per[late], strict=True)
+            ]
         annot = text.astype(str)
     sns.heatmap(
         m,
@@ -150,6 +163,7 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
     _ticks(ax, m, x, y, _role(x, y))
     shown = annot is not False and bool(np.any(np.char.startswith(annot, "P")))
     marked = annot is not False and bool(np.any(np.char.endswith(annot, TRANSIENT_MARK)))
+    settles = annot is not False and bool(np.any(np.char.find(annot, SETTLED_MARK) >= 0))
     ax.set_title("dominant label (Pn: periodic, period n)" if shown else "dominant label")
     handles = [Patch(color=LABEL_COLORS.get(lab, _OTHER), label=lab) for lab in order]
     if marked:
@@ -164,6 +178,11 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
                 label="stops later: leaves the\ncam's reach or diverges\n(transient)",
             )
         )
+    if settles:
+        handles.append(
+            Line2D([], [], ls="", marker=f"${SETTLED_MARK}$", color="#000000", markersize=9,
+                   label="→Pn: settles on period n\nlater (transient)")
+        )  # fmt: skip
     ax.legend(
         handles=handles,
         loc="upper left",

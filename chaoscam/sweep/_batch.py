@@ -75,21 +75,23 @@ def _group_key(task: Any) -> tuple:
 
 
 def _fates(plist, indices, seed: int, fate: float, backend: str) -> list[dict[str, Any]]:
-    """The fate fields of members run again to ``fate`` seconds without the tangent (the
-    same motion, bit for bit): one ensemble call, as the process engine's one run each."""
+    """The fate fields of members run again to ``fate`` seconds with the tangent (the same
+    motion, bit for bit): one ensemble call, as the process engine's one run each."""
     from ..integrate import simulate_ensemble
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the model's warnings came with the first run
         ens = simulate_ensemble(
-            list(plist), list(indices), seed=seed, duration=fate, transient=0.0, backend=backend
-        )
+            list(plist), list(indices), seed=seed, duration=fate, transient=0.0,
+            backend=backend, tangent=True,
+        )  # fmt: skip
     rows_of = ens.sections.groupby("member").indices
-    t = ens.sections["t"].to_numpy()
-    return [
-        fate_fields(str(ens.members["status"].iat[j]), t[rows_of.get(j, [])])
-        for j in range(len(plist))
-    ]
+    out = []
+    for j, p in enumerate(plist):
+        rows = rows_of.get(j, [])
+        sec = ens.sections.iloc[rows].reset_index(drop=True)
+        out.append(fate_fields(str(ens.members["status"].iat[j]), sec, ens.jacobians[rows], p))
+    return out
 
 
 def run_batch(

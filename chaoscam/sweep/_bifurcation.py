@@ -35,7 +35,7 @@ from ._common import (
     write_tables,
 )
 from ._grid import Axis, SweepError, realization_index, validate_grid
-from ._tasks import BranchTask
+from ._tasks import BranchTask, fate_columns
 
 __all__ = ["Bifurcation", "bifurcation", "read_bifurcation", "initial_offsets"]
 
@@ -63,8 +63,9 @@ class Bifurcation:
         ``ic``, ``seed``, ``sim_index``, ``theta_f0``, ``omega_f0`` (NaN = in contact),
         ``continued``, ``status``, ``label``, ``period``, ``n_points``, ``recorded_s``
         (seconds of section recording behind the label: duration - transient, or the
-        extension's when the verdict was extended), ``reasons``, ``warnings``, ``fate``
-        and ``left_at`` (with a ``fate`` horizon, as for :class:`RegimeMap`) and
+        extension's when the verdict was extended), ``reasons``, ``warnings``, ``fate``,
+        ``left_at``, ``fate_label`` and ``fate_period`` (with a ``fate`` horizon, as for
+        :class:`RegimeMap`) and
         ``ev_<name>`` evidence values (``ev_exponent``: the tangent exponent per iterate
         of the section map, λ₁·T).
     config : dict
@@ -173,8 +174,7 @@ def _tables(records: list[dict], axis: Axis) -> tuple[pd.DataFrame, pd.DataFrame
             "recorded_s": np.array([r["recorded_s"] for r in records], dtype=float),
             "reasons": [r["reasons"] for r in records],
             "warnings": [r["warnings"] for r in records],
-            "fate": [r.get("fate") for r in records],
-            "left_at": np.array([r.get("left_at", np.nan) for r in records], dtype=float),
+            **fate_columns(records),
         }
     )
     verdicts = pd.concat([verdicts, evidence_columns(records)], axis=1)
@@ -306,9 +306,10 @@ def bifurcation(
         conditions of each value.
     fate : float, optional
         As for :func:`regime_map`: runs labelled chaotic, quasiperiodic or undetermined are
-        continued to this time [s] to see whether they stay in the cam's reach (verdict
-        columns ``fate`` and ``left_at``); a continued chain still starts its next value
-        from the recorded run.
+        continued to this time [s] to see whether they stay in the cam's reach and what they
+        are at the end (verdict columns ``fate``, ``left_at``, ``fate_label``,
+        ``fate_period``); a continued chain still starts its next value from the recorded
+        run.
 
     Returns
     -------

@@ -36,7 +36,7 @@ from ._common import (
 )
 from ._grid import Axis, SweepError, realization_index, validate_grid
 from ._stats import max_halfwidth, summarize_cells
-from ._tasks import RealizationTask
+from ._tasks import RealizationTask, fate_columns
 
 __all__ = ["RegimeMap", "regime_map", "read_regime_map"]
 
@@ -57,9 +57,10 @@ class RegimeMap:
         :func:`realization_index`), ``status``, ``label``, ``period``, ``n_section``,
         ``recorded_s`` (seconds of section recording behind the label: duration - transient,
         or the extension's when the verdict was extended), ``n_impacts``,
-        ``contact_fraction``, ``truncated_mass``, ``reasons``, ``warnings``, ``fate`` and
-        ``left_at`` (with a ``fate`` horizon: the status there and when the run stopped;
-        None / NaN for runs not continued) and one ``ev_<name>`` column per evidence value
+        ``contact_fraction``, ``truncated_mass``, ``reasons``, ``warnings``, ``fate``,
+        ``left_at``, ``fate_label`` and ``fate_period`` (with a ``fate`` horizon: the status
+        there, when the run stopped, and the verdict at the end of one that stayed; None /
+        NaN for runs not continued) and one ``ev_<name>`` column per evidence value
         (NaN where a run has none; ``ev_exponent`` is the tangent exponent per iterate of
         the section map, λ₁·T, and
         ``ev_lyapunov_model`` is in 1/s).
@@ -218,8 +219,7 @@ def _rows(records: list[dict], cells: pd.DataFrame, x: Axis, y: Axis) -> pd.Data
         head[name] = np.array([r[name] for r in records], dtype=dtype)
     head["reasons"] = [r["reasons"] for r in records]
     head["warnings"] = [r["warnings"] for r in records]
-    head["fate"] = [r.get("fate") for r in records]
-    head["left_at"] = np.array([r.get("left_at", np.nan) for r in records], dtype=float)
+    head = head.assign(**fate_columns(records))
     return pd.concat([head, evidence_columns(records)], axis=1)
 
 
@@ -321,13 +321,18 @@ def regime_map(
         after a few periods); default ``"cpu"``, bit-identical everywhere.
     fate : float, optional
         Horizon [s]: each realization labelled chaotic, quasiperiodic or undetermined is
-        simulated again to this time, without the tangent (the same motion, bit for bit), to
-        see whether it stays in the cam's reach: transient chaos, which a label over
-        ``duration`` cannot see (at (omega, xi) = (42.5 rad/s, 0.40) the motion is chaotic
-        for 229 s and then leaves). Its row gets ``fate`` (the status at the horizon:
-        ``"OK"``, ``"LEFT_REACH"``, ...) and ``left_at`` (the last section time before it
-        stopped, NaN if it stayed), and each cell ``n_transient`` (how many left before the
-        horizon). Labels are not changed: they describe the recorded window. Must exceed
+        simulated again to this time, with the tangent (the same motion, bit for bit), to
+        see whether it stays in the cam's reach and what it is at the end: transient chaos,
+        which a label over ``duration`` cannot see (at (omega, xi) = (42.5 rad/s, 0.40) the
+        motion is chaotic for 229 s and then leaves; at xi = 0.30 it is chaotic for ~53 s
+        and then settles on a period 30). Its row gets ``fate`` (the status at the horizon:
+        ``"OK"``, ``"LEFT_REACH"``, ...), ``left_at`` (the last section time before it
+        stopped, NaN if it stayed) and, if it stayed, ``fate_label`` and ``fate_period``
+        (the model's verdict on the continued run's last half, certificate included;
+        :func:`chaoscam.sweep._tasks.fate_fields`), and each cell ``n_transient`` (how many
+        left before the horizon), ``n_settled`` and ``settled_period`` (how many were
+        periodic there, and their period). Labels are not changed: they describe the
+        recorded window. Must exceed
         ``duration``; None (default) continues nothing. The time estimate (a warning
         beyond an hour) counts it for every run, an upper bound: only the runs not labelled
         periodic are continued.

@@ -125,7 +125,9 @@ def summarize_cells(
         ``truncated_mass``, the probability mass of Normal(mu, sigma^2) below ``l_min``
         that the truncation removed; ``n_transient``, how many of the cell's realizations
         a ``fate`` horizon found to stop later (leave the cam's reach or diverge; 0 where
-        none was checked, see :func:`chaoscam.sweep.regime_map`).
+        none was checked, see :func:`chaoscam.sweep.regime_map`); ``n_settled`` and
+        ``settled_period``, how many it found periodic at the horizon (transient chaos
+        that settles, :func:`fate_settled`) and their most frequent period.
     """
     labels = _labels(rows["label"].unique() if len(rows) else [])
     out = cells.sort_values("cell").reset_index(drop=True).copy()
@@ -172,7 +174,22 @@ def summarize_cells(
     out["truncated_mass"] = out["cell"].map(mass).astype(float)
     stopped = fate_split(rows)[1]["cell"]
     out["n_transient"] = out["cell"].map(stopped.value_counts()).fillna(0).astype(np.int64)
+    settled = fate_settled(rows)
+    out["n_settled"] = out["cell"].map(settled["cell"].value_counts()).fillna(0).astype(np.int64)
+    mode = (
+        settled.groupby("cell")["fate_period"].agg(lambda s: s.mode().min()) if len(settled) else {}
+    )
+    out["settled_period"] = pd.array(out["cell"].map(mode), dtype="Int64")
     return out
+
+
+def fate_settled(rows: pd.DataFrame) -> pd.DataFrame:
+    """The rows a ``fate`` horizon continued that stayed in the cam's reach and were periodic
+    at the horizon (``fate_label``): their motion over the recorded window was a transient
+    that settles on a periodic orbit later. Empty without those columns."""
+    if "fate_label" not in rows:
+        return rows.iloc[:0]
+    return rows[(rows["fate"] == "OK") & (rows["fate_label"] == "periodic")]
 
 
 def fate_split(rows: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:

@@ -27,14 +27,16 @@ __all__ = [
     "RealizationTask",
     "BranchTask",
     "RunSummary",
+    "fate_columns",
     "fate_fields",
     "run_task",
 ]
 
 FATE_LABELS = frozenset({"chaotic", "quasiperiodic", "undetermined"})
 """Labels whose runs a sweep's ``fate`` horizon continues: their motion is not a certified
-attracting orbit, so it may still leave the cam's reach later (transient chaos: at
-(omega, xi) = (42.5 rad/s, 0.40) the motion is chaotic for 229 s and then leaves)."""
+attracting orbit, so it may still leave the cam's reach or settle later (transient chaos: at
+(omega, xi) = (42.5 rad/s, 0.40) the motion is chaotic for 229 s and then leaves; at
+xi = 0.30 it is chaotic for ~53 s and then settles on a period 30)."""
 
 
 @dataclass(frozen=True)
@@ -194,19 +196,55 @@ class RunSummary:
     truncated_mass: float
 
 
-def fate_fields(status: str, sections_t) -> dict[str, Any]:
-    """The record's ``fate`` (the status name at the horizon: ``"OK"`` the motion stayed in
-    the cam's reach, ``"LEFT_REACH"``, ``"DIVERGED"``, ...) and ``left_at`` [s], the last
-    section time before a run that stopped (it stopped within the next cam period; NaN for
-    one that stayed), from the fate run's status and section times."""
-    t = pd.Series(sections_t, dtype=float)
-    stopped = status != Status.OK.name and len(t) > 0
-    return {"fate": status, "left_at": float(t.iloc[-1]) if stopped else math.nan}
+FATE_LATE = 0.5
+"""The part of a fate run (its last half) on which its verdict at the horizon is taken: a
+run that settles does so well before (xi = 0.30 settles on a period 30 at 53 s at dt)."""
+
+
+def fate_fields(status: str, section: pd.DataFrame, jacobians, params: Params) -> dict[str, Any]:
+    """The record's fate at the horizon, from the fate run's status, section (k, t, theta_f,
+    omega_f) and stroboscopic Jacobians (one per section row): ``fate`` (the status name:
+    ``"OK"`` the motion stayed in the cam's reach, ``"LEFT_REACH"``, ``"DIVERGED"``, ...),
+    ``left_at`` [s] (the last section time before a run that stopped, within a cam period
+    of it; NaN for one that stayed) and, for one that stayed, ``fate_label`` and
+    ``fate_period``: the model's verdict on the run's last half (:data:`FATE_LATE`;
+    :func:`chaoscam.classify.classify_section_run`, certificate included), which says
+    whether chaos over the recorded window settles later (None for one that stopped, and
+    without ``jacobians``: a run of the adaptive integrator, whose tangent is not kept)."""
+    from ..classify import classify_section_run
+
+    t = section["t"].to_numpy(dtype=float)
+    if status != Status.OK.name or jacobians is None or not len(t):
+        left = float(t[-1]) if len(t) and status != Status.OK.name else math.nan
+        return {"fate": status, "left_at": left, "fate_label": None, "fate_period": None}
+    late = (t >= (1.0 - FATE_LATE) * t[-1]) & (section["k"].to_numpy() > 0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a short late window warns like the first run did
+        v = classify_section_run(
+            section.loc[late, ["theta_f", "omega_f"]].to_numpy(dtype=float),
+            jacobians[late],
+            params,
+        )
+    return {"fate": status, "left_at": math.nan, "fate_label": v.label, "fate_period": v.period}
+
+
+FATE_FIELDS = ("fate", "left_at", "fate_label", "fate_period")
+"""A record's fate fields (:func:`fate_fields`); None in a run not continued."""
+
+
+def fate_columns(records: list[dict]) -> dict[str, Any]:
+    """The fate columns of a sweep's table (None / NaN where a run was not continued)."""
+    return {
+        "fate": [r.get("fate") for r in records],
+        "left_at": [math.nan if r.get("left_at") is None else r["left_at"] for r in records],
+        "fate_label": [r.get("fate_label") for r in records],
+        "fate_period": pd.array([r.get("fate_period") for r in records], dtype="Int64"),
+    }
 
 
 def _fate(params: Params, task: Any) -> dict[str, Any]:
-    """Run the realization again, without the tangent (the same motion, bit for bit), to
-    ``task.fate`` seconds: does it stay in the cam's reach?"""
+    """Run the realization again to ``task.fate`` seconds, with the tangent (the same
+    motion, bit for bit): does it stay in the cam's reach, and what is it at the end?"""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the model's warnings came with the first run
         long = simulate(
@@ -216,8 +254,9 @@ def _fate(params: Params, task: Any) -> dict[str, Any]:
             seed=task.seed,
             index=task.sim_index,
             series=False,
+            tangent=params.integrator == "rk4",
         )
-    return fate_fields(long.status.name, long.section["t"])
+    return fate_fields(long.status.name, long.section, long.jacobians, params)
 
 
 def status_fields(status: Status) -> dict[str, Any]:
@@ -317,8 +356,7 @@ class RealizationTask:
             "reasons": fields["reasons"],
             "warnings": fields["warnings"],
             "evidence": fields["evidence"],
-            "fate": fields.get("fate"),
-            "left_at": fields.get("left_at", math.nan),
+            **{name: fields.get(name) for name in FATE_FIELDS},
         }
 
 
@@ -379,8 +417,7 @@ class BranchTask:
             "reasons": fields["reasons"],
             "warnings": fields["warnings"],
             "evidence": fields["evidence"],
-            "fate": fields.get("fate"),
-            "left_at": fields.get("left_at", math.nan),
+            **{name: fields.get(name) for name in FATE_FIELDS},
             "section": {c: sec[c].tolist() for c in sec.columns},
             "next_state": nxt,
         }

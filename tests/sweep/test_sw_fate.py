@@ -61,7 +61,46 @@ def test_a_run_that_stays_is_recorded_as_staying():
     rm = regime_map(Axis("omega", (42.5,)), Axis("xi", (0.4,)), **KW)
     row = rm.realizations.iloc[0]
     assert row["label"] == "chaotic" and row["fate"] == "OK" and math.isnan(row["left_at"])
-    assert rm.cells["n_transient"].iloc[0] == 0
+    assert row["fate_label"] == "chaotic" and pd.isna(row["fate_period"])  # still, at 20-40 s
+    assert rm.cells["n_transient"].iloc[0] == 0 and rm.cells["n_settled"].iloc[0] == 0
+
+
+@pytest.fixture(scope="module")
+def settling():
+    """xi = 0.30 at Table 1 otherwise: chaotic over 10-20 s, settled on an attracting period
+    30 from ~53 s (at dt; an independent referee's 600 s runs at dt, dt/2, dt/4 end on the
+    same orbit)."""
+    kw = dict(duration=20.0, transient=10.0, fate=100.0, workers=1)
+    omega = Axis("omega", (Params().omega,))
+    return {e: regime_map(Axis("xi", (0.3,)), omega, engine=e, **kw)
+            for e in ("ensemble", "process")}  # fmt: skip
+
+
+def test_chaos_that_settles_later_gets_the_verdict_at_the_horizon(settling):
+    """The fate run's last half is classified (certificate included): periodic 30, on both
+    engines alike; the label over the recorded window is kept, the cell counts the run as
+    settled, the figure marks the cell with ->P30 and the sentence names it."""
+    from matplotlib.figure import Figure
+
+    from chaoscam.experiments._sensitivity import transient_finding
+    from chaoscam.report._sweep_figures import SETTLED_MARK, plot_dominant
+
+    cols = ["label", "fate", "left_at", "fate_label", "fate_period"]
+    for engine, rm in settling.items():
+        row = rm.realizations.iloc[0]
+        assert row["label"] == "chaotic" and row["fate"] == "OK", engine
+        assert (row["fate_label"], row["fate_period"]) == ("periodic", 30), engine
+        cell = rm.cells.iloc[0]
+        assert (cell["n_settled"], cell["settled_period"], cell["n_transient"]) == (1, 30, 0)
+    a, b = (settling[e].realizations[cols] for e in ("ensemble", "process"))
+    pd.testing.assert_frame_equal(a, b)
+    ax = Figure().subplots()
+    plot_dominant(settling["process"].cells, "xi", "omega", ax)
+    assert [t.get_text() for t in ax.texts] == [f"{SETTLED_MARK}P30"]
+    assert any("settles on period n" in t.get_text() for t in ax.get_legend().get_texts())
+    s = transient_finding(settling["process"].realizations, 100.0, "value", name=lambda r: "here")
+    assert "the 1 value labelled chaotic stays in the cam's reach." in s
+    assert "1 of them settles on a periodic orbit by then (period 30" in s and "(here)" in s
 
 
 def test_without_a_horizon_nothing_is_continued():
@@ -183,6 +222,12 @@ def test_the_command_line_summary_names_the_continued_runs(tmp_path, capsys):
     assert "labels: chaotic 1, left_reach 1" in out
     assert "fate: 1 of the 1 run(s) labelled chaotic stopped later (LEFT_REACH 1; " in out
     assert "last section at 27.9 s): transient motion" in out
+    argv = ["bifurcation", "--param", "xi", "--values", "0.3", "--duration", "20"]
+    argv += ["--transient", "10", "--fate", "100", "--workers", "1", "--quiet"]
+    assert main([*argv, "--out", str(tmp_path / "b.parquet")]) == 0
+    out = capsys.readouterr().out
+    assert "every run labelled chaotic stayed in the cam's reach; 1 periodic at the horizon" in out
+    assert "(period(s) 30 1): transient motion that settles" in out
 
 
 def test_the_report_clause_is_empty_when_no_run_was_continued():
