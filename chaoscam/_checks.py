@@ -12,11 +12,18 @@ from typing import Any
 
 from .model import ParameterError
 
-__all__ = ["flag", "whole", "real", "params_arg", "with_overrides"]
+__all__ = ["COUNT_MAX", "flag", "whole", "real", "params_arg", "with_overrides"]
+
+COUNT_MAX = 2**63 - 1
+"""Largest seed or realization index: the tables store them as 64-bit integers (a seed of
+2**64 ran a whole sweep and then failed writing its table, and again on --resume)."""
 
 
 def whole(name: str, value: Any, *, low: int = 0, high: int | None = None) -> int:
-    """``value`` as an int in [low, high]; bools, floats (1.5 or 2.0) and text refused."""
+    """``value`` as an int in [low, high]; bools, floats (1.5 or 2.0) and text refused. A seed
+    or an index (``name`` "seed", "index") is also kept <= :data:`COUNT_MAX`."""
+    if high is None and name in ("seed", "index"):
+        high = COUNT_MAX
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise ParameterError(
             f"{name} = {value!r} must be an integer >= {low} (got {type(value).__name__})"

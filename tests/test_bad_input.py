@@ -80,6 +80,17 @@ CLI_CASES = {
     "bifurcation duration 1e9": ([*BIF, "--duration", "1e9", "--out", "OUT.parquet"], "memory"),
     "map seed -1": ([*MAP, "--seed", "-1", "--out", "OUT.parquet"], "seed"),
     "bifurcation seed -1": ([*BIF, "--seed", "-1", "--out", "OUT.parquet"], "seed"),
+    # Beyond the tables' 64-bit integers: the sweep ran, then failed writing (and on resume).
+    "map seed 2**64": (
+        [*MAP, "--seed", str(2**64), "--out", "OUT.parquet"],
+        "<= 9223372036854775807",
+    ),
+    "bifurcation seed 2**63": ([*BIF, "--seed", str(2**63), "--out", "OUT.parquet"], "seed"),
+    "ensemble first 2**63-1": (
+        [*ENS, "--first", str(2**63 - 1), "--out", "OUT.parquet"],
+        "--first",
+    ),
+    "simulate index 2**63": ([*SIM, "--index", str(2**63)], "index"),
     "process workers 99999": (
         [*BIF[:-3], "--engine", "process", "--workers", "99999", "--out", "OUT.parquet"],
         "workers",

@@ -28,6 +28,7 @@ from pathlib import Path
 
 from ._ensemble_parts import (
     atomic_text,
+    check_outputs,
     commit_parts,
     config_digest,
     fingerprint,
@@ -128,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_locked(args: argparse.Namespace) -> int:
-    from .._checks import whole
+    from .._checks import COUNT_MAX, whole
     from .._ensemble_verdicts import classify_ensemble
     from .._provenance import code_identity
     from ..integrate import simulate_ensemble
@@ -136,6 +137,7 @@ def _run_locked(args: argparse.Namespace) -> int:
     from ..sweep._checkpoint import (
         differences,
         discard_checkpoint,
+        file_identity,
         not_a_folder,
         remove_leftovers,
     )
@@ -144,7 +146,7 @@ def _run_locked(args: argparse.Namespace) -> int:
 
     out: Path = args.out
     members_n = whole("--members", args.members, low=1)
-    whole("--first", args.first)
+    whole("--first", args.first, high=COUNT_MAX - (members_n - 1))  # every index fits int64
     params = parse_assignments(args.set)
     duration, transient = run_settings(args.duration, args.transient, args.seed)
     out, sections_path, impacts_path = output_paths(out)
@@ -175,7 +177,9 @@ def _run_locked(args: argparse.Namespace) -> int:
     elif args.resume and not parts.exists() and finished_run(out, (result, digest)):
         print(f"already finished: {out} (same configuration); nothing to do")
         return 0
-    elif not (args.resume and parts.exists()):
+    elif args.resume and parts.exists():
+        check_outputs(parts, (out, sections_path, impacts_path))
+    else:
         for path in (out, sections_path, impacts_path):
             if path.exists() and not args.force:
                 # The part size is not recorded: it decides where a run is saved, not what
@@ -215,7 +219,11 @@ def _run_locked(args: argparse.Namespace) -> int:
         tmp = parts.with_name(f".tmp-{os.getpid()}-{parts.name}")
         shutil.rmtree(tmp, ignore_errors=True)
         tmp.mkdir()
-        atomic_text(tmp / "config.json", json.dumps({"digest": digest, "config": config}, indent=1))
+        replaces = {  # what --force replaces, as it is now (a resume replaces no other)
+            p.name: file_identity(p) for p in (out, sections_path, impacts_path) if p.exists()
+        }
+        saved = {"digest": digest, "config": config, "replaces": replaces}
+        atomic_text(tmp / "config.json", json.dumps(saved, indent=1))
         os.replace(tmp, parts)
     for tmp in parts.glob(".tmp-*"):
         tmp.unlink(missing_ok=True)

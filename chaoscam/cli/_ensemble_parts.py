@@ -140,6 +140,31 @@ def run_record(parts: Path, starts: range, config: dict) -> dict:
     return {"kind": "ensemble", "version": __version__, "backends": sorted(used), **config}
 
 
+STAGED = "staged.json"
+"""In an ensemble's parts folder: the outputs its commit was placing, as file identities."""
+
+
+def check_outputs(parts: Path, outputs: tuple[Path, ...]) -> None:
+    """Before resuming the run whose parts are ``parts``: refuse an output that is neither
+    one its ``--force`` start was asked to replace (``config.json``'s ``replaces``, as that
+    file was then) nor one its commit placed before a kill (:data:`STAGED`); it was made
+    since, and the resume would overwrite it."""
+    from ..sweep._checkpoint import file_identity
+
+    try:
+        staged = json.loads((parts / STAGED).read_text())
+    except (OSError, ValueError):
+        staged = {}
+    known = [manifest(parts).get("replaces") or {}, staged if isinstance(staged, dict) else {}]
+    for path in outputs:
+        if path.exists() and all(k.get(path.name) != file_identity(path) for k in known):
+            raise FileExistsError(
+                f"{path} was not there, or not as it is now, when the unfinished run in "
+                f"{parts} started: resuming would overwrite it. Move it away, or choose "
+                "another --out (nothing was overwritten)"
+            )
+
+
 def commit_parts(
     parts: Path,
     starts: range,
@@ -182,6 +207,13 @@ def commit_parts(
             # The replaced (--force) output's companion that this run does not write (its
             # impacts, without --keep-impacts): left, it would pass for this run's.
             target.unlink(missing_ok=True)
+    from ..sweep._checkpoint import file_identity
+
+    # What the outputs will be once placed (renames keep size and mtime): a resume after a
+    # kill in the middle of placing them recognises them as this run's (check_outputs).
+    atomic_text(
+        parts / STAGED, json.dumps({targets[n].name: file_identity(staged[n]) for n in names})
+    )
     placed = []
     for name in sorted(names, key=lambda n: n == "members"):  # members last
         target = targets[name]

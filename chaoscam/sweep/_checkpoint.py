@@ -216,6 +216,10 @@ class CheckpointStore:
     flush_interval : float
         Seconds between part files while records arrive [s]; 0 writes one part per record.
         At most this much finished work is lost (and simply recomputed) when killed.
+    replaces : list of Path
+        The outputs this run was asked to replace (``--force``): the manifest records what
+        they are when it starts (:func:`file_identity`), so that a resume replaces those
+        files and no other made since (:func:`guard_outputs`).
     """
 
     def __init__(
@@ -225,7 +229,9 @@ class CheckpointStore:
         *,
         resume: bool,
         flush_interval: float = 1.0,
+        replaces: tuple[Path, ...] = (),
     ) -> None:
+        self._replaces = {p.name: file_identity(p) for p in replaces if p.exists()}
         self.path = Path(directory)
         self.hash = config_hash(config)
         self.flush_interval = float(flush_interval)
@@ -259,7 +265,7 @@ class CheckpointStore:
         tmp = self.path.with_name(f".tmp-{os.getpid()}-{self.path.name}")
         shutil.rmtree(tmp, ignore_errors=True)
         tmp.mkdir(parents=True)
-        manifest = {"hash": self.hash, "config": config}
+        manifest = {"hash": self.hash, "config": config, "replaces": self._replaces}
         _atomic_write(tmp / "manifest.json", json.dumps(manifest, indent=1).encode())
         os.replace(tmp, self.path)
 
@@ -381,12 +387,15 @@ def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> 
     finished output of the same configuration is reused as is; one of another configuration
     is refused, unless the checkpoint beside it is this configuration's: a ``--force`` run
     over that output was interrupted, and its resume finishes it (replacing the output, as
-    the ``--force`` asked).
+    the ``--force`` asked). Only the file that run found there is replaced: one made since
+    (another command writing the free name after the interruption) is refused.
     """
     existing = [p for p in outputs if p.exists()]
     if not existing:
         return False
     ours = _checkpoint_hash(checkpoint_dir(outputs[0])) == config_hash(config)
+    if ours:
+        _check_replaced(checkpoint_dir(outputs[0]), existing, config)
     if not outputs[0].exists() and not ours:
         # A companion without its main table: nothing to finish or reuse.
         raise FileExistsError(
@@ -413,6 +422,12 @@ def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> 
     return not checkpoint_dir(outputs[0]).exists() and all(p.exists() for p in outputs)
 
 
+def file_identity(path: Path) -> list[int]:
+    """What tells one file at ``path`` from another made there later: [size, mtime in ns]."""
+    st = path.stat()
+    return [st.st_size, st.st_mtime_ns]
+
+
 def _read_manifest(directory: Path) -> dict[str, Any]:
     """A checkpoint's ``manifest.json``; OSError or ValueError when it cannot be read or is
     not a JSON object."""
@@ -420,6 +435,24 @@ def _read_manifest(directory: Path) -> dict[str, Any]:
     if not isinstance(manifest, dict):
         raise ValueError(f"a JSON {type(manifest).__name__}, not an object")
     return manifest
+
+
+def _check_replaced(directory: Path, existing: list[Path], config: dict[str, Any]) -> None:
+    """Refuse an output beside this configuration's checkpoint that is neither this
+    configuration's (a finished table) nor a file the interrupted run was asked to replace
+    (``--force``: recorded in its manifest as it was then): one made since would be
+    overwritten silently by the resume."""
+    replaces = _read_manifest(directory).get("replaces") or {}
+    for path in existing:
+        meta = read_sweep_metadata(path)
+        if meta is not None and meta.get("hash") == config_hash(config):
+            continue  # this configuration's own table (written before the checkpoint went)
+        if replaces.get(path.name) != file_identity(path):
+            raise FileExistsError(
+                f"{path} was not there, or not as it is now, when the interrupted run of this "
+                "checkpoint started: it would be overwritten. Move it away, or choose "
+                "another --out (nothing was overwritten)"
+            )
 
 
 def _checkpoint_hash(directory: Path) -> str | None:

@@ -10,10 +10,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .._checks import whole
 from .._parquet import read_frame
 from .._warn import warn
 from ..integrate._driver import check_window
-from ..model import ParameterError
 from ._backends import make_backend
 from ._checkpoint import (
     CheckpointStore,
@@ -45,8 +45,7 @@ def run_settings(duration: float, transient: float | None, seed: int) -> tuple[f
     if transient is None and isinstance(duration, int | float) and not isinstance(duration, bool):
         transient = 0.5 * float(duration)  # checked with the duration just below
     duration, transient = check_window(duration, transient)
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ParameterError(f"seed = {seed!r} must be an integer >= 0")
+    whole("seed", seed)
     return float(duration), float(transient)
 
 
@@ -186,7 +185,11 @@ def open_store(
         discard_checkpoint(ckpt)
     elif guard_outputs([out, companion(out, second)], config, resume):
         return None, True
-    return CheckpointStore(ckpt, config, resume=resume, flush_interval=flush_interval), False
+    replaces = (out, companion(out, second)) if force else ()
+    store = CheckpointStore(
+        ckpt, config, resume=resume, flush_interval=flush_interval, replaces=replaces
+    )
+    return store, False
 
 
 RECORD_BYTES = 4096

@@ -49,12 +49,10 @@ def test_writes_members_sections_impacts_equal_to_the_api(tmp_path):
     assert list(members.reasons) == list(api.members.reasons)
 
 
-def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, capsys):
-    """Ctrl-C after the first part keeps it; --resume finishes to the uninterrupted result."""
+def _interrupted(tmp_path, monkeypatch, extra=()) -> None:
+    """Run ARGS into tmp_path/ens.parquet, Ctrl-C'd on its second part."""
     import chaoscam.integrate as integrate
 
-    whole = tmp_path / "whole.parquet"
-    assert main([*ARGS, "--out", str(whole)]) == 0
     real = integrate.simulate_ensemble
     calls = []
 
@@ -65,14 +63,21 @@ def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, ca
         return real(*args, **kwargs)
 
     monkeypatch.setattr(integrate, "simulate_ensemble", interrupted_on_the_second_part)
+    assert main([*ARGS, *extra, "--out", str(tmp_path / "ens.parquet")]) == 130
+    monkeypatch.setattr(integrate, "simulate_ensemble", real)
+
+
+def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, capsys):
+    """Ctrl-C after the first part keeps it; --resume finishes to the uninterrupted result."""
+    whole = tmp_path / "whole.parquet"
+    assert main([*ARGS, "--out", str(whole)]) == 0
     out = tmp_path / "ens.parquet"
-    assert main([*ARGS, "--out", str(out)]) == 130
+    _interrupted(tmp_path, monkeypatch)
     err = capsys.readouterr().err
     said = [line for line in err.splitlines() if "interrupted" in line]
     assert len(said) == 1 and "--resume" in said[0]  # one message, with the resume hint
     assert "2 of 5 members are finished" in said[0]  # what is kept, counted
     assert not out.exists() and len(list((tmp_path / "ens.parts").glob("*.done"))) == 1
-    monkeypatch.setattr(integrate, "simulate_ensemble", real)
     assert main([*ARGS, "--out", str(out)]) == 2  # an unfinished run is not overwritten
     assert main([*ARGS, "--set", "xi=0.3", "--resume", "--out", str(out)]) == 2  # not its config
     # resumed without --chunk: the part size the run started with (2), not today's default
@@ -81,6 +86,25 @@ def test_an_interrupted_run_resumes_to_the_same_result(tmp_path, monkeypatch, ca
     assert pd.read_parquet(out).equals(pd.read_parquet(whole))
     a = pd.read_parquet(tmp_path / "ens.sections.parquet")
     assert a.equals(pd.read_parquet(tmp_path / "whole.sections.parquet"))
+
+
+@pytest.mark.parametrize("name", ["ens.parquet", "ens.sections.parquet"])
+def test_a_file_made_at_the_output_after_the_interruption_is_kept(
+    tmp_path, monkeypatch, name, capsys
+):
+    """Ctrl-C, another command writes the free output name, --resume: refused, the file kept
+    (the resume replaced it silently); a --force run's own replaced output is replaced."""
+    _interrupted(tmp_path, monkeypatch)
+    made = tmp_path / name
+    made.write_bytes(b"someone else's")
+    out = tmp_path / "ens.parquet"
+    assert main([*ARGS, "--resume", "--out", str(out)]) == 2
+    assert "not there, or not as it is now" in capsys.readouterr().err
+    assert made.read_bytes() == b"someone else's"
+    # the same file, there before a --force run that was interrupted: that run replaces it
+    _interrupted(tmp_path, monkeypatch, ["--force"])
+    assert main([*ARGS, "--resume", "--out", str(out)]) == 0
+    assert made.read_bytes() != b"someone else's" and pd.read_parquet(out).shape[0] == 5
 
 
 def test_sigterm_says_terminated_once(tmp_path, monkeypatch, capsys):

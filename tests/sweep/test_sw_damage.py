@@ -136,6 +136,25 @@ def test_an_interrupted_force_run_over_another_output_resumes(tmp_path, referenc
         regime_map(X, Y, classify=stop, out=out, resume=True, **{**GRID, "seed": 4})
 
 
+def test_a_file_made_at_the_output_after_the_interruption_is_not_overwritten(tmp_path):
+    """Ctrl-C, then another command writes the free output names, then --resume: refused,
+    the files kept (the resume replaced them silently: it took any foreign output beside
+    its checkpoint for one a --force run had been asked to replace)."""
+    import pandas as pd
+
+    from chaoscam.sweep._common import companion
+
+    out, _, stop = _interrupted(tmp_path)
+    made = {p: p.write_bytes(b"someone else's") for p in (out, companion(out, "cells"))}
+    for path in made:
+        with pytest.raises(FileExistsError, match="not there.*when the interrupted run"):
+            regime_map(X, Y, classify=stop, out=out, resume=True, **GRID)
+        assert path.read_bytes() == b"someone else's"
+        path.unlink()
+    res = regime_map(X, Y, classify=stop, out=out, resume=True, **GRID)  # now it finishes
+    assert isinstance(res.cells, pd.DataFrame) and not checkpoint_dir(out).exists()
+
+
 def test_what_a_run_killed_while_writing_its_tables_left_is_removed(tmp_path, reference):
     """A SIGKILL while the tables were written leaves ``.tmp-PID-NAME`` files beside them:
     the next run over that output removes those of processes that no longer run."""
