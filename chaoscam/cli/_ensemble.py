@@ -36,6 +36,7 @@ from ._ensemble_parts import (
     manifest,
     output_paths,
     part_done,
+    readable_table,
     recorded_config,
     write_table,
 )
@@ -175,6 +176,12 @@ def _run_locked(args: argparse.Namespace) -> int:
     if args.force:
         discard_checkpoint(parts)
     elif args.resume and not parts.exists() and finished_run(out, (result, digest)):
+        for path in (sections_path, impacts_path)[: 1 + args.keep_impacts]:
+            if not readable_table(path):
+                raise UsageError(
+                    f"{out} is this configuration's finished run, but {path} is missing or "
+                    "damaged; pass --force (without --resume) to compute the run again"
+                )
         print(f"already finished: {out} (same configuration); nothing to do")
         return 0
     elif args.resume and parts.exists():

@@ -99,6 +99,16 @@ def finished_run(out: Path, digests: tuple[str, ...]) -> bool:
     return meta.get(_META_KEY) in {d.encode() for d in digests}
 
 
+def readable_table(path: Path) -> bool:
+    """True when ``path`` is a Parquet file whose data can be read (not missing, cut short
+    or damaged: its pages' checksums are verified)."""
+    try:
+        read_frame(path)
+    except Exception:  # missing, not Parquet, a failed checksum: not readable
+        return False
+    return True
+
+
 def recorded_config(out: Path) -> dict | None:
     """The configuration a finished members file records (:func:`run_record`), for saying
     what differs; None when it has none (not a chaoscam ensemble, or unreadable)."""

@@ -368,16 +368,25 @@ def run_sweep(
     """
     from ._common import companion, lock_outputs, open_store, reemit_warnings, unique_sorted
     from ._engine import SweepInterrupted
+    from ._grid import SweepError
 
     with lock_outputs(out):
         store, reuse = open_store(out, second, config, resume, flush_interval, force)
         if reuse:
+            try:
+                result = read(out)
+            except (OSError, ValueError) as err:  # pyarrow's errors are among them
+                raise SweepError(
+                    f"{out} is this configuration's finished run, but it or its companion "
+                    f"cannot be read back ({err}); pass --force without --resume (force=True "
+                    "in Python) to compute it again"
+                ) from None
             if progress:
                 print(
                     f"already finished: {out} (same configuration); read, nothing run",
                     file=sys.stderr,
                 )
-            return read(out)
+            return result
         # Outputs there now are this configuration's (a resumed run's) or --force's; any
         # other that appears while the plan runs is not replaced at the end.
         replace = force or (

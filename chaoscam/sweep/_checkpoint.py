@@ -413,7 +413,13 @@ def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> 
     if meta is None or meta.get("hash") != config_hash(config):
         if ours:
             return False
-        why = differences(meta.get("config"), config) if meta else ""
+        if meta is None:
+            raise SweepError(
+                f"{existing[0]} is not a readable chaoscam sweep (damaged, cut short, or "
+                "another kind of file), so --resume cannot reuse it. Pass --force without "
+                "--resume to compute it again, or choose another --out"
+            )
+        why = differences(meta.get("config"), config)
         raise SweepError(
             f"{existing[0]} was made by a different configuration{why} (or is not a chaoscam "
             "sweep); --resume continues only the same command. Choose another --out, or pass "

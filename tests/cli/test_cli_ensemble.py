@@ -107,6 +107,19 @@ def test_a_file_made_at_the_output_after_the_interruption_is_kept(
     assert made.read_bytes() != b"someone else's" and pd.read_parquet(out).shape[0] == 5
 
 
+def test_a_finished_run_with_a_damaged_companion_is_not_reused(tmp_path, capsys):
+    """--resume over a finished run whose sections file is cut short (or gone) said
+    "already finished"; the report then failed on it. Now: exit 2 naming the file."""
+    out = tmp_path / "ens.parquet"
+    assert main([*ARGS, "--out", str(out)]) == 0
+    sections = tmp_path / "ens.sections.parquet"
+    sections.write_bytes(sections.read_bytes()[:500])
+    assert main([*ARGS, "--resume", "--out", str(out)]) == 2
+    assert "ens.sections.parquet is missing or damaged" in capsys.readouterr().err
+    sections.unlink()
+    assert main([*ARGS, "--resume", "--out", str(out)]) == 2
+
+
 def test_sigterm_says_terminated_once(tmp_path, monkeypatch, capsys):
     """SIGTERM during the members (what chaoscam.cli's handler does: a KeyboardInterrupt
     after noting the signal): one "terminated" line with what is kept and the resume hint,

@@ -220,3 +220,23 @@ def test_a_companion_without_its_main_table_is_named_a_leftover(tmp_path):
             regime_map(X, Y, resume=resume, **kw)
     regime_map(X, Y, force=True, **kw)
     assert out.exists()
+
+
+def test_a_damaged_finished_output_is_named_on_resume(tmp_path):
+    """--resume over a finished run whose companion was cut short raised pyarrow's
+    traceback, and one whose main table was cut short was called "another configuration":
+    each now names the damage and says to pass --force."""
+    from chaoscam.sweep._common import companion
+
+    out = tmp_path / "m.parquet"
+    kw = dict(classify=SpreadClassifier(), out=out, **GRID)
+    regime_map(X, Y, **kw)
+    cells = companion(out, "cells")
+    cells.write_bytes(cells.read_bytes()[:300])
+    with pytest.raises(SweepError, match="companion cannot be read back.*--force"):
+        regime_map(X, Y, resume=True, **kw)
+    out.write_bytes(out.read_bytes()[:300])
+    with pytest.raises(SweepError, match="not a readable chaoscam sweep.*--force"):
+        regime_map(X, Y, resume=True, **kw)
+    regime_map(X, Y, force=True, **kw)  # computed again
+    assert regime_map(X, Y, resume=True, **kw).cells.shape[0] == 6
