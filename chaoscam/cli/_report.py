@@ -110,6 +110,8 @@ def run_paper(args: argparse.Namespace) -> int:
     from ..sweep._backends import local_workers
     from . import UsageError
 
+    if args.force and args.resume:
+        raise UsageError("--force starts over and --resume continues: give one of them")
     if args.workers is not None:
         try:
             local_workers(args.workers)  # what every sweep of the report would refuse
@@ -152,7 +154,7 @@ def run_paper(args: argparse.Namespace) -> int:
 
         print(f"chaoscam: {stop_word()}; {RESUME_HINT}", file=sys.stderr)
         return 130
-    print(f"report: {args.out}")
+    print(f"report: {run.path}")
     if run.failed:
         print(
             f"chaoscam: {len(run.failed)} stage(s) failed, the report says what is missing:\n  "

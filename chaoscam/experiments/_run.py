@@ -125,7 +125,9 @@ def run_paper(
     one, if any. A second run into the same folder (the same ``paper-data``) is refused while
     this one works (:class:`chaoscam._outputs.OutputLock`), and without ``force`` the report
     is put in place only if its name is still free: a file that appeared there meanwhile is
-    kept, and this run's report goes beside it with an ``OutputError`` naming both.
+    kept, and this run's report goes beside it with an ``OutputError`` naming both. When
+    every stage failed, an existing report is kept and this run's page, which holds only
+    what failed, goes to ``NAME.failed.html`` beside it (:attr:`PaperRun.path`).
     """
     from .._outputs import OutputLock
     from ..sweep._backends import local_workers
@@ -261,6 +263,8 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
     title = f"chaoscam: the paper's {done_text} reproduced" + (" (quick run)" if quick else "")
     if failed:
         title += f" (incomplete: {len(failed)} of {len(funcs)} stages failed)"
+    if not results and out.exists():  # nothing ran: keep the report there, put this one beside
+        out, force = out.with_name(f"{out.stem}.failed{out.suffix}"), True
     written = write_report(parts, out, title=title, command=command, replace=force)
     return PaperRun(written, tuple(failed))
 
@@ -345,12 +349,17 @@ RESUME_HINT = (
 """What an interrupted report or figure script says it kept and how to go on."""
 
 
+DEFAULT_OUTDIR = "reports/paper-data"
+"""Where ``analyses/figN.py`` writes when no OUTDIR is given (created when missing)."""
+
+
 def figure_script(number: int, argv: list[str] | None = None) -> int:
     """The body of ``analyses/figN.py`` (and, for :data:`SENSITIVITY`,
     ``analyses/sensitivity.py``): run one stage of ``chaoscam paper``, print what it found.
 
     Usage: ``python analyses/figN.py [--quick] [--force | --resume] [--workers N] [OUTDIR]``
-    (default OUTDIR: reports/paper-data, created when missing). The stage's data files
+    (default OUTDIR: reports/paper-data, created when missing; a named OUTDIR must exist, as
+    the folder of any output named on the command line). The stage's data files
     (:func:`data_files`) are checked before any work, as ``chaoscam paper`` checks them: an
     existing one is replaced only with ``--force`` (the committed ``reports/paper-data``
     holds the full report's data, which a ``--quick`` run would otherwise overwrite), and
@@ -376,7 +385,7 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     ap.add_argument(
         "outdir",
         nargs="?",
-        default="reports/paper-data",
+        default=DEFAULT_OUTDIR,
         metavar="OUTDIR",
         help="folder for the data and PNG (default: reports/paper-data)",
     )
@@ -392,9 +401,13 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     try:
         if args.workers is not None:
             local_workers(args.workers)  # every sweep of the stage would refuse it
+        if args.force and args.resume:
+            raise OutputError("--force starts over and --resume continues: give one of them")
         if outdir.exists() and not outdir.is_dir():
             raise OutputError(f"OUTDIR {outdir}: is a file, not a folder")
-        outdir.mkdir(parents=True, exist_ok=True)
+        if args.outdir != DEFAULT_OUTDIR and not outdir.is_dir():
+            raise OutputError(f"OUTDIR {outdir}: no such folder; create it first")
+        outdir.mkdir(parents=True, exist_ok=True)  # the default folder is ours to create
         held.enter_context(OutputLock(outdir, "OUTDIR"))
         for file in data_files(number):
             _check_data_file(

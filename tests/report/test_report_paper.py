@@ -101,6 +101,42 @@ def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch, capsys):
     assert "1 stage(s) failed" in err and "no luck" in err and out.exists()
 
 
+def test_a_run_where_every_stage_failed_keeps_the_report_there(tmp_path, monkeypatch, capsys):
+    """--resume (or --force) over a finished report, every stage failing: the report there
+    is kept and the failure page goes beside it (it replaced a 2.5 MB report with a 12 KB
+    page of failures)."""
+    from chaoscam.experiments import _paper
+
+    out = tmp_path / "p.html"
+    assert main(["paper", "--quick", "--figures", "5", "--out", str(out)]) == 0
+    before = out.read_bytes()
+
+    def boom(quick, outdir, workers=None):
+        raise RuntimeError("no luck")
+
+    monkeypatch.setitem(_paper.FIGURES, 5, boom)
+    assert main(["paper", "--quick", "--figures", "5", "--resume", "--out", str(out)]) == 1
+    assert out.read_bytes() == before
+    failed = tmp_path / "p.failed.html"
+    assert "no luck" in failed.read_text() and f"report: {failed}" in capsys.readouterr().out
+
+
+def test_force_and_resume_together_are_refused(tmp_path, capsys):
+    """The sweeps and ensembles refused --force with --resume; the paper (and figN.py)
+    took both and resumed."""
+    from chaoscam.experiments import figure_script
+
+    assert main(["paper", "--force", "--resume", "--out", str(tmp_path / "p.html")]) == 2
+    assert "give one of them" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as stop:
+        figure_script(3, [str(tmp_path), "--force", "--resume"])
+    assert stop.value.code == 2 and "give one of them" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as stop:  # a named OUTDIR is the user's: not created
+        figure_script(3, [str(tmp_path / "missing"), "--quick"])
+    assert stop.value.code == 2 and "no such folder" in capsys.readouterr().err
+    assert not (tmp_path / "missing").exists()
+
+
 def test_a_stage_asked_for_by_a_later_figure_keeps_its_title(tmp_path, monkeypatch):
     """figures=[8]: the shared stage of Figs. 7-10 is titled as such (it fell back to the
     function's name, fig7_10)."""
