@@ -63,6 +63,21 @@ def read_trajectory(path: str | Path, *, need_data: bool = True):
     return traj
 
 
+def _check_finite(path: Path, status: Status, tables) -> None:
+    """Refuse NaN or infinite times and states in a run that ended normally: chaoscam writes
+    none there, so the file was edited or damaged in a way its checksums did not see."""
+    if status is not Status.OK:
+        return  # a run that diverged may end on a non-finite state
+    for name, table in tables:
+        for col in ("t", "theta_f", "omega_f"):
+            bad = int((~np.isfinite(table[col].to_numpy(dtype=float))).sum())
+            if bad:
+                raise ValueError(
+                    f"{path}: damaged: {bad} NaN or infinite value(s) in {col} of {name} "
+                    "(a run chaoscam wrote has none); not classified"
+                )
+
+
 def load_trajectory(path) -> Trajectory:
     """Rebuild a :class:`Trajectory` from a Parquet file written by ``Trajectory.to_parquet``.
 
@@ -135,7 +150,14 @@ def load_trajectory(path) -> Trajectory:
                     f"{path}: column {col!r} of {name} holds {table_[col].dtype} values, not "
                     "numbers; not a file chaoscam wrote (or it was edited)"
                 )
-    section = section.reindex(columns=list(SECTION_COLUMNS))
+    lacking = [c for c in SECTION_COLUMNS if c not in section.columns]
+    if lacking:
+        raise ValueError(
+            f"{path}: the section metadata lacks column(s) {', '.join(lacking)}; not a file "
+            "chaoscam wrote (or it was edited)"
+        )
+    section = section[list(SECTION_COLUMNS)]
+    _check_finite(path, status, (("the table", frame), ("the section metadata", section)))
     if len(section):  # JSON does not keep dtypes: 0.0 alone reads back as an integer
         section = section.astype({c: np.int64 if c == "k" else np.float64 for c in section})
     if len(impacts) and set(impacts.columns) == set(IMPACT_COLUMNS):  # as simulate gives them

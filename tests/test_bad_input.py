@@ -3,6 +3,7 @@ exit code 2 (the API: ParameterError / SweepError / TypeError), never a tracebac
 scalars accepted; a run that could not simulate what was asked exits 1 with the cause."""
 
 import dataclasses
+import json
 import math
 
 import numpy as np
@@ -170,7 +171,19 @@ def test_report_and_classify_refuse_the_same_files(tmp_path, capsys):
     del meta[b"chaoscam.digest"]  # as another program (or an older chaoscam) writes it
     pq.write_table(table.replace_schema_metadata(meta), tmp_path / "meta.parquet")
     pq.write_table(pa.table({"x": [1.0]}), tmp_path / "plain.parquet")
-    for name in ("col", "meta", "plain"):
+    # Data edited in place (the digest covers the metadata), and a section cut to one
+    # column: both ended in a ValueError traceback from the classifier.
+    theta = table.column("theta_f").to_numpy().copy()
+    theta[5] = np.nan
+    edited = table.set_column(table.schema.get_field_index("theta_f"), "theta_f", pa.array(theta))
+    pq.write_table(edited, tmp_path / "nan.parquet")
+    meta = dict(table.schema.metadata)
+    section = json.loads(meta[b"chaoscam.section"])
+    section["columns"], section["data"] = ["k"], [row[:1] for row in section["data"]]
+    meta[b"chaoscam.section"] = json.dumps(section).encode()
+    del meta[b"chaoscam.digest"]
+    pq.write_table(table.replace_schema_metadata(meta), tmp_path / "sect.parquet")
+    for name in ("col", "meta", "plain", "nan", "sect"):
         path = str(tmp_path / f"{name}.parquet")
         assert main(["classify", path]) == 2
         assert main(["report", path, "--out", str(tmp_path / f"{name}.html")]) == 2
