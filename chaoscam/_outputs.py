@@ -19,7 +19,14 @@ import os
 from collections.abc import Iterator
 from pathlib import Path
 
-__all__ = ["OutputError", "check_output", "atomic_path", "atomic_write_bytes", "OutputLock"]
+__all__ = [
+    "OutputError",
+    "check_output",
+    "atomic_path",
+    "atomic_write_bytes",
+    "OutputLock",
+    "lock_all",
+]
 
 
 class OutputError(ValueError):
@@ -230,3 +237,14 @@ class OutputLock:
 
     def __exit__(self, *exc) -> None:
         self.release()
+
+
+@contextlib.contextmanager
+def lock_all(paths, what: str = "output"):
+    """:class:`OutputLock` on each of ``paths`` (a run's output and its companions), so that
+    a second process naming any of them (``--out X.verdicts.parquet`` while a sweep writes
+    ``X.parquet``) is refused at its start, not the first run at its end."""
+    with contextlib.ExitStack() as stack:
+        for path in paths:
+            stack.enter_context(OutputLock(path, what))
+        yield

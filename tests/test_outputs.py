@@ -209,6 +209,32 @@ def test_locked_output_refused_with_exit_2(tmp_path, command, capsys):
     assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == []
 
 
+@pytest.mark.parametrize(
+    "command, held",
+    [
+        ("bifurcation", "o.verdicts.parquet"),  # its companion, written by another sweep
+        ("regime-map", "o.cells.parquet"),
+        ("ensemble", "o.sections.parquet"),
+        ("simulate", "o.parquet"),  # a sweep's output
+    ],
+)
+def test_a_companion_in_use_is_refused_too(tmp_path, command, held, capsys):
+    """The lock covers a run's companions: a second run naming one (--out X.verdicts.parquet
+    while a sweep writes X.parquet) ran to its end and then failed; and `simulate --out`
+    took no lock at all."""
+    out = tmp_path / "o.parquet"
+    build = {"regime-map": _map, "bifurcation": _bif, "ensemble": _ens}.get(command)
+    argv = build(out) if build else ["simulate", "--duration", "0.2", "--out", str(out)]
+    proc = _hold_lock(tmp_path / held)
+    try:
+        assert main(argv) == 2
+    finally:
+        proc.kill()
+        proc.wait()
+    assert "in use by another chaoscam process" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == []
+
+
 def test_two_writers_started_together(tmp_path):
     """Two regime maps on one output started together: one is refused (exit 2, a message),
     the other ends normally with every row (3 cells x 4 realizations with sigma > 0, and the

@@ -103,7 +103,7 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from .._outputs import OutputLock, check_output
+    from .._outputs import check_output, lock_all
     from . import UsageError
 
     out: Path = args.out
@@ -125,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
     from ..sweep._batch import numba_threads
 
     # The thread count for this run only (fork-safe layer first), restored after.
-    with OutputLock(out), numba_threads(args.workers):
+    with lock_all(output_paths(out)), numba_threads(args.workers):
         return _run_locked(args)
 
 

@@ -29,14 +29,22 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from .._outputs import atomic_path, check_output
-    from .._simulate import raw_run
-    from . import parse_assignments, show_warning
+    from .._outputs import check_output, lock_all
 
     out = check_output(args.out, force=args.force, suffixes=(".parquet", ".csv"))
     section = check_output(args.section, flag="--section", force=args.force, suffixes=(".csv",))
     impacts = check_output(args.impacts, flag="--impacts", force=args.force, suffixes=(".csv",))
     _distinct(("--out", out), ("--section", section), ("--impacts", impacts))
+    # Locked as a sweep locks its outputs: a run writing one of them refuses this one.
+    with lock_all([p for p in (out, section, impacts) if p is not None]):
+        return _run(args, out, section, impacts)
+
+
+def _run(args: argparse.Namespace, out, section, impacts) -> int:
+    from .._outputs import atomic_path
+    from .._simulate import raw_run
+    from . import parse_assignments, show_warning
+
     params = parse_assignments(args.set)
     settings = dict(
         duration=args.duration,

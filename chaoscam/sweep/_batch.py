@@ -370,7 +370,7 @@ def run_sweep(
     from ._engine import SweepInterrupted
     from ._grid import SweepError
 
-    with lock_outputs(out):
+    with lock_outputs(out, second):
         store, reuse = open_store(out, second, config, resume, flush_interval, force)
         if reuse:
             try:

@@ -143,14 +143,15 @@ def read_tables(
     return read_frame(path), read_frame(other), config
 
 
-def lock_outputs(out: Path | None):
-    """An OS lock on a sweep's output (and so on its checkpoint) for the whole run; a
-    second process on the same output is refused. No output: nothing to lock."""
+def lock_outputs(out: Path | None, second: str):
+    """An OS lock on a sweep's output (and so on its checkpoint) and on its companion
+    (FILE.<second>.parquet) for the whole run; a second process on either is refused. No
+    output: nothing to lock."""
     import contextlib
 
-    from .._outputs import OutputLock
+    from .._outputs import lock_all
 
-    return contextlib.nullcontext() if out is None else OutputLock(out)
+    return contextlib.nullcontext() if out is None else lock_all([out, companion(out, second)])
 
 
 def open_store(
