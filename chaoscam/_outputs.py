@@ -82,6 +82,7 @@ def check_output(
         raise OutputError(f"{flag} {path}: {folder} is a file, not a folder")
     if not folder.is_dir():
         raise OutputError(f"{flag} {path}: the folder {folder} does not exist; create it first")
+    _check_name_length(folder, path, flag)
     _probe(folder, f"{flag} {path}")
     if path.exists() or path.is_symlink():
         if not force:
@@ -93,6 +94,26 @@ def check_output(
         if path.exists() and not os.access(path, os.W_OK):
             raise OutputError(f"{flag} {path}: exists and is read-only")
     return path
+
+
+NAME_ROOM = 24
+"""Bytes a file name must leave free for the names made from it: ``.tmp-PID-NAME.ckpt``
+(an atomic write or a checkpoint folder on its way, PID up to 7 digits) is 18 longer."""
+
+
+def _check_name_length(folder: Path, path: Path, flag: str) -> None:
+    """Refuse a name too long for the names made from it (a 230-character output ran a whole
+    sweep, then failed writing its companion's temporary file, and again on --resume)."""
+    try:
+        most = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        most = 255
+    size = len(path.name.encode())
+    if size > most - NAME_ROOM:
+        raise OutputError(
+            f"{flag} {path}: the file name is {size} bytes; at most {most - NAME_ROOM} here "
+            f"({most} less {NAME_ROOM} for the temporary and companion names made from it)"
+        )
 
 
 def _probe(folder: Path, what: str) -> None:

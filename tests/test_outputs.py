@@ -387,3 +387,14 @@ def test_path_messages_say_what_the_path_is(tmp_path, capsys):
     assert check_output(link, force=True) == link
     assert main(["simulate", "--duration", "0.05", "--out", str(link), "--force"]) == 0
     assert not link.is_symlink() and pd.read_parquet(link).shape[0] > 0
+
+
+def test_a_name_too_long_for_its_companions_is_refused_before_the_work(tmp_path, capsys):
+    """A 230-character output ran a whole sweep, wrote its table, then failed on its
+    companion's temporary name (over 255 bytes), and again on --resume: now exit 2 first,
+    naming the length, for the output or its companion."""
+    for stem in ("a" * 225, "a" * 215):  # the output itself; its .verdicts companion
+        out = tmp_path / f"{stem}.parquet"
+        assert main(_bif(out)) == 2
+        assert "bytes; at most" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == []
