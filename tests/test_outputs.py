@@ -398,3 +398,21 @@ def test_a_name_too_long_for_its_companions_is_refused_before_the_work(tmp_path,
         assert main(_bif(out)) == 2
         assert "bytes; at most" in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == []
+
+
+def test_a_full_disk_names_the_simulation_output(tmp_path, monkeypatch, capsys):
+    """simulate --out on a full disk printed "[Errno 28] No space left on device" without
+    the file; now the file and that nothing was written there."""
+    import errno
+
+    from chaoscam import Trajectory
+
+    def full(self, path):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Trajectory, "to_parquet", full)
+    out = tmp_path / "s.parquet"
+    assert main(["simulate", "--duration", "0.2", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert f"No space left on device while writing {out}; nothing was written" in err
+    assert not out.exists()

@@ -74,8 +74,16 @@ def _run(args: argparse.Namespace, out, section, impacts) -> int:
         (impacts, "impacts", lambda tmp: traj.impacts.to_csv(tmp, index=False)),
     ):
         if path is not None:
-            with atomic_path(path, replace=args.force) as tmp:
-                write(tmp)
+            try:
+                with atomic_path(path, replace=args.force) as tmp:
+                    write(tmp)
+            except OSError as err:  # a full disk: name the file, say nothing half-written
+                if isinstance(err, FileExistsError):
+                    raise
+                raise OSError(
+                    err.errno, f"{err.strerror or err} while writing {path}; nothing was "
+                    "written there (atomic write): fix the cause and run again"
+                ) from None  # fmt: skip
             print(f"{label}: {path}")
     return _exit_code(traj, notes)
 

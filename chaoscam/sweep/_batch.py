@@ -366,8 +366,7 @@ def run_sweep(
     ``keys`` (one per key), warn once per message the runs raised, ``build`` the result
     from the records, write it to ``out`` and remove the checkpoint.
     """
-    from ._common import companion, lock_outputs, open_store, reemit_warnings, unique_sorted
-    from ._engine import SweepInterrupted
+    from ._common import companion, lock_outputs, open_store
     from ._grid import SweepError
 
     with lock_outputs(out, second):
@@ -392,19 +391,39 @@ def run_sweep(
         replace = force or (
             out is not None and any(p.exists() for p in (out, companion(out, second)))
         )
-        run_plan(
-            plan, eng, store, workers=workers, scheduler=scheduler, progress=progress, desc=desc
-        )
         try:
-            records = unique_sorted(store.records(), keys)
-            reemit_warnings(records)
-            result = build(records)
-            if out is not None:
-                result.to_parquet(out, replace=replace)
-                store.remove()
-        except KeyboardInterrupt:
-            # Every record is in the checkpoint; a resume writes the tables from it.
-            if out is None:
+            run_plan(
+                plan, eng, store, workers=workers, scheduler=scheduler, progress=progress,
+                desc=desc,
+            )  # fmt: skip
+            return _finish(plan, store, out, keys, build, replace)
+        except OSError as err:  # a full disk, a folder gone: say what is kept, and where
+            if out is None or isinstance(err, FileExistsError):
                 raise
-            raise SweepInterrupted(plan.total, plan.total, store.path) from None
-        return result
+            raise OSError(
+                err.errno,
+                f"{err.strerror or err} while saving the results of {out}"
+                + (f" ({err.filename})" if err.filename else "")
+                + f"; the runs finished and saved so far are kept in {store.path}: fix the "
+                "cause (free space) and run the same command with --resume",
+            ) from None
+
+
+def _finish(plan, store, out: Path | None, keys, build, replace: bool):
+    """The result from the finished records, written to ``out`` (its checkpoint removed)."""
+    from ._common import reemit_warnings, unique_sorted
+    from ._engine import SweepInterrupted
+
+    try:
+        records = unique_sorted(store.records(), keys)
+        reemit_warnings(records)
+        result = build(records)
+        if out is not None:
+            result.to_parquet(out, replace=replace)
+            store.remove()
+    except KeyboardInterrupt:
+        # Every record is in the checkpoint; a resume writes the tables from it.
+        if out is None:
+            raise
+        raise SweepInterrupted(plan.total, plan.total, store.path) from None
+    return result

@@ -240,3 +240,26 @@ def test_a_damaged_finished_output_is_named_on_resume(tmp_path):
         regime_map(X, Y, resume=True, **kw)
     regime_map(X, Y, force=True, **kw)  # computed again
     assert regime_map(X, Y, resume=True, **kw).cells.shape[0] == 6
+
+
+def test_a_full_disk_at_the_end_says_what_is_kept_and_resumes(tmp_path, monkeypatch, reference):
+    """ENOSPC while the tables are written: the message names the output, the checkpoint
+    that keeps every finished run and --resume (it printed only "[Errno 28] ... No space
+    left on device"); after the cause is gone the resume writes the tables."""
+    import errno
+
+    from chaoscam.sweep._regime import RegimeMap
+
+    out = tmp_path / "m.parquet"
+
+    def full(self, path, replace=False):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(RegimeMap, "to_parquet", full)
+    with pytest.raises(OSError, match="No space left on device while saving the results of") as e:
+        regime_map(X, Y, classify=SpreadClassifier(), out=out, **GRID)
+    assert e.value.errno == errno.ENOSPC
+    assert f"kept in {checkpoint_dir(out)}" in str(e.value) and "--resume" in str(e.value)
+    monkeypatch.undo()
+    res = regime_map(X, Y, classify=SpreadClassifier(), out=out, resume=True, **GRID)
+    frames_equal(res.realizations, reference.realizations)
