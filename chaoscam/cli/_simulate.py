@@ -36,11 +36,25 @@ def run(args: argparse.Namespace) -> int:
     impacts = check_output(args.impacts, flag="--impacts", force=args.force, suffixes=(".csv",))
     _distinct(("--out", out), ("--section", section), ("--impacts", impacts))
     # Locked as a sweep locks its outputs: a run writing one of them refuses this one.
+    written: list = []
     with lock_all([p for p in (out, section, impacts) if p is not None]):
-        return _run(args, out, section, impacts)
+        try:
+            return _run(args, out, section, impacts, written)
+        except KeyboardInterrupt:  # one message, saying what is on disk
+            import sys
+
+            from . import stop_word
+
+            print(
+                f"chaoscam: {stop_word()}; "
+                + (f"written: {', '.join(map(str, written))}; " if written else "")
+                + "no output is half-written (each is written whole or not at all)",
+                file=sys.stderr,
+            )
+            return 130
 
 
-def _run(args: argparse.Namespace, out, section, impacts) -> int:
+def _run(args: argparse.Namespace, out, section, impacts, written: list) -> int:
     from .._outputs import atomic_path
     from .._simulate import raw_run
     from . import parse_assignments, show_warning
@@ -84,6 +98,7 @@ def _run(args: argparse.Namespace, out, section, impacts) -> int:
                     err.errno, f"{err.strerror or err} while writing {path}; nothing was "
                     "written there (atomic write): fix the cause and run again"
                 ) from None  # fmt: skip
+            written.append(path)
             print(f"{label}: {path}")
     return _exit_code(traj, notes)
 

@@ -42,3 +42,20 @@ def test_bad_value_exits_2(capsys):
     assert "m = -1.0" in capsys.readouterr().err
     assert main(["simulate", "--duration", "-1"]) == 2
     assert main(["simulate", "--duration", "0.1", "--set", "omega"]) == 2
+
+
+def test_ctrl_c_while_writing_says_what_is_on_disk(tmp_path, monkeypatch, capsys):
+    """Ctrl-C after the summary, while the outputs are written: one line saying which are
+    written and that none is half-written (it said only "interrupted")."""
+    out, section = tmp_path / "s.parquet", tmp_path / "sec.csv"
+
+    def stopped(self, *args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pd.DataFrame, "to_csv", stopped)
+    argv = ["simulate", "--duration", "0.2", "--out", str(out), "--section", str(section)]
+    assert main(argv) == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"chaoscam: interrupted; written: {out}; no output is half-written "
+                   "(each is written whole or not at all)"]  # fmt: skip
+    assert out.exists() and not section.exists()
