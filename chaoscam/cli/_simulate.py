@@ -37,10 +37,13 @@ def run(args: argparse.Namespace) -> int:
     _distinct(("--out", out), ("--section", section), ("--impacts", impacts))
     # Locked as a sweep locks its outputs: a run writing one of them refuses this one.
     written: list = []
-    with lock_all([p for p in (out, section, impacts) if p is not None]):
+    asked = [p for p in (out, section, impacts) if p is not None]
+    with lock_all(asked):
         try:
             return _run(args, out, section, impacts, written)
         except KeyboardInterrupt:  # one message, saying what is on disk
+            if not asked:
+                raise  # nothing to write: the plain "interrupted"
             import sys
 
             from . import stop_word
