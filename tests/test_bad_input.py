@@ -395,7 +395,7 @@ def test_resume_over_a_damaged_output_or_manifest_exits_2(tmp_path, capsys, dama
         (ckpt / "manifest.json").write_text("[]")
     assert main([*BIF, "--resume", "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    said = "not a chaoscam sweep" if damage == "output" else "no readable manifest.json"
+    said = "not a readable chaoscam sweep" if damage == "output" else "no readable manifest.json"
     assert err.startswith("chaoscam: error:") and said in err, err
 
 
