@@ -61,6 +61,7 @@ MAPS_AND_SWEEPS = (
     "Bifurcation diagram over l_lambda (sensitivity-hertz.parquet)",
     "Bifurcation diagram over J (sensitivity-J.parquet)",
     "Bifurcation diagram over y_O (sensitivity-pivot.parquet)",
+    "Bifurcation diagram over friction_arm (sensitivity-arm.parquet)",
     "Model parameters every run starts from",
     'id="sensitivity-stiffness"',
     'id="why"',
