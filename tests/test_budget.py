@@ -154,3 +154,31 @@ def test_cli_warns_before_the_work():
     assert "J = 1e-09" in first and "rtol" in first
     assert running
     assert proc.returncode == 130, rest
+
+
+def test_the_extensions_the_estimate_leaves_out_are_warned_about(monkeypatch):
+    """A map of 0.5 s runs was estimated at 5.6 h and took ~83 h: nearly every run, with
+    0.25 s recorded, was undetermined and extended to 120 s. The check now warns with the
+    bound when the runs record less than the extension cap; it stays quiet when they record
+    as much, or when no classifier extends."""
+    import chaoscam.sweep._regime as regime
+    from chaoscam.sweep import Axis
+
+    class Stop(Exception):
+        pass
+
+    def stop_after_the_check(*args, **kwargs):  # the config step after the budget check
+        raise Stop
+
+    monkeypatch.setattr(regime, "code_identity", stop_after_the_check)
+    grid = (Axis("l_lambda", (0.005, 0.01)), Axis("l_lambda_sigma", (0.0, 0.001)))
+    with pytest.warns(RuntimeWarning) as caught, pytest.raises(Stop):
+        regime_map(*grid, realizations=10**6, duration=0.5, workers=1)
+    said = [str(w.message) for w in caught]
+    assert any("will take about" in m for m in said)  # the estimate itself
+    assert any("records 0.25 s per run; an undetermined run is extended up to 120 s" in m
+               for m in said)  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(Stop):  # 120 s recorded: nothing left out
+            regime_map(*grid, realizations=10, duration=240.0, workers=1)

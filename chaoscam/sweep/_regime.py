@@ -406,8 +406,8 @@ def regime_map(
         keeps_sections=False,
         what="this regime map",
         fate=fate,
-        # the fate runs as if every run were continued: an upper bound
-        factor=1 + 2 * lyapunov + check_step + (fate / duration if fate else 0.0),
+        extend_to=getattr(classify, "extend_to", None),
+        factor=1 + 2 * lyapunov + check_step + (fate / duration if fate else 0.0),  # fate: bound
         reduce="the grid, the realizations or the duration",
     )
     config = {
