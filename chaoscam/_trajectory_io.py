@@ -36,12 +36,16 @@ class TrajectoryFileError(ValueError):
     """A trajectory file is missing, unreadable, not chaoscam's, or holds too little data."""
 
 
-def check_enough(n: int, what: str, where: str | Path) -> None:
-    """Refuse ``n`` < :data:`MIN_POINTS` rows of ``what`` in ``where``: too little data."""
+SIMULATE_LONGER = "simulate longer, or keep more of the run after the transient"
+
+
+def check_enough(n: int, what: str, where: str | Path, hint: str = SIMULATE_LONGER) -> None:
+    """Refuse ``n`` < :data:`MIN_POINTS` rows of ``what`` in ``where``: too little data
+    (``hint``: what to do, for a simulated run by default)."""
     if n < MIN_POINTS:
         raise TrajectoryFileError(
             f"{where}: too little data: {n} {what}, at least {MIN_POINTS} are needed for a "
-            "verdict (simulate longer, or keep more of the run after the transient)"
+            f"verdict ({hint})"
         )
 
 

@@ -155,7 +155,8 @@ def test_header_only_or_one_row_csv(tmp_path, text, capsys):
     path = tmp_path / "s.csv"
     path.write_text(text)
     assert main(["classify-series", str(path), "--column", "x", "--dt", "0.01"]) == 2
-    assert "too little data" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "too little data" in err and "record a longer signal" in err  # not "simulate"
 
 
 def test_report_and_classify_refuse_the_same_files(tmp_path, capsys):

@@ -148,8 +148,15 @@ def run_classify_series(args: argparse.Namespace) -> int:
         raise UsageError(f"{path}: {what}")
     try:
         frame = pd.read_csv(path)
-    except (ValueError, OSError, UnicodeDecodeError) as err:
+        header = [str(c) for c in pd.read_csv(path, header=None, nrows=1).iloc[0]]
+    except (ValueError, OSError, UnicodeDecodeError, IndexError) as err:
         raise UsageError(f"{path}: not a readable CSV file ({err})") from None
+    twice = sorted({c for c in args.column if header.count(c) > 1})
+    if twice:  # pandas would read the first and rename the others "NAME.1"
+        raise UsageError(
+            f"{path}: the header names column {', '.join(map(repr, twice))} more than once; "
+            "rename the copies so that --column picks one"
+        )
     missing = [c for c in args.column if c not in frame.columns]
     if missing:
         raise UsageError(
@@ -172,7 +179,7 @@ def run_classify_series(args: argparse.Namespace) -> int:
     from .._trajectory_io import TrajectoryFileError, check_enough
 
     try:
-        check_enough(len(data), "rows", path)
+        check_enough(len(data), "rows", path, "record a longer signal")
     except TrajectoryFileError as err:
         raise UsageError(str(err)) from None
     try:

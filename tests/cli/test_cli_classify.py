@@ -130,6 +130,8 @@ def test_series_section_with_wide_bands_says_it_is_not_certified(tmp_path, capsy
         (["--column", "x", "--section", "--forcing-period", "1"], "x\n1\n2\n", "forcing"),
         (["--column", "x", "--dt", "0.1"], "x\n1\nfoo\n", "not numbers"),
         (["--column", "x", "--column", "x", "--section"], "x\n1\n2\n", "'x' given more than once"),
+        # pandas read the first of two same-named columns and renamed the other "x.1"
+        (["--column", "x", "--dt", "0.1"], "x,x\n1,2\n3,4\n", "names column 'x' more than once"),
     ],
     ids=[
         "missing-file",
@@ -140,6 +142,7 @@ def test_series_section_with_wide_bands_says_it_is_not_certified(tmp_path, capsy
         "section-forcing",
         "text",
         "column-twice",
+        "header-twice",
     ],
 )
 def test_series_bad_input_exits_2(tmp_path, capsys, extra, content, message):
