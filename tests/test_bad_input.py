@@ -398,6 +398,8 @@ def test_resume_over_a_damaged_output_or_manifest_exits_2(tmp_path, capsys, dama
     err = capsys.readouterr().err
     said = "not a readable chaoscam sweep" if damage == "output" else "no readable manifest.json"
     assert err.startswith("chaoscam: error:") and said in err, err
+    assert "--force without --resume" in err  # the way forward, which it did not say
+    assert main([*BIF, "--force", "--out", str(out)]) == 0
 
 
 def test_trajectory_file_with_text_in_a_number_column(tmp_path):

@@ -274,7 +274,9 @@ class CheckpointStore:
             manifest = _read_manifest(self.path)
         except (OSError, ValueError) as err:
             raise SweepError(
-                f"{self.path}: no readable manifest.json ({err}); not a chaoscam checkpoint"
+                f"{self.path}: no readable manifest.json ({err}); not a chaoscam checkpoint, "
+                "or a damaged one whose runs cannot be matched to a configuration: pass "
+                "--force without --resume (force=True in Python) to start over"
             ) from None
         if manifest.get("hash") != self.hash:
             raise SweepError(
