@@ -37,7 +37,9 @@ class FrozenDict(dict):
 
 def freeze_fields(result, *names: str) -> None:
     """In a frozen dataclass's ``__post_init__``: make the named fields read-only, a dict as a
-    :class:`FrozenDict`, an array as a read-only view of itself (None stays None)."""
+    :class:`FrozenDict`, an array as a read-only view of itself (None stays None). It guards
+    against changing a result by accident, not on purpose: a pickled or deep-copied result
+    is a separate copy, writable, and a view's flag can be set back."""
     for name in names:
         value = getattr(result, name)
         if isinstance(value, dict):

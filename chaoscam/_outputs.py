@@ -265,6 +265,9 @@ def lock_all(paths, what: str = "output"):
     """:class:`OutputLock` on each of ``paths`` (a run's output and its companions), so that
     a second process naming any of them (``--out X.verdicts.parquet`` while a sweep writes
     ``X.parquet``) is refused at its start, not the first run at its end."""
+    paths = [Path(p) for p in paths]
+    for path in paths:  # first: a lock's name (.NAME.lock) is longer than the name
+        _check_name_length(path.parent if str(path.parent) else Path("."), path, "--out")
     with contextlib.ExitStack() as stack:
         for path in paths:
             stack.enter_context(OutputLock(path, what))

@@ -182,3 +182,9 @@ def test_the_extensions_the_estimate_leaves_out_are_warned_about(monkeypatch):
         warnings.simplefilter("error")
         with pytest.raises(Stop):  # 120 s recorded: nothing left out
             regime_map(*grid, realizations=10, duration=240.0, workers=1)
+    from chaoscam.sweep._tasks import DefaultClassifier
+
+    for never in (DefaultClassifier(lyapunov=True), DefaultClassifier(tangent=False)):
+        with pytest.warns(RuntimeWarning) as caught, pytest.raises(Stop):  # these never extend
+            regime_map(*grid, realizations=10**6, duration=0.5, workers=1, classify=never)
+        assert not any("extended up to" in str(w.message) for w in caught)

@@ -393,7 +393,7 @@ def test_a_name_too_long_for_its_companions_is_refused_before_the_work(tmp_path,
     """A 230-character output ran a whole sweep, wrote its table, then failed on its
     companion's temporary name (over 255 bytes), and again on --resume: now exit 2 first,
     naming the length, for the output or its companion."""
-    for stem in ("a" * 225, "a" * 215):  # the output itself; its .verdicts companion
+    for stem in ("a" * 244, "a" * 225, "a" * 215):  # its lock's name; itself; its companion
         out = tmp_path / f"{stem}.parquet"
         assert main(_bif(out)) == 2
         assert "bytes; at most" in capsys.readouterr().err

@@ -169,8 +169,8 @@ def section_period(
     not the spread within a band. A band's width is the jitter the orbit carries
     (integration error, a slowly converging transient, noise); it is reported
     (`PeriodResult.jitter`) next to the extent, so that "period 8, bands 3e-4 rad on an
-    orbit of 0.3 rad" can be read off the result. Bands whose centres lie within one
-    tolerance of each other overlap: such a lag is refused. The smallest n that fits is
+    orbit of 0.3 rad" can be read off the result. Bands whose centres lie within a few band
+    widths of each other overlap: such a lag is refused (`distinct`). The smallest n that fits is
     returned. Looking at the bands of a lag, instead of clustering, also checks the order
     in which the clusters are visited, and a slow drift along a curve (a quasiperiodic
     orbit near a resonance p/n) widens the bands over the record and is refused.

@@ -184,9 +184,7 @@ def _run_locked(args: argparse.Namespace) -> int:
                 )
         print(f"already finished: {out} (same configuration); nothing to do")
         return 0
-    elif args.resume and parts.exists():
-        check_outputs(parts, (out, sections_path, impacts_path))
-    else:
+    elif not (args.resume and parts.exists()):  # a resume's outputs: checked with its parts
         for path in (out, sections_path, impacts_path):
             if path.exists() and not args.force:
                 # The part size is not recorded: it decides where a run is saved, not what
@@ -222,6 +220,7 @@ def _run_locked(args: argparse.Namespace) -> int:
                 f"{parts} belongs to another configuration{why} (or has no readable "
                 "config.json); not resumed: use the original command, or --force to start over"
             )
+        check_outputs(parts, (out, sections_path, impacts_path))
     else:
         tmp = parts.with_name(f".tmp-{os.getpid()}-{parts.name}")
         shutil.rmtree(tmp, ignore_errors=True)

@@ -337,15 +337,15 @@ def _fate_text(rows, fate, what: str) -> str:
     without a horizon."""
     from ..sweep._stats import continued_labels, fate_settled, fate_split
 
-    if not fate:
+    checked, stopped = fate_split(rows) if fate else (rows.iloc[:0], None)
+    if not len(checked):  # no horizon, or no run to continue (all periodic or out of reach)
         return ""
-    checked, stopped = fate_split(rows)
-    if not len(checked):
-        return ""  # a horizon, but no run to continue (all periodic or out of reach)
+    judged = "fate_label" in rows and rows["fate_label"].notna().any()  # not adaptive runs
     return (
         f"; continued to {float(fate):g} s, {len(stopped)} of the {len(checked)} {what} "
-        f"{continued_labels(checked)} stop before it and {len(fate_settled(rows))} settle "
-        "on a periodic orbit (transient motion)"
+        f"{continued_labels(checked)} stop before it"
+        + (f" and {len(fate_settled(rows))} settle on a periodic orbit" if judged else "")
+        + " (transient motion)"
     )
 
 

@@ -46,11 +46,11 @@ ANNOTATE_PERIODS = 400
 text, at a smaller size beyond ``ANNOTATE_CELLS``)."""
 
 TRANSIENT_MARK = "↗"
-SETTLED_MARK = "→"
-"""Before Pn in a cell whose runs settle on period n after the recorded window (a fate
-horizon's verdict), the cell's label describing a transient."""
 """Written in a dominant-label cell where a ``fate`` horizon found runs that leave the cam's
 reach later (transient chaos; see :func:`chaoscam.sweep.regime_map`)."""
+SETTLED_MARK = "→"
+"""Before Pn in a cell where a fate horizon found runs that settle on period n after the
+recorded window (its verdict on the continued run): the cell's label describes a transient."""
 
 _SYMBOLS = {
     "l_lambda": "l_λ",
@@ -181,7 +181,7 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
     if settles:
         handles.append(
             Line2D([], [], ls="", marker=f"${SETTLED_MARK}$", color="#000000", markersize=9,
-                   label="→Pn: settles on period n\nlater (transient)")
+                   label="→Pn: runs settle on\nperiod n later (transient)")
         )  # fmt: skip
     ax.legend(
         handles=handles,

@@ -15,6 +15,7 @@ batch it ran in, the thread count or an interruption.
 
 from __future__ import annotations
 
+import errno
 import sys
 import warnings
 from collections.abc import Callable, Sequence
@@ -397,16 +398,21 @@ def run_sweep(
                 desc=desc,
             )  # fmt: skip
             return _finish(plan, store, out, keys, build, replace)
-        except OSError as err:  # a full disk, a folder gone: say what is kept, and where
-            if out is None or isinstance(err, FileExistsError):
-                raise
-            raise OSError(
+        except OSError as err:  # a full disk: say what is kept, and where
+            if out is None or err.errno not in SAVE_ERRNOS:
+                raise  # not a failure to save (a lost connection, a file that appeared)
+            raise type(err)(
                 err.errno,
                 f"{err.strerror or err} while saving the results of {out}"
                 + (f" ({err.filename})" if err.filename else "")
                 + f"; the runs finished and saved so far are kept in {store.path}: fix the "
                 "cause (free space) and run the same command with --resume",
             ) from None
+
+
+SAVE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EROFS})
+"""The errors of a disk that takes no more (full, over quota, failing, read-only): a sweep
+stopped by one says where its finished runs are kept and to --resume once it is fixed."""
 
 
 def _finish(plan, store, out: Path | None, keys, build, replace: bool):

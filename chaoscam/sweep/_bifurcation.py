@@ -362,7 +362,7 @@ def bifurcation(
         keeps_sections=True,
         what="this bifurcation diagram",
         fate=fate,
-        extend_to=getattr(classify, "extend_to", None),
+        classify=classify,
         # the fate runs as if every run were continued: an upper bound
         factor=1 + 2 * lyapunov + check_step + (fate / duration if fate else 0.0),
         reduce="the values, the initial conditions or the duration",

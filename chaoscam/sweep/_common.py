@@ -210,7 +210,7 @@ def check_sweep_budget(
     reduce: str,
     factor: float = 1.0,
     fate: float | None = None,
-    extend_to: float | None = None,
+    classify=None,
 ) -> None:
     """Refuse a sweep that cannot fit in memory, warn about one that takes hours.
 
@@ -218,10 +218,10 @@ def check_sweep_budget(
     step checks run more), one per worker in memory at a time, their records (and, with
     ``keeps_sections``, their section points) all kept by the driver. With a ``fate``
     horizon a worker may hold a run continued to it (its section from ``duration`` on).
-    ``extend_to`` (the classifier's extension cap [s] recorded, or None) adds a warning when
-    the runs record less and the extensions of undetermined runs, which the estimate does
-    not count, could take more than an hour (a map of 0.5 s runs was estimated at 5.6 h
-    and took ~83 h: nearly every run was extended).
+    ``classify`` (the sweep's classifier; its :func:`extension_cap`) adds a warning when the
+    extensions of undetermined runs, which the estimate does not count, could take more than
+    an hour and more than 10 times the estimate: runs that record far less than the cap (a
+    map of 0.5 s runs was estimated at 5.6 h and took ~83 h: nearly every run extended).
     """
     from .._budget import WARN_SECONDS, JobEstimate, check_budget, estimate
     from .._budget import _human_seconds as human_seconds
@@ -242,16 +242,24 @@ def check_sweep_budget(
         reduce=reduce,
         run=dict(params=base, duration=duration, what="each run of the base model"),
     )
-    recorded = duration - transient
+    recorded, extend_to = duration - transient, extension_cap(classify)
     if extend_to is not None and recorded < extend_to:
-        worst = seconds * (transient + extend_to) / duration
-        if worst > WARN_SECONDS:
+        more = one.seconds * runs / n * (extend_to - recorded) / duration
+        if more > max(WARN_SECONDS, 10 * seconds):
             warn(
                 f"{what} records {recorded:g} s per run; an undetermined run is extended up "
                 f"to {extend_to:g} s recorded, which the time estimate does not count: if "
-                f"most are, about {human_seconds(worst)}. Record more per run (duration - "
-                "transient) for fewer extensions"
+                f"most are, about {human_seconds(more)} more. Record more per run (duration "
+                "- transient) for fewer extensions"
             )
+
+
+def extension_cap(classify) -> float | None:
+    """The recorded time [s] a sweep's classifier extends an undetermined run to, or None
+    when it never extends (the tangent verdict alone extends: not with ``tangent=False`` or
+    ``lyapunov=True``, nor a classifier of one's own)."""
+    extends = getattr(classify, "needs_tangent", False)
+    return getattr(classify, "extend_to", None) if extends else None
 
 
 def backend_for(workers: int | None, scheduler: Any):

@@ -406,7 +406,7 @@ def regime_map(
         keeps_sections=False,
         what="this regime map",
         fate=fate,
-        extend_to=getattr(classify, "extend_to", None),
+        classify=classify,
         factor=1 + 2 * lyapunov + check_step + (fate / duration if fate else 0.0),  # fate: bound
         reduce="the grid, the realizations or the duration",
     )

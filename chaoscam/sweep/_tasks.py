@@ -209,8 +209,9 @@ def fate_fields(status: str, section: pd.DataFrame, jacobians, params: Params) -
     of it; NaN for one that stayed) and, for one that stayed, ``fate_label`` and
     ``fate_period``: the model's verdict on the run's last half (:data:`FATE_LATE`;
     :func:`chaoscam.classify.classify_section_run`, certificate included), which says
-    whether chaos over the recorded window settles later (None for one that stopped, and
-    without ``jacobians``: a run of the adaptive integrator, whose tangent is not kept)."""
+    whether chaos over the recorded window settles later (None for one that stopped, for a
+    last half without a whole cam period, and without ``jacobians``: a run of the adaptive
+    integrator, whose tangent is not kept, so its sweeps say nothing of settling)."""
     from ..classify import classify_section_run
 
     t = section["t"].to_numpy(dtype=float)
@@ -218,6 +219,8 @@ def fate_fields(status: str, section: pd.DataFrame, jacobians, params: Params) -
         left = float(t[-1]) if len(t) and status != Status.OK.name else math.nan
         return {"fate": status, "left_at": left, "fate_label": None, "fate_period": None}
     late = (t >= (1.0 - FATE_LATE) * t[-1]) & (section["k"].to_numpy() > 0)
+    if not late.any():  # a horizon within a cam period or so: nothing to judge
+        return {"fate": status, "left_at": math.nan, "fate_label": None, "fate_period": None}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a short late window warns like the first run did
         v = classify_section_run(

@@ -263,3 +263,16 @@ def test_a_full_disk_at_the_end_says_what_is_kept_and_resumes(tmp_path, monkeypa
     monkeypatch.undo()
     res = regime_map(X, Y, classify=SpreadClassifier(), out=out, resume=True, **GRID)
     frames_equal(res.realizations, reference.realizations)
+
+
+def test_an_error_that_is_not_the_disk_is_not_reworded(tmp_path, monkeypatch):
+    """A lost connection (an OSError) during the runs was reported as a save failure ("fix
+    the cause (free space)"), its type lost; only a disk that takes no more is reworded."""
+    from chaoscam.sweep import _batch
+
+    def lost(*args, **kwargs):
+        raise ConnectionError("scheduler closed the connection")
+
+    monkeypatch.setattr(_batch, "run_plan", lost)
+    with pytest.raises(ConnectionError, match="^scheduler closed the connection$"):
+        regime_map(X, Y, classify=SpreadClassifier(), out=tmp_path / "m.parquet", **GRID)

@@ -97,7 +97,7 @@ def test_chaos_that_settles_later_gets_the_verdict_at_the_horizon(settling):
     ax = Figure().subplots()
     plot_dominant(settling["process"].cells, "xi", "omega", ax)
     assert [t.get_text() for t in ax.texts] == [f"{SETTLED_MARK}P30"]
-    assert any("settles on period n" in t.get_text() for t in ax.get_legend().get_texts())
+    assert any("runs settle on\nperiod n" in t.get_text() for t in ax.get_legend().get_texts())
     s = transient_finding(settling["process"].realizations, 100.0, "value", name=lambda r: "here")
     assert "the 1 value labelled chaotic stays in the cam's reach." in s
     assert "1 of them settles on a periodic orbit by then (period 30" in s and "(here)" in s
@@ -238,3 +238,24 @@ def test_the_report_clause_is_empty_when_no_run_was_continued():
     assert _fate_text(rows, 300.0, "cells") == ""
     rows.loc[0, ["label", "fate"]] = ["chaotic", "OK"]
     assert _fate_text(rows, 300.0, "cells").startswith("; continued to 300 s, 0 of the 1 cells")
+
+
+def test_a_horizon_without_a_whole_late_period_is_not_judged():
+    """A fate run whose last half holds no whole cam period (a horizon just past a short
+    run) crashed the sweep in the classifier (no Jacobian); it is now left unjudged."""
+    for engine in ("process", "ensemble"):
+        rm = regime_map(Axis("omega", (42.5,)), Axis("xi", (0.3,)), duration=0.05,
+                        transient=0.0, fate=0.1, workers=1, engine=engine)  # fmt: skip
+        row = rm.realizations.iloc[0]
+        assert row["fate"] == "OK" and row["fate_label"] is None, engine
+
+
+def test_the_summary_says_nothing_of_settling_where_nothing_was_judged():
+    """Rows without fate verdicts (an adaptive sweep, a file from before them): the HTML
+    summary said "0 settle"; now it leaves settling out."""
+    from chaoscam.report._html import _fate_text
+
+    rows = pd.DataFrame({"label": ["chaotic"], "fate": ["OK"], "fate_label": [None]})
+    assert "settle" not in _fate_text(rows, 300.0, "runs")
+    rows["fate_label"] = ["periodic"]
+    assert "and 1 settle on a periodic orbit" in _fate_text(rows, 300.0, "runs")
