@@ -225,8 +225,8 @@ def _transient(table) -> str:
         return ""
     settled = fate_settled(table)
     late = (
-        f"; {len(settled)} periodic at the horizon (period(s) "
-        f"{_counts(settled['fate_period'].astype(int))}): transient motion that settles"
+        f"; {len(settled)} periodic on the continued run's last half (period(s) "
+        f"{_counts(settled['fate_period'].astype(int))})"
         if len(settled)
         else ""
     )

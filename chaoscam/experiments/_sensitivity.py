@@ -181,7 +181,9 @@ def transient_finding(rows: pd.DataFrame, horizon: float, what: str, where=None,
 
 
 def _settled_finding(rows: pd.DataFrame, name=None) -> str:
-    """The clause on the continued runs found periodic at the fate horizon."""
+    """The clause on the continued runs that are periodic on the fate run's last half: the
+    chaotic ones settle after the recorded window (transient chaos); the undetermined ones
+    needed the longer window for a verdict."""
     from ..sweep._stats import fate_settled
 
     settled = fate_settled(rows)
@@ -190,10 +192,17 @@ def _settled_finding(rows: pd.DataFrame, name=None) -> str:
     k = len(settled)
     named = f" ({'; '.join(map(name, settled.itertuples()))})" if name else ""
     periods = ", ".join(str(p) for p in sorted(set(settled["fate_period"].dropna().astype(int))))
+    chaotic = int((settled["label"] == "chaotic").sum())
+    why = []
+    if chaotic:
+        why.append(f"{chaotic} labelled chaotic settle{'s' * (chaotic == 1)} later")
+    if k > chaotic:
+        why.append(f"{k - chaotic} labelled otherwise needed the longer window for a verdict")
     return (
-        f" {k} of them settle{'s' * (k == 1)} on a periodic orbit by then (period "
-        f"{periods}, on the run's last half, certified where the model is deterministic)"
-        f"{named}: a transient over the recorded window, which the label describes."
+        f" {k} of them {'is' if k == 1 else 'are'} periodic on the continued run's last half "
+        f"(period {periods}; the classifier's verdict there, at the run's step){named}: "
+        + " and ".join(why)
+        + "."
     )
 
 

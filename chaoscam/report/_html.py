@@ -333,8 +333,8 @@ def add_regime_map(
 
 def _fate_text(rows, fate, what: str) -> str:
     """The summary's clause on a sweep's fate horizon: how many of the continued runs
-    stopped before it, and how many settled on a periodic orbit (transient motion); empty
-    without a horizon."""
+    stopped before it, and how many are periodic on the continued run's last half (transient
+    motion); empty without a horizon."""
     from ..sweep._stats import continued_labels, fate_settled, fate_split
 
     checked, stopped = fate_split(rows) if fate else (rows.iloc[:0], None)
@@ -344,7 +344,7 @@ def _fate_text(rows, fate, what: str) -> str:
     return (
         f"; continued to {float(fate):g} s, {len(stopped)} of the {len(checked)} {what} "
         f"{continued_labels(checked)} stop before it"
-        + (f" and {len(fate_settled(rows))} settle on a periodic orbit" if judged else "")
+        + (f" and {len(fate_settled(rows))} are periodic later" if judged else "")
         + " (transient motion)"
     )
 

@@ -181,7 +181,7 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
     if settles:
         handles.append(
             Line2D([], [], ls="", marker=f"${SETTLED_MARK}$", color="#000000", markersize=9,
-                   label="→Pn: runs settle on\nperiod n later (transient)")
+                   label="→Pn: runs periodic (n)\nlater (transient)")
         )  # fmt: skip
     ax.legend(
         handles=handles,

@@ -97,10 +97,11 @@ def test_chaos_that_settles_later_gets_the_verdict_at_the_horizon(settling):
     ax = Figure().subplots()
     plot_dominant(settling["process"].cells, "xi", "omega", ax)
     assert [t.get_text() for t in ax.texts] == [f"{SETTLED_MARK}P30"]
-    assert any("runs settle on\nperiod n" in t.get_text() for t in ax.get_legend().get_texts())
+    assert any("runs periodic (n)\nlater" in t.get_text() for t in ax.get_legend().get_texts())
     s = transient_finding(settling["process"].realizations, 100.0, "value", name=lambda r: "here")
     assert "the 1 value labelled chaotic stays in the cam's reach." in s
-    assert "1 of them settles on a periodic orbit by then (period 30" in s and "(here)" in s
+    assert "1 of them is periodic on the continued run's last half (period 30;" in s
+    assert "(here): 1 labelled chaotic settles later." in s
 
 
 def test_without_a_horizon_nothing_is_continued():
@@ -226,8 +227,8 @@ def test_the_command_line_summary_names_the_continued_runs(tmp_path, capsys):
     argv += ["--transient", "10", "--fate", "100", "--workers", "1", "--quiet"]
     assert main([*argv, "--out", str(tmp_path / "b.parquet")]) == 0
     out = capsys.readouterr().out
-    assert "every run labelled chaotic stayed in the cam's reach; 1 periodic at the horizon" in out
-    assert "(period(s) 30 1): transient motion that settles" in out
+    assert "stayed in the cam's reach; 1 periodic on the continued" in out
+    assert "run's last half (period(s) 30 1)" in out
 
 
 def test_the_report_clause_is_empty_when_no_run_was_continued():
@@ -252,10 +253,31 @@ def test_a_horizon_without_a_whole_late_period_is_not_judged():
 
 def test_the_summary_says_nothing_of_settling_where_nothing_was_judged():
     """Rows without fate verdicts (an adaptive sweep, a file from before them): the HTML
-    summary said "0 settle"; now it leaves settling out."""
+    summary said "0 settle"; now it leaves the later verdicts out."""
     from chaoscam.report._html import _fate_text
 
     rows = pd.DataFrame({"label": ["chaotic"], "fate": ["OK"], "fate_label": [None]})
-    assert "settle" not in _fate_text(rows, 300.0, "runs")
+    assert "periodic later" not in _fate_text(rows, 300.0, "runs")
     rows["fate_label"] = ["periodic"]
-    assert "and 1 settle on a periodic orbit" in _fate_text(rows, 300.0, "runs")
+    assert "and 1 are periodic later" in _fate_text(rows, 300.0, "runs")
+
+
+def test_the_sentence_tells_a_settling_from_a_verdict_that_needed_longer():
+    """(omega, xi) = (45, 0.20) is undetermined over 10 s and periodic 11 (to the band
+    tolerance, not certified) on 150-300 s, where it is the same motion (period 22 at dt,
+    bands 4e-7 rad): the sentence said it "settles on a periodic orbit ... certified"."""
+    from chaoscam.experiments._sensitivity import transient_finding
+
+    rows = pd.DataFrame(
+        {
+            "label": ["chaotic", "undetermined"],
+            "fate": ["OK", "OK"],
+            "left_at": [np.nan, np.nan],
+            "fate_label": ["periodic", "periodic"],
+            "fate_period": pd.array([30, 11], dtype="Int64"),
+        }
+    )
+    s = transient_finding(rows, 300.0, "cell")
+    assert "2 of them are periodic on the continued run's last half (period 11, 30;" in s
+    assert "1 labelled chaotic settles later and 1 labelled otherwise needed the longer" in s
+    assert "certified" not in s
