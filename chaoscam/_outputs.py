@@ -267,7 +267,7 @@ def lock_all(paths, what: str = "output"):
     ``X.parquet``) is refused at its start, not the first run at its end."""
     paths = [Path(p) for p in paths]
     for path in paths:  # first: a lock's name (.NAME.lock) is longer than the name
-        _check_name_length(path.parent if str(path.parent) else Path("."), path, "--out")
+        _check_name_length(path.parent, path, "--out")
     with contextlib.ExitStack() as stack:
         for path in paths:
             stack.enter_context(OutputLock(path, what))

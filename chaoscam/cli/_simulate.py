@@ -97,7 +97,7 @@ def _run(args: argparse.Namespace, out, section, impacts, written: list) -> int:
             except OSError as err:  # a full disk: name the file, say nothing half-written
                 if isinstance(err, FileExistsError):
                     raise
-                raise OSError(
+                raise type(err)(
                     err.errno, f"{err.strerror or err} while writing {path}; nothing was "
                     "written there (atomic write): fix the cause and run again"
                 ) from None  # fmt: skip

@@ -171,11 +171,11 @@ def stiffness_finding(yf: pd.DataFrame, hertz: pd.DataFrame) -> tuple[str, list[
 def transient_finding(rows: pd.DataFrame, horizon: float, what: str, where=None, name=None) -> str:
     """The sentence on transient motion: of the runs labelled chaotic, quasiperiodic or
     undetermined (continued to the fate ``horizon``), how many stop before it, when, and how
-    many of those were labelled chaotic over the recorded window, then how many settle on a
-    periodic orbit (:func:`_settled_finding`); from ``rows`` with columns label, fate,
-    left_at, fate_label and fate_period.
+    many of those were labelled chaotic over the recorded window, then how many are periodic
+    on the continued run's last half (:func:`_settled_finding`); from ``rows`` with columns
+    label, fate, left_at, fate_label and fate_period.
     ``what`` names one run ("cell", "value"); ``where(row)``, when given, names the runs
-    labelled chaotic that left, ``name(row)`` those that settle. Empty when no run was
+    labelled chaotic that left, ``name(row)`` those periodic later. Empty when no run was
     continued."""
     return _left_finding(rows, horizon, what, where) + _settled_finding(rows, name)
 
@@ -405,7 +405,9 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         )
         + transient_finding(rm.realizations, FATE_S[quick], "cell", cell_name, cell_name)
         .replace("transient chaos,", f"transient chaos (marked {TRANSIENT_MARK}),")
-        .replace("a transient over", f"a transient (marked {SETTLED_MARK}Pn) over")
+        .replace(
+            "continued run's last half (", f"continued run's last half (marked {SETTLED_MARK}Pn; "
+        )
         + step_finding(rm.realizations, lambda r: f"(ω, ξ) = ({r.omega:.3g}, {r.xi:.3g})")
     )
     choices, bifs = open_choices(quick, outdir, workers, classify, hertz_tags)

@@ -49,8 +49,9 @@ TRANSIENT_MARK = "↗"
 """Written in a dominant-label cell where a ``fate`` horizon found runs that leave the cam's
 reach later (transient chaos; see :func:`chaoscam.sweep.regime_map`)."""
 SETTLED_MARK = "→"
-"""Before Pn in a cell where a fate horizon found runs that settle on period n after the
-recorded window (its verdict on the continued run): the cell's label describes a transient."""
+"""Before Pn in a cell where a fate horizon found runs periodic (n) on the continued run's
+last half, after the recorded window its label describes (chaos that settles, or a verdict
+that needed the longer window)."""
 
 _SYMBOLS = {
     "l_lambda": "l_λ",

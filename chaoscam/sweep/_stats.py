@@ -126,8 +126,8 @@ def summarize_cells(
         that the truncation removed; ``n_transient``, how many of the cell's realizations
         a ``fate`` horizon found to stop later (leave the cam's reach or diverge; 0 where
         none was checked, see :func:`chaoscam.sweep.regime_map`); ``n_settled`` and
-        ``settled_period``, how many it found periodic at the horizon (transient chaos
-        that settles, :func:`fate_settled`) and their most frequent period.
+        ``settled_period``, how many it found periodic on the continued run's last half
+        (:func:`fate_settled`) and their most frequent period.
     """
     labels = _labels(rows["label"].unique() if len(rows) else [])
     out = cells.sort_values("cell").reset_index(drop=True).copy()
@@ -168,25 +168,28 @@ def summarize_cells(
     out["lyapunov_n"] = out["cell"].map(g.size()).fillna(0).astype(np.int64)
     per = rows[rows["label"] == "periodic"] if "period" in rows else rows.iloc[:0]
     per = per[per["period"].notna()] if len(per) else per
-    mode = per.groupby("cell")["period"].agg(lambda s: s.mode().min()) if len(per) else {}
-    out["period"] = pd.array(out["cell"].map(mode), dtype="Int64")
+    out["period"] = _modal_period(out["cell"], per, "period")
     mass = rows.groupby("cell")["truncated_mass"].first() if len(rows) else pd.Series(dtype=float)
     out["truncated_mass"] = out["cell"].map(mass).astype(float)
     stopped = fate_split(rows)[1]["cell"]
     out["n_transient"] = out["cell"].map(stopped.value_counts()).fillna(0).astype(np.int64)
     settled = fate_settled(rows)
     out["n_settled"] = out["cell"].map(settled["cell"].value_counts()).fillna(0).astype(np.int64)
-    mode = (
-        settled.groupby("cell")["fate_period"].agg(lambda s: s.mode().min()) if len(settled) else {}
-    )
-    out["settled_period"] = pd.array(out["cell"].map(mode), dtype="Int64")
+    out["settled_period"] = _modal_period(out["cell"], settled, "fate_period")
     return out
+
+
+def _modal_period(cells: pd.Series, rows: pd.DataFrame, column: str):
+    """Per cell, the most frequent ``column`` of ``rows`` (the smallest on a tie; NA where
+    the cell has none), as a nullable integer column."""
+    mode = rows.groupby("cell")[column].agg(lambda s: s.mode().min()) if len(rows) else {}
+    return pd.array(cells.map(mode), dtype="Int64")
 
 
 def fate_settled(rows: pd.DataFrame) -> pd.DataFrame:
     """The rows a ``fate`` horizon continued that stayed in the cam's reach and were periodic
-    at the horizon (``fate_label``): their motion over the recorded window was a transient
-    that settles on a periodic orbit later. Empty without those columns."""
+    on the continued run's last half (``fate_label``): chaos that settles later, or a verdict
+    that needed the longer window. Empty without those columns."""
     if "fate_label" not in rows:
         return rows.iloc[:0]
     return rows[(rows["fate"] == "OK") & (rows["fate_label"] == "periodic")]

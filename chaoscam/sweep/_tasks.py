@@ -215,12 +215,18 @@ def fate_fields(status: str, section: pd.DataFrame, jacobians, params: Params) -
     from ..classify import classify_section_run
 
     t = section["t"].to_numpy(dtype=float)
-    if status != Status.OK.name or jacobians is None or not len(t):
-        left = float(t[-1]) if len(t) and status != Status.OK.name else math.nan
-        return {"fate": status, "left_at": left, "fate_label": None, "fate_period": None}
+    stopped = status != Status.OK.name
+    unjudged = {
+        "fate": status,
+        "left_at": float(t[-1]) if stopped and len(t) else math.nan,
+        "fate_label": None,
+        "fate_period": None,
+    }
+    if stopped or jacobians is None or not len(t):
+        return unjudged
     late = (t >= (1.0 - FATE_LATE) * t[-1]) & (section["k"].to_numpy() > 0)
     if not late.any():  # a horizon within a cam period or so: nothing to judge
-        return {"fate": status, "left_at": math.nan, "fate_label": None, "fate_period": None}
+        return unjudged
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a short late window warns like the first run did
         v = classify_section_run(
