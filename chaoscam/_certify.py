@@ -55,22 +55,23 @@ band tolerance)."""
 
 REFINE_ITER = 8  # Newton iterations on a refined step (from an orbit or a band point)
 ORBIT_REFINE = (2, 4)
-"""Step divisors at which a periodic orbit that shooting does not certify on the run's grid
-is shot for again (from the same section point): where chattering dominates, the tangent on
-the default grid (dt = 2e-6 s) overstates the dominant multiplier and λ₁ (its error is in
-the Hertz contact phase that ends each chattering sequence, whose closings are near-grazing).
-Measured: ξ = 0.45, period 6: |μ|max = 2.97 at dt, 0.0047 at dt/2, 0.072 at dt/4, 0.026 at
-dt/8 (λ₁ from the run: +0.63 at dt, −2.53 at dt/2, −2.75 on the adaptive path: a sticking
-orbit); ω = 26 rad/s, ξ = 0.3, period 7: 19 (not converged), 2.42, 1.43, 1.30 (unstable: 7-band
-chaos); (ω, ξ) = (20, 0.6), a sticking period 1: Newton stalls at dt (residual 1.4e-7 rad,
-|μ|max 13), converges at dt/2 and dt/4 with |μ|max 0.0073 and 1.6e-4; (32.5, 0.5), period 6:
-|μ|max 1.23 at dt, 0.43 at dt/2, 0.33 at dt/4 where Newton stalls at 4e-7 rad (600 s runs at
-dt and dt/2: 6 bands of 4e-7 rad, λ₁ = −0.32 ± 0.03 1/s at dt/2). Only an orbit that
-converges unstable on the run's grid, or stalls there within ``MODEL_ATOL``, and that the
-run lies on within ``MODEL_ATOL``, is shot for again, and a refined step counts a stalled
-Newton within ``MODEL_ATOL`` as converged (on the default model's 8 chaotic bands, 1.4e-4 rad
-from the run, Newton stalls at 2e-6 rad; its refined orbits are unstable,
-|μ|max 33 and 23). An orbit certified at every refined step decides "periodic"; one
+"""Step divisors at which a periodic orbit that shooting does not certify on the run's grid is shot
+for again (from the same section point): where chattering dominates, the tangent on the default
+grid (dt = 2e-6 s) overstates the dominant multiplier and λ₁ (its error is in the Hertz contact
+phase that ends each chattering sequence, whose closings are near-grazing). Measured: ξ = 0.45,
+period 6: |μ|max = 2.97 at dt, 0.0047 at dt/2, 0.072 at dt/4, 0.026 at dt/8, from one orbit
+point (from others an independent referee got 1.9–3.6 at dt, while kicks of 1e-4 to 1e-9 decay
+on the grid: the grid's tangent errs, not its motion); λ₁ from the run: +0.63 at dt, −2.53 at
+dt/2, −2.75 on the adaptive path: a sticking orbit; ω = 26 rad/s, ξ = 0.3, period 7: 19 (not
+converged), 2.42, 1.43, 1.30 (unstable: 7-band chaos); (ω, ξ) = (20, 0.6), a sticking period 1:
+Newton stalls at dt (residual 1.4e-7 rad, |μ|max 13), converges at dt/2 and dt/4 with |μ|max
+0.0073 and 1.6e-4; (32.5, 0.5), period 6: |μ|max 1.23 at dt, 0.43 at dt/2, 0.33 at dt/4 where
+Newton stalls at 4e-7 rad (600 s runs at dt and dt/2: 6 bands of 4e-7 rad, λ₁ = −0.32 ± 0.03 1/s
+at dt/2). Only an orbit that converges unstable on the run's grid, or stalls there within
+``MODEL_ATOL``, and that the run lies on within ``MODEL_ATOL``, is shot for again, and a refined
+step counts a stalled Newton within ``MODEL_ATOL`` as converged (on the default model's 8
+chaotic bands, 1.4e-4 rad from the run, Newton stalls at 2e-6 rad; its refined orbits are
+unstable, |μ|max 33 and 23). An orbit certified at every refined step decides "periodic"; one
 attracting at some refined steps only leaves the verdict undetermined; otherwise the grid's
 verdict stands."""
 

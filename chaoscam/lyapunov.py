@@ -62,7 +62,7 @@ class ModelLyapunov:
         impact (one had jumped, the other not yet).
     unsynced : int
         Renormalisations done while the impact counts still differed after `max_wait`
-        steps (a grazing impact or a closing near v_min seen by one trajectory only).
+        steps (a chattering sequence ended one micro-impact apart, or a grazing impact).
     status : Status
         How the reference run ended (``Status.OK`` unless it failed).
     message : str
@@ -91,6 +91,15 @@ class ModelLyapunov:
     def ok(self) -> bool:
         """True when the exponent is a number (finite or -inf)."""
         return not math.isnan(self.exponent)
+
+
+def _growths(logs, lengths, window, synced) -> str:
+    """' (mean growth ... against ... for the others)' over the averaged window, in 1/s."""
+    u, o = window & ~synced, window & synced
+    if not (u.any() and o.any()):
+        return ""
+    r = [float(logs[m].sum() / lengths[m].sum()) for m in (u, o)]
+    return f" (their growth {r[0]:+.3g} 1/s against {r[1]:+.3g} 1/s for the others)"
 
 
 class _Draws:
@@ -200,7 +209,7 @@ def lyapunov_model(
     n_align: int = 5,
     max_wait: int | None = None,
     direction_seed: int = 0,
-    exclude_unsynced: bool = True,
+    exclude_unsynced: bool = False,
     **overrides: Any,
 ) -> ModelLyapunov:
     """Largest Lyapunov exponent of the cam-follower model by Benettin's two-trajectory method.
@@ -225,16 +234,18 @@ def lyapunov_model(
     the separation turn to the most unstable direction). The scaling changes finite-time
     values only, not the limit.
 
-    Impacts: the restitution jump (4) makes the flow discontinuous, but its derivative
-    (with the saltation matrix) is finite away from grazing; two trajectories d0 apart hit
-    the cam at times a lag ~ d0 apart, and between those two instants their separation is
-    the size of the jump. A renormalisation that falls in such a lag is therefore postponed
-    step by step (up to `max_wait` steps) until both have applied the same number of jumps;
-    a mismatch that persists (a grazing contact, or an approach speed near v_min, seen by
-    one trajectory only) is counted in `unsynced`, reported in `message`, and that interval
-    is left out of the average (`exclude_unsynced`): its separation measures a jump of the
-    numerical flow (the v_min threshold is a model decision) or a grazing singularity, not
-    a stretching rate.
+    Impacts: the restitution jump (4) makes the flow discontinuous (its derivative, with the
+    saltation matrix, is finite away from grazing); twins d0 apart hit the cam a lag ~ d0
+    apart, during which their separation is the jump's size, so a renormalisation in such a
+    lag is postponed step by step (up to `max_wait` steps) until both applied the same
+    number of jumps. A mismatch that persists (`unsynced`, named in `message`) is here a
+    chattering sequence that ended one micro-impact apart (approach speeds ~5e-7 m/s: a
+    tiny jump) or a grazing contact. Those intervals are averaged by default: on the
+    default model they are sticking phases, 21 % of the intervals and strongly contracting,
+    and leaving them out (``exclude_unsynced=True``) raised λ₁ from +1.67 ± 0.09 to +3.83 ±
+    0.14 1/s (320 s after 20 s; the tangent exponent: +1.82 at dt/2, +1.51 at dt/4; an
+    independent referee's twins, renormalised every period whatever the impacts: +1.48).
+    At ξ = 0.43, x_O = -0.45, ω = 45 and v_min = 1e-3 it changed nothing beyond the errors.
 
     Parameters
     ----------
@@ -262,7 +273,7 @@ def lyapunov_model(
     direction_seed : int
         Seed of the initial direction (``numpy.random.default_rng(SeedSequence(...))``).
     exclude_unsynced : bool
-        Leave out of the average the intervals that end with different impact counts.
+        Leave out the intervals that end with different impact counts (biased: see Impacts).
 
     Returns
     -------
@@ -279,40 +290,32 @@ def lyapunov_model(
     period, whose two exponents (divided by T) carry no trivial zero. So a periodic response
     has λ₁ < 0, a quasiperiodic one λ₁ = 0 and a chaotic one λ₁ > 0.
 
-    Cost: two runs of the kernel (about twice ``simulate(series=False)`` of the same
-    duration; ``benchmarks/bench_lyapunov_model.py`` measures the ratio), plus one Python
-    call per interval (the postponed steps run compiled: :func:`advance_pair`).
+    Cost: about twice ``simulate(series=False)`` (``benchmarks/bench_lyapunov_model.py``),
+    plus one Python call per interval (postponed steps run compiled: :func:`advance_pair`).
 
     Limits: a finite-time average (see `stderr`); near a grazing impact the flow's
-    derivative is unbounded and the exponent ill-defined (watch `unsynced`); the chattering
-    guard and the v_min threshold are discontinuities of the numerical flow itself.
-    Contact-dominated responses (the follower riding the cam, or chattering down to it
-    every period) are the weak case: the static penetration is only ~3e-9 m, so a
-    separation of d0 = 1e-8 rad (5e-9 m at the contact) already lifts the follower off the
-    cam, and the numerical flow is rough at that scale (whether a micro-crossing of the gap
-    falls inside a step, whether an approach speed clears v_min). Measured on 20 s after a
-    10 s transient: with d0 from 1e-14 to 1e-5 the estimate for a period-1 contact orbit
-    (e = 0.02 m) ranges from +54 to -7 1/s (d0 = 1e-8: -3.5), while for the default
-    (mostly flight, impacts) it stays within 3-5 1/s for d0 from 1e-8 to 1e-4. There the
-    value is a finite-size exponent at scale d0; trust its sign only together with the
-    section and spectrum evidence. A tangent (variational) method with saltation matrices
-    would remove the d0 dependence.
+    derivative is unbounded (watch `unsynced`). Contact is the weak case: the static
+    penetration is ~3e-9 m, so d0 = 1e-8 rad (5e-9 m at the contact) already lifts the
+    follower off the cam, and twins that both stick to the cam can leave it bit for bit
+    equal. Measured (v_min = 0, 2026-11-27): the default, 320 s after 20 s, +1.67 ± 0.09 1/s at
+    d0 = 1e-8, +1.11 at 1e-6, -2.28 at 1e-4 (its 8 bands' scale), -inf at 1e-10 (merged while
+    sticking); the contact orbit e = 0.02 m (20 s after 10 s): -inf at d0 = 1e-14 and 1e-11,
+    -26.2 at 1e-8, -28.5 at 1e-5 (tangent at dt/4: -24.4). A finite-size exponent at scale
+    d0, then: trust its sign only with the section and spectrum evidence, and -inf only where
+    a larger d0 agrees. The tangent exponent (:func:`chaoscam.lyapunov_spectrum`) has no d0
+    but overstates λ₁ on the default grid where chattering dominates (+2.60 at dt, +1.51 at
+    dt/4 on the default; here +1.67 at dt).
 
-    Integrator: both trajectories always run on the fixed-step RK4 grid
-    (``integrator="rk4"``; ``settings["integrator"]`` says so when another was asked for).
-    With the adaptive integrator the two trajectories take different step sequences, and
-    that noise at the tolerance level enters the separation; in contact-dominated
-    responses it biases the estimate (omega = 45 rad/s, period 7: +0.29 1/s adaptive,
-    -0.75 1/s on the grid).
+    Integrator: both trajectories always run on the RK4 grid (``settings["integrator"]`` says
+    so when another was asked for): adaptive steps differ between the two, and that noise
+    enters the separation; in contact it biases the estimate (omega = 45 rad/s, period 7:
+    +0.29 1/s adaptive, -0.75 1/s on the grid).
     """
     p = params_arg(params)
     if overrides:
         p = with_overrides(p, overrides, lyapunov_model)
     asked = p.integrator
-    # Decision: both trajectories on the fixed-step RK4 grid, whatever the integrator asked
-    # for. Adaptive steps differ between reference and companion, and that step-sequence
-    # noise enters the separation: with integrator="adaptive" a period-7 orbit (omega = 45)
-    # came out at +0.29 1/s against -0.75 1/s on the grid.
+    # Decision: both trajectories on the RK4 grid (docstring, 'Integrator').
     p = p.replace(integrator="rk4")
     duration, transient = check_window(duration, transient, dt=p.dt)
     renorm_periods = whole("renorm_periods", renorm_periods, low=1)
@@ -423,15 +426,17 @@ def lyapunov_model(
 
     lg = np.asarray(logs)
     ln = np.asarray(lengths)
-    keep = (np.asarray(ends) > transient + 1e-12 * period) & (np.arange(lg.size) >= n_align)
-    if exclude_unsynced:
-        keep &= np.asarray(synced, dtype=bool)
+    window = (np.asarray(ends) > transient + 1e-12 * period) & (np.arange(lg.size) >= n_align)
+    sync = np.asarray(synced, dtype=bool)
+    keep = window & sync if exclude_unsynced else window
     settings["wall_time_s"] = time.perf_counter() - t_wall
     notes = []
     if lg.size and lg[-1] == -math.inf:
         notes.append(
-            "the two trajectories merged (d = 0): contraction faster than d0 can resolve; "
-            "the exponent is strongly negative"
+            f"the two trajectories merged (d = 0 at t = {ends[-1]:.6g} s): the separation fell "
+            "below what floating point resolves (both stuck to the cam, or a periodic orbit's "
+            f"contraction); -inf at d0 = {d0:g} is a periodic orbit's signature only if a "
+            "larger d0 agrees"
         )
         return ModelLyapunov(
             -math.inf,
@@ -463,13 +468,14 @@ def lyapunov_model(
     max_growth = float(lk.max())
     if unsynced:
         notes.append(
-            f"{unsynced} renormalisation(s) with the impact counts still different after "
-            f"{wait} steps (grazing, or an approach speed near v_min seen by one trajectory "
-            "only): "
+            f"{unsynced} of {lg.size} renormalisations ended with the impact counts still "
+            f"different after {wait} steps (a chattering sequence that ended one micro-impact "
+            "apart, or grazing, seen by one trajectory only): "
             + (
-                "those intervals are left out of the average"
+                "left out of the average (exclude_unsynced=True), which raises the estimate "
+                "where they are contracting sticking phases"
                 if exclude_unsynced
-                else f"those intervals may dominate the sum (largest growth e^{max_growth:.1f})"
+                else "kept in the average" + _growths(lg, ln, window, sync)
             )
         )
     if d0 * math.exp(max_growth) > 1e-3:

@@ -2,11 +2,14 @@
 
 The linearised flow ``V' = A(t) V`` with ``A = [[0, 1], [d theta''/d theta,
 d theta''/d theta']]`` is integrated with the state by the *same* RK4 stages
-(:func:`rk4_tangent_trig`), so V is the exact derivative of the discrete RK4 map and the state
-is bit-identical to :func:`._physics.rk4`'s. At a restitution jump (4)–(5) V is multiplied by
-the saltation matrix (:func:`saltation`; Müller 1995, Chaos Solitons Fractals 5(9);
-Leine & Nijmeijer 2004, *Dynamics and Bifurcations of Non-smooth Mechanical Systems*,
-sec. 3.5; Dankowicz & Nordmark 2000, Physica D 136). Contact onset and separation need none:
+(:func:`rk4_tangent_trig`), so between events V is the exact derivative of the RK4 steps and
+the state is bit-identical to :func:`._physics.rk4`'s. At a restitution jump (4)–(5) V is
+multiplied by the flow's saltation matrix at the located event (:func:`saltation`; Müller
+1995, Chaos Solitons Fractals 5(9); Leine & Nijmeijer 2004, *Dynamics and Bifurcations of
+Non-smooth Mechanical Systems*, sec. 3.5; Dankowicz & Nordmark 2000, Physica D 136), not a
+derivative of the event search; where chattering ends in sticking the default grid's V
+overstates the growth while the grid's motion does not (README, "Tangent dynamics checked
+independently"). Contact onset and separation need no saltation matrix:
 the contact force vanishes at delta = 0, so the vector field is continuous there (its Jacobian
 is not, which is why no RK4 step straddles delta = 0).
 
