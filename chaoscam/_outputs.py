@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -47,6 +48,7 @@ def check_output(
     flag: str = "--out",
     force: bool = False,
     suffixes: tuple[str, ...] | None = None,
+    force_hint: str = "pass --force",
 ) -> Path | None:
     """Check that ``path`` can be written, before any work is done.
 
@@ -60,6 +62,8 @@ def check_output(
         Replace an existing file (``--force``); without it an existing file is refused.
     suffixes : tuple of str, optional
         Allowed suffixes (case-insensitive), e.g. ``(".parquet", ".csv")``.
+    force_hint : str
+        How to replace an existing file, for the message (``pass replace=True`` in the API).
 
     Raises
     ------
@@ -88,7 +92,7 @@ def check_output(
         if not force:
             raise OutputError(
                 f"{flag} {path} exists; nothing was overwritten: choose another name, or "
-                "pass --force to replace it"
+                f"{force_hint} to replace it"
             )
         # A dangling link is replaced like a file (os.replace swaps the name, not its target).
         if path.exists() and not os.access(path, os.W_OK):
@@ -177,6 +181,16 @@ def _place_new(tmp: Path, path: Path) -> None:
         ) from None
 
 
+def write_new_parquet(table, path: str | Path, *, replace: bool = False) -> None:
+    """A pyarrow ``table`` to ``path`` atomically (:func:`chaoscam._parquet.write_table`),
+    refusing an existing file, a folder or a missing folder unless ``replace`` (the file)."""
+    from ._parquet import write_table
+
+    path = check_output(path, flag="path", force=replace, force_hint="pass replace=True")
+    with atomic_path(path, replace=replace) as tmp:
+        write_table(table, tmp)
+
+
 def atomic_write_bytes(path: str | Path, data: bytes, *, replace: bool = True) -> None:
     """Write ``data`` to ``path`` atomically (see :func:`atomic_path`)."""
     with atomic_path(path, replace=replace) as tmp:
@@ -189,10 +203,13 @@ class OutputLock:
     Taken without waiting: when another process holds it, :class:`OutputError` says so. The
     lock is released when the holder exits, however it exits (the OS drops ``flock`` locks
     with the process), so a killed run never leaves a stale lock. Usable as a context
-    manager; re-entrant within one process for the same path.
+    manager; re-entrant within one thread for the same path (a sweep called by the command
+    that locked its output), refused from another thread of the same process.
     """
 
-    _held: dict[str, int] = {}
+    _held: dict[str, int] = {}  # lock file -> descriptor, for this process
+    _owner: dict[str, int] = {}  # lock file -> the thread that took it
+    _table = threading.Lock()
 
     def __init__(self, path: str | Path, what: str = "output") -> None:
         self.target = Path(path)
@@ -205,12 +222,21 @@ class OutputLock:
         self._nested = False
 
     def acquire(self) -> OutputLock:
+        key = str(self.path.resolve())
+        with OutputLock._table:
+            if key in OutputLock._held:
+                if OutputLock._owner.get(key) != threading.get_ident():
+                    raise OutputError(
+                        f"{self.target} is in use by another thread of this process; wait "
+                        f"for it to finish, or choose another {self.what}"
+                    )
+                self._nested = True  # this thread holds it already (an API call inside)
+                return self
+            return self._take(key)
+
+    def _take(self, key: str) -> OutputLock:
         import fcntl
 
-        key = str(self.path.resolve())
-        if key in OutputLock._held:  # this process holds it already (an API call inside)
-            self._nested = True
-            return self
         while True:
             try:
                 fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
@@ -242,12 +268,16 @@ class OutputLock:
         os.pwrite(fd, str(os.getpid()).encode(), 0)
         self._fd = fd
         OutputLock._held[key] = fd
+        OutputLock._owner[key] = threading.get_ident()
         return self
 
     def release(self) -> None:
         if self._nested or self._fd is None:
             return
-        OutputLock._held.pop(str(self.path.resolve()), None)
+        with OutputLock._table:
+            key = str(self.path.resolve())
+            OutputLock._held.pop(key, None)
+            OutputLock._owner.pop(key, None)
         with contextlib.suppress(OSError):
             self.path.unlink()  # while still locked: a waiter re-checks the inode
         os.close(self._fd)

@@ -125,11 +125,17 @@ class Trajectory:
             "stats": self.stats,
         }
 
-    def to_parquet(self, path) -> None:
-        """Write the time series (or, without one, the section) with provenance metadata."""
+    def to_parquet(self, path, *, replace: bool = False) -> None:
+        """:meth:`parquet_table`, atomically; an existing file is refused unless replace=True."""
+        from ._outputs import write_new_parquet
+
+        write_new_parquet(self.parquet_table(), path, replace=replace)
+
+    def parquet_table(self):
+        """The series (or the section) as a pyarrow table; section, impacts, provenance: meta."""
         import pyarrow as pa
 
-        from ._parquet import exact_json, write_table
+        from ._parquet import exact_json
 
         frame = self.series if self.series is not None else self.section
         table = pa.Table.from_pandas(frame, preserve_index=False)
@@ -137,7 +143,7 @@ class Trajectory:
         meta[b"chaoscam.trajectory"] = json.dumps(self.provenance()).encode()
         for name in ("section", "impacts"):
             meta[f"chaoscam.{name}".encode()] = exact_json(getattr(self, name)).encode()
-        write_table(table.replace_schema_metadata(meta), path)
+        return table.replace_schema_metadata(meta)
 
 
 def _check_run(
@@ -204,16 +210,13 @@ def simulate(
         Sampling interval of the series [s], rounded to a whole number of steps.
     tangent : bool
         Also integrate the tangent dynamics through the impacts (:mod:`chaoscam.integrate.
-        _tangent`) and keep the Jacobian of the stroboscopic map over each recorded period
-        (``Trajectory.jacobians``), from which :func:`chaoscam.lyapunov_spectrum` and
-        :func:`chaoscam.periodic_orbit` work. Both integrators (the adaptive path carries
-        it by an RK4 step along each accepted step). The motion is the same with and
-        without it.
+        _tangent`; both integrators) and keep the stroboscopic map's Jacobian over each
+        recorded period (``Trajectory.jacobians``, for :func:`chaoscam.lyapunov_spectrum` and
+        :func:`chaoscam.periodic_orbit`). The motion is the same with and without it.
     resumable : bool
-        Keep a copy of the run's state near its end (``Trajectory.resume``; RK4 only, the
-        adaptive path keeps none), from which :func:`chaoscam.extend_trajectory` makes the
-        run longer without repeating it, to the same bits as a run made that long from
-        t = 0. The copy costs one more stop of the compiled call; the run is the same.
+        Keep a copy of the run's state near its end (``Trajectory.resume``; RK4 only), from
+        which :func:`chaoscam.extend_trajectory` makes the run longer without repeating it,
+        to the same bits as a run made that long from t = 0. The run is the same.
 
     Returns
     -------
@@ -223,12 +226,10 @@ def simulate(
 
     Notes
     -----
-    The follower starts in contact with the cam (``theta_f0``, ``omega_f0`` None). To start
-    from another state, e.g. a section point ``(theta_f, omega_f)`` of an earlier run (its
-    rows lie at t = k 2π/ω, where the cam is back at ``theta_c0``), pass
-    ``simulate(theta_f0=theta_f, omega_f0=omega_f)``: a new run from there, not the earlier
-    run's continuation to the bit (its contact state and line-length draws start afresh;
-    :func:`chaoscam.extend_trajectory` continues a run exactly).
+    The follower starts in contact with the cam (``theta_f0``, ``omega_f0`` None). From a
+    section point ``(theta_f, omega_f)`` of an earlier run (at t = k 2π/ω the cam is back at
+    ``theta_c0``), ``simulate(theta_f0=theta_f, omega_f0=omega_f)`` is a new run, not the
+    earlier one's continuation to the bit (:func:`chaoscam.extend_trajectory` is that).
     """
     return raw_run(
         params,

@@ -407,12 +407,101 @@ def test_a_full_disk_names_the_simulation_output(tmp_path, monkeypatch, capsys):
 
     from chaoscam import Trajectory
 
-    def full(self, path):
+    def full(self):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(Trajectory, "to_parquet", full)
+    monkeypatch.setattr(Trajectory, "parquet_table", full)
     out = tmp_path / "s.parquet"
     assert main(["simulate", "--duration", "0.2", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert f"No space left on device while writing {out}; nothing was written" in err
     assert not out.exists()
+
+
+def test_api_writers_refuse_an_existing_file_and_write_whole(tmp_path, monkeypatch):
+    """Trajectory.to_parquet and RegimeMap.to_parquet never replace a file without
+    replace=True, and a write that fails half-way leaves the old file as it was."""
+    import chaoscam
+    import chaoscam._parquet as parquet
+    from chaoscam.sweep import Axis, read_regime_map, regime_map
+
+    traj = chaoscam.simulate(duration=0.2)
+    path = tmp_path / "t.parquet"
+    traj.to_parquet(path)
+    before = path.read_bytes()
+    with pytest.raises(OutputError, match="exists; nothing was overwritten.*replace=True"):
+        traj.to_parquet(path)
+    with pytest.raises(OutputError, match="is a directory"):
+        traj.to_parquet(tmp_path)
+
+    def half(table, where):
+        Path(where).write_bytes(b"PAR1 half")
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(parquet, "write_table", half)
+    with pytest.raises(OSError, match="No space"):
+        traj.to_parquet(path, replace=True)
+    assert path.read_bytes() == before and not list(tmp_path.glob(".tmp-*"))
+    monkeypatch.undo()
+    m = regime_map(Axis("xi", (0.2,)), Axis("l_lambda_sigma", (0.0,)), realizations=1,
+                   duration=0.5, workers=1)  # fmt: skip
+    m.to_parquet(tmp_path / "m.parquet")
+    with pytest.raises(OutputError, match="m.parquet exists"):
+        m.to_parquet(tmp_path / "m.parquet")
+    (tmp_path / "n.cells.parquet").write_text("theirs")
+    with pytest.raises(OutputError, match="n.cells.parquet exists"):
+        m.to_parquet(tmp_path / "n.parquet")
+    assert not (tmp_path / "n.parquet").exists()
+    m.to_parquet(tmp_path / "m.parquet", replace=True)
+    assert read_regime_map(tmp_path / "m.parquet").cells.shape == m.cells.shape
+
+
+def test_a_second_thread_of_the_process_is_refused_the_lock(tmp_path):
+    """The lock is re-entrant in the thread that holds it (a sweep inside the command that
+    locked its output) and refused to another thread: two sweeps in one process on one
+    output must not both write it."""
+    import threading
+
+    target = tmp_path / "out.parquet"
+    held, done, seen = threading.Event(), threading.Event(), []
+
+    def holder():
+        with OutputLock(target):
+            held.set()
+            done.wait(10)
+
+    t = threading.Thread(target=holder)
+    t.start()
+    held.wait(10)
+    try:
+        with pytest.raises(OutputError, match="in use by another thread of this process"):
+            OutputLock(target).acquire()
+    finally:
+        done.set()
+        t.join()
+    with OutputLock(target), OutputLock(target):  # re-entrant in one thread
+        seen.append(1)
+    assert seen == [1]
+
+
+def test_a_resume_with_another_classifier_is_refused(tmp_path):
+    """Two partials of one function, or two lambdas, have different identities: a resume
+    with another one does not reuse the first one's labels."""
+    import functools
+
+    from chaoscam import classify_trajectory
+    from chaoscam.sweep import Axis, SweepError, regime_map
+    from chaoscam.sweep._tasks import classifier_identity
+
+    a = functools.partial(classify_trajectory, tangent=False)
+    b = functools.partial(classify_trajectory, tangent=True)
+    assert classifier_identity(a) != classifier_identity(b)
+    assert classifier_identity(lambda t: 1) != classifier_identity(lambda t: 2)
+    assert classifier_identity(a) == classifier_identity(
+        functools.partial(classify_trajectory, tangent=False)
+    )
+    kw = dict(realizations=1, seed=3, duration=0.5, workers=1, out=tmp_path / "m.parquet")
+    x, y = Axis("xi", (0.2,)), Axis("l_lambda_sigma", (0.0,))
+    regime_map(x, y, classify=a, **kw)
+    with pytest.raises(SweepError, match="differs in: classifier"):
+        regime_map(x, y, classify=b, resume=True, **kw)

@@ -123,7 +123,9 @@ def _distinct(*named) -> None:
 
 def _series_writer(traj, out):
     if out is not None and out.suffix.lower() == ".parquet":
-        return traj.to_parquet
+        from .._parquet import write_table
+
+        return lambda tmp: write_table(traj.parquet_table(), tmp)
     return lambda tmp: traj.series.to_csv(tmp, index=False)
 
 

@@ -485,11 +485,11 @@ def build_report(inputs, parts: ReportParts | None = None) -> ReportParts:
 
 
 def write_report(
-    parts: ReportParts, out: str | Path, *, title: str, command=None, replace: bool = True
+    parts: ReportParts, out: str | Path, *, title: str, command=None, replace: bool = False
 ) -> Path:
     """Render and write the report atomically into an existing folder; returns the path.
 
-    ``replace=False`` never writes over an existing file: the report then goes beside it
+    Never over an existing file unless ``replace=True``: the report then goes beside it
     (``NAME.PID.html``) with an :class:`chaoscam._outputs.OutputError` naming both.
     """
     from .._outputs import atomic_write_bytes, check_output

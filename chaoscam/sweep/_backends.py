@@ -178,6 +178,7 @@ def _worker_init(parent: int) -> None:
         except OSError:
             pass
     OutputLock._held.clear()
+    OutputLock._owner.clear()
 
 
 def _die_with_parent(parent: int) -> None:

@@ -425,7 +425,7 @@ def _finish(plan, store, out: Path | None, keys, build, replace: bool):
         reemit_warnings(records)
         result = build(records)
         if out is not None:
-            result.to_parquet(out, replace=replace)
+            result._write(out, replace=replace)
             store.remove()
     except KeyboardInterrupt:
         # Every record is in the checkpoint; a resume writes the tables from it.

@@ -14,7 +14,7 @@ import numbers
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import pandas as pd
@@ -26,13 +26,13 @@ from .._version import __version__
 from ..model import Params, contact_angle
 from ._batch import engine_device, run_sweep, sweep_engine
 from ._common import (
+    TwoTables,
     check_fate,
     check_sweep_budget,
     evidence_columns,
     period_column,
     read_tables,
     run_settings,
-    write_tables,
 )
 from ._grid import Axis, SweepError, realization_index, validate_grid
 from ._tasks import BranchTask, fate_columns
@@ -48,7 +48,7 @@ POINT_COLUMNS = ("k", "t", "theta_f", "omega_f", "l_lambda")
 
 
 @dataclass(frozen=True)
-class Bifurcation:
+class Bifurcation(TwoTables):
     """A bifurcation diagram: section points and verdicts, with the settings used.
 
     Attributes
@@ -72,6 +72,7 @@ class Bifurcation:
         The settings that fix the result.
     """
 
+    _tables: ClassVar[tuple[str, str]] = ("points", "verdicts")
     points: pd.DataFrame
     verdicts: pd.DataFrame
     config: dict[str, Any] = field(default_factory=dict)
@@ -82,11 +83,6 @@ class Bifurcation:
     @property
     def param(self) -> str:
         return self.config["axis"]["name"]
-
-    def to_parquet(self, path: str | Path, *, replace: bool = True) -> None:
-        """Points to ``FILE.parquet``, verdicts to ``FILE.verdicts.parquet``
-        (``replace=False``: never over an existing file)."""
-        write_tables(path, self.points, "verdicts", self.verdicts, self.config, replace=replace)
 
 
 def read_bifurcation(path: str | Path) -> Bifurcation:

@@ -93,6 +93,34 @@ def companion(out: Path, what: str) -> Path:
     return out.with_name(f"{stem}.{what}.parquet")
 
 
+def check_pair(path: str | Path, second: str, replace: bool) -> None:
+    """Refuse, before writing, a sweep's ``FILE.parquet`` or ``FILE.<second>.parquet`` that
+    exists (unless ``replace``), a folder, or a missing folder, naming the file."""
+    from .._outputs import check_output
+
+    path = Path(path)
+    for name in (path, companion(path, second)):
+        check_output(name, flag="path", force=replace, force_hint="pass replace=True")
+
+
+class TwoTables:
+    """``to_parquet`` of a sweep's result: its main table to ``FILE.parquet`` and the second
+    to ``FILE.<second>.parquet`` (names in ``_tables``), with the configuration."""
+
+    _tables: tuple[str, str]
+
+    def to_parquet(self, path: str | Path, *, replace: bool = False) -> None:
+        """Both tables, each atomically; an existing file is refused unless ``replace=True``."""
+        check_pair(path, self._tables[1], replace)
+        self._write(path, replace=replace)
+
+    def _write(self, path: str | Path, *, replace: bool) -> None:
+        """Both tables (``replace=False``: a file that appeared meanwhile is kept)."""
+        main, second = self._tables
+        frames = getattr(self, main), getattr(self, second)
+        write_tables(path, frames[0], second, frames[1], self.config, replace=replace)
+
+
 def write_tables(
     path: str | Path,
     main: pd.DataFrame,

@@ -13,7 +13,7 @@ from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import pandas as pd
@@ -25,6 +25,7 @@ from .._version import __version__
 from ..model import ParameterError, Params, realizations_identical
 from ._batch import engine_device, run_sweep, sweep_engine
 from ._common import (
+    TwoTables,
     as_axis,
     check_fate,
     check_sweep_budget,
@@ -32,7 +33,6 @@ from ._common import (
     period_column,
     read_tables,
     run_settings,
-    write_tables,
 )
 from ._grid import Axis, SweepError, realization_index, validate_grid
 from ._stats import max_halfwidth, summarize_cells
@@ -45,7 +45,7 @@ DEFAULT_CAP = 1000
 
 
 @dataclass(frozen=True)
-class RegimeMap:
+class RegimeMap(TwoTables):
     """A regime map: one row per realization and one per cell, with the settings used.
 
     Attributes
@@ -71,6 +71,7 @@ class RegimeMap:
         duration, transient, classifier, adaptive settings, version).
     """
 
+    _tables: ClassVar[tuple[str, str]] = ("realizations", "cells")
     realizations: pd.DataFrame
     cells: pd.DataFrame
     config: dict[str, Any] = field(default_factory=dict)
@@ -85,11 +86,6 @@ class RegimeMap:
     @property
     def y(self) -> str:
         return self.config["y"]["name"]
-
-    def to_parquet(self, path: str | Path, *, replace: bool = True) -> None:
-        """Realizations to ``FILE.parquet``, cells to ``FILE.cells.parquet``
-        (``replace=False``: never over an existing file)."""
-        write_tables(path, self.realizations, "cells", self.cells, self.config, replace=replace)
 
 
 def read_regime_map(path: str | Path) -> RegimeMap:

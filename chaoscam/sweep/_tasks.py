@@ -8,7 +8,10 @@ function of its task: the same on any worker, in any order, on any backend.
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import importlib
+import marshal
 import math
 import warnings
 from collections.abc import Callable
@@ -88,18 +91,39 @@ class DefaultClassifier:
 def classifier_identity(classify: Callable) -> str:
     """A stable text naming a classifier and its settings, part of a run's configuration.
 
-    ``module.qualname`` for a function; for an instance, its class's name plus ``repr``
-    (a dataclass's repr lists its fields, so two settings never share an identity).
+    ``module.qualname`` for a function (plus a digest of its code for a lambda or a local
+    function, whose names are not unique); for ``functools.partial``, its function's identity
+    with the bound arguments; for an instance, its class's name plus ``repr`` (a dataclass's
+    repr lists its fields, so two settings never share an identity).
     """
     if isinstance(classify, type) or not callable(classify):
         raise TypeError(f"classify must be a function or an instance, got {classify!r}")
+    if isinstance(classify, functools.partial):  # its own name is functools.partial's
+        keywords = sorted(classify.keywords.items())
+        return (
+            f"functools.partial({classifier_identity(classify.func)}, args={classify.args!r}, "
+            f"keywords={keywords!r})"
+        )
     if hasattr(classify, "__qualname__") and hasattr(classify, "__module__"):
-        return f"{classify.__module__}.{classify.__qualname__}"
+        name = f"{classify.__module__}.{classify.__qualname__}"
+        code = getattr(classify, "__code__", None)
+        if "<" in classify.__qualname__ and code is not None:  # <lambda>, <locals>: not unique
+            name += ":" + _code_digest(classify, code)
+        return name
     cls = type(classify)
     text = repr(classify)
     if not is_dataclass(classify) and " at 0x" in text:  # the default repr names an address
         text = repr(sorted(getattr(classify, "__dict__", {}).items()))
     return f"{cls.__module__}.{cls.__qualname__}:{text}"
+
+
+def _code_digest(func: Callable, code) -> str:
+    """A digest of a lambda's or a local function's code, defaults and closure: two of them
+    with one name get two identities (a closure value whose repr names an address gives a new
+    identity each run, so a resume is refused rather than mixing classifiers)."""
+    cells = tuple(repr(c.cell_contents) for c in (func.__closure__ or ()))
+    extra = repr((func.__defaults__, func.__kwdefaults__, cells)).encode()
+    return hashlib.sha256(marshal.dumps(code) + extra).hexdigest()[:16]
 
 
 def needs_series(classify: Callable) -> bool:

@@ -383,8 +383,8 @@ def test_a_report_that_appeared_meanwhile_is_kept(tmp_path, monkeypatch):
 
 
 def test_write_report_keeps_an_existing_file_and_needs_its_folder(tmp_path):
-    """write_report(replace=False) never writes over a file (its report goes beside it,
-    named in the error); a missing folder is refused (it was created)."""
+    """write_report never writes over a file unless replace=True (by default its report
+    goes beside it, named in the error); a missing folder is refused (it was created)."""
     from chaoscam._outputs import OutputError
     from chaoscam.report import write_report
     from chaoscam.report._html import ReportParts
@@ -392,9 +392,9 @@ def test_write_report_keeps_an_existing_file_and_needs_its_folder(tmp_path):
     out = tmp_path / "r.html"
     out.write_text("theirs")
     with pytest.raises(OutputError, match="another process wrote it while this run worked"):
-        write_report(ReportParts(), out, title="t", replace=False)
+        write_report(ReportParts(), out, title="t")
     assert out.read_text() == "theirs" and len(list(tmp_path.glob("r.*.html"))) == 1
-    write_report(ReportParts(), out, title="t")
+    write_report(ReportParts(), out, title="t", replace=True)
     assert "<html" in out.read_text()
     with pytest.raises(OutputError, match="does not exist"):
         write_report(ReportParts(), tmp_path / "no" / "r.html", title="t")
