@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 
-from ._checks import of_type, real
+from ._checks import flag, of_type, real
 from ._simulate import KernelRun, RawRun, Trajectory, _check_run, output_block, simulate
 from .integrate import _kernel as k
 from .model import ParameterError
@@ -63,7 +63,7 @@ def extend_trajectory(
             f"duration = {duration!r} s must be >= the run's duration, {s['duration']!r} s"
         )
     had_series = traj.series is not None
-    keep_series = had_series if series is None else bool(series)
+    keep_series = had_series if series is None else flag("series", series)
     if keep_series and not had_series:
         raise ParameterError(
             "series = True: the run kept no time series, so its extension cannot have one "

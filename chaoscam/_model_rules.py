@@ -52,6 +52,18 @@ def with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, d
             "within its interval: run longer"
         )
         v = Verdict("undetermined", None, v.evidence, v.reasons + (reason,), v.settings)
+    chaotic = [e.name for e in v.evidence if e.vote == "chaotic"]
+    need = int(v.settings.get("thresholds", {}).get("min_chaotic_votes", 2))
+    if v.label == "chaotic" and votes.get("exponent") != "chaotic" and len(chaotic) < need:
+        # The section-only path's rule (analysis._classify_section._decide) on the series
+        # path too, so that one run gets one label with or without its series: a broadband
+        # spectrum of 1.5 s with 11 section points called omega = 45, xi = 0.2 chaotic,
+        # where the extended run is periodic 11.
+        reason = (
+            f"only {', '.join(chaotic)} votes chaotic; {need} independent methods or a "
+            "positive tangent exponent are needed: run longer"
+        )
+        v = Verdict("undetermined", None, v.evidence, v.reasons + (reason,), v.settings)
     if (
         v.label == "periodic"
         and not realizations_identical(p)

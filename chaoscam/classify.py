@@ -99,6 +99,9 @@ def _evidence_verdict(
     t0 = traj.settings["transient"] + discard
     sec = traj.section
     points = sec.loc[sec["t"] >= t0 - 1e-9 * period, _SECTION_COORDS].to_numpy(dtype=float)
+    if not len(points):  # the analysis layer refuses an empty section
+        why = f"no section point after t = {t0:g} s (cam period {period:.4g} s): simulate longer"
+        return Verdict("undetermined", None, (), (why,), {"discard": discard})
     opts = dict(options)
     opts.setdefault("atol", (MODEL_ATOL, MODEL_ATOL / period))
     if traj.series is None:

@@ -491,7 +491,32 @@ API_REVIEW_CASES = [
         "keep_impacts",
     ),
     (lambda: chaoscam.periodic_orbit(Params(), [0.0, 0.0], 10**6), "the shooting .up to"),
+    # a second review (2026-11-27): flags that took "no" as True, a string half-width
+    (lambda: bifurcation("xi", [0.4], duration=0.3, continuation="no"), "continuation = 'no'"),
+    (lambda: regime_map(("xi", [0.4]), ("omega", [30.0]), resume="yes"), "resume = 'yes'"),
+    (lambda: regime_map(("xi", [0.4]), ("omega", [30.0]), force="no"), "force = 'no'"),
+    (
+        lambda: regime_map(("xi", [0.4]), ("omega", [30.0]), target_halfwidth="0.1"),
+        "target half-width = '0.1'",
+    ),
+    (
+        lambda: chaoscam.integrate.simulate_ensemble(Params(), [0], duration=0.2, resumable="no"),
+        "resumable = 'no'",
+    ),
+    (
+        lambda: chaoscam.extend_trajectory(
+            chaoscam.simulate(duration=0.2, resumable=True), 0.4, series="no"
+        ),
+        "series = 'no'",
+    ),
 ]
+
+
+def test_numpy_scalars_are_numbers():
+    """A window or horizon given as numpy scalars (np.int64(1), np.float32(0.5)) was
+    refused as not 'a finite number', which it is."""
+    tr = chaoscam.simulate(duration=np.int64(1), transient=np.float32(0.5), series=False)
+    assert tr.settings["duration"] == 1.0 and tr.settings["transient"] == 0.5
 
 
 @pytest.mark.parametrize("i", range(len(API_REVIEW_CASES)))

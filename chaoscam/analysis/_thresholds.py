@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass, fields, replace
 
 __all__ = ["Thresholds"]
@@ -141,7 +142,7 @@ class Thresholds:
     def __post_init__(self):
         for f in fields(self):
             v = getattr(self, f.name)
-            if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
+            if not (isinstance(v, numbers.Real) and math.isfinite(v) and v >= 0):
                 raise ValueError(f"Thresholds.{f.name} must be a finite number >= 0, got {v!r}")
         if not self.stationary_low <= 1.0 <= self.stationary_high:
             raise ValueError("Thresholds: need stationary_low <= 1 <= stationary_high")

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import numbers
 import os
 import signal
 import threading
@@ -67,11 +68,11 @@ def check_window(duration, transient, *, dt: float | None = None) -> tuple[float
     ``transient`` in [0, duration); both [s], returned as floats. Every run's entry point
     (simulate, ensembles, the exponents, the sweeps) checks its window here."""
     if isinstance(duration, bool) or not (
-        isinstance(duration, int | float) and math.isfinite(duration) and duration > 0
+        isinstance(duration, numbers.Real) and math.isfinite(duration) and duration > 0
     ):
         raise ParameterError(f"duration = {duration!r} s must be a finite number > 0")
     if isinstance(transient, bool) or not (
-        isinstance(transient, int | float) and 0 <= transient < duration
+        isinstance(transient, numbers.Real) and 0 <= transient < duration
     ):
         raise ParameterError(f"transient = {transient!r} s must be in [0, duration = {duration})")
     if dt is not None and round(duration / dt) < 1:

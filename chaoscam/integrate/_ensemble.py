@@ -155,6 +155,7 @@ def simulate_ensemble(
     """
     duration, transient = check_window(duration, transient)
     keep_impacts, tangent = flag("keep_impacts", keep_impacts), flag("tangent", tangent)
+    resumable = flag("resumable", resumable)
     use_gpu, device = _pick_backend(backend)
     if batch is None:
         batch = _gpu.GPU_BATCH if use_gpu else _CPU_BATCH

@@ -408,6 +408,13 @@ def run_sweep(
                 + f"; the runs finished and saved so far are kept in {store.path}: fix the "
                 "cause (free space) and run the same command with --resume",
             ) from None
+        except Exception:
+            # A run that failed before finishing any (a bad initial condition, a classifier
+            # that cannot be pickled) keeps no checkpoint: it would only block the corrected
+            # command ("holds the checkpoint of an interrupted run").
+            if next(iter(store.records()), None) is None:
+                store.remove()
+            raise
 
 
 SAVE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EROFS})

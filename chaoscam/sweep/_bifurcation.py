@@ -23,7 +23,7 @@ from .._checks import flag, params_arg, whole
 from .._frozen import freeze_fields
 from .._provenance import code_identity
 from .._version import __version__
-from ..model import Params, contact_angle
+from ..model import ParameterError, Params, contact_angle
 from ._batch import engine_device, run_sweep, sweep_engine
 from ._common import (
     TwoTables,
@@ -323,6 +323,8 @@ def bifurcation(
     duration, transient = run_settings(duration, transient, seed)
     fate = check_fate(fate, duration)
     lyapunov, check_step = flag("lyapunov", lyapunov), flag("check_step", check_step)
+    resume, force = flag("resume", resume), flag("force", force)
+    continuation = flag("continuation", continuation)
     validate_grid(base, [axis])
     counted = isinstance(initial_conditions, numbers.Integral) and not isinstance(
         initial_conditions, bool
@@ -336,6 +338,11 @@ def bifurcation(
         specs = [("absolute", *_state(s)) for s in _states(initial_conditions)]
         if not specs:
             raise SweepError("initial conditions: the list is empty")
+        for i, (_, th, om) in enumerate(specs):  # before any run (and any checkpoint)
+            try:
+                base.replace(theta_f0=th, omega_f0=om)
+            except ParameterError as err:
+                raise ParameterError(f"initial_conditions[{i}] = ({th}, {om}): {err}") from None
         n_specs = len(specs)
     classify, eng, series = sweep_engine(
         classify,

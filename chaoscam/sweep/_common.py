@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 from collections import Counter
 from pathlib import Path
 from typing import Any
@@ -42,7 +43,7 @@ __all__ = [
 
 def run_settings(duration: float, transient: float | None, seed: int) -> tuple[float, float]:
     """Validated (duration, transient) [s]; transient None = half the duration."""
-    if transient is None and isinstance(duration, int | float) and not isinstance(duration, bool):
+    if transient is None and isinstance(duration, numbers.Real) and not isinstance(duration, bool):
         transient = 0.5 * float(duration)  # checked with the duration just below
     duration, transient = check_window(duration, transient)
     whole("seed", seed)
@@ -54,7 +55,7 @@ def check_fate(fate: float | None, duration: float) -> float | None:
     if fate is None:
         return None
     if isinstance(fate, bool) or not (
-        isinstance(fate, int | float) and math.isfinite(fate) and fate > duration
+        isinstance(fate, numbers.Real) and math.isfinite(fate) and fate > duration
     ):
         raise SweepError(
             f"fate = {fate!r} s: the time to which runs labelled chaotic, quasiperiodic or "

@@ -9,6 +9,7 @@ model: with sigma = 0 every realization of a cell is the same, so one per cell s
 
 from __future__ import annotations
 
+import numbers
 from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -353,10 +354,13 @@ def regime_map(
     duration, transient = run_settings(duration, transient, seed)
     fate = check_fate(fate, duration)
     lyapunov, check_step = flag("lyapunov", lyapunov), flag("check_step", check_step)
+    resume, force = flag("resume", resume), flag("force", force)
     realizations = whole("realizations", realizations, low=1)
     adaptive = None
     if target_halfwidth is not None:
-        if not 0.0 < target_halfwidth < 0.5:
+        if isinstance(target_halfwidth, bool) or not (
+            isinstance(target_halfwidth, numbers.Real) and 0.0 < target_halfwidth < 0.5
+        ):
             raise SweepError(f"target half-width = {target_halfwidth!r} must be in (0, 0.5)")
         cap = (
             DEFAULT_CAP
@@ -376,7 +380,7 @@ def regime_map(
             "(--target-halfwidth)"
         )
     if isinstance(confidence, bool) or not (
-        isinstance(confidence, int | float) and 0.0 < confidence < 1.0
+        isinstance(confidence, numbers.Real) and 0.0 < confidence < 1.0
     ):
         # before any run: summarize_cells would refuse it only at the end
         raise SweepError(f"confidence = {confidence!r}: the intervals' level, in (0, 1), e.g. 0.95")

@@ -16,6 +16,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+from .._checks import flag
 from .._simulate import Trajectory, simulate
 from ..model import Params
 from ._tasks import OUTPUT_DT
@@ -106,7 +107,7 @@ def replay(sweep: Any, row: Any, *, tangent: bool = True, refine: int = 0) -> Tr
         raise ValueError(f"refine = {refine!r}: must be an integer >= 0 (step halvings)")
     for _ in range(refine):
         p = p.refined()
-    tangent = bool(tangent) and p.integrator == "rk4"
+    tangent = flag("tangent", tangent) and p.integrator == "rk4"
     return simulate(
         p,
         duration=float(cfg["duration"]),

@@ -460,3 +460,28 @@ def test_analysis_options_go_where_they_apply():
     bare = chaoscam.simulate(duration=2.0, series=False)
     with pytest.raises(TypeError, match="options are classify_section's: .*zero_one"):
         classify_trajectory(bare, spectrum_options={})
+
+
+def test_one_label_with_or_without_the_series():
+    """The series path needs what the section path needs for "chaotic" (the tangent
+    exponent's vote, or two independent chaotic votes): omega = 45, xi = 0.2 over 1.5 s (11
+    section points) was chaotic from a broadband spectrum alone with its series and periodic
+    11 without, once extended; so the process and ensemble engines disagreed on that cell."""
+    p = Params(omega=45.0, xi=0.2)
+    labels = set()
+    for series in (True, False):
+        tr = chaoscam.simulate(p, duration=3.0, transient=1.5, series=series)
+        v = chaoscam.classify_trajectory(tr)
+        labels.add((v.label, v.period))
+    assert labels == {("periodic", 11)}
+
+
+def test_a_run_without_a_section_point_is_undetermined_or_extended():
+    """A recorded window shorter than a cam period (no section point) was a raw ValueError
+    from the analysis layer; it is undetermined with the reason, and the default (tangent,
+    extended) runs it longer instead."""
+    tr = chaoscam.simulate(duration=0.3, transient=0.25)
+    for kw in ({"tangent": False}, {"lyapunov": True}, {"extend_to": None}):
+        v = chaoscam.classify_trajectory(tr, **kw)
+        assert v.label == "undetermined" and "no section point after t = 0.25 s" in v.reasons[0]
+    assert chaoscam.classify_trajectory(tr).settings["extended"]["recorded_s"] > 1.0

@@ -132,3 +132,26 @@ def test_a_diagram_over_the_initial_state_refuses_what_would_overwrite_it(kw, wh
 
     with pytest.raises(SweepError, match=what):
         bifurcation("theta_f0", [0.1, 0.2], duration=1.0, workers=1, **kw)
+
+
+def test_a_sweep_that_finished_nothing_leaves_no_checkpoint(tmp_path):
+    """A bad explicit initial condition is named (initial_conditions[0]) before any run, and
+    a sweep whose runs all failed keeps no empty checkpoint, which would only block the
+    corrected command as 'an interrupted run'."""
+    from chaoscam.model import ParameterError
+
+    out = tmp_path / "b.parquet"
+    with pytest.raises(ParameterError, match=r"initial_conditions\[0\] = \(10.0, 0.0\)"):
+        bifurcation("l_lambda", "0.008:0.012:2", initial_conditions=[(10.0, 0.0)], out=out,
+                    duration=0.5, workers=1, progress=False)  # fmt: skip
+
+    def broken(traj):
+        raise RuntimeError("classifier broke")
+
+    with pytest.raises(Exception, match="classifier broke"):
+        bifurcation("l_lambda", "0.008:0.012:2", classify=broken, out=out, duration=0.5,
+                    workers=1, progress=False)  # fmt: skip
+    assert list(tmp_path.iterdir()) == []
+    b = bifurcation("l_lambda", "0.008:0.012:2", initial_conditions=[(0.1, 0.0)], out=out,
+                    duration=0.5, workers=1, progress=False)  # fmt: skip
+    assert len(b.verdicts) == 2 and out.exists()

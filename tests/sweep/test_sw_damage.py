@@ -182,7 +182,7 @@ def test_ctrl_c_while_the_tables_are_written_says_how_to_resume(tmp_path, refere
     from chaoscam.sweep._regime import RegimeMap
 
     out = tmp_path / "m.parquet"
-    with mock.patch.object(RegimeMap, "to_parquet", side_effect=KeyboardInterrupt):
+    with mock.patch.object(RegimeMap, "_write", side_effect=KeyboardInterrupt):
         with pytest.raises(SweepInterrupted) as stopped:
             regime_map(X, Y, classify=SpreadClassifier(), out=out, **GRID)
     total = len(reference.realizations)
@@ -255,7 +255,7 @@ def test_a_full_disk_at_the_end_says_what_is_kept_and_resumes(tmp_path, monkeypa
     def full(self, path, replace=False):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(RegimeMap, "to_parquet", full)
+    monkeypatch.setattr(RegimeMap, "_write", full)
     with pytest.raises(OSError, match="No space left on device while saving the results of") as e:
         regime_map(X, Y, classify=SpreadClassifier(), out=out, **GRID)
     assert e.value.errno == errno.ENOSPC
