@@ -17,7 +17,14 @@ __all__ = ["FrozenDict", "freeze_fields"]
 
 
 class FrozenDict(dict):
-    """A read-only dict; ``{**d, key: value}`` or ``dict(d)`` gives a changeable copy."""
+    """A read-only dict, its nested dicts too (``config["base"]["omega"] = 40`` changed what
+    a replay simulates); ``{**d, key: value}`` or ``dict(d)`` gives a changeable copy (one
+    level: copy a nested record the same way)."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        for key, value in dict.items(self):
+            dict.__setitem__(self, key, _frozen(value))
 
     def _refuse(self, *args, **kwargs):
         raise TypeError(
@@ -33,6 +40,15 @@ class FrozenDict(dict):
 
     def __repr__(self) -> str:
         return dict.__repr__(self)
+
+
+def _frozen(value):
+    """A dict as a FrozenDict; a list or tuple with its dicts frozen (the sequence kept)."""
+    if isinstance(value, dict) and not isinstance(value, FrozenDict):
+        return FrozenDict(value)
+    if isinstance(value, list | tuple) and any(isinstance(v, dict) for v in value):
+        return type(value)(_frozen(v) for v in value)
+    return value
 
 
 def freeze_fields(result, *names: str) -> None:

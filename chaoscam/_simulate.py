@@ -365,7 +365,8 @@ def output_block(p: Params) -> int:
     per_step = p.max_events_per_step + p.flight_merge + 2
     if p.resample == "interval":
         per_step += int(p.dt / p.resample_dt) + 2
-    return max(_BLOCK, 4 * per_step, 4 * (int(p.dt / p.cam_period) + 2))
+    step = p.h_max if p.integrator == "adaptive" else p.dt  # the longest step
+    return max(_BLOCK, 4 * per_step, 4 * (int(step / p.cam_period) + 2))
 
 
 class KernelRun:
@@ -377,6 +378,8 @@ class KernelRun:
         self.p, self.y, self.cnt, self.c, self.lam, self.stream = p, y, cnt, c, lam, stream
         self.parts = parts
         self.block = output_block(p)
+        if p.integrator == "adaptive" and c[k.C_STRIDE] > 0:  # series rows in an h_max step
+            self.block = max(self.block, 4 * (int(p.h_max / (c[k.C_STRIDE] * p.dt)) + 2))
         self.buffers = Buffers.empty(self.block if c[k.C_STRIDE] > 0 else 1, self.block, self.block)
         self.kept: RunCopy | None = None  # its rows are attached by result()
         self.rows_at_copy: dict[str, int] = {}
@@ -467,9 +470,11 @@ def _summary(run: Trajectory | RawRun) -> str:
     s = run.stats
     fraction = s["contact_fraction"]
     contact = "n/a (no step recorded)" if math.isnan(fraction) else f"{fraction:.4f}"
+    end = run.final_state[0]  # NaN for a run read from a file that kept no section row
+    reached = "an end time not recorded in the file" if math.isnan(end) else f"{end:.4g} s"
     return (
         f"status: {run.status.name} - {run.message}\n"
-        f"simulated: {run.final_state[0]:.4g} s of {run.settings['duration']:.4g} s "
+        f"simulated: {reached} of {run.settings['duration']:.4g} s "
         f"(transient {run.settings['transient']:.4g} s discarded), dt = {run.params.dt:g} s\n"
         f"impacts: {s['n_impacts']} applied ({s['n_macro_impacts']} macro, "
         f"{s['n_micro_impacts']} micro, {s['n_chatter_ends']} chattering ends), "
@@ -486,15 +491,6 @@ def _series_frame(p: Params, a: np.ndarray) -> pd.DataFrame:
 
     t, th, om, lam = a[:, 0], a[:, 1], a[:, 2], a[:, 3]
     d = gap(p, t, th)
-    return pd.DataFrame(
-        {
-            "t": t,
-            "theta_f": th,
-            "omega_f": om,
-            "theta_fc": contact_angle(p, t),
-            "gap": d,
-            "contact": d <= 0.0,
-            "F_n": normal_force(p, t, th, om, lam),
-            "l_lambda": lam,
-        }
-    )
+    force = normal_force(p, t, th, om, lam)
+    columns = (t, th, om, contact_angle(p, t), d, d <= 0.0, force, lam)
+    return pd.DataFrame(dict(zip(SERIES_COLUMNS, columns, strict=True)))

@@ -512,6 +512,18 @@ API_REVIEW_CASES = [
 ]
 
 
+def test_event_tol_and_h_max_are_bounded_and_the_longest_step_fits_its_buffers():
+    """event_tol near dt silently collapsed event location onto the grid (822 -> 164 impacts
+    in 0.5 s at 1e-5 s), and h_max = 5 s stopped with an internal error (a step's series rows
+    did not fit a buffer): both are bounded, and the longest allowed step fits."""
+    with pytest.raises(ParameterError, match=r"event_tol = 1e-05 \[s\] is outside"):
+        Params(event_tol=1e-5)
+    with pytest.raises(ParameterError, match=r"h_max = 5.0 \[s\] is outside"):
+        Params(h_max=5.0)
+    tr = chaoscam.simulate(duration=0.5, integrator="adaptive", h_max=1.0, output_dt=1e-5)
+    assert tr.ok and len(tr.series) > 40_000
+
+
 def test_numpy_scalars_are_numbers():
     """A window or horizon given as numpy scalars (np.int64(1), np.float32(0.5)) was
     refused as not 'a finite number', which it is."""

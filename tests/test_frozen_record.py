@@ -81,3 +81,19 @@ def test_a_results_arrays_are_read_only():
     with pytest.raises(TypeError, match="read-only"):
         spectrum.settings["n"] = 1
     assert np.isfinite(chaoscam.lyapunov_spectrum(trajectory=run).exponents).all()  # still readable
+
+
+def test_nested_records_are_frozen_too():
+    """A sweep's config["base"] was a plain dict inside the frozen record: changing it
+    changed what replay simulates (found by an API review). Nested dicts are read-only; a
+    copy is changeable."""
+    from chaoscam.sweep import regime_map
+
+    m = regime_map("xi=0.2", "l_lambda_sigma=0", realizations=1, duration=0.3, workers=1)
+    with pytest.raises(TypeError, match="read-only"):
+        m.config["base"]["omega"] = 40.0
+    with pytest.raises(TypeError, match="read-only"):
+        m.config["x"]["name"] = "omega"
+    copy = dict(m.config["base"])
+    copy["omega"] = 40.0
+    assert m.config["base"]["omega"] != 40.0

@@ -33,6 +33,7 @@ INTEGRATORS = ("rk4", "adaptive")
 # (lower, upper, lower_inclusive, upper_inclusive); None = unbounded.
 _POS = (0.0, None, False, None)
 _NONNEG = (0.0, None, True, None)
+_TO_1 = (0.0, 1.0, False, True)
 
 
 def _meta(doc: str, unit: str, rng: tuple | None = _POS, choices: tuple | None = None) -> dict:
@@ -278,7 +279,11 @@ class Params:
     )
     event_tol: float = field(
         default=1e-12,
-        metadata=_meta("tolerance on the located impact time", "s"),
+        metadata=_meta(
+            "located impact time's tolerance, at most 1e-9 s (1e-8 merged micro-impacts)",
+            "s",
+            (0.0, 1e-9, False, True),
+        ),
     )
     max_events_per_step: int = field(
         default=8,
@@ -294,11 +299,8 @@ class Params:
         default=16,
         metadata=_meta(
             "most grid steps taken as one RK4 step where a bound on the gap's curvature proves "
-            "no contact can occur (free pendulum, truncation error ~1e-19 rad per merged "
-            "step); the step still ends on the grid. 1 = plain fixed-step RK4 everywhere. "
-            "Default 16: 6x faster, and equal to plain RK4 within 5e-9 s / 1e-8 rad on the "
-            "first ten impacts and on 20 s sections of periodic responses (tests). At most "
-            "1024: buffers are sized by it",
+            "no contact can occur (free pendulum); 1 = plain RK4. Default 16: 6x faster, equal "
+            "to plain RK4 within 5e-9 s / 1e-8 rad (tests). At most 1024 (buffers)",
             "-",
             (1, 1024, True, True),
         ),
@@ -306,10 +308,8 @@ class Params:
     rtol: float = field(
         default=1e-12,
         metadata=_meta(
-            "adaptive integrator: relative tolerance of the local error of (theta_f, theta_f'). "
-            "Default 1e-12: 20 s sections of periodic responses within 1e-6 rad of converged "
-            "fixed-step RK4 (tests); the first ten impacts of the chaotic default run to 1e-6 s "
-            "need 1e-13 (benchmarks/bench_work_precision.py)",
+            "adaptive integrator: relative tolerance of the local error of (theta_f, theta_f'); "
+            "1e-12: periodic sections within 1e-6 rad of converged RK4 (tests)",
             "-",
             (0.0, 1e-2, False, True),
         ),
@@ -324,7 +324,7 @@ class Params:
     )
     h_max: float = field(
         default=0.005,
-        metadata=_meta("adaptive integrator: largest step (flight) [s]", "s"),
+        metadata=_meta("adaptive integrator: largest step (flight), at most 1 s", "s", _TO_1),
     )
 
     # ------------------------------------------------------------------------------------
