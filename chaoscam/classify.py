@@ -308,9 +308,8 @@ def classify_trajectory(
     t = k 2 pi / omega as section points and the cam period T = 2 pi / omega as forcing
     period (MODEL.md, "Poincaré sections"). A trajectory simulated without series
     (``series=False``) is classified from its section alone
-    (:func:`chaoscam.analysis.classify_section`); with the ~90 points of a 20 s run that
-    calls a period reliably, but a quasiperiodic versus chaotic call then needs
-    ``lyapunov=True``.
+    (:func:`chaoscam.analysis.classify_section`), with the tangent exponent (``tangent``)
+    separating quasiperiodic from chaotic; both ask the same of a chaotic call.
 
     Parameters
     ----------
@@ -366,7 +365,8 @@ def classify_trajectory(
         runs are; one simulated here for its tangent is), else it runs from t = 0: the
         same bits either way. None: never extend.
     **options
-        Passed to the analysis classifier (``rtol``, ``lyapunov_tol`` [1/s], ``seed``, ...).
+        Passed to the analysis classifier (``rtol``, ``atol``, ``seed``, ...; ``lyapunov_tol``
+        [1/s] with ``lyapunov`` only: the tangent exponent is judged by its interval).
 
     Returns
     -------
@@ -379,7 +379,12 @@ def classify_trajectory(
     of_type("traj", traj, Trajectory, "from chaoscam.simulate or load_trajectory")
     tangent, lyapunov = flag("tangent", tangent), flag("lyapunov", lyapunov)
     check_step = flag("check_step", check_step)
-    check_options(options, "classify_trajectory", series=traj.series is not None)
+    check_options(
+        options,
+        "classify_trajectory",
+        series=traj.series is not None,
+        tangent=tangent and not lyapunov,
+    )
     discard = real("discard", discard, low=0.0, unit="s")
     if extend_to is not None:  # None: never extend
         extend_to = real("extend_to", extend_to, low=0.0, unit="s")

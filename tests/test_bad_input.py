@@ -524,6 +524,37 @@ def test_event_tol_and_h_max_are_bounded_and_the_longest_step_fits_its_buffers()
     assert tr.ok and len(tr.series) > 40_000
 
 
+@pytest.mark.parametrize("atol", ["x", float("nan"), float("inf"), -1.0, [1e-5], True])
+def test_a_bad_atol_is_refused_by_every_classifier(atol):
+    """atol="x" made the period evidence fail and the other votes said "quasiperiodic";
+    inf made uniform noise "periodic 1"; NaN found no period in a clean period 2."""
+    from chaoscam.analysis import classify_section, classify_signal, section_period
+
+    pts = np.array([[0.1, 0.2], [0.3, 0.4]] * 50)
+    x = np.sin(np.linspace(0.0, 60.0, 2000))
+    calls = (
+        lambda: section_period(pts, atol=atol),
+        lambda: classify_section(pts, atol=atol),
+        lambda: classify_signal(x, 0.01, 1.0, section=pts, atol=atol),
+        lambda: chaoscam.classify_trajectory(_RUN, tangent=False, atol=atol),
+    )
+    for call in calls:
+        with pytest.raises(ValueError, match="atol = .* must be a finite number >= 0, or 2 of"):
+            call()
+
+
+_RUN = chaoscam.simulate(duration=1.0)
+
+
+def test_lyapunov_tol_is_checked_and_said_unused_on_the_tangent_path():
+    """lyapunov_tol=-5 was accepted, and on the tangent path any value was dropped in
+    silence (the tangent exponent is judged by its confidence interval)."""
+    with pytest.raises(ValueError, match="lyapunov_tol = -5.0"):
+        chaoscam.classify_trajectory(_RUN, lyapunov_tol=-5.0)
+    with pytest.warns(RuntimeWarning, match="lyapunov_tol is not used"):
+        chaoscam.classify_trajectory(_RUN, lyapunov_tol=0.5, extend_to=None)
+
+
 def test_numpy_scalars_are_numbers():
     """A window or horizon given as numpy scalars (np.int64(1), np.float32(0.5)) was
     refused as not 'a finite number', which it is."""

@@ -18,7 +18,7 @@ from ._lyapunov_series import lyapunov_from_series
 from ._sections import local_maxima
 from ._spectrum import check_spectrum_options, spectrum_analysis
 from ._thresholds import Thresholds, resolve
-from ._validate import MIN_SERIES, as_points, as_series, check_settings
+from ._validate import MIN_SERIES, as_points, as_series, check_atol, check_settings
 from ._verdict import Evidence, Verdict, combine
 
 __all__ = ["classify_section", "classify_signal"]
@@ -228,6 +228,7 @@ def classify_signal(
     zero_one_per_period = _check_signal_settings(locals())
     if section is not None:
         section = as_points(section, "section")
+        check_atol("classify_signal", atol, section.shape[1])
     thr = resolve(thresholds, rtol, min_points_aperiodic)
     settings = dict(
         dt=dt,

@@ -8,7 +8,7 @@ from collections.abc import Sequence
 from ._evidence import lyapunov_evidence, section_evidence
 from ._exponent import as_exponent, exponent_evidence
 from ._thresholds import Thresholds, resolve
-from ._validate import as_points, check_settings
+from ._validate import as_points, check_atol, check_settings
 from ._verdict import Verdict, combine
 
 __all__ = ["classify_section"]
@@ -165,6 +165,7 @@ def classify_section(
     quasiperiodic from chaotic.
     """
     x = as_points(points)
+    check_atol("classify_section", atol, x.shape[1])
     check_settings(
         "classify_section",
         lyapunov=(lyapunov, "number?"),

@@ -10,8 +10,10 @@ from __future__ import annotations
 
 import inspect
 
+from .._warn import warn
 from ._classify import classify_signal
 from ._classify_section import classify_section
+from ._validate import check_atol, check_settings
 
 __all__ = ["SECTION_OPTIONS", "SIGNAL_OPTIONS", "check_options", "section_options"]
 
@@ -38,10 +40,19 @@ SECTION_OPTIONS = _settings(classify_section)
 """What a run with its section alone may pass through (to :func:`classify_section`)."""
 
 
-def check_options(options: dict, caller: str, *, series: bool) -> None:
+def check_options(options: dict, caller: str, *, series: bool, tangent: bool = False) -> None:
     """Refuse (TypeError) an option the classifier of this run does not take, naming the
     ones it does: :func:`classify_signal`'s for a run with a series, else
-    :func:`classify_section`'s."""
+    :func:`classify_section`'s; refuse (ValueError) a bad ``atol`` (two coordinates) or
+    ``lyapunov_tol``, and warn that the tangent verdict does not use ``lyapunov_tol``."""
+    check_atol(caller, options.get("atol"), 2)
+    check_settings(caller, lyapunov_tol=(options.get("lyapunov_tol"), "real>=0?"))
+    if tangent and options.get("lyapunov_tol") is not None:
+        warn(
+            f"{caller}: lyapunov_tol judges the two-trajectory exponent (lyapunov=True); the "
+            "tangent verdict judges its exponent by its confidence interval "
+            "(Thresholds.exponent_zero, exponent_z), so lyapunov_tol is not used"
+        )
     allowed = SIGNAL_OPTIONS if series else SECTION_OPTIONS
     fn = "classify_signal" if series else "classify_section"
     unknown = sorted(set(options) - allowed)

@@ -11,7 +11,7 @@ import numpy as np
 
 from .._frozen import freeze_fields
 from ._thresholds import Thresholds
-from ._validate import as_points, check_settings
+from ._validate import as_points, check_atol, check_settings
 
 __all__ = [
     "PeriodResult",
@@ -248,6 +248,7 @@ def section_period(
         band_separation = defaults.band_separation
     x = as_points(points)
     n = x.shape[0]
+    check_atol("section_period", atol, x.shape[1])
     settings = dict(
         rtol=rtol,
         atol=atol,

@@ -81,3 +81,21 @@ def check_settings(fn: str, **settings: tuple[Any, str]) -> None:
             none = " or None" if rule.endswith("?") else ""
             got = "" if isinstance(value, number) else f" (got {type(value).__name__})"
             raise ValueError(f"{fn}: {name} = {value!r} must be {what}{bound}{none}{got}")
+
+
+def check_atol(fn: str, atol: Any, d: int) -> None:
+    """Refuse an ``atol`` that is not None, one finite number >= 0, or ``d`` of them (one
+    per coordinate): a string failed deep inside numpy, NaN found no period and inf made
+    any set of points periodic 1."""
+    if atol is None:
+        return
+    try:
+        a = np.asarray(atol, dtype=float)
+    except (TypeError, ValueError):
+        a = None
+    ok = a is not None and not isinstance(atol, bool) and (a.ndim == 0 or a.shape == (d,))
+    if not (ok and np.isfinite(a).all() and (a >= 0).all()):
+        raise ValueError(
+            f"{fn}: atol = {atol!r} must be a finite number >= 0, or {d} of them (one per "
+            "coordinate), or None"
+        )
