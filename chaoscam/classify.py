@@ -394,10 +394,10 @@ def classify_trajectory(
             f"discard = {discard!r} s must be in [0, {recorded:g}) s: the run records "
             f"{recorded:g} s after its transient"
         )
+    how = dict(tangent=tangent, lyapunov=lyapunov, check_step=check_step, discard=discard)
+    how["extend_to"] = extend_to if tangent and not lyapunov else None  # None: not extended
     settings = {
-        "classify": dict(
-            tangent=tangent, lyapunov=lyapunov, check_step=check_step, discard=discard, **options
-        ),
+        "classify": {**how, **options},
         "trajectory": {
             "params": traj.params.to_dict(),
             "settings": dict(traj.settings),

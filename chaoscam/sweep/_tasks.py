@@ -13,6 +13,7 @@ import hashlib
 import importlib
 import marshal
 import math
+import numbers
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, is_dataclass
@@ -21,6 +22,7 @@ from typing import Any
 import pandas as pd
 
 from .._simulate import simulate
+from ..analysis import LABELS
 from ..integrate import Status
 from ..model import Params
 
@@ -173,16 +175,22 @@ def verdict_fields(verdict: Any) -> dict[str, Any]:
     ``recorded_s``, the recorded time of the extended run the verdict was made on
     (``settings["extended"]``; None when made on the run as given).
 
-    Works with any object with ``label``, ``period``, ``evidence`` (items with ``name``,
-    ``value``) and ``reasons``. Values that are not numbers become NaN; a repeated evidence
-    name keeps its first value.
+    Works with any object with ``label`` (one of :data:`LABELS`), ``period`` (a whole
+    number >= 1, or None), ``evidence`` (items with ``name``, ``value``) and ``reasons``;
+    another label or period is a ValueError (the run's task fails naming it). Values that
+    are not numbers become NaN; a repeated evidence name keeps its first value.
     """
     evidence: dict[str, float] = {}
     for e in getattr(verdict, "evidence", ()) or ():
         evidence.setdefault(str(e.name), _number(e.value))
-    period = getattr(verdict, "period", None)
+    label, period = verdict.label, getattr(verdict, "period", None)
+    if label not in LABELS:  # a custom classifier's: it would become a cell's dominant label
+        raise ValueError(f"the classifier's label {label!r} is not one of {', '.join(LABELS)}")
+    whole = isinstance(period, numbers.Real) and not isinstance(period, bool)
+    if period is not None and not (whole and float(period).is_integer() and period >= 1):
+        raise ValueError(f"the classifier's period {period!r} is not a whole number >= 1 or None")
     return {
-        "label": str(verdict.label),
+        "label": str(label),
         "period": None if period is None else int(period),
         "reasons": "; ".join(str(r) for r in (getattr(verdict, "reasons", ()) or ())),
         "evidence": evidence,

@@ -188,3 +188,22 @@ def test_readers_name_a_file_of_another_kind(tmp_path, reference):
     (tmp_path / "m.cells.parquet").unlink()
     with pytest.raises(FileNotFoundError, match="m.cells.parquet: no such file"):
         read_regime_map(out)
+
+
+def test_a_custom_classifier_label_outside_the_four_is_refused():
+    """A classifier returning label "wobbly" and period 2.7 was stored as ("wobbly", 2): the
+    period cut silently and the label a cell's dominant one. The run's task fails naming it."""
+    from types import SimpleNamespace
+
+    from chaoscam.sweep._engine import TaskFailed
+
+    def odd(traj):
+        return SimpleNamespace(label="wobbly", period=None, evidence=(), reasons=())
+
+    def cut(traj):
+        return SimpleNamespace(label="periodic", period=2.7, evidence=(), reasons=())
+
+    for classify, named in ((odd, "label 'wobbly' is not one of"), (cut, "period 2.7 is not")):
+        with pytest.raises(TaskFailed, match=named):
+            regime_map("xi=0.2", "l_lambda_sigma=0", classify=classify, realizations=1,
+                       duration=0.3, workers=1)  # fmt: skip
