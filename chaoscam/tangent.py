@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import params_arg, real, whole
+from ._checks import of_type, params_arg, real, whole
 from ._frozen import freeze_fields
 from ._warn import warn
 from .analysis import TangentSpectrum, spectrum_from_jacobians
@@ -65,6 +65,9 @@ def lyapunov_spectrum(
     sequence.
     """
     if trajectory is not None:
+        from ._simulate import Trajectory
+
+        of_type("trajectory", trajectory, Trajectory, "from chaoscam.simulate(tangent=True)")
         given = {
             k_: v
             for k_, v, default in (

@@ -555,6 +555,20 @@ def test_lyapunov_tol_is_checked_and_said_unused_on_the_tangent_path():
         chaoscam.classify_trajectory(_RUN, lyapunov_tol=0.5, extend_to=None)
 
 
+def test_review_tracebacks_are_named():
+    """lyapunov_spectrum(trajectory="run.parquet") was an AttributeError, run_paper(figures=3)
+    a TypeError from list(3), and a contact period that rounds to zero steps a
+    ZeroDivisionError in the step warning."""
+    from chaoscam._run_warnings import resolution_warning
+    from chaoscam.experiments import run_paper
+
+    with pytest.raises(TypeError, match="trajectory must be a chaoscam Trajectory"):
+        chaoscam.lyapunov_spectrum(trajectory="run.parquet")
+    with pytest.raises(ValueError, match=r"figures = \[99\]: choose from"):
+        run_paper(quick=True, out="unused.html", figures=99)
+    assert "a step longer than the period" in resolution_warning(Params(l_lambda=1e300))
+
+
 def test_numpy_scalars_are_numbers():
     """A window or horizon given as numpy scalars (np.int64(1), np.float32(0.5)) was
     refused as not 'a finite number', which it is."""

@@ -134,7 +134,7 @@ def run_paper(
     from ._store import store_mode
 
     if figures is not None:
-        figures = list(figures)
+        figures = list(figures) if isinstance(figures, list | tuple | set | range) else [figures]
         unknown = [f for f in figures if f not in FIGURES]
         if not figures or unknown:
             raise ValueError(
