@@ -19,6 +19,8 @@ def resolution_warning(p: Params) -> str | None:
     if steps >= 20 or p.integrator != "rk4":
         return None
     few = f"only {steps:.1f} steps" if steps >= 1 else "a step longer than the period"
+    if 0 < steps < 1:
+        few = f"a step {1 / steps:.3g}x the period"
     return (
         f"dt = {p.dt:g} s resolves the contact oscillation (period {period:.3g} s) with "
         f"{few}; use dt <= {period / 40:.2g} s (40 steps), and check the verdict "

@@ -13,7 +13,15 @@ import pytest
 import chaoscam
 from chaoscam import ParameterError, Params
 from chaoscam.cli import main
-from chaoscam.sweep import SweepError, bifurcation, regime_map
+from chaoscam.sweep import (
+    Axis,
+    SweepError,
+    bifurcation,
+    initial_offsets,
+    realization_index,
+    regime_map,
+    wilson_interval,
+)
 
 SIM = ["simulate", "--duration", "0.05"]
 BIF = [
@@ -567,6 +575,26 @@ def test_review_tracebacks_are_named():
     with pytest.raises(ValueError, match=r"figures = \[99\]: choose from"):
         run_paper(quick=True, out="unused.html", figures=99)
     assert "a step longer than the period" in resolution_warning(Params(l_lambda=1e300))
+
+
+@pytest.mark.parametrize(
+    "call, named",
+    [
+        (lambda: Axis(3, [1.0]), "axis name 3"),
+        (lambda: Axis("l_lambda", [True]), "not True/False"),
+        (lambda: realization_index("a", 0), "cell = 'a'"),
+        (lambda: realization_index(1.7, 0), "cell = 1.7"),
+        (lambda: realization_index(0, True), "index = True"),
+        (lambda: initial_offsets(2.5), "n = 2.5"),
+        (lambda: wilson_interval(float("nan"), 5), "whole numbers"),
+        (lambda: wilson_interval(2.5, 5), "whole numbers"),
+    ],
+)
+def test_sweep_helpers_name_a_bad_argument(call, named):
+    """Public sweep helpers refused these with an AttributeError, TypeError or scipy's words,
+    or silently cut 1.7 to 1, True to 1, 2.5 successes to a fraction (API review)."""
+    with pytest.raises(ValueError, match=named):
+        call()
 
 
 def test_numpy_scalars_are_numbers():

@@ -98,7 +98,7 @@ def initial_offsets(n: int) -> list[tuple[float, float]]:
     """
     from scipy.stats import qmc
 
-    if n <= 1:
+    if whole("n", n, low=0) <= 1:
         return []
     u = qmc.Halton(d=2, scramble=False).random(n)[1:]
     d_theta, omega = IC_BOX

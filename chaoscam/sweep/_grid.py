@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._checks import whole
 from ..model import FIELD_DOCS, LineLengthStream, ParameterError, Params, field_names
 
 __all__ = ["Axis", "SweepError", "parse_range", "realization_index", "cell_params"]
@@ -88,6 +89,8 @@ class Axis:
     values: tuple[float, ...]
 
     def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            raise SweepError(f"axis name {self.name!r}: must be a Params field's name (a str)")
         if self.name not in field_names():
             Params().replace(**{self.name: 0.0})  # raises with a "did you mean"
         if FIELD_DOCS[self.name]["choices"] is not None:
@@ -101,6 +104,8 @@ class Axis:
             vals = tuple(float(v) for v in self.values)
         except (TypeError, ValueError):
             raise SweepError(f"axis {self.name}: values must be numbers") from None
+        if any(isinstance(v, bool) for v in self.values):  # Params refuses a bool too
+            raise SweepError(f"axis {self.name}: values must be numbers, not True/False")
         if len(vals) > MAX_AXIS_POINTS:
             raise SweepError(f"axis {self.name}: more than {MAX_AXIS_POINTS} values")
         if not vals:
@@ -166,9 +171,10 @@ def realization_index(cell: int, index: int) -> int:
     count nor on how many realizations a cell ends with (adaptive sampling only appends
     indices), nor on the size of the grid beyond the cell number itself.
     """
-    c, i = int(cell), int(index)
-    if c < 0 or i < 0:
-        raise SweepError(f"cell = {c} and index = {i} must be >= 0")
+    try:
+        c, i = whole("cell", cell, low=0), whole("index", index, low=0)
+    except ParameterError as err:
+        raise SweepError(str(err)) from None
     s = c + i
     return s * (s + 1) // 2 + i
 

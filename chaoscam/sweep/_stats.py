@@ -57,6 +57,8 @@ def wilson_interval(k, n, confidence: float = 0.95) -> tuple[np.ndarray, np.ndar
         raise ValueError(f"confidence = {confidence!r} must be in (0, 1)")
     k = np.asarray(k, dtype=float)
     n = np.asarray(n, dtype=float)
+    if not (np.isfinite(k).all() and np.isfinite(n).all()) or (k % 1).any() or (n % 1).any():
+        raise ValueError(f"k = {k} and n = {n} must be whole numbers (counts)")
     if np.any(k < 0) or np.any(k > n):
         raise ValueError("need 0 <= k <= n")
     z = float(ndtri(0.5 + confidence / 2.0))
