@@ -586,6 +586,7 @@ def test_review_tracebacks_are_named():
         (lambda: realization_index(1.7, 0), "cell = 1.7"),
         (lambda: realization_index(0, True), "index = True"),
         (lambda: initial_offsets(2.5), "n = 2.5"),
+        (lambda: bifurcation(Axis("xi", (0.2,)), "0.3:0.4:2"), "has its values"),
         (lambda: wilson_interval(float("nan"), 5), "whole numbers"),
         (lambda: wilson_interval(2.5, 5), "whole numbers"),
     ],

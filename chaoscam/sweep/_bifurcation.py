@@ -311,6 +311,8 @@ def bifurcation(
     -------
     Bifurcation
     """
+    if isinstance(param, Axis) and values is not None:  # the values were ignored
+        raise SweepError(f"the Axis {param.name} has its values: give values=None")
     if isinstance(param, Axis):
         axis = param
     elif values is None:
