@@ -46,7 +46,7 @@ def _frozen(value):
     """A dict as a FrozenDict; a list or tuple with its dicts frozen (the sequence kept)."""
     if isinstance(value, dict) and not isinstance(value, FrozenDict):
         return FrozenDict(value)
-    if isinstance(value, list | tuple) and any(isinstance(v, dict) for v in value):
+    if type(value) in (list, tuple):  # not a namedtuple: its fields stay as they are
         return type(value)(_frozen(v) for v in value)
     return value
 

@@ -123,7 +123,7 @@ def _check_name_length(folder: Path, path: Path, flag: str) -> None:
 def _probe(folder: Path, what: str) -> None:
     """Create and remove a file in ``folder``: the only sure test that it takes files
     (``os.access`` says yes to root on a read-only mount)."""
-    probe = folder / f".tmp-{os.getpid()}-probe"
+    probe = folder / f".tmp-{os.getpid()}-{threading.get_ident()}-probe"  # one per thread
     try:
         with open(probe, "x"):
             pass
@@ -183,9 +183,12 @@ def _place_new(tmp: Path, path: Path) -> None:
 
 def write_new_parquet(table, path: str | Path, *, replace: bool = False) -> None:
     """A pyarrow ``table`` to ``path`` atomically (:func:`chaoscam._parquet.write_table`),
-    refusing an existing file, a folder or a missing folder unless ``replace`` (the file)."""
+    refusing an existing file, a folder or a missing folder unless ``replace`` (the file); a
+    file object (not a path) is written into as it is."""
     from ._parquet import write_table
 
+    if not isinstance(path, str | os.PathLike):  # a file object: pyarrow writes into it
+        return write_table(table, path)
     path = check_output(path, flag="path", force=replace, force_hint="pass replace=True")
     with atomic_path(path, replace=replace) as tmp:
         write_table(table, tmp)
@@ -274,14 +277,14 @@ class OutputLock:
     def release(self) -> None:
         if self._nested or self._fd is None:
             return
-        with OutputLock._table:
+        with OutputLock._table:  # all of it: another thread must not open the dying file
             key = str(self.path.resolve())
             OutputLock._held.pop(key, None)
             OutputLock._owner.pop(key, None)
-        with contextlib.suppress(OSError):
-            self.path.unlink()  # while still locked: a waiter re-checks the inode
-        os.close(self._fd)
-        self._fd = None
+            with contextlib.suppress(OSError):
+                self.path.unlink()  # while still locked: a waiter re-checks the inode
+            os.close(self._fd)
+            self._fd = None
 
     def __enter__(self) -> OutputLock:
         return self.acquire()

@@ -378,9 +378,10 @@ class KernelRun:
         self.p, self.y, self.cnt, self.c, self.lam, self.stream = p, y, cnt, c, lam, stream
         self.parts = parts
         self.block = output_block(p)
-        if p.integrator == "adaptive" and c[k.C_STRIDE] > 0:  # series rows in an h_max step
-            self.block = max(self.block, 4 * (int(p.h_max / (c[k.C_STRIDE] * p.dt)) + 2))
-        self.buffers = Buffers.empty(self.block if c[k.C_STRIDE] > 0 else 1, self.block, self.block)
+        rows = self.block if c[k.C_STRIDE] > 0 else 1  # series: an adaptive step's samples too
+        if p.integrator == "adaptive" and c[k.C_STRIDE] > 0:
+            rows = max(rows, 4 * (int(p.h_max / (c[k.C_STRIDE] * p.dt)) + 2))
+        self.buffers = Buffers.empty(rows, self.block, self.block)
         self.kept: RunCopy | None = None  # its rows are attached by result()
         self.rows_at_copy: dict[str, int] = {}
 

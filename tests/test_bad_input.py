@@ -532,8 +532,10 @@ def test_event_tol_and_h_max_are_bounded_and_the_longest_step_fits_its_buffers()
     assert tr.ok and len(tr.series) > 40_000
 
 
-@pytest.mark.parametrize("atol", ["x", float("nan"), float("inf"), -1.0, [1e-5], True])
-def test_a_bad_atol_is_refused_by_every_classifier(atol):
+@pytest.mark.parametrize(
+    "atol", ["x", "1e-3", float("nan"), float("inf"), -1.0, [1e-5], True, [True, True]]
+)
+def test_a_bad_atol_is_refused_by_every_classifier(atol, run1):
     """atol="x" made the period evidence fail and the other votes said "quasiperiodic";
     inf made uniform noise "periodic 1"; NaN found no period in a clean period 2."""
     from chaoscam.analysis import classify_section, classify_signal, section_period
@@ -544,23 +546,25 @@ def test_a_bad_atol_is_refused_by_every_classifier(atol):
         lambda: section_period(pts, atol=atol),
         lambda: classify_section(pts, atol=atol),
         lambda: classify_signal(x, 0.01, 1.0, section=pts, atol=atol),
-        lambda: chaoscam.classify_trajectory(_RUN, tangent=False, atol=atol),
+        lambda: chaoscam.classify_trajectory(run1, tangent=False, atol=atol),
     )
     for call in calls:
         with pytest.raises(ValueError, match="atol = .* must be a finite number >= 0, or 2 of"):
             call()
 
 
-_RUN = chaoscam.simulate(duration=1.0)
+@pytest.fixture(scope="module")
+def run1():
+    return chaoscam.simulate(duration=1.0)
 
 
-def test_lyapunov_tol_is_checked_and_said_unused_on_the_tangent_path():
+def test_lyapunov_tol_is_checked_and_said_unused_on_the_tangent_path(run1):
     """lyapunov_tol=-5 was accepted, and on the tangent path any value was dropped in
     silence (the tangent exponent is judged by its confidence interval)."""
     with pytest.raises(ValueError, match="lyapunov_tol = -5.0"):
-        chaoscam.classify_trajectory(_RUN, lyapunov_tol=-5.0)
+        chaoscam.classify_trajectory(run1, lyapunov_tol=-5.0)
     with pytest.warns(RuntimeWarning, match="lyapunov_tol is not used"):
-        chaoscam.classify_trajectory(_RUN, lyapunov_tol=0.5, extend_to=None)
+        chaoscam.classify_trajectory(run1, lyapunov_tol=0.5, extend_to=None)
 
 
 def test_review_tracebacks_are_named():
@@ -572,8 +576,9 @@ def test_review_tracebacks_are_named():
 
     with pytest.raises(TypeError, match="trajectory must be a chaoscam Trajectory"):
         chaoscam.lyapunov_spectrum(trajectory="run.parquet")
-    with pytest.raises(ValueError, match=r"figures = \[99\]: choose from"):
-        run_paper(quick=True, out="unused.html", figures=99)
+    for figures in (99, np.array([99]), (f for f in [99])):  # one figure, or any iterable
+        with pytest.raises(ValueError, match=r"figures = \[.*99\)?\]: choose from"):
+            run_paper(quick=True, out="unused.html", figures=figures)
     assert "a step longer than the period" in resolution_warning(Params(l_lambda=1e300))
 
 

@@ -97,3 +97,17 @@ def test_nested_records_are_frozen_too():
     copy = dict(m.config["base"])
     copy["omega"] = 40.0
     assert m.config["base"]["omega"] != 40.0
+
+
+def test_freezing_keeps_namedtuples_and_reaches_lists_of_lists():
+    """A namedtuple holding a dict was rebuilt from a generator (a TypeError); dicts inside a
+    list of lists stayed writable."""
+    from collections import namedtuple
+
+    from chaoscam._frozen import FrozenDict
+
+    Point = namedtuple("Point", "x y")
+    rec = FrozenDict({"p": Point(1, {"a": 1}), "deep": [[{"b": 2}]]})
+    assert rec["p"].x == 1
+    with pytest.raises(TypeError, match="read-only"):
+        rec["deep"][0][0]["b"] = 3

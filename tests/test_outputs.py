@@ -505,3 +505,54 @@ def test_a_resume_with_another_classifier_is_refused(tmp_path):
     regime_map(x, y, classify=a, **kw)
     with pytest.raises(SweepError, match="differs in: classifier"):
         regime_map(x, y, classify=b, resume=True, **kw)
+
+
+def test_threads_writing_into_one_folder_do_not_collide(tmp_path):
+    """The folder probe was named by the process id only: four threads saving runs into one
+    folder failed with 'cannot write in the folder (File exists)'."""
+    import threading
+
+    import chaoscam
+
+    traj = chaoscam.simulate(duration=0.1, series=False)
+    errors = []
+
+    def save(i):
+        try:
+            for j in range(15):
+                traj.to_parquet(tmp_path / f"run{i}-{j}.parquet")
+        except Exception as err:  # noqa: BLE001 - collected for the assertion
+            errors.append(err)
+
+    threads = [threading.Thread(target=save, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == [] and len(list(tmp_path.glob("run*.parquet"))) == 60
+
+
+def test_classifier_identities_tell_methods_apart_and_ignore_where_code_sits():
+    """Bound methods of two instances shared one identity; a lambda's moved down a line or
+    compiled under another file name changed it (a resume of the same code was refused);
+    a partial's argument with the default repr named an address (new in every process)."""
+    import functools
+
+    from chaoscam import classify_trajectory
+    from chaoscam.sweep._tasks import classifier_identity as ident
+
+    class Clf:
+        def __init__(self, tol):
+            self.tol = tol
+
+        def classify(self, traj):
+            return classify_trajectory(traj)
+
+    assert ident(Clf(0.1).classify) != ident(Clf(0.5).classify)
+    assert ident(Clf(0.1).classify) == ident(Clf(0.1).classify)
+    one = eval(compile("lambda t: t", "a.py", "eval"))
+    moved = eval(compile("\n\n(lambda t:\n t)", "b.py", "eval"))
+    assert ident(one) == ident(moved) != ident(eval(compile("lambda t: 2", "a.py", "eval")))
+    part = functools.partial(classify_trajectory, helper=Clf(1.0))
+    assert " at 0x" not in ident(part)
+    assert ident(part) == ident(functools.partial(classify_trajectory, helper=Clf(1.0)))

@@ -89,11 +89,13 @@ def check_atol(fn: str, atol: Any, d: int) -> None:
     any set of points periodic 1."""
     if atol is None:
         return
-    try:
-        a = np.asarray(atol, dtype=float)
+    items = atol if isinstance(atol, list | tuple | np.ndarray) else [atol]
+    numeric = all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in items)
+    try:  # "1e-3" or True would pass np.asarray: refused above
+        a = np.asarray(atol, dtype=float) if numeric else None
     except (TypeError, ValueError):
         a = None
-    ok = a is not None and not isinstance(atol, bool) and (a.ndim == 0 or a.shape == (d,))
+    ok = a is not None and (a.ndim == 0 or a.shape == (d,))
     if not (ok and np.isfinite(a).all() and (a >= 0).all()):
         raise ValueError(
             f"{fn}: atol = {atol!r} must be a finite number >= 0, or {d} of them (one per "

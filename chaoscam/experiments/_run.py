@@ -8,6 +8,7 @@ self-contained HTML file whose summary sets each figure against the paper;
 
 from __future__ import annotations
 
+import numbers
 import time
 import warnings
 from dataclasses import dataclass
@@ -134,7 +135,7 @@ def run_paper(
     from ._store import store_mode
 
     if figures is not None:
-        figures = list(figures) if isinstance(figures, list | tuple | set | range) else [figures]
+        figures = [figures] if isinstance(figures, numbers.Integral) else list(figures)
         unknown = [f for f in figures if f not in FIGURES]
         if not figures or unknown:
             raise ValueError(

@@ -179,6 +179,7 @@ def _worker_init(parent: int) -> None:
             pass
     OutputLock._held.clear()
     OutputLock._owner.clear()
+    OutputLock._table = threading.Lock()  # a fork may have copied it held
 
 
 def _die_with_parent(parent: int) -> None:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import importlib
-import marshal
+import inspect
 import math
 import numbers
 import warnings
@@ -93,39 +93,56 @@ class DefaultClassifier:
 def classifier_identity(classify: Callable) -> str:
     """A stable text naming a classifier and its settings, part of a run's configuration.
 
-    ``module.qualname`` for a function (plus a digest of its code for a lambda or a local
-    function, whose names are not unique); for ``functools.partial``, its function's identity
-    with the bound arguments; for an instance, its class's name plus ``repr`` (a dataclass's
-    repr lists its fields, so two settings never share an identity).
+    ``module.qualname`` for a function (plus a digest of its code, defaults and closure for
+    a lambda or a local function, whose names are not unique; the digest leaves out line
+    numbers and file names, so moving the code does not change it); for a bound method, its
+    instance's identity too; for ``functools.partial``, its function's identity with the
+    bound arguments; for an instance, its class's name plus ``repr`` (a dataclass's repr
+    lists its fields, so two settings never share an identity), or its attributes where
+    the repr would name a memory address.
     """
     if isinstance(classify, type) or not callable(classify):
         raise TypeError(f"classify must be a function or an instance, got {classify!r}")
     if isinstance(classify, functools.partial):  # its own name is functools.partial's
-        keywords = sorted(classify.keywords.items())
-        return (
-            f"functools.partial({classifier_identity(classify.func)}, args={classify.args!r}, "
-            f"keywords={keywords!r})"
-        )
+        args = [_stable_repr(v) for v in classify.args]
+        keywords = sorted((k_, _stable_repr(v)) for k_, v in classify.keywords.items())
+        inner = classifier_identity(classify.func)
+        return f"functools.partial({inner}, args={args!r}, keywords={keywords!r})"
     if hasattr(classify, "__qualname__") and hasattr(classify, "__module__"):
         name = f"{classify.__module__}.{classify.__qualname__}"
+        if inspect.ismethod(classify):  # Clf(0.1).classify and Clf(0.5).classify differ
+            return f"{name}@{_stable_repr(classify.__self__)}"
         code = getattr(classify, "__code__", None)
         if "<" in classify.__qualname__ and code is not None:  # <lambda>, <locals>: not unique
             name += ":" + _code_digest(classify, code)
         return name
     cls = type(classify)
-    text = repr(classify)
-    if not is_dataclass(classify) and " at 0x" in text:  # the default repr names an address
-        text = repr(sorted(getattr(classify, "__dict__", {}).items()))
-    return f"{cls.__module__}.{cls.__qualname__}:{text}"
+    return f"{cls.__module__}.{cls.__qualname__}:{_stable_repr(classify)}"
+
+
+def _stable_repr(value: Any) -> str:
+    """``repr(value)``, or its attributes where the repr would name a memory address."""
+    if inspect.isfunction(value) or inspect.ismethod(value) or isinstance(value, functools.partial):
+        return classifier_identity(value)
+    text = repr(value)
+    if " at 0x" in text and not is_dataclass(value) and hasattr(value, "__dict__"):
+        text = repr(sorted((k_, _stable_repr(v)) for k_, v in vars(value).items()))
+    return text
+
+
+def _code_key(code) -> tuple:
+    """A code object's content without its position (file, line numbers)."""
+    consts = tuple(_code_key(c) if inspect.iscode(c) else repr(c) for c in code.co_consts)
+    return (code.co_code, consts, code.co_names, code.co_varnames)
 
 
 def _code_digest(func: Callable, code) -> str:
     """A digest of a lambda's or a local function's code, defaults and closure: two of them
-    with one name get two identities (a closure value whose repr names an address gives a new
-    identity each run, so a resume is refused rather than mixing classifiers)."""
-    cells = tuple(repr(c.cell_contents) for c in (func.__closure__ or ()))
-    extra = repr((func.__defaults__, func.__kwdefaults__, cells)).encode()
-    return hashlib.sha256(marshal.dumps(code) + extra).hexdigest()[:16]
+    with one name get two identities (a closure value whose repr names an address and has no
+    attributes gives a new identity each run: a resume is refused rather than mixing)."""
+    cells = tuple(_stable_repr(c.cell_contents) for c in (func.__closure__ or ()))
+    extra = (func.__defaults__, func.__kwdefaults__, cells)
+    return hashlib.sha256(repr((_code_key(code), extra)).encode()).hexdigest()[:16]
 
 
 def needs_series(classify: Callable) -> bool:
