@@ -592,6 +592,10 @@ def test_review_tracebacks_are_named():
         (lambda: realization_index(0, True), "index = True"),
         (lambda: initial_offsets(2.5), "n = 2.5"),
         (lambda: bifurcation(Axis("xi", (0.2,)), "0.3:0.4:2"), "has its values"),
+        (
+            lambda: bifurcation("xi", [0.2], initial_conditions=[(0.1, 0.0), (0.1, 0.0)]),
+            r"initial_conditions\[1\] = \(0.1, 0.0\) is given twice",
+        ),
         (lambda: wilson_interval(float("nan"), 5), "whole numbers"),
         (lambda: wilson_interval(2.5, 5), "whole numbers"),
     ],
@@ -601,6 +605,15 @@ def test_sweep_helpers_name_a_bad_argument(call, named):
     or silently cut 1.7 to 1, True to 1, 2.5 successes to a fraction (API review)."""
     with pytest.raises(ValueError, match=named):
         call()
+
+
+def test_reading_a_folder_as_a_sweep_says_so(tmp_path):
+    """read_regime_map(folder) said "no such file"."""
+    from chaoscam.sweep import read_bifurcation, read_regime_map
+
+    for read in (read_regime_map, read_bifurcation):
+        with pytest.raises(SweepError, match="is a directory"):
+            read(tmp_path)
 
 
 def test_numpy_scalars_are_numbers():

@@ -345,6 +345,8 @@ def bifurcation(
                 base.replace(theta_f0=th, omega_f0=om)
             except ParameterError as err:
                 raise ParameterError(f"initial_conditions[{i}] = ({th}, {om}): {err}") from None
+            if specs.index(specs[i]) < i:  # as an axis value twice: the same runs again
+                raise SweepError(f"initial_conditions[{i}] = ({th}, {om}) is given twice")
         n_specs = len(specs)
     classify, eng, series = sweep_engine(
         classify,

@@ -155,6 +155,8 @@ def read_tables(
     if path.name.endswith(tail):  # the companion named: read its main file
         path = path.with_name(path.name[: -len(tail)] + ".parquet")
     what, other = _KIND_NAMES[kind], companion(path, second)
+    if path.is_dir():
+        raise SweepError(f"{path} is a directory; give the {what}'s .parquet file")
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no such file")
     meta = read_sweep_metadata(path)
