@@ -16,6 +16,7 @@ import numpy as np
 
 from ._certify import MODEL_ATOL, ORBIT_REFINE, REFINE_ITER, certify
 from .analysis import Evidence, Verdict, section_period
+from .analysis._classify_section import unsupported_chaos
 from .model import Params, realizations_identical
 
 __all__ = ["BAND_RTOL", "MODEL_ATOL", "ORBIT_REFINE", "REFINE_ITER", "with_model_evidence"]
@@ -52,9 +53,9 @@ def with_model_evidence(v: Verdict, p: Params, points, spec) -> tuple[Verdict, d
             "within its interval: run longer"
         )
         v = Verdict("undetermined", None, v.evidence, v.reasons + (reason,), v.settings)
-    chaotic = [e.name for e in v.evidence if e.vote == "chaotic"]
     need = int(v.settings.get("thresholds", {}).get("min_chaotic_votes", 2))
-    if v.label == "chaotic" and votes.get("exponent") != "chaotic" and len(chaotic) < need:
+    chaotic = unsupported_chaos(v.evidence, need) if v.label == "chaotic" else None
+    if chaotic is not None:
         # The section-only path's rule (analysis._classify_section._decide) on the series
         # path too, so that one run gets one label with or without its series: a broadband
         # spectrum of 1.5 s with 11 section points called omega = 45, xi = 0.2 chaotic,

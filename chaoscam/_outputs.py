@@ -210,8 +210,7 @@ class OutputLock:
     that locked its output), refused from another thread of the same process.
     """
 
-    _held: dict[str, int] = {}  # lock file -> descriptor, for this process
-    _owner: dict[str, int] = {}  # lock file -> the thread that took it
+    _held: dict[str, tuple[int, int]] = {}  # lock file -> (descriptor, thread that took it)
     _table = threading.Lock()
 
     def __init__(self, path: str | Path, what: str = "output") -> None:
@@ -228,7 +227,7 @@ class OutputLock:
         key = str(self.path.resolve())
         with OutputLock._table:
             if key in OutputLock._held:
-                if OutputLock._owner.get(key) != threading.get_ident():
+                if OutputLock._held[key][1] != threading.get_ident():
                     raise OutputError(
                         f"{self.target} is in use by another thread of this process; wait "
                         f"for it to finish, or choose another {self.what}"
@@ -270,8 +269,7 @@ class OutputLock:
         os.ftruncate(fd, 0)
         os.pwrite(fd, str(os.getpid()).encode(), 0)
         self._fd = fd
-        OutputLock._held[key] = fd
-        OutputLock._owner[key] = threading.get_ident()
+        OutputLock._held[key] = (fd, threading.get_ident())
         return self
 
     def release(self) -> None:
@@ -280,7 +278,6 @@ class OutputLock:
         with OutputLock._table:  # all of it: another thread must not open the dying file
             key = str(self.path.resolve())
             OutputLock._held.pop(key, None)
-            OutputLock._owner.pop(key, None)
             with contextlib.suppress(OSError):
                 self.path.unlink()  # while still locked: a waiter re-checks the inode
             os.close(self._fd)

@@ -18,9 +18,12 @@ def resolution_warning(p: Params) -> str | None:
     steps = period / p.dt
     if steps >= 20 or p.integrator != "rk4":
         return None
-    few = f"only {steps:.1f} steps" if steps >= 1 else "a step longer than the period"
-    if 0 < steps < 1:
+    if steps >= 1:
+        few = f"only {steps:.1f} steps"
+    elif steps > 0:
         few = f"a step {1 / steps:.3g}x the period"
+    else:  # a period that rounds to zero
+        few = "a step longer than the period"
     return (
         f"dt = {p.dt:g} s resolves the contact oscillation (period {period:.3g} s) with "
         f"{few}; use dt <= {period / 40:.2g} s (40 steps), and check the verdict "

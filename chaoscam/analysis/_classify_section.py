@@ -20,6 +20,15 @@ def _undetermined(v: Verdict, reason: str) -> Verdict:
     return Verdict("undetermined", None, v.evidence, (*v.reasons, reason), v.settings)
 
 
+def unsupported_chaos(evidence, need: int) -> list[str] | None:
+    """The names voting chaotic when they are fewer than ``need`` and none is decisive (the
+    exponent's): a chaotic label they alone cannot carry; None when it is supported."""
+    chaotic = [e.name for e in evidence if e.vote == "chaotic"]
+    if any(name in _DECISIVE for name in chaotic) or len(chaotic) >= need:
+        return None
+    return chaotic
+
+
 def _decide(
     v: Verdict, n: int, thr: Thresholds, zero_one: bool, given: bool, upper: float
 ) -> Verdict:
@@ -30,8 +39,8 @@ def _decide(
     by_name = {e.name: e for e in v.evidence}
     expo = by_name.get("exponent")
     if v.label == "chaotic":
-        chaotic = [e.name for e in v.evidence if e.vote == "chaotic"]
-        if not any(name in _DECISIVE for name in chaotic) and len(chaotic) < thr.min_chaotic_votes:
+        chaotic = unsupported_chaos(v.evidence, thr.min_chaotic_votes)
+        if chaotic is not None:
             v = _undetermined(
                 v,
                 f"only {', '.join(chaotic)} votes chaotic; {thr.min_chaotic_votes} independent "

@@ -91,10 +91,7 @@ def check_atol(fn: str, atol: Any, d: int) -> None:
         return
     items = atol if isinstance(atol, list | tuple | np.ndarray) else [atol]
     numeric = all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in items)
-    try:  # "1e-3" or True would pass np.asarray: refused above
-        a = np.asarray(atol, dtype=float) if numeric else None
-    except (TypeError, ValueError):
-        a = None
+    a = np.asarray(atol, dtype=float) if numeric else None  # not "1e-3" or True, which it reads
     ok = a is not None and (a.ndim == 0 or a.shape == (d,))
     if not (ok and np.isfinite(a).all() and (a >= 0).all()):
         raise ValueError(

@@ -172,13 +172,12 @@ def _worker_init(parent: int) -> None:
     _die_with_parent(parent)
     from .._outputs import OutputLock
 
-    for fd in OutputLock._held.values():  # a forked worker holds copies of the lock files
+    for fd, _ in OutputLock._held.values():  # a forked worker holds copies of the lock files
         try:
             os.close(fd)
         except OSError:
             pass
     OutputLock._held.clear()
-    OutputLock._owner.clear()
     OutputLock._table = threading.Lock()  # a fork may have copied it held
 
 

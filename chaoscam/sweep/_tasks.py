@@ -203,8 +203,8 @@ def verdict_fields(verdict: Any) -> dict[str, Any]:
     label, period = verdict.label, getattr(verdict, "period", None)
     if label not in LABELS:  # a custom classifier's: it would become a cell's dominant label
         raise ValueError(f"the classifier's label {label!r} is not one of {', '.join(LABELS)}")
-    whole = isinstance(period, numbers.Real) and not isinstance(period, bool)
-    if period is not None and not (whole and float(period).is_integer() and period >= 1):
+    number = isinstance(period, numbers.Real) and not isinstance(period, bool)
+    if period is not None and not (number and float(period).is_integer() and period >= 1):
         raise ValueError(f"the classifier's period {period!r} is not a whole number >= 1 or None")
     return {
         "label": str(label),
