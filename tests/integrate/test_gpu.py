@@ -173,6 +173,21 @@ def test_simulated_gpu_equals_cpu():
 
 
 @needs_numba_cuda
+def test_a_small_launch_is_not_warned_about():
+    """numba-cuda's low-occupancy warning (a launch of few blocks: a small batch or a refill)
+    is filtered out by run_on_gpu, else a sweep records it against every run of the batch."""
+    from numba.cuda.core import errors
+
+    msg = "Grid size 16 will likely result in GPU under-utilization due to low occupancy."
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        warnings.filterwarnings("ignore", message=_gpu._SMALL_GRID)
+        warnings.warn(errors.NumbaPerformanceWarning(msg), stacklevel=1)
+        warnings.warn(errors.NumbaPerformanceWarning("another hint"), stacklevel=1)
+    assert [str(w.message) for w in caught] == [str(errors.NumbaPerformanceWarning("another hint"))]
+
+
+@needs_numba_cuda
 @pytest.mark.parametrize("method", [None, 0, 1], ids=["both", "rk4", "adaptive"])
 def test_kernel_compiles_to_ptx_for_h100(method):
     """The ensemble kernels (each integrator, and advance with both) compile to PTX for sm_90,
