@@ -39,6 +39,15 @@ checkpoints, long enough that every thread has several members to balance."""
 MAX_BATCH = 256
 """Members per batch at most (bounds the memory of one compiled call)."""
 
+GPU_MAP_BATCH = 8_192
+"""Members per batch when a sweep's batches run on a GPU (each member one CUDA thread). A
+batch takes about as long with a few members as with hundreds (measured on an H200,
+2026-11-27: 64 members of 0.5 s took 1.2 s, as one does; 1,024 members of a regime map,
+20 s with the tangent, 132 s), so batches must be large for the device's rate; 8,192 keeps a
+checkpoint every few minutes, and the host's labels of a batch (about 8 ms a member there,
+one core) under about a minute. Launches stay short (a member stops for its draws and
+impact rows every few hundred impacts), so a Ctrl-C is still answered within seconds."""
+
 
 def batch_size(base: Params, duration: float, transient: float, threads: int) -> int:
     """Members per batch: about :data:`BATCH_SECONDS` of work on ``threads`` threads, from
@@ -240,8 +249,10 @@ def resolve_engine(
         except ValueError as err:
             raise SweepError(str(err)) from None
     # Local CPU batches run one per thread, each a batch's work on one core (a GPU batch
-    # fills its device; a Dask worker runs numba threads over its own cores).
-    by_task = threads if threads is not None and threads > 1 and device == "cpu" else 1
+    # fills its device; a Dask worker runs numba threads over its own cores). Without a GPU
+    # here, device="gpu" or "auto" runs the CPU's batches.
+    gpu = device != "cpu" and scheduler is None and _gpu_ready()
+    by_task = threads if threads is not None and threads > 1 and not gpu else 1
     size = batch_size(base, run[0], run[1], 1 if by_task > 1 else threads or 1)
 
     extend_to = classify.extend_to
@@ -250,9 +261,17 @@ def resolve_engine(
         return BatchTask(tasks, device, extend_to)
 
     identity = f"{ENGINE_CLASSIFIER}, extend_to={extend_to}"
+    if gpu:
+        return Engine("ensemble", identity, pack, GPU_MAP_BATCH, threads)
     if by_task > 1:
         return Engine("ensemble", identity, pack, size, None, by_task)
     return Engine("ensemble", identity, pack, size, threads)
+
+
+def _gpu_ready() -> bool:
+    from ..integrate._gpu import gpu_status
+
+    return gpu_status()[0]
 
 
 def engine_device(eng: Engine, device: str) -> str:
@@ -262,9 +281,7 @@ def engine_device(eng: Engine, device: str) -> str:
     configuration: a GPU's results equal the CPU's only within ``GPU_TOLERANCE``."""
     if eng.name != "ensemble" or device == "cpu":
         return "cpu"
-    from ..integrate._gpu import gpu_status
-
-    return "gpu" if gpu_status()[0] else "cpu"
+    return "gpu" if _gpu_ready() else "cpu"
 
 
 def sweep_engine(

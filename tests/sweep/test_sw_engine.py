@@ -273,3 +273,22 @@ def test_the_table_says_how_long_the_label_was_recorded():
     v = classify_trajectory(traj)
     extended = v.settings.get("extended")
     assert extended is not None and row["recorded_s"] == extended["recorded_s"] == 12.0
+
+
+@pytest.mark.parametrize("ready", [True, False])
+def test_a_gpu_sweep_runs_large_batches_only_where_a_gpu_can_run(monkeypatch, ready):
+    """A GPU thread runs one member, so GPU batches hold GPU_MAP_BATCH members; where no GPU
+    can run, device="gpu" falls back to the CPU's batches."""
+    from chaoscam.integrate import _gpu
+    from chaoscam.sweep import DefaultClassifier
+
+    monkeypatch.setattr(_gpu, "gpu_status", lambda: (ready, "test"))
+    eng = _batch.resolve_engine(
+        "ensemble", "gpu", DefaultClassifier(), "id", Params(), (20.0, 0.0), 2, None
+    )
+    cpu = _batch.resolve_engine(
+        "ensemble", "cpu", DefaultClassifier(), "id", Params(), (20.0, 0.0), 2, None
+    )
+    assert eng.name == "ensemble" and cpu.pack_size < _batch.GPU_MAP_BATCH
+    assert eng.pack_size == (_batch.GPU_MAP_BATCH if ready else cpu.pack_size)
+    assert _batch.engine_device(eng, "gpu") == ("gpu" if ready else "cpu")
