@@ -1,0 +1,126 @@
+"""Regime map on a GPU against the 2-core engines (issue 13), measured in one run.
+
+Run: python benchmarks/bench_regime_gpu.py [--realizations N] [--reference N]
+
+The (mu, sigma) map of 2 x 2 cells (mu = 0.008 and 0.015 m, sigma = 1 and 2 mm), default
+model, 20 s after the default transient, undetermined members extended to ``--extend-to``
+recorded seconds. The GPU runs ``--realizations`` members a cell (``device="gpu"``, the
+ensemble engine); the references run the first ``--reference`` of them on 2 cores: the process
+engine (``engine="process"``, 2 workers, today's sweep) and the ensemble engine on the CPU
+(2 threads). Rates are trajectories per second end to end (the sweep's set-up, its host
+labelling and the extension of undetermined members included; compilation excluded by a
+warm-up); the reference rates are measured on their smaller sample (a rate does not depend on
+the sample size beyond a batch).
+
+It prints how the GPU run's wall time divides between the device calls (simulation and
+extension) and the host, and compares the labels of the realizations both ran: a GPU's sections
+equal the CPU's only within ``GPU_TOLERANCE`` over a cam period and part later on chaotic runs
+(see ``chaoscam.integrate._gpu``), so chaotic members agree in label, not in numbers.
+Without a GPU it says why on one line and exits 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import threading
+import time
+
+from chaoscam.integrate import _gpu
+from chaoscam.sweep import Axis, DefaultClassifier, regime_map
+
+
+class _DeviceClock:
+    """Wall time spent inside ``run_on_gpu`` (launches, transfers and refills)."""
+
+    def __init__(self) -> None:
+        self.seconds = 0.0
+        self.calls = 0
+        self._lock = threading.Lock()
+        self._inner = _gpu.run_on_gpu
+
+    def __call__(self, *args, **kwargs):
+        t0 = time.perf_counter()
+        try:
+            return self._inner(*args, **kwargs)
+        finally:
+            with self._lock:
+                self.seconds += time.perf_counter() - t0
+                self.calls += 1
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--realizations", type=int, default=1024, help="GPU members a cell")
+    ap.add_argument("--reference", type=int, default=8, help="2-core members a cell")
+    ap.add_argument("--duration", type=float, default=20.0, help="recorded time [s]")
+    ap.add_argument("--extend-to", type=float, default=40.0, help="extension cap [s]")
+    args = ap.parse_args()
+    ok, reason = _gpu.gpu_status()
+    if not ok or "simulator" in reason:
+        print(f"GPU: not available ({reason}); nothing measured")
+        return
+    x = Axis("l_lambda", (0.008, 0.015))
+    y = Axis("l_lambda_sigma", (0.001, 0.002))
+    cells = len(x.values) * len(y.values)
+    kw = dict(seed=1, duration=args.duration, classify=DefaultClassifier(extend_to=args.extend_to))
+    print(
+        f"GPU: {reason}; cores here {os.cpu_count()}; map 2 x 2 cells, {args.duration:g} s, "
+        f"extended to {args.extend_to:g} s"
+    )
+
+    t0 = time.perf_counter()
+    regime_map(Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.001,)),
+               realizations=2, duration=1.0, engine="ensemble", device="gpu")  # fmt: skip
+    print(f"warm-up (GPU kernel compilation): {time.perf_counter() - t0:.1f} s")
+    clock = _DeviceClock()
+    _gpu.run_on_gpu = clock
+    try:
+        t0 = time.perf_counter()
+        gpu = regime_map(x, y, realizations=args.realizations, engine="ensemble",
+                         device="gpu", **kw)  # fmt: skip
+        wall = time.perf_counter() - t0
+    finally:
+        _gpu.run_on_gpu = clock._inner
+    runs = cells * args.realizations
+    print(
+        f"GPU map: {runs:,} runs in {wall:.1f} s = {runs / wall:,.1f} traj/s (device "
+        f"{gpu.config.get('device')}); {clock.seconds:.1f} s in {clock.calls} device calls, "
+        f"{wall - clock.seconds:.1f} s on the host (labels, extension set-up, checkpoints)"
+    )
+
+    rates = {}
+    tables = {}
+    for engine, device in (("process", "cpu"), ("ensemble", "cpu")):
+        regime_map(Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.001,)),
+                   realizations=2, duration=1.0, engine=engine, workers=2)  # fmt: skip
+        t0 = time.perf_counter()
+        ref = regime_map(x, y, realizations=args.reference, engine=engine, device=device,
+                         workers=2, **kw)  # fmt: skip
+        wall_ref = time.perf_counter() - t0
+        rates[engine] = cells * args.reference / wall_ref
+        tables[engine] = ref.realizations
+        print(
+            f"{engine} engine, 2 cores: {cells * args.reference} runs in {wall_ref:.1f} s = "
+            f"{rates[engine]:.1f} traj/s"
+        )
+    g = runs / wall
+    print(
+        f"ratio GPU map / 2-core process engine: {g / rates['process']:.0f}x; / 2-core "
+        f"ensemble engine: {g / rates['ensemble']:.0f}x"
+    )
+    a = gpu.realizations.set_index(["cell", "index"])
+    for engine, table in tables.items():
+        b = table.set_index(["cell", "index"])
+        common = a.loc[b.index]
+        agree = float((common["label"] == b["label"]).mean())
+        print(
+            f"labels of the {len(b)} realizations both ran, GPU against the {engine} engine: "
+            f"{agree:.0%} agree (GPU {common['label'].value_counts().to_dict()}, CPU "
+            f"{b['label'].value_counts().to_dict()})"
+        )
+    print(f"GPU labels, all members: {gpu.realizations['label'].value_counts().to_dict()}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# Issue 13's GPU checks in one call on a lent NVIDIA machine (run from the repository root).
+#
+#   bash benchmarks/device_check.sh [WHEELS]
+#
+# WHEELS (default .whl) holds cp312 wheels of what the device's image lacks: nolds and future
+# (chaoscam's dependencies) and numpy 2.4 (numba-cuda 0.30 compiles no kernel under numpy 2.5,
+# see chaoscam.integrate._gpu); they are installed with --target, nothing else is touched.
+# Steps, most important first: versions; whether the image's own numba-cuda compiles a kernel
+# under its numpy; then in one Python process (the GPU kernel compiled once), under one time
+# limit (CHECK_SECONDS, default 420): the rate against members, duration and buffer room
+# (bench_gpu_profile.py, up to 40,000 members within its budget), the device tests
+# (tests/integrate/test_gpu.py -m gpu) and a regime map on the GPU against the 2-core engines
+# (bench_regime_gpu.py). bench_gpu.py's 40,000 x 20 s did not finish in 340 s on an H200
+# (2026-11-27): run it alone, with a longer limit, once the profile says it can.
+set -u
+WHEELS=${1:-.whl}
+export PYTHONUNBUFFERED=1
+step() { echo; echo "== $* ($(date -u +%T))"; }
+
+step versions
+nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv
+python3 -c "import sys, numpy, numba; print('python', sys.version.split()[0], '| numpy', numpy.__version__, '| numba', numba.__version__)"
+python3 -m pip list 2>/dev/null | grep -iE '^(numba|numba-cuda|cuda-bindings|cuda-python|llvmlite|scipy|pandas|pyarrow|seaborn|matplotlib|jinja2|tqdm) '
+
+step "the image's numba-cuda under its own numpy: a trivial kernel"
+timeout -k 5 90 python3 - <<'PY'
+import numpy as np
+from numba import cuda
+
+@cuda.jit
+def add(a):
+    i = cuda.grid(1)
+    if i < a.size:
+        a[i] += 1.0
+
+a = cuda.to_device(np.zeros(64))
+add[1, 64](a)
+print("compiled and ran:", a.copy_to_host().sum() == 64.0)
+PY
+echo "exit $?"
+
+step "wheels: nolds, future, numpy 2.4 (--target, ahead of the image's)"
+python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --target /tmp/site \
+    "$WHEELS"/nolds-*.whl "$WHEELS"/future-*.whl "$WHEELS"/numpy-*.whl || exit 1
+export PYTHONPATH=/tmp/site:$PWD
+python3 -c "import numpy, numba, chaoscam; from chaoscam.integrate._gpu import gpu_status; print('numpy', numpy.__version__, '| numba', numba.__version__, '|', gpu_status())"
+
+step "bench_gpu_profile, device tests, bench_regime_gpu: one process"
+timeout -k 5 "${CHECK_SECONDS:-420}" python3 - <<'PY'
+import runpy
+import sys
+import time
+import traceback
+
+import pytest
+
+T0 = time.perf_counter()
+
+
+def run(script, *argv):
+    print(f"-- {script} {' '.join(argv)} at {time.perf_counter() - T0:.0f} s", flush=True)
+    sys.argv = [script, *argv]
+    try:
+        runpy.run_path(script, run_name="__main__")
+    except Exception:
+        traceback.print_exc()
+
+
+run("benchmarks/bench_gpu_profile.py", "--budget", "200")
+code = pytest.main(["-q", "-p", "no:cacheprovider", "-m", "gpu", "tests/integrate/test_gpu.py"])
+print(f"-- device tests: pytest exit {int(code)} at {time.perf_counter() - T0:.0f} s")
+run("benchmarks/bench_regime_gpu.py", "--realizations", "1024", "--reference", "4")
+PY
+echo "exit $?"
+step done
