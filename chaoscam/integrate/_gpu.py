@@ -49,11 +49,26 @@ from ._adaptive import run_chunk_adaptive
 from ._advance import advance
 from ._driver import drive_members
 
-__all__ = ["GPU_BATCH", "GPU_TOLERANCE", "GPUFallbackWarning", "gpu_status", "run_on_gpu"]
+__all__ = [
+    "GPU_BATCH",
+    "GPU_LAYOUT",
+    "GPU_TOLERANCE",
+    "GPUFallbackWarning",
+    "gpu_status",
+    "run_on_gpu",
+]
 
 GPU_BATCH = 65_536  # members per device batch: ~42 kB each for 20 s runs (about 2.7 GB)
 GPU_TOLERANCE = 1e-6  # rad and rad/s: GPU against CPU sections, first period or periodic
-_BLOCK = 64  # threads per block: 202 registers a thread on an H200 (255 from ptxas 12.9)
+_BLOCK = 64  # threads per block: 202 registers a thread on an H200 (196 from ptxas 12.9)
+GPU_LAYOUT = "C"
+"""The members' memory order on the device. "C": a member's row contiguous, as on the CPU
+(what the H200 ran, 2026-11-27). "F": one field of consecutive members contiguous, so that a
+warp's 32 reads of the same field (a constant, a counter, the state, each step) fall in 2
+cache lines instead of 32; it is the same arithmetic through other strides (bit-identical
+under the CUDA simulator, tested); it takes 255 registers a thread with spills for RK4 against
+196 without (ptxas 12.9), and its speed on a device is not yet measured
+(``benchmarks/bench_gpu_profile.py`` compares the two)."""
 _SMALL_GRID = r".*Grid size \d+ will likely result in GPU under-utilization"
 """numba-cuda's NumbaPerformanceWarning for a launch of few blocks (message, with its ANSI
 codes). A small batch or a refill relaunch is expected; a sweep would otherwise record the
@@ -139,13 +154,12 @@ def _members(cuda, step):
 def _step_function(method: int | None):
     """The per-member function a kernel calls: the integrator itself when a batch has one.
 
-    A kernel specialised to one integrator spills less than one that can take either
-    (ptxas 12.9 on :func:`kernel_ptx`'s PTX for sm_90, 254-255 registers a thread: RK4 164 B
-    of spill stores and 488 B of spill loads, the adaptive path 40 and 280 B, measured
-    2026-11-25 after the per-contact resampling and the step budget added two constants;
-    before them RK4 132 / 464 B and the adaptive path 8 / 56 B, and 48 / 276 B for RK4
-    before its steps shared their trigonometry; ``advance``, which holds both, 592 and
-    1,656 B). Their effect on a device has not been measured.
+    A kernel specialised to one integrator takes fewer registers than one that can take
+    either (ptxas 12.9 for sm_90 on :func:`kernel_ptx`'s PTX with contiguous rows, as
+    :func:`run_on_gpu` launches it, 2026-11-27: RK4 196 registers a thread, the adaptive path
+    184, ``advance`` with both 236, no spills; the H200's driver gave RK4 202 registers and
+    40 B of local memory. Members in the "F" order: RK4 255, with 92 B of spill stores and 244
+    B of spill loads. For arrays of any strides, RK4 255 with 164 / 488 B.)
     """
     if method == k.METHOD_RK4:
         return k.run_chunk
@@ -180,21 +194,29 @@ def _batch_method(c: np.ndarray) -> int | None:
     return int(methods[0]) if methods.size == 1 else None
 
 
-def kernel_ptx(cc: tuple[int, int] = (9, 0), method: int | None = None) -> str:
+def kernel_ptx(
+    cc: tuple[int, int] = (9, 0), method: int | None = None, layout: str | None = None
+) -> str:
     """PTX of the ensemble kernel for compute capability ``cc``; needs NVVM, not a device.
 
     ``method``: ``_kernel.METHOD_RK4``, ``METHOD_ADAPTIVE`` or None (the kernel that takes
-    both). numba-cuda asks the current device for the compute capability of device
-    functions even when ``compile_ptx`` is given one, so a stand-in device with ``cc`` is put
-    in its place for the compilation.
+    both). ``layout``: the arrays' memory order as :func:`run_on_gpu` launches them ("C" or
+    "F"), or None for arrays of any strides. numba-cuda asks the current device for the
+    compute capability of device functions even when ``compile_ptx`` is given one, so a
+    stand-in device with ``cc`` is put in its place for the compilation.
     """
     from unittest import mock
 
     import numba.cuda.dispatcher as dispatcher
     from numba import cuda, float64, int64
 
-    a2, a3 = float64[:, :], float64[:, :, :]
-    sig = (a2, int64[:, :], a2, int64, a2, a3, a3, a3, int64[:])
+    if layout == "C":
+        a2, a3, i2 = float64[:, ::1], float64[:, :, ::1], int64[:, ::1]
+    elif layout == "F":
+        a2, a3, i2 = float64[::1, :], float64[::1, :, :], int64[::1, :]
+    else:
+        a2, a3, i2 = float64[:, :], float64[:, :, :], int64[:, :]
+    sig = (a2, i2, a2, int64, a2, a3, a3, a3, int64[::1])
     device = types.SimpleNamespace(compute_capability=cc)
     with mock.patch.object(dispatcher, "get_current_device", lambda: device):
         ptx, _ = cuda.compile_ptx(_members(cuda, _step_function(method)), sig, cc=cc)
@@ -216,7 +238,7 @@ def kernel_info(method: int | None = k.METHOD_RK4) -> dict:
 
 
 def run_on_gpu(
-    y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts=False
+    y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts=False, layout=None
 ) -> None:
     """Run stacked members to ``n_stop`` on the GPU; arrays as in ``_ensemble._run_batch``.
 
@@ -226,19 +248,33 @@ def run_on_gpu(
     Updates ``y``, ``cnt``, ``lam``, ``section`` and ``status`` in place; ``impacts`` is
     brought back from the device only with ``keep_impacts`` (otherwise only counted).
     ``hand_back(j, lam_j, n)`` empties member ``j``'s impact rows and returns its draws with
-    the used ones dropped and ``n`` new ones appended.
+    the used ones dropped and ``n`` new ones appended. ``layout``: the members' memory order
+    on the device, "C" or "F" (default :data:`GPU_LAYOUT`).
     """
+    order = GPU_LAYOUT if layout is None else layout
+    if order not in ("C", "F"):
+        raise ValueError(f"layout = {order!r} must be 'C' or 'F'")
     from numba import cuda
 
     kern = _kernel(_batch_method(c))
     n = y.shape[0]
-    d_y, d_cnt, d_c, d_lam, d_status = (cuda.to_device(a) for a in (y, cnt, c, lam, status))
-    d_series = cuda.device_array((n, 1, k.SERIES_COLS))
+
+    def put(a):
+        return cuda.to_device(np.asarray(a, order=order))
+
+    def get(d, host) -> None:
+        if order == "C":
+            d.copy_to_host(host)
+        else:  # copy_to_host(host) wants the device's strides
+            host[...] = d.copy_to_host()
+
+    d_y, d_cnt, d_c, d_lam, d_status = (put(a) for a in (y, cnt, c, lam, status))
+    d_series = cuda.device_array((n, 1, k.SERIES_COLS), order=order)
     if cnt[:, k.I_N_SECTION].any():  # rows of an earlier launch (a resumable run's first)
-        d_section = cuda.to_device(section)
+        d_section = put(section)
     else:
-        d_section = cuda.device_array(section.shape)
-    d_impacts = cuda.device_array(impacts.shape)
+        d_section = cuda.device_array(section.shape, order=order)
+    d_impacts = cuda.device_array(impacts.shape, order=order)
     blocks = (n + _BLOCK - 1) // _BLOCK
 
     def launch(need: np.ndarray) -> np.ndarray:
@@ -252,22 +288,24 @@ def run_on_gpu(
         return status[need]
 
     def refill(need: np.ndarray) -> None:
-        d_cnt.copy_to_host(cnt)
-        if keep_impacts:
+        get(d_cnt, cnt)
+        if keep_impacts and order == "C":
             for j in need:
                 d_impacts[j].copy_to_host(impacts[j])
+        elif keep_impacts:  # a member's rows are not contiguous there
+            impacts[need] = d_impacts.copy_to_host()[need]
         for j in need:  # the same width again: as many new draws as were used
             lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
-        d_cnt.copy_to_device(cnt)
-        if 8 * need.size < n:
+        d_cnt.copy_to_device(np.asarray(cnt, order=order))
+        if order == "C" and 8 * need.size < n:
             for j in need:
                 d_lam[j].copy_to_device(lam[j])
         else:
-            d_lam.copy_to_device(lam)
+            d_lam.copy_to_device(np.asarray(lam, order=order))
 
     drive_members(n, launch, refill, np.flatnonzero(status == k.NEED_BUFFER))
-    d_y.copy_to_host(y)
-    d_cnt.copy_to_host(cnt)
-    d_section.copy_to_host(section)
+    get(d_y, y)
+    get(d_cnt, cnt)
+    get(d_section, section)
     if keep_impacts:
-        d_impacts.copy_to_host(impacts)
+        get(d_impacts, impacts)

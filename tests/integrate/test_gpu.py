@@ -91,6 +91,12 @@ def test_auto_backend_uses_an_available_gpu(monkeypatch):
     assert ens.settings["batch"] == _gpu.GPU_BATCH
 
 
+def test_an_unknown_layout_is_refused():
+    """run_on_gpu takes the members' memory order "C" or "F" and names the field otherwise."""
+    with pytest.raises(ValueError, match=r"layout = 'X' must be 'C' or 'F'"):
+        _gpu.run_on_gpu(*([None] * 9), layout="X")
+
+
 @pytest.mark.parametrize("version", ["2.5.0", "2.5.0rc1", "3.0.0.dev0+git123"])
 def test_numpy_2_5_rules_the_backend_out(monkeypatch, version):
     """Under numpy >= 2.5 (numba-cuda cannot compile there) the status says why and how to fix."""
@@ -118,9 +124,10 @@ def test_import_does_not_load_numba_cuda():
 
 
 _SIMULATED = """
-import json, numpy as np
+import json, sys, numpy as np
 from chaoscam import Params
-from chaoscam.integrate import _ensemble, simulate_ensemble
+from chaoscam.integrate import _ensemble, _gpu, simulate_ensemble
+_gpu.GPU_LAYOUT = sys.argv[1]  # the members' memory order on the device
 _ensemble._ROOM.update(gpu=(64, 256), cpu=(64, 256))  # many refills: relaunches on the device
 out = {}
 cases = {
@@ -153,12 +160,14 @@ print(json.dumps(out))
 
 
 @needs_numba_cuda
-def test_simulated_gpu_equals_cpu():
+@pytest.mark.parametrize("layout", ["C", "F"])
+def test_simulated_gpu_equals_cpu(layout):
     """Under the CUDA simulator the GPU driver (batches, relaunch after refills) equals the CPU
-    path: the kernel there runs the compiled CPU code, so within GPU_TOLERANCE means equal."""
+    path bit for bit, in either memory order of the members (GPU_LAYOUT): the kernel there
+    runs the compiled CPU code, through the device arrays' strides."""
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
     out = subprocess.run(
-        [sys.executable, "-c", _SIMULATED],
+        [sys.executable, "-c", _SIMULATED, layout],
         check=True,
         capture_output=True,
         text=True,
@@ -168,7 +177,7 @@ def test_simulated_gpu_equals_cpu():
     result = json.loads(out.stdout.strip().splitlines()[-1])
     for case in result.values():
         assert case["backend"] == "gpu" and case["shape"] and case["n"] > 0
-        assert case["diff"] <= _gpu.GPU_TOLERANCE
+        assert case["diff"] == 0.0
         assert case["members"] and case["impacts"]
 
 
@@ -188,12 +197,16 @@ def test_a_small_launch_is_not_warned_about():
 
 
 @needs_numba_cuda
-@pytest.mark.parametrize("method", [None, 0, 1], ids=["both", "rk4", "adaptive"])
-def test_kernel_compiles_to_ptx_for_h100(method):
+@pytest.mark.parametrize(
+    "method, layout",
+    [(None, None), (0, None), (1, None), (0, "F")],
+    ids=["both", "rk4", "adaptive", "rk4-members-minor"],
+)
+def test_kernel_compiles_to_ptx_for_h100(method, layout):
     """The ensemble kernels (each integrator, and advance with both) compile to PTX for sm_90,
-    without a device."""
+    without a device; the RK4 kernel also for members in the "F" memory order."""
     try:
-        ptx = _gpu.kernel_ptx((9, 0), method)
+        ptx = _gpu.kernel_ptx((9, 0), method, layout)
     except Exception as exc:  # NVVM missing: nothing to check here
         if "NVVM" in str(exc) or "nvvm" in str(exc):
             pytest.skip(f"NVVM unavailable: {exc}")
