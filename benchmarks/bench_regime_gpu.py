@@ -106,8 +106,8 @@ def main() -> None:
         )
     g = runs / wall
     print(
-        f"ratio GPU map / 2-core process engine: {g / rates['process']:.0f}x; / 2-core "
-        f"ensemble engine: {g / rates['ensemble']:.0f}x"
+        f"ratio GPU map / 2-core process engine: {g / rates['process']:.2f}x; / 2-core "
+        f"ensemble engine: {g / rates['ensemble']:.2f}x"
     )
     a = gpu.realizations.set_index(["cell", "index"])
     for engine, table in tables.items():
