@@ -194,14 +194,15 @@ def test_gpu_fallback_is_one_line(tmp_path, capsys, monkeypatch):
 
 
 @pytest.mark.parametrize(
-    "backend, gpu, chunk", [("cpu", True, 128), ("gpu", False, 1024), ("auto", False, 128),
-                            ("auto", True, 1024)]
+    "backend, gpu, chunk", [("cpu", True, 128), ("gpu", True, 8192), ("gpu", False, 128),
+                            ("auto", False, 128), ("auto", True, 8192)]
 )  # fmt: skip
 def test_default_part_size_follows_the_backend_that_runs(
     tmp_path, monkeypatch, backend, gpu, chunk
 ):
     """Without --chunk a part holds 128 members on the CPU (an interruption loses little),
-    1,024 where a GPU runs them; an explicit --chunk wins, and a bad one is refused."""
+    8,192 where a GPU runs them (not where --backend gpu falls back to the CPU); an explicit
+    --chunk wins, and a bad one is refused."""
     import argparse
 
     from chaoscam.cli import _ensemble
