@@ -376,9 +376,13 @@ def _chunk(args: argparse.Namespace, parts: Path) -> int:
 
 
 def _progress_batch(backend: str) -> int | None:
-    """Members per compiled call: small on the CPU (progress), the default on a GPU."""
-    if backend == "gpu":
-        return None
+    """Members per compiled call: small on the CPU (progress), the default where a GPU runs
+    them (``gpu`` or ``auto`` with a GPU here; without one both run on the CPU)."""
+    if backend in ("gpu", "auto"):
+        from ..integrate._gpu import gpu_status
+
+        if gpu_status()[0]:
+            return None
     from ..integrate._driver import thread_count
 
     return PROGRESS_PER_THREAD * thread_count()

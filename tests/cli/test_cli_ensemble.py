@@ -316,3 +316,20 @@ def test_workers_and_device_on_the_ensemble_command(tmp_path, capsys, monkeypatc
     assert main([*base, "--workers", "0", "--out", str(tmp_path / "c.parquet")]) == 2
     assert "--workers 0: must be in [1, " in capsys.readouterr().err
     assert not (tmp_path / "c.parquet").exists()
+
+
+@pytest.mark.parametrize(
+    "backend, gpu, on_gpu",
+    [("cpu", True, False), ("gpu", True, True), ("gpu", False, False), ("auto", True, True),
+     ("auto", False, False)],
+)  # fmt: skip
+def test_members_per_call_follow_the_backend_that_runs(monkeypatch, backend, gpu, on_gpu):
+    """A GPU takes a part in one call (None: the ensemble's default); the CPU takes small
+    calls, so that the progress bar moves, also where --backend gpu or auto falls back."""
+    from chaoscam.cli import _ensemble
+    from chaoscam.integrate import _gpu
+
+    monkeypatch.setattr(_gpu, "gpu_status", lambda: (gpu, "test"))
+    size = _ensemble._progress_batch(backend)
+    assert (size is None) == on_gpu
+    assert on_gpu or size >= _ensemble.PROGRESS_PER_THREAD
