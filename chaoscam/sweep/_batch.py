@@ -46,7 +46,8 @@ batch takes about as long with a few members as with hundreds (measured on an H2
 20 s with the tangent, 132 s), so batches must be large for the device's rate; 8,192 keeps a
 checkpoint every few minutes, and the host's labels of a batch (about 8 ms a member there,
 one core) under about a minute. Launches stay short (a member stops for its draws and
-impact rows every few hundred impacts), so a Ctrl-C is still answered within seconds."""
+impact rows every few hundred impacts: tens of seconds on the device), so a Ctrl-C is still
+answered within a launch."""
 
 
 def batch_size(base: Params, duration: float, transient: float, threads: int) -> int:
@@ -257,8 +258,21 @@ def resolve_engine(
 
     extend_to = classify.extend_to
 
+    # Locally, the backend that will run, said once here rather than in every record; a
+    # Dask scheduler's workers decide for themselves.
+    backend = device if scheduler is not None else ("gpu" if gpu else "cpu")
+    if device == "gpu" and backend == "cpu":
+        from ..integrate._gpu import GPUFallbackWarning, gpu_status
+
+        reason = gpu_status()[1]
+        warnings.warn(
+            f"GPU backend unavailable: {reason}; the sweep runs on the CPU",
+            GPUFallbackWarning,
+            stacklevel=4,
+        )
+
     def pack(tasks: tuple) -> BatchTask:
-        return BatchTask(tasks, device, extend_to)
+        return BatchTask(tasks, backend, extend_to)
 
     identity = f"{ENGINE_CLASSIFIER}, extend_to={extend_to}"
     if gpu:

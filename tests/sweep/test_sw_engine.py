@@ -279,16 +279,40 @@ def test_the_table_says_how_long_the_label_was_recorded():
 def test_a_gpu_sweep_runs_large_batches_only_where_a_gpu_can_run(monkeypatch, ready):
     """A GPU thread runs one member, so GPU batches hold GPU_MAP_BATCH members; where no GPU
     can run, device="gpu" falls back to the CPU's batches."""
+    import contextlib
+
     from chaoscam.integrate import _gpu
     from chaoscam.sweep import DefaultClassifier
 
     monkeypatch.setattr(_gpu, "gpu_status", lambda: (ready, "test"))
-    eng = _batch.resolve_engine(
-        "ensemble", "gpu", DefaultClassifier(), "id", Params(), (20.0, 0.0), 2, None
-    )
+    said = contextlib.nullcontext() if ready else pytest.warns(_gpu.GPUFallbackWarning)
+    with said:
+        eng = _batch.resolve_engine(
+            "ensemble", "gpu", DefaultClassifier(), "id", Params(), (20.0, 0.0), 2, None
+        )
     cpu = _batch.resolve_engine(
         "ensemble", "cpu", DefaultClassifier(), "id", Params(), (20.0, 0.0), 2, None
     )
     assert eng.name == "ensemble" and cpu.pack_size < _batch.GPU_MAP_BATCH
     assert eng.pack_size == (_batch.GPU_MAP_BATCH if ready else cpu.pack_size)
     assert _batch.engine_device(eng, "gpu") == ("gpu" if ready else "cpu")
+
+
+def test_a_gpu_sweep_without_a_gpu_says_so_once(monkeypatch):
+    """device="gpu" where no GPU can run: one GPUFallbackWarning for the sweep, and its
+    records carry no fallback warning each (they ran on the CPU, as the config says)."""
+    import warnings
+
+    from chaoscam.integrate import _gpu
+
+    monkeypatch.setattr(_gpu, "gpu_status", lambda: (False, "no CUDA device (test)"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        m = regime_map(
+            Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.001,)), realizations=2,
+            duration=1.0, engine="ensemble", device="gpu", workers=2,
+        )  # fmt: skip
+    fallback = [w for w in caught if issubclass(w.category, _gpu.GPUFallbackWarning)]
+    assert len(fallback) == 1 and "no CUDA device (test)" in str(fallback[0].message)
+    assert m.config["device"] == "cpu"
+    assert not m.realizations["warnings"].str.contains("GPU").any()
