@@ -70,9 +70,9 @@ under the CUDA simulator, tested); it takes 255 registers a thread with spills f
 196 without (ptxas 12.9), and its speed on a device is not yet measured
 (``benchmarks/bench_gpu_profile.py`` compares the two)."""
 _SMALL_GRID = r".*Grid size \d+ will likely result in GPU under-utilization"
-"""numba-cuda's NumbaPerformanceWarning for a launch of few blocks (message, with its ANSI
-codes). A small batch or a refill relaunch is expected; a sweep would otherwise record the
-warning against every run of the batch (seen on an H200, 2026-11-27)."""
+"""numba-cuda's NumbaPerformanceWarning for a launch configured with few blocks (message,
+with its ANSI codes). A small batch is expected; a sweep would otherwise record the warning
+against every run of the batch (seen on an H200, 2026-11-27)."""
 _NUMPY_TRAP = (2, 5)  # numba-cuda <= 0.30.4 compiles no kernel under numpy >= 2.5
 
 
@@ -276,24 +276,32 @@ def run_on_gpu(
         d_section = cuda.device_array(section.shape, order=order)
     d_impacts = cuda.device_array(impacts.shape, order=order)
     blocks = (n + _BLOCK - 1) // _BLOCK
+    # numba-cuda warns when a launch is configured with few blocks; a small batch is the
+    # caller's choice. Configured once, so the process-wide filters change once a call.
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=_SMALL_GRID)
+        configured = kern[blocks, _BLOCK]
 
     def launch(need: np.ndarray) -> np.ndarray:
         """Every thread starts; those whose member is done return at once."""
-        with warnings.catch_warnings():  # a small batch is the caller's choice, not an error
-            warnings.filterwarnings("ignore", message=_SMALL_GRID)
-            kern[blocks, _BLOCK](
-                d_y, d_cnt, d_c, n_stop, d_lam, d_series, d_section, d_impacts, d_status
-            )
+        configured(d_y, d_cnt, d_c, n_stop, d_lam, d_series, d_section, d_impacts, d_status)
         d_status.copy_to_host(status)
         return status[need]
 
-    def refill(need: np.ndarray) -> None:
-        get(d_cnt, cnt)
-        if keep_impacts and order == "C":
+    def impact_rows(need: np.ndarray) -> None:
+        """The filled impact rows of the members in ``need``, brought to ``impacts``."""
+        if order == "C":
             for j in need:
                 d_impacts[j].copy_to_host(impacts[j])
-        elif keep_impacts:  # a member's rows are not contiguous there
-            impacts[need] = d_impacts.copy_to_host()[need]
+            return
+        m = int(cnt[need, k.I_N_IMPACT].max())  # F: a column of the used rows is contiguous
+        for col in range(impacts.shape[2]):
+            impacts[need, :m, col] = d_impacts[:, :m, col].copy_to_host()[need]
+
+    def refill(need: np.ndarray) -> None:
+        get(d_cnt, cnt)
+        if keep_impacts:
+            impact_rows(need)
         for j in need:  # the same width again: as many new draws as were used
             lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
         d_cnt.copy_to_device(np.asarray(cnt, order=order))

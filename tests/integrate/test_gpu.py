@@ -218,12 +218,15 @@ def test_kernel_compiles_to_ptx_for_h100(method, layout):
 @pytest.mark.gpu
 @pytest.mark.skipif(not _on_device(), reason="no CUDA device")
 @pytest.mark.parametrize(
-    "params, duration, transient",
-    [(Params(l_lambda_sigma=0.002), 0.25, 0.0), (Params(xi=0.2), 20.0, 10.0)],
-    ids=["first-period", "periodic"],
-)
-def test_device_equals_cpu_within_tolerance(params, duration, transient):
-    """On a GPU, sections of the first cam period and of a periodic orbit equal the CPU's."""
+    "params, duration, transient, layout",
+    [(Params(l_lambda_sigma=0.002), 0.25, 0.0, "C"), (Params(xi=0.2), 20.0, 10.0, "C"),
+     (Params(l_lambda_sigma=0.002), 0.25, 0.0, "F")],
+    ids=["first-period", "periodic", "first-period-members-minor"],
+)  # fmt: skip
+def test_device_equals_cpu_within_tolerance(monkeypatch, params, duration, transient, layout):
+    """On a GPU, sections of the first cam period and of a periodic orbit equal the CPU's
+    (the first period also with the members' arrays in the "F" order)."""
+    monkeypatch.setattr(_gpu, "GPU_LAYOUT", layout)
     runs = [
         simulate_ensemble(
             params, range(8), seed=3, duration=duration, transient=transient, backend=b
