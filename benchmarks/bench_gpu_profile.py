@@ -51,18 +51,34 @@ class _Clock:
         return timed
 
 
-def measure(p, members, duration, room, layout) -> tuple[float, _Clock]:
+def measure(p, members, duration, room, layout):
+    """(wall time, clock, sections) of one GPU ensemble with this room and layout."""
     clock = _Clock()
     inner, _gpu.drive_members = _gpu.drive_members, clock.wrap(_gpu.drive_members)
     before, _ensemble._ROOM["gpu"] = _ensemble._ROOM["gpu"], room
     order, _gpu.GPU_LAYOUT = _gpu.GPU_LAYOUT, layout
     try:
         t0 = time.perf_counter()
-        simulate_ensemble(p, range(members), seed=1, duration=duration, backend="gpu")
-        return time.perf_counter() - t0, clock
+        ens = simulate_ensemble(p, range(members), seed=1, duration=duration, backend="gpu")
+        return time.perf_counter() - t0, clock, ens.sections
     finally:
         _gpu.drive_members, _ensemble._ROOM["gpu"] = inner, before
         _gpu.GPU_LAYOUT = order
+
+
+def _compiled(p) -> list[str]:
+    """The layouts whose kernel compiles and runs here (an error is printed, not raised)."""
+    ok = []
+    for layout in ("C", "F"):
+        t0 = time.perf_counter()
+        try:
+            measure(p, 64, 0.01, _ensemble._ROOM["gpu"], layout)
+        except Exception as exc:  # keep the other layout's numbers
+            print(f"layout {layout}: failed ({type(exc).__name__}: {exc}); not measured")
+            continue
+        print(f"layout {layout}: compiled and ran in {time.perf_counter() - t0:.1f} s")
+        ok.append(layout)
+    return ok
 
 
 def main() -> None:
@@ -73,37 +89,49 @@ def main() -> None:
     if not ok:
         print(f"GPU: not available ({reason}); nothing measured")
         return
+    print(f"GPU: {reason}")
     p = Params(l_lambda_sigma=0.002)
-    t0 = time.perf_counter()
-    for layout in ("C", "F"):
-        _gpu.GPU_LAYOUT, before = layout, _gpu.GPU_LAYOUT
-        simulate_ensemble(p, range(64), seed=1, duration=0.01, backend="gpu")
-        _gpu.GPU_LAYOUT = before
-    print(f"GPU: {reason}; both layouts compiled in {time.perf_counter() - t0:.1f} s")
+    layouts = _compiled(p)
     small, big = _ensemble._ROOM["gpu"], (16_384, 4_096)
+    # the open questions first: each layout at a full device, then the room, then length
     plan = [
-        (64, 0.5, small, "C"), (64, 0.5, big, "C"), (64, 0.5, small, "F"),
-        (1_024, 0.5, small, "C"), (1_024, 0.5, small, "F"), (1_024, 0.5, big, "C"),
-        (8_192, 0.5, small, "C"), (8_192, 0.5, small, "F"), (8_192, 0.5, big, "C"),
-        (40_000, 0.5, small, "C"), (40_000, 0.5, small, "F"), (40_000, 2.0, small, "C"),
-        (40_000, 20.0, small, "C"),
+        (64, 0.5, small, "C"), (64, 0.5, small, "F"),
+        (8_192, 0.5, small, "C"), (8_192, 0.5, small, "F"),
+        (40_000, 0.5, small, "C"), (40_000, 0.5, small, "F"),
+        (8_192, 0.5, big, "C"), (40_000, 2.0, small, "best"), (40_000, 20.0, small, "best"),
     ]  # fmt: skip
     last = None  # (wall, members, duration) of the configuration before
+    walls: dict[tuple[int, str], float] = {}
+    sections = {}
     start = time.perf_counter()
     for members, duration, room, layout in plan:
+        if layout == "best":  # the faster at 40,000 x 0.5 s
+            layout = min(layouts, key=lambda x: walls.get((40_000, x), float("inf")))
+        if layout not in layouts:
+            continue
         what = f"{members:>6,} x {duration:>4g} s, room {room}, layout {layout}"
         if last is not None:
             guess = last[0] * members / last[1] * duration / last[2]
             if guess > args.budget - (time.perf_counter() - start):
                 print(f"skipped {what}: about {guess:.0f} s")
                 continue
-        wall, c = measure(p, members, duration, room, layout)
+        wall, c, sec = measure(p, members, duration, room, layout)
         last = (wall, members, duration)
+        walls[(members, layout)] = wall
+        if members == 64:
+            sections[layout] = sec[["k", "t", "theta_f", "omega_f"]].to_numpy()
         rate = members / wall
         print(
             f"{what}: {wall:7.2f} s = {rate:9,.1f} traj/s ({rate * duration / 20:9,.1f} 20-s "
             f"traj/s); {c.launches} launches {c.launch:.2f} s, refills {c.refill:.2f} s",
             flush=True,
+        )
+    if len(sections) == 2:
+        a, b = sections["C"], sections["F"]
+        same = a.shape == b.shape and bool((a == b).all())
+        diff = float(abs(a - b).max()) if a.shape == b.shape else float("inf")
+        print(
+            f"layouts C and F, 64 x 0.5 s sections: identical {same} (max |difference| {diff:.1e})"
         )
 
 
