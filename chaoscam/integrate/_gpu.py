@@ -27,9 +27,9 @@ was not interrupted (see :func:`_kernel.run_chunk`), so this relaunch changes no
 
 Measured on an NVIDIA H200 (2026-11-27, ``benchmarks/device_check.sh``): the tolerance
 tests pass; the RK4 kernel takes 202 registers and 40 B of local memory a thread; but one
-thread takes 4.8 us a grid step, hundreds of times a CPU core, so a 20-s member takes about
-50 s on the device and 40,000 of them more than 340 s (below 120 trajectories a second; a
-1,024-run regime map ran as fast as 2 CPU cores). See the README's "Ensembles and the GPU".
+thread takes 4.8 us a grid step over the first 0.5 s, hundreds of times a CPU core, and
+40,000 members of 20 s took more than 340 s (below 120 trajectories a second; a 1,024-run
+regime map ran as fast as 2 CPU cores). See the README's "Ensembles and the GPU".
 
 numba-cuda is imported lazily, on first use: ``import chaoscam`` never imports it.
 """
