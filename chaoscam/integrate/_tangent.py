@@ -9,7 +9,17 @@ multiplied by the flow's saltation matrix at the located event (:func:`saltation
 Non-smooth Mechanical Systems*, sec. 3.5; Dankowicz & Nordmark 2000, Physica D 136), not a
 derivative of the event search; where chattering ends in sticking the default grid's V
 overstates the growth while the grid's motion does not (README, "Tangent dynamics checked
-independently"). Contact onset and separation need no saltation matrix:
+independently"). Cause (found 2026-11-27, measured on the ξ = 0.45 period 6): the RK4
+substep that follows a located event inside a chatter cycle (after a micro-impact's rebound,
+or an opening) takes the full equations from the surface, and one of its stages dips about
+1e-12 m into the cam (the stage extrapolation doubles the rod's acceleration term), where the
+Hertz force is negligible in the state but not in its derivative; V uses the flight side at
+every stage and the flow's saltation, so it misses the grid map's dependence on the event
+time (sensitivity l1/v, 2e5 s/rad at a 2.5e-6 m/s closing). Each chatter cycle's V is then
+1-30 % too large (a factor ~3 over the period); the stage's dip shrinks as h^2, hence the
+convergence with dt. The contact steps, the saltation and the sticking projection are exact
+there. A fix (flight substeps from the surface, or the event-time term in V) is not made yet.
+Contact onset and separation need no saltation matrix:
 the contact force vanishes at delta = 0, so the vector field is continuous there (its Jacobian
 is not, which is why no RK4 step straddles delta = 0).
 
