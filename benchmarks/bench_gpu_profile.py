@@ -25,28 +25,29 @@ from chaoscam.integrate import _ensemble, _gpu, simulate_ensemble
 
 
 class _Clock:
+    """Seconds spent in ``drive_members``' launches and refills, and the launches made."""
+
     def __init__(self) -> None:
         self.launch = self.refill = 0.0
         self.launches = 0
 
+    def _timed(self, fn, field: str):
+        def timed(x):
+            t0 = time.perf_counter()
+            try:
+                return fn(x)
+            finally:
+                setattr(self, field, getattr(self, field) + time.perf_counter() - t0)
+
+        return timed
+
     def wrap(self, drive):
         def timed(n, launch, refill, need=None):
-            def tl(x):
-                t0 = time.perf_counter()
-                try:
-                    return launch(x)
-                finally:
-                    self.launch += time.perf_counter() - t0
-                    self.launches += 1
+            def counted(x):
+                self.launches += 1
+                return launch(x)
 
-            def tr(x):
-                t0 = time.perf_counter()
-                try:
-                    return refill(x)
-                finally:
-                    self.refill += time.perf_counter() - t0
-
-            return drive(n, tl, tr, need)
+            return drive(n, self._timed(counted, "launch"), self._timed(refill, "refill"), need)
 
         return timed
 

@@ -367,23 +367,19 @@ def _chunk(args: argparse.Namespace, parts: Path) -> int:
         stored = saved.get("chunk") if isinstance(saved, dict) else None
         if isinstance(stored, int) and not isinstance(stored, bool) and stored >= 1:
             return stored
-    on_gpu = False
-    if args.backend in ("gpu", "auto"):  # "gpu" without one falls back to the CPU
-        from ..integrate._gpu import gpu_status
+    from ..integrate._gpu import runs_on_gpu
 
-        on_gpu = gpu_status()[0]
-    return GPU_CHUNK if on_gpu else CPU_CHUNK
+    return GPU_CHUNK if runs_on_gpu(args.backend) else CPU_CHUNK
 
 
 def _progress_batch(backend: str) -> int | None:
     """Members per compiled call: small on the CPU (progress), the default where a GPU runs
     them (``gpu`` or ``auto`` with a GPU here; without one both run on the CPU)."""
-    if backend in ("gpu", "auto"):
-        from ..integrate._gpu import gpu_status
-
-        if gpu_status()[0]:
-            return None
     from ..integrate._driver import thread_count
+    from ..integrate._gpu import runs_on_gpu
+
+    if runs_on_gpu(backend):
+        return None
 
     return PROGRESS_PER_THREAD * thread_count()
 

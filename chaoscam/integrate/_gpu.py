@@ -56,6 +56,7 @@ __all__ = [
     "GPUFallbackWarning",
     "gpu_status",
     "run_on_gpu",
+    "runs_on_gpu",
 ]
 
 GPU_BATCH = 65_536  # members per device batch: ~42 kB each for 20 s runs (about 2.7 GB)
@@ -93,6 +94,12 @@ def gpu_status() -> tuple[bool, str]:
     if importlib.util.find_spec("numba_cuda") is None:
         return False, "numba-cuda is not installed (pip install 'chaoscam[gpu]')"
     return _device_status()
+
+
+def runs_on_gpu(backend: str) -> bool:
+    """Whether ``backend`` ("cpu", "gpu" or "auto") runs on a GPU here: "gpu" and "auto" do
+    where :func:`gpu_status` says one can run; otherwise the CPU runs them."""
+    return backend in ("gpu", "auto") and gpu_status()[0]
 
 
 def _numpy_trap() -> str:

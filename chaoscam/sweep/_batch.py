@@ -249,10 +249,12 @@ def resolve_engine(
             threads = local_workers(workers)
         except ValueError as err:
             raise SweepError(str(err)) from None
+    from ..integrate._gpu import runs_on_gpu
+
     # Local CPU batches run one per thread, each a batch's work on one core (a GPU batch
     # fills its device; a Dask worker runs numba threads over its own cores). Without a GPU
     # here, device="gpu" or "auto" runs the CPU's batches.
-    gpu = device != "cpu" and scheduler is None and _gpu_ready()
+    gpu = scheduler is None and runs_on_gpu(device)
     by_task = threads if threads is not None and threads > 1 and not gpu else 1
     size = batch_size(base, run[0], run[1], 1 if by_task > 1 else threads or 1)
 
@@ -282,20 +284,14 @@ def resolve_engine(
     return Engine("ensemble", identity, pack, size, threads)
 
 
-def _gpu_ready() -> bool:
-    from ..integrate._gpu import gpu_status
-
-    return gpu_status()[0]
-
-
 def engine_device(eng: Engine, device: str) -> str:
     """Where a sweep's realizations run: "gpu" when the ensemble engine was asked for a GPU
     ("gpu" or "auto") and one can run here (else the CPU path runs them, see
     :func:`chaoscam.integrate._gpu.gpu_status`), otherwise "cpu". Recorded in the
     configuration: a GPU's results equal the CPU's only within ``GPU_TOLERANCE``."""
-    if eng.name != "ensemble" or device == "cpu":
-        return "cpu"
-    return "gpu" if _gpu_ready() else "cpu"
+    from ..integrate._gpu import runs_on_gpu
+
+    return "gpu" if eng.name == "ensemble" and runs_on_gpu(device) else "cpu"
 
 
 def sweep_engine(
