@@ -5,7 +5,7 @@ The fixed-step RK4 kernel (:mod:`._kernel`) and the adaptive one (:mod:`._adapti
 time differently, but at a scheduled time (a stroboscopic section ``k T``, a line-length
 draw ``j dt_l``) and at a located closing they do exactly the same, here: record the section
 point with the map's Jacobian, draw the next line length, apply the restitution law (4)–(5)
-with its saltation matrix and record the impact. All are inlined into the kernels.
+with its tangent and record the impact. All are inlined into the kernels.
 """
 
 from __future__ import annotations
@@ -41,11 +41,12 @@ from ._layout import (
     Y_J22,
 )
 from ._physics import stiffness
-from ._tangent import saltation
+from ._tangent import jump_derivatives, saltation
 
 __all__ = [
     "at_scheduled",
     "commit_tangent",
+    "event_tangent",
     "impact",
     "next_scheduled",
     "reset_tangent",
@@ -140,7 +141,7 @@ def reset_tangent(y):
 
 
 @njit(cache=True, inline="always")
-def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c):
+def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c, salt):
     """The impact law (4)–(5) at a located closing at (t, th) with lever arm l1 and dC/dt.n.
 
     The approach speed is ``v = -(l1 theta' - dC/dt.n)``. When ``v > v_min`` (0 by default:
@@ -150,9 +151,11 @@ def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c):
     chattering sequence (the infinitely many ever shorter bounces whose speeds fall by ``xi``
     each, Nordmark & Piiroinen 2009, Nonlinear Dyn. 58): it is replaced by its accumulation
     point, a plastic closure ``theta'+ = (dC/dt.n) / l1`` (gap rate 0), after which the
-    compliant contact carries the motion. Each applied jump multiplies the tangent by its
-    saltation matrix and is recorded (after the transient) with its kind: macro, micro (slower
-    than ``v_micro``) or chatter end. Under impact resampling a macro impact draws a new line
+    compliant contact carries the motion. With ``salt``, each applied jump multiplies the
+    tangent by its saltation matrix (the adaptive kernel; the RK4 kernel calls
+    :func:`event_tangent` at every located event instead). Each applied jump is recorded
+    (after the transient) with its kind: macro, micro (slower than ``v_micro``) or chatter
+    end. Under impact resampling a macro impact draws a new line
     length (``resample="contact"``: a new contact), and so does every applied jump under
     ``resample="impact"``. Closings slower than ``v_min`` are left to the compliant force and
     counted.
@@ -170,7 +173,7 @@ def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c):
         xi = c[C_XI]
         kind = IMPACT_MICRO if -rate < c[C_V_MICRO] else IMPACT_MACRO
     om_after = -xi * om + (1.0 + xi) * cdn / l1
-    if tangent_on(t, c):
+    if salt and tangent_on(t, c):
         s11, s21, s22 = saltation(t, th, om, om_after, l1, cdn, xi, c)
         v11, v21, v12, v22 = y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22]
         y[Y_J11] = s11 * v11
@@ -192,6 +195,47 @@ def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c):
         impacts[i, 7] = kind
         cnt[I_N_IMPACT] += 1
     return om_after, K
+
+
+@njit(cache=True, inline="always")
+def event_tangent(y, t, th, om_before, om_after, xi, l1, cdn, b_th, b_om, a_after, c):
+    """The tangent V through a located event of the RK4 kernel: a closing (with its jump
+    when ``om_after != om_before``, restitution ``xi``) or an opening.
+
+    V arrives as the derivative of the state at the event *time held fixed*, and ``b`` is the
+    velocity of the substep that located it (its end's derivative in its length,
+    :func:`._tangent.rk4_time_derivatives`). The event time moves by ``w V`` with
+    ``w = -h_x / (h_t + h_x b)``, ``h_x = (l_1, 0)``, ``h_t = -dC/dt.n``; the state there by
+    ``(V + b w)``; the jump maps that by its derivatives in state and time; and V leaves
+    again with the time held fixed, along ``f+ = (om_after, a_after)``:
+
+    ``V <- g_x (V + b w) + g_t w - f+ w``.
+
+    With ``b = f-`` this is Müller's saltation matrix (:func:`._tangent.saltation`); the RK4
+    substep's own b differs from f- where a stage changes side of the surface. Returns w's
+    two entries (the kernel adds their term for the substep that starts here,
+    :func:`._tangent.rk4_time_derivatives`), both 0 where the event time does not move
+    (a tangential event, ``h_t + h_x b = 0``).
+    """
+    rate = l1 * b_th - cdn
+    if rate == 0.0:
+        return 0.0, 0.0
+    w1 = -l1 * y[Y_J11] / rate
+    w2 = -l1 * y[Y_J12] / rate
+    v11 = y[Y_J11] + b_th * w1
+    v12 = y[Y_J12] + b_th * w2
+    v21 = y[Y_J21] + b_om * w1
+    v22 = y[Y_J22] + b_om * w2
+    if om_after != om_before:
+        q_th, q_t = jump_derivatives(t, th, l1, cdn, c)
+        g_th = (1.0 + xi) * q_th
+        g_t = (1.0 + xi) * q_t
+        v21, v22 = g_th * v11 - xi * v21 + g_t * w1, g_th * v12 - xi * v22 + g_t * w2
+    y[Y_J11] = v11 - om_after * w1
+    y[Y_J12] = v12 - om_after * w2
+    y[Y_J21] = v21 - a_after * w1
+    y[Y_J22] = v22 - a_after * w2
+    return w1, w2
 
 
 @njit(cache=True, inline="always")

@@ -69,17 +69,19 @@ def test_located_crossing_is_within_1e_10_s_of_the_root():
     assert along(tau) <= 0.0
 
 
-def _textbook_rk4(t, th, om, h, K, c, side=None):
+def _textbook_rk4(t, th, om, h, K, c, side=None, rest=None):
     """Classical RK4 written out in Python with the kernel's own right-hand side, each stage
-    evaluated at its own time and angle (with ``side``, the Jacobian's stages too)."""
+    evaluated at its own time and angle (with ``side``, the Jacobian's stages too: the first
+    on ``side``, the others on ``rest``, by default ``side`` too)."""
     from chaoscam.integrate._tangent import _column
 
-    def f(ts, ths, oms):
+    def f(ts, ths, oms, first=False):
         if side is None:
             return k.acceleration(ts, ths, oms, K, c), 0.0, 0.0
-        return k.acceleration_jacobian(ts, ths, oms, K, c, side)
+        later = side if rest is None else rest
+        return k.acceleration_jacobian(ts, ths, oms, K, c, side if first else later)
 
-    a1, p1, q1 = f(t, th, om)
+    a1, p1, q1 = f(t, th, om, first=True)
     th2, om2 = th + 0.5 * h * om, om + 0.5 * h * a1
     a2, p2, q2 = f(t + 0.5 * h, th2, om2)
     th3, om3 = th + 0.5 * h * om2, om + 0.5 * h * a2
@@ -116,9 +118,10 @@ def test_steps_that_share_trigonometry_are_the_textbook_steps_to_the_bit(side):
         g, l1, cdn, *trig = k.geometry_at(t, th, c)
         assert (g, l1, cdn) == k.geometry(t, th, c)
         in_contact += g < 0.0
-        (th1, om1), cols, div = _textbook_rk4(t, th, om, h, K, c, side)
-        r = rk4_tangent_trig(t, th, om, h, K, c, 1.0, 0.0, 0.0, 1.0, side, *trig)
-        assert r[:2] == (th1, om1) and r[2:6] == cols and r[6] == div
+        for rest in (side, k.JAC_NATURAL):  # the flow's tangent, the grid map's
+            (th1, om1), cols, div = _textbook_rk4(t, th, om, h, K, c, side, rest)
+            r = rk4_tangent_trig(t, th, om, h, K, c, 1.0, 0.0, 0.0, 1.0, side, rest, *trig)
+            assert r[:2] == (th1, om1) and r[2:6] == cols and r[6] == div
         assert r[7:] == k.cam_trig(t + h, c)
         (th1, om1), _, _ = _textbook_rk4(t, th, om, h, K, c)
         assert k.rk4_trig(t, th, om, h, K, c, *trig)[:2] == (th1, om1)
