@@ -57,6 +57,11 @@ CLI_CASES = {
     "output-dt -1": ([*SIM, "--output-dt", "-1"], "output_dt"),
     "output-dt nan": ([*SIM, "--output-dt", "nan"], "output_dt"),
     "omega 1e300": ([*SIM, "--set", "omega=1e300"], "omega"),
+    "omega 1_0 (Python would read 10)": ([*SIM, "--set", "omega=1_0"], "omega = '1_0'"),
+    "tangent_events grid on the adaptive path": (
+        [*SIM, "--set", "integrator=adaptive", "--set", "tangent_events=grid"],
+        "tangent_events",
+    ),
     "l 1e308": ([*SIM, "--set", "l=1e308"], "l ="),
     "flight_merge 1e9": ([*SIM, "--set", "flight_merge=1000000000"], "flight_merge"),
     "max_events 1e12": (
@@ -207,6 +212,11 @@ API_TYPE_CASES = [
     (lambda: chaoscam.simulate(index=-1), ParameterError, "index"),
     (lambda: bifurcation("l_lambda", 0.01), SweepError, "sequence"),
     (lambda: regime_map(("omega", [1e300]), ("xi", [0.4])), ParameterError, "omega"),
+    (
+        lambda: regime_map(("omega", [30.0]), ("xi", [0.4]), scheduler=3),
+        SweepError,
+        "scheduler = 3 is not a Dask scheduler",
+    ),
     (
         lambda: regime_map(
             ("omega", [30.0]), ("xi", [0.4]), flush_interval=math.nan, out="x.parquet"

@@ -27,9 +27,9 @@ length is rounded so that its end is the double the kernel stamps it with
 With ``c[C_TANGENT]`` set, the tangent matrix is integrated with the state (:mod:`._tangent`)
 from shortly before the recording starts (:func:`._steps.tangent_on`) and carried through each
 located event by the flow's saltation matrix or, with ``Params.tangent_events = "grid"``, as
-the grid map's own derivative (:func:`._steps.event_tangent`); at each section time the Jacobian of the stroboscopic map over
-the last period is written beside the section point and the tangent restarts from the
-identity. The state is the same with and without it.
+the grid map's own derivative (:func:`._steps.event_tangent`); at each section time the
+Jacobian of the stroboscopic map over the last period is written beside the section point
+and the tangent restarts from the identity. The state is the same with and without it.
 
 The model's equations live in :mod:`._physics`, the array layout in :mod:`._layout` (whose
 names this module re-exports for its callers), the location of events inside a step in

@@ -471,8 +471,10 @@ def parse_value(name: str, text: str) -> Any:
         return None
     if FIELD_DOCS[name]["choices"] is not None:
         return text.strip()
+    kind = "an integer" if f.type == "int" else "a number"
+    if "_" in text:  # Python reads "1_0" as 10: a typo, not a number
+        raise ParameterError(f"{name} = {text!r} must be {kind} (no '_' in it)")
     try:
         return int(text) if f.type == "int" else float(text)
     except ValueError:
-        kind = "an integer" if f.type == "int" else "a number"
         raise ParameterError(f"{name} = {text!r} must be {kind}") from None

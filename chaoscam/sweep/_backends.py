@@ -487,6 +487,13 @@ def make_backend(workers: int | None = None, scheduler: Any = None):
     ``workers`` = None uses every core; 1 runs in this process.
     """
     if scheduler is not None:
+        if not isinstance(scheduler, str) and not hasattr(scheduler, "submit"):
+            from ._grid import SweepError
+
+            raise SweepError(
+                f"scheduler = {scheduler!r} is not a Dask scheduler: give 'local', the "
+                "address of a running one ('tcp://HOST:PORT') or a distributed.Client"
+            )
         return DaskBackend(scheduler, workers)
     n = local_workers(workers)
     return SerialBackend() if n == 1 else ProcessBackend(n)
