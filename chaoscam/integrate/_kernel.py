@@ -447,6 +447,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             K = at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)
 
         # End of the grid step: checks and outputs. Here g and l1 belong to (t_end, th).
+        shift = False  # an event that ended the step: its start-time term is dropped (above)
         cnt[I_STEP] = n + 1
         if not (math.isfinite(th) and math.isfinite(om)):
             return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, NON_FINITE)

@@ -204,7 +204,8 @@ def event_tangent(y, t, th, om_before, om_after, xi, l1, cdn, b_th, b_om, a_afte
 
     V arrives as the derivative of the state at the event *time held fixed*, and ``b`` is the
     velocity of the substep that located it (its end's derivative in its length,
-    :func:`._tangent.rk4_time_derivatives`). The event time moves by ``w V`` with
+    :func:`._tangent.rk4_time_derivatives`; for a free-flight substep the flight field at its
+    end, O(h^4) from that). The event time moves by ``w V`` with
     ``w = -h_x / (h_t + h_x b)``, ``h_x = (l_1, 0)``, ``h_t = -dC/dt.n``; the state there by
     ``(V + b w)``; the jump maps that by its derivatives in state and time; and V leaves
     again with the time held fixed, along ``f+ = (om_after, a_after)``:
