@@ -213,6 +213,11 @@ API_TYPE_CASES = [
     (lambda: bifurcation("l_lambda", 0.01), SweepError, "sequence"),
     (lambda: regime_map(("omega", [1e300]), ("xi", [0.4])), ParameterError, "omega"),
     (
+        lambda: Axis.parse("0:1.7976931348623157e308:4", name="l_lambda"),
+        SweepError,
+        "l_lambda range .*overflow a float",
+    ),
+    (
         lambda: regime_map(("omega", [30.0]), ("xi", [0.4]), scheduler=3),
         SweepError,
         "scheduler = 3 is not a Dask scheduler",

@@ -127,7 +127,15 @@ class Axis:
         """``num`` evenly spaced values from ``start`` to ``stop``, both included."""
         start, stop = (v.item() if type(v).__module__ == "numpy" else v for v in (start, stop))
         parse_range(f"{start!r}:{stop!r}:{num}", what=name)
-        return cls(name, tuple(np.linspace(start, stop, num).tolist()))
+        try:
+            with np.errstate(over="raise"):  # ends near the largest float: no silent inf
+                values = np.linspace(start, stop, num)
+        except FloatingPointError:
+            raise SweepError(
+                f"{name} range {start!r}:{stop!r}:{num}: its points overflow a float; narrow "
+                "the range"
+            ) from None
+        return cls(name, tuple(values.tolist()))
 
     @classmethod
     def parse(cls, text: str, name: str | None = None) -> Axis:
