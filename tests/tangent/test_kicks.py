@@ -1,0 +1,46 @@
+"""The direct perturbation test (chaoscam.tangent.kick_test): finite kicks on the map itself,
+which decide stability where chattering ends in sticking and no tangent can (README, "Tangent
+dynamics checked independently")."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from chaoscam import ParameterError, Params, simulate
+from chaoscam.tangent import kick_test
+
+
+def _settled_point(p):
+    sec = simulate(p, duration=130.0, transient=100.0, series=False).section
+    return sec[["theta_f", "omega_f"]].to_numpy()[-1]
+
+
+@pytest.mark.parametrize(
+    ("changes", "n", "returns"),
+    [
+        ({"xi": 0.45}, 6, True),  # sticking period 6: every tangent-free measure attracts
+        ({"omega": 32.5, "xi": 0.5}, 6, True),  # period 6 the grid tangent leaves undetermined
+        ({"l_lambda": 0.015}, 8, False),  # 8-band chaos: 1e-8 kicks grow ~250x in 12 periods
+    ],
+    ids=["xi=0.45", "(32.5, 0.5)", "l_lambda=15mm"],
+)
+def test_kicks_tell_attracting_orbits_from_chaos(changes, n, returns):
+    """Kicks of 1e-7 and 1e-6 rad (and 30x in rad/s) return below a tenth of themselves within
+    12 orbit periods on the attracting orbits and not on the chaotic bands (measured at dt,
+    separation over kick after 12 periods: <= 0.004 for the orbits, 0.61-0.82 for the chaos,
+    whose 1e-8 kicks grow 8-9x; on the orbits a 1e-8 kick ends at 0.01-0.11 of itself)."""
+    p = Params(**changes)
+    test = kick_test(p, _settled_point(p), n)
+    assert test.returns is returns
+    assert test.growth.shape == (3, 2, 13)
+    assert np.allclose(test.growth[:, :, 0], 1.0, rtol=1e-6)  # the kicks, in the scaled norm
+    if not returns:
+        assert test.growth[0, :, -1].min() > 1.0  # the smallest kicks grow
+
+
+def test_bad_arguments_name_themselves():
+    with pytest.raises(ParameterError, match="kicks"):
+        kick_test(Params(), (0.0, 1.0), kicks=(0.0,))
+    with pytest.raises(ParameterError, match="n ="):
+        kick_test(Params(), (0.0, 1.0), n=0)
