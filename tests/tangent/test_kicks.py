@@ -26,17 +26,17 @@ def _settled_point(p):
     ids=["xi=0.45", "(32.5, 0.5)", "l_lambda=15mm"],
 )
 def test_kicks_tell_attracting_orbits_from_chaos(changes, n, returns):
-    """Kicks of 1e-7 and 1e-6 rad (and 30x in rad/s) return below a tenth of themselves within
-    12 orbit periods on the attracting orbits and not on the chaotic bands (measured at dt,
-    separation over kick after 12 periods: <= 0.004 for the orbits, 0.61-0.82 for the chaos,
-    whose 1e-8 kicks grow 8-9x; on the orbits a 1e-8 kick ends at 0.01-0.11 of itself)."""
+    """Kicks of ±1e-7 and ±1e-6 rad (and ±30x in rad/s) return below a tenth of themselves
+    within 40 orbit periods on the attracting orbits and not on the chaotic bands (measured at
+    dt, largest separation over kick at the end: <= 5e-5 and 5e-4 for the orbits, 0.67 for the
+    chaos, where some 1e-8 kicks grow 7x)."""
     p = Params(**changes)
     test = kick_test(p, _settled_point(p), n)
     assert test.returns is returns
-    assert test.growth.shape == (3, 2, 13)
+    assert test.growth.shape == (3, 4, 41)
     assert np.allclose(test.growth[:, :, 0], 1.0, rtol=1e-6)  # the kicks, in the scaled norm
     if not returns:
-        assert test.growth[0, :, -1].min() > 1.0  # the smallest kicks grow
+        assert test.growth[:, :, -1].max() > 1.0  # some kick grows
 
 
 def test_bad_arguments_name_themselves():
