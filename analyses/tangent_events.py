@@ -18,7 +18,7 @@ by chatter cycle against central differences of the grid map, is a test:
 tests/tangent/test_event_time.py.
 
 Usage: python analyses/tangent_events.py [--quick]
-(--quick: 120 s runs and no dt/4 column, no third table. The full tables take about 7 minutes
+(--quick: 120 s runs and no dt/4 column, no third table. The full tables took 6 minutes
 on 2 cores.)
 """
 
