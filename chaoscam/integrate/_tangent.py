@@ -250,9 +250,10 @@ def saltation(t, th, om_before, om_after, l1, cdn, xi, c):
     ``f+- = (theta'+-, theta''_flight)``: the contact force vanishes on the surface, so both
     sides share the free pendulum's acceleration. ``xi`` = 0 gives the plastic closure that
     ends a complete chattering (a singular S). Whatever the geometry,
-    ``det S = -xi (h_t + h_x f+)/(h_t + h_x f-) = xi^2``. The adaptive kernel applies it;
-    the RK4 kernel, whose substeps around an event are not the flow, applies the same law
-    with the substeps' own rates (:func:`._steps.event_tangent`).
+    ``det S = -xi (h_t + h_x f+)/(h_t + h_x f-) = xi^2``. The adaptive kernel applies it, and
+    so does the RK4 kernel with the flow's tangent (``Params.tangent_events = "flow"``, the
+    default); the grid map's tangent applies the same law with its substeps' own rates
+    (:func:`._steps.event_tangent`).
 
     Returns ``(s11, s21, s22)``; ``s12`` is 0.
     """

@@ -28,13 +28,14 @@ from chaoscam.integrate._constants import initial_counters, initial_state, kerne
 
 def _leaving_state(p, c, rate):
     """A state on the contact surface at t = 0.0123 s moving out at gap rate ``rate`` [m/s]."""
-    t, th, _ = _leaving_state_at(c, 0.0123)
+    t = 0.0123
+    th = _surface_angle(c, t)
     _, l1, cdn = ph.geometry(t, th, c)
     return t, th, (cdn + rate) / l1
 
 
-def _leaving_state_at(c, t):
-    """(t, theta_f on the contact surface at t (by bisection), None)."""
+def _surface_angle(c, t):
+    """theta_f on the contact surface at time t (by bisection)."""
     lo, hi = -1.5, 1.5  # theta_f where delta changes sign, by bisection
     g_lo = ph.geometry(t, lo, c)[0]
     for _ in range(200):
@@ -44,7 +45,7 @@ def _leaving_state_at(c, t):
             lo, g_lo = mid, g_mid
         else:
             hi = mid
-    return t, lo, None
+    return lo
 
 
 def _substep(c, K, t, x, h, first=ph.JAC_NATURAL):
@@ -277,7 +278,7 @@ def test_an_event_that_ends_a_grid_step_leaves_no_term_for_the_next():
     c = grid.c
     n = 6150
     t_end = (n + 1) * p.dt
-    _, th_e, _ = _leaving_state_at(c, t_end)
+    th_e = _surface_angle(c, t_end)
     _, l1, cdn = ph.geometry(t_end, th_e, c)
     th0, om0 = ph.rk4_flight(th_e, (cdn - 2.5e-6) / l1, -p.dt, c)  # one free step back
 
