@@ -178,10 +178,15 @@ def _banded_verdict(v: Verdict, p: Params, points, n: int, extra: dict):
             ), extra
         if cert.certified:
             e = Evidence("periodic_orbit", cert.period, "periodic", detail)
+            where = (
+                "finite kicks return to it at the run's step and at half of it"
+                if cert.kicked
+                else "it is attracting at every refined step"
+            )
             note = (
-                f"the tangent exponent on the run's grid is positive, but the period-"
-                f"{cert.period} orbit in the bands is attracting at every refined step: the "
-                "exponent's sign is the grid's error in the chattering phases"
+                f"the tangent exponent on the run's grid is positive, but the run lies on the "
+                f"period-{cert.period} orbit in the bands and {where}: the exponent's sign is "
+                "the grid's error in the chattering phases"
             )
             return Verdict("periodic", cert.period, v.evidence + (e,), (note,), v.settings), extra
         if cert.status == "step-dependent":

@@ -256,6 +256,8 @@ class KickTest:
     returns : bool
         Every kick of at least :data:`KICK_DECIDES` ends at most :data:`KICK_RETURN` of its
         size: the motion attracts what is near it, at the scale the model resolves.
+    points : ndarray, shape (periods * n + 1, 2)
+        The unkicked run's section points x, P(x), ..., P^(periods·n)(x): where it went.
     """
 
     kicks: tuple
@@ -264,9 +266,10 @@ class KickTest:
     omega_scale: float
     growth: np.ndarray
     returns: bool
+    points: np.ndarray
 
     def __post_init__(self) -> None:
-        freeze_fields(self, "growth")
+        freeze_fields(self, "growth", "points")
 
 
 def kick_test(
@@ -303,7 +306,8 @@ def kick_test(
     sizes = tuple(real("kicks", v, low=0.0, strict=True) for v in kicks)
     x = np.asarray(x, dtype=float)
     scale = np.array([1.0, omega_scale])
-    base = iterate_map(params, x, periods * n)[::n] / scale
+    points = iterate_map(params, x, periods * n)
+    base = points[::n] / scale
     directions = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
     growth = np.empty((len(sizes), len(directions), periods + 1))
     for i, size in enumerate(sizes):
@@ -312,7 +316,7 @@ def kick_test(
             growth[i, j] = np.abs(kicked[::n] / scale - base).max(axis=1) / size
     final = growth[[i for i, v in enumerate(sizes) if v >= KICK_DECIDES], :, -1]
     returns = bool(final.size) and bool(np.all(final <= KICK_RETURN))
-    return KickTest(sizes, n, periods, omega_scale, growth, returns)
+    return KickTest(sizes, n, periods, omega_scale, growth, returns, points)
 
 
 @dataclass(frozen=True)

@@ -247,3 +247,86 @@ def test_banded_chaos_names_the_votes_it_outweighs():
     band = next(e for e in v.evidence if e.name == "banded_chaos")
     named = [n for n, vote in votes.items() if vote in ("periodic", "quasiperiodic")]
     assert named and f"outweighs the {', '.join(named)} vote(s)" in band.detail
+
+
+def _kicks(returns_at):
+    """A stand-in for kick_test: returns (or not) at the steps in ``returns_at`` (dt
+    divisors), the unkicked motion periodic."""
+    from chaoscam.tangent import KickTest
+
+    def kick(p, x, n, **kw):
+        f = round(Params().dt / p.dt)
+        growth = np.full((2, 4, 41), 0.01 if f in returns_at else 0.5)
+        pts = np.tile([[0.1, 2.0]], (40 * n + 1, 1))
+        return KickTest(kw["kicks"], n, 40, 30.0, growth, f in returns_at, pts)
+
+    return kick
+
+
+def _unstable_everywhere(monkeypatch, returns_at):
+    from chaoscam import _certify
+
+    def shoot(p, x, n, **kw):
+        return dataclasses.replace(_orbit([[0.1, 2.0]]), multipliers=np.array([2.0, 0.1]))
+
+    monkeypatch.setattr(_certify, "periodic_orbit", shoot)
+    monkeypatch.setattr(_certify, "iterate_map", lambda p, x, n: np.tile([0.1, 2.0], (n + 1, 1)))
+    monkeypatch.setattr(_certify, "kick_test", _kicks(returns_at))
+    rng = np.random.default_rng(1)
+    return np.array([0.1, 2.0]) + 1e-9 * rng.standard_normal((40, 2))
+
+
+def test_kicks_that_return_at_both_steps_certify_an_orbit_the_multipliers_call_unstable(
+    monkeypatch,
+):
+    """Newton's orbit is unstable on the grid and at every refined step, the run lies on it,
+    and finite kicks return at dt and dt/2: certified, by kicks (the map's derivative is not
+    the judge below its event jitter), with a record per step."""
+    from chaoscam import _certify
+
+    run = _unstable_everywhere(monkeypatch, returns_at=(1, 2))
+    extra: dict = {}
+    cert = _certify.certify(Params(), run, 1, extra)
+    assert cert.certified and cert.kicked and cert.refined, cert.detail
+    assert [r["dt"] for r in extra["kick_test"]] == [Params().dt, Params().dt / 2]
+    assert "kicks of 1e-07, 1e-06 rad return" in cert.detail
+
+
+def test_kicks_that_return_on_the_grid_alone_certify_nothing(monkeypatch):
+    """Kicks return at dt but not at dt/2: the attraction is the grid's (as at xi = 0.525),
+    and the orbit stays unstable."""
+    from chaoscam import _certify
+
+    run = _unstable_everywhere(monkeypatch, returns_at=(1,))
+    extra: dict = {}
+    cert = _certify.certify(Params(), run, 1, extra)
+    assert cert.status == "unstable" and not cert.kicked
+    assert [r["returns"] for r in extra["kick_test"]] == [True, False]
+    assert "do not return" in cert.detail
+
+
+def test_no_kicks_for_a_run_that_keeps_away_from_the_orbit(monkeypatch):
+    """Chaotic bands around an unstable orbit (the run 1e-4 rad from it) cost no kicks."""
+    from chaoscam import _certify
+
+    run = _unstable_everywhere(monkeypatch, returns_at=(1, 2)) + np.array([1e-4, 0.0])
+    extra: dict = {}
+    cert = _certify.certify(Params(), run, 1, extra)
+    assert not cert.certified and "kick_test" not in extra
+
+
+def test_kicks_decide_an_orbit_certified_on_the_grid_alone(monkeypatch):
+    """Newton certifies the orbit at dt but not at dt/2 ("step-dependent"): kicks that return
+    at both steps certify it; kicks that return at dt only leave it step-dependent."""
+    from chaoscam import _certify
+
+    def shoot(p, x, n, **kw):
+        mu = [0.5, 0.1] if p.dt == Params().dt else [2.0, 0.1]
+        return dataclasses.replace(_orbit([[0.1, 2.0]]), multipliers=np.array(mu))
+
+    run = _unstable_everywhere(monkeypatch, returns_at=(1, 2))
+    monkeypatch.setattr(_certify, "periodic_orbit", shoot)
+    cert = _certify.certify(Params(), run, 1, {})
+    assert cert.certified and cert.kicked, cert.detail
+    monkeypatch.setattr(_certify, "kick_test", _kicks((1,)))
+    assert _certify.certify(Params(), run, 1, {}).status == "step-dependent"
