@@ -141,6 +141,11 @@ def lyapunov_spectrum(
 # --- periodic orbits ------------------------------------------------------------------------
 
 
+MAP_ROWS = 64
+"""Cam periods of the map at most per compiled call (then the driver hands back: the same
+bits, and a sweep asked to stop sees it; at dt = 2.5e-8 s a call is then a few seconds)."""
+
+
 class _MapRunner:
     """n iterates of the stroboscopic map of a deterministic model, from t = 0, with DP^n."""
 
@@ -157,7 +162,9 @@ class _MapRunner:
         self.n = n
         self.n_stop = int(math.floor(n * p.cam_period / p.dt)) + 2
         self.lam = np.full(4096, p.l_lambda)
-        self.buffers = Buffers.empty(1, n + 4 + int(p.dt / p.cam_period), 4096)
+        # At most MAP_ROWS section rows a call: the driver hands back (and a stop request is
+        # seen) every MAP_ROWS cam periods, even on an orbit with few impacts.
+        self.buffers = Buffers.empty(1, min(n, MAP_ROWS) + 4 + int(p.dt / p.cam_period), 4096)
         self.c = kernel_constants(self.p, tangent=tangent)
         self.calls = 0
 

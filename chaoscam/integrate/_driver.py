@@ -369,7 +369,9 @@ def drive(
     with, and must leave ``cnt[I_LAM_POS]`` pointing at the draw in use in them. ``run`` is
     the compiled call (:func:`run_one`; the two-trajectory exponent passes
     :func:`._kernel.run_chunk`, the same RK4 kernel without the one-member batch, and the
-    periodic-orbit shooting :func:`alone_kernel`'s pick).
+    periodic-orbit shooting :func:`alone_kernel`'s pick). On a sweep's thread asked to stop
+    (:func:`members_on_this_thread`), the next call raises :class:`StopRequested`: a
+    verdict's shooting and kicks stop within one call, not at the end of the member.
     """
     code = k.NEED_BUFFER
     before = (0.0, 0)  # (time, draw in use) when the last call began
@@ -377,6 +379,7 @@ def drive(
 
     def launch(need: np.ndarray) -> np.ndarray:
         nonlocal code, before, filled
+        check_stop()  # a sweep thread asked to stop: between two calls (a verdict's shooting)
         before = (y[k.Y_TIME], cnt[k.I_LAM_POS])
         code = run(y, cnt, c, n_stop, lam, buffers.series, buffers.section, buffers.impacts)
         filled = False

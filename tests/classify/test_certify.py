@@ -5,6 +5,7 @@ checked against the model"): each case is one the classifier got wrong before th
 import dataclasses
 
 import numpy as np
+import pytest
 
 from chaoscam import Params, simulate
 from chaoscam._certify import APPROACH, MODEL_ATOL, _sharp_doubling, on_orbit
@@ -231,6 +232,27 @@ def test_an_orbit_of_the_grid_alone_is_step_dependent_and_not_extended():
         and "rerun with dt = 5e-07 s" in step.detail
     )
     assert "extended" not in v.settings
+    # Finite kicks agree: they return at dt (the grid's attraction) and not at dt/2.
+    kicks = v.settings["kick_test"]
+    assert [r["returns"] for r in kicks] == [True, False], kicks
+    assert "do not return" in step.detail
+
+
+@pytest.mark.slow
+def test_kicks_certify_a_period_8_whose_multipliers_read_unstable():
+    """Fig. 4's l_lambda = 16.75 mm at its step (3.8e-7 s): the run approaches a period-8
+    orbit that Newton finds unstable at dt and dt/2 (|mu|max 2.0, 2.3), where 300 s runs at
+    dt and dt/2 keep 8 bands of 2.4e-6 rad (lambda_1 = +0.15 +- 0.08 and -0.05 +- 0.06 1/s):
+    periodic 8 to the band tolerance. Kicks of 1e-7 and 1e-6 rad return at both steps (to
+    0.014 and 0.012 of themselves): periodic 8, certified by kicks. It was undetermined."""
+    traj = simulate(
+        Params(l_lambda=0.01675, dt=3.8e-7), duration=20.0, transient=10.0, tangent=True
+    )
+    v = classify_trajectory(traj)
+    assert (v.label, v.period) == ("periodic", 8), v.reasons
+    orbit = {e.name: e for e in v.evidence}["periodic_orbit"]
+    assert orbit.vote == "periodic" and "kicks of 1e-07, 1e-06 rad return" in orbit.detail
+    assert all(r["returns"] for r in v.settings["kick_test"])
 
 
 def test_banded_chaos_names_the_votes_it_outweighs():
