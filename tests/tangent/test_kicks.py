@@ -31,12 +31,18 @@ def test_kicks_tell_attracting_orbits_from_chaos(changes, n, returns):
     dt, largest separation over kick at the end: <= 5e-5 and 5e-4 for the orbits, 0.67 for the
     chaos, where some 1e-8 kicks grow 7x)."""
     p = Params(**changes)
-    test = kick_test(p, _settled_point(p), n)
+    x = _settled_point(p)
+    test = kick_test(p, x, n)
     assert test.returns is returns
-    assert test.growth.shape == (3, 4, 41)
+    assert test.growth.shape == (3, 4, 41) and test.points.shape == (40 * n + 1, 2)
     assert np.allclose(test.growth[:, :, 0], 1.0, rtol=1e-6)  # the kicks, in the scaled norm
     if not returns:
         assert test.growth[:, :, -1].max() > 1.0  # some kick grows
+    # Stopping at the first refusal gives the same answer, with the same bits where it ran.
+    short = kick_test(p, x, n, until_refused=True)
+    ran = ~np.isnan(short.growth)
+    assert short.returns is returns and np.array_equal(short.growth[ran], test.growth[ran])
+    assert bool(ran.all()) is returns  # all run when they return; some skipped when refused
 
 
 def test_bad_arguments_name_themselves():
