@@ -42,6 +42,7 @@ __all__ = [
     "MAX_DOUBLINGS",
     "MODEL_ATOL",
     "CONFIRM_REFINE",
+    "KICK_MIN_PERIODS",
     "KICK_SIZES",
     "KICK_STEPS",
     "ORBIT_REFINE",
@@ -131,6 +132,13 @@ KICK_STEPS = (1, 2)
 """Step divisors at which the kick certificate (:func:`_kicked`) asks finite perturbations
 to return: the run's step and half of it (as :data:`CONFIRM_REFINE` asks of Newton's orbit;
 an attraction of the grid alone is the step's)."""
+
+KICK_MIN_PERIODS = 8
+"""Orbit periods the run's own section must hold before kicks are asked (``len(points) >=
+KICK_MIN_PERIODS * n``, as :func:`on_orbit` needs 8n points to see a run approach): the kicks
+follow 40 orbit periods, 9 runs at dt and 9 at dt/2, so on a short window they cost tens of
+times the run (the quick report's Fig. 6, 4 s recorded at dt = 2e-7 s: 110 s instead of
+10 s); a classifier that extends an undetermined run asks them on the longer one."""
 
 KICK_SIZES = (1e-7, 1e-6)
 """Kick sizes [rad] of the kick certificate: the sizes that decide
@@ -250,6 +258,8 @@ def certify(
         detail += "; " + summary
         if again == "certified":
             return Certificate("certified", n, orbit, detail)
+        if len(points) < KICK_MIN_PERIODS * n:
+            return Certificate("step-dependent", n, orbit, detail)
         kicked, summary = _kicked(p, points, n, extra)
         detail += "; " + summary
         if kicked:
@@ -310,7 +320,8 @@ def certify(
         if status2 == "certified":
             return Certificate("certified", twice.period, twice.orbit, detail, True)
     stalled = orbit.converged or orbit.residual <= MODEL_ATOL
-    if confirm and status in KICKED and sits and stalled:
+    long_enough = len(points) >= KICK_MIN_PERIODS * n
+    if confirm and status in KICKED and sits and stalled and long_enough:
         # The multipliers left it open, the run lies on the orbit or approaches it: finite
         # perturbations decide.
         kicked, summary = _kicked(p, points, n, extra)

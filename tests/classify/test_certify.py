@@ -352,3 +352,15 @@ def test_kicks_decide_an_orbit_certified_on_the_grid_alone(monkeypatch):
     assert cert.certified and cert.kicked, cert.detail
     monkeypatch.setattr(_certify, "kick_test", _kicks((1,)))
     assert _certify.certify(Params(), run, 1, {}).status == "step-dependent"
+
+
+def test_a_run_shorter_than_8_orbit_periods_asks_no_kicks(monkeypatch):
+    """Kicks follow 40 orbit periods at dt and dt/2: a run of fewer than 8 orbit periods
+    (KICK_MIN_PERIODS) is not kicked; it stays unstable (a classifier that extends asks them
+    on the longer run)."""
+    from chaoscam import _certify
+
+    run = _unstable_everywhere(monkeypatch, returns_at=(1, 2))[:7]
+    extra: dict = {}
+    cert = _certify.certify(Params(), run, 1, extra)
+    assert cert.status == "unstable" and "kick_test" not in extra
