@@ -2,17 +2,18 @@
 
 The sweeps step-check chaotic, periodic and quasiperiodic verdicts (``check_step``), but a run
 that leaves the cam's reach is labelled by its status (``left_reach``) and not re-run. This
-script re-runs every ``left_reach`` run of the committed report's (omega, xi) map and xi sweep
-(reports/paper-data) alone (:func:`chaoscam.sweep.replay_params`: the sweep's own parameters,
-seed and index) at dt, dt/2 and dt/4 for 300 s (the report's fate horizon) and prints, per
-run, the time it left at each step, then how many leave within the sweep's 20 s window and
-how many only later.
+script re-runs every ``left_reach`` run of the full report's (omega, xi) map and xi sweep
+(reports/paper-data, written by ``chaoscam paper``; not in the repository) alone
+(:func:`chaoscam.sweep.replay_params`: the sweep's own parameters, seed and index) at dt,
+dt/2 and dt/4 for 300 s (the report's fate horizon) and prints, per run, the time it left at
+each step, then how many leave within the sweep's 20 s window and how many only later.
 
 Usage: python analyses/escape_step.py   (about a minute on 2 cores)
 """
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 from chaoscam import simulate
@@ -36,6 +37,9 @@ def _rows():
 
 
 def main() -> None:
+    for name in ("sensitivity-omega-xi.parquet", "sensitivity-xi.parquet"):
+        if not (DATA / name).is_file():
+            sys.exit(f"{DATA / name}: no such file; run `chaoscam paper` (the full report) first")
     print("| run | left at dt, dt/2, dt/4 [s] (stayed: -) |")
     print("|---|---|")
     window = later = stayed = total = 0
