@@ -1,6 +1,6 @@
 """Where a GPU ensemble's time goes: launches against refills, per buffer room and layout.
 
-Run: python benchmarks/bench_gpu_profile.py [--budget SECONDS]
+Run: python benchmarks/bench_gpu_profile.py [--budget SECONDS] [--plan scaling|layouts]
 
 A member stops for a refill whenever its line-length draws or impact rows (the room,
 ``_ensemble._ROOM["gpu"]``) run out, and each stop is a relaunch of the batch, in which the
@@ -9,10 +9,15 @@ The members' memory order on the device (``_gpu.GPU_LAYOUT``: "C", a member's ro
 or "F", a field of consecutive members contiguous, which coalesces a warp's reads but took
 255 registers with spills against 196 in ptxas 12.9) is the other choice compared.
 For each (members, duration, room, layout) it prints the wall time, the number of launches,
-the time in launches and in refills, and the rate. Short runs first; a configuration whose
-time, estimated from the one before it as if time grew with members x duration (an
-overestimate while the device is not full), would pass ``--budget`` seconds in all is
-skipped with a note.
+the time in launches and in refills, and the rate.
+
+Plans: "scaling" (the default) asks where a full device's time goes (33,792 members x 0.5 s
+took 140 s on an H200 in the staged layout, 2026-11-27, against 1.3-1.6 s for 64 members):
+one full wave (132 x 256 members: 4 blocks, 8 warps, a multiprocessor), one block a
+multiprocessor, one block, each 0.25 s, then the full wave with 32x the room (one launch),
+none skipped. "layouts", the earlier plan: short runs first, and a configuration whose time,
+estimated from the one before it as if time grew with members x duration (an overestimate
+while the device is not full), would pass ``--budget`` seconds in all is skipped with a note.
 """
 
 from __future__ import annotations
@@ -85,6 +90,15 @@ def _compiled(p) -> list[str]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--budget", type=float, default=150.0, help="seconds in all")
+    ap.add_argument(
+        "--plan",
+        choices=("scaling", "layouts"),
+        default="scaling",
+        help="scaling: one full wave of an H200 (132 x 256 members), one block a "
+        "multiprocessor and one block, 0.25 s each, then the full wave with 32x the room, "
+        "in the 'C' layout, none skipped (the caller's time limit stops it); layouts: the "
+        "earlier plan over layouts, room and length, skipped by estimate",
+    )
     args = ap.parse_args()
     ok, reason = _gpu.gpu_status()
     if not ok:
@@ -95,7 +109,12 @@ def main() -> None:
     layouts = _compiled(p)
     small, big = _ensemble._ROOM["gpu"], (16_384, 4_096)
     # the open questions first: each layout at a full device, then the room, then length
-    plan = [
+    full, per_sm = 132 * 256, 132 * 64  # an H200 at 8 warps, and at 2, a multiprocessor
+    scaling = [
+        (full, 0.25, small, "C"), (per_sm, 0.25, small, "C"), (64, 0.25, small, "C"),
+        (full, 0.25, big, "C"),
+    ]  # fmt: skip
+    plan = scaling if args.plan == "scaling" else [
         (64, 0.5, small, "C"), (64, 0.5, small, "F"),
         (8_192, 0.5, small, "C"), (8_192, 0.5, small, "F"),
         (40_000, 0.5, small, "C"), (40_000, 0.5, small, "F"),
@@ -111,7 +130,7 @@ def main() -> None:
         if layout not in layouts:
             continue
         what = f"{members:>6,} x {duration:>4g} s, room {room}, layout {layout}"
-        if last is not None:
+        if last is not None and args.plan == "layouts":
             guess = last[0] * members / last[1] * duration / last[2]
             if guess > args.budget - (time.perf_counter() - start):
                 print(f"skipped {what}: about {guess:.0f} s")

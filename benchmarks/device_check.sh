@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Issue 13's GPU checks in one call on a lent NVIDIA machine (run from the repository root).
 #
-#   bash benchmarks/device_check.sh [WHEELS]     (about 7 minutes)
+#   bash benchmarks/device_check.sh [WHEELS]     (about 7 minutes; results in $OUT)
 #
 # WHEELS (default .whl) holds cp312 wheels of what the device's image lacks: nolds and future
 # (chaoscam's dependencies) and numpy 2.4 (numba-cuda 0.30 compiles no kernel under numpy 2.5,
@@ -9,19 +9,26 @@
 # Made where pip works (the device reaches no index), e.g.
 #   pip download --no-deps --only-binary=:all: --python-version 3.12 --implementation cp \
 #     --platform manylinux_2_28_x86_64 -d .whl nolds==0.6.2 future==1.0.0 numpy==2.4.6
-# Steps, most important first: versions; whether the image's own numba-cuda compiles a kernel
-# under its numpy; then in one Python process (the GPU kernels compiled once), under one time
-# limit (CHECK_SECONDS, default 300): the rate against members, layout ("C" rows or "F"
-# member-minor, and whether they give the same sections) and buffer room (bench_gpu_profile.py,
-# up to 40,000 members within a 90 s budget), the device tests (tests/integrate/test_gpu.py
-# -m gpu, both layouts), and with RUN_MAP=1 a regime map on the GPU against the 2-core
-# engines (bench_regime_gpu.py, about 140 s, measured once already); last, where ncu can read
-# the counters, an Nsight Compute profile of one short launch (gpu_ncu_target.py;
-# NCU_SECONDS, default 120): how much of each warp runs (branch divergence), occupancy, memory
-# traffic and what the warps wait on. About 7 minutes in all without the map. bench_gpu.py's
-# 40,000 x 20 s did not finish in 340 s on an H200 (2026-11-27): run it alone, with a longer
-# limit, once the profile says it can.
-set -u
+# Steps: versions (the image's numba-cuda under its own numpy 2.5 compiles no kernel: seen on
+# an H200, 2026-11-27); then, under one time limit (CHECK_SECONDS, default 240), where a full
+# device's time goes (bench_gpu_profile.py --plan scaling: a full wave, a block a
+# multiprocessor and one block, 0.25 s each, then the full wave in one launch, each split into
+# launches and host refills); with RUN_TESTS=1 the device tests; last, where ncu can read the
+# counters (NCU_SECONDS each, default 90), two Nsight Compute profiles of one launch: a full
+# wave (33,792 members x 0.02 s) with a one-pass set of counters (active threads a warp,
+# warps resident, issue rate, cache hit rates, memory throughput), then 1,024 members x
+# 0.05 s with the full sections (stall reasons, occupancy, launch statistics). Outputs go to
+# $OUT where it is set (profile.log, ncu_*.txt). About 7 minutes in all.
+#
+# Measured 2026-11-27 (H200, two calls): the RK4 kernel ("C", 216 registers) ran 2.16 of a
+# warp's 32 threads at a time over 1,024 members' first launch (0.05 s), issuing every 6.2
+# cycles with one warp a scheduler (L1 hit rate 99.8 %, memory 0.3 % busy); but in that
+# launch every member stopped for a refill at its own time (256 impact rows; 811 impacts in
+# the first 0.05 s), so idle lanes count with divergent ones: gpu_ncu_target.py now gives
+# the room for one launch. 33,792 members x 0.5 s took 140 s staged in thread-local arrays
+# and 145 s with a block barrier after every loop iteration (branch wip/gpu-variants),
+# against 1.3-1.6 s for 64 members: where the full device's time goes is the first question.
+set -u -o pipefail
 WHEELS=${1:-.whl}
 export PYTHONUNBUFFERED=1
 step() { echo; echo "== $* ($(date -u +%T))"; }
@@ -31,71 +38,46 @@ nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=c
 python3 -c "import sys, numpy, numba; print('python', sys.version.split()[0], '| numpy', numpy.__version__, '| numba', numba.__version__)"
 python3 -m pip list 2>/dev/null | grep -iE '^(numba|numba-cuda|cuda-bindings|cuda-python|llvmlite|scipy|pandas|pyarrow|seaborn|matplotlib|jinja2|tqdm) '
 
-step "the image's numba-cuda under its own numpy: a trivial kernel"
-timeout -k 5 90 python3 - <<'PY'
-import numpy as np
-from numba import cuda
-
-@cuda.jit
-def add(a):
-    i = cuda.grid(1)
-    if i < a.size:
-        a[i] += 1.0
-
-a = cuda.to_device(np.zeros(64))
-add[1, 64](a)
-print("compiled and ran:", a.copy_to_host().sum() == 64.0)
-PY
-echo "exit $?"
-
 step "wheels: nolds, future, numpy 2.4 (--target, ahead of the image's)"
 python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --target /tmp/site \
     "$WHEELS"/nolds-*.whl "$WHEELS"/future-*.whl "$WHEELS"/numpy-*.whl || exit 1
 export PYTHONPATH=/tmp/site:$PWD
 python3 -c "import numpy, numba, chaoscam; from chaoscam.integrate._gpu import gpu_status; print('numpy', numpy.__version__, '| numba', numba.__version__, '|', gpu_status())"
 
-step "bench_gpu_profile, device tests (and the regime map with RUN_MAP=1): one process"
-timeout -k 5 "${CHECK_SECONDS:-300}" python3 - <<'PY'
-import os
-import runpy
-import sys
-import time
-import traceback
-
-import pytest
-
-T0 = time.perf_counter()
-
-
-def run(script, *argv):
-    print(f"-- {script} {' '.join(argv)} at {time.perf_counter() - T0:.0f} s", flush=True)
-    sys.argv = [script, *argv]
-    try:
-        runpy.run_path(script, run_name="__main__")
-    except Exception:
-        traceback.print_exc()
-
-
-run("benchmarks/bench_gpu_profile.py", "--budget", "90")
-code = pytest.main(["-q", "-p", "no:cacheprovider", "-m", "gpu", "tests/integrate/test_gpu.py"])
-print(f"-- device tests: pytest exit {int(code)} at {time.perf_counter() - T0:.0f} s")
-if os.environ.get("RUN_MAP") == "1":  # measured 2026-11-27: about 140 s, whatever the size
-    run("benchmarks/bench_regime_gpu.py", "--realizations", "256", "--reference", "4")
-PY
+OUTDIR=${OUT:-/tmp}
+step "where a full device's time goes (bench_gpu_profile.py --plan scaling, CHECK_SECONDS)"
+timeout -k 5 "${CHECK_SECONDS:-240}" python3 benchmarks/bench_gpu_profile.py --plan scaling \
+    2>&1 | tee "$OUTDIR/profile.log"
 echo "exit $?"
 
-step "Nsight Compute: one launch of 1,024 members x 0.05 s (warp efficiency, occupancy, stalls)"
-if ! command -v ncu >/dev/null 2>&1; then
-    echo "ncu not on the PATH: skipped"
-elif [ "$(id -u)" != 0 ] && grep -q "RmProfilingAdminOnly: 1" /proc/driver/nvidia/params 2>/dev/null; then
-    echo "GPU counters are for root only here: skipped"
-else
-    timeout -k 5 "${NCU_SECONDS:-120}" ncu --target-processes all -k regex:advance_members \
-        --launch-skip 1 --launch-count 1 --section SpeedOfLight --section Occupancy \
-        --section LaunchStats --section WarpStateStats --section SchedulerStats \
-        --section MemoryWorkloadAnalysis \
-        --metrics smsp__thread_inst_executed_per_inst_executed.ratio,smsp__sass_thread_inst_executed_op_dfma_pred_on.sum \
-        python3 benchmarks/gpu_ncu_target.py
+if [ "${RUN_TESTS:-0}" = 1 ]; then
+    step "device tests (tests/integrate/test_gpu.py -m gpu)"
+    timeout -k 5 300 python3 -m pytest -q -p no:cacheprovider -m gpu tests/integrate/test_gpu.py
     echo "exit $?"
+fi
+
+ncu_run() {  # a name for the output, then ncu's options and the target
+    local name=$1
+    shift
+    timeout -k 5 "${NCU_SECONDS:-90}" ncu --clock-control none --target-processes all \
+        -k regex:advance_members --launch-skip 1 --launch-count 1 "$@" 2>&1 \
+        | tee "$OUTDIR/ncu_$name.txt"
+    echo "exit $?"
+}
+FULL_METRICS=smsp__thread_inst_executed_per_inst_executed.ratio,\
+sm__warps_active.avg.per_cycle_active,smsp__issue_active.avg.per_cycle_active,\
+smsp__inst_executed.sum,sm__cycles_active.avg,gpu__time_duration.sum,\
+l1tex__t_sector_hit_rate.pct,lts__t_sector_hit_rate.pct,\
+dram__throughput.avg.pct_of_peak_sustained_elapsed,launch__registers_per_thread
+if command -v ncu >/dev/null 2>&1; then
+    step "Nsight Compute: a full wave's first launch (33,792 members x 0.02 s), one pass"
+    ncu_run full --metrics "$FULL_METRICS" python3 benchmarks/gpu_ncu_target.py 33792 0.02
+    step "Nsight Compute: 1,024 members x 0.05 s, full sections"
+    ncu_run sections --section SpeedOfLight --section Occupancy --section LaunchStats \
+        --section WarpStateStats --section SchedulerStats --section MemoryWorkloadAnalysis \
+        --metrics smsp__thread_inst_executed_per_inst_executed.ratio \
+        python3 benchmarks/gpu_ncu_target.py 1024 0.05
+else
+    echo "ncu not on the PATH: skipped"
 fi
 step done
