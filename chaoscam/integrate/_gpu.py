@@ -29,7 +29,11 @@ Measured on an NVIDIA H200 (2026-11-27, ``benchmarks/device_check.sh``): the tol
 tests pass; the RK4 kernel takes 202 registers and 40 B of local memory a thread; but one
 thread takes 4.8 us a grid step over the first 0.5 s, hundreds of times a CPU core, and
 40,000 members of 20 s took more than 340 s (below 120 trajectories a second; a 1,024-run
-regime map ran as fast as 2 CPU cores). See the README's "Ensembles and the GPU".
+regime map ran as fast as 2 CPU cores). A second session (2026-11-27): 33,792 members x
+0.5 s took 140 s with the member's rows staged in registers, 145 s with the warp's threads
+meeting after every loop iteration (branch ``wip/gpu-variants``), about half the speed of 2
+CPU cores; one launch ran 2.16 of a warp's 32 threads at a time, not waiting on memory.
+See the README's "Ensembles and the GPU" and benchmarks/PROFILE.md.
 
 numba-cuda is imported lazily, on first use: ``import chaoscam`` never imports it.
 """
