@@ -1,6 +1,7 @@
 """What a GPU warp would make of the RK4 ensemble kernel's work, modelled on the CPU.
 
 Run: python benchmarks/gpu_warp_model.py [DURATION]   (default 4 s; about 10 s)
+     python benchmarks/gpu_warp_model.py --tail [MEMBERS]   (default 8,192; about 50 s)
 
 A warp runs 32 members in SIMT: in a step of the kernel's loop, a member in merged free
 flight, one in a contact step and one locating an impact take different branches, and the
@@ -29,6 +30,12 @@ after the first half second, 1.8 % and 20 % in it); equal-units bound 0.64-0.97 
 noisiest figure: one interruption moves a member's total). Nsight Compute on an H200 read
 2.16 threads active of 32 for the RK4 kernel over its first 0.05 s, a launch in which each
 member also stopped for a refill at its own time (PROFILE.md).
+
+``--tail``: the spread of whole members' costs over 0.5 s, which sets how long a launch of one
+thread a member waits for its slowest. Measured here (2026-11-27, two runs, the machine
+otherwise idle; a run beside the test suite gave a false 41x): 8,192 members, median
+12.3-12.9 Mcycles, p99 28.3-29.4, max 44.8-59.8 (3.6-4.6x the median); a group's slowest
+against its mean: 1.86-1.88 (32), 1.91-1.94 (64), 2.98-3.11 (2,048).
 """
 
 from __future__ import annotations
@@ -98,6 +105,50 @@ def _aligned(values: np.ndarray, inside: np.ndarray) -> np.ndarray:
     return out
 
 
+@njit
+def _whole_runs(y, cnt, c, n_stop, lam, section, impacts, cost):
+    """Each member's whole run in cycles (buffers only counted); -1 if out of draws."""
+    series = np.empty((1, k.SERIES_COLS))
+    for j in range(y.shape[0]):
+        t0 = _cycles()
+        while True:
+            code = k.run_chunk(y[j], cnt[j], c[j], n_stop, lam[j], series, section[j], impacts[j])
+            if code != k.NEED_BUFFER:
+                cost[j] = _cycles() - t0
+                break
+            if cnt[j, k.I_LAM_POS] > lam.shape[1] - 64:
+                cost[j] = -1
+                break
+            cnt[j, k.I_N_IMPACT] = 0
+            cnt[j, k.I_N_SECTION] = 0
+
+
+def tail(members: int, duration: float = 0.5) -> None:
+    """The spread of whole members' costs: a launch of one thread a member lasts as long as
+    its slowest member, so a full device waits for the dearest of tens of thousands."""
+    p = Params(l_lambda_sigma=0.002)
+    cost = np.zeros(members, np.int64)
+    for s0 in range(0, members, 2048):
+        m = min(2048, members - s0)
+        st = fresh([p] * m, list(range(s0, s0 + m)), 1, duration, 0.0, False, (8192, 4096))
+        section = np.empty((m, 64, k.SECTION_COLS))
+        impacts = np.empty((m, 4096, k.IMPACT_COLS))
+        n_stop = int(round(duration / p.dt))
+        _whole_runs(st.y, st.cnt, st.c, n_stop, st.lam, section, impacts, cost[s0 : s0 + m])
+    if (cost < 0).any():
+        raise SystemExit("a member ran out of draws: enlarge the room")
+    mc = cost / 1e6
+    q = np.percentile(mc, [50, 90, 99, 99.9])
+    print(
+        f"{members:,} members x {duration:g} s, Mcycles a member: median {q[0]:.1f}, p90 "
+        f"{q[1]:.1f}, p99 {q[2]:.1f}, p99.9 {q[3]:.1f}, max {mc.max():.1f} "
+        f"({mc.max() / q[0]:.1f}x the median)"
+    )
+    for size in (WARP, 64, 2048):
+        g = mc[: members // size * size].reshape(-1, size)
+        print(f"  groups of {size}: slowest / mean {(g.max(1) / g.mean(1)).mean():.2f}")
+
+
 def main(duration: float = 4.0) -> None:
     p = Params(l_lambda_sigma=0.002)
     start = fresh([p] * WARP, list(range(WARP)), 1, duration, 0.0, False, (200_000, 4096))
@@ -139,4 +190,7 @@ def main(duration: float = 4.0) -> None:
 
 
 if __name__ == "__main__":
-    main(*(float(a) for a in sys.argv[1:2]))
+    if sys.argv[1:2] == ["--tail"]:
+        tail(int(sys.argv[2]) if len(sys.argv) > 2 else 8192)
+    else:
+        main(*(float(a) for a in sys.argv[1:2]))
