@@ -15,9 +15,9 @@
 # multiprocessor and one block, 0.25 s each, then the full wave in one launch, each split into
 # launches and host refills); with RUN_TESTS=1 the device tests; last, where ncu can read the
 # counters (NCU_SECONDS each, default 90), two Nsight Compute profiles of one launch: a full
-# wave (33,792 members x 0.02 s) with a one-pass set of counters (active threads a warp,
-# warps resident, issue rate, cache hit rates, memory throughput), then 1,024 members x
-# 0.05 s with the full sections (stall reasons, occupancy, launch statistics). Outputs go to
+# wave (33,792 members x 0.02 s) with every stall reason (instruction fetch among them),
+# active threads a warp and occupancy, then 1,024 members x 0.05 s with the full sections
+# (memory, launch statistics). Outputs go to
 # $OUT where it is set (profile.log, ncu_*.txt). About 7 minutes in all.
 #
 # Measured 2026-11-27 (H200, two calls): the RK4 kernel ("C", 216 registers) ran 2.16 of a
@@ -64,14 +64,14 @@ ncu_run() {  # a name for the output, then ncu's options and the target
         | tee "$OUTDIR/ncu_$name.txt"
     echo "exit $?"
 }
-FULL_METRICS=smsp__thread_inst_executed_per_inst_executed.ratio,\
-sm__warps_active.avg.per_cycle_active,smsp__issue_active.avg.per_cycle_active,\
-smsp__inst_executed.sum,sm__cycles_active.avg,gpu__time_duration.sum,\
-l1tex__t_sector_hit_rate.pct,lts__t_sector_hit_rate.pct,\
-dram__throughput.avg.pct_of_peak_sustained_elapsed,launch__registers_per_thread
 if command -v ncu >/dev/null 2>&1; then
-    step "Nsight Compute: a full wave's first launch (33,792 members x 0.02 s), one pass"
-    ncu_run full --metrics "$FULL_METRICS" python3 benchmarks/gpu_ncu_target.py 33792 0.02
+    # every stall reason (--print-details all): a kernel of some 30,000 PTX lines may stall
+    # on instruction fetch once 8 warps a multiprocessor run different parts of it
+    step "Nsight Compute: a full wave's launch (33,792 members x 0.02 s), stall reasons"
+    ncu_run full --section SpeedOfLight --section WarpStateStats --section SchedulerStats \
+        --section Occupancy --print-details all \
+        --metrics smsp__thread_inst_executed_per_inst_executed.ratio,smsp__inst_executed.sum \
+        python3 benchmarks/gpu_ncu_target.py 33792 0.02
     step "Nsight Compute: 1,024 members x 0.05 s, full sections"
     ncu_run sections --section SpeedOfLight --section Occupancy --section LaunchStats \
         --section WarpStateStats --section SchedulerStats --section MemoryWorkloadAnalysis \
