@@ -30,11 +30,13 @@ from chaoscam.integrate import _ensemble, _gpu, simulate_ensemble
 
 
 class _Clock:
-    """Seconds spent in ``drive_members``' launches and refills, and the launches made."""
+    """Seconds spent in ``drive_members``' launches and refills, the launches made, and each
+    launch's (members launched, seconds)."""
 
     def __init__(self) -> None:
         self.launch = self.refill = 0.0
         self.launches = 0
+        self.each: list[tuple[int, float]] = []
 
     def _timed(self, fn, field: str):
         def timed(x):
@@ -50,7 +52,10 @@ class _Clock:
         def timed(n, launch, refill, need=None):
             def counted(x):
                 self.launches += 1
-                return launch(x)
+                t0 = time.perf_counter()
+                codes = launch(x)
+                self.each.append((len(x), time.perf_counter() - t0))
+                return codes
 
             return drive(n, self._timed(counted, "launch"), self._timed(refill, "refill"), need)
 
@@ -146,6 +151,8 @@ def main() -> None:
             f"traj/s); {c.launches} launches {c.launch:.2f} s, refills {c.refill:.2f} s",
             flush=True,
         )
+        each = ", ".join(f"{m:,} members {t:.2f} s" for m, t in c.each[:12])
+        print(f"    launches: {each}{' ...' if len(c.each) > 12 else ''}", flush=True)
     if len(sections) == 2:
         a, b = sections["C"], sections["F"]
         same = a.shape == b.shape and bool((a == b).all())
