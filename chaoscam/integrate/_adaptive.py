@@ -305,7 +305,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             (budget > 0 and taken > budget)
             or cnt[I_N_SERIES] + samples_per_step > series.shape[0]
             or cnt[I_N_SECTION] + 2 > section.shape[0]
-            or cnt[I_N_IMPACT] + 2 > impacts.shape[0]
+            or 0 < impacts.shape[0] < cnt[I_N_IMPACT] + 2  # (no rows: counted only)
             or cnt[I_LAM_POS] + 3 >= lam.shape[0]
         ):
             return leave(y, cnt, th, om, t, h, events, window, surf, NEED_BUFFER, c)

@@ -39,13 +39,15 @@ if TYPE_CHECKING:
 __all__ = ["BACKENDS", "Ensemble", "extend_ensemble", "simulate_ensemble"]
 
 _ROOM = {"cpu": (2048, 2048), "gpu": (512, 256)}
-"""Room per member and launch, on each backend: (line-length draws, impact rows; the rows
-are only counted, unless impacts are kept). A member stops for a refill when either runs
-out (a 20 s run of Table 1 applies ~15,000 impacts, most of them the micro-impacts of
-chattering, each with a draw under resample="impact"), and every stop is a relaunch, where
-the CPU's threads wait for the slowest member: 2048 of each cut a regime map's kernel time
-by 6 % against 512 and 256 (measured on 2 cores), for 144 KiB a member (150 MB for a batch
-of 1024). The GPU keeps the small room: its batches hold tens of thousands of members."""
+"""Room per member and launch, on each backend: (line-length draws, impact rows). Impact
+rows are used only when impacts are kept (``keep_impacts``); otherwise the kernel counts the
+impacts in a buffer of no rows and a member stops only when its draws run out. A member
+stops for a refill when either runs out (a 20 s run of Table 1 applies ~15,000 impacts,
+most of them the micro-impacts of chattering, each with a draw under resample="impact"),
+and every stop is a relaunch, where the CPU's threads wait for the slowest member: 2048 of
+each cut a regime map's kernel time by 6 % against 512 and 256 (measured on 2 cores, when
+rows were filled whether kept or not), for 144 KiB a member (150 MB for a batch of 1024).
+The GPU keeps the small room: its batches hold tens of thousands of members."""
 _CPU_BATCH = 1024
 BACKENDS = ("cpu", "gpu", "auto")
 

@@ -18,10 +18,14 @@ moves them by 1e-6 and 1e-8). Ensemble statistics are what a GPU run is for. Und
 simulator (``NUMBA_ENABLE_CUDASIM=1``) the kernel calls the compiled CPU code and results are
 bit-identical.
 
-Buffers. Members run on the device until they end or return ``NEED_BUFFER`` (impact rows or
-line-length draws used up). Those are refilled on the host exactly as on the CPU path (the
-impact count moved to the member's total, the used draws replaced by the next ones of the
-same stream, keeping the row width) and the kernel is launched again for them only; the
+Buffers. Members run on the device until they end or return ``NEED_BUFFER`` (line-length
+draws used up, or impact rows where impacts are kept; otherwise the kernel only counts
+them: a 20-s member of Table 1 applies ~14,000 impacts, and with 256 rows it stopped 43-49
+times, each stop a relaunch of the batch that waits for its slowest member again, 2.1x the
+time of one launch for 512 members in ``benchmarks/gpu_warp_model.py --tail``'s model).
+Those are refilled on the host exactly as on the CPU path (the impact count moved to the
+member's total, the used draws replaced by the next ones of the same stream, keeping the
+row width) and the kernel is launched again for them only; the
 other threads return at once. A run resumed after a hand-back is bit-identical to one that
 was not interrupted (see :func:`_kernel.run_chunk`), so this relaunch changes nothing.
 
@@ -63,7 +67,7 @@ __all__ = [
     "runs_on_gpu",
 ]
 
-GPU_BATCH = 65_536  # members per device batch: ~42 kB each for 20 s runs (about 2.7 GB)
+GPU_BATCH = 65_536  # members per device batch: ~19 kB each for 20 s runs, 42 kB with impacts kept
 GPU_TOLERANCE = 1e-6  # rad and rad/s: GPU against CPU sections, first period or periodic
 _BLOCK = 64  # threads per block: 202 registers a thread on an H200 (196 from ptxas 12.9)
 GPU_LAYOUT = "C"

@@ -199,7 +199,8 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     lam : float64[:]
         Line-length draws; ``lam[cnt[I_LAM_POS]]`` is the one in use.
     series, section, impacts : float64[:, SERIES_COLS], [:, SECTION_COLS], [:, IMPACT_COLS]
-        Output buffers, filled from the row counts in ``cnt``.
+        Output buffers, filled from the row counts in ``cnt``. ``impacts`` of no rows: the
+        impacts are counted in ``cnt[I_N_IMPACT]``, not recorded, and never ask for room.
 
     Returns
     -------
@@ -250,7 +251,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             (budget > 0 and taken > budget)
             or cnt[I_N_SERIES] + samples_per_block > series.shape[0]
             or cnt[I_N_SECTION] + sections_per_step > section.shape[0]
-            or cnt[I_N_IMPACT] + max_events > impacts.shape[0]
+            or 0 < impacts.shape[0] < cnt[I_N_IMPACT] + max_events  # (no rows: counted only)
             or cnt[I_LAM_POS] + draws_per_step >= lam.shape[0]
         ):
             cnt[I_SURFACE] = (1 if jumped else 0) + (2 if settled else 0)

@@ -107,7 +107,10 @@ def run_batch(
     n_sec = int((duration - t_start) / p0.cam_period) + 4 + int(p0.dt / p0.cam_period)
     y, cnt, c, lam, streams = start.y, start.cnt, start.c, start.lam, start.streams
     section = np.empty((n, n_sec, k.SECTION_COLS))
-    impacts = np.empty((n, room[1] + _margin(plist), k.IMPACT_COLS))
+    # impacts not kept are only counted by the kernel (a buffer of no rows): a member then
+    # stops for room only when its draws run out (on a GPU each stop relaunches the batch)
+    rows = room[1] + _margin(plist) if keep_impacts else 0
+    impacts = np.empty((n, rows, k.IMPACT_COLS))
     status = start.status.copy()
     n_impacts = start.impacts.copy()
 

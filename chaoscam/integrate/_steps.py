@@ -155,10 +155,11 @@ def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c, salt):
     tangent by its saltation matrix (the adaptive kernel; the RK4 kernel calls
     :func:`event_tangent` at every located event instead). Each applied jump is recorded
     (after the transient) with its kind: macro, micro (slower than ``v_micro``) or chatter
-    end. Under impact resampling a macro impact draws a new line
-    length (``resample="contact"``: a new contact), and so does every applied jump under
-    ``resample="impact"``. Closings slower than ``v_min`` are left to the compliant force and
-    counted.
+    end, as a row of ``impacts``, or only counted when that buffer has no rows (an ensemble
+    that keeps no impacts then never stops to empty them). Under impact resampling a macro
+    impact draws a new line length (``resample="contact"``: a new contact), and so does
+    every applied jump under ``resample="impact"``. Closings slower than ``v_min`` are left
+    to the compliant force and counted.
 
     Returns (theta' after, stiffness in use).
     """
@@ -185,14 +186,15 @@ def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c, salt):
         K = stiffness(lam[cnt[I_LAM_POS]], c)
     if t >= c[C_T_RECORD]:
         i = cnt[I_N_IMPACT]
-        impacts[i, 0] = t
-        impacts[i, 1] = th
-        impacts[i, 2] = om
-        impacts[i, 3] = om_after
-        impacts[i, 4] = rate
-        impacts[i, 5] = l1
-        impacts[i, 6] = lam[cnt[I_LAM_POS]]
-        impacts[i, 7] = kind
+        if impacts.shape[0] > 0:  # a buffer of no rows: the impacts are only counted
+            impacts[i, 0] = t
+            impacts[i, 1] = th
+            impacts[i, 2] = om
+            impacts[i, 3] = om_after
+            impacts[i, 4] = rate
+            impacts[i, 5] = l1
+            impacts[i, 6] = lam[cnt[I_LAM_POS]]
+            impacts[i, 7] = kind
         cnt[I_N_IMPACT] += 1
     return om_after, K
 

@@ -8,6 +8,38 @@ from chaoscam import ParameterError, Params, classify_ensemble, simulate
 from chaoscam.integrate import simulate_ensemble
 
 
+@pytest.mark.parametrize("integrator", ["rk4", "adaptive"])
+def test_impacts_not_kept_are_counted_without_stopping(monkeypatch, integrator):
+    """Without keep_impacts the kernel counts the impacts in a buffer of no rows: the same
+    sections and impact counts, bit for bit, as with rows kept, and a member stops for a
+    refill only when its draws run out (each stop is a relaunch on a GPU)."""
+    from chaoscam.integrate import _ensemble, _members
+
+    monkeypatch.setitem(_ensemble._ROOM, "cpu", (256, 64))  # rows run out long before draws
+    stops = []
+    drive = _members.drive_members
+
+    def counted(n, launch, refill, need=None):
+        def refill_counted(members):
+            stops.append(len(members))
+            refill(members)
+
+        return drive(n, launch, refill_counted, need)
+
+    monkeypatch.setattr(_members, "drive_members", counted)
+    p = Params(l_lambda_sigma=0.002, integrator=integrator)
+    runs = {}
+    for keep in (True, False):
+        stops.clear()
+        ens = simulate_ensemble(p, [0, 1], seed=5, duration=1.0, keep_impacts=keep)
+        runs[keep] = (ens, sum(stops))
+    (kept, kept_stops), (counted_only, counted_stops) = runs[True], runs[False]
+    assert kept.sections.equals(counted_only.sections)
+    assert kept.members.equals(counted_only.members)
+    assert kept.members.n_impacts.min() > 10 * 64  # ~800 impacts in the first 0.05 s
+    assert counted_stops < kept_stops / 4
+
+
 def test_ensemble_members_equal_single_runs():
     """Each ensemble member is bit-identical to simulate() of the same (seed, index)."""
     from chaoscam.integrate import simulate_ensemble
@@ -30,7 +62,7 @@ def test_ensemble_members_that_refill_equal_single_runs(integrator):
     from chaoscam.integrate import _ensemble, simulate_ensemble
 
     p = Params(l_lambda_sigma=0.002, integrator=integrator)
-    ens = simulate_ensemble(p, [0, 1, 2], seed=5, duration=4.0)
+    ens = simulate_ensemble(p, [0, 1, 2], seed=5, duration=4.0, keep_impacts=True)
     assert ens.members.n_impacts.min() > max(_ensemble._ROOM["cpu"])  # more than one launch holds
     for member in range(3):
         one = simulate(p, seed=5, index=member, duration=4.0, series=False)
