@@ -1,7 +1,7 @@
 """What a GPU warp would make of the RK4 ensemble kernel's work, modelled on the CPU.
 
 Run: python benchmarks/gpu_warp_model.py [DURATION]   (default 4 s; about 10 s)
-     python benchmarks/gpu_warp_model.py --tail [MEMBERS]   (default 8,192; about 50 s)
+     python benchmarks/gpu_warp_model.py --tail [MEMBERS [DURATION]] [--keep-impacts]
 
 A warp runs 32 members in SIMT: in a step of the kernel's loop, a member in merged free
 flight, one in a contact step and one locating an impact take different branches, and the
@@ -31,11 +31,10 @@ noisiest figure: one interruption moves a member's total). Nsight Compute on an 
 2.16 threads active of 32 for the RK4 kernel over its first 0.05 s, a launch in which each
 member also stopped for a refill at its own time (PROFILE.md).
 
-``--tail``: the spread of whole members' costs over 0.5 s, which sets how long a launch of one
-thread a member waits for its slowest. Measured here (2026-11-27, two runs, the machine
-otherwise idle; a run beside the test suite gave a false 41x): 8,192 members, median
-12.3-12.9 Mcycles, p99 28.3-29.4, max 44.8-59.8 (3.6-4.6x the median); a group's slowest
-against its mean: 1.86-1.88 (32), 1.91-1.94 (64), 2.98-3.11 (2,048).
+``--tail MEMBERS [DURATION]``: whole members' costs as GPU threads run them, stopping for
+room (``_ensemble._ROOM["gpu"]``) as they do: how long one launch waits for its slowest
+member, and how much longer the batch takes when it is relaunched at every stop and waits
+for the slowest again each time.
 """
 
 from __future__ import annotations
@@ -106,47 +105,72 @@ def _aligned(values: np.ndarray, inside: np.ndarray) -> np.ndarray:
 
 
 @njit
-def _whole_runs(y, cnt, c, n_stop, lam, section, impacts, cost):
-    """Each member's whole run in cycles (buffers only counted); -1 if out of draws."""
+def _between_stops(y, cnt, c, n_stop, draws, width, section, impacts, cost, stops):
+    """Each member run as a GPU thread runs it: stopping whenever its ``width`` draws or its
+    impact rows run out, refilled as ``run_batch``'s ``hand_back`` does (rows emptied, used
+    draws dropped, the stream's next ones appended: a window sliding along ``draws``).
+    ``cost[j, s]``: cycles of member j's s-th run between stops; ``stops[j]``: their count."""
     series = np.empty((1, k.SERIES_COLS))
     for j in range(y.shape[0]):
-        t0 = _cycles()
-        while True:
-            code = k.run_chunk(y[j], cnt[j], c[j], n_stop, lam[j], series, section[j], impacts[j])
-            if code != k.NEED_BUFFER:
-                cost[j] = _cycles() - t0
-                break
-            if cnt[j, k.I_LAM_POS] > lam.shape[1] - 64:
-                cost[j] = -1
+        offset = 0
+        s = 0
+        while s < cost.shape[1]:
+            lam = draws[j, offset : offset + width]
+            t0 = _cycles()
+            code = k.run_chunk(y[j], cnt[j], c[j], n_stop, lam, series, section[j], impacts[j])
+            cost[j, s] = _cycles() - t0
+            s += 1
+            if code != k.NEED_BUFFER or offset + width + cnt[j, k.I_LAM_POS] > draws.shape[1]:
                 break
             cnt[j, k.I_N_IMPACT] = 0
-            cnt[j, k.I_N_SECTION] = 0
+            offset += cnt[j, k.I_LAM_POS]
+            cnt[j, k.I_LAM_POS] = 0
+        stops[j] = s
 
 
-def tail(members: int, duration: float = 0.5) -> None:
-    """The spread of whole members' costs: a launch of one thread a member lasts as long as
-    its slowest member, so a full device waits for the dearest of tens of thousands."""
+def tail(members: int, duration: float = 0.5, keep_impacts: bool = False) -> None:
+    """Whole members' costs as GPU threads: a launch lasts as long as its slowest member, and
+    a member stops for room (``_ensemble._ROOM["gpu"]``: its draws, and its impact rows when
+    impacts are kept) several times a run, each stop a relaunch of the batch that waits for
+    the slowest member again."""
+    from chaoscam.integrate._ensemble import _ROOM
+
     p = Params(l_lambda_sigma=0.002)
-    cost = np.zeros(members, np.int64)
+    draws_room, rows = _ROOM["gpu"]
+    rows = rows if keep_impacts else 0  # as run_batch: impacts not kept are only counted
+    n_stop = int(round(duration / p.dt))
+    cost = np.zeros((members, 400), np.int64)
+    stops = np.zeros(members, np.int64)
     for s0 in range(0, members, 2048):
         m = min(2048, members - s0)
-        st = fresh([p] * m, list(range(s0, s0 + m)), 1, duration, 0.0, False, (8192, 4096))
-        section = np.empty((m, 64, k.SECTION_COLS))
-        impacts = np.empty((m, 4096, k.IMPACT_COLS))
-        n_stop = int(round(duration / p.dt))
-        _whole_runs(st.y, st.cnt, st.c, n_stop, st.lam, section, impacts, cost[s0 : s0 + m])
-    if (cost < 0).any():
-        raise SystemExit("a member ran out of draws: enlarge the room")
+        st = fresh([p] * m, list(range(s0, s0 + m)), 1, duration, 0.0, False, (100_000, rows))
+        width = draws_room + (st.lam.shape[1] - 100_000)  # the GPU's: room and margin
+        section = np.empty((m, int(duration / p.cam_period) + 8, k.SECTION_COLS))
+        impacts = np.empty((m, rows + 64 if rows else 0, k.IMPACT_COLS))
+        _between_stops(st.y, st.cnt, st.c, n_stop, st.lam, width, section, impacts,
+                       cost[s0 : s0 + m], stops[s0 : s0 + m])  # fmt: skip
     mc = cost / 1e6
-    q = np.percentile(mc, [50, 90, 99, 99.9])
+    whole = mc.sum(axis=1)
+    q = np.percentile(whole, [50, 90, 99, 99.9])
     print(
-        f"{members:,} members x {duration:g} s, Mcycles a member: median {q[0]:.1f}, p90 "
-        f"{q[1]:.1f}, p99 {q[2]:.1f}, p99.9 {q[3]:.1f}, max {mc.max():.1f} "
-        f"({mc.max() / q[0]:.1f}x the median)"
+        f"{members:,} members x {duration:g} s, room {draws_room} draws, "
+        f"{rows if keep_impacts else 'no'} impact rows: {stops.min()}-"
+        f"{stops.max()} runs between stops a member; Mcycles a member: median {q[0]:.1f}, p90 "
+        f"{q[1]:.1f}, p99 {q[2]:.1f}, p99.9 {q[3]:.1f}, max {whole.max():.1f} "
+        f"({whole.max() / q[0]:.1f}x the median)"
     )
-    for size in (WARP, 64, 2048):
-        g = mc[: members // size * size].reshape(-1, size)
-        print(f"  groups of {size}: slowest / mean {(g.max(1) / g.mean(1)).mean():.2f}")
+    for size in sorted({WARP, 64, 2048, members}):
+        if size > members:
+            continue
+        groups = range(0, members // size * size, size)
+        one = np.mean([whole[a : a + size].max() for a in groups])
+        relaunched = np.mean([mc[a : a + size].max(axis=0).sum() for a in groups])
+        mean = whole.mean()
+        print(
+            f"  {size:,} together: one launch waits {one / mean:.2f}x a mean member, "
+            f"relaunched at every stop {relaunched / mean:.2f}x ({relaunched / one:.2f}x "
+            f"one launch)"
+        )
 
 
 def main(duration: float = 4.0) -> None:
@@ -191,6 +215,8 @@ def main(duration: float = 4.0) -> None:
 
 if __name__ == "__main__":
     if sys.argv[1:2] == ["--tail"]:
-        tail(int(sys.argv[2]) if len(sys.argv) > 2 else 8192)
+        keep = "--keep-impacts" in sys.argv
+        args = [a for a in sys.argv[2:] if a != "--keep-impacts"]
+        tail(int(args[0]) if args else 8192, *map(float, args[1:2]), keep_impacts=keep)
     else:
         main(*(float(a) for a in sys.argv[1:2]))
