@@ -14,10 +14,12 @@ the time in launches and in refills, and the rate.
 Plans: "scaling" (the default) asks where a full device's time goes (33,792 members x 0.5 s
 took 140 s on an H200 in the staged layout, 2026-11-27, against 1.3-1.6 s for 64 members):
 one full wave (132 x 256 members: 4 blocks, 8 warps, a multiprocessor), one block a
-multiprocessor, one block, each 0.25 s, then the full wave with 32x the room (one launch),
-none skipped. "layouts", the earlier plan: short runs first, and a configuration whose time,
-estimated from the one before it as if time grew with members x duration (an overestimate
-while the device is not full), would pass ``--budget`` seconds in all is skipped with a note.
+multiprocessor, one block, each 0.25 s, then the full wave with its impacts kept (256 rows:
+every member stops for room three or four times in its first 0.05 s; not kept, the impacts
+are only counted and a member stops only when its draws run out), none skipped. "layouts",
+the earlier plan: short runs first, and a configuration whose time, estimated from the one
+before it as if time grew with members x duration (an overestimate while the device is not
+full), would pass ``--budget`` seconds in all is skipped with a note.
 """
 
 from __future__ import annotations
@@ -62,7 +64,7 @@ class _Clock:
         return timed
 
 
-def measure(p, members, duration, room, layout):
+def measure(p, members, duration, room, layout, keep_impacts=False):
     """(wall time, clock, sections) of one GPU ensemble with this room and layout."""
     clock = _Clock()
     inner, _gpu.drive_members = _gpu.drive_members, clock.wrap(_gpu.drive_members)
@@ -70,7 +72,9 @@ def measure(p, members, duration, room, layout):
     order, _gpu.GPU_LAYOUT = _gpu.GPU_LAYOUT, layout
     try:
         t0 = time.perf_counter()
-        ens = simulate_ensemble(p, range(members), seed=1, duration=duration, backend="gpu")
+        ens = simulate_ensemble(
+            p, range(members), seed=1, duration=duration, backend="gpu", keep_impacts=keep_impacts
+        )
         return time.perf_counter() - t0, clock, ens.sections
     finally:
         _gpu.drive_members, _ensemble._ROOM["gpu"] = inner, before
@@ -100,7 +104,7 @@ def main() -> None:
         choices=("scaling", "layouts"),
         default="scaling",
         help="scaling: one full wave of an H200 (132 x 256 members), one block a "
-        "multiprocessor and one block, 0.25 s each, then the full wave with 32x the room, "
+        "multiprocessor and one block, 0.25 s each, then the full wave with its impacts kept, "
         "in the 'C' layout, none skipped (the caller's time limit stops it); layouts: the "
         "earlier plan over layouts, room and length, skipped by estimate",
     )
@@ -116,31 +120,32 @@ def main() -> None:
     # the open questions first: each layout at a full device, then the room, then length
     full, per_sm = 132 * 256, 132 * 64  # an H200 at 8 warps, and at 2, a multiprocessor
     scaling = [
-        (full, 0.25, small, "C"), (per_sm, 0.25, small, "C"), (64, 0.25, small, "C"),
-        (full, 0.25, big, "C"),
+        (full, 0.25, small, "C", False), (per_sm, 0.25, small, "C", False),
+        (64, 0.25, small, "C", False), (full, 0.25, small, "C", True),
     ]  # fmt: skip
-    plan = scaling if args.plan == "scaling" else [
+    plan = scaling if args.plan == "scaling" else [x + (False,) for x in [
         (64, 0.5, small, "C"), (64, 0.5, small, "F"),
         (8_192, 0.5, small, "C"), (8_192, 0.5, small, "F"),
         (40_000, 0.5, small, "C"), (40_000, 0.5, small, "F"),
         (8_192, 0.5, big, "C"), (40_000, 2.0, small, "best"), (40_000, 20.0, small, "best"),
-    ]  # fmt: skip
+    ]]  # fmt: skip
     last = None  # (wall, members, duration) of the configuration before
     walls: dict[tuple[int, str], float] = {}
     sections = {}
     start = time.perf_counter()
-    for members, duration, room, layout in plan:
+    for members, duration, room, layout, keep in plan:
         if layout == "best":  # the faster at 40,000 x 0.5 s
             layout = min(layouts, key=lambda x: walls.get((40_000, x), float("inf")))
         if layout not in layouts:
             continue
         what = f"{members:>6,} x {duration:>4g} s, room {room}, layout {layout}"
+        what += ", impacts kept" if keep else ""
         if last is not None and args.plan == "layouts":
             guess = last[0] * members / last[1] * duration / last[2]
             if guess > args.budget - (time.perf_counter() - start):
                 print(f"skipped {what}: about {guess:.0f} s")
                 continue
-        wall, c, sec = measure(p, members, duration, room, layout)
+        wall, c, sec = measure(p, members, duration, room, layout, keep)
         last = (wall, members, duration)
         walls[(members, layout)] = wall
         if members == 64:

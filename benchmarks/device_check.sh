@@ -12,8 +12,8 @@
 # Steps: versions (the image's numba-cuda under its own numpy 2.5 compiles no kernel: seen on
 # an H200, 2026-11-27); then, under one time limit (CHECK_SECONDS, default 240), where a full
 # device's time goes (bench_gpu_profile.py --plan scaling: a full wave, a block a
-# multiprocessor and one block, 0.25 s each, then the full wave in one launch, each split into
-# launches and host refills); with RUN_TESTS=1 the device tests; last, where ncu can read the
+# multiprocessor and one block, 0.25 s each, then the full wave with its impacts kept, which
+# stops every member for room three or four times; each split into launches and refills); with RUN_TESTS=1 the device tests; last, where ncu can read the
 # counters (NCU_SECONDS each, default 90), two Nsight Compute profiles of one launch: a full
 # wave (33,792 members x 0.02 s) with every stall reason (instruction fetch among them),
 # active threads a warp and occupancy, then 1,024 members x 0.05 s with the full sections
