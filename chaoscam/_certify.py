@@ -244,6 +244,7 @@ def certify(
     """
     orbit = periodic_orbit(p, points[-1], n)
     sits, dist, where = on_orbit(orbit, points)
+    long_enough = len(points) >= KICK_MIN_PERIODS * n  # for kicks (KICK_MIN_PERIODS)
     extra["periodic_orbit"] = _orbit_record(orbit, distance=dist)
     mu = float(np.max(np.abs(orbit.multipliers)))
     detail = (
@@ -258,7 +259,7 @@ def certify(
         detail += "; " + summary
         if again == "certified":
             return Certificate("certified", n, orbit, detail)
-        if len(points) < KICK_MIN_PERIODS * n:
+        if not long_enough:
             return Certificate("step-dependent", n, orbit, detail)
         kicked, summary = _kicked(p, points, n, extra)
         detail += "; " + summary
@@ -320,7 +321,6 @@ def certify(
         if status2 == "certified":
             return Certificate("certified", twice.period, twice.orbit, detail, True)
     stalled = orbit.converged or orbit.residual <= MODEL_ATOL
-    long_enough = len(points) >= KICK_MIN_PERIODS * n
     if confirm and status in KICKED and sits and stalled and long_enough:
         # The multipliers left it open, the run lies on the orbit or approaches it: finite
         # perturbations decide.
