@@ -1,0 +1,207 @@
+"""Kick audit of the report's periodic verdicts: do finite perturbations agree with Newton?
+
+A periodic verdict of the deterministic model is certified by Newton's multipliers on the
+grid and at dt/2 (``chaoscam._certify.certify``); kicks (``_certify._kicked``: kicks of 1e-7
+and 1e-6 rad in ±θ_f, 30× that in rad/s in ±θ̇_f, followed for 40 orbit periods at dt and at
+dt/2) are asked only where the multipliers leave the orbit open. This script asks the kicks
+of every periodic verdict of the full report's deterministic sweeps (reports/paper-data,
+written by ``chaoscam paper``; not in the repository): it runs each realization again alone
+to the length it was classified at (``simulate`` with the sweep's parameters, seed, index and
+transient, for the recorded seconds of the verdict: an extended run continues bit for bit),
+applies the kick certificate's own rule from its last section point, and prints one line per
+verdict and the counts. A verdict the kicks refuse is one where the multipliers and finite
+perturbations disagree: the line gives both.
+
+With ``--deep``, each refused verdict is then settled on the model: its realization is run to
+``--horizon`` seconds (default 300) at dt, dt/2 and dt/4, and for each step the script prints
+the widest band of the last 100 orbit periods' section points (at most the run's second
+half) at lag n and 2n, Newton's
+|mu|max from the run's last point, and where kicks of 1e-7 to 1e-4 rad end (the largest
+absolute distance over the four directions after 40 and 80 orbit periods: a slow contraction
+goes on, a floor or another attractor stays). Fig. 6's steps (5e-8 and 9.6e-8 s) make this
+dear: give it ``--horizon 60 --deep-steps 1,2 --deep-kicks 1e-7,1e-6`` there.
+``--refused-from AUDIT.md`` deep-checks the rows an earlier run's printed table refused,
+without asking the kicks of every verdict again.
+
+Usage: python analyses/kick_audit.py [--stages fig4,fig6-G1e-09,...] [--data DIR] [--workers N]
+       [--deep | --refused-from AUDIT.md] [--horizon S]
+       [--deep-steps 1,2,4] [--deep-kicks 1e-7,1e-6,...]
+       (all stages: about an hour on 2 cores, most of it Fig. 6's steps)
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from chaoscam import simulate
+from chaoscam._certify import MODEL_ATOL, _kicked, _widest_band
+from chaoscam.sweep import read_bifurcation, read_regime_map, replay_params
+from chaoscam.tangent import kick_test, periodic_orbit
+
+DATA = Path(__file__).resolve().parent.parent / "reports" / "paper-data"
+DIAGRAMS = (
+    "fig4",
+    "fig6-G1e-09",
+    "fig6-G1e-10",
+    "sensitivity-J",
+    "sensitivity-pivot",
+    "sensitivity-stiffness",
+    "sensitivity-xi",
+)
+MAPS = ("sensitivity-omega-xi", "fig7-10")  # regime maps (with a .cells.parquet)
+DEEP_KICKS = (1e-7, 1e-6, 1e-5, 1e-4)  # [rad]
+DEEP_PERIODS = 100  # orbit periods whose bands the deep check measures
+KICK_PERIODS = 40  # orbit periods the kick certificate follows (kick_test's default)
+
+
+def _jobs(data: Path, stages):
+    """(stage, what, params, duration, transient, seed, index, period) per periodic verdict."""
+    for stage in stages:
+        path = data / f"{stage}.parquet"
+        if not path.is_file():
+            sys.exit(f"{path}: no such file; run `chaoscam paper` (the full report) first")
+        if (data / f"{stage}.cells.parquet").is_file():  # a regime map (else a diagram)
+            sweep = read_regime_map(path)
+            rows, names = sweep.realizations, (sweep.config["x"]["name"], sweep.config["y"]["name"])
+        else:
+            sweep = read_bifurcation(path)
+            rows, names = sweep.verdicts, ("value",)
+        cfg = sweep.config
+        for _, row in rows[rows.label == "periodic"].iterrows():
+            p = replay_params(sweep, row)
+            if p.l_lambda_sigma > 0:
+                continue  # kicks ask a deterministic model
+            what = ", ".join(f"{n} = {row[n]:.4g}" for n in names)
+            if "ic" in row:
+                what += f", ic {row.ic}"
+            yield (
+                stage,
+                what,
+                p,
+                float(cfg["transient"]) + float(row.recorded_s),
+                float(cfg["transient"]),
+                int(row.seed),
+                int(row.sim_index),
+                int(row.period),
+            )
+
+
+def _points(p, duration, transient, seed, index):
+    tr = simulate(p, duration=duration, transient=transient, seed=seed, index=index, series=False)
+    sec = tr.section
+    return tr.status.name, sec.loc[sec["k"] > 0, ["theta_f", "omega_f"]].to_numpy(dtype=float)
+
+
+def _audit(job):
+    stage, what, p, duration, transient, seed, index, n = job
+    t0 = time.perf_counter()
+    _, points = _points(p, duration, transient, seed, index)
+    extra: dict = {}
+    ok, summary = _kicked(p, points, n, extra)
+    return stage, what, n, p.dt, ok, extra["kick_test"], summary, time.perf_counter() - t0
+
+
+def _deep(args):
+    """The refused verdict's realization run long at dt / f: a line in words."""
+    (stage, what, p, duration, transient, seed, index, n), f, horizon, sizes = args
+    p = p.replace(dt=p.dt / f)
+    t0 = time.perf_counter()
+    status, points = _points(p, horizon, transient, seed, index)
+    head = f"{stage} {what} (period {n}) at dt/{f}, {horizon:g} s: "
+    periods = min(DEEP_PERIODS, len(points) // (2 * n))  # at most the run's second half
+    if periods < 8:
+        return head + f"{status} after {len(points)} section points"
+    scale = np.array([1.0, p.cam_period])
+    last = points[-periods * n :] * scale
+    bands = [_widest_band(last, m) for m in (n, 2 * n)]
+    orbit = periodic_orbit(p, points[-1], n)
+    test = kick_test(p, points[-1], n, kicks=sizes, periods=2 * KICK_PERIODS)
+    ends = [
+        np.nanmax(test.growth[:, :, m], axis=1) * np.array(sizes)
+        for m in (KICK_PERIODS, 2 * KICK_PERIODS)
+    ]
+    kicks = ", ".join(f"{k:g} -> {a:.2g} / {b:.2g}" for k, a, b in zip(sizes, *ends, strict=True))
+    return head + (
+        f"bands of the last {periods} orbit periods {bands[0]:.2g} rad at lag n, "
+        f"{bands[1]:.2g} at 2n ({'within' if bands[0] <= MODEL_ATOL else 'above'} the "
+        f"band tolerance {MODEL_ATOL:g}); Newton |mu|max {np.max(np.abs(orbit.multipliers)):.3g}"
+        f" ({'certified' if orbit.certified else 'not certified'}); kicks end at [rad] "
+        f"{kicks} ({time.perf_counter() - t0:.0f} s)"
+    )
+
+
+def _refused_in(path: Path) -> set:
+    """(stage, run) of the rows an earlier audit's table marked refused ("NO")."""
+    rows = (line.split("|") for line in path.read_text().splitlines() if line.startswith("| "))
+    return {(c[1].strip(), c[2].strip()) for c in rows if len(c) > 6 and c[6].strip() == "NO"}
+
+
+def _audit_all(jobs, workers: int) -> list:
+    """Print the audit's table and counts; return the refused jobs."""
+    print(f"{len(jobs)} periodic verdicts of the deterministic model\n")
+    print(
+        "| stage | run | period | dt [s] "
+        "| kicks at dt, dt/2: largest end / kick, bands [rad] | agree |"
+    )
+    print("|---|---|---|---|---|---|")
+    refused, refused_jobs, t0 = [], [], time.perf_counter()
+    with ProcessPoolExecutor(workers) as pool:
+        for job, (stage, what, n, dt, ok, records, summary, _) in zip(
+            jobs, pool.map(_audit, jobs), strict=True
+        ):
+            steps = "; ".join(f"{r['largest_final']:.2g}, {r['bands']:.2g}" for r in records)
+            print(
+                f"| {stage} | {what} | {n} | {dt:.3g} | {steps} | {'yes' if ok else 'NO'} |",
+                flush=True,
+            )
+            if not ok:
+                refused.append((stage, what, n, summary))
+                refused_jobs.append(job)
+    print(
+        f"\nkicks certify {len(jobs) - len(refused)} of {len(jobs)} periodic verdicts "
+        f"({time.perf_counter() - t0:.0f} s)"
+    )
+    for stage, what, n, summary in refused:
+        print(f"refused: {stage} {what} (period {n}): {summary}")
+    return refused_jobs
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--stages", default=",".join(DIAGRAMS + MAPS))
+    ap.add_argument("--data", type=Path, default=DATA, help="the report's data folder")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--deep", action="store_true", help="settle each refused verdict")
+    ap.add_argument(
+        "--refused-from", type=Path, help="deep-check the refused rows of this earlier output"
+    )
+    ap.add_argument("--horizon", type=float, default=300.0, help="deep runs' end time [s]")
+    ap.add_argument("--deep-steps", default="1,2,4", help="deep runs' step divisors")
+    ap.add_argument("--deep-kicks", default=",".join(f"{k:g}" for k in DEEP_KICKS), help="[rad]")
+    args = ap.parse_args()
+    jobs = list(_jobs(args.data, args.stages.split(",")))
+    # dearest first (steps of the period over dt), so the pool ends together
+    jobs.sort(key=lambda j: -j[7] * j[2].cam_period / j[2].dt)
+    if args.refused_from:
+        keep = _refused_in(args.refused_from)
+        refused = [job for job in jobs if (job[0], job[1]) in keep]
+    else:
+        refused = _audit_all(jobs, args.workers)
+    if (args.deep or args.refused_from) and refused:
+        print(f"\nthe refused verdicts run to {args.horizon:g} s:")
+        steps = [int(f) for f in args.deep_steps.split(",")]
+        sizes = tuple(float(k) for k in args.deep_kicks.split(","))
+        deep = [(job, f, args.horizon, sizes) for job in refused for f in steps]
+        with ProcessPoolExecutor(args.workers) as pool:
+            for line in pool.map(_deep, deep):
+                print(line, flush=True)
+
+
+if __name__ == "__main__":
+    main()
