@@ -32,19 +32,18 @@ Usage: python analyses/kick_audit.py [--stages fig4,fig6-G1e-09,...] [--data DIR
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
+from _report_data import DATA, sweep_rows
 
 from chaoscam import simulate
 from chaoscam._certify import MODEL_ATOL, _kicked, _widest_band
-from chaoscam.sweep import read_bifurcation, read_regime_map, replay_params
+from chaoscam.sweep import replay_params
 from chaoscam.tangent import kick_test, periodic_orbit
 
-DATA = Path(__file__).resolve().parent.parent / "reports" / "paper-data"
 DIAGRAMS = (
     "fig4",
     "fig6-G1e-09",
@@ -63,15 +62,7 @@ KICK_PERIODS = 40  # orbit periods the kick certificate follows (kick_test's def
 def _jobs(data: Path, stages):
     """(stage, what, params, duration, transient, seed, index, period) per periodic verdict."""
     for stage in stages:
-        path = data / f"{stage}.parquet"
-        if not path.is_file():
-            sys.exit(f"{path}: no such file; run `chaoscam paper` (the full report) first")
-        if (data / f"{stage}.cells.parquet").is_file():  # a regime map (else a diagram)
-            sweep = read_regime_map(path)
-            rows, names = sweep.realizations, (sweep.config["x"]["name"], sweep.config["y"]["name"])
-        else:
-            sweep = read_bifurcation(path)
-            rows, names = sweep.verdicts, ("value",)
+        sweep, rows, names = sweep_rows(data, stage)
         cfg = sweep.config
         for _, row in rows[rows.label == "periodic"].iterrows():
             p = replay_params(sweep, row)
