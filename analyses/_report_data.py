@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from chaoscam.sweep import read_bifurcation, read_regime_map
+from chaoscam.sweep import read_bifurcation, read_regime_map, replay_params
 
 DATA = Path(__file__).resolve().parent.parent / "reports" / "paper-data"
 """Where ``chaoscam paper`` (the full report) writes its sweeps; not in the repository."""
@@ -24,3 +24,19 @@ def sweep_rows(data: Path, stage: str):
         return sweep, sweep.realizations, (sweep.config["x"]["name"], sweep.config["y"]["name"])
     sweep = read_bifurcation(path)
     return sweep, sweep.verdicts, ("value",)
+
+
+def deterministic_rows(data: Path, stages, labels):
+    """(stage, sweep, row, params, what) for each row labelled one of ``labels`` in the
+    stages' files, of the deterministic model only (σ = 0: kicks and certificates ask it);
+    ``what`` names the row's axis values (and initial condition) in words."""
+    for stage in stages:
+        sweep, rows, names = sweep_rows(data, stage)
+        for _, row in rows[rows.label.isin(labels)].iterrows():
+            p = replay_params(sweep, row)
+            if p.l_lambda_sigma > 0:
+                continue
+            what = ", ".join(f"{n} = {row[n]:.4g}" for n in names)
+            if "ic" in row:
+                what += f", ic {row.ic}"
+            yield stage, sweep, row, p, what

@@ -6,9 +6,9 @@ motion"), but not its figure diagrams and its other sensitivity sweeps. This scr
 same for those: every chaotic (and undetermined) verdict of the deterministic model in the
 stages named (reports/paper-data, written by ``chaoscam paper``; not in the repository) is
 simulated again alone to ``--horizon`` seconds with the tangent (the sweep's parameters, seed
-and index: the same motion, bit for bit) and judged as a sweep's fate is
-(``chaoscam.sweep._tasks.fate_fields``: the status at the horizon, and for a run that stayed
-the model's verdict on the run's last half, certificate included, at the run's own step).
+and index: the same motion, bit for bit) by the sweeps' own fate run
+(``chaoscam.sweep._tasks._fate``: the status at the horizon, and for a run that stayed the
+model's verdict on the run's last half, certificate included, at the run's own step).
 Prints one line per run and the counts: still chaotic, settled on a period, left the cam's
 reach, other. Writes nothing.
 
@@ -21,16 +21,15 @@ from __future__ import annotations
 
 import argparse
 import time
-import warnings
 from collections import Counter
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+from typing import NamedTuple
 
-from _report_data import DATA, sweep_rows
+from _report_data import DATA, deterministic_rows
 
-from chaoscam import simulate
-from chaoscam.sweep import replay_params
-from chaoscam.sweep._tasks import fate_fields
+from chaoscam import Params
+from chaoscam.sweep._tasks import _fate as run_fate
 
 STAGES = (  # the report's sweeps without a fate horizon of their own
     "fig4",
@@ -44,36 +43,28 @@ STAGES = (  # the report's sweeps without a fate horizon of their own
 )
 
 
-def _jobs(data: Path, stages, labels, horizon: float):
-    """(stage, what, label, params, seed, index, horizon) per verdict asked."""
-    for stage in stages:
-        sweep, rows, names = sweep_rows(data, stage)
-        for _, row in rows[rows.label.isin(labels)].iterrows():
-            p = replay_params(sweep, row)
-            if p.l_lambda_sigma > 0:
-                continue  # the deterministic model only
-            what = ", ".join(f"{n} = {row[n]:.4g}" for n in names)
-            if "ic" in row:
-                what += f", ic {row.ic}"
-            yield stage, what, row.label, p, int(row.seed), int(row.sim_index), horizon
+class Task(NamedTuple):
+    """One verdict to continue; the fields a sweep's fate run reads (seed, sim_index, fate)."""
+
+    stage: str
+    what: str
+    label: str
+    params: Params
+    seed: int
+    sim_index: int
+    fate: float  # [s] the horizon
 
 
-def _fate(job):
-    stage, what, label, p, seed, index, horizon = job
-    t0 = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the model's warnings came with the sweep's run
-        long = simulate(
-            p,
-            duration=horizon,
-            transient=0.0,
-            seed=seed,
-            index=index,
-            series=False,
-            tangent=p.integrator == "rk4",
-        )
-    fate = fate_fields(long.status.name, long.section, long.jacobians, p)
-    return stage, what, label, fate, time.perf_counter() - t0
+def _tasks(data: Path, stages, labels, horizon: float):
+    """A :class:`Task` per verdict of the deterministic model labelled one of ``labels``."""
+    for stage, _, row, p, what in deterministic_rows(data, stages, labels):
+        yield Task(stage, what, row.label, p, int(row.seed), int(row.sim_index), horizon)
+
+
+def _fate(task: Task) -> dict:
+    """The sweeps' own fate run (``sweep._tasks._fate``): the realization again to the
+    horizon with the tangent, its status and the verdict on its last half."""
+    return run_fate(task.params, task)
 
 
 def _outcome(fate: dict) -> str:
@@ -93,19 +84,19 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     args = ap.parse_args()
     labels = args.labels.split(",")
-    jobs = list(_jobs(args.data, args.stages.split(","), labels, args.horizon))
-    jobs.sort(key=lambda j: j[3].dt)  # dearest first, so the pool ends together
-    print(f"{len(jobs)} verdicts ({', '.join(labels)}) continued to {args.horizon:g} s\n")
+    tasks = list(_tasks(args.data, args.stages.split(","), labels, args.horizon))
+    tasks.sort(key=lambda t: t.params.dt)  # dearest first, so the pool ends together
+    print(f"{len(tasks)} verdicts ({', '.join(labels)}) continued to {args.horizon:g} s\n")
     print("| stage | run | label | at the horizon | left at [s] |")
     print("|---|---|---|---|---|")
     counts: dict = {}
     t0 = time.perf_counter()
     with ProcessPoolExecutor(args.workers) as pool:
-        for stage, what, label, fate, _ in pool.map(_fate, jobs):
+        for task, fate in zip(tasks, pool.map(_fate, tasks), strict=True):
             outcome = _outcome(fate)
             left = "" if fate["left_at"] != fate["left_at"] else f"{fate['left_at']:.1f}"
-            print(f"| {stage} | {what} | {label} | {outcome} | {left} |", flush=True)
-            counts.setdefault(label, Counter())[outcome.split(":")[0]] += 1
+            print(f"| {task.stage} | {task.what} | {task.label} | {outcome} | {left} |", flush=True)
+            counts.setdefault(task.label, Counter())[outcome.split(":")[0]] += 1
     print(f"\n({time.perf_counter() - t0:.0f} s)")
     for label, c in counts.items():
         print(f"{label}: " + ", ".join(f"{k} {v}" for k, v in c.most_common()))

@@ -35,13 +35,13 @@ import argparse
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
-from _report_data import DATA, sweep_rows
+from _report_data import DATA, deterministic_rows
 
-from chaoscam import simulate
+from chaoscam import Params, simulate
 from chaoscam._certify import MODEL_ATOL, _kicked, _widest_band
-from chaoscam.sweep import replay_params
 from chaoscam.tangent import kick_test, periodic_orbit
 
 DIAGRAMS = (
@@ -59,28 +59,33 @@ DEEP_PERIODS = 100  # orbit periods whose bands the deep check measures
 KICK_PERIODS = 40  # orbit periods the kick certificate follows (kick_test's default)
 
 
+class Job(NamedTuple):
+    """One periodic verdict to ask: its realization, classified length and period."""
+
+    stage: str
+    what: str
+    params: Params
+    duration: float  # [s] the transient and the verdict's recorded seconds
+    transient: float
+    seed: int
+    index: int
+    period: int
+
+
 def _jobs(data: Path, stages):
-    """(stage, what, params, duration, transient, seed, index, period) per periodic verdict."""
-    for stage in stages:
-        sweep, rows, names = sweep_rows(data, stage)
-        cfg = sweep.config
-        for _, row in rows[rows.label == "periodic"].iterrows():
-            p = replay_params(sweep, row)
-            if p.l_lambda_sigma > 0:
-                continue  # kicks ask a deterministic model
-            what = ", ".join(f"{n} = {row[n]:.4g}" for n in names)
-            if "ic" in row:
-                what += f", ic {row.ic}"
-            yield (
-                stage,
-                what,
-                p,
-                float(cfg["transient"]) + float(row.recorded_s),
-                float(cfg["transient"]),
-                int(row.seed),
-                int(row.sim_index),
-                int(row.period),
-            )
+    """A :class:`Job` per periodic verdict of the deterministic model."""
+    for stage, sweep, row, p, what in deterministic_rows(data, stages, ["periodic"]):
+        transient = float(sweep.config["transient"])
+        yield Job(
+            stage,
+            what,
+            p,
+            transient + float(row.recorded_s),
+            transient,
+            int(row.seed),
+            int(row.sim_index),
+            int(row.period),
+        )
 
 
 def _points(p, duration, transient, seed, index):
@@ -89,22 +94,23 @@ def _points(p, duration, transient, seed, index):
     return tr.status.name, sec.loc[sec["k"] > 0, ["theta_f", "omega_f"]].to_numpy(dtype=float)
 
 
-def _audit(job):
-    stage, what, p, duration, transient, seed, index, n = job
-    t0 = time.perf_counter()
-    _, points = _points(p, duration, transient, seed, index)
+def _audit(job: Job):
+    """(certified, the kick records per step, the summary in words) of the kick certificate
+    from the classified run's last section point."""
+    _, points = _points(job.params, job.duration, job.transient, job.seed, job.index)
     extra: dict = {}
-    ok, summary = _kicked(p, points, n, extra)
-    return stage, what, n, p.dt, ok, extra["kick_test"], summary, time.perf_counter() - t0
+    ok, summary = _kicked(job.params, points, job.period, extra)
+    return ok, extra["kick_test"], summary
 
 
 def _deep(args):
     """The refused verdict's realization run long at dt / f: a line in words."""
-    (stage, what, p, duration, transient, seed, index, n), f, horizon, sizes = args
-    p = p.replace(dt=p.dt / f)
+    job, f, horizon, sizes = args
+    n = job.period
+    p = job.params.replace(dt=job.params.dt / f)
     t0 = time.perf_counter()
-    status, points = _points(p, horizon, transient, seed, index)
-    head = f"{stage} {what} (period {n}) at dt/{f}, {horizon:g} s: "
+    status, points = _points(p, horizon, job.transient, job.seed, job.index)
+    head = f"{job.stage} {job.what} (period {n}) at dt/{f}, {horizon:g} s: "
     periods = min(DEEP_PERIODS, len(points) // (2 * n))  # at most the run's second half
     if periods < 8:
         return head + f"{status} after {len(points)} section points"
@@ -143,16 +149,15 @@ def _audit_all(jobs, workers: int) -> list:
     print("|---|---|---|---|---|---|")
     refused, refused_jobs, t0 = [], [], time.perf_counter()
     with ProcessPoolExecutor(workers) as pool:
-        for job, (stage, what, n, dt, ok, records, summary, _) in zip(
-            jobs, pool.map(_audit, jobs), strict=True
-        ):
+        for job, (ok, records, summary) in zip(jobs, pool.map(_audit, jobs), strict=True):
             steps = "; ".join(f"{r['largest_final']:.2g}, {r['bands']:.2g}" for r in records)
             print(
-                f"| {stage} | {what} | {n} | {dt:.3g} | {steps} | {'yes' if ok else 'NO'} |",
+                f"| {job.stage} | {job.what} | {job.period} | {job.params.dt:.3g} | {steps} "
+                f"| {'yes' if ok else 'NO'} |",
                 flush=True,
             )
             if not ok:
-                refused.append((stage, what, n, summary))
+                refused.append((job.stage, job.what, job.period, summary))
                 refused_jobs.append(job)
     print(
         f"\nkicks certify {len(jobs) - len(refused)} of {len(jobs)} periodic verdicts "
@@ -178,10 +183,10 @@ def main() -> None:
     args = ap.parse_args()
     jobs = list(_jobs(args.data, args.stages.split(",")))
     # dearest first (steps of the period over dt), so the pool ends together
-    jobs.sort(key=lambda j: -j[7] * j[2].cam_period / j[2].dt)
+    jobs.sort(key=lambda j: -j.period * j.params.cam_period / j.params.dt)
     if args.refused_from:
         keep = _refused_in(args.refused_from)
-        refused = [job for job in jobs if (job[0], job[1]) in keep]
+        refused = [job for job in jobs if (job.stage, job.what) in keep]
     else:
         refused = _audit_all(jobs, args.workers)
     if (args.deep or args.refused_from) and refused:

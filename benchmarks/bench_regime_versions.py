@@ -30,7 +30,8 @@ ENGINES = ("process", "ensemble", "default")
 
 
 def _cpu() -> float:
-    """CPU seconds used so far by this process and its finished children."""
+    """CPU seconds used so far by this process and its finished children (bench_regime_engine's
+    own, not imported: that file needs modules an older version lacks)."""
     me = resource.getrusage(resource.RUSAGE_SELF)
     kids = resource.getrusage(resource.RUSAGE_CHILDREN)
     return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
