@@ -48,7 +48,8 @@ def fresh(plist, indices, seed, duration, transient, tangent, room) -> _Start:
     """The members of a batch at t = 0."""
     n = len(indices)
     streams = [LineLengthStream(p, seed, i) for p, i in zip(plist, indices, strict=True)]
-    lam = np.stack([s.draw(_n_draws(plist, duration, room)) for s in streams])
+    draws = _n_draws(plist, duration, room)  # once: it is a maximum over the batch
+    lam = np.stack([s.draw(draws) for s in streams])
     y = _per_member(initial_state, plist)
     cnt = _per_member(lambda p: initial_counters(p, transient=transient), plist)
     c = _per_member(lambda p: kernel_constants(p, t_record=transient, tangent=tangent), plist)
@@ -74,13 +75,20 @@ def resumed(res: Resume, plist, duration, room) -> _Start:
     return _Start(res.step, y, cnt, c, lam, streams, res.rows, res.impacts, status)
 
 
+def _models(plist) -> list[Params]:
+    """The distinct parameter objects of ``plist`` (a batch of one model repeats one)."""
+    return list({id(p): p for p in plist}.values())
+
+
 def _margin(plist) -> int:
     """Rows and draws one grid step may use beyond the room (events, a merged flight)."""
-    return 4 * (max(p.max_events_per_step + p.flight_merge for p in plist) + 2)
+    return 4 * (max(p.max_events_per_step + p.flight_merge for p in _models(plist)) + 2)
 
 
 def _n_draws(plist, duration, room) -> int:
-    return max(_draws(p, duration, room[0]) for p in plist) + _margin(plist)
+    """Draws every member of the batch starts with: the most any of its models needs."""
+    models = _models(plist)
+    return max(_draws(p, duration, room[0]) for p in models) + _margin(models)
 
 
 def run_batch(

@@ -145,3 +145,24 @@ def test_equal_models_written_differently_are_the_same_models():
     fingerprint hashed their repr, which differs)."""
     ens = simulate_ensemble(Params(omega=10), [0], duration=1.0, transient=0.5, tangent=True)
     assert len(classify_ensemble(ens, Params(omega=10.0), extend_to=None).members) == 1
+
+
+def test_a_batch_sizes_its_draws_once_not_once_a_member(monkeypatch):
+    """The draws a batch starts with are a maximum over its models, asked once a batch: asked
+    once a member over every member it was quadratic, 137 s of host time before a full
+    H200 wave's 5-s launch (33,792 members)."""
+    from chaoscam.integrate import _members
+
+    asked = []
+    draws = _members._draws
+
+    def counted(p, duration, room):
+        asked.append(p)
+        return draws(p, duration, room)
+
+    monkeypatch.setattr(_members, "_draws", counted)
+    p = Params(l_lambda_sigma=0.002)
+    models = [p] * 300 + [Params(l_lambda_sigma=0.003)] * 300
+    start = _members.fresh(models, range(600), 1, 1.0, 0.0, False, (512, 256))
+    assert len(asked) == 2  # one a distinct model
+    assert start.lam.shape[0] == 600
