@@ -1,0 +1,103 @@
+"""A full GPU wave's rate by run length, its device time apart from the host's (issue 13).
+
+Run: python benchmarks/bench_gpu_wave.py [--members N] [--durations 0.25,2,5] [--cpu-members N]
+
+One wave fills the device once (default 132 x 256 = 33,792 members: an H200's 132
+multiprocessors at 8 warps each, what 216 registers a thread allow). For each duration it
+runs one ensemble of the default model with l_lambda_sigma = 2 mm (as bench_gpu.py) and
+prints the wall time, the time inside the kernel launches (``_gpu.drive_members``' launch
+calls) and the rest (the host: draws, set-up, copies, the result's tables), and the rate in
+member-seconds a second, against ``--cpu-members`` members of the same duration on 2 CPU
+threads of the same machine, measured in the same run.
+
+Why: on 2026-11-27 33,792 x 0.25 s took 142.6 s on an H200 of which 5.1 s were the launch:
+``_members.fresh`` sized every member's draws with a maximum over the whole batch, once a
+member (quadratic, 137 s at that size). Fixed; this benchmark says what a wave costs now.
+The first cam period of ``--check`` members is compared with the CPU's (``GPU_TOLERANCE``).
+Without a GPU it says why on one line and exits 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numba
+import numpy as np
+
+from chaoscam import Params
+from chaoscam.integrate import _gpu, simulate_ensemble
+
+
+def timed(p, members, duration, backend):
+    """(ensemble, wall seconds, [seconds inside the launches, launches]) of one run."""
+    inside = [0.0, 0]
+    drive = _gpu.drive_members
+
+    def clocked(n, launch, refill, need=None):
+        def launch_timed(x):
+            t0 = time.perf_counter()
+            try:
+                return launch(x)
+            finally:
+                inside[0] += time.perf_counter() - t0
+                inside[1] += 1
+
+        return drive(n, launch_timed, refill, need)
+
+    _gpu.drive_members = clocked
+    try:
+        t0 = time.perf_counter()
+        ens = simulate_ensemble(p, range(members), seed=1, duration=duration, backend=backend)
+        return ens, time.perf_counter() - t0, inside
+    finally:
+        _gpu.drive_members = drive
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--members", type=int, default=132 * 256, help="GPU members (one wave)")
+    ap.add_argument("--durations", default="0.25,2,5", help="run lengths [s], comma-separated")
+    ap.add_argument("--cpu-members", type=int, default=64, help="CPU sample a duration")
+    ap.add_argument("--check", type=int, default=64, help="members in the GPU = CPU check")
+    args = ap.parse_args()
+    durations = [float(x) for x in args.durations.split(",")]
+    p = Params(l_lambda_sigma=0.002)
+    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+    simulate_ensemble(p, range(2), seed=1, duration=0.01, backend="cpu")  # compile or load
+    cpu_rate = {}
+    for d in durations:
+        _, wall, _ = timed(p, args.cpu_members, d, "cpu")
+        cpu_rate[d] = args.cpu_members * d / wall
+        print(f"CPU, 2 threads: {args.cpu_members} x {d:g} s in {wall:.2f} s = "
+              f"{cpu_rate[d]:,.0f} member-s/s", flush=True)  # fmt: skip
+    ok, reason = _gpu.gpu_status()
+    if not ok or "simulator" in reason:
+        print(f"GPU: not available ({reason}); nothing measured on a GPU")
+        return
+    t0 = time.perf_counter()
+    simulate_ensemble(p, range(64), seed=1, duration=0.01, backend="gpu")
+    print(f"GPU: {reason}; compiled in {time.perf_counter() - t0:.1f} s", flush=True)
+    a = simulate_ensemble(p, range(args.check), seed=1, duration=0.25, backend="gpu").sections
+    b = simulate_ensemble(p, range(args.check), seed=1, duration=0.25, backend="cpu").sections
+    cols = ["t", "theta_f", "omega_f"]
+    same = a.shape == b.shape and np.array_equal(a.k, b.k)
+    diff = float(np.abs(a[cols].to_numpy() - b[cols].to_numpy()).max()) if same else np.inf
+    verdict = "ok" if diff <= _gpu.GPU_TOLERANCE else "FAILED"
+    print(f"check: first cam period of {args.check} members, max |GPU - CPU| {diff:.1e} "
+          f"(tolerance {_gpu.GPU_TOLERANCE:g}): {verdict}", flush=True)  # fmt: skip
+    for d in durations:
+        ens, wall, (inside, launches) = timed(p, args.members, d, "gpu")
+        rate = args.members * d / wall
+        print(
+            f"GPU: {args.members:,} x {d:g} s in {wall:.1f} s ({launches} launches "
+            f"{inside:.1f} s, host {wall - inside:.1f} s) = {rate:,.0f} member-s/s = "
+            f"{rate / 20:,.1f} 20-s traj/s; "
+            f"{rate / cpu_rate[d]:.1f}x 2 CPU threads; statuses "
+            f"{ens.members.status.value_counts().to_dict()}",
+            flush=True,
+        )
+
+
+if __name__ == "__main__":
+    main()
