@@ -11,15 +11,19 @@ or "F", a field of consecutive members contiguous, which coalesces a warp's read
 For each (members, duration, room, layout) it prints the wall time, the number of launches,
 the time in launches and in refills, and the rate.
 
-Plans: "scaling" (the default) asks where a full device's time goes (33,792 members x 0.5 s
-took 140 s on an H200 in the staged layout, 2026-11-27, against 1.3-1.6 s for 64 members):
-one full wave (132 x 256 members: 4 blocks, 8 warps, a multiprocessor), one block a
-multiprocessor, one block, each 0.25 s, then the full wave with its impacts kept (256 rows:
-every member stops for room three or four times in its first 0.05 s; not kept, the impacts
-are only counted and a member stops only when its draws run out), none skipped. "layouts",
-the earlier plan: short runs first, and a configuration whose time, estimated from the one
-before it as if time grew with members x duration (an overestimate while the device is not
-full), would pass ``--budget`` seconds in all is skipped with a note.
+Plans: "scaling" (the default) asks where a full device's time goes: one full wave (132 x
+256 members: 4 blocks, 8 warps, a multiprocessor), one block a multiprocessor, one block,
+each 0.25 s, then the full wave with its impacts kept (256 rows: every member stops for room
+three or four times in its first 0.05 s; not kept, the impacts are only counted and a member
+stops only when its draws run out), none skipped. "layouts", the earlier plan: short runs
+first, and a configuration whose time, estimated from the one before it as if time grew with
+members x duration (an overestimate while the device is not full), would pass ``--budget``
+seconds in all is skipped with a note.
+
+Measured on an H200, 2026-11-27 (third session), scaling: 33,792 / 8,448 / 64 members x
+0.25 s took 142.6 / 10.2 / 1.10 s, of which the launch 5.12 / 1.80 / 1.09 s; the rest was the
+host's quadratic set-up of a batch, since fixed (see benchmarks/PROFILE.md;
+bench_gpu_wave.py measures a wave now).
 """
 
 from __future__ import annotations

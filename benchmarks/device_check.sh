@@ -10,24 +10,19 @@
 #   pip download --no-deps --only-binary=:all: --python-version 3.12 --implementation cp \
 #     --platform manylinux_2_28_x86_64 -d .whl nolds==0.6.2 future==1.0.0 numpy==2.4.6
 # Steps: versions (the image's numba-cuda under its own numpy 2.5 compiles no kernel: seen on
-# an H200, 2026-11-27); then, under one time limit (CHECK_SECONDS, default 240), where a full
-# device's time goes (bench_gpu_profile.py --plan scaling: a full wave, a block a
-# multiprocessor and one block, 0.25 s each, then the full wave with its impacts kept, which
-# stops every member for room three or four times; each split into launches and refills); with RUN_TESTS=1 the device tests; last, where ncu can read the
-# counters (NCU_SECONDS each, default 90), two Nsight Compute profiles of one launch: a full
-# wave (33,792 members x 0.02 s) with every stall reason (instruction fetch among them),
-# active threads a warp and occupancy, then 1,024 members x 0.05 s with the full sections
-# (memory, launch statistics). Outputs go to
-# $OUT where it is set (profile.log, ncu_*.txt). About 7 minutes in all.
+# an H200, 2026-11-27); then, under one time limit (CHECK_SECONDS, default 330), a full wave's
+# rate by run length against 2 CPU threads of the machine (bench_gpu_wave.py, DURATIONS,
+# default 2 and 20 s: the 20-s rate is what the targets name, not yet timed on a device);
+# with RUN_TESTS=1 the device tests; last, where ncu can read the counters (NCU_SECONDS,
+# default 120), one Nsight Compute profile of a full wave's launch (33,792 members x
+# 0.005 s) with the warp states only and every stall reason (instruction fetch among them):
+# why 4x the warps gave 1.41x. Outputs go to $OUT where it is set (wave.log, ncu_full.txt).
 #
-# Measured 2026-11-27 (H200, two calls): the RK4 kernel ("C", 216 registers) ran 2.16 of a
-# warp's 32 threads at a time over 1,024 members' first launch (0.05 s), issuing every 6.2
-# cycles with one warp a scheduler (L1 hit rate 99.8 %, memory 0.3 % busy); but in that
-# launch every member stopped for a refill at its own time (256 impact rows; 811 impacts in
-# the first 0.05 s), so idle lanes count with divergent ones: gpu_ncu_target.py now gives
-# the room for one launch. 33,792 members x 0.5 s took 140 s staged in thread-local arrays
-# and 145 s with a block barrier after every loop iteration (branch wip/gpu-variants),
-# against 1.3-1.6 s for 64 members: where the full device's time goes is the first question.
+# Measured 2026-11-27 (H200, third session): after the host's quadratic set-up was fixed
+# (e7a316b), 33,792 members x 0.25 / 2 / 5 s ran at 1,073 / 2,231 / 2,954 member-seconds a
+# second, 14.0 / 11.3 / 11.3x the machine's 2 CPU threads, one launch a run. The full wave's
+# profile with five sections (--print-details all) was stopped at 110 s in ncu's replay, so
+# this one asks one section of a shorter launch. benchmarks/PROFILE.md has the sessions.
 set -u -o pipefail
 WHEELS=${1:-.whl}
 export PYTHONUNBUFFERED=1
@@ -45,9 +40,9 @@ export PYTHONPATH=/tmp/site:$PWD
 python3 -c "import numpy, numba, chaoscam; from chaoscam.integrate._gpu import gpu_status; print('numpy', numpy.__version__, '| numba', numba.__version__, '|', gpu_status())"
 
 OUTDIR=${OUT:-/tmp}
-step "where a full device's time goes (bench_gpu_profile.py --plan scaling, CHECK_SECONDS)"
-timeout -k 5 "${CHECK_SECONDS:-240}" python3 benchmarks/bench_gpu_profile.py --plan scaling \
-    2>&1 | tee "$OUTDIR/profile.log"
+step "a full wave's rate by run length (bench_gpu_wave.py, CHECK_SECONDS)"
+timeout -k 5 "${CHECK_SECONDS:-330}" python3 benchmarks/bench_gpu_wave.py \
+    --durations "${DURATIONS:-2,20}" 2>&1 | tee "$OUTDIR/wave.log"
 echo "exit $?"
 
 if [ "${RUN_TESTS:-0}" = 1 ]; then
@@ -56,27 +51,14 @@ if [ "${RUN_TESTS:-0}" = 1 ]; then
     echo "exit $?"
 fi
 
-ncu_run() {  # a name for the output, then ncu's options and the target
-    local name=$1
-    shift
-    timeout -k 5 "${NCU_SECONDS:-90}" ncu --clock-control none --target-processes all \
-        -k regex:advance_members --launch-skip 1 --launch-count 1 "$@" 2>&1 \
-        | tee "$OUTDIR/ncu_$name.txt"
-    echo "exit $?"
-}
 if command -v ncu >/dev/null 2>&1; then
-    # every stall reason (--print-details all): a kernel of some 30,000 PTX lines may stall
-    # on instruction fetch once 8 warps a multiprocessor run different parts of it
-    step "Nsight Compute: a full wave's launch (33,792 members x 0.02 s), stall reasons"
-    ncu_run full --section SpeedOfLight --section WarpStateStats --section SchedulerStats \
-        --section Occupancy --print-details all \
-        --metrics smsp__thread_inst_executed_per_inst_executed.ratio,smsp__inst_executed.sum \
-        python3 benchmarks/gpu_ncu_target.py 33792 0.02
-    step "Nsight Compute: 1,024 members x 0.05 s, full sections"
-    ncu_run sections --section SpeedOfLight --section Occupancy --section LaunchStats \
-        --section WarpStateStats --section SchedulerStats --section MemoryWorkloadAnalysis \
-        --metrics smsp__thread_inst_executed_per_inst_executed.ratio \
-        python3 benchmarks/gpu_ncu_target.py 1024 0.05
+    step "Nsight Compute: a full wave's launch (33,792 members x 0.005 s), warp states"
+    timeout -k 5 "${NCU_SECONDS:-120}" ncu --clock-control none --target-processes all \
+        -k regex:advance_members --launch-skip 1 --launch-count 1 \
+        --section WarpStateStats --print-details all \
+        --metrics smsp__thread_inst_executed_per_inst_executed.ratio,smsp__warps_active.avg.per_cycle_active \
+        python3 benchmarks/gpu_ncu_target.py 33792 0.005 2>&1 | tee "$OUTDIR/ncu_full.txt"
+    echo "exit $?"
 else
     echo "ncu not on the PATH: skipped"
 fi

@@ -50,10 +50,12 @@ labels, so an interruption loses at most that (the parts' size changes no result
 and 1,024 members per part took the same time for the README's 300 members, measured)."""
 
 GPU_CHUNK = 8_192
-"""Members per saved part on a GPU, where a launch takes about as long with 64 members as with
-hundreds (measured on an H200, 2026-11-27: 1,024 members of 20 s with the tangent took
-132 s of device time, as fast as 2 CPU cores), so a part must be large for the device's
-rate; as a sweep's GPU batches (``sweep._batch.GPU_MAP_BATCH``)."""
+"""Members per saved part on a GPU, where one thread is slow and the rate comes from many in
+flight (measured on an H200, 2026-11-27: 64 members of 0.25 s took 1.09 s of launch, 8,448
+took 1.80 s, a full wave of 33,792 took 5.1 s), so a part must be large; a quarter of an
+H200's wave keeps a part's device time and its host labels near a minute or two each for
+20-s runs, at 0.71 of a full wave's rate a member. As a sweep's GPU batches
+(``sweep._batch.GPU_MAP_BATCH``)."""
 
 
 def register(sub) -> None:

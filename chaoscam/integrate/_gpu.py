@@ -29,14 +29,14 @@ row width) and the kernel is launched again for them only; the
 other threads return at once. A run resumed after a hand-back is bit-identical to one that
 was not interrupted (see :func:`_kernel.run_chunk`), so this relaunch changes nothing.
 
-Measured on an NVIDIA H200 (2026-11-27, ``benchmarks/device_check.sh``): the tolerance
-tests pass; the RK4 kernel takes 202 registers and 40 B of local memory a thread; but one
-thread takes 4.8 us a grid step over the first 0.5 s, hundreds of times a CPU core, and
-40,000 members of 20 s took more than 340 s (below 120 trajectories a second; a 1,024-run
-regime map ran as fast as 2 CPU cores). A second session (2026-11-27): 33,792 members x
-0.5 s took 140 s with the member's rows staged in registers, 145 s with the warp's threads
-meeting after every loop iteration (branch ``wip/gpu-variants``), about half the speed of 2
-CPU cores; one launch ran 2.16 of a warp's 32 threads at a time, not waiting on memory.
+Measured on an NVIDIA H200 (2026-11-27, ``benchmarks/bench_gpu_wave.py``): the tolerance
+tests pass; the RK4 kernel takes 202-216 registers and 40 B of local memory a thread. One
+thread is slow (64 members of 0.25 s take 1.09 s, 4.8 us a grid step), so the device needs
+thousands of members in flight: a full wave of 33,792 members of 5 s ran in 57 s, 2,954
+member-seconds a second, 11.3x 2 CPU threads of that machine (the targets ask 3,000 20-s
+trajectories a second and 200x). One launch ran 2.4 of a warp's 32 threads at a time, not
+waiting on memory: members of a warp take different branches. (The earlier sessions'
+"as slow as 2 CPU cores" was the host's quadratic set-up of a batch, since fixed.)
 See the README's "Ensembles and the GPU" and benchmarks/PROFILE.md.
 
 numba-cuda is imported lazily, on first use: ``import chaoscam`` never imports it.

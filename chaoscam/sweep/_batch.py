@@ -40,14 +40,14 @@ MAX_BATCH = 256
 """Members per batch at most (bounds the memory of one compiled call)."""
 
 GPU_MAP_BATCH = 8_192
-"""Members per batch when a sweep's batches run on a GPU (each member one CUDA thread). A
-batch takes about as long with a few members as with hundreds (measured on an H200,
-2026-11-27: 64 members of 0.5 s took 1.2 s, as one does; 1,024 members of a regime map,
-20 s with the tangent, 132 s), so batches must be large for the device's rate; 8,192 keeps a
-checkpoint every few minutes, and the host's labels of a batch (about 8 ms a member there,
-one core) under about a minute. Launches stay short (a member stops for its draws and
-impact rows every few hundred impacts: tens of seconds on the device), so a Ctrl-C is still
-answered within a launch."""
+"""Members per batch when a sweep's batches run on a GPU (each member one CUDA thread). One
+thread is slow and the device's rate comes from many in flight (measured on an H200,
+2026-11-27, 0.25-s runs: 64 members took 1.09 s of launch, 8,448 took 1.80 s, a full wave of
+33,792 took 5.1 s; a 1,024-run regime map of 20 s with the tangent took 132 s, as fast as 2
+CPU cores), so batches must be large. 8,192, a quarter of an H200's wave (at 0.71 of a
+wave's rate a member), keeps a checkpoint every few minutes and the host's labels of a
+batch (about 8 ms a member there, one core) near a minute. A Ctrl-C is answered when the
+launch under way returns."""
 
 
 def batch_size(base: Params, duration: float, transient: float, threads: int) -> int:
