@@ -76,8 +76,9 @@ def register(sub) -> None:
         dest="backend",
         choices=("cpu", "gpu", "auto"),
         default="cpu",
-        help="cpu (default), gpu (falls back to the CPU with a notice), or auto (--device, "
-        "as the sweeps call it, is the same option)",
+        help="cpu (default), gpu (falls back to the CPU with a notice), or auto (the GPU "
+        "where one runs and --members is 4,096 or more; --device, as the sweeps call it, is "
+        "the same option)",
     )
     p.add_argument(
         "--workers",
@@ -152,6 +153,7 @@ def _run_locked(args: argparse.Namespace) -> int:
     out: Path = args.out
     members_n = whole("--members", args.members, low=1)
     whole("--first", args.first, high=COUNT_MAX - (members_n - 1))  # every index fits int64
+    args.backend = _settled(args.backend, members_n)
     params = parse_assignments(args.set)
     duration, transient = run_settings(args.duration, args.transient, args.seed)
     out, sections_path, impacts_path = output_paths(out)
@@ -372,6 +374,18 @@ def _chunk(args: argparse.Namespace, parts: Path) -> int:
     from ..integrate._gpu import runs_on_gpu
 
     return GPU_CHUNK if runs_on_gpu(args.backend) else CPU_CHUNK
+
+
+def _settled(backend: str, members: int) -> str:
+    """The backend every part runs on: ``auto`` settled once for the whole run, by its size
+    (:func:`chaoscam.integrate._gpu.by_size`) and the GPU here, so that a short last part
+    does not move to the other device."""
+    from ..integrate._gpu import by_size, runs_on_gpu
+
+    backend = by_size(backend, members)
+    if backend == "auto":
+        return "gpu" if runs_on_gpu(backend) else "cpu"
+    return backend
 
 
 def _progress_batch(backend: str) -> int | None:

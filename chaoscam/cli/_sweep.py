@@ -57,7 +57,8 @@ def _common(p: argparse.ArgumentParser) -> None:
         choices=("cpu", "gpu", "auto"),
         default="cpu",
         help="where the ensemble engine runs its batches (gpu: NVIDIA, numba-cuda; equal to "
-        "the CPU only within GPU_TOLERANCE); default cpu",
+        "the CPU only within GPU_TOLERANCE; auto: the GPU where one runs and the sweep has "
+        "4,096 runs or more); default cpu",
     )
     p.add_argument(
         "--scheduler",

@@ -124,8 +124,9 @@ def simulate_ensemble(
         ``"gpu"``: one CUDA thread per member (numba-cuda, ``pip install 'chaoscam[gpu]'``);
         where it cannot run (see :func:`_gpu.gpu_status`) the CPU path is used after a
         one-line :class:`GPUFallbackWarning` giving the reason. ``"auto"``: the GPU when
-        available, else the CPU without a notice. ``settings["backend"]`` records the one
-        used.
+        available and the ensemble has :data:`_gpu.AUTO_GPU_MIN` members or more (fewer
+        run as fast or faster on the CPU), else the CPU without a notice.
+        ``settings["backend"]`` records the one used.
     keep_impacts : bool
         Also return every member's impacts (``Ensemble.impacts``); by default they are only
         counted, so that memory stays flat for long runs.
@@ -158,6 +159,8 @@ def simulate_ensemble(
     duration, transient = check_window(duration, transient)
     keep_impacts, tangent = flag("keep_impacts", keep_impacts), flag("tangent", tangent)
     resumable = flag("resumable", resumable)
+    if backend == "auto" and hasattr(indices, "__len__"):
+        backend = _gpu.by_size(backend, len(indices))
     use_gpu, device = _pick_backend(backend)
     if batch is None:
         batch = _gpu.GPU_BATCH if use_gpu else _CPU_BATCH

@@ -61,7 +61,9 @@ __all__ = [
     "GPU_BATCH",
     "GPU_LAYOUT",
     "GPU_TOLERANCE",
+    "AUTO_GPU_MIN",
     "GPUFallbackWarning",
+    "by_size",
     "gpu_status",
     "run_on_gpu",
     "runs_on_gpu",
@@ -83,6 +85,15 @@ _SMALL_GRID = r".*Grid size \d+ will likely result in GPU under-utilization"
 with its ANSI codes). A small batch is expected; a sweep would otherwise record the warning
 against every run of the batch (seen on an H200, 2026-11-27)."""
 _NUMPY_TRAP = (2, 5)  # numba-cuda <= 0.30.4 compiles no kernel under numpy >= 2.5
+AUTO_GPU_MIN = 4_096
+"""Fewest members (an ensemble's, or a sweep's runs) for which ``"auto"`` runs them on a GPU.
+One GPU thread is slow and the device's rate comes from many in flight (an H200, 2026-11-27,
+0.25-s runs: 64 members took 1.09 s of launch, 8,448 took 1.80 s, 33,792 took 5.1 s, against
+77 member-seconds a second on 2 CPU threads; a 1,024-run regime map ran as fast as 2 CPU
+cores). From 4,096 members the device, by those measurements, outruns a CPU of 16 cores;
+below it ``"auto"`` runs on the CPU (``"gpu"`` still runs any size on the GPU). A sweep
+settles it by its runs before it starts; on Dask workers, which get CPU-sized batches, a
+sweep's ``"auto"`` is settled per batch, so they run on their CPUs."""
 
 
 class GPUFallbackWarning(RuntimeWarning):
@@ -102,6 +113,13 @@ def gpu_status() -> tuple[bool, str]:
     if importlib.util.find_spec("numba_cuda") is None:
         return False, "numba-cuda is not installed (pip install 'chaoscam[gpu]')"
     return _device_status()
+
+
+def by_size(backend: str, members: int) -> str:
+    """``backend`` with ``"auto"`` settled by the run's size: ``"cpu"`` for fewer than
+    :data:`AUTO_GPU_MIN` members, ``"auto"`` (the GPU where one runs) otherwise; ``"cpu"``
+    and ``"gpu"`` are returned as they are."""
+    return "cpu" if backend == "auto" and members < AUTO_GPU_MIN else backend
 
 
 def runs_on_gpu(backend: str) -> bool:

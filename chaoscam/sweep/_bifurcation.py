@@ -348,6 +348,9 @@ def bifurcation(
             if specs.index(specs[i]) < i:  # as an axis value twice: the same runs again
                 raise SweepError(f"initial_conditions[{i}] = ({th}, {om}) is given twice")
         n_specs = len(specs)
+    from ..integrate._gpu import by_size
+
+    device = by_size(device, len(axis) * n_specs)  # "auto": the CPU for a small sweep
     classify, eng, series = sweep_engine(
         classify,
         lyapunov,

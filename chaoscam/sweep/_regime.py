@@ -315,7 +315,8 @@ def regime_map(
     device : {"cpu", "gpu", "auto"}
         Where the ensemble engine runs its batches: ``"gpu"`` uses an NVIDIA GPU
         (numba-cuda), equal to the CPU only within ``GPU_TOLERANCE`` (chaotic members part
-        after a few periods); default ``"cpu"``, bit-identical everywhere.
+        after a few periods); default ``"cpu"``, bit-identical everywhere; ``"auto"``: the
+        GPU where one runs and the map has ``_gpu.AUTO_GPU_MIN`` (4,096) runs or more.
     fate : float, optional
         Horizon [s]: each realization labelled chaotic, quasiperiodic or undetermined is
         simulated again to this time, with the tangent (the same motion, bit for bit), to
@@ -385,6 +386,10 @@ def regime_map(
         # before any run: summarize_cells would refuse it only at the end
         raise SweepError(f"confidence = {confidence!r}: the intervals' level, in (0, 1), e.g. 0.95")
     validate_grid(base, [x, y])
+    from ..integrate._gpu import by_size
+
+    runs = len(x) * len(y) * (adaptive["max_realizations"] if adaptive else realizations)
+    device = by_size(device, runs)  # "auto": the CPU for a small sweep
     classify, eng, series = sweep_engine(
         classify,
         lyapunov,

@@ -221,6 +221,24 @@ def test_default_part_size_follows_the_backend_that_runs(
         _ensemble._chunk(ns(0), tmp_path / "none.parts")
 
 
+def test_auto_settles_once_by_the_run_size(tmp_path, monkeypatch):
+    """--backend auto is settled once for the whole run: the CPU below AUTO_GPU_MIN members
+    even with a GPU here, else the GPU where one runs, so that a short last part does not
+    move to the other device; cpu and gpu are kept as asked."""
+    from chaoscam.cli import _ensemble
+    from chaoscam.integrate import _gpu
+
+    for gpu, small, large in [(True, "cpu", "gpu"), (False, "cpu", "cpu")]:
+        monkeypatch.setattr(_gpu, "gpu_status", lambda gpu=gpu: (gpu, "test"))
+        assert _ensemble._settled("auto", _gpu.AUTO_GPU_MIN - 1) == small
+        assert _ensemble._settled("auto", _gpu.AUTO_GPU_MIN) == large
+        assert _ensemble._settled("gpu", 1) == "gpu" and _ensemble._settled("cpu", 10**6) == "cpu"
+    monkeypatch.setattr(_gpu, "gpu_status", lambda: (True, "test"))
+    out = tmp_path / "a.parquet"
+    assert main([*ARGS, "--backend", "auto", "--out", str(out)]) == 0  # 5 members: the CPU
+    assert len(pd.read_parquet(out)) == 5
+
+
 def test_progress_counts_every_member_from_the_first_batch(tmp_path, capsys):
     """The progress bar (stderr) has the total from the start and reaches it; the compiled
     calls are small batches, so it moves before the first part is done."""

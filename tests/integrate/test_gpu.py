@@ -75,8 +75,9 @@ def test_auto_backend_falls_back_silently(no_gpu):
     assert ens.settings["backend"] == "cpu"
 
 
-def test_auto_backend_uses_an_available_gpu(monkeypatch):
-    """backend="auto" dispatches to the GPU launcher when one is available, and records it."""
+@pytest.fixture
+def fake_gpu(monkeypatch) -> list[int]:
+    """A GPU "Fake GPU" that runs its launches on the CPU; returns the members of each."""
     monkeypatch.setattr(_gpu, "gpu_status", lambda: (True, "Fake GPU"))
     launched = []
 
@@ -85,10 +86,37 @@ def test_auto_backend_uses_an_available_gpu(monkeypatch):
         _members.run_on_cpu(*args)
 
     monkeypatch.setattr(_gpu, "run_on_gpu", fake_launcher)
+    return launched
+
+
+def test_auto_backend_uses_an_available_gpu(monkeypatch, fake_gpu):
+    """backend="auto" dispatches to the GPU launcher when one is available and the ensemble
+    has AUTO_GPU_MIN members (here lowered to 3), and records it."""
+    monkeypatch.setattr(_gpu, "AUTO_GPU_MIN", 3)
+    launched = fake_gpu
     ens = simulate_ensemble(Params(), range(3), duration=0.01, backend="auto")
     assert launched == [3]
     assert ens.settings["backend"] == "gpu" and ens.settings["device"] == "Fake GPU"
     assert ens.settings["batch"] == _gpu.GPU_BATCH
+
+
+def test_auto_backend_keeps_a_small_ensemble_on_the_cpu(monkeypatch, fake_gpu):
+    """Below AUTO_GPU_MIN members "auto" runs on the CPU, silently, even with a GPU here (a
+    thousand members ran no faster on an H200 than on 2 CPU cores); "gpu" still launches."""
+    monkeypatch.setattr(_gpu, "AUTO_GPU_MIN", 4)
+    launched = fake_gpu
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        small = simulate_ensemble(Params(), range(3), duration=0.01, backend="auto")
+    assert launched == [] and small.settings["backend"] == "cpu"
+    asked = simulate_ensemble(Params(), range(3), duration=0.01, backend="gpu")
+    assert launched == [3] and asked.settings["backend"] == "gpu"
+    assert [_gpu.by_size(b, n) for b, n in [("auto", 3), ("auto", 4), ("gpu", 1), ("cpu", 9)]] == [
+        "cpu",
+        "auto",
+        "gpu",
+        "cpu",
+    ]
 
 
 def test_an_unknown_layout_is_refused():

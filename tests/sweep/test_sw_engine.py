@@ -316,3 +316,20 @@ def test_a_gpu_sweep_without_a_gpu_says_so_once(monkeypatch):
     assert len(fallback) == 1 and "no CUDA device (test)" in str(fallback[0].message)
     assert m.config["device"] == "cpu"
     assert not m.realizations["warnings"].str.contains("GPU").any()
+
+
+def test_auto_device_runs_a_small_sweep_on_the_cpu(monkeypatch):
+    """device="auto" with a GPU here: a map of fewer than AUTO_GPU_MIN runs runs on the CPU
+    (recorded so), without a notice; device="gpu" would have used the GPU."""
+    import warnings
+
+    from chaoscam.integrate import _gpu
+
+    monkeypatch.setattr(_gpu, "gpu_status", lambda: (True, "Fake GPU"))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", _gpu.GPUFallbackWarning)
+        m = regime_map(
+            Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.001,)), realizations=2,
+            duration=1.0, engine="ensemble", device="auto", workers=2,
+        )  # fmt: skip
+    assert m.config["device"] == "cpu"
