@@ -103,6 +103,7 @@ def open_choices(quick: bool, outdir: Path, workers, classify, hertz_tags: list[
     from ..report._sweep_figures import sweep_diagram
     from ..sweep import bifurcation
     from ._paper import _save
+    from ._sensitivity import SWEEP_FATE_S
 
     p = Params()
     runs, figures = {}, []
@@ -116,7 +117,7 @@ def open_choices(quick: bool, outdir: Path, workers, classify, hertz_tags: list[
         path = outdir / f"{stem}.parquet"
         bif = bifurcation(
             name, values, base=base, duration=20.0, transient=10.0, classify=classify,
-            workers=workers, **stored(path),
+            workers=workers, fate=SWEEP_FATE_S[quick], **stored(path),
         )  # fmt: skip
         runs[name] = first_ic(bif)
         if name != "xi":

@@ -20,6 +20,7 @@ import pandas as pd
 from ..report._figures import png_bytes, png_uri, response_figure
 from ..report._html import Comparison, FigureItem
 from . import _steps
+from ._sensitivity import SWEEP_FATE_S
 from ._store import stored
 
 __all__ = ["FIGURES", "FigureResult", "data_files"]
@@ -211,6 +212,7 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
         initial_conditions=1 if quick else 3,
         classify=_classifier(quick),
         workers=workers,
+        fate=SWEEP_FATE_S[quick],
         **stored(path := outdir / "fig4.parquet"),
     )
     png = _save(sweep_diagram(bif), outdir, "fig4")
@@ -489,10 +491,9 @@ def _classifier(quick: bool):
     return DefaultClassifier(extend_to=QUICK_EXTEND_TO if quick else FULL_EXTEND_TO)
 
 
-QUICK_EXTEND_TO = 40.0
-"""Recorded time [s] the quick report extends an undetermined run to."""
-FULL_EXTEND_TO = 120.0
-"""Recorded time [s] the full report extends an undetermined run to (Fig. 6 included)."""
+QUICK_EXTEND_TO, FULL_EXTEND_TO = 40.0, 120.0
+"""Recorded time [s] the quick and the full report extend an undetermined run to (the full
+one's Fig. 6 included)."""
 
 
 FIGURES = {3: fig3, 4: fig4, 5: fig5, 6: fig6, 7: fig7_10, 8: fig7_10, 9: fig7_10, 10: fig7_10}

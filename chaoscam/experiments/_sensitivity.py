@@ -62,6 +62,14 @@ runs labelled chaotic, quasiperiodic or undetermined go on to it, to see whether
 the cam's reach (the full one covers (42.5 rad/s, 0.40), chaotic for 229 s and then out of
 reach)."""
 
+SWEEP_FATE_S = {True: None, False: FATE_S[False]}
+"""The fate horizon [s] of Fig. 4 and the other sensitivity diagrams (J, y_O, friction arm,
+literal damping, both stiffness sweeps), quick and full: the full report only (the quick
+one keeps its 90 s). Measured before it was added (analyses/fate_audit.py, at ca8da29): of
+245 chaotic verdicts of these sweeps, 4 of Fig. 4's settle on a period 8 by 300 s and one
+(J = 0.08823) leaves the cam's reach at 102 s; about 18 minutes more of the full report.
+Figs. 6 and 7-10 keep none (their steps and realizations would cost hours)."""
+
 CHECK_STEP = {True: False, False: True}
 """Whether the sweeps re-run each periodic, quasiperiodic or chaotic verdict at half the step
 and call it undetermined when it changes there (``check_step``; quick, full). The full run
@@ -254,7 +262,7 @@ def _stiffness(quick: bool, outdir: Path, workers, classify):
         path = outdir / f"sensitivity-{'stiffness' if name == 'Y_f' else 'hertz'}.parquet"
         bif = bifurcation(
             name, values, duration=20.0, transient=10.0, classify=classify, workers=workers,
-            **stored(path),
+            fate=SWEEP_FATE_S[quick], **stored(path),
         )  # fmt: skip
         out.append((bif, path, {v: k_of(v) for v in values}))
     return out

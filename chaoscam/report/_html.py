@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from .._provenance import code_rows
+from ..sweep._stats import fate_clause
 from ._figures import png_bytes, png_uri, response_figure
 from ._inputs import require_inputs
 
@@ -233,6 +234,8 @@ def add_bifurcation(
 ) -> None:
     """A bifurcation diagram, its verdicts per value and its provenance (``png``: its figure
     already rendered, else drawn here)."""
+    import pandas as pd
+
     from ._sweep_figures import sweep_diagram
 
     name = Path(path).name
@@ -243,6 +246,8 @@ def add_bifurcation(
     if png is None:
         png = png_bytes(sweep_diagram(bif))
     ev_cols = [c for c in v.columns if c.startswith("ev_")]
+    named = dict(fate="at the fate horizon", fate_label="label there", fate_period="period there")
+    later = [c for c in named if c in v] if cfg.get("fate") else []  # the sweep had a horizon
     parts.bifurcations.append(
         {
             "figure": FigureItem(
@@ -255,7 +260,8 @@ def add_bifurcation(
                 or f"{len(v)} runs, {len(bif.points)} section points; labels {_counts(counts)}.",
             ),
             "header": [param, "initial condition", "label", "period", "status"]
-            + [c[3:] for c in ev_cols],
+            + [c[3:] for c in ev_cols]
+            + [named[c] for c in later],
             "rows": [
                 (
                     _fmt(r["value"]),
@@ -264,6 +270,7 @@ def add_bifurcation(
                     _fmt(r["period"]),
                     r["status"],
                     *(_fmt(float(r[c])) for c in ev_cols),
+                    *(_fmt(r[c]) if pd.notna(r[c]) else "" for c in later),
                 )
                 for r in v.sort_values(["value", "ic"]).to_dict("records")
             ][:300],
@@ -272,7 +279,7 @@ def add_bifurcation(
     parts.provenance.append(_provenance_rows(path, "bifurcation", _sweep_settings(cfg)))
     parts.summary.append(
         f"{name}: bifurcation over {param}, labels {_counts(counts)}"
-        + _fate_text(v, cfg.get("fate"), "runs")
+        + fate_clause(v, cfg.get("fate"), "runs")
         + "."
     )
 
@@ -326,26 +333,8 @@ def add_regime_map(
     dom = c["dominant"].value_counts().to_dict() if len(c) else {}
     parts.summary.append(
         f"{name}: regime map {x} × {y}, dominant labels {_counts(dom)}"
-        + _fate_text(rm.realizations, cfg.get("fate"), "realizations")
+        + fate_clause(rm.realizations, cfg.get("fate"), "realizations")
         + "."
-    )
-
-
-def _fate_text(rows, fate, what: str) -> str:
-    """The summary's clause on a sweep's fate horizon: how many of the continued runs
-    stopped before it, and how many are periodic on the continued run's last half (transient
-    motion); empty without a horizon."""
-    from ..sweep._stats import continued_labels, fate_settled, fate_split
-
-    checked, stopped = fate_split(rows) if fate else (rows.iloc[:0], None)
-    if not len(checked):  # no horizon, or no run to continue (all periodic or out of reach)
-        return ""
-    judged = "fate_label" in rows and rows["fate_label"].notna().any()  # not adaptive runs
-    return (
-        f"; continued to {float(fate):g} s, {len(stopped)} of the {len(checked)} {what} "
-        f"{continued_labels(checked)} stop before it"
-        + (f" and {len(fate_settled(rows))} are periodic later" if judged else "")
-        + " (transient motion)"
     )
 
 

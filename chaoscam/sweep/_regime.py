@@ -391,19 +391,12 @@ def regime_map(
     runs = len(x) * len(y) * (adaptive["max_realizations"] if adaptive else realizations)
     device = by_size(device, runs)  # "auto": the CPU for a small sweep
     classify, eng, series = sweep_engine(
-        classify,
-        lyapunov,
-        check_step,
-        engine,
-        device,
-        base,
-        (duration, transient),
-        workers,
+        classify, lyapunov, check_step, engine, device, base, (duration, transient), workers,
         scheduler,
-    )
+    )  # fmt: skip
     check_sweep_budget(
         base,
-        runs=len(x) * len(y) * (adaptive["max_realizations"] if adaptive else realizations),
+        runs=runs,
         duration=duration,
         transient=transient,
         series=series,

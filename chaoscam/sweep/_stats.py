@@ -13,7 +13,14 @@ import numpy as np
 import pandas as pd
 from scipy.special import ndtri
 
-__all__ = ["LABEL_ORDER", "fate_split", "wilson_interval", "max_halfwidth", "summarize_cells"]
+__all__ = [
+    "LABEL_ORDER",
+    "fate_clause",
+    "fate_split",
+    "wilson_interval",
+    "max_halfwidth",
+    "summarize_cells",
+]
 
 LABEL_ORDER = (
     "periodic",
@@ -216,3 +223,19 @@ def continued_labels(checked: pd.DataFrame) -> str:
         return "continued"
     head = ", ".join(labels[:-1])
     return "labelled " + (f"{head} or {labels[-1]}" if head else labels[-1])
+
+
+def fate_clause(rows, fate, what: str) -> str:
+    """A report summary's clause on a sweep's fate horizon: how many of the continued runs
+    stopped before it, and how many are periodic on the continued run's last half (transient
+    motion); empty without a horizon."""
+    checked, stopped = fate_split(rows) if fate else (rows.iloc[:0], None)
+    if not len(checked):  # no horizon, or no run to continue (all periodic or out of reach)
+        return ""
+    judged = "fate_label" in rows and rows["fate_label"].notna().any()  # not adaptive runs
+    return (
+        f"; continued to {float(fate):g} s, {len(stopped)} of the {len(checked)} {what} "
+        f"{continued_labels(checked)} stop before it"
+        + (f" and {len(fate_settled(rows))} are periodic later" if judged else "")
+        + " (transient motion)"
+    )

@@ -111,10 +111,24 @@ def test_without_a_horizon_nothing_is_continued():
 
 
 def test_bifurcation_verdicts_carry_the_fate():
+    """The verdicts carry the fate, and the report's table shows it per run (the full
+    report's Fig. 4 and sensitivity diagrams have a horizon); a diagram without one has no
+    such columns."""
+    from chaoscam.report._html import ReportParts, add_bifurcation
+
     b = bifurcation("xi", [0.4, 0.7], base=Params(omega=25.0), **KW)
     v = b.verdicts.set_index("value")
     assert v.loc[0.7, "fate"] == "LEFT_REACH" and 27.0 < v.loc[0.7, "left_at"] < 28.0
     assert pd.isna(v.loc[0.4, "fate"])
+    parts = ReportParts()
+    add_bifurcation(parts, "b.parquet", b, png=b"")
+    table = parts.bifurcations[0]
+    assert table["header"][-3:] == ["at the fate horizon", "label there", "period there"]
+    rows = {r[0]: r for r in table["rows"]}
+    assert rows["0.7"][-3] == "LEFT_REACH" and rows["0.4"][-3:] == ("", "", "")
+    plain = bifurcation("xi", [0.7], base=Params(omega=25.0), duration=2.0, workers=1)
+    add_bifurcation(parts, "p.parquet", plain, png=b"")
+    assert "at the fate horizon" not in parts.bifurcations[1]["header"]
 
 
 @pytest.mark.parametrize("fate", [20.0, 5.0, float("inf"), float("nan"), True, "300"])
@@ -233,12 +247,12 @@ def test_the_command_line_summary_names_the_continued_runs(tmp_path, capsys):
 
 def test_the_report_clause_is_empty_when_no_run_was_continued():
     """A horizon, but every run periodic (or out of reach): no "0 of the 0 cells" clause."""
-    from chaoscam.report._html import _fate_text
+    from chaoscam.sweep._stats import fate_clause
 
     rows = pd.DataFrame({"label": ["periodic", "left_reach"], "fate": [None, None]})
-    assert _fate_text(rows, 300.0, "cells") == ""
+    assert fate_clause(rows, 300.0, "cells") == ""
     rows.loc[0, ["label", "fate"]] = ["chaotic", "OK"]
-    assert _fate_text(rows, 300.0, "cells").startswith("; continued to 300 s, 0 of the 1 cells")
+    assert fate_clause(rows, 300.0, "cells").startswith("; continued to 300 s, 0 of the 1 cells")
 
 
 def test_a_horizon_without_a_whole_late_period_is_not_judged():
@@ -254,12 +268,12 @@ def test_a_horizon_without_a_whole_late_period_is_not_judged():
 def test_the_summary_says_nothing_of_settling_where_nothing_was_judged():
     """Rows without fate verdicts (an adaptive sweep, a file from before them): the HTML
     summary said "0 settle"; now it leaves the later verdicts out."""
-    from chaoscam.report._html import _fate_text
+    from chaoscam.sweep._stats import fate_clause
 
     rows = pd.DataFrame({"label": ["chaotic"], "fate": ["OK"], "fate_label": [None]})
-    assert "periodic later" not in _fate_text(rows, 300.0, "runs")
+    assert "periodic later" not in fate_clause(rows, 300.0, "runs")
     rows["fate_label"] = ["periodic"]
-    assert "and 1 are periodic later" in _fate_text(rows, 300.0, "runs")
+    assert "and 1 are periodic later" in fate_clause(rows, 300.0, "runs")
 
 
 def test_the_sentence_tells_a_settling_from_a_verdict_that_needed_longer():
