@@ -233,9 +233,10 @@ def fate_clause(rows, fate, what: str) -> str:
     if not len(checked):  # no horizon, or no run to continue (all periodic or out of reach)
         return ""
     judged = "fate_label" in rows and rows["fate_label"].notna().any()  # not adaptive runs
+    settled = len(fate_settled(rows)) if judged else 0
     return (
         f"; continued to {float(fate):g} s, {len(stopped)} of the {len(checked)} {what} "
         f"{continued_labels(checked)} stop before it"
-        + (f" and {len(fate_settled(rows))} are periodic later" if judged else "")
-        + " (transient motion)"
+        + (f" and {settled} are periodic later" if judged else "")
+        + (" (transient motion)" if len(stopped) or settled else "")  # else none was
     )

@@ -273,7 +273,20 @@ def test_the_summary_says_nothing_of_settling_where_nothing_was_judged():
     rows = pd.DataFrame({"label": ["chaotic"], "fate": ["OK"], "fate_label": [None]})
     assert "periodic later" not in fate_clause(rows, 300.0, "runs")
     rows["fate_label"] = ["periodic"]
-    assert "and 1 are periodic later" in fate_clause(rows, 300.0, "runs")
+    assert "and 1 are periodic later (transient motion)" in fate_clause(rows, 300.0, "runs")
+
+
+def test_the_clause_calls_nothing_transient_where_nothing_was():
+    """Every continued run stayed and none settled: the clause gives the counts and no
+    "(transient motion)", which described nothing (the full report's stiffness diagrams)."""
+    from chaoscam.sweep._stats import fate_clause
+
+    rows = pd.DataFrame({"label": ["chaotic"], "fate": ["OK"], "fate_label": ["chaotic"]})
+    clause = fate_clause(rows, 300.0, "runs")
+    said = "; continued to 300 s, 0 of the 1 runs labelled chaotic stop before it"
+    assert clause == said + " and 0 are periodic later"
+    rows["fate"] = ["LEFT_REACH"]
+    assert fate_clause(rows, 300.0, "runs").endswith("(transient motion)")
 
 
 def test_the_sentence_tells_a_settling_from_a_verdict_that_needed_longer():
