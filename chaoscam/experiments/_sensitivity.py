@@ -67,7 +67,8 @@ SWEEP_FATE_S = {True: None, False: FATE_S[False]}
 literal damping, both stiffness sweeps), quick and full: the full report only (the quick
 one keeps its 90 s). Measured before it was added (analyses/fate_audit.py, at ca8da29): of
 245 chaotic verdicts of these sweeps, 4 of Fig. 4's settle on a period 8 by 300 s and one
-(J = 0.08823) leaves the cam's reach at 102 s; about 18 minutes more of the full report.
+(J = 0.08823) leaves the cam's reach at 102 s; the full report found the same at a93e02f,
+in about 14 minutes more (Fig. 4 982 s instead of 228 s; the sensitivity sweeps 546 s, 479).
 Figs. 6 and 7-10 keep none (their steps and realizations would cost hours)."""
 
 CHECK_STEP = {True: False, False: True}
