@@ -69,7 +69,7 @@ class _Clock:
 
 
 def measure(p, members, duration, room, layout, keep_impacts=False):
-    """(wall time, clock, sections) of one GPU ensemble with this room and layout."""
+    """(wall time, clock, ensemble) of one GPU ensemble with this room and layout."""
     clock = _Clock()
     inner, _gpu.drive_members = _gpu.drive_members, clock.wrap(_gpu.drive_members)
     before, _ensemble._ROOM["gpu"] = _ensemble._ROOM["gpu"], room
@@ -79,7 +79,7 @@ def measure(p, members, duration, room, layout, keep_impacts=False):
         ens = simulate_ensemble(
             p, range(members), seed=1, duration=duration, backend="gpu", keep_impacts=keep_impacts
         )
-        return time.perf_counter() - t0, clock, ens.sections
+        return time.perf_counter() - t0, clock, ens
     finally:
         _gpu.drive_members, _ensemble._ROOM["gpu"] = inner, before
         _gpu.GPU_LAYOUT = order
@@ -149,11 +149,11 @@ def main() -> None:
             if guess > args.budget - (time.perf_counter() - start):
                 print(f"skipped {what}: about {guess:.0f} s")
                 continue
-        wall, c, sec = measure(p, members, duration, room, layout, keep)
+        wall, c, ens = measure(p, members, duration, room, layout, keep)
         last = (wall, members, duration)
         walls[(members, layout)] = wall
         if members == 64:
-            sections[layout] = sec[["k", "t", "theta_f", "omega_f"]].to_numpy()
+            sections[layout] = ens.sections[["k", "t", "theta_f", "omega_f"]].to_numpy()
         rate = members / wall
         print(
             f"{what}: {wall:7.2f} s = {rate:9,.1f} traj/s ({rate * duration / 20:9,.1f} 20-s "

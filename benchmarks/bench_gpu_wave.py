@@ -13,7 +13,8 @@ threads of the same machine, measured in the same run.
 Why: on 2026-11-27 33,792 x 0.25 s took 142.6 s on an H200 of which 5.1 s were the launch:
 ``_members.fresh`` sized every member's draws with a maximum over the whole batch, once a
 member (quadratic, 137 s at that size). Fixed; this benchmark says what a wave costs now.
-The first cam period of ``--check`` members is compared with the CPU's (``GPU_TOLERANCE``).
+The first cam period of ``--check`` members is compared with the CPU's (``GPU_TOLERANCE``;
+bench_gpu.py's check); the launches are timed as bench_gpu_profile.py times them.
 Without a GPU it says why on one line and exits 0.
 """
 
@@ -23,35 +24,11 @@ import argparse
 import time
 
 import numba
-import numpy as np
+from bench_gpu import max_diff, timed  # run from benchmarks/, as the scripts are
+from bench_gpu_profile import measure
 
 from chaoscam import Params
-from chaoscam.integrate import _gpu, simulate_ensemble
-
-
-def timed(p, members, duration, backend):
-    """(ensemble, wall seconds, [seconds inside the launches, launches]) of one run."""
-    inside = [0.0, 0]
-    drive = _gpu.drive_members
-
-    def clocked(n, launch, refill, need=None):
-        def launch_timed(x):
-            t0 = time.perf_counter()
-            try:
-                return launch(x)
-            finally:
-                inside[0] += time.perf_counter() - t0
-                inside[1] += 1
-
-        return drive(n, launch_timed, refill, need)
-
-    _gpu.drive_members = clocked
-    try:
-        t0 = time.perf_counter()
-        ens = simulate_ensemble(p, range(members), seed=1, duration=duration, backend=backend)
-        return ens, time.perf_counter() - t0, inside
-    finally:
-        _gpu.drive_members = drive
+from chaoscam.integrate import _ensemble, _gpu, simulate_ensemble
 
 
 def main() -> None:
@@ -67,7 +44,7 @@ def main() -> None:
     simulate_ensemble(p, range(2), seed=1, duration=0.01, backend="cpu")  # compile or load
     cpu_rate = {}
     for d in durations:
-        _, wall, _ = timed(p, args.cpu_members, d, "cpu")
+        _, wall = timed(p, args.cpu_members, d, "cpu")
         cpu_rate[d] = args.cpu_members * d / wall
         print(f"CPU, 2 threads: {args.cpu_members} x {d:g} s in {wall:.2f} s = "
               f"{cpu_rate[d]:,.0f} member-s/s", flush=True)  # fmt: skip
@@ -78,16 +55,13 @@ def main() -> None:
     t0 = time.perf_counter()
     simulate_ensemble(p, range(64), seed=1, duration=0.01, backend="gpu")
     print(f"GPU: {reason}; compiled in {time.perf_counter() - t0:.1f} s", flush=True)
-    a = simulate_ensemble(p, range(args.check), seed=1, duration=0.25, backend="gpu").sections
-    b = simulate_ensemble(p, range(args.check), seed=1, duration=0.25, backend="cpu").sections
-    cols = ["t", "theta_f", "omega_f"]
-    same = a.shape == b.shape and np.array_equal(a.k, b.k)
-    diff = float(np.abs(a[cols].to_numpy() - b[cols].to_numpy()).max()) if same else np.inf
+    diff = max_diff(p, range(args.check), 0.25, 0.0)
     verdict = "ok" if diff <= _gpu.GPU_TOLERANCE else "FAILED"
     print(f"check: first cam period of {args.check} members, max |GPU - CPU| {diff:.1e} "
           f"(tolerance {_gpu.GPU_TOLERANCE:g}): {verdict}", flush=True)  # fmt: skip
     for d in durations:
-        ens, wall, (inside, launches) = timed(p, args.members, d, "gpu")
+        wall, clock, ens = measure(p, args.members, d, _ensemble._ROOM["gpu"], "C")
+        inside, launches = clock.launch, clock.launches
         rate = args.members * d / wall
         print(
             f"GPU: {args.members:,} x {d:g} s in {wall:.1f} s ({launches} launches "

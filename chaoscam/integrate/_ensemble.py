@@ -29,7 +29,7 @@ from . import _gpu
 from . import _kernel as k
 from ._constants import kernel_constants
 from ._driver import check_window, thread_count
-from ._members import fresh, resumed, run_batch, run_on_cpu
+from ._members import fresh, models_of, resumed, run_batch, run_on_cpu
 from ._resume import Resume
 from ._tangent import section_jacobians
 
@@ -159,12 +159,6 @@ def simulate_ensemble(
     duration, transient = check_window(duration, transient)
     keep_impacts, tangent = flag("keep_impacts", keep_impacts), flag("tangent", tangent)
     resumable = flag("resumable", resumable)
-    if backend == "auto" and hasattr(indices, "__len__"):
-        backend = _gpu.by_size(backend, len(indices))
-    use_gpu, device = _pick_backend(backend)
-    if batch is None:
-        batch = _gpu.GPU_BATCH if use_gpu else _CPU_BATCH
-    batch = whole("batch", batch, low=1)
     seed = whole("seed", seed)
     if isinstance(indices, str | bytes) or not hasattr(indices, "__iter__"):
         raise TypeError(
@@ -178,13 +172,17 @@ def simulate_ensemble(
     if plist and hasattr(indices, "__len__"):  # before the list: range(10**10) would hang there
         _check_memory(plist[0], duration, transient, len(indices))
     indices = [whole("index", i) for i in indices]
+    use_gpu, device = _pick_backend(_gpu.by_size(backend, len(indices)))  # "auto": by size
+    batch = whole(
+        "batch", (_gpu.GPU_BATCH if use_gpu else _CPU_BATCH) if batch is None else batch, low=1
+    )
     if not per_member:
         plist = plist * len(indices)
     if len(plist) != len(indices):
         raise ValueError(f"{len(plist)} parameter sets for {len(indices)} indices")
     if len({(p.dt, p.omega) for p in plist}) > 1:
         raise ValueError("members must share dt and omega")
-    models = {id(q): q for q in plist}.values()  # one model for all members: checked once
+    models = models_of(plist)  # one model for all members: checked once
     for text in dict.fromkeys(w for q in models for w in run_warnings(q)):
         warn(text)  # as simulate() warns
     t0 = time.perf_counter()

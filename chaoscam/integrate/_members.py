@@ -75,19 +75,19 @@ def resumed(res: Resume, plist, duration, room) -> _Start:
     return _Start(res.step, y, cnt, c, lam, streams, res.rows, res.impacts, status)
 
 
-def _models(plist) -> list[Params]:
+def models_of(plist) -> list[Params]:
     """The distinct parameter objects of ``plist`` (a batch of one model repeats one)."""
     return list({id(p): p for p in plist}.values())
 
 
 def _margin(plist) -> int:
     """Rows and draws one grid step may use beyond the room (events, a merged flight)."""
-    return 4 * (max(p.max_events_per_step + p.flight_merge for p in _models(plist)) + 2)
+    return 4 * (max(p.max_events_per_step + p.flight_merge for p in models_of(plist)) + 2)
 
 
 def _n_draws(plist, duration, room) -> int:
     """Draws every member of the batch starts with: the most any of its models needs."""
-    models = _models(plist)
+    models = models_of(plist)
     return max(_draws(p, duration, room[0]) for p in models) + _margin(models)
 
 
