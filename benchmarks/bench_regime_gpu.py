@@ -12,8 +12,10 @@ labelling and the extension of undetermined members included; compilation exclud
 warm-up); the reference rates are measured on their smaller sample (a rate does not depend on
 the sample size beyond a batch).
 
-It prints how the GPU run's wall time divides between the device calls (simulation and
-extension) and the host, and compares the labels of the realizations both ran: a GPU's sections
+It prints how the GPU run's wall time divides between the device calls (each listed with
+its members and seconds), the CPU batches (the extension of undetermined members: fewer than
+``_gpu.AUTO_GPU_MIN`` of them run on the host's cores, ``_ensemble_verdicts.EXTEND_BACKEND``)
+and the rest of the host's work (labels, set-up, checkpoints), and compares the labels of the realizations both ran: a GPU's sections
 equal the CPU's only within ``GPU_TOLERANCE`` over a cam period and part later on chaotic runs
 (see ``chaoscam.integrate._gpu``), so chaotic members agree in label, not in numbers.
 Without a GPU it says why on one line and exits 0.
@@ -26,18 +28,22 @@ import os
 import threading
 import time
 
-from chaoscam.integrate import _gpu
+from chaoscam.integrate import _ensemble, _gpu
 from chaoscam.sweep import Axis, DefaultClassifier, regime_map
 
 
 class _DeviceClock:
-    """Wall time spent inside ``run_on_gpu`` (launches, transfers and refills)."""
+    """Wall time spent inside a batch runner (``run_on_gpu``: launches, transfers and
+    refills; ``run_on_cpu``: the host's batches), with each call's members and seconds."""
 
-    def __init__(self) -> None:
-        self.seconds = 0.0
-        self.calls = 0
+    def __init__(self, inner) -> None:
+        self.calls: list[tuple[int, float]] = []
         self._lock = threading.Lock()
-        self._inner = _gpu.run_on_gpu
+        self._inner = inner
+
+    @property
+    def seconds(self) -> float:
+        return sum(s for _, s in self.calls)
 
     def __call__(self, *args, **kwargs):
         t0 = time.perf_counter()
@@ -45,8 +51,11 @@ class _DeviceClock:
             return self._inner(*args, **kwargs)
         finally:
             with self._lock:
-                self.seconds += time.perf_counter() - t0
-                self.calls += 1
+                self.calls.append((int(args[0].shape[0]), time.perf_counter() - t0))
+
+    def listing(self, most: int = 12) -> str:
+        shown = ", ".join(f"{n:,} members {s:.1f} s" for n, s in self.calls[:most])
+        return shown + (f", ... ({len(self.calls) - most} more)" if len(self.calls) > most else "")
 
 
 def main() -> None:
@@ -73,20 +82,23 @@ def main() -> None:
     regime_map(Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.001,)),
                realizations=2, duration=1.0, engine="ensemble", device="gpu")  # fmt: skip
     print(f"warm-up (GPU kernel compilation): {time.perf_counter() - t0:.1f} s")
-    clock = _DeviceClock()
-    _gpu.run_on_gpu = clock
+    clock, host = _DeviceClock(_gpu.run_on_gpu), _DeviceClock(_ensemble.run_on_cpu)
+    _gpu.run_on_gpu, _ensemble.run_on_cpu = clock, host
     try:
         t0 = time.perf_counter()
         gpu = regime_map(x, y, realizations=args.realizations, engine="ensemble",
                          device="gpu", **kw)  # fmt: skip
         wall = time.perf_counter() - t0
     finally:
-        _gpu.run_on_gpu = clock._inner
+        _gpu.run_on_gpu, _ensemble.run_on_cpu = clock._inner, host._inner
     runs = cells * args.realizations
     print(
         f"GPU map: {runs:,} runs in {wall:.1f} s = {runs / wall:,.1f} traj/s (device "
-        f"{gpu.config.get('device')}); {clock.seconds:.1f} s in {clock.calls} device calls, "
-        f"{wall - clock.seconds:.1f} s on the host (labels, extension set-up, checkpoints)"
+        f"{gpu.config.get('device')}); {clock.seconds:.1f} s in {len(clock.calls)} device "
+        f"calls ({clock.listing()}); {host.seconds:.1f} s in {len(host.calls)} CPU batches "
+        f"(extensions of few members: {host.listing()}); "
+        f"{wall - clock.seconds - host.seconds:.1f} s else on the host (labels, set-up, "
+        "checkpoints)"
     )
 
     rates = {}

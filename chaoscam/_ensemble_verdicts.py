@@ -31,6 +31,15 @@ __all__ = ["MemberVerdict", "classify_ensemble", "member_verdicts"]
 
 _COORDS = ["theta_f", "omega_f"]
 
+EXTEND_BACKEND = {"cpu": "cpu", "gpu": "auto"}
+"""Where the extensions of an ensemble run, by where it ran. A CPU run stays on the CPU (its
+verdicts are then the same bits as a longer CPU run's). A GPU run's extensions settle by size
+(``"auto"``: the GPU from ``_gpu.AUTO_GPU_MIN`` members), because one GPU thread is slow: on
+an H200 (2026-11-27) 64 members of 0.25 s took a 1.09 s launch, about 0.23 simulated seconds
+a second a thread, where one CPU core runs a default member at about 150 (0.13 s for 20 s).
+A few hundred undetermined members extended by 60 s would hold the device for minutes that
+the host's cores finish in seconds."""
+
 
 @dataclasses.dataclass(frozen=True)
 class MemberVerdict:
@@ -80,7 +89,10 @@ def member_verdicts(
     ``settings["extended"]`` records the time used. A run made with ``resumable=True`` is
     continued from where it stopped (:func:`chaoscam.integrate.extend_ensemble`: the same
     bits as running it again from t = 0, without repeating the transient and the time
-    already recorded). Raises ValueError when ``ens`` was run without ``tangent=True``.
+    already recorded). A CPU run's extensions run on the CPU; a GPU run's where
+    ``backend="auto"`` puts them (:data:`EXTEND_BACKEND`: on the CPU for fewer than
+    ``_gpu.AUTO_GPU_MIN`` members, continued from the GPU's state). Raises ValueError when
+    ``ens`` was run without ``tangent=True``.
 
     ``progress``, optional, is called as ``progress(0, extending=m, recorded_s=r)`` before
     each extension round (m members, to r seconds recorded) and as ``progress(n)`` after
@@ -100,6 +112,7 @@ def member_verdicts(
     t_wall = time.perf_counter()
     pending = [j for j, v in enumerate(verdicts) if _unsettled(v)]
     last, at = ens, list(range(len(members)))  # the latest run, and whose members it holds
+    more = EXTEND_BACKEND[s["backend"]]
     while pending and extend_to is not None and recorded < extend_to:
         recorded = min(extend_to, 4.0 * recorded)
         sub = [plist[j] for j in pending]
@@ -114,6 +127,7 @@ def member_verdicts(
                 members=[where[j] for j in pending],
                 resumable=True,
                 progress=progress,
+                backend=more,
             )
         else:
             longer = simulate_ensemble(
@@ -122,7 +136,7 @@ def member_verdicts(
                 seed=s["seed"],
                 duration=s["transient"] + recorded,
                 transient=s["transient"],
-                backend=s["backend"],
+                backend=more,
                 tangent=True,
                 progress=progress,
             )
@@ -131,6 +145,7 @@ def member_verdicts(
             "recorded_s": recorded,
             "wall_time_s": time.perf_counter() - t_wall,
             "why": "the verdict on the run as given was undetermined",
+            "backend": longer.settings["backend"],
         }
         last_t = longer.sections.groupby("member")["t"].max()
         for i, (j, v) in enumerate(zip(pending, _verdicts(longer, sub), strict=True)):

@@ -504,6 +504,10 @@ API_REVIEW_CASES = [
         "members = True",
     ),
     (
+        lambda: chaoscam.integrate.extend_ensemble(_tiny_ensemble(), Params(), 0.6, backend="tpu"),
+        "backend must be one of 'cpu', 'gpu', 'auto', got 'tpu'",
+    ),
+    (
         lambda: chaoscam.integrate.simulate_ensemble(Params(), range(1), duration=0.2, batch=1.5),
         "batch = 1.5",
     ),

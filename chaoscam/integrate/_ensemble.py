@@ -260,6 +260,7 @@ def extend_ensemble(
     members=None,
     resumable: bool = False,
     progress=None,
+    backend: str | None = None,
 ) -> Ensemble:
     """Members of ``ens`` continued to ``duration``, bit-identical to runs made that long.
 
@@ -283,6 +284,14 @@ def extend_ensemble(
         Keep a copy again, so that the result can be extended further.
     progress : callable, optional
         As for :func:`simulate_ensemble`.
+    backend : {"cpu", "gpu", "auto"} or None
+        Where the continuation runs; None (default): where ``ens`` ran. ``"auto"`` settles by
+        the members continued, as :func:`simulate_ensemble` does (the GPU from
+        ``_gpu.AUTO_GPU_MIN`` of them). A continuation on the other backend goes on from the
+        same state, so it is bit-identical to a run that changed backend there, and equal
+        to one made on either backend throughout only within ``_gpu.GPU_TOLERANCE`` (see
+        :func:`simulate_ensemble`). ``settings["backends"]`` lists where each leg ran;
+        ``settings["backend"]`` is the last.
 
     Raises
     ------
@@ -316,12 +325,17 @@ def extend_ensemble(
         if not np.array_equal(made, res.c[j]):
             raise ValueError(f"params[{picks[j]}] is not the model member {picks[j]} ran with")
     indices = [int(ens.members["index"].iat[j]) for j in picks]
-    use_gpu = s["backend"] == "gpu"
+    if backend is None:
+        use_gpu, device, batch = s["backend"] == "gpu", s.get("device", s["backend"]), s["batch"]
+    else:
+        use_gpu, device = _pick_backend(_gpu.by_size(backend, len(picks)))
+        same = ("gpu" if use_gpu else "cpu") == s["backend"]
+        batch = s["batch"] if same else (_gpu.GPU_BATCH if use_gpu else _CPU_BATCH)
     room = _ROOM["gpu" if use_gpu else "cpu"]
     t0 = time.perf_counter()
     parts = []
-    for first in range(0, len(picks), s["batch"]):
-        chunk = slice(first, first + s["batch"])
+    for first in range(0, len(picks), batch):
+        chunk = slice(first, first + batch)
         sub = res.select(range(len(picks))[chunk])
         parts.append(
             run_batch(
@@ -337,7 +351,16 @@ def extend_ensemble(
         )
         if progress is not None:
             progress(len(parts[-1][1]))
-    more = {"duration": duration, "continued_from": res.step, "models": models_digest(plist)}
+    used = "gpu" if use_gpu else "cpu"
+    more = {
+        "duration": duration,
+        "continued_from": res.step,
+        "models": models_digest(plist),
+        "backend": used,
+        "device": device,
+        "batch": batch,
+        "backends": [*s.get("backends", [s["backend"]]), used],
+    }
     return _assemble(parts, {**s, **more}, False, t0)
 
 

@@ -93,7 +93,8 @@ One GPU thread is slow and the device's rate comes from many in flight (an H200,
 cores). From 4,096 members the device, by those measurements, outruns a CPU of 16 cores;
 below it ``"auto"`` runs on the CPU (``"gpu"`` still runs any size on the GPU). A sweep
 settles it by its runs before it starts; on Dask workers, which get CPU-sized batches, a
-sweep's ``"auto"`` is settled per batch, so they run on their CPUs."""
+sweep's ``"auto"`` is settled per batch, so they run on their CPUs. The extensions and fate
+runs of a GPU run's few members settle by it too (``_ensemble_verdicts.EXTEND_BACKEND``)."""
 
 
 class GPUFallbackWarning(RuntimeWarning):

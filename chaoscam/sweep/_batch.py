@@ -87,14 +87,19 @@ def _group_key(task: Any) -> tuple:
 
 def _fates(plist, indices, seed: int, fate: float, backend: str) -> list[dict[str, Any]]:
     """The fate fields of members run again to ``fate`` seconds with the tangent (the same
-    motion, bit for bit): one ensemble call, as the process engine's one run each."""
+    motion, bit for bit): one ensemble call, as the process engine's one run each. After a
+    GPU batch they run where ``"auto"`` puts so few (:data:`chaoscam._ensemble_verdicts.
+    EXTEND_BACKEND`: the CPU for fewer than ``_gpu.AUTO_GPU_MIN``), the same realizations,
+    equal to the GPU's motion within ``GPU_TOLERANCE`` for a while and, when chaotic, only
+    in their statistics after."""
+    from .._ensemble_verdicts import EXTEND_BACKEND
     from ..integrate import simulate_ensemble
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the model's warnings came with the first run
         ens = simulate_ensemble(
             list(plist), list(indices), seed=seed, duration=fate, transient=0.0,
-            backend=backend, tangent=True,
+            backend=EXTEND_BACKEND[backend], tangent=True,
         )  # fmt: skip
     rows_of = ens.sections.groupby("member").indices
     out = []

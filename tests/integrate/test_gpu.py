@@ -187,6 +187,14 @@ a, b = longer.sections.to_numpy(), made.sections.to_numpy()
 out["continued"] = {"backend": longer.settings["backend"], "shape": a.shape == b.shape,
                     "n": len(a), "diff": float(np.abs(a - b).max()), "impacts": True,
                     "members": longer.members.equals(made.members)}
+# continued on the CPU from the device's copy (the CPU's room: refills at other points)
+on_cpu = _ensemble.extend_ensemble(short, p, 0.6, backend="cpu")
+a = on_cpu.sections.to_numpy()
+legs = list(on_cpu.settings["backends"])
+out["continued on the cpu"] = {"backend": "gpu" if legs == ["gpu", "cpu"] else str(legs),
+                               "shape": a.shape == b.shape, "n": len(a),
+                               "diff": float(np.abs(a - b).max()), "impacts": True,
+                               "members": on_cpu.members.equals(made.members)}
 print(json.dumps(out))
 """
 
@@ -271,3 +279,76 @@ def test_device_equals_cpu_within_tolerance(monkeypatch, params, duration, trans
     np.testing.assert_array_equal(a[:, 0], b[:, 0])
     np.testing.assert_allclose(a[:, 1:], b[:, 1:], rtol=0, atol=_gpu.GPU_TOLERANCE)
     assert (runs[0].members.status == "OK").all()
+
+
+def _same(a, b) -> None:
+    import pandas as pd
+
+    pd.testing.assert_frame_equal(a.sections, b.sections, check_exact=True)
+    pd.testing.assert_frame_equal(a.members, b.members, check_exact=True)
+    assert np.array_equal(a.jacobians, b.jacobians)
+
+
+CONTINUED = Params(l_lambda=0.011, l_lambda_sigma=0.0015)  # chattering: refills on the way
+RUN = dict(seed=1, transient=1.0, tangent=True)
+
+
+def test_a_gpu_runs_continuation_of_few_members_goes_to_the_cpu(monkeypatch, fake_gpu):
+    """extend_ensemble(backend="auto") of a GPU run continues fewer than AUTO_GPU_MIN
+    members on the CPU, from the GPU's state and with the CPU's room; backend=None stays on
+    the GPU. The fake GPU runs the CPU's kernel, so all three equal a CPU run made that long,
+    bit for bit: only where they ran differs (and a real device's rounding)."""
+    from chaoscam.integrate import extend_ensemble
+
+    short = simulate_ensemble(
+        CONTINUED, range(3), duration=2.0, resumable=True, backend="gpu", **RUN
+    )
+    assert short.settings["backend"] == "gpu" and len(fake_gpu) > 0
+    launched = len(fake_gpu)
+    on_gpu = extend_ensemble(short, CONTINUED, 4.0)
+    assert len(fake_gpu) > launched and on_gpu.settings["backend"] == "gpu"
+    launched = len(fake_gpu)
+    on_cpu = extend_ensemble(short, CONTINUED, 4.0, members=[2, 0], backend="auto")
+    assert len(fake_gpu) == launched  # not one launch
+    assert on_cpu.settings["backend"] == "cpu" and list(on_cpu.settings["backends"]) == [
+        "gpu",
+        "cpu",
+    ]
+    assert on_cpu.settings["batch"] == _members_batch_cpu()
+    _same(on_cpu, simulate_ensemble(CONTINUED, [2, 0], duration=4.0, backend="cpu", **RUN))
+    _same(on_gpu, simulate_ensemble(CONTINUED, range(3), duration=4.0, backend="cpu", **RUN))
+    monkeypatch.setattr(_gpu, "AUTO_GPU_MIN", 2)  # two members are now enough for the GPU
+    extend_ensemble(short, CONTINUED, 4.0, members=[2, 0], backend="auto")
+    assert len(fake_gpu) > launched
+
+
+def _members_batch_cpu() -> int:
+    from chaoscam.integrate import _ensemble
+
+    return _ensemble._CPU_BATCH
+
+
+def test_a_gpu_ensembles_extensions_run_on_the_cpu(fake_gpu):
+    """classify_ensemble on a GPU run: its undetermined member is extended on the CPU (no
+    launch after the run's own), the extension's note says where, and the verdict is the
+    CPU run's (the fake GPU runs the CPU's kernel)."""
+    from chaoscam import classify_ensemble
+    from chaoscam._ensemble_verdicts import member_verdicts
+
+    p = Params(omega=26.0, xi=0.3)  # undetermined after 20 s, chaotic when extended
+    run = dict(seed=1, duration=20.0, transient=10.0, tangent=True, resumable=True)
+    ens = simulate_ensemble(p, [0], backend="gpu", **run)
+    launched = len(fake_gpu)
+    (v,) = member_verdicts(ens, p)
+    assert len(fake_gpu) == launched
+    assert v.label == "chaotic" and v.verdict.settings["extended"]["backend"] == "cpu"
+    cpu = classify_ensemble(simulate_ensemble(p, [0], backend="cpu", **run), p).members
+    assert cpu["label"].iat[0] == v.label and cpu["reasons"].iat[0] == v.reasons
+
+
+def test_a_gpu_sweeps_fate_runs_run_on_the_cpu(fake_gpu):
+    """The fate runs of a GPU batch's few chaotic members go to the CPU (by size)."""
+    from chaoscam.sweep import _batch
+
+    (fields,) = _batch._fates([CONTINUED], [0], 1, 2.0, "gpu")
+    assert fake_gpu == [] and fields
