@@ -15,9 +15,10 @@ the sample size beyond a batch).
 It prints how the GPU run's wall time divides between the device calls (each listed with
 its members and seconds), the CPU batches (the extension of undetermined members: fewer than
 ``_gpu.AUTO_GPU_MIN`` of them run on the host's cores, ``_ensemble_verdicts.EXTEND_BACKEND``)
-and the rest of the host's work (labels, set-up, checkpoints), and compares the labels of the realizations both ran: a GPU's sections
-equal the CPU's only within ``GPU_TOLERANCE`` over a cam period and part later on chaotic runs
-(see ``chaoscam.integrate._gpu``), so chaotic members agree in label, not in numbers.
+and the rest of the host's work (labels, set-up, checkpoints), and compares the labels of the
+realizations both ran: a GPU's sections equal the CPU's only within ``GPU_TOLERANCE`` over a
+cam period and part later on chaotic runs (see ``chaoscam.integrate._gpu``), so chaotic
+members agree in label, not in numbers.
 Without a GPU it says why on one line and exits 0.
 """
 

@@ -12,6 +12,7 @@ so a member's verdict is the same whichever driver ran it.
 
 from __future__ import annotations
 
+import contextvars
 import dataclasses
 import time
 from collections.abc import Callable, Sequence
@@ -217,9 +218,12 @@ def _threaded(fn: Callable, items: list, threads: int) -> list:
     Ctrl-C in the waiting thread too) cancels the calls not yet started."""
     if threads <= 1 or len(items) <= 1:
         return [fn(x) for x in items]
+    # each call in a copy of this thread's context: a warning it raises is recorded where
+    # this thread's are (:func:`chaoscam._warn.recorded`, the sweeps' batches)
+    here = contextvars.copy_context()
     pool = ThreadPoolExecutor(min(threads, len(items)), thread_name_prefix="chaoscam-verdict")
     try:
-        return list(pool.map(fn, items))
+        return list(pool.map(lambda x: here.copy().run(fn, x), items))
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
 

@@ -55,3 +55,69 @@ def test_user_stacklevel_counts_the_frames_of_chaoscam_only():
         return user_stacklevel()
 
     assert warns_here() == 2
+
+
+def _printer_state() -> tuple:
+    return warnings.showwarning, warnings._showwarnmsg_impl, list(warnings.filters)
+
+
+def test_recorded_is_safe_on_threads_that_leave_out_of_order():
+    """Two threads record: A begins, B begins, A ends, B ends (the order that left a dead
+    list as the process's printer with catch_warnings). Each list holds its own thread's
+    warnings, a third thread's go where they went before, and the state is restored."""
+    import threading
+
+    from chaoscam._warn import recorded
+
+    before = _printer_state()
+    a_in, b_in, a_out = threading.Event(), threading.Event(), threading.Event()
+    got: dict[str, list[str]] = {}
+
+    def a() -> None:
+        with recorded() as log:
+            a_in.set()
+            b_in.wait(10)
+            warnings.warn("from A", stacklevel=1)
+        got["a"] = [str(m.message) for m in log]
+        a_out.set()
+
+    def b() -> None:
+        a_in.wait(10)
+        with recorded() as log:
+            b_in.set()
+            a_out.wait(10)
+            warnings.warn("from B", stacklevel=1)
+        got["b"] = [str(m.message) for m in log]
+
+    with warnings.catch_warnings(record=True) as outside:
+        warnings.simplefilter("always")
+        threads = [threading.Thread(target=a), threading.Thread(target=b)]
+        for t in threads:
+            t.start()
+        b_in.wait(10)
+        warnings.warn("from the main thread", stacklevel=1)  # while both record
+        for t in threads:
+            t.join(10)
+        inner = _printer_state()
+    assert got == {"a": ["from A"], "b": ["from B"]}
+    assert [str(m.message) for m in outside] == ["from the main thread"]
+    assert inner[1] is not None and _printer_state()[:2] == before[:2]
+    assert _printer_state()[2] == before[2]
+
+
+def test_a_verdict_threads_warnings_are_recorded_with_their_batch():
+    """The verdicts' pool threads run in a copy of the batch thread's context, so what they
+    warn is recorded with the batch, not printed."""
+    from chaoscam._ensemble_verdicts import _threaded
+    from chaoscam._warn import recorded
+
+    def judge(x: int) -> int:
+        warnings.warn(f"member {x}", stacklevel=1)
+        return x
+
+    with warnings.catch_warnings(record=True) as outside:
+        warnings.simplefilter("always")
+        with recorded() as log:
+            assert _threaded(judge, list(range(6)), 3) == list(range(6))
+    assert sorted(str(m.message) for m in log) == [f"member {x}" for x in range(6)]
+    assert outside == []

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from .._run_warnings import run_warnings
+from .._warn import quiet, recorded
 from ..model import Params, truncated_mass
 from ._tasks import FATE_LABELS, RunSummary, fate_fields, verdict_fields
 
@@ -95,8 +96,7 @@ def _fates(plist, indices, seed: int, fate: float, backend: str) -> list[dict[st
     from .._ensemble_verdicts import EXTEND_BACKEND
     from ..integrate import simulate_ensemble
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the model's warnings came with the first run
+    with quiet():  # the model's warnings came with the first run (quiet: on batch threads)
         ens = simulate_ensemble(
             list(plist), list(indices), seed=seed, duration=fate, transient=0.0,
             backend=EXTEND_BACKEND[backend], tangent=True,
@@ -129,8 +129,7 @@ def run_batch(
     records: list[dict[str, Any] | None] = [None] * len(tasks)
     for (seed, duration, transient, _, _, fate), picks in groups.items():
         plist = [tasks[i].params for i in picks]
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
+        with recorded() as caught:  # catch_warnings is not safe on the batch threads
             ens = simulate_ensemble(
                 plist,
                 [tasks[i].sim_index for i in picks],
@@ -142,7 +141,11 @@ def run_batch(
                 resumable=extend_to is not None,  # undetermined members are continued
             )
             verdicts = member_verdicts(ens, plist, extend_to=extend_to)
-        shared = [str(w.message) for w in caught]
+        # What the batch warned, less the models' own warnings (simulate_ensemble warns those
+        # once for every model in the group; each record adds its own model's below, as on
+        # the process engine, not its neighbours')
+        models = {w for q in {id(q): q for q in plist}.values() for w in run_warnings(q)}
+        shared = [str(w.message) for w in caught if str(w.message) not in models]
         later = [
             j for j, v in enumerate(verdicts) if v.verdict is not None and v.label in FATE_LABELS
         ]

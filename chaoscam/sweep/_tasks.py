@@ -22,6 +22,7 @@ from typing import Any
 import pandas as pd
 
 from .._simulate import simulate
+from .._warn import quiet
 from ..analysis import LABELS
 from ..integrate import Status
 from ..model import Params
@@ -276,8 +277,7 @@ def fate_fields(status: str, section: pd.DataFrame, jacobians, params: Params) -
     late = (t >= (1.0 - FATE_LATE) * t[-1]) & (section["k"].to_numpy() > 0)
     if not late.any():  # a horizon within a cam period or so: nothing to judge
         return unjudged
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # a short late window warns like the first run did
+    with quiet():  # a short late window warns like the first run did (on batch threads too)
         v = classify_section_run(
             section.loc[late, ["theta_f", "omega_f"]].to_numpy(dtype=float),
             jacobians[late],

@@ -333,3 +333,27 @@ def test_auto_device_runs_a_small_sweep_on_the_cpu(monkeypatch):
             duration=1.0, engine="ensemble", device="auto", workers=2,
         )  # fmt: skip
     assert m.config["device"] == "cpu"
+
+
+def test_a_batch_records_its_own_models_warnings_on_two_threads(monkeypatch):
+    """Batches of 3 runs that mix two cells whose step warnings differ (each names its own
+    contact period), on 2 batch threads: each record carries its own model's warnings only,
+    as on the process engine (they carried their batch neighbours' too), and the process's
+    warning state is as before (catch_warnings on two threads left a dead record list as
+    its printer: every later warning vanished)."""
+    import warnings
+
+    from chaoscam._run_warnings import run_warnings
+
+    monkeypatch.setattr(_batch, "batch_size", lambda *a, **k: 3)
+    before = warnings.showwarning, warnings._showwarnmsg_impl, list(warnings.filters)
+    base = Params(dt=8e-6)  # too coarse a step: each l_lambda's warning names its period
+    m = regime_map(
+        Axis("l_lambda", (0.008, 0.015)), Axis("l_lambda_sigma", (0.001,)), realizations=4,
+        base=base, duration=2.0, transient=0.5, engine="ensemble", workers=2,
+    )  # fmt: skip
+    assert (warnings.showwarning, warnings._showwarnmsg_impl) == before[:2]
+    assert list(warnings.filters) == before[2]
+    for _, row in m.realizations.iterrows():
+        own = run_warnings(base.replace(l_lambda=row["l_lambda"], l_lambda_sigma=0.001))
+        assert own and row["warnings"] == " | ".join(own)
