@@ -26,7 +26,7 @@ from ._model_rules import extensible, extension_stopped
 from .analysis import Verdict
 from .classify import EXTEND_TO, _with_settings, classify_section_run
 from .integrate import Ensemble, Status, extend_ensemble, simulate_ensemble
-from .model import Params
+from .model import Params, realizations_identical
 
 __all__ = ["MemberVerdict", "classify_ensemble", "member_verdicts"]
 
@@ -191,12 +191,17 @@ def _unsettled(v: MemberVerdict) -> bool:
 
 
 def _verdicts(ens: Ensemble, plist: list[Params]) -> list[MemberVerdict]:
-    """Each member's verdict, on as many threads as the ensemble ran on.
+    """Each member's verdict; those of a deterministic model on as many threads as the
+    ensemble ran on, the others on the calling thread meanwhile.
 
-    A verdict is a pure function of its member, so the threads change nothing but the time:
-    a deterministic member that looks periodic is certified by Newton shooting, whose map
+    A verdict is a pure function of its member, so the threads change nothing but the time.
+    A deterministic member that looks periodic is certified by Newton shooting, whose map
     iterates run compiled without the GIL (:func:`chaoscam.integrate._driver.run_alone`),
-    about two thirds of the verdicts' time in a regime map with a sigma = 0 row.
+    about two thirds of the verdicts' time in a regime map with a sigma = 0 row: threads
+    help there. A random member's verdict (no certificate) is numpy and Python under the GIL,
+    which threads only contend for: 128 members of sigma = 2 mm, 20 s recorded, took 3.3-3.6
+    ms each on one thread and 4.1-4.2, 4.5 and 4.7-5.6 ms on 2, 4 and 8 threads (2-core
+    machine, 2026-11-28).
     """
     transient = float(ens.settings["transient"])
     rows_of = ens.sections.groupby("member").indices  # member -> positions of its rows
@@ -210,20 +215,28 @@ def _verdicts(ens: Ensemble, plist: list[Params]) -> list[MemberVerdict]:
         )
 
     items = list(zip(ens.members["member"], ens.members["status"], strict=True))
-    return _threaded(verdict, items, int(ens.settings.get("threads", 1)))
+    shoot = [realizations_identical(plist[int(m)]) for m, _ in items]
+    pooled = [x for x, s in zip(items, shoot, strict=True) if s]
+    here = [x for x, s in zip(items, shoot, strict=True) if not s]
+    a, b = _threaded(verdict, pooled, int(ens.settings.get("threads", 1)), here)
+    done_a, done_b = iter(a), iter(b)
+    return [next(done_a) if s else next(done_b) for s in shoot]
 
 
-def _threaded(fn: Callable, items: list, threads: int) -> list:
-    """``[fn(x) for x in items]``, on up to ``threads`` threads, in order. An exception (a
+def _threaded(fn: Callable, items: list, threads: int, here: list = ()) -> tuple[list, list]:
+    """``([fn(x) for x in items], [fn(x) for x in here])``: ``items`` on up to ``threads``
+    threads, ``here`` on the calling thread meanwhile, each in order. An exception (a
     Ctrl-C in the waiting thread too) cancels the calls not yet started."""
     if threads <= 1 or len(items) <= 1:
-        return [fn(x) for x in items]
+        return [fn(x) for x in items], [fn(x) for x in here]
     # each call in a copy of this thread's context: a warning it raises is recorded where
     # this thread's are (:func:`chaoscam._warn.recorded`, the sweeps' batches)
-    here = contextvars.copy_context()
+    ctx = contextvars.copy_context()
     pool = ThreadPoolExecutor(min(threads, len(items)), thread_name_prefix="chaoscam-verdict")
     try:
-        return list(pool.map(lambda x: here.copy().run(fn, x), items))
+        futures = [pool.submit(ctx.copy().run, fn, x) for x in items]
+        mine = [fn(x) for x in here]
+        return [f.result() for f in futures], mine
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
 

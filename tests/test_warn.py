@@ -118,6 +118,6 @@ def test_a_verdict_threads_warnings_are_recorded_with_their_batch():
     with warnings.catch_warnings(record=True) as outside:
         warnings.simplefilter("always")
         with recorded() as log:
-            assert _threaded(judge, list(range(6)), 3) == list(range(6))
-    assert sorted(str(m.message) for m in log) == [f"member {x}" for x in range(6)]
+            assert _threaded(judge, list(range(6)), 3, [6, 7]) == (list(range(6)), [6, 7])
+    assert sorted(str(m.message) for m in log) == [f"member {x}" for x in range(8)]
     assert outside == []
