@@ -50,6 +50,7 @@ __all__ = [
     "members_kernel",
     "members_on_this_thread",
     "on_this_thread",
+    "stop_on",
     "run_members",
     "run_alone",
     "run_alone_rk4",
@@ -250,6 +251,20 @@ def members_on_this_thread(stop: threading.Event | None = None):
         yield
     finally:
         _here.stop, _here.active = before
+
+
+@contextlib.contextmanager
+def stop_on(stop: threading.Event):
+    """Within this context :func:`check_stop` raises :class:`StopRequested` on the calling
+    thread once ``stop`` is set (between two compiled calls), while its ensembles run as
+    anywhere else (numba's threads): a GPU sweep's labelling thread
+    (:class:`chaoscam.sweep._pipeline.PipelineBackend`)."""
+    before = getattr(_here, "stop", None)
+    _here.stop = stop
+    try:
+        yield
+    finally:
+        _here.stop = before
 
 
 def on_this_thread() -> bool:

@@ -47,11 +47,13 @@ from __future__ import annotations
 import functools
 import importlib.util
 import re
+import threading
 import types
 import warnings
 
 import numpy as np
 
+from .._warn import recorded
 from . import _kernel as k
 from ._adaptive import run_chunk_adaptive
 from ._advance import advance
@@ -85,6 +87,11 @@ _SMALL_GRID = r".*Grid size \d+ will likely result in GPU under-utilization"
 with its ANSI codes). A small batch is expected; a sweep would otherwise record the warning
 against every run of the batch (seen on an H200, 2026-11-27)."""
 _NUMPY_TRAP = (2, 5)  # numba-cuda <= 0.30.4 compiles no kernel under numpy >= 2.5
+DEVICE_LOCK = threading.Lock()
+"""Held by each :func:`run_on_gpu` call: a GPU sweep launches its next batch in the driver's
+thread while a labelling thread may extend 4,096 members or more on the device
+(:class:`chaoscam.sweep._pipeline.PipelineBackend`); they take turns."""
+
 AUTO_GPU_MIN = 4_096
 """Fewest members (an ensemble's, or a sweep's runs) for which ``"auto"`` runs them on a GPU.
 One GPU thread is slow and the device's rate comes from many in flight (an H200, 2026-11-27,
@@ -271,10 +278,24 @@ def kernel_info(method: int | None = k.METHOD_RK4) -> dict:
     }
 
 
+def _configured(kern, blocks: int):
+    """``kern[blocks, _BLOCK]`` without numba-cuda's low-occupancy warning (a launch of few
+    blocks: a small batch is the caller's choice, and a sweep would record it against every
+    run of the batch); any other warning is raised again. Thread-safe
+    (:func:`chaoscam._warn.recorded`, not ``catch_warnings``: a sweep labels on a thread)."""
+    with recorded() as said:
+        configured = kern[blocks, _BLOCK]
+    for w in said:
+        if not re.match(_SMALL_GRID, str(w.message)):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno, source=w.source)
+    return configured
+
+
 def run_on_gpu(
     y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts=False, layout=None
 ) -> None:
     """Run stacked members to ``n_stop`` on the GPU; arrays as in ``_ensemble._run_batch``.
+    One call at a time in this process (:data:`DEVICE_LOCK`).
 
     The members whose ``status`` is ``NEED_BUFFER`` run (every member of a fresh batch);
     the others keep their code, and their rows.
@@ -288,6 +309,13 @@ def run_on_gpu(
     order = GPU_LAYOUT if layout is None else layout
     if order not in ("C", "F"):
         raise ValueError(f"layout = {order!r} must be 'C' or 'F'")
+    with DEVICE_LOCK:
+        _run_on_gpu(
+            y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts, order
+        )
+
+
+def _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts, order):
     from numba import cuda
 
     kern = _kernel(_batch_method(c))
@@ -310,11 +338,7 @@ def run_on_gpu(
         d_section = cuda.device_array(section.shape, order=order)
     d_impacts = cuda.device_array(impacts.shape, order=order)
     blocks = (n + _BLOCK - 1) // _BLOCK
-    # numba-cuda warns when a launch is configured with few blocks; a small batch is the
-    # caller's choice. Configured once, so the process-wide filters change once a call.
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message=_SMALL_GRID)
-        configured = kern[blocks, _BLOCK]
+    configured = _configured(kern, blocks)
 
     def launch(need: np.ndarray) -> np.ndarray:
         """Every thread starts; those whose member is done return at once."""

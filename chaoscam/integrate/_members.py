@@ -7,6 +7,7 @@ into batches and come here for each; the members of a batch share ``dt`` and ``o
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -207,13 +208,29 @@ def _one_by_one(y, cnt, c, n_stop, lam, section, impacts, status):
     return launch
 
 
+PARALLEL_LOCK = threading.Lock()
+"""Held by every launch on numba's threads. The fork-safe workqueue threading layer
+(:func:`._driver.fork_safe_threads`) aborts the whole process when two Python threads launch
+parallel kernels at once (measured: two threads calling ``simulate_ensemble`` killed the
+interpreter with "Concurrent access has been detected"); with the lock they take turns.
+Both ways to run ensembles from several threads inside chaoscam avoid it anyway (the sweeps'
+batch threads run members one by one, a GPU sweep's launches need no CPU threads), so it
+guards a user's own threads and a stand-in device."""
+
+
 def _in_parallel(y, cnt, c, n_stop, lam, section, impacts, status):
-    """A launch of the members ``need`` on numba's threads (``prange``)."""
+    """A launch of the members ``need`` on numba's threads (``prange``), one launch at a
+    time in this process (:data:`PARALLEL_LOCK`)."""
     fork_safe_threads()
     n = y.shape[0]
-    run_members = members_kernel(c)
+    kernel = members_kernel(c)
+
+    def run_members(*args) -> None:
+        with PARALLEL_LOCK:
+            kernel(*args)
 
     def launch(need: np.ndarray) -> np.ndarray:
+        check_stop()  # a thread asked to stop (stop_on): before the next compiled call
         if need.size == n:  # every member (the first launch): in place, no copies
             run_members(
                 y, cnt, c, n_stop, lam, np.empty((n, 1, k.SERIES_COLS)), section, impacts, status

@@ -6,7 +6,8 @@ A :class:`BatchTask` packs a sweep's tasks (:class:`~._tasks.RealizationTask`,
 runs a whole batch) with the tangent dynamics, then labels each member from its section and
 stroboscopic Jacobians (:func:`chaoscam.classify_ensemble`: section structure, tangent
 exponent, n-band chaos, periodic-orbit certificate). Each task's record is built by the task
-itself (``task.record``), so it has the same fields as on the process engine.
+itself (``task.record``), so it has the same fields as on the process engine. The two
+phases, running and labelling, live in :mod:`._batch_run`.
 
 Bit-identity: an ensemble member equals ``simulate(params, seed=seed, index=sim_index)``
 bit for bit, and its verdict uses its own arrays only, so a record does not depend on the
@@ -18,15 +19,13 @@ from __future__ import annotations
 import errno
 import sys
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from .._run_warnings import run_warnings
-from .._warn import quiet, recorded
-from ..model import Params, truncated_mass
-from ._tasks import FATE_LABELS, RunSummary, fate_fields, verdict_fields
+from ..model import Params
+from ._batch_run import Launched, _fates, label_batch, launch_batch, run_batch  # noqa: F401
 
 __all__ = ["ENGINE_CLASSIFIER", "BatchTask", "batch_size", "run_batch", "run_sweep"]
 
@@ -80,106 +79,13 @@ class BatchTask:
     def run(self) -> list[dict[str, Any]]:
         return run_batch(self.tasks, self.backend, self.extend_to)
 
+    def launch(self) -> list[Launched]:
+        """The first phase of :meth:`run`: the members run (:func:`._batch_run.launch_batch`)."""
+        return launch_batch(self.tasks, self.backend, self.extend_to)
 
-def _group_key(task: Any) -> tuple:
-    p = task.params
-    return (task.seed, task.duration, task.transient, p.dt, p.omega, task.fate)
-
-
-def _fates(plist, indices, seed: int, fate: float, backend: str) -> list[dict[str, Any]]:
-    """The fate fields of members run again to ``fate`` seconds with the tangent (the same
-    motion, bit for bit): one ensemble call, as the process engine's one run each. After a
-    GPU batch they run where ``"auto"`` puts so few (:data:`chaoscam._ensemble_verdicts.
-    EXTEND_BACKEND`: the CPU for fewer than ``_gpu.AUTO_GPU_MIN``), the same realizations,
-    equal to the GPU's motion within ``GPU_TOLERANCE`` for a while and, when chaotic, only
-    in their statistics after."""
-    from .._ensemble_verdicts import EXTEND_BACKEND
-    from ..integrate import simulate_ensemble
-
-    with quiet():  # the model's warnings came with the first run (quiet: on batch threads)
-        ens = simulate_ensemble(
-            list(plist), list(indices), seed=seed, duration=fate, transient=0.0,
-            backend=EXTEND_BACKEND[backend], tangent=True,
-        )  # fmt: skip
-    rows_of = ens.sections.groupby("member").indices
-    out = []
-    for j, p in enumerate(plist):
-        rows = rows_of.get(j, [])
-        sec = ens.sections.iloc[rows].reset_index(drop=True)
-        out.append(fate_fields(str(ens.members["status"].iat[j]), sec, ens.jacobians[rows], p))
-    return out
-
-
-def run_batch(
-    tasks: Sequence[Any], backend: str = "cpu", extend_to: float | None = 120.0
-) -> list[dict[str, Any]]:
-    """The records of ``tasks``, simulated as ensembles of members that share the grid;
-    undetermined members are extended up to ``extend_to`` s recorded (see
-    :func:`chaoscam.classify_ensemble`).
-
-    Members of one compiled call must share (seed, duration, transient, dt, omega); the
-    tasks are grouped by those, keeping their order within a group.
-    """
-    from .._ensemble_verdicts import member_verdicts
-    from ..integrate import simulate_ensemble
-
-    groups: dict[tuple, list[int]] = {}
-    for i, t in enumerate(tasks):
-        groups.setdefault(_group_key(t), []).append(i)
-    records: list[dict[str, Any] | None] = [None] * len(tasks)
-    for (seed, duration, transient, _, _, fate), picks in groups.items():
-        plist = [tasks[i].params for i in picks]
-        with recorded() as caught:  # catch_warnings is not safe on the batch threads
-            ens = simulate_ensemble(
-                plist,
-                [tasks[i].sim_index for i in picks],
-                seed=seed,
-                duration=duration,
-                transient=transient,
-                backend=backend,
-                tangent=True,
-                resumable=extend_to is not None,  # undetermined members are continued
-            )
-            verdicts = member_verdicts(ens, plist, extend_to=extend_to)
-        # What the batch warned, less the models' own warnings (simulate_ensemble warns those
-        # once for every model in the group; each record adds its own model's below, as on
-        # the process engine, not its neighbours')
-        models = {w for q in {id(q): q for q in plist}.values() for w in run_warnings(q)}
-        shared = [str(w.message) for w in caught if str(w.message) not in models]
-        later = [
-            j for j, v in enumerate(verdicts) if v.verdict is not None and v.label in FATE_LABELS
-        ]
-        fates: dict[int, dict[str, Any]] = {}
-        if fate is not None and later:
-            plater = [plist[j] for j in later]
-            ilater = [tasks[picks[j]].sim_index for j in later]
-            fates = dict(
-                zip(later, _fates(plater, ilater, seed, fate, ens.settings["backend"]), strict=True)
-            )
-        rows_of = ens.sections.groupby("member").indices
-        members = ens.members
-        for j, i in enumerate(picks):
-            sec = ens.sections.iloc[rows_of.get(j, [])].drop(columns="member")
-            status = str(members["status"].iat[j])
-            run = RunSummary(
-                status,
-                sec.reset_index(drop=True),
-                int(members["n_impacts"].iat[j]),
-                float(members["contact_fraction"].iat[j]),
-                truncated_mass(plist[j].l_lambda, plist[j].l_lambda_sigma, plist[j].l_min),
-            )
-            v = verdicts[j]  # without a verdict: labelled by its status, or too short to judge
-            fields = (
-                verdict_fields(v.verdict)
-                if v.verdict is not None
-                else {"label": v.label, "period": None, "reasons": v.reasons, "evidence": {}}
-            )
-            fields.update(fates.get(j, {}))
-            seen = [w for w in (*run_warnings(plist[j]), *shared) if w]
-            fields["status"] = status
-            fields["warnings"] = " | ".join(dict.fromkeys(seen))
-            records[i] = tasks[i].record(run, fields)
-    return records  # type: ignore[return-value]
+    def label(self, launched: list[Launched]) -> list[dict[str, Any]]:
+        """The second phase: their records from what :meth:`launch` gave."""
+        return label_batch(self.tasks, launched, self.extend_to)
 
 
 ENGINES = ("auto", "ensemble", "process")
@@ -195,7 +101,8 @@ class Engine:
     """A sweep's resolved engine: its name, the classifier identity it records, and how
     the driver runs it (``pack``/``pack_size`` for :func:`._engine.execute`, ``threads``
     numba threads in this process when local, ``task_threads`` > 1: that many batches at
-    once on the threads of a :class:`._backends.ThreadBackend`)."""
+    once on the threads of a :class:`._backends.ThreadBackend`; ``pipeline``: a local GPU's
+    batches, launched while the last is labelled, :class:`._pipeline.PipelineBackend`)."""
 
     name: str
     identity: str
@@ -203,6 +110,7 @@ class Engine:
     pack_size: int = 1
     threads: int | None = None
     task_threads: int = 1
+    pipeline: bool = False
 
 
 def resolve_engine(
@@ -286,7 +194,7 @@ def resolve_engine(
 
     identity = f"{ENGINE_CLASSIFIER}, extend_to={extend_to}"
     if gpu:
-        return Engine("ensemble", identity, pack, GPU_MAP_BATCH, threads)
+        return Engine("ensemble", identity, pack, GPU_MAP_BATCH, threads, pipeline=True)
     if by_task > 1:
         return Engine("ensemble", identity, pack, size, None, by_task)
     return Engine("ensemble", identity, pack, size, threads)
@@ -351,13 +259,16 @@ def numba_threads(n: int | None):
 def run_plan(plan, eng: Engine, store, *, workers, scheduler, progress: bool, desc: str) -> None:
     """Execute a sweep's plan on its engine: the ensemble engine in this process, one batch
     per thread on ``eng.task_threads`` threads or one batch at a time on ``eng.threads``
-    numba threads (or its batches on Dask), the process engine on a pool of ``workers``
-    processes (or Dask)."""
+    numba threads (a GPU's: launched while the last is labelled; or its batches on Dask),
+    the process engine on a pool of ``workers`` processes (or Dask)."""
     from ._backends import SerialBackend, ThreadBackend
     from ._common import backend_for
     from ._engine import execute
+    from ._pipeline import PipelineBackend
 
-    if eng.name == "ensemble" and scheduler is None:
+    if eng.name == "ensemble" and scheduler is None and eng.pipeline:
+        backend = PipelineBackend(eng.threads)
+    elif eng.name == "ensemble" and scheduler is None:
         backend = ThreadBackend(eng.task_threads) if eng.task_threads > 1 else SerialBackend()
     else:
         backend = backend_for(workers, scheduler)

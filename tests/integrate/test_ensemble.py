@@ -166,3 +166,38 @@ def test_a_batch_sizes_its_draws_once_not_once_a_member(monkeypatch):
     start = _members.fresh(models, range(600), 1, 1.0, 0.0, False, (512, 256))
     assert len(asked) == 2  # one a distinct model
     assert start.lam.shape[0] == 600
+
+
+_TWO_THREADS = """
+import json, threading
+from chaoscam import Params
+from chaoscam.integrate import simulate_ensemble
+p = Params(l_lambda_sigma=0.002)
+alone = simulate_ensemble(p, range(6), duration=1.0).sections
+out = {}
+def go(name):
+    out[name] = [simulate_ensemble(p, range(6), duration=1.0).sections.equals(alone)
+                 for _ in range(3)]
+threads = [threading.Thread(target=go, args=(n,)) for n in "ab"]
+for t in threads:
+    t.start()
+for t in threads:
+    t.join()
+print(json.dumps(out))
+"""
+
+
+def test_ensembles_from_two_threads_take_turns_on_numbas_threads():
+    """Two Python threads calling simulate_ensemble at once: numba's workqueue layer aborted
+    the interpreter ("Concurrent access has been detected"); the launches now take turns
+    (_members.PARALLEL_LOCK) and give the bits of a call alone. In a child process: an
+    abort would end this one."""
+    import json
+    import subprocess
+    import sys
+
+    out = subprocess.run(
+        [sys.executable, "-c", _TWO_THREADS], capture_output=True, text=True, timeout=600
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == {"a": [True] * 3, "b": [True] * 3}

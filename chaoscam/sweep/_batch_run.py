@@ -1,0 +1,164 @@
+"""A batch of sweep tasks through the ensemble engine, in two phases.
+
+:func:`launch_batch` runs the members (one compiled ensemble call per group of tasks that
+share the grid, on the CPU's threads or a GPU); :func:`label_batch` judges them
+(:func:`chaoscam._ensemble_verdicts.member_verdicts`: section, tangent exponent, orbit
+certificate, extensions of undetermined members), runs the fate runs and builds each
+task's record (``task.record``, the same fields as on the process engine).
+:func:`run_batch` is the two in a row. Apart, they let a GPU sweep launch its next batch
+while the host labels the last (:class:`._pipeline.PipelineBackend`).
+
+Bit-identity: an ensemble member equals ``simulate(params, seed=seed, index=sim_index)``
+bit for bit, and its verdict uses its own arrays only, so a record does not depend on the
+batch it ran in, the thread count, the phases' threads or an interruption.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from .._run_warnings import run_warnings
+from .._warn import quiet, recorded
+from ..model import Params, truncated_mass
+from ._tasks import FATE_LABELS, RunSummary, fate_fields, verdict_fields
+
+__all__ = ["Launched", "label_batch", "launch_batch", "run_batch"]
+
+
+def _group_key(task: Any) -> tuple:
+    p = task.params
+    return (task.seed, task.duration, task.transient, p.dt, p.omega, task.fate)
+
+
+@dataclass(frozen=True)
+class Launched:
+    """One group of a batch after its ensemble call: its key (seed, duration, transient,
+    dt, omega, fate), the positions of its tasks in the batch, their models, the ensemble,
+    and what the call warned."""
+
+    key: tuple
+    picks: list[int]
+    plist: list[Params]
+    ens: Any
+    warned: list[str]
+
+
+def launch_batch(
+    tasks: Sequence[Any], backend: str = "cpu", extend_to: float | None = 120.0
+) -> list[Launched]:
+    """The ensembles of ``tasks``, one compiled call per group of tasks that share (seed,
+    duration, transient, dt, omega, fate), keeping their order within a group; kept
+    resumable when undetermined members may be extended (``extend_to`` not None)."""
+    from ..integrate import simulate_ensemble
+
+    groups: dict[tuple, list[int]] = {}
+    for i, t in enumerate(tasks):
+        groups.setdefault(_group_key(t), []).append(i)
+    out = []
+    for key, picks in groups.items():
+        seed, duration, transient = key[:3]
+        plist = [tasks[i].params for i in picks]
+        with recorded() as caught:  # catch_warnings is not safe on the batch threads
+            ens = simulate_ensemble(
+                plist,
+                [tasks[i].sim_index for i in picks],
+                seed=seed,
+                duration=duration,
+                transient=transient,
+                backend=backend,
+                tangent=True,
+                resumable=extend_to is not None,  # undetermined members are continued
+            )
+        out.append(Launched(key, picks, plist, ens, [str(w.message) for w in caught]))
+    return out
+
+
+def _fates(plist, indices, seed: int, fate: float, backend: str) -> list[dict[str, Any]]:
+    """The fate fields of members run again to ``fate`` seconds with the tangent (the same
+    motion, bit for bit): one ensemble call, as the process engine's one run each. After a
+    GPU batch they run where ``"auto"`` puts so few (:data:`chaoscam._ensemble_verdicts.
+    EXTEND_BACKEND`: the CPU for fewer than ``_gpu.AUTO_GPU_MIN``), the same realizations,
+    equal to the GPU's motion within ``GPU_TOLERANCE`` for a while and, when chaotic, only
+    in their statistics after."""
+    from .._ensemble_verdicts import EXTEND_BACKEND
+    from ..integrate import simulate_ensemble
+
+    with quiet():  # the model's warnings came with the first run (quiet: on batch threads)
+        ens = simulate_ensemble(
+            list(plist), list(indices), seed=seed, duration=fate, transient=0.0,
+            backend=EXTEND_BACKEND[backend], tangent=True,
+        )  # fmt: skip
+    rows_of = ens.sections.groupby("member").indices
+    out = []
+    for j, p in enumerate(plist):
+        rows = rows_of.get(j, [])
+        sec = ens.sections.iloc[rows].reset_index(drop=True)
+        out.append(fate_fields(str(ens.members["status"].iat[j]), sec, ens.jacobians[rows], p))
+    return out
+
+
+def label_batch(
+    tasks: Sequence[Any], launched: list[Launched], extend_to: float | None = 120.0
+) -> list[dict[str, Any]]:
+    """The records of ``tasks`` from their launched groups: each member's verdict (the
+    undetermined extended up to ``extend_to`` s recorded, see
+    :func:`chaoscam.classify_ensemble`), its fate where the sweep asks one, its warnings."""
+    from .._ensemble_verdicts import member_verdicts
+
+    records: list[dict[str, Any] | None] = [None] * len(tasks)
+    for group in launched:
+        seed, fate = group.key[0], group.key[5]
+        picks, plist, ens = group.picks, group.plist, group.ens
+        with recorded() as caught:
+            verdicts = member_verdicts(ens, plist, extend_to=extend_to)
+        # What the batch warned, less the models' own warnings (simulate_ensemble warns those
+        # once for every model in the group; each record adds its own model's below, as on
+        # the process engine, not its neighbours')
+        models = {w for q in {id(q): q for q in plist}.values() for w in run_warnings(q)}
+        said = [*group.warned, *(str(w.message) for w in caught)]
+        shared = [w for w in said if w not in models]
+        later = [
+            j for j, v in enumerate(verdicts) if v.verdict is not None and v.label in FATE_LABELS
+        ]
+        fates: dict[int, dict[str, Any]] = {}
+        if fate is not None and later:
+            plater = [plist[j] for j in later]
+            ilater = [tasks[picks[j]].sim_index for j in later]
+            fates = dict(
+                zip(later, _fates(plater, ilater, seed, fate, ens.settings["backend"]), strict=True)
+            )
+        rows_of = ens.sections.groupby("member").indices
+        members = ens.members
+        for j, i in enumerate(picks):
+            sec = ens.sections.iloc[rows_of.get(j, [])].drop(columns="member")
+            status = str(members["status"].iat[j])
+            run = RunSummary(
+                status,
+                sec.reset_index(drop=True),
+                int(members["n_impacts"].iat[j]),
+                float(members["contact_fraction"].iat[j]),
+                truncated_mass(plist[j].l_lambda, plist[j].l_lambda_sigma, plist[j].l_min),
+            )
+            v = verdicts[j]  # without a verdict: labelled by its status, or too short to judge
+            fields = (
+                verdict_fields(v.verdict)
+                if v.verdict is not None
+                else {"label": v.label, "period": None, "reasons": v.reasons, "evidence": {}}
+            )
+            fields.update(fates.get(j, {}))
+            seen = [w for w in (*run_warnings(plist[j]), *shared) if w]
+            fields["status"] = status
+            fields["warnings"] = " | ".join(dict.fromkeys(seen))
+            records[i] = tasks[i].record(run, fields)
+    return records  # type: ignore[return-value]
+
+
+def run_batch(
+    tasks: Sequence[Any], backend: str = "cpu", extend_to: float | None = 120.0
+) -> list[dict[str, Any]]:
+    """The records of ``tasks``, simulated as ensembles of members that share the grid;
+    undetermined members are extended up to ``extend_to`` s recorded (see
+    :func:`chaoscam.classify_ensemble`): :func:`launch_batch`, then :func:`label_batch`."""
+    return label_batch(tasks, launch_batch(tasks, backend, extend_to), extend_to)

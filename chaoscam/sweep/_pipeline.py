@@ -1,0 +1,83 @@
+"""A GPU sweep's local backend: the device runs the next batch while the host labels the last.
+
+A sweep's GPU batch has two phases (:mod:`._batch_run`): its launch, where the host mostly
+waits for the device, and its labels (verdicts, the extensions of undetermined members and
+the fate runs, which go to the CPU for so few members: ``_ensemble_verdicts.EXTEND_BACKEND``),
+where the device would wait for the host. One after another, as the serial backend runs
+them, neither overlaps. :class:`PipelineBackend` launches a batch at submission, in the
+driver's thread (so numba-cuda is used from that thread only, and Ctrl-C stops a launch as
+on the serial backend, when it returns), and hands its labels to one labelling thread; the
+engine keeps two batches in flight, so the next launch runs while the last is labelled.
+
+Estimated on the H200's measurements (2026-11-27/28), not measured on a device: a batch of
+8,192 members × 20 s takes about 80 s of launch (a quarter wave at 0.71 of a wave's rate),
+its labels about 3.3 ms a member on one core (27 s) plus the extensions; the pipeline hides
+the shorter of the two. The records are those of the serial backend, bit for bit (tested):
+a record depends on its member only.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import threading
+from collections.abc import Callable, Iterable
+from typing import Any
+
+__all__ = ["PipelineBackend"]
+
+
+class PipelineBackend:
+    """Launches in the driver's thread, labels on one labelling thread (see the module).
+
+    ``threads``: numba's thread count for the labelling thread's CPU work (the driver's is
+    set by the sweep; numba's count is per thread). A task without the two phases
+    (``launch``, ``label``) runs whole at submission, as on :class:`._backends.SerialBackend`.
+    """
+
+    name = "pipeline"
+    workers = 1  # the engine keeps 2 x workers tasks in flight: one labelled, one launched
+
+    def __init__(self, threads: int | None = None) -> None:
+        self.threads = threads
+        self._stop = threading.Event()
+        self._pool = cf.ThreadPoolExecutor(1, thread_name_prefix="chaoscam-labels")
+
+    def _label(self, task: Any, launched: Any) -> Any:
+        import numba
+
+        from ..integrate._driver import stop_on
+
+        if self.threads is not None:
+            numba.set_num_threads(self.threads)  # numba's count is per thread
+        with stop_on(self._stop):  # stops between two compiled calls when cancelled
+            return task.label(launched)
+
+    def submit(self, fn: Callable, arg: Any) -> cf.Future:
+        fut: cf.Future = cf.Future()
+        if not (hasattr(arg, "launch") and hasattr(arg, "label")):
+            try:
+                fut.set_result(fn(arg))
+            except Exception as err:  # KeyboardInterrupt passes through to the engine
+                fut.set_exception(err)
+            return fut
+        try:
+            launched = arg.launch()  # here: the driver's thread, the device's one user
+        except Exception as err:
+            fut.set_exception(err)
+            return fut
+        return self._pool.submit(self._label, arg, launched)
+
+    def wait_any(self, futures: Iterable[cf.Future]) -> set:
+        return cf.wait(list(futures), return_when=cf.FIRST_COMPLETED).done
+
+    def result(self, fut: cf.Future) -> Any:
+        return fut.result()
+
+    def cancel(self, futures: Iterable[cf.Future]) -> None:
+        self._stop.set()
+        for fut in futures:
+            fut.cancel()
+
+    def close(self) -> None:
+        self._stop.set()  # labels under way stop at their next compiled call
+        self._pool.shutdown(wait=True, cancel_futures=True)
