@@ -134,10 +134,10 @@ class ThreadBackend:
 
     name = "threads"
 
-    def __init__(self, workers: int) -> None:
+    def __init__(self, workers: int, prefix: str = "chaoscam-batch") -> None:
         self.workers = int(workers)
         self._stop = threading.Event()
-        self._pool = cf.ThreadPoolExecutor(self.workers, thread_name_prefix="chaoscam-batch")
+        self._pool = cf.ThreadPoolExecutor(self.workers, thread_name_prefix=prefix)
 
     def _run(self, fn: Callable, arg: Any) -> Any:
         from ..integrate._driver import members_on_this_thread

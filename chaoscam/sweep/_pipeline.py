@@ -19,15 +19,17 @@ a record depends on its member only.
 from __future__ import annotations
 
 import concurrent.futures as cf
-import threading
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from typing import Any
+
+from ._backends import ThreadBackend
 
 __all__ = ["PipelineBackend"]
 
 
-class PipelineBackend:
-    """Launches in the driver's thread, labels on one labelling thread (see the module).
+class PipelineBackend(ThreadBackend):
+    """Launches in the driver's thread, labels on one labelling thread (see the module);
+    waits, cancels and closes as a :class:`._backends.ThreadBackend` of one thread.
 
     ``threads``: numba's thread count for the labelling thread's CPU work (the driver's is
     set by the sweep; numba's count is per thread). A task without the two phases
@@ -35,12 +37,11 @@ class PipelineBackend:
     """
 
     name = "pipeline"
-    workers = 1  # the engine keeps 2 x workers tasks in flight: one labelled, one launched
 
     def __init__(self, threads: int | None = None) -> None:
+        # the engine keeps 2 x workers tasks in flight: one labelled, one launched
+        super().__init__(1, prefix="chaoscam-labels")
         self.threads = threads
-        self._stop = threading.Event()
-        self._pool = cf.ThreadPoolExecutor(1, thread_name_prefix="chaoscam-labels")
 
     def _label(self, task: Any, launched: Any) -> Any:
         import numba
@@ -66,18 +67,3 @@ class PipelineBackend:
             fut.set_exception(err)
             return fut
         return self._pool.submit(self._label, arg, launched)
-
-    def wait_any(self, futures: Iterable[cf.Future]) -> set:
-        return cf.wait(list(futures), return_when=cf.FIRST_COMPLETED).done
-
-    def result(self, fut: cf.Future) -> Any:
-        return fut.result()
-
-    def cancel(self, futures: Iterable[cf.Future]) -> None:
-        self._stop.set()
-        for fut in futures:
-            fut.cancel()
-
-    def close(self) -> None:
-        self._stop.set()  # labels under way stop at their next compiled call
-        self._pool.shutdown(wait=True, cancel_futures=True)
