@@ -17,6 +17,11 @@
 # default 120), one Nsight Compute profile of a full wave's launch (33,792 members x
 # 0.005 s) with the warp states only and every stall reason (instruction fetch among them):
 # why 4x the warps gave 1.41x. Outputs go to $OUT where it is set (wave.log, ncu_full.txt).
+# A regime map on the GPU (bench_regime_gpu.py: MAP_SECONDS, default 0 = skipped; MAP_RUNS
+# realizations a cell, default 2048, 4 cells: one batch of 8,192) measures what 2026-11-28
+# changed without a device: extensions and fate runs of few members on the CPU, and the next
+# batch launched while the last is labelled; it lists every device call and CPU batch. A
+# second call can run it alone: CHECK_SECONDS=0 NCU_SECONDS=0 MAP_SECONDS=400.
 #
 # Measured 2026-11-27 (H200, third session): after the host's quadratic set-up was fixed
 # (e7a316b), 33,792 members x 0.25 / 2 / 5 s ran at 1,073 / 2,231 / 2,954 member-seconds a
@@ -40,10 +45,19 @@ export PYTHONPATH=/tmp/site:$PWD
 python3 -c "import numpy, numba, chaoscam; from chaoscam.integrate._gpu import gpu_status; print('numpy', numpy.__version__, '| numba', numba.__version__, '|', gpu_status())"
 
 OUTDIR=${OUT:-/tmp}
-step "a full wave's rate by run length (bench_gpu_wave.py, CHECK_SECONDS)"
-timeout -k 5 "${CHECK_SECONDS:-330}" python3 benchmarks/bench_gpu_wave.py \
-    --durations "${DURATIONS:-2,20}" 2>&1 | tee "$OUTDIR/wave.log"
-echo "exit $?"
+if [ "${CHECK_SECONDS:-330}" != 0 ]; then
+    step "a full wave's rate by run length (bench_gpu_wave.py, CHECK_SECONDS)"
+    timeout -k 5 "${CHECK_SECONDS:-330}" python3 benchmarks/bench_gpu_wave.py \
+        --durations "${DURATIONS:-2,20}" 2>&1 | tee "$OUTDIR/wave.log"
+    echo "exit $?"
+fi
+
+if [ "${MAP_SECONDS:-0}" != 0 ]; then
+    step "a regime map on the GPU (bench_regime_gpu.py, MAP_SECONDS)"
+    timeout -k 5 "$MAP_SECONDS" python3 benchmarks/bench_regime_gpu.py \
+        --realizations "${MAP_RUNS:-2048}" --reference 4 2>&1 | tee "$OUTDIR/map.log"
+    echo "exit $?"
+fi
 
 if [ "${RUN_TESTS:-0}" = 1 ]; then
     step "device tests (tests/integrate/test_gpu.py -m gpu)"
@@ -51,7 +65,9 @@ if [ "${RUN_TESTS:-0}" = 1 ]; then
     echo "exit $?"
 fi
 
-if command -v ncu >/dev/null 2>&1; then
+if [ "${NCU_SECONDS:-120}" = 0 ]; then
+    echo "NCU_SECONDS=0: the profile skipped"
+elif command -v ncu >/dev/null 2>&1; then
     step "Nsight Compute: a full wave's launch (33,792 members x 0.005 s), warp states"
     timeout -k 5 "${NCU_SECONDS:-120}" ncu --clock-control none --target-processes all \
         -k regex:advance_members --launch-skip 1 --launch-count 1 \
