@@ -40,7 +40,9 @@ MAX_BATCH = 256
 """Members per batch at most (bounds the memory of one compiled call)."""
 
 GPU_MAP_BATCH = 8_192
-"""Members per batch when a sweep's batches run on a GPU (each member one CUDA thread). One
+"""Members per batch when a sweep's batches run on a GPU (each member one CUDA thread; on Dask,
+with ``device="gpu"``, every worker's batch: a CPU-sized batch of ~100 members held a GPU
+for as long as one member's run, a lone thread simulating about 0.23 s a second). One
 thread is slow and the device's rate comes from many in flight (measured on an H200,
 2026-11-27, 0.25-s runs: 64 members took 1.09 s of launch, 8,448 took 1.80 s, a full wave of
 33,792 took 5.1 s; a 1,024-run regime map of 20 s with the tangent took 132 s, as fast as 2
@@ -195,6 +197,8 @@ def resolve_engine(
     identity = f"{ENGINE_CLASSIFIER}, extend_to={extend_to}"
     if gpu:
         return Engine("ensemble", identity, pack, GPU_MAP_BATCH, threads, pipeline=True)
+    if scheduler is not None and device == "gpu":  # Dask workers' GPUs: batches they can fill
+        return Engine("ensemble", identity, pack, GPU_MAP_BATCH)
     if by_task > 1:
         return Engine("ensemble", identity, pack, size, None, by_task)
     return Engine("ensemble", identity, pack, size, threads)

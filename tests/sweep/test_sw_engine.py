@@ -298,6 +298,20 @@ def test_a_gpu_sweep_runs_large_batches_only_where_a_gpu_can_run(monkeypatch, re
     assert _batch.engine_device(eng, "gpu") == ("gpu" if ready else "cpu")
 
 
+@pytest.mark.parametrize(("device", "large"), [("gpu", True), ("auto", False), ("cpu", False)])
+def test_dask_workers_asked_for_their_gpus_get_batches_a_gpu_can_fill(device, large):
+    """On Dask the driver cannot see the workers' devices: device="gpu" sends batches of
+    GPU_MAP_BATCH (CPU-sized ones held a GPU for one member's run time each); "auto", settled
+    on each worker by its batch's size, and "cpu" keep the CPU's batches."""
+    from chaoscam.sweep import DefaultClassifier
+
+    eng = _batch.resolve_engine(
+        "ensemble", device, DefaultClassifier(), "id", Params(), (20.0, 0.0), None, object()
+    )
+    assert (eng.pack_size == _batch.GPU_MAP_BATCH) is large
+    assert not eng.pipeline  # the workers run whole batches
+
+
 def test_a_gpu_sweep_without_a_gpu_says_so_once(monkeypatch):
     """device="gpu" where no GPU can run: one GPUFallbackWarning for the sweep, and its
     records carry no fallback warning each (they ran on the CPU, as the config says)."""
