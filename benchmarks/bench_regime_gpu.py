@@ -3,14 +3,15 @@
 Run: python benchmarks/bench_regime_gpu.py [--realizations N] [--reference N]
 
 The (mu, sigma) map of 2 x 2 cells (mu = 0.008 and 0.015 m, sigma = 1 and 2 mm), default
-model, 20 s after the default transient, undetermined members extended to ``--extend-to``
-recorded seconds. The GPU runs ``--realizations`` members a cell (``device="gpu"``, the
-ensemble engine); the references run the first ``--reference`` of them on 2 cores: the process
-engine (``engine="process"``, 2 workers, today's sweep) and the ensemble engine on the CPU
-(2 threads). Rates are trajectories per second end to end (the sweep's set-up, its host
-labelling and the extension of undetermined members included; compilation excluded by a
-warm-up); the reference rates are measured on their smaller sample (a rate does not depend on
-the sample size beyond a batch).
+model, ``--duration`` 20 s simulated (regime_map's duration: its first half the transient),
+undetermined members extended to ``--extend-to`` recorded seconds. The GPU runs
+``--realizations`` members a cell (``device="gpu"``, the ensemble engine); the references
+run the first ``--reference`` of them on 2 cores: the process engine (``engine="process"``,
+2 workers, today's sweep) and the ensemble engine on the CPU (2 threads). Rates are
+trajectories per second end to end (the sweep's set-up, its host labelling and the extension
+of undetermined members included; compilation excluded by a warm-up); the reference rates
+are measured on their smaller sample (a rate does not depend on the sample size beyond a
+batch).
 
 It prints how the GPU run's wall time divides between the device calls (each listed with
 its members and seconds), the CPU batches (the extension of undetermined members: fewer than
@@ -35,16 +36,20 @@ from chaoscam.sweep import Axis, DefaultClassifier, regime_map
 
 class _DeviceClock:
     """Wall time spent inside a batch runner (``run_on_gpu``: launches, transfers and
-    refills; ``run_on_cpu``: the host's batches), with each call's members and seconds."""
+    refills; ``run_on_cpu``: the host's batches), with each call's members, start (seconds
+    after ``origin``) and length: the starts show whether the host's work overlapped a
+    launch (a GPU sweep labels a batch while the next one is launched)."""
+
+    origin = time.perf_counter()
 
     def __init__(self, inner) -> None:
-        self.calls: list[tuple[int, float]] = []
+        self.calls: list[tuple[int, float, float]] = []
         self._lock = threading.Lock()
         self._inner = inner
 
     @property
     def seconds(self) -> float:
-        return sum(s for _, s in self.calls)
+        return sum(s for _, _, s in self.calls)
 
     def __call__(self, *args, **kwargs):
         t0 = time.perf_counter()
@@ -52,10 +57,13 @@ class _DeviceClock:
             return self._inner(*args, **kwargs)
         finally:
             with self._lock:
-                self.calls.append((int(args[0].shape[0]), time.perf_counter() - t0))
+                self.calls.append((int(args[0].shape[0]), t0, time.perf_counter() - t0))
 
     def listing(self, most: int = 12) -> str:
-        shown = ", ".join(f"{n:,} members {s:.1f} s" for n, s in self.calls[:most])
+        shown = ", ".join(
+            f"{n:,} members at {t - _DeviceClock.origin:.1f} s for {s:.1f} s"
+            for n, t, s in self.calls[:most]
+        )
         return shown + (f", ... ({len(self.calls) - most} more)" if len(self.calls) > most else "")
 
 
@@ -63,7 +71,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--realizations", type=int, default=1024, help="GPU members a cell")
     ap.add_argument("--reference", type=int, default=8, help="2-core members a cell")
-    ap.add_argument("--duration", type=float, default=20.0, help="recorded time [s]")
+    ap.add_argument("--duration", type=float, default=20.0, help="simulated [s]")
     ap.add_argument("--extend-to", type=float, default=40.0, help="extension cap [s]")
     args = ap.parse_args()
     ok, reason = _gpu.gpu_status()
@@ -86,7 +94,7 @@ def main() -> None:
     clock, host = _DeviceClock(_gpu.run_on_gpu), _DeviceClock(_ensemble.run_on_cpu)
     _gpu.run_on_gpu, _ensemble.run_on_cpu = clock, host
     try:
-        t0 = time.perf_counter()
+        t0 = _DeviceClock.origin = time.perf_counter()
         gpu = regime_map(x, y, realizations=args.realizations, engine="ensemble",
                          device="gpu", **kw)  # fmt: skip
         wall = time.perf_counter() - t0
@@ -98,8 +106,11 @@ def main() -> None:
         f"{gpu.config.get('device')}); {clock.seconds:.1f} s in {len(clock.calls)} device "
         f"calls ({clock.listing()}); {host.seconds:.1f} s in {len(host.calls)} CPU batches "
         f"(extensions of few members: {host.listing()}); "
-        f"{wall - clock.seconds - host.seconds:.1f} s else on the host (labels, set-up, "
-        "checkpoints)"
+        + (
+            f"{rest:.1f} s else on the host (labels, set-up, checkpoints)"
+            if (rest := wall - clock.seconds - host.seconds) >= 0
+            else f"the device calls and the CPU batches overlapped by at least {-rest:.1f} s"
+        )
     )
 
     rates = {}

@@ -18,10 +18,13 @@
 # 0.005 s) with the warp states only and every stall reason (instruction fetch among them):
 # why 4x the warps gave 1.41x. Outputs go to $OUT where it is set (wave.log, ncu_full.txt).
 # A regime map on the GPU (bench_regime_gpu.py: MAP_SECONDS, default 0 = skipped; MAP_RUNS
-# realizations a cell, default 2048, 4 cells: one batch of 8,192) measures what 2026-11-28
-# changed without a device: extensions and fate runs of few members on the CPU, and the next
-# batch launched while the last is labelled; it lists every device call and CPU batch. A
-# second call can run it alone: CHECK_SECONDS=0 NCU_SECONDS=0 MAP_SECONDS=400.
+# realizations a cell, default 4096, 4 cells: two batches of 8,192, so that the second's
+# launch can overlap the first's labels; MAP_DURATION simulated seconds, default 20) measures
+# what 2026-11-28 changed without a device: extensions and fate runs of few members on the
+# CPU, and the next batch launched while the last is labelled; it lists every device call
+# and CPU batch with its start and length. By the H200's wave rate the two launches take
+# about 80 s each. A second call can run it alone, within the session's 15 minutes after a
+# first default call (about 450 s): CHECK_SECONDS=0 NCU_SECONDS=0 MAP_SECONDS=330.
 #
 # Measured 2026-11-27 (H200, third session): after the host's quadratic set-up was fixed
 # (e7a316b), 33,792 members x 0.25 / 2 / 5 s ran at 1,073 / 2,231 / 2,954 member-seconds a
@@ -55,7 +58,8 @@ fi
 if [ "${MAP_SECONDS:-0}" != 0 ]; then
     step "a regime map on the GPU (bench_regime_gpu.py, MAP_SECONDS)"
     timeout -k 5 "$MAP_SECONDS" python3 benchmarks/bench_regime_gpu.py \
-        --realizations "${MAP_RUNS:-2048}" --reference 4 2>&1 | tee "$OUTDIR/map.log"
+        --realizations "${MAP_RUNS:-4096}" --duration "${MAP_DURATION:-20}" --reference 4 \
+        2>&1 | tee "$OUTDIR/map.log"
     echo "exit $?"
 fi
 
