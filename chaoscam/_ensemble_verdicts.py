@@ -26,6 +26,7 @@ from ._model_rules import extensible, extension_stopped
 from .analysis import Verdict
 from .classify import EXTEND_TO, _with_settings, classify_section_run
 from .integrate import Ensemble, Status, extend_ensemble, simulate_ensemble
+from .integrate._driver import check_stop
 from .model import Params, realizations_identical
 
 __all__ = ["MemberVerdict", "classify_ensemble", "member_verdicts"]
@@ -208,6 +209,7 @@ def _verdicts(ens: Ensemble, plist: list[Params]) -> list[MemberVerdict]:
     empty = np.empty(0, dtype=np.int64)
 
     def verdict(item: tuple[int, str]) -> MemberVerdict:
+        check_stop()  # a labelling thread asked to stop: before each member (a prompt Ctrl-C)
         m, status = item
         pick = rows_of.get(m, empty)
         return _member(
