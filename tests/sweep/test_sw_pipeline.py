@@ -119,3 +119,16 @@ def test_labels_asked_to_stop_stop_before_the_next_member(monkeypatch):
     with stop_on(stop), pytest.raises(StopRequested):
         _ensemble_verdicts.member_verdicts(ens, p)
     assert judged == []
+
+
+def test_a_continued_diagram_on_the_pipeline_is_the_cpus(device):
+    """A bifurcation diagram with continuation (each value's start is the last value's end,
+    so its tasks exist only after the records before them): the same points on the
+    pipeline as on the CPU."""
+    from chaoscam.sweep import bifurcation
+
+    kw = dict(duration=4.0, transient=2.0, initial_conditions=2, continuation=True, workers=1)
+    a = bifurcation("xi", "0.2:0.3:3", engine="ensemble", device="gpu", **kw)
+    b = bifurcation("xi", "0.2:0.3:3", engine="ensemble", device="cpu", **kw)
+    assert a.config["device"] == "gpu" and b.config["device"] == "cpu"
+    frames_equal(a.points, b.points)
