@@ -56,11 +56,14 @@ class MemberVerdict:
     verdict: Verdict | None
 
 
-def _member(status: str, points: pd.DataFrame, jac: np.ndarray, p: Params, transient: float):
+def _member(status: str, t, k, xy, jac: np.ndarray, p: Params, transient: float):
+    """One member's verdict from its section rows as arrays (times ``t``, indices ``k``,
+    points ``xy`` = (theta_f, omega_f)) and their Jacobians; arrays, not a DataFrame slice
+    a member (pandas indexing was a quarter of a random member's verdict time)."""
     st = Status[status]
     if st is not Status.OK:
         return MemberVerdict(st.label or "undetermined", None, st.message, None)
-    keep = ((points["t"] >= transient - 1e-9 * p.cam_period) & (points["k"] > 0)).to_numpy()
+    keep = (t >= transient - 1e-9 * p.cam_period) & (k > 0)
     if keep.sum() < 2:
         why = (
             f"{int(keep.sum())} section point(s) after the transient: too few to judge; "
@@ -69,7 +72,7 @@ def _member(status: str, points: pd.DataFrame, jac: np.ndarray, p: Params, trans
         # An undetermined verdict like any other, so that the member is extended as
         # classify_trajectory extends such a run (the engines' labels agree).
         return MemberVerdict("undetermined", None, why, Verdict("undetermined", None, (), (why,)))
-    v = classify_section_run(points.loc[keep, _COORDS].to_numpy(dtype=float), jac[keep], p)
+    v = classify_section_run(xy[keep], jac[keep], p)
     return MemberVerdict(v.label, v.period, "; ".join(v.reasons), v)
 
 
@@ -207,13 +210,15 @@ def _verdicts(ens: Ensemble, plist: list[Params]) -> list[MemberVerdict]:
     transient = float(ens.settings["transient"])
     rows_of = ens.sections.groupby("member").indices  # member -> positions of its rows
     empty = np.empty(0, dtype=np.int64)
+    sec = ens.sections
+    t, k, xy = sec["t"].to_numpy(), sec["k"].to_numpy(), sec[_COORDS].to_numpy(dtype=float)
 
     def verdict(item: tuple[int, str]) -> MemberVerdict:
         check_stop()  # a labelling thread asked to stop: before each member (a prompt Ctrl-C)
         m, status = item
         pick = rows_of.get(m, empty)
         return _member(
-            status, ens.sections.iloc[pick], ens.jacobians[pick], plist[int(m)], transient
+            status, t[pick], k[pick], xy[pick], ens.jacobians[pick], plist[int(m)], transient
         )
 
     items = list(zip(ens.members["member"], ens.members["status"], strict=True))
