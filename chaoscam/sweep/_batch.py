@@ -48,8 +48,8 @@ thread is slow and the device's rate comes from many in flight (measured on an H
 33,792 took 5.1 s; a 1,024-run regime map of 20 s with the tangent took 132 s, as fast as 2
 CPU cores), so batches must be large. 8,192, a quarter of an H200's wave (at 0.71 of a
 wave's rate a member), keeps a checkpoint every few minutes and the host's labels of a
-batch (8 ms a member in that map, its extension included; 3.3 ms for a random member's
-verdict alone on this machine) near a minute, which the next batch's launch now overlaps
+batch (8 ms a member in that map, its extension included; on this machine now about 2.8 ms
+a random member, verdict and record) near a minute, which the next batch's launch overlaps
 (:class:`._pipeline.PipelineBackend`). A Ctrl-C is answered when the launch under way
 returns."""
 
