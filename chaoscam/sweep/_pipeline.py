@@ -47,9 +47,10 @@ class PipelineBackend(ThreadBackend):
     def _label(self, task: Any, launched: Any) -> Any:
         import numba
 
-        from ..integrate._driver import stop_on
+        from ..integrate._driver import fork_safe_threads, stop_on
 
         if self.threads is not None:
+            fork_safe_threads()  # set_num_threads starts the threads: the layer first
             numba.set_num_threads(self.threads)  # numba's count is per thread
         with stop_on(self._stop):  # stops between two compiled calls when cancelled
             return task.label(launched)
