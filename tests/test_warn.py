@@ -121,3 +121,24 @@ def test_a_verdict_threads_warnings_are_recorded_with_their_batch():
             assert _threaded(judge, list(range(6)), 3, [6, 7]) == (list(range(6)), [6, 7])
     assert sorted(str(m.message) for m in log) == [f"member {x}" for x in range(8)]
     assert outside == []
+
+
+def test_no_library_module_swaps_the_warnings_state_itself():
+    """``warnings.catch_warnings`` swaps process-wide state and is not safe where a sweep's
+    batches run on threads; the library records and silences warnings through
+    chaoscam._warn.recorded / quiet. Only the top-level drivers (the command line, the
+    paper's experiments), which run on the main thread, use it directly."""
+    import ast
+    from pathlib import Path
+
+    root = Path(chaoscam.__file__).parent
+    drivers = ("cli", "experiments")
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        rel = path.relative_to(root)
+        if rel.parts[0] in drivers or rel.name == "_warn.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Attribute) and node.attr == "catch_warnings":
+                found.append(f"{rel}:{node.lineno}")
+    assert found == []

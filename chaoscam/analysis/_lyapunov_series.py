@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._warn import recorded
 from .._warn import warn as warn_user
 from ._validate import as_series, check_settings
 
@@ -190,8 +190,7 @@ def lyapunov_from_series(
     if y.size < min_points:
         reasons.append(f"only {y.size} samples (< {min_points})")
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with recorded() as caught:  # nolds's warnings, kept as reasons (thread-safe: chaoscam._warn)
         try:
             if method == "rosenstein":
                 le, (ks, div, poly) = nolds.lyap_r(

@@ -14,7 +14,6 @@ import importlib
 import inspect
 import math
 import numbers
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, is_dataclass
 from typing import Any
@@ -22,7 +21,7 @@ from typing import Any
 import pandas as pd
 
 from .._simulate import simulate
-from .._warn import quiet
+from .._warn import quiet, recorded
 from ..analysis import LABELS
 from ..integrate import Status
 from ..model import Params
@@ -303,8 +302,7 @@ def fate_columns(records: list[dict]) -> dict[str, Any]:
 def _fate(params: Params, task: Any) -> dict[str, Any]:
     """Run the realization again to ``task.fate`` seconds, with the tangent (the same
     motion, bit for bit): does it stay in the cam's reach, and what is it at the end?"""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the model's warnings came with the first run
+    with quiet():  # the model's warnings came with the first run
         long = simulate(
             params,
             duration=task.fate,
@@ -325,8 +323,7 @@ def status_fields(status: Status) -> dict[str, Any]:
 def _run(params: Params, task: Any) -> tuple[RunSummary, dict[str, Any]]:
     """Simulate and classify; a run that did not end normally is labelled by its status."""
     tangent = bool(getattr(task.classify, "needs_tangent", False)) and params.integrator == "rk4"
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with recorded() as caught:  # (thread-safe: chaoscam._warn)
         traj = simulate(
             params,
             duration=task.duration,
