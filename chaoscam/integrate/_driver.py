@@ -245,16 +245,17 @@ def members_on_this_thread(stop: threading.Event | None = None):
     same bits. ``stop``: when set, the next call raises :class:`StopRequested` (a prompt
     Ctrl-C; a compiled call itself cannot be interrupted).
     """
-    before = getattr(_here, "stop", None), getattr(_here, "active", False)
-    _here.stop, _here.active = stop, True
+    before = getattr(_here, "active", False)
+    _here.active = True
     try:
-        yield
+        with stop_on(stop):
+            yield
     finally:
-        _here.stop, _here.active = before
+        _here.active = before
 
 
 @contextlib.contextmanager
-def stop_on(stop: threading.Event):
+def stop_on(stop: threading.Event | None):
     """Within this context :func:`check_stop` raises :class:`StopRequested` on the calling
     thread once ``stop`` is set (between two compiled calls), while its ensembles run as
     anywhere else (numba's threads): a GPU sweep's labelling thread

@@ -172,7 +172,7 @@ def simulate_ensemble(
     if plist and hasattr(indices, "__len__"):  # before the list: range(10**10) would hang there
         _check_memory(plist[0], duration, transient, len(indices))
     indices = [whole("index", i) for i in indices]
-    use_gpu, device = _pick_backend(_gpu.by_size(backend, len(indices)))  # "auto": by size
+    use_gpu, device = _pick_backend(backend, len(indices))
     batch = whole(
         "batch", (_gpu.GPU_BATCH if use_gpu else _CPU_BATCH) if batch is None else batch, low=1
     )
@@ -328,7 +328,7 @@ def extend_ensemble(
     if backend is None:
         use_gpu, device, batch = s["backend"] == "gpu", s.get("device", s["backend"]), s["batch"]
     else:
-        use_gpu, device = _pick_backend(_gpu.by_size(backend, len(picks)))
+        use_gpu, device = _pick_backend(backend, len(picks))
         same = ("gpu" if use_gpu else "cpu") == s["backend"]
         batch = s["batch"] if same else (_gpu.GPU_BATCH if use_gpu else _CPU_BATCH)
     room = _ROOM["gpu" if use_gpu else "cpu"]
@@ -403,12 +403,14 @@ def _assemble(parts, settings: dict, keep_impacts: bool, t0: float) -> Ensemble:
     return Ensemble(sec, members, settings, impacts, jac, resume)
 
 
-def _pick_backend(backend: str) -> tuple[bool, str]:
-    """(use the GPU?, the device in words) for ``backend``; warns if "gpu" cannot run."""
+def _pick_backend(backend: str, members: int) -> tuple[bool, str]:
+    """(use the GPU?, the device in words) for ``backend`` and a run of ``members``
+    (``"auto"`` settled by size, :func:`._gpu.by_size`); warns if "gpu" cannot run."""
     if backend not in BACKENDS:
         raise ValueError(
             f"backend must be one of {', '.join(map(repr, BACKENDS))}, got {backend!r}"
         )
+    backend = _gpu.by_size(backend, members)
     if backend == "cpu":
         return False, "cpu"
     ok, reason = _gpu.gpu_status()

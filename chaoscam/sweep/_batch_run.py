@@ -21,6 +21,7 @@ from typing import Any
 
 from .._run_warnings import run_warnings
 from .._warn import quiet, recorded
+from ..integrate._members import models_of
 from ..model import Params, truncated_mass
 from ._tasks import FATE_LABELS, RunSummary, fate_fields, verdict_fields
 
@@ -116,7 +117,7 @@ def label_batch(
         # What the batch warned, less the models' own warnings (simulate_ensemble warns those
         # once for every model in the group; each record adds its own model's below, as on
         # the process engine, not its neighbours')
-        models = {w for q in {id(q): q for q in plist}.values() for w in run_warnings(q)}
+        models = {w for q in models_of(plist) for w in run_warnings(q)}
         said = [*group.warned, *(str(w.message) for w in caught)]
         shared = [w for w in said if w not in models]
         later = [

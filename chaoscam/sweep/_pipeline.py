@@ -23,7 +23,7 @@ import concurrent.futures as cf
 from collections.abc import Callable
 from typing import Any
 
-from ._backends import ThreadBackend
+from ._backends import SerialBackend, ThreadBackend
 
 __all__ = ["PipelineBackend"]
 
@@ -56,16 +56,10 @@ class PipelineBackend(ThreadBackend):
             return task.label(launched)
 
     def submit(self, fn: Callable, arg: Any) -> cf.Future:
-        fut: cf.Future = cf.Future()
+        now = SerialBackend()  # runs a call here, as a finished future
         if not (hasattr(arg, "launch") and hasattr(arg, "label")):
-            try:
-                fut.set_result(fn(arg))
-            except Exception as err:  # KeyboardInterrupt passes through to the engine
-                fut.set_exception(err)
-            return fut
-        try:
-            launched = arg.launch()  # here: the driver's thread, the device's one user
-        except Exception as err:
-            fut.set_exception(err)
-            return fut
-        return self._pool.submit(self._label, arg, launched)
+            return now.submit(fn, arg)
+        launched = now.submit(type(arg).launch, arg)  # here: the driver's thread, the device's
+        if launched.exception() is not None:
+            return launched
+        return self._pool.submit(self._label, arg, launched.result())

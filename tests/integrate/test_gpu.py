@@ -16,7 +16,10 @@ import numpy as np
 import pytest
 
 from chaoscam import Params
-from chaoscam.integrate import _gpu, _members, simulate_ensemble
+from chaoscam.integrate import _ensemble, _gpu, _members, simulate_ensemble
+
+# a chattering model (refills on the way), its run settings, and a bit-for-bit comparison
+from .test_resume import CHAOTIC, RUN, _same
 
 HAS_NUMBA_CUDA = importlib.util.find_spec("numba_cuda") is not None
 needs_numba_cuda = pytest.mark.skipif(not HAS_NUMBA_CUDA, reason="numba-cuda not installed")
@@ -284,18 +287,6 @@ def test_device_equals_cpu_within_tolerance(monkeypatch, params, duration, trans
     assert (runs[0].members.status == "OK").all()
 
 
-def _same(a, b) -> None:
-    import pandas as pd
-
-    pd.testing.assert_frame_equal(a.sections, b.sections, check_exact=True)
-    pd.testing.assert_frame_equal(a.members, b.members, check_exact=True)
-    assert np.array_equal(a.jacobians, b.jacobians)
-
-
-CONTINUED = Params(l_lambda=0.011, l_lambda_sigma=0.0015)  # chattering: refills on the way
-RUN = dict(seed=1, transient=1.0, tangent=True)
-
-
 def test_a_gpu_runs_continuation_of_few_members_goes_to_the_cpu(monkeypatch, fake_gpu):
     """extend_ensemble(backend="auto") of a GPU run continues fewer than AUTO_GPU_MIN
     members on the CPU, from the GPU's state and with the CPU's room; backend=None stays on
@@ -303,32 +294,24 @@ def test_a_gpu_runs_continuation_of_few_members_goes_to_the_cpu(monkeypatch, fak
     bit for bit: only where they ran differs (and a real device's rounding)."""
     from chaoscam.integrate import extend_ensemble
 
-    short = simulate_ensemble(
-        CONTINUED, range(3), duration=2.0, resumable=True, backend="gpu", **RUN
-    )
+    short = simulate_ensemble(CHAOTIC, range(3), duration=2.0, resumable=True, backend="gpu", **RUN)
     assert short.settings["backend"] == "gpu" and len(fake_gpu) > 0
     launched = len(fake_gpu)
-    on_gpu = extend_ensemble(short, CONTINUED, 4.0)
+    on_gpu = extend_ensemble(short, CHAOTIC, 4.0)
     assert len(fake_gpu) > launched and on_gpu.settings["backend"] == "gpu"
     launched = len(fake_gpu)
-    on_cpu = extend_ensemble(short, CONTINUED, 4.0, members=[2, 0], backend="auto")
+    on_cpu = extend_ensemble(short, CHAOTIC, 4.0, members=[2, 0], backend="auto")
     assert len(fake_gpu) == launched  # not one launch
     assert on_cpu.settings["backend"] == "cpu" and list(on_cpu.settings["backends"]) == [
         "gpu",
         "cpu",
     ]
-    assert on_cpu.settings["batch"] == _members_batch_cpu()
-    _same(on_cpu, simulate_ensemble(CONTINUED, [2, 0], duration=4.0, backend="cpu", **RUN))
-    _same(on_gpu, simulate_ensemble(CONTINUED, range(3), duration=4.0, backend="cpu", **RUN))
+    assert on_cpu.settings["batch"] == _ensemble._CPU_BATCH
+    _same(on_cpu, simulate_ensemble(CHAOTIC, [2, 0], duration=4.0, backend="cpu", **RUN))
+    _same(on_gpu, simulate_ensemble(CHAOTIC, range(3), duration=4.0, backend="cpu", **RUN))
     monkeypatch.setattr(_gpu, "AUTO_GPU_MIN", 2)  # two members are now enough for the GPU
-    extend_ensemble(short, CONTINUED, 4.0, members=[2, 0], backend="auto")
+    extend_ensemble(short, CHAOTIC, 4.0, members=[2, 0], backend="auto")
     assert len(fake_gpu) > launched
-
-
-def _members_batch_cpu() -> int:
-    from chaoscam.integrate import _ensemble
-
-    return _ensemble._CPU_BATCH
 
 
 def test_a_gpu_ensembles_extensions_run_on_the_cpu(fake_gpu):
@@ -353,5 +336,5 @@ def test_a_gpu_sweeps_fate_runs_run_on_the_cpu(fake_gpu):
     """The fate runs of a GPU batch's few chaotic members go to the CPU (by size)."""
     from chaoscam.sweep import _batch
 
-    (fields,) = _batch._fates([CONTINUED], [0], 1, 2.0, "gpu")
+    (fields,) = _batch._fates([CHAOTIC], [0], 1, 2.0, "gpu")
     assert fake_gpu == [] and fields
