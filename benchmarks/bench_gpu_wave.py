@@ -1,6 +1,7 @@
 """A full GPU wave's rate by run length, its device time apart from the host's (issue 13).
 
 Run: python benchmarks/bench_gpu_wave.py [--members N] [--durations 0.25,2,5] [--cpu-members N]
+                                          [--legs K]
 
 One wave fills the device once (default 132 x 256 = 33,792 members: an H200's 132
 multiprocessors at 8 warps each, what 216 registers a thread allow). For each duration it
@@ -15,6 +16,14 @@ Why: on 2026-11-27 33,792 x 0.25 s took 142.6 s on an H200 of which 5.1 s were t
 member (quadratic, 137 s at that size). Fixed; this benchmark says what a wave costs now.
 The first cam period of ``--check`` members is compared with the CPU's (``GPU_TOLERANCE``;
 bench_gpu.py's check); the launches are timed as bench_gpu_profile.py times them.
+With ``--legs K`` each duration runs as K legs of equal length, the first a resumable
+``simulate_ensemble`` and each next an ``extend_ensemble`` on the GPU, and a line is printed
+after each leg: a call that runs out of time still says how far the wave got, and the legs'
+rates say whether later simulated seconds cost more than earlier ones. Each extension goes on
+from its members' last section before the leg's end (``_resume``), so it runs again up to a cam
+period (0.22 s at the default omega): the legs' rates count only the new seconds, a lower bound.
+Why: on an H100 (2026-11-28) one launch of a full wave x 20 s did not end within the 250 s
+a call left it, and printed nothing.
 Without a GPU it says why on one line and exits 0.
 """
 
@@ -25,10 +34,10 @@ import time
 
 import numba
 from bench_gpu import max_diff, timed  # run from benchmarks/, as the scripts are
-from bench_gpu_profile import measure
+from bench_gpu_profile import _Clock, measure
 
 from chaoscam import Params
-from chaoscam.integrate import _ensemble, _gpu, simulate_ensemble
+from chaoscam.integrate import _ensemble, _gpu, extend_ensemble, simulate_ensemble
 
 
 def main() -> None:
@@ -37,6 +46,7 @@ def main() -> None:
     ap.add_argument("--durations", default="0.25,2,5", help="run lengths [s], comma-separated")
     ap.add_argument("--cpu-members", type=int, default=64, help="CPU sample a duration")
     ap.add_argument("--check", type=int, default=64, help="members in the GPU = CPU check")
+    ap.add_argument("--legs", type=int, default=1, help="legs a duration, a line after each")
     args = ap.parse_args()
     durations = [float(x) for x in args.durations.split(",")]
     p = Params(l_lambda_sigma=0.002)
@@ -60,17 +70,51 @@ def main() -> None:
     print(f"check: first cam period of {args.check} members, max |GPU - CPU| {diff:.1e} "
           f"(tolerance {_gpu.GPU_TOLERANCE:g}): {verdict}", flush=True)  # fmt: skip
     for d in durations:
+        if args.legs > 1:
+            _in_legs(p, args.members, d, args.legs, cpu_rate[d])
+            continue
         wall, clock, ens = measure(p, args.members, d, _ensemble._ROOM["gpu"], "C")
         inside, launches = clock.launch, clock.launches
-        rate = args.members * d / wall
-        print(
-            f"GPU: {args.members:,} x {d:g} s in {wall:.1f} s ({launches} launches "
-            f"{inside:.1f} s, host {wall - inside:.1f} s) = {rate:,.0f} member-s/s = "
-            f"{rate / 20:,.1f} 20-s traj/s; "
-            f"{rate / cpu_rate[d]:.1f}x 2 CPU threads; statuses "
-            f"{ens.members.status.value_counts().to_dict()}",
-            flush=True,
-        )
+        _report(f"{args.members:,} x {d:g} s", args.members * d, wall, inside, launches,
+                cpu_rate[d], ens)  # fmt: skip
+
+
+def _report(what, member_seconds, wall, inside, launches, cpu_rate, ens) -> None:
+    rate = member_seconds / wall
+    print(
+        f"GPU: {what} in {wall:.1f} s ({launches} launches {inside:.1f} s, host "
+        f"{wall - inside:.1f} s) = {rate:,.0f} member-s/s = {rate / 20:,.1f} 20-s traj/s; "
+        f"{rate / cpu_rate:.1f}x 2 CPU threads; statuses "
+        f"{ens.members.status.value_counts().to_dict()}",
+        flush=True,
+    )
+
+
+def _in_legs(p, members, duration, legs, cpu_rate) -> None:
+    """One wave of ``duration`` in ``legs`` legs (module docstring), a line after each."""
+    ends = [duration * (i + 1) / legs for i in range(legs)]
+    total = 0.0
+    clock = _Clock()
+    inner, _gpu.drive_members = _gpu.drive_members, clock.wrap(_gpu.drive_members)
+    try:
+        ens, start = None, 0.0
+        for end in ends:
+            t0 = time.perf_counter()
+            before, launches = clock.launch, clock.launches
+            if ens is None:
+                ens = simulate_ensemble(p, range(members), seed=1, duration=end,
+                                        backend="gpu", resumable=True)  # fmt: skip
+            else:
+                ens = extend_ensemble(ens, p, end, resumable=True, backend="gpu")
+            wall = time.perf_counter() - t0
+            total += wall
+            _report(f"{members:,} x {start:g}-{end:g} s (leg)", members * (end - start), wall,
+                    clock.launch - before, clock.launches - launches, cpu_rate, ens)  # fmt: skip
+            start = end
+    finally:
+        _gpu.drive_members = inner
+    print(f"GPU: {members:,} x {duration:g} s in {legs} legs, {total:.1f} s = "
+          f"{members * duration / total:,.0f} member-s/s", flush=True)  # fmt: skip
 
 
 if __name__ == "__main__":

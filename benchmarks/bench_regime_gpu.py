@@ -20,7 +20,17 @@ and the rest of the host's work (labels, set-up, checkpoints), and compares the 
 realizations both ran: a GPU's sections equal the CPU's only within ``GPU_TOLERANCE`` over a
 cam period and part later on chaotic runs (see ``chaoscam.integrate._gpu``), so chaotic
 members agree in label, not in numbers.
+Each device call and CPU batch is also printed as it ends, so a call cut short by a time
+limit still shows how far the map got.
 Without a GPU it says why on one line and exits 0.
+
+Measured on an H100 (2026-11-28, ``--realizations 512 --duration 20 --reference 4``): 2,048
+runs in 108.7 s = 18.8 traj/s, 4.14x the 2-core process engine (4.6 traj/s) and 3.78x the
+2-core ensemble engine (5.0), all 2,048 chaotic, the 16 both ran 100 % equal. One device call
+of 87.1 s (20 s a member: 0.23 simulated seconds a second a thread, a lone thread's rate: the
+batch was far from filling the device), the 530 undetermined members' extension on the host's
+16 cores 12.8 s, the rest 8.7 s. At 4,096 a cell (two batches of 8,192) the map did not end
+within the 240 s its call left it.
 """
 
 from __future__ import annotations
@@ -42,10 +52,11 @@ class _DeviceClock:
 
     origin = time.perf_counter()
 
-    def __init__(self, inner) -> None:
+    def __init__(self, inner, name: str = "") -> None:
         self.calls: list[tuple[int, float, float]] = []
         self._lock = threading.Lock()
         self._inner = inner
+        self._name = name  # printed as each call ends, when given (a call cut short says so)
 
     @property
     def seconds(self) -> float:
@@ -58,13 +69,17 @@ class _DeviceClock:
         finally:
             with self._lock:
                 self.calls.append((int(args[0].shape[0]), t0, time.perf_counter() - t0))
+                if self._name:
+                    print(f"  {self._name}: {self.listing(most=0, last=1)}", flush=True)
 
-    def listing(self, most: int = 12) -> str:
+    def listing(self, most: int = 12, last: int = 0) -> str:
+        """The first ``most`` calls, or the ``last`` ones."""
+        calls = self.calls[-last:] if last else self.calls[:most]
         shown = ", ".join(
-            f"{n:,} members at {t - _DeviceClock.origin:.1f} s for {s:.1f} s"
-            for n, t, s in self.calls[:most]
+            f"{n:,} members at {t - _DeviceClock.origin:.1f} s for {s:.1f} s" for n, t, s in calls
         )
-        return shown + (f", ... ({len(self.calls) - most} more)" if len(self.calls) > most else "")
+        more = len(self.calls) - most
+        return shown + (f", ... ({more} more)" if not last and more > 0 else "")
 
 
 def main() -> None:
@@ -91,7 +106,8 @@ def main() -> None:
     regime_map(Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.001,)),
                realizations=2, duration=1.0, engine="ensemble", device="gpu")  # fmt: skip
     print(f"warm-up (GPU kernel compilation): {time.perf_counter() - t0:.1f} s")
-    clock, host = _DeviceClock(_gpu.run_on_gpu), _DeviceClock(_ensemble.run_on_cpu)
+    clock = _DeviceClock(_gpu.run_on_gpu, "device call")
+    host = _DeviceClock(_ensemble.run_on_cpu, "CPU batch")
     _gpu.run_on_gpu, _ensemble.run_on_cpu = clock, host
     try:
         t0 = _DeviceClock.origin = time.perf_counter()

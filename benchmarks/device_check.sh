@@ -12,19 +12,30 @@
 # Steps: versions (the image's numba-cuda under its own numpy 2.5 compiles no kernel: seen on
 # an H200, 2026-11-27); then, under one time limit (CHECK_SECONDS, default 330), a full wave's
 # rate by run length against 2 CPU threads of the machine (bench_gpu_wave.py, DURATIONS,
-# default 2 and 20 s: the 20-s rate is what the targets name, not yet timed on a device);
+# default 20 s, the run length the targets name, in LEGS legs, default 4, a line after each);
 # with RUN_TESTS=1 the device tests; last, where ncu can read the counters (NCU_SECONDS,
 # default 120), one Nsight Compute profile of a full wave's launch (33,792 members x
 # 0.005 s) with the warp states only and every stall reason (instruction fetch among them):
 # why 4x the warps gave 1.41x. Outputs go to $OUT where it is set (wave.log, ncu_full.txt).
 # A regime map on the GPU (bench_regime_gpu.py: MAP_SECONDS, default 0 = skipped; MAP_RUNS
-# realizations a cell, default 4096, 4 cells: two batches of 8,192, so that the second's
-# launch can overlap the first's labels; MAP_DURATION simulated seconds, default 20) measures
-# what 2026-11-28 changed without a device: extensions and fate runs of few members on the
-# CPU, and the next batch launched while the last is labelled; it lists every device call
-# and CPU batch with its start and length. By the H200's wave rate the two launches take
-# about 80 s each. A second call can run it alone, within the session's 15 minutes after a
-# first default call (about 450 s): CHECK_SECONDS=0 NCU_SECONDS=0 MAP_SECONDS=330.
+# realizations a cell, default 2048, 4 cells: two batches of 8,192, so that the second's
+# launch can overlap the first's labels; MAP_DURATION simulated seconds, default 10)
+# measures the extensions and fate runs of few members on the CPU (measured 2026-11-28:
+# 530 members in 12.8 s on the host's 16 cores) and the next batch launched while the last is
+# labelled (not yet measured: one batch then); it prints every device call and CPU batch
+# with its start and length as it ends. A second call can run it alone, within the
+# session's 15 minutes after a first default call (about 450 s):
+# CHECK_SECONDS=0 NCU_SECONDS=0 MAP_SECONDS=300 bash benchmarks/device_check.sh .whl
+#
+# Measured 2026-11-28 (H100, two calls, 557 s and 150 s of the 15 minutes): 2 CPU threads
+# 229 member-s/s at 20 s; compiled in 30.2 s; GPU = CPU check 1.9e-8; one launch of a full
+# wave x 20 s (DURATIONS=20, no legs then) had not ended 245 s after it began (so under
+# 2,760 member-s/s, 138 twenty-second traj/s, 12x the 2 threads) and printed nothing: hence
+# LEGS. The map at MAP_RUNS=4096 did not end in 240 s; at 512 (second call,
+# CHECK_SECONDS=0 NCU_SECONDS=0 MAP_SECONDS=262 MAP_RUNS=512): 2,048 runs in 108.7 s,
+# 18.8 traj/s, 4.14x the 2-core process engine (PROFILE.md). A next session's first call can
+# be the default (about 300 s for the wave, then the profile), its second the map (above:
+# two batches of 8,192 x 10 s, about 60-90 s of launch each by these rates).
 #
 # Measured 2026-11-27 (H200, third session): after the host's quadratic set-up was fixed
 # (e7a316b), 33,792 members x 0.25 / 2 / 5 s ran at 1,073 / 2,231 / 2,954 member-seconds a
@@ -51,14 +62,14 @@ OUTDIR=${OUT:-/tmp}
 if [ "${CHECK_SECONDS:-330}" != 0 ]; then
     step "a full wave's rate by run length (bench_gpu_wave.py, CHECK_SECONDS)"
     timeout -k 5 "${CHECK_SECONDS:-330}" python3 benchmarks/bench_gpu_wave.py \
-        --durations "${DURATIONS:-2,20}" 2>&1 | tee "$OUTDIR/wave.log"
+        --durations "${DURATIONS:-20}" --legs "${LEGS:-4}" 2>&1 | tee "$OUTDIR/wave.log"
     echo "exit $?"
 fi
 
 if [ "${MAP_SECONDS:-0}" != 0 ]; then
     step "a regime map on the GPU (bench_regime_gpu.py, MAP_SECONDS)"
     timeout -k 5 "$MAP_SECONDS" python3 benchmarks/bench_regime_gpu.py \
-        --realizations "${MAP_RUNS:-4096}" --duration "${MAP_DURATION:-20}" --reference 4 \
+        --realizations "${MAP_RUNS:-2048}" --duration "${MAP_DURATION:-10}" --reference 4 \
         2>&1 | tee "$OUTDIR/map.log"
     echo "exit $?"
 fi
