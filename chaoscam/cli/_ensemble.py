@@ -31,15 +31,14 @@ from ._ensemble_parts import (
     check_outputs,
     commit_parts,
     config_digest,
-    fingerprint,
     finished_run,
     manifest,
     output_paths,
     part_done,
     readable_table,
     recorded_config,
-    write_table,
 )
+from ._ensemble_run import Part, PartRun, backend_for, both_phases
 from ._options import add_run_options, path_arg
 
 __all__ = ["register"]
@@ -136,10 +135,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _run_locked(args: argparse.Namespace) -> int:
     from .._checks import COUNT_MAX, whole
-    from .._ensemble_verdicts import classify_ensemble
     from .._provenance import code_identity
-    from ..integrate import simulate_ensemble
-    from ..integrate._gpu import GPUFallbackWarning
     from ..sweep._checkpoint import (
         differences,
         discard_checkpoint,
@@ -247,71 +243,43 @@ def _run_locked(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     done_before = 0
     bar = _bar(args, args.members)
-    batch = _progress_batch(args.backend)
-    noticed = False  # the GPU fallback notice is printed once, on one line
+    noticed = []  # the GPU fallback notice is printed once, on one line
     last = args.first + args.members
     starts = range(args.first, last, chunk)
     names = ("members", "sections") + (("impacts",) if args.keep_impacts else ())
-    for start in starts:
-        stop = min(start + chunk, last)
-        if part_done(parts, start, names):
-            done_before += stop - start
-            bar.update(stop - start)
-            continue
-        t_chunk = time.perf_counter()
-        bar.set_description(_SIMULATING, refresh=False)
-        try:
-            with warnings.catch_warnings(record=True) as caught:
-                warnings.simplefilter("always", GPUFallbackWarning)
-                ens = simulate_ensemble(
-                    params,
-                    range(start, stop),
-                    seed=args.seed,
-                    duration=duration,
-                    transient=transient,
-                    backend=args.backend,
-                    keep_impacts=args.keep_impacts,
-                    tangent=args.classify,
-                    resumable=args.classify,  # undetermined members are continued
-                    batch=batch,
-                    progress=bar.update,
-                )
-                if args.classify:
-                    ens = classify_ensemble(ens, params, progress=_extending(bar))
-            for w in caught:
-                if issubclass(w.category, GPUFallbackWarning) and not noticed:
-                    print(f"chaoscam: {w.message}", file=sys.stderr, flush=True)
-                    noticed = True
-                elif not issubclass(w.category, GPUFallbackWarning) and str(w.message) not in said:
-                    warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-        except KeyboardInterrupt:
-            bar.close()
-            kept = start - args.first  # the parts before this one, all finished
-            print(
-                f"chaoscam: {stop_word()}; {kept} of {args.members} members are finished and "
-                f"kept in {parts} (parts of {chunk}): run the same command with --resume to "
-                "continue",
-                file=sys.stderr,
-            )
-            return 130  # the one message (the sweeps' rule); 143 after SIGTERM
-        offset = start - args.first
-        tables = {"members": ens.members, "sections": ens.sections, "impacts": ens.impacts}
-        files = {}
-        for name in names:
-            table = tables[name].assign(member=tables[name]["member"] + offset)
-            path = parts / f"{start:012d}.{name}.parquet"
-            write_table(table, path)  # atomic, with the checksums of chaoscam._parquet
-            files[name] = fingerprint(path)
-        atomic_text(
-            parts / f"{start:012d}.done",
-            json.dumps({"files": files, "settings": ens.settings}, default=str),
+    run = PartRun(args, params, duration, transient, parts, names, bar,
+                  _progress_batch(args.backend))  # fmt: skip
+    backend = backend_for(args.backend)  # on a GPU: the next part launched while one is labelled
+    pending = []
+    try:
+        for start in starts:
+            stop = min(start + chunk, last)
+            if part_done(parts, start, names):
+                done_before += stop - start
+                run.update(stop - start)
+                continue
+            bar.set_description(_SIMULATING, refresh=False)
+            pending.append(backend.submit(both_phases, Part(start, stop, run)))
+            while len(pending) > 1 or (pending and pending[0].done()):
+                _said(backend.result(pending.pop(0)), args, bar, said, noticed)
+        while pending:
+            _said(backend.result(pending.pop(0)), args, bar, said, noticed)
+    except KeyboardInterrupt:
+        backend.cancel(pending)
+        backend.close()  # the labels under way stop at their next compiled call or member
+        bar.close()
+        # a part's marker is written last: parts finished here, on the labelling thread,
+        # or by an earlier run
+        kept = sum(min(s + chunk, last) - s for s in starts if (parts / f"{s:012d}.done").exists())
+        print(
+            f"chaoscam: {stop_word()}; {kept} of {args.members} members are finished and "
+            f"kept in {parts} (parts of {chunk}): run the same command with --resume to "
+            "continue",
+            file=sys.stderr,
         )
-        if not args.quiet:
-            bar.write(
-                f"members {start}..{stop - 1}: {ens.settings['backend']}, "
-                f"{(stop - start) / (time.perf_counter() - t_chunk):.1f} members/s"
-                + (" with their labels" if args.classify else "")
-            )
+        return 130  # the one message (the sweeps' rule); 143 after SIGTERM
+    finally:
+        backend.close()
     bar.close()
 
     members = commit_parts(parts, starts, names, out, result, ours, config)
@@ -376,6 +344,27 @@ def _chunk(args: argparse.Namespace, parts: Path) -> int:
     return GPU_CHUNK if runs_on_gpu(args.backend) else CPU_CHUNK
 
 
+def _said(done, args, bar, said: set[str], noticed: list) -> None:
+    """What a written part says on the terminal (the command's thread, in the parts'
+    order): its recorded warnings (the GPU fallback once, on one line; not those said before
+    the run) and its rate."""
+    from ..integrate._gpu import GPUFallbackWarning
+
+    for w in done.caught:
+        if issubclass(w.category, GPUFallbackWarning):
+            if not noticed:
+                print(f"chaoscam: {w.message}", file=sys.stderr, flush=True)
+                noticed.append(True)
+        elif str(w.message) not in said:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if not args.quiet:
+        bar.write(
+            f"members {done.start}..{done.stop - 1}: {done.backend}, "
+            f"{(done.stop - done.start) / (time.perf_counter() - done.began):.1f} members/s"
+            + (" with their labels" if args.classify else "")
+        )
+
+
 def _settled(backend: str, members: int) -> str:
     """The backend every part runs on: ``auto`` settled once for the whole run, by its size
     (:func:`chaoscam.integrate._gpu.by_size`) and the GPU here, so that a short last part
@@ -419,22 +408,6 @@ def _bar(args, total: int):
         smoothing=0.1,
         mininterval=0.5,
     )
-
-
-def _extending(bar):
-    """classify_ensemble's progress on ``bar``: an extension round adds its members to the
-    total and says what it runs; its batches advance the bar."""
-
-    def progress(n: int, extending: int = 0, recorded_s: float | None = None) -> None:
-        if extending:
-            bar.total += extending
-            bar.set_description(
-                f"ensemble (extending {extending} undetermined to {recorded_s:g} s recorded)",
-                refresh=False,
-            )
-        bar.update(n)
-
-    return progress
 
 
 def _check_budget(
