@@ -164,18 +164,29 @@ def stop_word() -> str:
     return "terminated" if _SIGTERM["seen"] else "interrupted"
 
 
+class interrupts_ignored:
+    """A context in which a second Ctrl-C is ignored (in the main thread, where handlers
+    live): a command that stops says once what it kept, and waits for its threads to stop.
+    A class, not ``contextlib``: this module is imported at every start."""
+
+    def __enter__(self) -> None:
+        import signal
+        import threading
+
+        main_thread = threading.current_thread() is threading.main_thread()
+        self._before = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
+
+    def __exit__(self, *exc) -> None:
+        import signal
+
+        if self._before is not None:
+            signal.signal(signal.SIGINT, self._before)
+
+
 def _interrupted() -> int:
     """Say "interrupted" (or "terminated") once; a second Ctrl-C meanwhile is ignored."""
-    import signal
-    import threading
-
-    main_thread = threading.current_thread() is threading.main_thread()
-    before = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
-    try:
+    with interrupts_ignored():
         print(f"chaoscam: {stop_word()}", file=sys.stderr)
-    finally:
-        if before is not None:
-            signal.signal(signal.SIGINT, before)
     return 130
 
 

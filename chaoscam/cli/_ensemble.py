@@ -144,7 +144,7 @@ def _run_locked(args: argparse.Namespace) -> int:
         remove_leftovers,
     )
     from ..sweep._common import run_settings
-    from . import UsageError, parse_assignments, stop_word
+    from . import UsageError, interrupts_ignored, parse_assignments, stop_word
 
     out: Path = args.out
     members_n = whole("--members", args.members, low=1)
@@ -265,8 +265,9 @@ def _run_locked(args: argparse.Namespace) -> int:
         while pending:
             _said(backend.result(pending.pop(0)), args, bar, said, noticed)
     except KeyboardInterrupt:
-        backend.cancel(pending)
-        backend.close()  # the labels under way stop at their next compiled call or member
+        with interrupts_ignored():  # a second Ctrl-C: the labels under way stop all the same
+            backend.cancel(pending)
+            backend.close()  # they stop at their next compiled call or member
         bar.close()
         # a part's marker is written last: parts finished here, on the labelling thread,
         # or by an earlier run

@@ -125,7 +125,11 @@ def test_a_ctrl_c_in_a_launch_stops_the_labels_and_resumes(
 
 def test_a_stop_reaches_the_labels_under_way(device, monkeypatch, tmp_path, capsys):
     """Ctrl-C while the labelling thread is in a part's first verdict: the labelling stops
-    before the next member (StopRequested), not at the part's end, so nothing is kept."""
+    before the next member (StopRequested), not at the part's end, so nothing is kept; a
+    second Ctrl-C while it stops is ignored, and the one message still counts what is kept."""
+    import os
+    import signal
+
     import chaoscam.integrate as integrate
     from chaoscam.sweep._pipeline import PipelineBackend
 
@@ -137,6 +141,7 @@ def test_a_stop_reaches_the_labels_under_way(device, monkeypatch, tmp_path, caps
         verdicts.append(threading.current_thread().name)
         labelling.set()
         assert cancelled.wait(60)  # the stop is asked while this member is labelled
+        os.kill(os.getpid(), signal.SIGINT)  # a second Ctrl-C while the labels stop
         return real_verdicts(*args, **kw)
 
     def simulate(*args, **kw):
@@ -156,5 +161,6 @@ def test_a_stop_reaches_the_labels_under_way(device, monkeypatch, tmp_path, caps
     out = tmp_path / "ens.parquet"
     assert main([*CLASSIFY, "--backend", "gpu", "--out", str(out)]) == 130
     assert verdicts == ["chaoscam-labels_0"]  # one member of the part's two, then the stop
-    assert "0 of 5 members are finished" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "0 of 5 members are finished" in err and err.count("interrupted") == 1
     assert not list((tmp_path / "ens.parts").glob("*.done"))
