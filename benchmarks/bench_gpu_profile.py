@@ -29,6 +29,7 @@ bench_gpu_wave.py measures a wave now).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import time
 
 from chaoscam import Params
@@ -68,21 +69,29 @@ class _Clock:
         return timed
 
 
-def measure(p, members, duration, room, layout, keep_impacts=False):
-    """(wall time, clock, ensemble) of one GPU ensemble with this room and layout."""
+@contextlib.contextmanager
+def clocked():
+    """A :class:`_Clock` on ``_gpu.drive_members`` while inside (restored on the way out)."""
     clock = _Clock()
     inner, _gpu.drive_members = _gpu.drive_members, clock.wrap(_gpu.drive_members)
+    try:
+        yield clock
+    finally:
+        _gpu.drive_members = inner
+
+
+def measure(p, members, duration, room, layout, keep_impacts=False):
+    """(wall time, clock, ensemble) of one GPU ensemble with this room and layout."""
     before, _ensemble._ROOM["gpu"] = _ensemble._ROOM["gpu"], room
     order, _gpu.GPU_LAYOUT = _gpu.GPU_LAYOUT, layout
     try:
-        t0 = time.perf_counter()
-        ens = simulate_ensemble(
-            p, range(members), seed=1, duration=duration, backend="gpu", keep_impacts=keep_impacts
-        )
-        return time.perf_counter() - t0, clock, ens
+        with clocked() as clock:
+            t0 = time.perf_counter()
+            ens = simulate_ensemble(p, range(members), seed=1, duration=duration,
+                                    backend="gpu", keep_impacts=keep_impacts)  # fmt: skip
+            return time.perf_counter() - t0, clock, ens
     finally:
-        _gpu.drive_members, _ensemble._ROOM["gpu"] = inner, before
-        _gpu.GPU_LAYOUT = order
+        _ensemble._ROOM["gpu"], _gpu.GPU_LAYOUT = before, order
 
 
 def _compiled(p) -> list[str]:

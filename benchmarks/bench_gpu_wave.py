@@ -34,7 +34,7 @@ import time
 
 import numba
 from bench_gpu import max_diff, timed  # run from benchmarks/, as the scripts are
-from bench_gpu_profile import _Clock, measure
+from bench_gpu_profile import clocked, measure
 
 from chaoscam import Params
 from chaoscam.integrate import _ensemble, _gpu, extend_ensemble, simulate_ensemble
@@ -94,9 +94,7 @@ def _in_legs(p, members, duration, legs, cpu_rate) -> None:
     """One wave of ``duration`` in ``legs`` legs (module docstring), a line after each."""
     ends = [duration * (i + 1) / legs for i in range(legs)]
     total = 0.0
-    clock = _Clock()
-    inner, _gpu.drive_members = _gpu.drive_members, clock.wrap(_gpu.drive_members)
-    try:
+    with clocked() as clock:
         ens, start = None, 0.0
         for end in ends:
             t0 = time.perf_counter()
@@ -111,8 +109,6 @@ def _in_legs(p, members, duration, legs, cpu_rate) -> None:
             _report(f"{members:,} x {start:g}-{end:g} s (leg)", members * (end - start), wall,
                     clock.launch - before, clock.launches - launches, cpu_rate, ens)  # fmt: skip
             start = end
-    finally:
-        _gpu.drive_members = inner
     print(f"GPU: {members:,} x {duration:g} s in {legs} legs, {total:.1f} s = "
           f"{members * duration / total:,.0f} member-s/s", flush=True)  # fmt: skip
 
