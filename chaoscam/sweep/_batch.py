@@ -288,6 +288,7 @@ def run_plan(plan, eng: Engine, store, *, workers, scheduler, progress: bool, de
                 desc=desc,
                 pack=eng.pack,
                 pack_size=eng.pack_size,
+                spread=eng.task_threads if isinstance(backend, ThreadBackend) else 1,
             )
     finally:
         backend.close()

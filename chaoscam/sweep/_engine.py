@@ -111,6 +111,20 @@ def _next_task(queue: deque, source: Iterator[Any], pack, size: int):
     return pack(tuple(tasks)) if pack is not None else tasks[0]
 
 
+def _share(plan: Plan, saved: int, inflight: dict, size: int, spread: int) -> int:
+    """How many tasks the next pack takes when ``spread`` packs run at once: at most
+    ``size``, and at most the tasks not yet submitted over twice ``spread`` (guided
+    scheduling), so that a sweep of few tasks, or a sweep's last ones, keep every thread
+    busy instead of one thread running one large pack while the others wait. Measured on
+    2 cores: the quick report's small sweeps (3-11 values of 20 s, one pack each) ran on
+    one core."""
+    if spread <= 1:
+        return size
+    flying = sum(len(getattr(task, "tasks", (task,))) for task in inflight.values())
+    left = plan.total - saved - flying
+    return max(1, min(size, -(-left // (2 * spread))))
+
+
 def execute(
     plan: Plan,
     backend,
@@ -120,14 +134,17 @@ def execute(
     desc: str = "",
     pack=None,
     pack_size: int = 1,
+    spread: int = 1,
 ) -> None:
     """Run ``plan`` on ``backend``, storing every record in ``store``.
 
     Records already in ``store`` (a resumed checkpoint) are given to the plan first and not
     run again. With ``pack``, up to ``pack_size`` tasks travel as one (``pack(tasks)``, whose
     ``run`` returns their records in a list: the ensemble engine); the plan sees each record
-    as if its task ran alone. Raises :class:`SweepInterrupted` on Ctrl-C after saving what
-    finished.
+    as if its task ran alone. With ``spread`` > 1 (packs run that many at once, one a
+    thread), a pack takes fewer tasks as they run out (:func:`_share`); a member's record
+    does not depend on its pack. Raises :class:`SweepInterrupted` on Ctrl-C after saving
+    what finished.
     """
     size = pack_size if pack is not None else 1
     store.open()
@@ -149,7 +166,7 @@ def execute(
     try:
         while True:
             while len(inflight) < window:
-                task = _next_task(queue, source, pack, size)
+                task = _next_task(queue, source, pack, _share(plan, saved, inflight, size, spread))
                 if task is None:
                     break
                 inflight[backend.submit(run_task, task)] = task

@@ -87,6 +87,30 @@ def test_threads_and_batches_do_not_change_the_table(maps, monkeypatch):
     frames_equal(one.cells, maps["ensemble"].cells)
 
 
+def test_few_tasks_are_spread_over_every_thread(maps, monkeypatch):
+    """A sweep of fewer tasks than a batch holds runs them as several smaller batches, one
+    a thread at once (guided: at most the tasks left over twice the threads), not as one
+    batch on one thread while the other waits; the table is the same."""
+    import threading
+
+    monkeypatch.setattr(_batch, "batch_size", lambda *a, **k: 256)
+    real, sizes, names = _batch.run_batch, [], set()
+
+    def record(tasks, backend="cpu", extend_to=None):
+        sizes.append(len(tasks))
+        names.add(threading.current_thread().name)
+        return real(tasks, backend, extend_to)
+
+    monkeypatch.setattr(_batch, "run_batch", record)
+    spread = regime_map(XI, SIGMA, engine="ensemble", workers=2, **KW)
+    total = len(maps["ensemble"].realizations)
+    assert sum(sizes) == total and max(sizes) <= -(-total // 4) and len(names) == 2
+    frames_equal(spread.realizations, maps["ensemble"].realizations)
+    sizes.clear()
+    regime_map(XI, SIGMA, engine="ensemble", workers=1, **KW)
+    assert sizes == [total]  # one thread: nothing to spread, one batch
+
+
 def test_an_interrupted_ensemble_map_resumes_to_the_same_table(maps, tmp_path, monkeypatch):
     """Ctrl-C after the first batch saves it; --resume finishes to the whole table (one
     worker: the batches run one after another in this thread)."""
