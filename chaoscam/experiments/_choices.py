@@ -121,7 +121,7 @@ def open_choices(quick: bool, outdir: Path, workers, classify, hertz_tags: list[
         )  # fmt: skip
         runs[name] = first_ic(bif)
         if name != "xi":
-            figures.append((str(path), bif, _save(sweep_diagram(bif), outdir, stem)))
+            figures.append((str(path), bif, _save(outdir, stem, sweep_diagram, bif)))
     text = choices_finding(runs["J"], runs["y_O"], runs["friction_arm"], runs["xi"], hertz_tags)
     rows = pd.concat([runs[name].assign(what=name) for name in ("J", "y_O", "friction_arm")])
     return text + step_finding(rows, lambda r: f"{r.what} = {r.value:.3g}"), figures

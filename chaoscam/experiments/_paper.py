@@ -17,9 +17,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..report._figures import png_bytes, png_uri, response_figure
+from ..report._figures import response_figure
 from ..report._html import Comparison, FigureItem
 from . import _steps
+from ._drawing import draw, uri_of
+from ._paper_figures import fig3_figure, fig5_figure
 from ._sensitivity import SWEEP_FATE_S
 from ._store import stored
 
@@ -94,14 +96,12 @@ class FigureResult:
         return self.title or f"Fig. {self.number}"
 
 
-def _save(fig, outdir: Path, name: str) -> bytes:
-    """Render ``fig`` once and write it to ``outdir/name.png``; returns the PNG, which the
-    report embeds as it is (rendering is a fifth of a quick report's time: never twice)."""
-    from .._outputs import atomic_write_bytes
-
-    png = png_bytes(fig, dpi=110)
-    atomic_write_bytes(outdir / f"{name}.png", png)
-    return png
+def _save(outdir: Path, name: str, build, *args, **kwargs):
+    """The figure ``build(*args, **kwargs)`` rendered once to ``outdir/name.png``
+    (:func:`._drawing.draw`: its PNG, which the report embeds as it is, or within
+    ``chaoscam paper`` a drawing on the drawing thread that :func:`._drawing.settle`
+    collects at the stage's end)."""
+    return draw(outdir / f"{name}.png", build, *args, **kwargs)
 
 
 def _write(path: Path, write) -> None:
@@ -137,8 +137,6 @@ def _is_subsequence(wanted: list[str], seq: list[str]) -> bool:
 
 def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 3: the random contact-line length resampled every ``resample_dt`` (a time series)."""
-    from matplotlib.figure import Figure
-
     from .._simulate import simulate
     from ..model import Params
 
@@ -148,24 +146,15 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
     traj = simulate(p, duration=4.0 if quick else 20.0, seed=3)
     s = traj.series[["t", "l_lambda"]]
     _write(outdir / "fig3.csv", lambda tmp: s.to_csv(tmp, index=False))
-    fig = Figure(figsize=(9, 3.6), layout="constrained")
-    ax = fig.subplots()
-    ax.plot(s["t"], s["l_lambda"], lw=0.7, color="#0072B2", drawstyle="steps-post")
-    ax.axhline(mu, color="#D55E00", ls="--", lw=0.8, label=f"μ = {mu} m")
-    ax.set(
-        xlabel="time t [s]",
-        ylabel="contact line length l_λ [m]",
-        title=f"l_λ ~ N(μ, σ²) truncated at l_min, resampled every {p.resample_dt} s",
-    )
-    ax.legend(frameon=False)
-    png = _save(fig, outdir, "fig3")
+
+    png = _save(outdir, "fig3", fig3_figure, s, mu, p.resample_dt)
     draws = s["l_lambda"].to_numpy()[:: max(1, int(round(p.resample_dt / 1e-3)))]
     m, sd, n = float(draws.mean()), float(draws.std(ddof=1)), len(draws)
     res.figures.append(
         FigureItem(
             "fig3",
             "Fig. 3 — random contact-line length over time",
-            png_uri(png),
+            uri_of(png),
             f"Step plot of the line length l_lambda in m against time in s, around mu = {mu} m.",
             f"{n} draws: mean {m:.5f} m, standard deviation {sd:.5f} m "
             f"(set: μ = {mu}, σ = {sigma}; "
@@ -215,7 +204,7 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
         fate=SWEEP_FATE_S[quick],
         **stored(path := outdir / "fig4.parquet"),
     )
-    png = _save(sweep_diagram(bif), outdir, "fig4")
+    png = _save(outdir, "fig4", sweep_diagram, bif)
     res.bifurcations.append((str(path), bif, png))
     v = bif.verdicts[bif.verdicts["ic"] == 0].sort_values("value")
     labels = [
@@ -262,8 +251,6 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
 def fig5(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 5: fractal joint stiffness K_n against D for G ∈ {1e-9, 1e-10, 1e-11} m."""
-    from matplotlib.figure import Figure
-
     from ..model import ParameterError, Params, fractal_stiffness
 
     res = FigureResult(5)
@@ -279,23 +266,14 @@ def fig5(quick: bool, outdir: Path, workers=None) -> FigureResult:
             rows.append({"G": g, "D": float(d), "K_n": kn})
     df = pd.DataFrame(rows)
     _write(outdir / "fig5.csv", lambda tmp: df.to_csv(tmp, index=False))
-    fig = Figure(figsize=(8, 4.5), layout="constrained")
-    ax = fig.subplots()
-    for g, sub in df.groupby("G", sort=False):
-        ax.semilogy(sub["D"], sub["K_n"], label=f"G = {g:g} m")
-    ax.set(
-        xlabel="fractal dimension D [-]",
-        ylabel="normal stiffness K_n [N/m]",
-        title="Majumdar–Bhushan joint stiffness, eqs. (15)/(17)",
-    )
-    ax.legend(frameon=False)
-    png = _save(fig, outdir, "fig5")
+
+    png = _save(outdir, "fig5", fig5_figure, df)
     hertz = p.stiffness_at(p.l_lambda)
     res.figures.append(
         FigureItem(
             "fig5",
             "Fig. 5 — fractal stiffness against D",
-            png_uri(png),
+            uri_of(png),
             "Three curves of K_n in N/m (log scale) against D from 1.36 to 1.56, one per G.",
             f"Table 1 values for E, k, φ, A_r. For scale, the Hertz line stiffness at "
             f"l_λ = {p.l_lambda} m is {hertz:.3g} N/m; the fractal values are "
@@ -352,7 +330,7 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
             workers=workers,
             **stored(path),
         )
-        png = _save(sweep_diagram(bif, note=f"G = {g:g} m"), outdir, tag)
+        png = _save(outdir, tag, sweep_diagram, bif, note=f"G = {g:g} m")
         res.bifurcations.append((str(path), bif, png))
         counts = bif.verdicts["label"].value_counts().to_dict()
         found.append(f"G = {g:g} m (dt = {dt:g} s): " + _counts(counts))
@@ -399,7 +377,7 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
         workers=workers,
         **stored(path := outdir / "fig7-10.parquet"),
     )
-    png = _save(regime_map_figure(rm.cells, x="l_lambda", y="l_lambda_sigma"), outdir, "fig7-10")
+    png = _save(outdir, "fig7-10", regime_map_figure, rm.cells, x="l_lambda", y="l_lambda_sigma")
     res.regime_maps.append((str(path), rm, png))
     for mu in MU_PAPER:
         for sigma in (0.0, max(sigmas)):
@@ -408,7 +386,7 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
             )
             name = _fig7_trajectory(mu, sigma)
             _write(outdir / f"{name}.parquet", traj.to_parquet)
-            png = _save(response_figure(traj, title=f"μ = {mu} m, σ = {sigma} m"), outdir, name)
+            png = _save(outdir, name, response_figure, traj, title=f"μ = {mu} m, σ = {sigma} m")
             res.trajectories.append((str(outdir / f"{name}.parquet"), traj, png))
     c = rm.cells.set_index(["l_lambda", "l_lambda_sigma"])
 

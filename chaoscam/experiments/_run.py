@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ._drawing import drawing, settle
 from ._paper import (
     FIGURES,
     FULL_EXTEND_TO,
@@ -183,23 +184,26 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
     results = []
     failed: list[str] = []
     ran = set()
-    for stage, fn in enumerate(funcs, 1):
-        t0 = time.perf_counter()
-        title = STAGE_TITLES.get(stages[fn], fn.__name__)
-        say(f"[{stage}/{len(funcs)}] {title} ...")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
+    # Each stage's figures are drawn on one thread while its next sweep runs (._drawing);
+    # a stage ends when they are drawn, and a drawing's error fails its stage.
+    with drawing(), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        for stage, fn in enumerate(funcs, 1):
+            t0 = time.perf_counter()
+            title = STAGE_TITLES.get(stages[fn], fn.__name__)
+            say(f"[{stage}/{len(funcs)}] {title} ...")
             try:
                 r = fn(quick, outdir, workers=workers)
+                settle(r)
             except Exception as err:  # a figure that fails is reported, not hidden
                 failed.append(f"{title}: failed with {type(err).__name__}: {err}")
                 parts.missing.append(failed[-1])
                 say(f"[{stage}/{len(funcs)}] {failed[-1]}")
                 continue
-        r.seconds = time.perf_counter() - t0
-        ran.add(fn)
-        say(f"[{stage}/{len(funcs)}] {title}: {r.seconds:.0f} s")
-        results.append(r)
+            r.seconds = time.perf_counter() - t0
+            ran.add(fn)
+            say(f"[{stage}/{len(funcs)}] {title}: {r.seconds:.0f} s")
+            results.append(r)
     audit, audit_s = _audit_stage(results, quick, workers, say, parts)
     total = time.perf_counter() - t_all
     done = [n for n in wanted if FIGURES[n] in ran]

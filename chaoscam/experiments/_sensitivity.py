@@ -300,7 +300,6 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     "Sensitivity"); ``classify`` as for the sweeps (the report's quick run caps the
     extension of undetermined runs)."""
     from ..model import Params
-    from ..report._figures import png_uri
     from ..report._sweep_figures import (
         SETTLED_MARK,
         TRANSIENT_MARK,
@@ -308,12 +307,13 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         sweep_diagram,
     )
     from ..sweep import Axis, bifurcation, regime_map
+    from ._drawing import uri_of
     from ._paper import FigureResult, _save
 
     res = FigureResult(0, title="Sensitivity (why the paper differs)")
     # 1. stiffness
     sweeps = _stiffness(quick, outdir, workers, classify)
-    png_k = _save(_stiffness_figure(sweeps), outdir, "sensitivity-stiffness")
+    png_k = _save(outdir, "sensitivity-stiffness", _stiffness_figure, sweeps)
     (bif_k, path_k, k_yf), (bif_h, path_h, k_h) = sweeps
     yf, hertz = (
         first_ic(b).assign(K_n=lambda f, k=k: f["value"].map(k)).sort_values("K_n")
@@ -325,7 +325,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         FigureItem(
             "sensitivity-stiffness",
             "Sensitivity to the contact stiffness",
-            png_uri(png_k),
+            uri_of(png_k),
             "Section angle against contact stiffness on a log axis, coloured by verdict, "
             "with the paper's stiffness range shaded.",
             f"{len(yf)} stiffnesses through Y_f and {len(hertz)} through l_λ across the "
@@ -336,9 +336,9 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         )
     )
     res.bifurcations.append(
-        (str(path_k), bif_k, _save(sweep_diagram(bif_k), outdir, "sensitivity-yf"))
+        (str(path_k), bif_k, _save(outdir, "sensitivity-yf", sweep_diagram, bif_k))
     )
-    png_h = _save(sweep_diagram(bif_h), outdir, "sensitivity-hertz")
+    png_h = _save(outdir, "sensitivity-hertz", sweep_diagram, bif_h)
     res.bifurcations.append((str(path_h), bif_h, png_h))
     # 2. restitution
     bif_x = bifurcation(
@@ -351,7 +351,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         fate=FATE_S[quick],
         **stored(path_x := outdir / "sensitivity-xi.parquet"),
     )
-    png_x = _save(sweep_diagram(bif_x), outdir, "sensitivity-xi")
+    png_x = _save(outdir, "sensitivity-xi", sweep_diagram, bif_x)
     res.bifurcations.append((str(path_x), bif_x, png_x))
     v_x = first_ic(bif_x)
     res.why.append(
@@ -379,7 +379,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         fate=FATE_S[quick],
         **stored(path_m := outdir / "sensitivity-omega-xi.parquet"),
     )
-    png_m = _save(regime_map_figure(rm.cells, x="omega", y="xi"), outdir, "sensitivity-omega-xi")
+    png_m = _save(outdir, "sensitivity-omega-xi", regime_map_figure, rm.cells, x="omega", y="xi")
     res.regime_maps.append((str(path_m), rm, png_m))
     cells = rm.cells
     tags = pd.Series(

@@ -192,9 +192,10 @@ def test_data_files_are_exactly_what_the_figures_write(tmp_path, monkeypatch, nu
     """data_files (what `paper` checks before the work) lists every file the figure script
     (0: the sensitivity stage) writes, and nothing it does not (runs shrunk, PNGs not drawn)."""
     from chaoscam.experiments import _paper
+    from chaoscam.report import _figures
 
     _shrink_the_runs(monkeypatch)
-    monkeypatch.setattr(_paper, "png_bytes", lambda fig, dpi=None: b"\x89PNG")
+    monkeypatch.setattr(_figures, "png_bytes", lambda fig, dpi=None: b"\x89PNG")
     stage = _paper._sensitivity_stage if number == _paper.SENSITIVITY else _paper.FIGURES[number]
     res = stage(True, tmp_path, workers=1)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(_paper.data_files(number))
@@ -282,7 +283,7 @@ def test_each_figure_is_rendered_once_and_the_report_embeds_its_file(tmp_path, m
 
     import chaoscam.report._classify
     from chaoscam import classify_trajectory
-    from chaoscam.experiments import _paper, run_paper
+    from chaoscam.experiments import run_paper
     from chaoscam.report import _figures, _html
 
     _shrink_the_runs(monkeypatch)
@@ -294,7 +295,7 @@ def test_each_figure_is_rendered_once_and_the_report_embeds_its_file(tmp_path, m
         rendered.append(b"\x89PNG-%d" % len(rendered))
         return rendered[-1]
 
-    for module in (_paper, _html, _figures):
+    for module in (_html, _figures):  # the report's own, and the stages' drawing thread's
         monkeypatch.setattr(module, "png_bytes", stub)
     out = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 4, 5, 7]).path
     files = {p.name: p.read_bytes() for p in (tmp_path / "paper-data").glob("*.png")}
