@@ -119,7 +119,9 @@ def run_paper(
     replaced only with ``force``. With ``echo`` (the command line), each stage's start and
     duration go to stderr and the findings, figure by figure, to stdout. A stage that raises
     is reported in the report's "What is missing" and in :attr:`PaperRun.failed`; the
-    others still run.
+    others still run. Where the RK4 kernel is not compiled yet (a fresh install), a second
+    process compiles some of its callees meanwhile
+    (:func:`chaoscam.integrate._precompile.start_beside`).
 
     ``resume`` continues an interrupted report in the same folder: each sweep whose output
     is there and finished (same configuration) is read back, the one under way finishes from
@@ -132,6 +134,7 @@ def run_paper(
     what failed, goes to ``NAME.failed.html`` beside it (:attr:`PaperRun.path`).
     """
     from .._outputs import OutputLock
+    from ..integrate._precompile import start_beside
     from ..sweep._backends import local_workers
     from ._store import store_mode
 
@@ -152,8 +155,15 @@ def run_paper(
     with OutputLock(out.parent / "paper-data", "folder (--out OTHER/paper.html)"):
         outdir = check_paper_outputs(out, figures, force=force)  # again, under the lock
         outdir.mkdir(exist_ok=True)
-        with store_mode(force=force, resume=resume):
-            return _run_stages(quick, out, outdir, figures, workers, command, echo, force)
+        helper = start_beside()  # a fresh install: half the kernel's compilation beside us
+        try:
+            with store_mode(force=force, resume=resume):
+                return _run_stages(quick, out, outdir, figures, workers, command, echo, force)
+        finally:
+            if helper is not None and helper.poll() is None:
+                helper.terminate()
+            if helper is not None:
+                helper.wait()
 
 
 def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> PaperRun:
