@@ -146,7 +146,6 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
     traj = simulate(p, duration=4.0 if quick else 20.0, seed=3)
     s = traj.series[["t", "l_lambda"]]
     _write(outdir / "fig3.csv", lambda tmp: s.to_csv(tmp, index=False))
-
     png = _save(outdir, "fig3", fig3_figure, s, mu, p.resample_dt)
     draws = s["l_lambda"].to_numpy()[:: max(1, int(round(p.resample_dt / 1e-3)))]
     m, sd, n = float(draws.mean()), float(draws.std(ddof=1)), len(draws)
@@ -266,7 +265,6 @@ def fig5(quick: bool, outdir: Path, workers=None) -> FigureResult:
             rows.append({"G": g, "D": float(d), "K_n": kn})
     df = pd.DataFrame(rows)
     _write(outdir / "fig5.csv", lambda tmp: df.to_csv(tmp, index=False))
-
     png = _save(outdir, "fig5", fig5_figure, df)
     hertz = p.stiffness_at(p.l_lambda)
     res.figures.append(

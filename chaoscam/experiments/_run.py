@@ -160,9 +160,8 @@ def run_paper(
             with store_mode(force=force, resume=resume):
                 return _run_stages(quick, out, outdir, figures, workers, command, echo, force)
         finally:
-            if helper is not None and helper.poll() is None:
-                helper.terminate()
             if helper is not None:
+                helper.terminate()  # nothing once it has ended
                 helper.wait()
 
 
