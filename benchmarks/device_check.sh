@@ -76,7 +76,7 @@ fi
 
 if [ "${RUN_TESTS:-0}" = 1 ]; then
     step "device tests (tests/integrate/test_gpu.py -m gpu)"
-    timeout -k 5 300 python3 -m pytest -q -p no:cacheprovider -m gpu tests/integrate/test_gpu.py
+    timeout -k 5 300 python3 -m pytest -q -p no:cacheprovider -o addopts= -m gpu tests/integrate/test_gpu.py
     echo "exit $?"
 fi
 
