@@ -3,10 +3,11 @@
 A stage hands each figure to :func:`draw` as the function that builds it and its arguments.
 Inside :func:`drawing` (what :func:`._run.run_paper` opens around its stages) the figure is
 built, rendered and written on one drawing thread, and :func:`draw` returns a
-:class:`Drawing` at once, so the stage goes on to its next sweep meanwhile; :func:`settle`
-swaps every drawing of a stage's result for its PNG at the stage's end, raising a drawing's
-error there (the stage then fails, as if it had drawn the figure itself). Outside it (the
-``analyses/`` scripts, the tests) :func:`draw` draws at once and returns the PNG.
+:class:`Drawing` at once, so the stage goes on to its next sweep meanwhile, and the next
+stage after it; :func:`settle` swaps every drawing of a stage's result for its PNG once every
+stage has run, raising a drawing's error there (the stage then fails, as if it had drawn the
+figure itself). Outside it (the ``analyses/`` scripts, the tests) :func:`draw` draws at once
+and returns the PNG.
 
 All of a report's Matplotlib work goes through :func:`draw`, so one thread does it all:
 Matplotlib is not thread-safe, and the figures are built there too, not only rendered.

@@ -100,7 +100,7 @@ def _save(outdir: Path, name: str, build, *args, **kwargs):
     """The figure ``build(*args, **kwargs)`` rendered once to ``outdir/name.png``
     (:func:`._drawing.draw`: its PNG, which the report embeds as it is, or within
     ``chaoscam paper`` a drawing on the drawing thread that :func:`._drawing.settle`
-    collects at the stage's end)."""
+    collects once every stage has run)."""
     return draw(outdir / f"{name}.png", build, *args, **kwargs)
 
 

@@ -193,8 +193,16 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
     results = []
     failed: list[str] = []
     ran = set()
-    # Each stage's figures are drawn on one thread while its next sweep runs (._drawing);
-    # a stage ends when they are drawn, and a drawing's error fails its stage.
+    # Each stage's figures are drawn on one thread while the stages go on (._drawing): a
+    # stage's seconds are its own work, its figures are settled once every stage has run, and
+    # a drawing's error fails its stage then.
+    drawn = []
+
+    def fail(stage: int, title: str, err: Exception) -> None:  # reported, not hidden
+        failed.append(f"{title}: failed with {type(err).__name__}: {err}")
+        parts.missing.append(failed[-1])
+        say(f"[{stage}/{len(funcs)}] {failed[-1]}")
+
     with drawing(), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         for stage, fn in enumerate(funcs, 1):
@@ -203,15 +211,19 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
             say(f"[{stage}/{len(funcs)}] {title} ...")
             try:
                 r = fn(quick, outdir, workers=workers)
-                settle(r)
-            except Exception as err:  # a figure that fails is reported, not hidden
-                failed.append(f"{title}: failed with {type(err).__name__}: {err}")
-                parts.missing.append(failed[-1])
-                say(f"[{stage}/{len(funcs)}] {failed[-1]}")
+            except Exception as err:
+                fail(stage, title, err)
                 continue
             r.seconds = time.perf_counter() - t0
-            ran.add(fn)
             say(f"[{stage}/{len(funcs)}] {title}: {r.seconds:.0f} s")
+            drawn.append((stage, title, fn, r))
+        for stage, title, fn, r in drawn:
+            try:
+                settle(r)
+            except Exception as err:
+                fail(stage, title, err)
+                continue
+            ran.add(fn)
             results.append(r)
     audit, audit_s = _audit_stage(results, quick, workers, say, parts)
     total = time.perf_counter() - t_all

@@ -88,3 +88,30 @@ def test_a_stage_whose_figure_fails_to_draw_is_reported_failed(tmp_path, monkeyp
     text = run.path.read_text()
     assert "Fig. 3 — random contact-line length over time" in text and "no ink" in text
     assert (tmp_path / "paper-data" / "fig3.png").exists() and _drawing_threads() == []
+
+
+def test_a_stages_figures_are_drawn_while_the_next_stage_runs(tmp_path, monkeypatch):
+    """Fig. 3's figure is still being built when Fig. 5's stage starts: its build waits for
+    an event that stage sets, and it sees it (a stage no longer waits for its own figures,
+    they are settled once every stage has run); both figures reach the report."""
+    from chaoscam.experiments import _paper, run_paper
+    from chaoscam.report import _figures
+
+    real_png, real_fig5 = _figures.png_bytes, _paper.FIGURES[5]
+    next_stage, seen = threading.Event(), []
+
+    def fig3_waits(fig, dpi=96):
+        if tuple(fig.get_size_inches()) == (9.0, 3.6):  # Fig. 3's size
+            seen.append(next_stage.wait(20))
+        return real_png(fig, dpi=dpi)
+
+    def fig5_starts(*args, **kwargs):
+        next_stage.set()
+        return real_fig5(*args, **kwargs)
+
+    monkeypatch.setattr(_figures, "png_bytes", fig3_waits)
+    monkeypatch.setitem(_paper.FIGURES, 5, fig5_starts)
+    run = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 5])
+    assert seen == [True] and run.failed == ()
+    assert (tmp_path / "paper-data" / "fig3.png").exists()
+    assert (tmp_path / "paper-data" / "fig5.png").exists() and _drawing_threads() == []
