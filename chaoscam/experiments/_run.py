@@ -121,7 +121,7 @@ def run_paper(
     is reported in the report's "What is missing" and in :attr:`PaperRun.failed`; the
     others still run. Where the RK4 kernel is not compiled yet (a fresh install), a second
     process compiles some of its callees meanwhile
-    (:func:`chaoscam.integrate._precompile.start_beside`).
+    (:func:`chaoscam.integrate._precompile.start_once`, at its first RK4 run).
 
     ``resume`` continues an interrupted report in the same folder: each sweep whose output
     is there and finished (same configuration) is read back, the one under way finishes from
@@ -134,7 +134,6 @@ def run_paper(
     what failed, goes to ``NAME.failed.html`` beside it (:attr:`PaperRun.path`).
     """
     from .._outputs import OutputLock
-    from ..integrate._precompile import start_beside
     from ..sweep._backends import local_workers
     from ._store import store_mode
 
@@ -155,14 +154,8 @@ def run_paper(
     with OutputLock(out.parent / "paper-data", "folder (--out OTHER/paper.html)"):
         outdir = check_paper_outputs(out, figures, force=force)  # again, under the lock
         outdir.mkdir(exist_ok=True)
-        helper = start_beside()  # a fresh install: half the kernel's compilation beside us
-        try:
-            with store_mode(force=force, resume=resume):
-                return _run_stages(quick, out, outdir, figures, workers, command, echo, force)
-        finally:
-            if helper is not None:
-                helper.terminate()  # nothing once it has ended
-                helper.wait()
+        with store_mode(force=force, resume=resume):
+            return _run_stages(quick, out, outdir, figures, workers, command, echo, force)
 
 
 def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> PaperRun:

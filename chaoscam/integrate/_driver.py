@@ -164,8 +164,16 @@ def members_kernel(c: np.ndarray):
 def alone_kernel(c: np.ndarray):
     """The compiled single-trajectory call for constants ``c``, without the GIL:
     :func:`run_alone_rk4` for the RK4 kernel, else :func:`run_alone`. Picking keeps the
-    adaptive kernel out of an RK4 process: compiling it costs a fresh install ~10 s."""
-    return run_alone_rk4 if _all_rk4(c) else run_alone
+    adaptive kernel out of an RK4 process: compiling it costs a fresh install ~10 s.
+    Before the RK4 kernel is compiled or loaded in this process, a fresh install's second
+    compiling process is started (:mod:`._precompile`: the first run 25 s -> 15 s)."""
+    if not _all_rk4(c):
+        return run_alone
+    if not run_alone_rk4.signatures:  # its first call in this process: it will compile
+        from ._precompile import start_once
+
+        start_once()
+    return run_alone_rk4
 
 
 def fork_safe_threads() -> None:

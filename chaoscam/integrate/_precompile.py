@@ -1,5 +1,9 @@
 """The RK4 kernel's first compilation on two cores: a second process compiles some callees.
 
+Started by the first RK4 run of a process (:func:`start_once`, from
+:func:`._driver.alone_kernel`) where numba's cache lacks these callees: the first
+``simulate``, sweep, ensemble or ``chaoscam paper`` of a fresh install.
+
 numba compiles :func:`._kernel.run_chunk` once per install (``cache=True``), in one process,
 on one core: 22-25 s on the 2-core machine, most of it numba's own Python (type inference
 and lowering of each callee, each compiled on its own as the caller's typing reaches it),
@@ -21,11 +25,13 @@ the kernel compiles them itself, as without this module.
 
 from __future__ import annotations
 
+import atexit
 import os
 import subprocess
 import sys
+import threading
 
-__all__ = ["start_beside"]
+__all__ = ["start_beside", "start_once"]
 
 
 def _callees():
@@ -75,8 +81,52 @@ def start_beside() -> subprocess.Popen | None:
     )
 
 
+_started = False
+_start_lock = threading.Lock()
+
+
+def start_once() -> None:
+    """:func:`start_beside` the first time a process asks (the first RK4 run, through
+    :func:`._driver.alone_kernel`), in a process that is not a sweep's worker (those fork or
+    spawn by the dozen: one second process is enough); the second process ends by itself,
+    and is ended with this one at the latest."""
+    global _started
+    with _start_lock:
+        if _started:
+            return
+        _started = True
+    import multiprocessing
+
+    if multiprocessing.parent_process() is not None:
+        return
+    proc = start_beside()
+    if proc is not None:
+        atexit.register(_end, proc)
+
+
+def _end(proc: subprocess.Popen) -> None:
+    proc.terminate()  # nothing once it has ended
+    proc.wait()
+
+
+def _end_with_parent() -> None:
+    """End this process (at once, in a thread beside the compilation) when the process that
+    started it ends: a run killed on a fresh install leaves no compiler behind."""
+    import time
+
+    parent = os.getppid()
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.1)
+        os._exit(0)
+
+    threading.Thread(target=watch, name="chaoscam-parent-watch", daemon=True).start()
+
+
 def main() -> None:
     """Compile each callee of :func:`_callees` into numba's cache, in order."""
+    _end_with_parent()
     for dispatcher, signature in _callees():
         dispatcher.compile(signature)
 

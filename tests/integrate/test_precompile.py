@@ -60,3 +60,83 @@ def test_the_second_process_starts_only_where_a_callee_is_not_cached(monkeypatch
     monkeypatch.setattr(_precompile, "_cached", lambda d: False)
     proc = _precompile.start_beside()
     assert proc is not None and proc.wait(timeout=120) == 0
+
+
+def test_start_once_starts_one_second_process_a_process_and_none_in_a_worker(monkeypatch):
+    """The first ask starts it, the next asks do not (however many threads ask); a sweep's
+    worker process (one with a parent) starts none."""
+    import multiprocessing
+
+    started = []
+    monkeypatch.setattr(_precompile, "start_beside", lambda: started.append(1))
+    monkeypatch.setattr(_precompile, "_started", False)
+    for _ in range(3):
+        _precompile.start_once()
+    assert started == [1]
+    monkeypatch.setattr(_precompile, "_started", False)
+    monkeypatch.setattr(multiprocessing, "parent_process", lambda: object())
+    _precompile.start_once()
+    assert started == [1]
+
+
+@pytest.mark.slow
+def test_a_fresh_installs_first_simulate_starts_the_second_process(tmp_path):
+    """In an empty cache a plain ``simulate`` (no ``chaoscam paper``) starts the second
+    process once, before the kernel compiles, and its run is the same bits as one without
+    it. About 35 s: two compilations from empty caches."""
+    code = (
+        "import chaoscam.integrate._precompile as p\n"
+        "calls = []\n"
+        "real = p.start_beside\n"
+        "p.start_beside = lambda: calls.append(real()) or calls[-1]\n"
+        + PROBE.split("for d, sig")[0]
+        + "chaoscam.simulate(duration=0.5)\n"
+        "print(len(calls), calls[0] is not None)\n"
+    )
+    helped = _run(code, tmp_path / "a", "-c").splitlines()
+    env_off = PROBE.split("for d, sig")[0]
+    alone = _run(
+        "import chaoscam.integrate._precompile as p\np.start_once = lambda: None\n" + env_off,
+        tmp_path / "b",
+        "-c",
+    ).splitlines()
+    assert helped[-1] == "1 True" and helped[0] == alone[0]
+
+
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` is there and not a zombie (Linux /proc)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except (FileNotFoundError, ProcessLookupError):
+        return False
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self/stat"), reason="needs Linux /proc")
+def test_the_second_process_ends_when_its_parent_is_killed(tmp_path):
+    """A run SIGKILLed on a fresh install leaves no compiler behind: the second process,
+    compiling into an empty cache (about 10 s of work), ends within 3 s of its parent."""
+    import signal
+    import time
+
+    code = (
+        "import subprocess, sys, time\n"
+        "p = subprocess.Popen([sys.executable, '-m', 'chaoscam.integrate._precompile'])\n"
+        "print(p.pid, flush=True)\n"
+        "time.sleep(60)\n"
+    )
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    parent = subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE)
+    helper = int(parent.stdout.readline())
+    try:
+        time.sleep(1.5)  # importing numba, or compiling
+        assert _running(helper)
+        parent.kill()
+        parent.wait(timeout=10)
+        t0 = time.monotonic()
+        while _running(helper) and time.monotonic() - t0 < 3.0:
+            time.sleep(0.05)
+        assert not _running(helper)
+    finally:
+        if _running(helper):
+            os.kill(helper, signal.SIGKILL)
