@@ -7,17 +7,23 @@ import sys
 import pytest
 
 from chaoscam.integrate import _precompile
+from tests.sweep.test_sw_signals import _alive
 
-# A run's last section point, printed exactly, and how each of the second process's callees
-# came to this process: numba's cache hits and misses for it.
-PROBE = """
+# A run's last section point, printed exactly; PROBE adds how each of the second process's
+# callees came to this process: numba's cache hits and misses for it.
+LAST_POINT = """
 import chaoscam
-from chaoscam.integrate._precompile import _callees
 traj = chaoscam.simulate(duration=2.0, seed=3)
 print(repr(tuple(traj.section[["theta_f", "omega_f"]].iloc[-1])))
+"""
+PROBE = (
+    LAST_POINT
+    + """
+from chaoscam.integrate._precompile import _callees
 for d, sig in _callees():
     print(d.py_func.__name__, sum(d.stats.cache_hits.values()), sum(d.stats.cache_misses.values()))
 """
+)
 
 
 def _run(code: str, cache, *args: str) -> str:
@@ -89,27 +95,17 @@ def test_a_fresh_installs_first_simulate_starts_the_second_process(tmp_path):
         "calls = []\n"
         "real = p.start_beside\n"
         "p.start_beside = lambda: calls.append(real()) or calls[-1]\n"
-        + PROBE.split("for d, sig")[0]
+        + LAST_POINT
         + "chaoscam.simulate(duration=0.5)\n"
         "print(len(calls), calls[0] is not None)\n"
     )
     helped = _run(code, tmp_path / "a", "-c").splitlines()
-    env_off = PROBE.split("for d, sig")[0]
     alone = _run(
-        "import chaoscam.integrate._precompile as p\np.start_once = lambda: None\n" + env_off,
+        "import chaoscam.integrate._precompile as p\np.start_once = lambda: None\n" + LAST_POINT,
         tmp_path / "b",
         "-c",
     ).splitlines()
     assert helped[-1] == "1 True" and helped[0] == alone[0]
-
-
-def _running(pid: int) -> bool:
-    """Whether process ``pid`` is there and not a zombie (Linux /proc)."""
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
-    except (FileNotFoundError, ProcessLookupError):
-        return False
 
 
 @pytest.mark.skipif(not os.path.exists("/proc/self/stat"), reason="needs Linux /proc")
@@ -130,13 +126,10 @@ def test_the_second_process_ends_when_its_parent_is_killed(tmp_path):
     helper = int(parent.stdout.readline())
     try:
         time.sleep(1.5)  # importing numba, or compiling
-        assert _running(helper)
+        assert _alive([helper], timeout=0) == [helper]
         parent.kill()
         parent.wait(timeout=10)
-        t0 = time.monotonic()
-        while _running(helper) and time.monotonic() - t0 < 3.0:
-            time.sleep(0.05)
-        assert not _running(helper)
+        assert _alive([helper], timeout=3.0) == []
     finally:
-        if _running(helper):
-            os.kill(helper, signal.SIGKILL)
+        for pid in _alive([helper], timeout=0):
+            os.kill(pid, signal.SIGKILL)
