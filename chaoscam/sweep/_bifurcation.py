@@ -95,14 +95,28 @@ def initial_offsets(n: int) -> list[tuple[float, float]]:
 
     The points of the unscrambled 2-D Halton sequence (bases 2 and 3), skipping its origin,
     mapped onto `IC_BOX`: spread evenly, and the same for every value and every seed.
+    The sequence is computed here (:func:`_radical_inverse`), the same bits as
+    ``scipy.stats.qmc.Halton(d=2, scramble=False)`` (tested): importing ``scipy.stats``
+    took about a second at the start of every sweep's process.
     """
-    from scipy.stats import qmc
-
     if whole("n", n, low=0) <= 1:
         return []
-    u = qmc.Halton(d=2, scramble=False).random(n)[1:]
     d_theta, omega = IC_BOX
-    return [(float(a * d_theta), float((2.0 * b - 1.0) * omega)) for a, b in u]
+    return [
+        (_radical_inverse(i, 2) * d_theta, (2.0 * _radical_inverse(i, 3) - 1.0) * omega)
+        for i in range(1, n)
+    ]
+
+
+def _radical_inverse(i: int, base: int) -> float:
+    """The van der Corput point of index ``i`` in ``base``: its digits mirrored about the
+    point, ``sum_k d_k base^-(k+1)`` for ``i = sum_k d_k base^k``."""
+    x, scale = 0.0, 1.0 / base
+    while i > 0:
+        i, digit = divmod(i, base)
+        x += digit * scale
+        scale /= base
+    return x
 
 
 class _BranchPlan:

@@ -60,6 +60,21 @@ def test_initial_conditions_are_lifted_off_the_cam(chained):
     assert len(set(offs)) == 5
 
 
+def test_initial_offsets_are_scipys_halton_points_bit_for_bit():
+    """The offsets computed without scipy.stats are the ones scipy's unscrambled Halton
+    sequence gave (the diagrams made before stay the same bits)."""
+    from scipy.stats import qmc
+
+    from chaoscam.sweep._bifurcation import IC_BOX
+
+    n = 300
+    u = qmc.Halton(d=2, scramble=False).random(n)[1:]
+    d_theta, omega = IC_BOX
+    want = [(float(a * d_theta), float((2.0 * b - 1.0) * omega)) for a, b in u]
+    assert initial_offsets(n) == want
+    assert initial_offsets(1) == [] and initial_offsets(0) == []
+
+
 def test_explicit_initial_states():
     """Given states are used as they are, for every value."""
     b = bifurcation("xi", [0.42], initial_conditions=[(0.1, 0.0), (0.2, 1.0)], **KW)
