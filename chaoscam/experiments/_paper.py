@@ -23,6 +23,7 @@ from . import _steps
 from ._drawing import draw, uri_of
 from ._paper_figures import fig3_figure, fig5_figure
 from ._sensitivity import SWEEP_FATE_S
+from ._side_by_side import side_by_side
 from ._store import stored
 
 __all__ = ["FIGURES", "FigureResult", "data_files"]
@@ -377,15 +378,17 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
     )
     png = _save(outdir, "fig7-10", regime_map_figure, rm.cells, x="l_lambda", y="l_lambda_sigma")
     res.regime_maps.append((str(path), rm, png))
-    for mu in MU_PAPER:
-        for sigma in (0.0, max(sigmas)):
-            traj = simulate(
-                Params(l_lambda=mu, l_lambda_sigma=sigma), duration=20.0, transient=10.0, seed=7
-            )
-            name = _fig7_trajectory(mu, sigma)
-            _write(outdir / f"{name}.parquet", traj.to_parquet)
-            png = _save(outdir, name, response_figure, traj, title=f"μ = {mu} m, σ = {sigma} m")
-            res.trajectories.append((str(outdir / f"{name}.parquet"), traj, png))
+    cases = [(mu, sigma) for mu in MU_PAPER for sigma in (0.0, max(sigmas))]
+
+    def response(case):
+        p = Params(l_lambda=case[0], l_lambda_sigma=case[1])
+        return simulate(p, duration=20.0, transient=10.0, seed=7)
+
+    for (mu, sigma), traj in zip(cases, side_by_side(response, cases, workers), strict=True):
+        name = _fig7_trajectory(mu, sigma)
+        _write(outdir / f"{name}.parquet", traj.to_parquet)
+        png = _save(outdir, name, response_figure, traj, title=f"μ = {mu} m, σ = {sigma} m")
+        res.trajectories.append((str(outdir / f"{name}.parquet"), traj, png))
     c = rm.cells.set_index(["l_lambda", "l_lambda_sigma"])
 
     def cell(mu, sigma):

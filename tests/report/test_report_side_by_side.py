@@ -1,0 +1,62 @@
+"""A stage's single runs side by side on threads (experiments._side_by_side)."""
+
+import threading
+import time
+
+import pytest
+
+from chaoscam import simulate
+from chaoscam.experiments._side_by_side import side_by_side
+from chaoscam.model import Params
+
+
+def test_side_by_side_runs_on_threads_and_keeps_the_order():
+    """Two calls run at once (each waits for the other to have started), and the results
+    come back in the order of the items, not of completion."""
+    started = threading.Barrier(2, timeout=10)
+
+    def fn(x):
+        started.wait()  # a BrokenBarrierError unless both run at the same time
+        return x * 10
+
+    assert side_by_side(fn, [1, 2], workers=2) == [10, 20]
+    assert side_by_side(lambda x: x + 1, [3, 1, 2], workers=1) == [4, 2, 3]
+    assert side_by_side(lambda x: x, [], workers=2) == []
+
+
+def test_side_by_side_raises_the_first_error_and_drops_the_runs_not_begun():
+    """An error is raised in the caller; items queued behind the running ones are not run."""
+    ran = []
+
+    def fn(x):
+        ran.append(x)
+        if x == 0:
+            raise ValueError("run 0 failed")
+        time.sleep(0.05)  # the queue behind would take 2.5 s on one thread
+        return x
+
+    with pytest.raises(ValueError, match="run 0 failed"):
+        side_by_side(fn, [0] + list(range(1, 50)), workers=2)
+    assert 0 in ran and len(ran) < 50
+    assert not [t for t in threading.enumerate() if t.name.startswith("chaoscam-side")]
+
+
+def test_side_by_side_checks_workers():
+    with pytest.raises(ValueError, match="workers = 0 must be in"):
+        side_by_side(lambda x: x, [1, 2], workers=0)
+
+
+def test_figs_7_10_responses_side_by_side_are_the_bits_of_one_after_another():
+    """Two of Figs. 7-10's responses (σ = 0 and σ > 0), shortened, on two threads: the same
+    section, series and impacts as run alone."""
+    cases = [(0.008, 0.0), (0.015, 0.004)]
+
+    def response(case):
+        p = Params(l_lambda=case[0], l_lambda_sigma=case[1])
+        return simulate(p, duration=3.0, transient=1.0, seed=7)
+
+    alone = [response(c) for c in cases]
+    both = side_by_side(response, cases, workers=2)
+    for a, b in zip(alone, both, strict=True):
+        assert a.section.equals(b.section) and a.series.equals(b.series)
+        assert a.impacts.equals(b.impacts)
