@@ -23,7 +23,7 @@ from .._run_warnings import run_warnings
 from .._warn import quiet, recorded
 from ..integrate._members import models_of
 from ..model import Params, truncated_mass
-from ._tasks import FATE_LABELS, RunSummary, fate_fields, verdict_fields
+from ._tasks import FATE_LABELS, FATE_LATE, RunSummary, fate_fields, verdict_fields
 
 __all__ = ["Launched", "label_batch", "launch_batch", "run_batch"]
 
@@ -51,7 +51,8 @@ def launch_batch(
 ) -> list[Launched]:
     """The ensembles of ``tasks``, one compiled call per group of tasks that share (seed,
     duration, transient, dt, omega, fate), keeping their order within a group; kept
-    resumable when undetermined members may be extended (``extend_to`` not None)."""
+    resumable when undetermined members may be extended (``extend_to`` not None) or fate
+    runs continued (a ``fate`` horizon)."""
     from ..integrate import simulate_ensemble
 
     groups: dict[tuple, list[int]] = {}
@@ -70,34 +71,61 @@ def launch_batch(
                 transient=transient,
                 backend=backend,
                 tangent=True,
-                resumable=extend_to is not None,  # undetermined members are continued
+                # undetermined members are extended, and fate runs go on, from the copy
+                resumable=extend_to is not None or key[5] is not None,
             )
         out.append(Launched(key, picks, plist, ens, [str(w.message) for w in caught]))
     return out
 
 
-def _fates(plist, indices, seed: int, fate: float, backend: str) -> list[dict[str, Any]]:
-    """The fate fields of members run again to ``fate`` seconds with the tangent (the same
-    motion, bit for bit): one ensemble call, as the process engine's one run each. After a
-    GPU batch they run where ``"auto"`` puts so few (:data:`chaoscam._ensemble_verdicts.
-    EXTEND_BACKEND`: the CPU for fewer than ``_gpu.AUTO_GPU_MIN``), the same realizations,
-    equal to the GPU's motion within ``GPU_TOLERANCE`` for a while and, when chaotic, only
-    in their statistics after."""
-    from .._ensemble_verdicts import EXTEND_BACKEND
-    from ..integrate import simulate_ensemble
+def _fates(ens, plist, later, seed: int, fate: float) -> list[dict[str, Any]]:
+    """The fate fields of members ``later`` of ``ens`` (models ``plist``, every member's)
+    run on to ``fate`` seconds with the tangent: continued from the copy a resumable run
+    keeps (:func:`chaoscam.integrate.extend_ensemble`, bit-identical to a run made that long,
+    without repeating the first run's time: 20 of a 100-s horizon's seconds in the
+    report), else run again from t = 0. One ensemble call, as the process engine's one run
+    each (:func:`._tasks.fate_fields` on the same rows: a continued run records from the
+    first run's transient on, so it is taken only where the run's last half, the rows
+    judged, starts after that transient; see :func:`_continues`).
 
+    After a GPU batch they run where ``"auto"`` puts so few
+    (:data:`chaoscam._ensemble_verdicts.EXTEND_BACKEND`: the CPU for fewer than
+    ``_gpu.AUTO_GPU_MIN``): continued, they go on from the GPU's state; run again, they are
+    the same realizations, equal to the GPU's motion within ``GPU_TOLERANCE`` for a while
+    and, when chaotic, only in their statistics after."""
+    from .._ensemble_verdicts import EXTEND_BACKEND
+    from ..integrate import extend_ensemble, simulate_ensemble
+
+    s = ens.settings
+    backend = EXTEND_BACKEND[s["backend"]]
     with quiet():  # the model's warnings came with the first run (quiet: on batch threads)
-        ens = simulate_ensemble(
-            list(plist), list(indices), seed=seed, duration=fate, transient=0.0,
-            backend=EXTEND_BACKEND[backend], tangent=True,
-        )  # fmt: skip
-    rows_of = ens.sections.groupby("member").indices
+        if _continues(ens, plist, fate):
+            long = extend_ensemble(ens, list(plist), fate, members=later, backend=backend)
+        else:
+            long = simulate_ensemble(
+                [plist[j] for j in later],
+                [int(ens.members["index"].iat[j]) for j in later],
+                seed=seed, duration=fate, transient=0.0, backend=backend, tangent=True,
+            )  # fmt: skip
+    rows_of = long.sections.groupby("member").indices
     out = []
-    for j, p in enumerate(plist):
-        rows = rows_of.get(j, [])
-        sec = ens.sections.iloc[rows].reset_index(drop=True)
-        out.append(fate_fields(str(ens.members["status"].iat[j]), sec, ens.jacobians[rows], p))
+    for i, j in enumerate(later):
+        rows = rows_of.get(i, [])
+        sec = long.sections.iloc[rows].reset_index(drop=True)
+        out.append(
+            fate_fields(str(long.members["status"].iat[i]), sec, long.jacobians[rows], plist[j])
+        )
     return out
+
+
+def _continues(ens, plist, fate: float) -> bool:
+    """Whether ``ens`` can go on to ``fate`` with the fate fields of a run made from t = 0:
+    it kept a copy, and the last half of a run that stays to the horizon (from
+    ``(1 - FATE_LATE) t_last``, its last section ``t_last > fate - T``) starts after the
+    transient, from which a continued run records."""
+    period = max(p.cam_period for p in plist)
+    late = (1.0 - FATE_LATE) * (fate - period)
+    return ens.resume is not None and late > ens.settings["transient"] + period
 
 
 def label_batch(
@@ -125,11 +153,7 @@ def label_batch(
         ]
         fates: dict[int, dict[str, Any]] = {}
         if fate is not None and later:
-            plater = [plist[j] for j in later]
-            ilater = [tasks[picks[j]].sim_index for j in later]
-            fates = dict(
-                zip(later, _fates(plater, ilater, seed, fate, ens.settings["backend"]), strict=True)
-            )
+            fates = dict(zip(later, _fates(ens, plist, later, seed, fate), strict=True))
         rows_of = ens.sections.groupby("member").indices
         members = ens.members
         for j, i in enumerate(picks):

@@ -332,9 +332,14 @@ def test_a_gpu_ensembles_extensions_run_on_the_cpu(fake_gpu):
     assert cpu["label"].iat[0] == v.label and cpu["reasons"].iat[0] == v.reasons
 
 
-def test_a_gpu_sweeps_fate_runs_run_on_the_cpu(fake_gpu):
-    """The fate runs of a GPU batch's few chaotic members go to the CPU (by size)."""
+@pytest.mark.parametrize("resumable", [True, False])
+def test_a_gpu_sweeps_fate_runs_run_on_the_cpu(fake_gpu, resumable):
+    """The fate runs of a GPU batch's few chaotic members go to the CPU (by size), whether
+    continued from the batch's copy or run again."""
     from chaoscam.sweep import _batch
 
-    (fields,) = _batch._fates([CHAOTIC], [0], 1, 2.0, "gpu")
-    assert fake_gpu == [] and fields
+    run = dict(duration=2.0, transient=0.0, tangent=True, resumable=resumable)
+    ens = simulate_ensemble(CHAOTIC, [0], seed=1, backend="gpu", **run)
+    launched = list(fake_gpu)
+    (fields,) = _batch._fates(ens, [CHAOTIC], [0], 1, 8.0)
+    assert fake_gpu == launched and fields["fate"] == "OK"

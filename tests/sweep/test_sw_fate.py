@@ -308,3 +308,24 @@ def test_the_sentence_tells_a_settling_from_a_verdict_that_needed_longer():
     assert "2 of them are periodic on the continued run's last half (period 11, 30;" in s
     assert "1 labelled chaotic settles later and 1 labelled otherwise needed the longer" in s
     assert "certified" not in s
+
+
+def test_fate_runs_continued_from_the_batch_copy_equal_runs_made_again():
+    """The ensemble engine continues a batch's fate runs from its resumable copy; their
+    fields (status, where it left, the verdict on the last half) equal those of runs made
+    again from t = 0, and a horizon whose last half would start before the transient is run
+    again (the rows judged would be missing from a continued run)."""
+    from chaoscam.integrate import simulate_ensemble
+    from chaoscam.sweep._batch_run import _continues, _fates
+
+    plist = [Params(omega=25.0, xi=0.7), Params(omega=25.0, xi=0.45)]  # leaves; stays
+    run = dict(seed=1, duration=20.0, transient=10.0, tangent=True)
+    kept = simulate_ensemble(plist, [3, 5], resumable=True, **run)
+    plain = simulate_ensemble(plist, [3, 5], **run)
+    assert _continues(kept, plist, 40.0) and not _continues(plain, plist, 40.0)
+    assert not _continues(kept, plist, 20.5)  # last half from ~10.1 s: too near the transient
+    continued = _fates(kept, plist, [0, 1], 1, 40.0)
+    again = _fates(plain, plist, [0, 1], 1, 40.0)
+    assert continued == again
+    assert continued[0]["fate"] == "LEFT_REACH" and 27.0 < continued[0]["left_at"] < 28.0
+    assert continued[1]["fate"] == "OK" and continued[1]["fate_label"] == "chaotic"
