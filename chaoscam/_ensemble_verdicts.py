@@ -230,16 +230,18 @@ def _verdicts(ens: Ensemble, plist: list[Params]) -> list[MemberVerdict]:
     return [next(done_a) if s else next(done_b) for s in shoot]
 
 
-def _threaded(fn: Callable, items: list, threads: int, here: list = ()) -> tuple[list, list]:
+def _threaded(
+    fn: Callable, items: list, threads: int, here: list = (), prefix: str = "chaoscam-verdict"
+) -> tuple[list, list]:
     """``([fn(x) for x in items], [fn(x) for x in here])``: ``items`` on up to ``threads``
-    threads, ``here`` on the calling thread meanwhile, each in order. An exception (a
-    Ctrl-C in the waiting thread too) cancels the calls not yet started."""
+    threads (named ``prefix``), ``here`` on the calling thread meanwhile, each in order. An
+    exception (a Ctrl-C in the waiting thread too) cancels the calls not yet started."""
     if threads <= 1 or len(items) <= 1:
         return [fn(x) for x in items], [fn(x) for x in here]
     # each call in a copy of this thread's context: a warning it raises is recorded where
     # this thread's are (:func:`chaoscam._warn.recorded`, the sweeps' batches)
     ctx = contextvars.copy_context()
-    pool = ThreadPoolExecutor(min(threads, len(items)), thread_name_prefix="chaoscam-verdict")
+    pool = ThreadPoolExecutor(min(threads, len(items)), thread_name_prefix=prefix)
     try:
         futures = [pool.submit(ctx.copy().run, fn, x) for x in items]
         mine = [fn(x) for x in here]

@@ -96,8 +96,7 @@ def _fates(ens, plist, later, seed: int, fate: float) -> list[dict[str, Any]]:
     from .._ensemble_verdicts import EXTEND_BACKEND
     from ..integrate import extend_ensemble, simulate_ensemble
 
-    s = ens.settings
-    backend = EXTEND_BACKEND[s["backend"]]
+    backend = EXTEND_BACKEND[ens.settings["backend"]]
     with quiet():  # the model's warnings came with the first run (quiet: on batch threads)
         if _continues(ens, plist, fate):
             long = extend_ensemble(ens, list(plist), fate, members=later, backend=backend)
