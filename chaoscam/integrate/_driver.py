@@ -51,6 +51,7 @@ __all__ = [
     "members_on_this_thread",
     "on_this_thread",
     "stop_on",
+    "stops_here",
     "run_members",
     "run_alone",
     "run_alone_rk4",
@@ -267,13 +268,22 @@ def stop_on(stop: threading.Event | None):
     """Within this context :func:`check_stop` raises :class:`StopRequested` on the calling
     thread once ``stop`` is set (between two compiled calls), while its ensembles run as
     anywhere else (numba's threads): a GPU sweep's labelling thread
-    (:class:`chaoscam.sweep._pipeline.PipelineBackend`)."""
-    before = getattr(_here, "stop", None)
-    _here.stop = stop
+    (:class:`chaoscam.sweep._pipeline.PipelineBackend`), a sweep run beside another
+    (:func:`chaoscam.experiments._side_by_side.beside`). The contexts nest: the events of
+    the enclosing ones are still watched, so an inner context (a serial sweep's
+    :func:`members_on_this_thread`) cannot hide a stop asked of the whole thread."""
+    before = stops_here()
+    _here.stops = before if stop is None else (*before, stop)
     try:
         yield
     finally:
-        _here.stop = before
+        _here.stops = before
+
+
+def stops_here() -> tuple[threading.Event, ...]:
+    """The stop events :func:`check_stop` watches on the calling thread (none: it is not
+    inside :func:`stop_on`)."""
+    return getattr(_here, "stops", ())
 
 
 def on_this_thread() -> bool:
@@ -283,8 +293,7 @@ def on_this_thread() -> bool:
 
 def check_stop() -> None:
     """Raise :class:`StopRequested` if this thread's run was asked to stop."""
-    stop = getattr(_here, "stop", None)
-    if stop is not None and stop.is_set():
+    if any(stop.is_set() for stop in stops_here()):
         raise StopRequested("stopped on request")
 
 

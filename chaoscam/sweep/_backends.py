@@ -106,8 +106,8 @@ class SerialBackend:
             fut.set_exception(err)
         return fut
 
-    def wait_any(self, futures: Iterable[cf.Future]) -> set:
-        return set(futures)
+    def wait_any(self, futures: Iterable[cf.Future], timeout: float | None = None) -> set:
+        return set(futures)  # each ran at its submission
 
     def result(self, fut: cf.Future) -> Any:
         return fut.result()
@@ -148,8 +148,8 @@ class ThreadBackend:
     def submit(self, fn: Callable, arg: Any) -> cf.Future:
         return self._pool.submit(self._run, fn, arg)
 
-    def wait_any(self, futures: Iterable[cf.Future]) -> set:
-        return cf.wait(list(futures), return_when=cf.FIRST_COMPLETED).done
+    def wait_any(self, futures: Iterable[cf.Future], timeout: float | None = None) -> set:
+        return cf.wait(list(futures), timeout=timeout, return_when=cf.FIRST_COMPLETED).done
 
     def result(self, fut: cf.Future) -> Any:
         return fut.result()
@@ -259,8 +259,8 @@ class ProcessBackend:
             self.recover()
             return self._pool.submit(fn, arg)
 
-    def wait_any(self, futures: Iterable[cf.Future]) -> set:
-        return cf.wait(list(futures), return_when=cf.FIRST_COMPLETED).done
+    def wait_any(self, futures: Iterable[cf.Future], timeout: float | None = None) -> set:
+        return cf.wait(list(futures), timeout=timeout, return_when=cf.FIRST_COMPLETED).done
 
     def result(self, fut: cf.Future) -> Any:
         try:
@@ -353,8 +353,8 @@ class DaskBackend:
                 raise BackendLost(self._lost(err)) from None
             raise
 
-    def wait_any(self, futures: Iterable[Any]) -> set:
-        """The finished futures.
+    def wait_any(self, futures: Iterable[Any], timeout: float | None = None) -> set:
+        """The finished futures (none after ``timeout`` seconds, if given).
 
         With no worker connected it says so once on stderr after ``_DASK_NOTICE_S`` and
         raises :class:`BackendLost` after :data:`DASK_NO_WORKER_S` without one; a lost
@@ -363,13 +363,12 @@ class DaskBackend:
         import time
 
         futures = list(futures)
+        poll = _DASK_POLL_S if timeout is None else min(_DASK_POLL_S, timeout)
         started = time.monotonic()
         seen_worker = started  # the last time a worker was known to be connected
         while True:
             try:
-                done = self._distributed.wait(
-                    futures, timeout=_DASK_POLL_S, return_when="FIRST_COMPLETED"
-                ).done
+                done = self._distributed.wait(futures, poll, return_when="FIRST_COMPLETED").done
             except self._distributed.TimeoutError:
                 done = set()
             except Exception as err:  # the scheduler is gone or the connection broke
@@ -379,6 +378,8 @@ class DaskBackend:
             if self.client.status not in ("running", "connecting"):
                 raise BackendLost(self._lost(None))
             now = time.monotonic()
+            if timeout is not None and now - started >= timeout:
+                return set()
             if now - started < _DASK_NOTICE_S:
                 continue
             if self._workers_now():

@@ -15,6 +15,7 @@ from collections import Counter, deque
 from collections.abc import Iterator
 from typing import Any, Protocol
 
+from ..integrate._driver import StopRequested, check_stop, stops_here
 from ._backends import BackendLost, SerialBackend, WorkerLost
 from ._grid import SweepError
 from ._tasks import run_task
@@ -23,6 +24,12 @@ __all__ = ["SweepInterrupted", "TaskFailed", "execute"]
 
 MAX_RETRIES = 3
 """Times a task may lose its worker before the run stops with an error."""
+
+STOP_POLL_S = 0.1
+"""How often [s] a sweep whose thread can be asked to stop (inside
+:func:`chaoscam.integrate._driver.stop_on`: a sweep run beside another,
+:func:`chaoscam.experiments._side_by_side.beside`) looks whether it was, while it waits for
+its tasks. Only the main thread gets Ctrl-C; another thread learns of it this way."""
 
 
 class TaskFailed(RuntimeError):
@@ -125,6 +132,19 @@ def _share(plan: Plan, saved: int, inflight: dict, size: int, spread: int) -> in
     return max(1, min(size, -(-left // (2 * spread))))
 
 
+def _finished(backend, futures: list) -> set:
+    """``backend.wait_any(futures)``; on a thread that can be asked to stop (:func:`stops_here`
+    is not empty), :data:`STOP_POLL_S` at a time, raising
+    :class:`~chaoscam.integrate._driver.StopRequested` once it is asked."""
+    if not stops_here():
+        return backend.wait_any(futures)
+    while True:
+        check_stop()
+        done = backend.wait_any(futures, timeout=STOP_POLL_S)
+        if done:
+            return done
+
+
 def execute(
     plan: Plan,
     backend,
@@ -172,10 +192,12 @@ def execute(
                 inflight[backend.submit(run_task, task)] = task
             if not inflight:
                 break
-            for fut in backend.wait_any(list(inflight)):
+            for fut in _finished(backend, list(inflight)):
                 task = inflight.pop(fut)
                 try:
                     record = backend.result(fut)
+                except StopRequested:  # this thread was asked to stop (serial: in the task)
+                    raise
                 except WorkerLost as err:
                     retries[task.key()] += 1
                     if retries[task.key()] > MAX_RETRIES:
@@ -199,7 +221,7 @@ def execute(
                         bar.total = plan.total
                     bar.update(1)
             store.maybe_flush()
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, StopRequested):
         backend.cancel(list(inflight))
         store.flush()  # a record stored but not yet counted by the plan is saved too
         raise SweepInterrupted(max(saved, plan.done), plan.total, store.path) from None

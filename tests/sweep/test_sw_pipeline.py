@@ -102,6 +102,24 @@ def test_a_labelling_thread_asked_to_stop_stops_at_its_next_compiled_call():
     simulate_ensemble(Params(), range(2), duration=0.1)  # outside: no stop
 
 
+def test_an_inner_stop_context_does_not_hide_the_threads_stop():
+    """stop_on nests: inside a second context (a serial sweep's batch on a thread run
+    beside another sweep) the first context's stop request still stops the thread."""
+    from chaoscam.integrate._driver import StopRequested, check_stop, stop_on, stops_here
+
+    outer, inner = threading.Event(), threading.Event()
+    with stop_on(outer):
+        with stop_on(inner), stop_on(None):
+            assert stops_here() == (outer, inner)
+            check_stop()  # neither set
+            outer.set()
+            with pytest.raises(StopRequested):
+                check_stop()
+        assert stops_here() == (outer,)
+    assert stops_here() == ()
+    check_stop()  # outside: nothing watched
+
+
 def test_labels_asked_to_stop_stop_before_the_next_member(monkeypatch):
     """A random member's verdict runs no compiled call, so the verdicts check the stop
     request before each member: a cancelled labelling of 8,192 members (about 27 s of
