@@ -101,7 +101,7 @@ def settle(result) -> None:
 
     for name in ("bifurcations", "regime_maps", "trajectories"):
         rows = getattr(result, name)
-        rows[:] = [(path, found, png_of(png)) for path, found, png in rows]
+        rows[:] = [(path, found, png_of(png), *rest) for path, found, png, *rest in rows]
     for name in ("figures", "why_figures"):
         items = getattr(result, name)
         items[:] = [

@@ -242,8 +242,8 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
             add_regime_map(parts, path, rm, png=png)
         for path, bif, png in r.bifurcations:
             add_bifurcation(parts, path, bif, png=png)
-        for path, traj, png in r.trajectories:
-            add_trajectory(parts, path, traj, png=png)
+        for path, traj, png, verdict in r.trajectories:
+            add_trajectory(parts, path, traj, png=png, verdict=verdict)
         new = (
             [f.id for f in parts.paper_figures[before[0] :]]
             + [m["figure"].id for m in parts.regime_maps[before[1] :]]

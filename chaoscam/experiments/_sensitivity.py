@@ -295,10 +295,40 @@ def _stiffness_figure(sweeps):
     return fig
 
 
+def _omega_xi_map(quick: bool, outdir: Path, workers, classify):
+    """The (ω, ξ) regime map, one deterministic run a cell continued to the fate horizon;
+    returns (the map, its data file)."""
+    from ..sweep import Axis, regime_map
+
+    omegas = (20.0, 50.0, 6) if quick else (10.0, 50.0, 17)
+    xis = (0.1, 0.7, 6) if quick else (0.1, 0.7, 13)
+    rm = regime_map(
+        Axis.linspace("omega", *omegas),
+        Axis.linspace("xi", *xis),
+        realizations=1,
+        duration=20.0,
+        transient=10.0,
+        classify=classify,
+        workers=workers,
+        fate=FATE_S[quick],
+        **stored(path := outdir / "sensitivity-omega-xi.parquet"),
+    )
+    return rm, path
+
+
 def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
-    """The three sweeps, their figures and the findings (a FigureResult titled
-    "Sensitivity"); ``classify`` as for the sweeps (the report's quick run caps the
-    extension of undetermined runs)."""
+    """The sweeps, their figures and the findings (a FigureResult titled "Sensitivity");
+    ``classify`` as for the sweeps (the report's quick run caps the extension of
+    undetermined runs). The (ω, ξ) map, the longest sweep, runs beside the others
+    (:func:`._side_by_side.beside`), so no sweep's last runs leave a core idle."""
+    from ._side_by_side import beside
+
+    with beside(_omega_xi_map, quick, outdir, workers, classify) as omega_xi:
+        return _sensitivity(quick, outdir, workers, classify, omega_xi)
+
+
+def _sensitivity(quick: bool, outdir: Path, workers, classify, omega_xi):
+    """:func:`sensitivity` while ``omega_xi`` (a future of :func:`_omega_xi_map`) runs."""
     from ..model import Params
     from ..report._sweep_figures import (
         SETTLED_MARK,
@@ -306,7 +336,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         regime_map_figure,
         sweep_diagram,
     )
-    from ..sweep import Axis, bifurcation, regime_map
+    from ..sweep import bifurcation
     from ._drawing import uri_of
     from ._paper import FigureResult, _save
 
@@ -365,20 +395,9 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         )
         + step_finding(v_x, lambda r: f"ξ = {r.value:.3g}")
     )
-    # 3. (omega, xi) map
-    omegas = (20.0, 50.0, 6) if quick else (10.0, 50.0, 17)
-    xis = (0.1, 0.7, 6) if quick else (0.1, 0.7, 13)
-    rm = regime_map(
-        Axis.linspace("omega", *omegas),
-        Axis.linspace("xi", *xis),
-        realizations=1,
-        duration=20.0,
-        transient=10.0,
-        classify=classify,
-        workers=workers,
-        fate=FATE_S[quick],
-        **stored(path_m := outdir / "sensitivity-omega-xi.parquet"),
-    )
+    # 3. (omega, xi) map, under way since the stage began; the last sweeps first
+    choices, bifs = open_choices(quick, outdir, workers, classify, hertz_tags)
+    rm, path_m = omega_xi.result()
     png_m = _save(outdir, "sensitivity-omega-xi", regime_map_figure, rm.cells, x="omega", y="xi")
     res.regime_maps.append((str(path_m), rm, png_m))
     cells = rm.cells
@@ -419,7 +438,6 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
         )
         + step_finding(rm.realizations, lambda r: f"(ω, ξ) = ({r.omega:.3g}, {r.xi:.3g})")
     )
-    choices, bifs = open_choices(quick, outdir, workers, classify, hertz_tags)
     res.why.append(choices)
     res.bifurcations.extend(bifs)
     return res

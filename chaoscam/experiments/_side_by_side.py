@@ -1,17 +1,28 @@
-"""A stage's independent single runs side by side on the local cores.
+"""A stage's independent work side by side on the local cores.
 
-The report's single trajectories (Figs. 7–10's six responses) spend their time in the
-compiled kernel, which runs without the GIL (:func:`chaoscam.integrate._driver.run_one`), so
-threads of this process run them on every core, each the same bits as alone. One after
-another they left a core idle for about a second of the quick report.
+The report's runs spend their time in the compiled kernel, which runs without the GIL
+(:func:`chaoscam.integrate._driver.run_one`), so threads of this process run them on every
+core, each the same bits as alone.
+
+* :func:`side_by_side`: single runs (Figs. 7–10's six responses). One after another they
+  left a core idle for about a second of the quick report.
+* :func:`beside`: a whole sweep on its own thread while the stage runs its other sweeps (the
+  sensitivity stage's (ω, ξ) map). Each sweep ends on its slowest runs, one core working:
+  the map's last cell alone for ~2.5 s of its fate run, and ~1 s at each small sweep's end.
+  Beside each other, one sweep's end is the other's middle. Each sweep is deterministic
+  per run, so the records are the same bits as one after another.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import contextlib
+import contextvars
+import threading
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
 from typing import Any
 
-__all__ = ["side_by_side"]
+__all__ = ["beside", "side_by_side"]
 
 
 def side_by_side(fn: Callable[[Any], Any], items: Sequence[Any], workers=None) -> list[Any]:
@@ -28,3 +39,37 @@ def side_by_side(fn: Callable[[Any], Any], items: Sequence[Any], workers=None) -
     from ..sweep._backends import local_workers
 
     return _threaded(fn, list(items), local_workers(workers), prefix="chaoscam-side")[0]
+
+
+@contextlib.contextmanager
+def beside(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Iterator[Future]:
+    """A block during which ``fn(*args, **kwargs)`` runs on a thread of its own, in a copy
+    of this thread's context (the report's drawing thread, output mode and warnings); the
+    block reads its value with ``.result()`` of the future it gets.
+
+    The thread runs inside :func:`chaoscam.integrate._driver.stop_on`: when the block ends
+    with an error (a Ctrl-C, a SIGTERM or a failed sweep in the calling thread), ``fn`` is
+    asked to stop and waited for. A sweep stops at its next compiled call (its engine looks
+    every :data:`chaoscam.sweep._engine.STOP_POLL_S`) with its finished runs checkpointed,
+    like a sweep stopped by Ctrl-C, so ``chaoscam paper --resume`` goes on from both. Its
+    error is then dropped: the block's own is raised. A block that ends normally waits for
+    ``fn`` too; an error of ``fn`` not read by the block is raised then.
+    """
+    from ..integrate._driver import stop_on
+
+    stop = threading.Event()
+
+    def run() -> Any:
+        with stop_on(stop):
+            return fn(*args, **kwargs)
+
+    pool = ThreadPoolExecutor(1, thread_name_prefix="chaoscam-beside")
+    future = pool.submit(contextvars.copy_context().run, run)
+    try:
+        yield future
+    except BaseException:
+        stop.set()
+        raise
+    finally:
+        pool.shutdown(wait=True)
+    future.result()

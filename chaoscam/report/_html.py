@@ -161,19 +161,27 @@ def _provenance_rows(source: str, kind: str, rows: dict[str, Any]) -> dict[str, 
 
 
 def add_trajectory(
-    parts: ReportParts, path: str, traj, *, caption: str = "", png: bytes | None = None
+    parts: ReportParts,
+    path: str,
+    traj,
+    *,
+    caption: str = "",
+    png: bytes | None = None,
+    verdict=None,
 ) -> None:
     """A trajectory's response figure, its classification and its provenance.
 
     ``png``: the response figure already rendered (:func:`._figures.png_bytes`, the paper's
     stages render each figure once, for its file and for the report); without it the figure
-    is drawn here, titled with the file name and the label.
+    is drawn here, titled with the file name and the label. ``verdict``: ``traj``'s verdict
+    by :func:`._classify.classify`, already computed (the paper's stage classifies its
+    responses side by side); without it the trajectory is classified here.
     """
     from ._classify import classifier_name, classify
 
     name = Path(path).name
     p = traj.params
-    verdict = classify(traj)
+    verdict = classify(traj) if verdict is None else verdict
     s = traj.settings
     parts.provenance.append(
         _provenance_rows(

@@ -162,21 +162,26 @@ def test_paper_refuses_a_worker_count_before_any_work(tmp_path, capsys):
 
 def _shrink_the_runs(monkeypatch):
     """Stand-ins for the figures' sweeps and runs: the same calls, two values, a second of
-    model time, the test classifier, in this process."""
+    model time (a fate horizon of one), the test classifier, in this process; the report's
+    classifier of single runs without the tangent and extensions."""
     import chaoscam._simulate
+    import chaoscam.report._classify
     import chaoscam.sweep
+    from chaoscam import classify_trajectory
     from tests.sweep._helpers import SpreadClassifier
 
     bif, rmap, sim = chaoscam.sweep.bifurcation, chaoscam.sweep.regime_map, chaoscam.simulate
     short = dict(duration=0.5, transient=0.25, workers=1, classify=SpreadClassifier())
 
     def small_bifurcation(param, values, **kw):
+        kw = {**kw, "fate": 1.0} if kw.get("fate") else kw
         if not isinstance(values, str):
             return bif(param, list(values)[:2], **{**kw, **short})
         start, stop, _ = values.split(":")
         return bif(param, f"{start}:{stop}:2", **{**kw, **short})
 
     def small_regime_map(x, y, **kw):
+        kw = {**kw, "fate": 1.0} if kw.get("fate") else kw
         return rmap(x, y, **{**kw, **short, "realizations": 2})
 
     def short_simulate(params, **kw):
@@ -185,6 +190,8 @@ def _shrink_the_runs(monkeypatch):
     monkeypatch.setattr(chaoscam.sweep, "bifurcation", small_bifurcation)
     monkeypatch.setattr(chaoscam.sweep, "regime_map", small_regime_map)
     monkeypatch.setattr(chaoscam._simulate, "simulate", short_simulate)
+    quick = lambda traj: classify_trajectory(traj, tangent=False, extend_to=None)  # noqa: E731
+    monkeypatch.setattr(chaoscam.report._classify, "classify", quick)
 
 
 @pytest.mark.parametrize("number", [3, 4, 5, 6, 7, 0])
@@ -264,6 +271,55 @@ def test_an_interrupted_report_resumes_without_redoing_its_finished_sweeps(
     assert findings(resumed) == findings(fresh) and len(findings(fresh)) > 3
 
 
+def test_ctrl_c_in_the_sensitivity_stage_stops_the_map_beside_it_and_resume_finishes(
+    tmp_path, monkeypatch
+):
+    """The (ω, ξ) map runs beside the stage's other sweeps: a Ctrl-C in the ξ sweep asks the
+    map to stop too (it stops with its checkpoint), the stage raises the Ctrl-C, and a
+    resumed stage gives the findings of a stage run without interruption."""
+    import chaoscam.sweep
+    from chaoscam.experiments import _paper
+    from chaoscam.experiments._store import store_mode
+    from chaoscam.integrate._driver import stops_here
+    from chaoscam.report import _figures
+    from chaoscam.sweep import SweepInterrupted
+
+    _shrink_the_runs(monkeypatch)
+    monkeypatch.setattr(_figures, "png_bytes", lambda fig, dpi=None: b"\x89PNG")
+    small_bif, small_map = chaoscam.sweep.bifurcation, chaoscam.sweep.regime_map
+    map_ends = []
+
+    def stopped_at_xi(param, values, **kw):
+        if param == "xi":
+            raise KeyboardInterrupt
+        return small_bif(param, values, **kw)
+
+    def map_under_way(x, y, **kw):
+        (stop,) = stops_here()  # the map's thread can be asked to stop ...
+        assert stop.wait(60)  # ... and is, once the ξ sweep is interrupted
+        try:
+            return small_map(x, y, **kw)
+        except SweepInterrupted as err:
+            map_ends.append(err)
+            raise
+
+    monkeypatch.setattr(chaoscam.sweep, "bifurcation", stopped_at_xi)
+    monkeypatch.setattr(chaoscam.sweep, "regime_map", map_under_way)
+    with pytest.raises(KeyboardInterrupt) as err:
+        _paper._sensitivity_stage(True, tmp_path, workers=1)
+    assert not isinstance(err.value, SweepInterrupted)  # the ξ sweep's Ctrl-C, not the map's
+    assert len(map_ends) == 1 and "--resume" in str(map_ends[0])
+    assert (tmp_path / "sensitivity-omega-xi.parquet.ckpt").is_dir()
+    assert not (tmp_path / "sensitivity-omega-xi.parquet").exists()
+    monkeypatch.setattr(chaoscam.sweep, "bifurcation", small_bif)
+    monkeypatch.setattr(chaoscam.sweep, "regime_map", small_map)
+    with store_mode(resume=True):
+        resumed = _paper._sensitivity_stage(True, tmp_path, workers=1)
+    (tmp_path / "fresh").mkdir()
+    fresh = _paper._sensitivity_stage(True, tmp_path / "fresh", workers=1)
+    assert resumed.why == fresh.why and len(fresh.why) == 4
+
+
 def test_paper_unwritable_places_are_refused(tmp_path, capsys):
     """A paper-data that is a file, or a report folder that does not exist: exit 2 with a
     message, nothing run."""
@@ -281,14 +337,10 @@ def test_each_figure_is_rendered_once_and_the_report_embeds_its_file(tmp_path, m
     to paper-data (rendering was a fifth of a quick report's time, each figure drawn twice)."""
     import base64
 
-    import chaoscam.report._classify
-    from chaoscam import classify_trajectory
     from chaoscam.experiments import run_paper
     from chaoscam.report import _figures, _html
 
     _shrink_the_runs(monkeypatch)
-    quick = lambda traj: classify_trajectory(traj, tangent=False, extend_to=None)  # noqa: E731
-    monkeypatch.setattr(chaoscam.report._classify, "classify", quick)
     rendered = []
 
     def stub(fig, dpi=96):  # a distinct stand-in PNG per rendering

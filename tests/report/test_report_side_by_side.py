@@ -60,3 +60,56 @@ def test_figs_7_10_responses_side_by_side_are_the_bits_of_one_after_another():
     for a, b in zip(alone, both, strict=True):
         assert a.section.equals(b.section) and a.series.equals(b.series)
         assert a.impacts.equals(b.impacts)
+
+
+def test_beside_runs_its_call_meanwhile_in_a_copy_of_the_context():
+    """The call runs while the block does (each waits for the other), sees the caller's
+    context variables, and its value is the future's."""
+    import contextvars
+
+    from chaoscam.experiments._side_by_side import beside
+
+    var = contextvars.ContextVar("var", default="unset")
+    var.set("caller's")
+    both = threading.Barrier(2, timeout=10)
+
+    def fn(x):
+        both.wait()
+        return x, var.get()
+
+    with beside(fn, 3) as fut:
+        both.wait()  # a BrokenBarrierError unless fn runs meanwhile
+        assert fut.result() == (3, "caller's")
+
+
+def test_beside_asks_its_call_to_stop_when_the_block_fails():
+    """An error in the block (a Ctrl-C, a failed sweep) sets the call's stop request, which
+    :func:`check_stop` sees; the block's error is raised, no thread is left behind."""
+    from chaoscam.experiments._side_by_side import beside
+    from chaoscam.integrate._driver import StopRequested, check_stop
+
+    seen = []
+
+    def fn():
+        while True:  # a sweep's loop: stops between two compiled calls
+            try:
+                check_stop()
+            except StopRequested:
+                seen.append("stopped")
+                raise
+            time.sleep(0.01)
+
+    with pytest.raises(KeyboardInterrupt), beside(fn):
+        raise KeyboardInterrupt
+    assert seen == ["stopped"]
+    assert not [t for t in threading.enumerate() if t.name.startswith("chaoscam-beside")]
+
+
+def test_an_error_of_the_call_beside_is_raised_when_the_block_ends():
+    from chaoscam.experiments._side_by_side import beside
+
+    def fn():
+        raise ValueError("the map failed")
+
+    with pytest.raises(ValueError, match="the map failed"), beside(fn):
+        pass

@@ -135,6 +135,18 @@ def test_an_interrupted_ensemble_map_resumes_to_the_same_table(maps, tmp_path, m
     frames_equal(done.realizations, maps["ensemble"].realizations)
 
 
+def _noting_a_stop(run_batch, stopped: list, tasks, backend, extend_to):
+    """``run_batch``'s records; a batch stopped on request (StopRequested, raised again)
+    has its size noted in ``stopped``."""
+    from chaoscam.integrate._driver import StopRequested
+
+    try:
+        return run_batch(tasks, backend, extend_to)
+    except StopRequested:
+        stopped.append(len(tasks))
+        raise
+
+
 def test_two_workers_run_batches_on_threads_and_a_ctrl_c_stops_them(maps, tmp_path, monkeypatch):
     """With two workers the batches run on two threads at once, each member by member
     (no prange launch); a Ctrl-C in the waiting driver saves the finished batches, stops
@@ -143,7 +155,6 @@ def test_two_workers_run_batches_on_threads_and_a_ctrl_c_stops_them(maps, tmp_pa
     import threading
 
     from chaoscam.integrate import _members
-    from chaoscam.integrate._driver import StopRequested
     from chaoscam.sweep import SweepInterrupted, _backends
 
     monkeypatch.setattr(_batch, "batch_size", lambda *a, **k: 2)
@@ -157,11 +168,7 @@ def test_two_workers_run_batches_on_threads_and_a_ctrl_c_stops_them(maps, tmp_pa
         calls.append(1)
         if len(calls) == 2:  # the second batch is under way when Ctrl-C comes
             assert interrupted.wait(60)
-        try:
-            return real_run(tasks, backend, extend_to)
-        except StopRequested:
-            stopped.append(len(tasks))
-            raise
+        return _noting_a_stop(real_run, stopped, tasks, backend, extend_to)
 
     def ctrl_c_on_second_wait(self, futures):
         waits.append(1)
@@ -183,6 +190,56 @@ def test_two_workers_run_batches_on_threads_and_a_ctrl_c_stops_them(maps, tmp_pa
     assert stopped  # a batch under way stopped between two compiled calls
     monkeypatch.setattr(_batch, "run_batch", real_run)
     monkeypatch.setattr(_backends.ThreadBackend, "wait_any", real_wait)
+    done = regime_map(XI, SIGMA, engine="ensemble", out=out, resume=True, workers=2, **KW)
+    frames_equal(done.realizations, maps["ensemble"].realizations)
+
+
+def test_a_sweep_beside_an_interrupted_caller_stops_and_resumes(maps, tmp_path, monkeypatch):
+    """A map on a thread beside its caller (experiments._side_by_side.beside: the report's
+    (ω, ξ) map) gets no Ctrl-C itself: when the caller is interrupted, the map's engine sees
+    its thread's stop request while it waits (every STOP_POLL_S), saves the finished batch,
+    stops the running one at its next compiled call, joins its threads, and --resume
+    finishes to the table of one run."""
+    import threading
+    import time
+
+    from chaoscam.experiments._side_by_side import beside
+    from chaoscam.sweep import SweepInterrupted, _engine
+
+    monkeypatch.setattr(_batch, "batch_size", lambda *a, **k: 2)
+    stored_one, interrupted = threading.Event(), threading.Event()
+    stopped, waits = [], []
+    real_run, real_finished = _batch.run_batch, _engine._finished
+
+    def held_back(tasks, backend="cpu", extend_to=None):
+        if threading.current_thread().name.endswith("_1"):  # the second thread's batches
+            assert interrupted.wait(60)
+            time.sleep(10 * _engine.STOP_POLL_S)  # until the engine has seen the request
+        return _noting_a_stop(real_run, stopped, tasks, backend, extend_to)
+
+    def finished(backend, futures):
+        waits.append(1)
+        if len(waits) > 1:  # the loop waits again once a batch was stored
+            stored_one.set()
+        return real_finished(backend, futures)
+
+    monkeypatch.setattr(_batch, "run_batch", held_back)
+    monkeypatch.setattr(_engine, "_finished", finished)
+    before = threading.active_count()
+    out = tmp_path / "map.parquet"
+    with pytest.raises(KeyboardInterrupt):
+        with beside(regime_map, XI, SIGMA, engine="ensemble", out=out, workers=2, **KW) as fut:
+            assert stored_one.wait(60)
+            interrupted.set()
+            raise KeyboardInterrupt
+    err = fut.exception()
+    assert isinstance(err, SweepInterrupted) and "--resume" in str(err)
+    saved = int(str(err).split(" of ")[0].split()[-1])
+    assert 2 <= saved < 8
+    assert stopped  # the batch under way stopped between two compiled calls
+    assert threading.active_count() == before  # the map's and beside's threads joined
+    monkeypatch.setattr(_batch, "run_batch", real_run)
+    monkeypatch.setattr(_engine, "_finished", real_finished)
     done = regime_map(XI, SIGMA, engine="ensemble", out=out, resume=True, workers=2, **KW)
     frames_equal(done.realizations, maps["ensemble"].realizations)
 
