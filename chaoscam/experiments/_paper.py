@@ -379,7 +379,7 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
         return traj, classify(traj)
 
     # the six responses run beside the map, in its last runs' idle core
-    with beside(side_by_side, response, cases, workers) as responses:
+    with beside(workers, side_by_side, response, cases, workers) as responses:
         rm = regime_map(
             Axis("l_lambda", MU_PAPER),
             Axis("l_lambda_sigma", sigmas),

@@ -320,10 +320,11 @@ def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
     """The sweeps, their figures and the findings (a FigureResult titled "Sensitivity");
     ``classify`` as for the sweeps (the report's quick run caps the extension of
     undetermined runs). The (ω, ξ) map, the longest sweep, runs beside the others
-    (:func:`._side_by_side.beside`), so no sweep's last runs leave a core idle."""
+    (:func:`._side_by_side.beside`, where ``workers`` is every core), so no sweep's last
+    runs leave a core idle."""
     from ._side_by_side import beside
 
-    with beside(_omega_xi_map, quick, outdir, workers, classify) as omega_xi:
+    with beside(workers, _omega_xi_map, quick, outdir, workers, classify) as omega_xi:
         return _sensitivity(quick, outdir, workers, classify, omega_xi)
 
 

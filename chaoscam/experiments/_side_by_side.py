@@ -7,10 +7,11 @@ core, each the same bits as alone.
 * :func:`side_by_side`: single runs (Figs. 7–10's six responses). One after another they
   left a core idle for about a second of the quick report.
 * :func:`beside`: a whole sweep on its own thread while the stage runs its other sweeps (the
-  sensitivity stage's (ω, ξ) map). Each sweep ends on its slowest runs, one core working:
-  the map's last cell alone for ~2.5 s of its fate run, and ~1 s at each small sweep's end.
-  Beside each other, one sweep's end is the other's middle. Each sweep is deterministic
-  per run, so the records are the same bits as one after another.
+  sensitivity stage's (ω, ξ) map; Figs. 7–10's responses beside their map). Each sweep
+  ends on its slowest runs, one core working: the map's last cell alone for ~2.5 s of its
+  fate run, and ~1 s at each small sweep's end. Beside each other, one sweep's end is the
+  other's middle. Each sweep is deterministic per run, so the records are the same bits as
+  one after another.
 """
 
 from __future__ import annotations
@@ -42,21 +43,33 @@ def side_by_side(fn: Callable[[Any], Any], items: Sequence[Any], workers=None) -
 
 
 @contextlib.contextmanager
-def beside(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Iterator[Future]:
+def beside(workers, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Iterator[Future]:
     """A block during which ``fn(*args, **kwargs)`` runs on a thread of its own, in a copy
     of this thread's context (the report's drawing thread, output mode and warnings); the
-    block reads its value with ``.result()`` of the future it gets.
+    block reads its value with ``.result()`` of the future it gets (``workers`` and ``fn``
+    are positional only: a ``workers=`` keyword is ``fn``'s).
 
-    The thread runs inside :func:`chaoscam.integrate._driver.stop_on`: when the block ends
-    with an error (a Ctrl-C, a SIGTERM or a failed sweep in the calling thread), ``fn`` is
-    asked to stop and waited for. A sweep stops at its next compiled call (its engine looks
-    every :data:`chaoscam.sweep._engine.STOP_POLL_S`) with its finished runs checkpointed,
-    like a sweep stopped by Ctrl-C, so ``chaoscam paper --resume`` goes on from both. Its
-    error is then dropped: the block's own is raised. A block that ends normally waits for
-    ``fn`` too; an error of ``fn`` not read by the block is raised then.
+    Only where the stage may use every core (``workers`` None, or at least the cores this
+    process may use): two sweeps then share those cores. With fewer ``workers`` (a user
+    leaving cores free) ``fn`` runs on the calling thread instead, when the block first
+    reads its result (or at its end), so no more than ``workers`` cores are used.
+
+    On its thread ``fn`` runs inside :func:`chaoscam.integrate._driver.stop_on`: when the
+    block ends with an error (a Ctrl-C, a SIGTERM or a failed sweep in the calling thread),
+    ``fn`` is asked to stop and waited for. A sweep stops at its next compiled call (its
+    engine looks every :data:`chaoscam.sweep._engine.STOP_POLL_S`) with its finished runs
+    checkpointed, like a sweep stopped by Ctrl-C, so ``chaoscam paper --resume`` goes on
+    from both. Its error is then dropped: the block's own is raised. A block that ends
+    normally waits for ``fn`` too; an error of ``fn`` not read by the block is raised then.
     """
     from ..integrate._driver import stop_on
+    from ..sweep._backends import default_workers, local_workers
 
+    if workers is not None and local_workers(workers) < default_workers():
+        later = _Later(lambda: fn(*args, **kwargs))
+        yield later
+        later.result()
+        return
     stop = threading.Event()
 
     def run() -> Any:
@@ -73,3 +86,19 @@ def beside(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Iterator[Future
     finally:
         pool.shutdown(wait=True)
     future.result()
+
+
+class _Later(Future):
+    """A future whose call runs on the thread that first asks for its result."""
+
+    def __init__(self, call: Callable[[], Any]) -> None:
+        super().__init__()
+        self._call = call
+
+    def result(self, timeout=None):
+        if not self.done():
+            try:
+                self.set_result(self._call())
+            except BaseException as err:  # a Ctrl-C too: raised below, as the call's
+                self.set_exception(err)
+        return super().result(timeout)

@@ -305,8 +305,8 @@ def test_ctrl_c_in_the_sensitivity_stage_stops_the_map_beside_it_and_resume_fini
 
     monkeypatch.setattr(chaoscam.sweep, "bifurcation", stopped_at_xi)
     monkeypatch.setattr(chaoscam.sweep, "regime_map", map_under_way)
-    with pytest.raises(KeyboardInterrupt) as err:
-        _paper._sensitivity_stage(True, tmp_path, workers=1)
+    with pytest.raises(KeyboardInterrupt) as err:  # every core: the map beside (its sweeps
+        _paper._sensitivity_stage(True, tmp_path)  # run on one worker, the stand-ins')
     assert not isinstance(err.value, SweepInterrupted)  # the ξ sweep's Ctrl-C, not the map's
     assert len(map_ends) == 1 and "--resume" in str(map_ends[0])
     assert (tmp_path / "sensitivity-omega-xi.parquet.ckpt").is_dir()

@@ -77,7 +77,7 @@ def test_beside_runs_its_call_meanwhile_in_a_copy_of_the_context():
         both.wait()
         return x, var.get()
 
-    with beside(fn, 3) as fut:
+    with beside(None, fn, 3) as fut:
         both.wait()  # a BrokenBarrierError unless fn runs meanwhile
         assert fut.result() == (3, "caller's")
 
@@ -99,7 +99,7 @@ def test_beside_asks_its_call_to_stop_when_the_block_fails():
                 raise
             time.sleep(0.01)
 
-    with pytest.raises(KeyboardInterrupt), beside(fn):
+    with pytest.raises(KeyboardInterrupt), beside(None, fn):
         raise KeyboardInterrupt
     assert seen == ["stopped"]
     assert not [t for t in threading.enumerate() if t.name.startswith("chaoscam-beside")]
@@ -111,5 +111,27 @@ def test_an_error_of_the_call_beside_is_raised_when_the_block_ends():
     def fn():
         raise ValueError("the map failed")
 
-    with pytest.raises(ValueError, match="the map failed"), beside(fn):
+    with pytest.raises(ValueError, match="the map failed"), beside(None, fn):
+        pass
+
+
+def test_beside_with_fewer_workers_than_cores_runs_its_call_here_when_asked():
+    """A user who leaves cores free gets no second sweep's threads: with one worker the
+    call runs on the calling thread, at the block's first .result() (or at its end)."""
+    from chaoscam.experiments._side_by_side import beside
+
+    ran = []
+
+    def fn():
+        ran.append(threading.current_thread())
+        return 7
+
+    with beside(1, fn) as fut:
+        assert ran == []
+        assert fut.result() == 7 and fut.result() == 7
+    assert ran == [threading.current_thread()]
+    with beside(1, fn):
+        pass
+    assert len(ran) == 2
+    with pytest.raises(ValueError, match="workers = 0 must be in"), beside(0, fn):
         pass

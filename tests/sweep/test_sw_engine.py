@@ -228,7 +228,9 @@ def test_a_sweep_beside_an_interrupted_caller_stops_and_resumes(maps, tmp_path, 
     before = threading.active_count()
     out = tmp_path / "map.parquet"
     with pytest.raises(KeyboardInterrupt):
-        with beside(regime_map, XI, SIGMA, engine="ensemble", out=out, workers=2, **KW) as fut:
+        with beside(
+            None, regime_map, XI, SIGMA, engine="ensemble", out=out, workers=2, **KW
+        ) as fut:
             assert stored_one.wait(60)
             interrupted.set()
             raise KeyboardInterrupt
