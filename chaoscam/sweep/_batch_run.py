@@ -23,7 +23,7 @@ from .._run_warnings import run_warnings
 from .._warn import quiet, recorded
 from ..integrate._members import models_of
 from ..model import Params, truncated_mass
-from ._tasks import FATE_LABELS, FATE_LATE, RunSummary, fate_fields, verdict_fields
+from ._tasks import FATE_LABELS, RunSummary, fate_continues, fate_fields, verdict_fields
 
 __all__ = ["Launched", "label_batch", "launch_batch", "run_batch"]
 
@@ -118,13 +118,11 @@ def _fates(ens, plist, later, seed: int, fate: float) -> list[dict[str, Any]]:
 
 
 def _continues(ens, plist, fate: float) -> bool:
-    """Whether ``ens`` can go on to ``fate`` with the fate fields of a run made from t = 0:
-    it kept a copy, and the last half of a run that stays to the horizon (from
-    ``(1 - FATE_LATE) t_last``, its last section ``t_last > fate - T``) starts after the
-    transient, from which a continued run records."""
+    """Whether ``ens`` can go on to ``fate`` with the fate fields of a run made from t = 0
+    (:func:`._tasks.fate_continues`: it kept a copy, and the judged last half starts after
+    the transient, from which a continued run records)."""
     period = max(p.cam_period for p in plist)
-    late = (1.0 - FATE_LATE) * (fate - period)
-    return ens.resume is not None and late > ens.settings["transient"] + period
+    return fate_continues(ens.resume is not None, ens.settings["transient"], fate, period)
 
 
 def label_batch(

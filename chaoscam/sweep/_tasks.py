@@ -299,19 +299,34 @@ def fate_columns(records: list[dict]) -> dict[str, Any]:
     }
 
 
-def _fate(params: Params, task: Any) -> dict[str, Any]:
-    """Run the realization again to ``task.fate`` seconds, with the tangent (the same
-    motion, bit for bit): does it stay in the cam's reach, and what is it at the end?"""
+def fate_continues(resumable: bool, transient: float, fate: float, period: float) -> bool:
+    """Whether a run kept resumable can go on to the horizon ``fate`` with the fate fields
+    of a run made from t = 0: the last half of a run that stays to the horizon (from
+    ``(1 - FATE_LATE) t_last``, its last section ``t_last > fate - period``) starts a cam
+    ``period`` after the ``transient``, from which a continued run records."""
+    return resumable and (1.0 - FATE_LATE) * (fate - period) > transient + period
+
+
+def _fate(params: Params, task: Any, traj) -> dict[str, Any]:
+    """The realization of ``traj`` run on to ``task.fate`` seconds with the tangent (the
+    same motion, bit for bit): does it stay in the cam's reach, and what is it at the end?
+    Continued from the copy a resumable run keeps (:func:`chaoscam._extend.extend_trajectory`,
+    without repeating its first seconds) where :func:`fate_continues`, else run again."""
+    from .._extend import extend_trajectory
+
     with quiet():  # the model's warnings came with the first run
-        long = simulate(
-            params,
-            duration=task.fate,
-            transient=0.0,
-            seed=task.seed,
-            index=task.sim_index,
-            series=False,
-            tangent=params.integrator == "rk4",
-        )
+        if fate_continues(traj.resume is not None, task.transient, task.fate, params.cam_period):
+            long = extend_trajectory(traj, task.fate, series=False)
+        else:
+            long = simulate(
+                params,
+                duration=task.fate,
+                transient=0.0,
+                seed=task.seed,
+                index=task.sim_index,
+                series=False,
+                tangent=params.integrator == "rk4",
+            )
     return fate_fields(long.status.name, long.section, long.jacobians, params)
 
 
@@ -337,7 +352,7 @@ def _run(params: Params, task: Any) -> tuple[RunSummary, dict[str, Any]]:
         )
         fields = verdict_fields(task.classify(traj)) if traj.ok else status_fields(traj.status)
     if traj.ok and task.fate is not None and fields["label"] in FATE_LABELS:
-        fields.update(_fate(params, task))
+        fields.update(_fate(params, task, traj))
     seen = dict.fromkeys(str(w.message) for w in caught)
     fields["status"] = traj.status.name
     fields["warnings"] = " | ".join(seen)

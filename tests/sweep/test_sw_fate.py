@@ -329,3 +329,39 @@ def test_fate_runs_continued_from_the_batch_copy_equal_runs_made_again():
     assert continued == again
     assert continued[0]["fate"] == "LEFT_REACH" and 27.0 < continued[0]["left_at"] < 28.0
     assert continued[1]["fate"] == "OK" and continued[1]["fate_label"] == "chaotic"
+
+
+def test_the_process_engines_fate_runs_continued_equal_runs_made_again(monkeypatch):
+    """The process engine continues a task's fate run from its resumable run
+    (extend_trajectory) where fate_continues, with the fields of the run made again from
+    t = 0; without a copy, or for a horizon too near the transient, it runs it again."""
+    from types import SimpleNamespace
+
+    import chaoscam._extend
+    from chaoscam.sweep import _tasks
+
+    task = SimpleNamespace(seed=1, sim_index=3, transient=10.0, fate=40.0)
+    calls = []
+    real = chaoscam._extend.extend_trajectory
+    monkeypatch.setattr(
+        chaoscam._extend, "extend_trajectory", lambda *a, **k: calls.append(1) or real(*a, **k)
+    )
+    for p, fate in (
+        (Params(omega=25.0, xi=0.7), "LEFT_REACH"),
+        (Params(omega=25.0, xi=0.45), "OK"),
+    ):
+        run = dict(duration=20.0, transient=10.0, seed=1, index=3, series=False, tangent=True)
+        kept = chaoscam.simulate(p, resumable=True, **run)
+        plain = chaoscam.simulate(p, **run)
+        n = len(calls)
+        continued = _tasks._fate(p, task, kept)
+        assert len(calls) == n + 1  # continued, not run again
+        again = _tasks._fate(p, task, plain)
+        assert len(calls) == n + 1  # no copy: run again
+        assert continued == again and continued["fate"] == fate
+        near = SimpleNamespace(seed=1, sim_index=3, transient=10.0, fate=20.5)
+        _tasks._fate(p, near, kept)
+        assert len(calls) == n + 1  # last half from ~10.1 s: run again
+    assert _tasks.fate_continues(True, 10.0, 40.0, 0.2) and not _tasks.fate_continues(
+        False, 10.0, 40.0, 0.2
+    )
