@@ -310,14 +310,14 @@ def fate_continues(resumable: bool, transient: float, fate: float, period: float
 def _fate(params: Params, task: Any, traj=None) -> dict[str, Any]:
     """The task's realization run on to ``task.fate`` seconds with the tangent (the same
     motion, bit for bit): does it stay in the cam's reach, and what is it at the end?
-    Continued from the copy its first run ``traj`` keeps when resumable
-    (:func:`chaoscam._extend.extend_trajectory`, without repeating its first seconds) where
-    :func:`fate_continues`, else (or without ``traj``: the fate audit) run again."""
+    Continued from its first run ``traj``'s copy (:func:`chaoscam._extend.extend_trajectory`)
+    where :func:`fate_continues`, else (or without ``traj``: the fate audit) run again."""
     from .._extend import extend_trajectory
 
-    resumable = traj is not None and traj.resume is not None
     with quiet():  # the model's warnings came with the first run
-        if resumable and fate_continues(True, task.transient, task.fate, params.cam_period):
+        if traj is not None and fate_continues(
+            traj.resume is not None, task.transient, task.fate, params.cam_period
+        ):
             long = extend_trajectory(traj, task.fate, series=False)
         else:
             long = simulate(
