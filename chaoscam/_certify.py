@@ -77,13 +77,16 @@ converged), 2.42, 1.43, 1.30 (unstable: 7-band chaos); (ω, ξ) = (20, 0.6), a s
 Newton stalls at dt (residual 1.4e-7 rad, |μ|max 13), converges at dt/2 and dt/4 with |μ|max
 0.0073 and 1.6e-4; (32.5, 0.5), period 6: |μ|max 1.23 at dt, 0.43 at dt/2, 0.33 at dt/4 where
 Newton stalls at 4e-7 rad (600 s runs at dt and dt/2: 6 bands of 4e-7 rad, λ₁ = −0.32 ± 0.03 1/s
-at dt/2). Only an orbit that converges unstable on the run's grid, or stalls there within
-``MODEL_ATOL``, and that the run lies on within ``MODEL_ATOL``, is shot for again, and a refined
-step counts a stalled Newton within ``MODEL_ATOL`` as converged (on the default model's 8
-chaotic bands, 1.4e-4 rad from the run, Newton stalls at 2e-6 rad; its refined orbits are
-unstable, |μ|max 33 and 23). An orbit certified at every refined step decides "periodic"; one
-attracting at some refined steps only leaves the verdict undetermined; otherwise the grid's
-verdict stands."""
+at dt/2). (These with Illinois regula falsi locating the events. With the Newton crossing
+search, (32.5, 0.5) gives 1.33 at dt, 0.37 at dt/2 where Newton stalls, and a converged orbit
+of 2.78 at dt/4 that the motion does not settle on: "mixed", undetermined; its 600 s runs keep
+6 bands, λ₁ > 0 on the grid's tangent at dt and < 0 at dt/2.) Only an orbit that converges
+unstable on the run's grid, or stalls there within ``MODEL_ATOL``, and that the run lies on
+within ``MODEL_ATOL``, is shot for again, and a refined step counts a stalled Newton within
+``MODEL_ATOL`` as converged (on the default model's 8 chaotic bands, 1.4e-4 rad from the run,
+Newton stalls at 2e-6 rad; its refined orbits are unstable, |μ|max 33 and 23). An orbit
+certified at every refined step decides "periodic"; one attracting at some refined steps only
+leaves the verdict undetermined; otherwise the grid's verdict stands."""
 
 APPROACH = 0.5
 """A run approaches an orbit when its largest distance to it over the last 4n section points

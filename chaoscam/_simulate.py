@@ -350,7 +350,7 @@ def raw_run(
         "solver": (
             "dop853-adaptive+interpolant-events"
             if p.integrator == "adaptive"
-            else "rk4-fixed-step+illinois-events"
+            else "rk4-fixed-step+newton-events"
         ),
         "version": __version__,
         "tangent": bool(tangent),

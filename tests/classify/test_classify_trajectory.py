@@ -125,10 +125,11 @@ def test_step_check_failure_makes_the_verdict_undetermined(periodic, default3, m
 
 
 def test_step_check_extends_the_half_step_run_as_the_grid_run():
-    """Table 1's point is undetermined on its 10 s recorded and chaotic once extended to 40 s;
-    its half-step run must be extended the same way before the two are compared (it was
-    not: "chaotic" against an unextended "undetermined" read as a changed verdict)."""
-    tr = chaoscam.simulate(duration=20.0, transient=10.0)
+    """xi = 0.43 at Table 1 otherwise is undetermined on its 10 s recorded (period 11, no
+    attracting orbit certified) and chaotic once extended to 40 s; its half-step run must be
+    extended the same way before the two are compared (it was not: "chaotic" against an
+    unextended "undetermined" read as a changed verdict)."""
+    tr = chaoscam.simulate(Params(xi=0.43), duration=20.0, transient=10.0)
     v = classify_trajectory(tr, check_step=True)
     assert v.label == "chaotic", v.reasons
     assert v.settings["extended"]["recorded_s"] == 40.0
@@ -220,11 +221,11 @@ UNSETTLED_BANDS = {
         0,
         "orbit found is unstable",
     ),
-    # index 2: with the exact clock (issue 10) realization 1's short run already has a
-    # positive exponent beyond its interval (chaotic); 2, 3, 4 are undecided, as 1 was
+    # index 1: with the Newton crossing search, realizations 0 and 1 are undecided on their
+    # short runs and 2 to 7 already have a positive exponent beyond its interval (chaotic)
     "random line length, 8 bands": (
         dict(l_lambda=0.008, l_lambda_sigma=0.0015),
-        2,
+        1,
         "the line length is random",
     ),
 }
@@ -370,7 +371,7 @@ def test_ensemble_verdicts_on_threads_equal_the_serial_ones(monkeypatch):
     from chaoscam._ensemble_verdicts import member_verdicts
     from chaoscam.integrate import simulate_ensemble
 
-    models = [Params(xi=0.2), Params(xi=0.45), Params(xi=0.24), Params(e=0.03), Params()]
+    models = [Params(xi=0.2), Params(xi=0.45), Params(xi=0.24), Params(e=0.03), Params(xi=0.43)]
     ens = simulate_ensemble(models, [0] * 5, seed=1, duration=20.0, transient=10.0, tangent=True)
     where = []
     shoot = _certify.periodic_orbit

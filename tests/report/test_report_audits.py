@@ -63,10 +63,10 @@ def test_a_settled_period_one_cell_is_certified_by_the_kicks(tmp_path):
 
 
 def test_a_chaotic_verdict_is_continued_to_the_horizon(tmp_path):
-    """A one-value xi diagram at 0.42 (chaotic over its 10 s window, default model): the
+    """A one-value xi diagram at 0.31 (chaotic over its 10 s window, Table 1 otherwise): the
     fate audit runs it again to 40 s and reports its status and the verdict on the last half
     there, and counts it."""
-    bifurcation("xi", (0.42,), duration=20.0, workers=1, out=tmp_path / "sensitivity-xi.parquet")
+    bifurcation("xi", (0.31,), duration=20.0, workers=1, out=tmp_path / "sensitivity-xi.parquet")
     done = _audit(FATE, tmp_path, "sensitivity-xi", "--horizon", "40")
     assert done.returncode == 0, done.stderr
     assert "1 verdicts (chaotic, undetermined) continued to 40 s" in done.stdout, done.stdout
