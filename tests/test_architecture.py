@@ -13,6 +13,7 @@ LAYERS = (
     "chaoscam._version",
     "chaoscam._provenance",
     "chaoscam._lazy",
+    "chaoscam._numba_cache",
     "chaoscam._warn",
     "chaoscam._parquet",
     "chaoscam._frozen",

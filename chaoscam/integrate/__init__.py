@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from .._lazy import lazy_face
+from .._numba_cache import guard
+
+# numba's cached kernels call functions of this package's other files: compiled from these
+# sources only (a callee's edit does not reach a cached caller; see chaoscam._numba_cache).
+guard(Path(__file__).parent)
 
 # Public names and the submodule that defines each: imported on first use (PEP 562),
 # so that importing the package stays cheap.
