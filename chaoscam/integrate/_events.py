@@ -138,23 +138,19 @@ def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight, trig):
         if x >= 0.0:
             xp, fp = x, fx
         x = on_clock(t, m)
-        fx, dx = _gap_at(t, th, om, x, K, c, flight, trig)
-        fx *= s
-        dx *= s
+        fx, dx = _gap_at(t, th, om, x, K, c, flight, trig, s)
         if fx == 0.0:
             return x  # the gap is 0.0 here to its last bit: the crossing, found exactly
         a, fa, b, fb, side = illinois_update(a, fa, b, fb, x, fx, side)
         if b - a > 0.5 * w2:  # three trials without halving the bracket: bisect
             xp, fp = x, fx
             x = on_clock(t, 0.5 * (a + b))
-            fx, dx = _gap_at(t, th, om, x, K, c, flight, trig)
-            fx *= s
-            dx *= s
+            fx, dx = _gap_at(t, th, om, x, K, c, flight, trig, s)
             if fx == 0.0:
                 return x
             a, fa, b, fb, _ = illinois_update(a, fa, b, fb, x, fx, 0)
-            width = math.inf  # (the bisection's own halving starts the next count)
-            w1 = math.inf
+            w1 = w2 = math.inf  # the bisection's own halving starts the next count
+            continue
         w2, w1 = w1, width
     return b
 
@@ -162,12 +158,11 @@ def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight, trig):
 @njit(cache=True, inline="always")
 def model_root(x, fx, dx, xp, fp):
     """The root nearest x of the parabola through (x, fx) with slope dx there and through
-    (xp, fp) (xp < 0: none, and the line through (x, fx) with slope dx: Newton's step). A
-    micro-flight's gap is a parabola to a few parts in 1e6 over a step, so from two trials
-    the root comes to the gap's resolution. Newton's estimate where the parabola has no
-    root."""
+    (xp, fp). A micro-flight's gap is a parabola to a few parts in 1e6 over a step, so from
+    two trials the root comes to the gap's resolution. Newton's estimate where the parabola
+    has no root (or xp = x)."""
     u = -fx / dx
-    if xp >= 0.0 and xp != x:
+    if xp != x:
         e = xp - x
         q = (fp - fx - dx * e) / (e * e)  # the curvature's half
         disc = dx * dx - 4.0 * q * fx
@@ -177,15 +172,15 @@ def model_root(x, fx, dx, xp, fp):
 
 
 @njit(cache=True)
-def _gap_at(t, th, om, m, K, c, flight, trig):
-    """The gap and its rate ``l_1 theta' - dC/dt.n`` after a substep of length m from
-    (t, th, om): the free pendulum's, or the full equations' (:func:`gap_after`)."""
+def _gap_at(t, th, om, m, K, c, flight, trig, s):
+    """``s`` times the gap and its rate ``l_1 theta' - dC/dt.n`` after a substep of length m
+    from (t, th, om): the free pendulum's, or the full equations' (:func:`gap_after`)."""
     if flight:
         th1, om1 = rk4_flight(th, om, m, c)
         delta, l1, cdn = geometry(t + m, th1, c)
-        return delta, l1 * om1 - cdn
-    delta, l1, cdn, om1 = gap_after(t, th, om, m, K, c, trig)
-    return delta, l1 * om1 - cdn
+    else:
+        delta, l1, cdn, om1 = gap_after(t, th, om, m, K, c, trig)
+    return s * delta, s * (l1 * om1 - cdn)
 
 
 # The stand-in for a gap of exactly 0 at a segment's start, signed by the gap rate: only its
