@@ -92,6 +92,39 @@ def cam_trig(t, c):
     return math.cos(thc), math.sin(thc)
 
 
+ROTATE_MAX = 0.01  # [rad] an angle this close to a known one is rotated to (rotate)
+
+
+@njit(cache=True, inline="always")
+def rotate(a, ca, sa, b):
+    """(cos(a + b), sin(a + b)) from ca = cos a, sa = sin a.
+
+    For |b| < ROTATE_MAX by the addition theorem with Taylor polynomials of cos b and sin b
+    (truncation below b^8 / 8! < 1e-20), else directly. The stages of a step sit close to
+    its start, so they need no new transcendental calls: cos/sin were 40 % of the RK4
+    kernel's time when every stage called them (``benchmarks/PROFILE.md``). The result is
+    within a few units in the last place of the direct call's; it is never rotated on from
+    (a step's end takes its values directly), so these differences do not accumulate.
+    """
+    if abs(b) >= ROTATE_MAX:
+        return math.cos(a + b), math.sin(a + b)
+    b2 = b * b
+    cb = 1.0 - b2 * (0.5 - b2 * (1.0 / 24.0 - b2 * (1.0 / 720.0)))
+    sb = b * (1.0 - b2 * (1.0 / 6.0 - b2 * (1.0 / 120.0 - b2 * (1.0 / 5040.0))))
+    return ca * cb - sa * sb, sa * cb + ca * sb
+
+
+@njit(cache=True, inline="always")
+def cam_trig_near(t, s, cc, sc, c):
+    """(cos, sin) of the cam angle at ``t + s`` given them at t (cc, sc): rotated by
+    omega ((t + s) - t) (:func:`rotate`) where that is under ROTATE_MAX, else
+    :func:`cam_trig` at ``t + s``."""
+    b = c[C_OMEGA] * ((t + s) - t)
+    if abs(b) >= ROTATE_MAX:
+        return cam_trig(t + s, c)
+    return rotate(0.0, cc, sc, b)
+
+
 @njit(cache=True)
 def geometry(t, th, c):
     """Gap delta, lever arm l_1 and normal cam speed dC/dt . n at time t and angle th."""
@@ -271,22 +304,26 @@ def rk4_trig(t, th, om, h, K, c, cc, sc, ct, st):
     ct, st), e.g. from :func:`geometry_at`; returns ``(th, om, cc4, sc4)``, the last two the
     cam angle's cos/sin at ``t + h``, where a gap at the step's end can take them from.
 
-    Stages 2 and 3 share their time ``t + h/2``, so the cam's trigonometry is evaluated
-    twice per step instead of four times (the results are the same bits as
-    :func:`acceleration` at each stage: the same functions of the same doubles).
+    Stages 2 and 3 share their time ``t + h/2``; the cam's cos/sin there and theta_f's at
+    stages 2-4 are rotated from the start's (:func:`rotate`), so a step makes two
+    transcendental calls (the cam and theta_f at its end, which the gap there needs too)
+    instead of six. The end's are direct, so no rounding is carried from step to step.
     """
     a1 = acceleration_trig(cc, sc, ct, st, om, K, c)
-    cm, sm = cam_trig(t + 0.5 * h, c)
+    cm, sm = cam_trig_near(t, 0.5 * h, cc, sc, c)
     th2 = th + 0.5 * h * om
     om2 = om + 0.5 * h * a1
-    a2 = acceleration_trig(cm, sm, math.cos(th2), math.sin(th2), om2, K, c)
+    ct2, st2 = rotate(th, ct, st, th2 - th)
+    a2 = acceleration_trig(cm, sm, ct2, st2, om2, K, c)
     th3 = th + 0.5 * h * om2
     om3 = om + 0.5 * h * a2
-    a3 = acceleration_trig(cm, sm, math.cos(th3), math.sin(th3), om3, K, c)
+    ct3, st3 = rotate(th, ct, st, th3 - th)
+    a3 = acceleration_trig(cm, sm, ct3, st3, om3, K, c)
     c4, s4 = cam_trig(t + h, c)
     th4 = th + h * om3
     om4 = om + h * a3
-    a4 = acceleration_trig(c4, s4, math.cos(th4), math.sin(th4), om4, K, c)
+    ct4, st4 = rotate(th, ct, st, th4 - th)
+    a4 = acceleration_trig(c4, s4, ct4, st4, om4, K, c)
     return (
         th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
         om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
@@ -300,16 +337,21 @@ def rk4_flight(th, om, h, c):
     """RK4 step of the free pendulum J theta'' = -(m g l/2) cos theta (no contact force).
 
     Exactly the step :func:`rk4` takes whenever the gap stays positive over the step, at a
-    quarter of the cost; :func:`closing_bound` decides when that is guaranteed.
+    quarter of the cost; :func:`closing_bound` decides when that is guaranteed. The stages'
+    cosines are rotated from the start's (:func:`rotate`): one sincos a step, not four cos.
     """
     k = -c[C_GRAV] * c[C_INV_J]
-    a1 = k * math.cos(th)
+    ct, st = math.cos(th), math.sin(th)
+    a1 = k * ct
     om2 = om + 0.5 * h * a1
-    a2 = k * math.cos(th + 0.5 * h * om)
+    th2 = th + 0.5 * h * om
+    a2 = k * rotate(th, ct, st, th2 - th)[0]
     om3 = om + 0.5 * h * a2
-    a3 = k * math.cos(th + 0.5 * h * om2)
+    th3 = th + 0.5 * h * om2
+    a3 = k * rotate(th, ct, st, th3 - th)[0]
     om4 = om + h * a3
-    a4 = k * math.cos(th + h * om3)
+    th4 = th + h * om3
+    a4 = k * rotate(th, ct, st, th4 - th)[0]
     return (
         th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
         om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),

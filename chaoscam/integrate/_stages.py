@@ -3,7 +3,7 @@
 Trigonometric calls are three quarters of the cost of the right-hand side (1)–(3) (23.5 ns
 per evaluation in contact, of which 17.7 ns for cos/sin of the cam angle and of theta_f).
 The stages of a step sit close to its start, so their cos/sin are rotated from the start's
-values by the addition theorem instead (:func:`rotate`); the physics itself stays in
+values by the addition theorem instead (:func:`._physics.rotate`); the physics itself stays in
 :func:`chaoscam.integrate._kernel.acceleration_trig` and ``geometry_trig``.
 """
 
@@ -15,8 +15,15 @@ from numba import njit
 
 from . import _kernel as k
 from ._kernel import C_GRAV, C_INV_J, C_OMEGA
+from ._physics import rotate as _rotate_inline
 
-ROTATE_MAX = 0.01  # [rad] rotations by less than this use Taylor polynomials (see rotate)
+
+@njit(cache=True, error_model="numpy")
+def rotate(a, ca, sa, b):
+    """:func:`._physics.rotate` as a function of its own for the adaptive path's stages:
+    inlined (numba's ``inline="always"``, as the RK4 steps take it) into every DOP853 stage,
+    it lengthens the kernels' first compilation."""
+    return _rotate_inline(a, ca, sa, b)
 
 
 @njit(cache=True, error_model="numpy")
@@ -26,22 +33,6 @@ def accel_trig(tr, om, K, c, flight):
     if flight:
         return -c[C_GRAV] * c[C_INV_J] * tr[3]
     return k.acceleration_trig(tr[1], tr[2], tr[3], tr[4], om, K, c)
-
-
-@njit(cache=True, error_model="numpy")
-def rotate(a, ca, sa, b):
-    """(cos(a + b), sin(a + b)) from ca = cos a, sa = sin a.
-
-    For |b| < ROTATE_MAX by the addition theorem with Taylor polynomials of cos b and sin b
-    (truncation below b^8 / 8! < 1e-16), else directly: the stages of a step sit close to
-    its start, so they need no new transcendental calls.
-    """
-    if abs(b) >= ROTATE_MAX:
-        return math.cos(a + b), math.sin(a + b)
-    b2 = b * b
-    cb = 1.0 - b2 * (0.5 - b2 * (1.0 / 24.0 - b2 * (1.0 / 720.0)))
-    sb = b * (1.0 - b2 * (1.0 / 6.0 - b2 * (1.0 / 120.0 - b2 * (1.0 / 5040.0))))
-    return ca * cb - sa * sb, sa * cb + ca * sb
 
 
 @njit(cache=True, error_model="numpy")

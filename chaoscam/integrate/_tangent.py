@@ -48,6 +48,8 @@ from ._physics import (
     acceleration_jacobian_trig,
     cam_angle,
     cam_trig,
+    cam_trig_near,
+    rotate,
 )
 
 
@@ -91,17 +93,20 @@ def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, first, rest, cc, sc
     sc; theta_f: ct, st) and hands on the cam angle's cos/sin at ``t + h`` (cc4, sc4).
     """
     a1, p1, q1 = acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, first)
-    cm, sm = cam_trig(t + 0.5 * h, c)
+    cm, sm = cam_trig_near(t, 0.5 * h, cc, sc, c)
     th2 = th + 0.5 * h * om
     om2 = om + 0.5 * h * a1
-    a2, p2, q2 = acceleration_jacobian_trig(cm, sm, math.cos(th2), math.sin(th2), om2, K, c, rest)
+    ct2, st2 = rotate(th, ct, st, th2 - th)
+    a2, p2, q2 = acceleration_jacobian_trig(cm, sm, ct2, st2, om2, K, c, rest)
     th3 = th + 0.5 * h * om2
     om3 = om + 0.5 * h * a2
-    a3, p3, q3 = acceleration_jacobian_trig(cm, sm, math.cos(th3), math.sin(th3), om3, K, c, rest)
+    ct3, st3 = rotate(th, ct, st, th3 - th)
+    a3, p3, q3 = acceleration_jacobian_trig(cm, sm, ct3, st3, om3, K, c, rest)
     c4, s4 = cam_trig(t + h, c)
     th4 = th + h * om3
     om4 = om + h * a3
-    a4, p4, q4 = acceleration_jacobian_trig(c4, s4, math.cos(th4), math.sin(th4), om4, K, c, rest)
+    ct4, st4 = rotate(th, ct, st, th4 - th)
+    a4, p4, q4 = acceleration_jacobian_trig(c4, s4, ct4, st4, om4, K, c, rest)
     # The same stages for each column (x, y) of V: x' = y, y' = p x + q y.
     n11, n21 = _column(v11, v21, h, p1, q1, p2, q2, p3, q3, p4, q4)
     n12, n22 = _column(v12, v22, h, p1, q1, p2, q2, p3, q3, p4, q4)
@@ -140,23 +145,20 @@ def rk4_time_derivatives(t, th, om, h, K, c, first, cc, sc, ct, st, f_th, f_om):
     dependence (:func:`._physics.acceleration_jacobian_time_trig`).
     """
     a1, p1, q1, r1 = acceleration_jacobian_time_trig(cc, sc, ct, st, om, K, c, first)
-    cm, sm = cam_trig(t + 0.5 * h, c)
+    cm, sm = cam_trig_near(t, 0.5 * h, cc, sc, c)
     th2 = th + 0.5 * h * om
     om2 = om + 0.5 * h * a1
-    a2, p2, q2, r2 = acceleration_jacobian_time_trig(
-        cm, sm, math.cos(th2), math.sin(th2), om2, K, c, JAC_NATURAL
-    )
+    ct2, st2 = rotate(th, ct, st, th2 - th)
+    a2, p2, q2, r2 = acceleration_jacobian_time_trig(cm, sm, ct2, st2, om2, K, c, JAC_NATURAL)
     th3 = th + 0.5 * h * om2
     om3 = om + 0.5 * h * a2
-    a3, p3, q3, r3 = acceleration_jacobian_time_trig(
-        cm, sm, math.cos(th3), math.sin(th3), om3, K, c, JAC_NATURAL
-    )
+    ct3, st3 = rotate(th, ct, st, th3 - th)
+    a3, p3, q3, r3 = acceleration_jacobian_time_trig(cm, sm, ct3, st3, om3, K, c, JAC_NATURAL)
     c4, s4 = cam_trig(t + h, c)
     th4 = th + h * om3
     om4 = om + h * a3
-    a4, p4, q4, r4 = acceleration_jacobian_time_trig(
-        c4, s4, math.cos(th4), math.sin(th4), om4, K, c, JAC_NATURAL
-    )
+    ct4, st4 = rotate(th, ct, st, th4 - th)
+    a4, p4, q4, r4 = acceleration_jacobian_time_trig(c4, s4, ct4, st4, om4, K, c, JAC_NATURAL)
     # the start moved: dX_1 = f, dT_i = 1 - c_i, dh = -1 (so dX_i = f - sum_j a_ij k_j + ...)
     x, y = f_th, f_om
     d1x, d1y = y, r1 + p1 * x + q1 * y
@@ -190,20 +192,24 @@ def rk4_flight_tangent(th, om, h, c, v11, v21, v12, v22):
     ``(th, om, v11, v21, v12, v22)``.
     """
     k = -c[C_GRAV] * c[C_INV_J]
-    a1 = k * math.cos(th)
+    ct, st = math.cos(th), math.sin(th)
+    a1 = k * ct
     om2 = om + 0.5 * h * a1
     th2 = th + 0.5 * h * om
-    a2 = k * math.cos(th2)
+    ct2, st2 = rotate(th, ct, st, th2 - th)
+    a2 = k * ct2
     om3 = om + 0.5 * h * a2
     th3 = th + 0.5 * h * om2
-    a3 = k * math.cos(th3)
+    ct3, st3 = rotate(th, ct, st, th3 - th)
+    a3 = k * ct3
     om4 = om + h * a3
     th4 = th + h * om3
-    a4 = k * math.cos(th4)
-    p1 = -k * math.sin(th)
-    p2 = -k * math.sin(th2)
-    p3 = -k * math.sin(th3)
-    p4 = -k * math.sin(th4)
+    ct4, st4 = rotate(th, ct, st, th4 - th)
+    a4 = k * ct4
+    p1 = -k * st
+    p2 = -k * st2
+    p3 = -k * st3
+    p4 = -k * st4
     # the columns of V through the same stages; no damping in flight (q = 0)
     n11, n21 = _column(v11, v21, h, p1, 0.0, p2, 0.0, p3, 0.0, p4, 0.0)
     n12, n22 = _column(v12, v22, h, p1, 0.0, p2, 0.0, p3, 0.0, p4, 0.0)

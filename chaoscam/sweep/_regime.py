@@ -322,8 +322,9 @@ def regime_map(
         simulated again to this time, with the tangent (the same motion, bit for bit), to
         see whether it stays in the cam's reach and what it is at the end: transient chaos,
         which a label over ``duration`` cannot see (at (omega, xi) = (42.5 rad/s, 0.40) the
-        motion is chaotic for 122 s and then leaves; at xi = 0.28 it is chaotic for ~50 s
-        and then settles on a period 10). Its row gets ``fate`` (the status at the horizon:
+        motion is chaotic for 174 s and then leaves; at xi = 0.3459 a period-6 orbit in bands
+        of ~5e-7 rad reads chaotic over 10-20 s and periodic 6 over 50-100 s, README "Fate
+        of the motion"). Its row gets ``fate`` (the status at the horizon:
         ``"OK"``, ``"LEFT_REACH"``, ...), ``left_at`` (the last section time before it
         stopped, NaN if it stayed) and, if it stayed, ``fate_label`` and ``fate_period``
         (the model's verdict on the continued run's last half, certificate included;

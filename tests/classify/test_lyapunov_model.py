@@ -153,9 +153,9 @@ def test_compiled_postponement_equals_the_stepwise_one(monkeypatch, rows):
 
     monkeypatch.setattr(lm, "advance_pair", counted)
     p = Params(l_lambda=0.011, l_lambda_sigma=0.0015)  # of its 4 waits, 1 ends in agreement
-    fast = lyapunov_model(p, duration=6.0, index=3)
+    fast = lyapunov_model(p, duration=6.0, index=2)
     monkeypatch.setattr(lm, "_postpone", _stepwise_postpone)
-    slow = lyapunov_model(p, duration=6.0, index=3)
+    slow = lyapunov_model(p, duration=6.0, index=2)
     assert fast.postponed > fast.unsynced > 0  # some waits end in agreement, some do not
     assert (fast.exponent, fast.postponed, fast.unsynced) == (
         slow.exponent,

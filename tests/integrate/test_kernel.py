@@ -69,39 +69,74 @@ def test_located_crossing_is_within_1e_10_s_of_the_root():
     assert along(tau) <= 0.0
 
 
-def _textbook_rk4(t, th, om, h, K, c, side=None, rest=None):
+def _textbook_rk4(t, th, om, h, K, c, side=None, rest=None, signs=None):
     """Classical RK4 written out in Python with the kernel's own right-hand side, each stage
-    evaluated at its own time and angle (with ``side``, the Jacobian's stages too: the first
-    on ``side``, the others on ``rest``, by default ``side`` too)."""
+    evaluated at its own time and angle with cos/sin called directly (with ``side``, the
+    Jacobian's stages too: the first on ``side``, the others on ``rest``, by default ``side``
+    too). ``signs`` (12 of +-1) moves stages 2-4's cos/sin of the cam angle and of theta_f by
+    two units of 2^-52 each, a rounding as large as :func:`._physics.rotate`'s."""
+    import math
+
+    from chaoscam.integrate._physics import acceleration_jacobian_trig
     from chaoscam.integrate._tangent import _column
 
-    def f(ts, ths, oms, first=False):
+    def f(ts, ths, oms, stage):
+        thc = k.cam_angle(ts, c)
+        trig = [math.cos(thc), math.sin(thc), math.cos(ths), math.sin(ths)]
+        if signs is not None and stage > 0:
+            trig = [
+                x + 2.0 * 2.0**-52 * e
+                for x, e in zip(trig, signs[4 * stage - 4 : 4 * stage], strict=True)
+            ]
         if side is None:
-            return k.acceleration(ts, ths, oms, K, c), 0.0, 0.0
+            return k.acceleration_trig(*trig, oms, K, c), 0.0, 0.0
         later = side if rest is None else rest
-        return k.acceleration_jacobian(ts, ths, oms, K, c, side if first else later)
+        return acceleration_jacobian_trig(*trig, oms, K, c, side if stage == 0 else later)
 
-    a1, p1, q1 = f(t, th, om, first=True)
+    a1, p1, q1 = f(t, th, om, 0)
     th2, om2 = th + 0.5 * h * om, om + 0.5 * h * a1
-    a2, p2, q2 = f(t + 0.5 * h, th2, om2)
+    a2, p2, q2 = f(t + 0.5 * h, th2, om2, 1)
     th3, om3 = th + 0.5 * h * om2, om + 0.5 * h * a2
-    a3, p3, q3 = f(t + 0.5 * h, th3, om3)
+    a3, p3, q3 = f(t + 0.5 * h, th3, om3, 2)
     th4, om4 = th + h * om3, om + h * a3
-    a4, p4, q4 = f(t + h, th4, om4)
+    a4, p4, q4 = f(t + h, th4, om4, 3)
     state = (
         th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
         om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
     )
     cols = _column.py_func(1.0, 0.0, h, p1, q1, p2, q2, p3, q3, p4, q4)
     cols += _column.py_func(0.0, 1.0, h, p1, q1, p2, q2, p3, q3, p4, q4)
-    return state, cols, h / 6.0 * (q1 + 2.0 * q2 + 2.0 * q3 + q4)
+    return np.array(state), np.array(cols), h / 6.0 * (q1 + 2.0 * q2 + 2.0 * q3 + q4)
+
+
+def test_rotated_cos_and_sin_are_within_two_units_of_the_direct_calls():
+    """_physics.rotate (the addition theorem with Taylor polynomials) gives cos/sin of a + b
+    within 2 units of 2^-52 of math.cos/math.sin for |b| < ROTATE_MAX, and the direct calls
+    beyond."""
+    import math
+
+    from chaoscam.integrate._physics import ROTATE_MAX, rotate
+
+    rng = np.random.default_rng(0)
+    worst = 0.0
+    for _ in range(20_000):
+        a = float(rng.uniform(-4.0, 4.0))
+        b = float(rng.uniform(-ROTATE_MAX, ROTATE_MAX)) * float(rng.choice([1.0, 1e-3, 1e-6]))
+        cr, sr = rotate(a, math.cos(a), math.sin(a), b)
+        worst = max(worst, abs(cr - math.cos(a + b)), abs(sr - math.sin(a + b)))
+    assert worst <= 2.0 * 2.0**-52
+    a, b = 0.3, 2.0 * ROTATE_MAX
+    assert rotate(a, math.cos(a), math.sin(a), b) == (math.cos(a + b), math.sin(a + b))
 
 
 @pytest.mark.parametrize("side", [k.JAC_NATURAL, k.JAC_FLIGHT, k.JAC_CONTACT])
-def test_steps_that_share_trigonometry_are_the_textbook_steps_to_the_bit(side):
-    """rk4_trig / rk4_tangent_trig (stage 1 from the start's geometry, one cam angle for
-    stages 2 and 3, stage 4's cam handed on) and gap_after equal RK4 evaluated stage by stage
-    with the kernel's right-hand side, bit for bit, in flight and in contact."""
+def test_steps_with_rotated_stages_are_the_textbook_steps_to_rounding(side):
+    """rk4_trig / rk4_tangent_trig (stage 1 from the start's geometry, stages 2-4's cos/sin
+    rotated from it, stage 4's cam handed on) equal RK4 evaluated stage by stage with the
+    kernel's right-hand side and direct cos/sin, to within what rounding those cos/sin by two
+    units moves the textbook step (the largest move over 8 random roundings), in flight and in
+    contact. The tangent step's state is rk4_trig's, bit for bit, and gap_after is the
+    geometry at rk4_trig's end."""
     from chaoscam.integrate._events import gap_after
     from chaoscam.integrate._tangent import rk4_tangent_trig
 
@@ -118,15 +153,57 @@ def test_steps_that_share_trigonometry_are_the_textbook_steps_to_the_bit(side):
         g, l1, cdn, *trig = k.geometry_at(t, th, c)
         assert (g, l1, cdn) == k.geometry(t, th, c)
         in_contact += g < 0.0
-        for rest in (side, k.JAC_NATURAL):  # the flow's tangent, the grid map's
-            (th1, om1), cols, div = _textbook_rk4(t, th, om, h, K, c, side, rest)
+        plain = k.rk4_trig(t, th, om, h, K, c, *trig)
+        for rest in (side, k.JAC_NATURAL, None):  # the flow's tangent, the grid map's, none
+            jac = (side, rest) if rest is not None else ()
+            x, cols, div = _textbook_rk4(t, th, om, h, K, c, *jac)
+            moves = [
+                _textbook_rk4(t, th, om, h, K, c, *jac, signs=rng.choice([-1, 1], 12))
+                for _ in range(8)
+            ]
+            env_x = np.max([np.abs(m[0] - x) for m in moves], axis=0)
+            env_cols = np.max([np.abs(m[1] - cols) for m in moves], axis=0)
+            env_div = max(abs(m[2] - div) for m in moves)
+            ulps = 2.0 * np.spacing(np.abs(x))
+            assert np.all(np.abs(np.array(plain[:2]) - x) <= env_x + ulps)
+            if rest is None:
+                continue
             r = rk4_tangent_trig(t, th, om, h, K, c, 1.0, 0.0, 0.0, 1.0, side, rest, *trig)
-            assert r[:2] == (th1, om1) and r[2:6] == cols and r[6] == div
-        assert r[7:] == k.cam_trig(t + h, c)
-        (th1, om1), _, _ = _textbook_rk4(t, th, om, h, K, c)
-        assert k.rk4_trig(t, th, om, h, K, c, *trig)[:2] == (th1, om1)
-        assert gap_after(t, th, om, h, K, c, tuple(trig)) == (*k.geometry(t + h, th1, c), om1)
+            assert r[:2] == plain[:2]
+            assert np.all(
+                np.abs(np.array(r[2:6]) - cols) <= env_cols + 2.0 * np.spacing(np.abs(cols))
+            )
+            assert abs(r[6] - div) <= env_div + 2.0 * np.spacing(abs(div))
+        assert r[7:] == k.cam_trig(t + h, c) == plain[2:]
+        assert gap_after(t, th, om, h, K, c, tuple(trig)) == (
+            *k.geometry(t + h, plain[0], c),
+            plain[1],
+        )
     assert 20 < in_contact < 80
+
+
+def test_the_free_pendulums_step_is_the_same_with_and_without_its_tangent():
+    """rk4_flight and rk4_flight_tangent rotate the same stages: the same state to the bit,
+    and within rounding of the textbook free-pendulum step with direct cosines."""
+    import math
+
+    from chaoscam.integrate._tangent import rk4_flight_tangent
+
+    c = kernel_constants(Params())
+    g = -c[k.C_GRAV] * c[k.C_INV_J]
+    rng = np.random.default_rng(2)
+    for _ in range(200):
+        th, om = float(rng.uniform(-1.5, 1.5)), float(rng.uniform(-20, 20))
+        h = float(rng.choice([2e-6, 3.2e-5, 1e-3]))
+        x = k.rk4_flight(th, om, h, c)
+        assert rk4_flight_tangent(th, om, h, c, 1.0, 0.0, 0.0, 1.0)[:2] == x
+        a1 = g * math.cos(th)
+        a2 = g * math.cos(th + 0.5 * h * om)
+        a3 = g * math.cos(th + 0.5 * h * (om + 0.5 * h * a1))
+        a4 = g * math.cos(th + h * (om + 0.5 * h * a2))
+        om1 = om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+        # each stage's cosine within 2 units: |g| h 2^-51 on theta_f' at most
+        assert abs(x[1] - om1) <= abs(g) * h * 2.0**-51 + 4.0 * math.ulp(om1)
 
 
 @pytest.mark.parametrize("integrator", ["rk4", "adaptive"])

@@ -338,7 +338,7 @@ def test_process_engine_forks_after_the_ensemble_engine_ran(first):
 
 def test_the_table_says_how_long_the_label_was_recorded():
     """recorded_s is the extended run's recorded time where the default classifier extended
-    an undetermined verdict (here 3 s -> 12 s), else the run's own."""
+    an undetermined verdict (here 3 s -> 120 s), else the run's own."""
     from chaoscam import classify_trajectory, simulate
 
     m = regime_map(
@@ -355,7 +355,7 @@ def test_the_table_says_how_long_the_label_was_recorded():
     )
     v = classify_trajectory(traj)
     extended = v.settings.get("extended")
-    assert extended is not None and row["recorded_s"] == extended["recorded_s"] == 12.0
+    assert extended is not None and row["recorded_s"] == extended["recorded_s"] == 120.0
 
 
 @pytest.mark.parametrize("ready", [True, False])

@@ -280,7 +280,7 @@ def test_an_event_that_ends_a_grid_step_leaves_no_term_for_the_next():
     t_end = (n + 1) * p.dt
     th_e = _surface_angle(c, t_end)
     _, l1, cdn = ph.geometry(t_end, th_e, c)
-    th0, om0 = ph.rk4_flight(th_e, (cdn - 2.5e-6) / l1, -p.dt, c)  # one free step back
+    th0, om0 = ph.rk4_flight(th_e, (cdn - 2.4e-6) / l1, -p.dt, c)  # one free step back
 
     def run(kick, n_stop, split=None, impacts=None):
         y, cnt = grid.start((th0 + kick, om0))
