@@ -158,6 +158,47 @@ def test_ctrl_c_inside_an_import_lock_callback_is_sent_again(monkeypatch):
         cli._on_sigint(signal.SIGINT, sys._getframe())
 
 
+@pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_an_interrupt_lost_on_its_way_still_gives_one_line(monkeypatch, capsys, signum, code):
+    """A Ctrl-C (or SIGTERM) whose KeyboardInterrupt a C extension's import turns into an
+    ImportError (numpy: 'PyCapsule_Import could not import module "datetime"', then its
+    "bad install" message and a traceback, exit 1: 2 of 42 Ctrl-Cs 0.1 s into a loaded
+    start-up), or that a guard around an optional import swallows (a clean clone's suite
+    once ran a Ctrl-C'd `simulate` to its end, exit 0), still gives the one line and 130
+    (143). Without a signal an ImportError propagates and a finished run exits 0."""
+    from chaoscam import cli
+
+    handler = {signal.SIGINT: cli._on_sigint, signal.SIGTERM: cli._on_sigterm}[signum]
+    word = "interrupted" if signum == signal.SIGINT else "terminated"
+
+    def converted(argv):
+        try:
+            handler(signum, sys._getframe())
+        except KeyboardInterrupt:
+            raise ImportError('PyCapsule_Import could not import module "datetime"') from None
+
+    def swallowed(argv):
+        try:
+            handler(signum, sys._getframe())
+        except KeyboardInterrupt:
+            pass  # as `except ImportError: pass` around an optional import, once converted
+        return 0
+
+    for dispatch in (converted, swallowed):
+        monkeypatch.setattr(cli, "_dispatch", dispatch)
+        assert cli.main([]) == code
+        assert capsys.readouterr().err.strip() == f"chaoscam: {word}"
+
+    def broken(argv):
+        raise ImportError("not an interrupt")
+
+    monkeypatch.setattr(cli, "_dispatch", broken)
+    with pytest.raises(ImportError, match="not an interrupt"):
+        cli.main([])
+    monkeypatch.setattr(cli, "_dispatch", lambda argv: 0)
+    assert cli.main([]) == 0
+
+
 def test_sigterm_stops_a_single_run_whose_cam_period_holds_many_steps():
     """SIGTERM reaches a `simulate` inside the compiled kernel: with omega = 1 rad/s and
     dt = 2e-8 s a cam period holds 3e8 steps, and a compiled call that ran to the next
