@@ -108,6 +108,12 @@ def rotate(a, ca, sa, b):
     """
     if abs(b) >= ROTATE_MAX:
         return math.cos(a + b), math.sin(a + b)
+    return _turn(ca, sa, b)
+
+
+@njit(cache=True, inline="always")
+def _turn(ca, sa, b):
+    """:func:`rotate`'s addition theorem, for |b| < ROTATE_MAX."""
     b2 = b * b
     cb = 1.0 - b2 * (0.5 - b2 * (1.0 / 24.0 - b2 * (1.0 / 720.0)))
     sb = b * (1.0 - b2 * (1.0 / 6.0 - b2 * (1.0 / 120.0 - b2 * (1.0 / 5040.0))))
@@ -122,7 +128,7 @@ def cam_trig_near(t, s, cc, sc, c):
     b = c[C_OMEGA] * ((t + s) - t)
     if abs(b) >= ROTATE_MAX:
         return cam_trig(t + s, c)
-    return rotate(0.0, cc, sc, b)
+    return _turn(cc, sc, b)
 
 
 @njit(cache=True)

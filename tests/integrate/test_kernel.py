@@ -1,5 +1,7 @@
 """The compiled kernel against the numpy model, and its event location."""
 
+import math
+
 import numpy as np
 import pytest
 from scipy.optimize import brentq
@@ -75,8 +77,6 @@ def _textbook_rk4(t, th, om, h, K, c, side=None, rest=None, signs=None):
     Jacobian's stages too: the first on ``side``, the others on ``rest``, by default ``side``
     too). ``signs`` (12 of +-1) moves stages 2-4's cos/sin of the cam angle and of theta_f by
     two units of 2^-52 each, a rounding as large as :func:`._physics.rotate`'s."""
-    import math
-
     from chaoscam.integrate._physics import acceleration_jacobian_trig
     from chaoscam.integrate._tangent import _column
 
@@ -113,8 +113,6 @@ def test_rotated_cos_and_sin_are_within_two_units_of_the_direct_calls():
     """_physics.rotate (the addition theorem with Taylor polynomials) gives cos/sin of a + b
     within 2 units of 2^-52 of math.cos/math.sin for |b| < ROTATE_MAX, and the direct calls
     beyond."""
-    import math
-
     from chaoscam.integrate._physics import ROTATE_MAX, rotate
 
     rng = np.random.default_rng(0)
@@ -185,8 +183,6 @@ def test_steps_with_rotated_stages_are_the_textbook_steps_to_rounding(side):
 def test_the_free_pendulums_step_is_the_same_with_and_without_its_tangent():
     """rk4_flight and rk4_flight_tangent rotate the same stages: the same state to the bit,
     and within rounding of the textbook free-pendulum step with direct cosines."""
-    import math
-
     from chaoscam.integrate._tangent import rk4_flight_tangent
 
     c = kernel_constants(Params())
