@@ -1,5 +1,5 @@
 """The periodic-orbit certificate (chaoscam._certify) on cells of the (omega, xi) map whose
-truth was settled by 600 s runs, step halving and shooting (README, "The (omega, xi) map
+truth was settled by 600 s runs, step halving and shooting (docs/findings.md, "The (omega, xi) map
 checked against the model"): each case is one the classifier got wrong before this module."""
 
 import dataclasses

@@ -6,8 +6,8 @@ doubles near it (1e-14 m at t = 60 s, 7e-14 m at 300 s), and so does a substep w
 time ``t + tau`` is rounded while the state moved by ``tau``. Both made the gap's sign at the
 end of a chattering sequence a matter of rounding: closings with no approach speed, plastic
 closures followed by openings of 1e-11 s, ever more the later the time, and a largest
-Lyapunov exponent that fell with dt instead of converging (README, "Verdicts through the
-impacts").
+Lyapunov exponent that fell with dt instead of converging (docs/verdicts.md, "Tangent
+exponent and multipliers under step halving").
 """
 
 import math

@@ -72,10 +72,10 @@ def settling():
     keeps 6 bands of 4e-7 to 8e-7 rad; the grid's tangent exponent is positive, and kicks from
     the 40-s extension's end do not return (the largest ends at 0.87 of its 1e-6 rad) while
     those from 100 s do. At dt/2 the 10-20 s window is periodic 6, and 300-s runs at dt, dt/2
-    and dt/4 are periodic 6 over 200-300 s: a verdict that moves with its window (README,
-    "Fate of the motion"). Found by scanning xi at the edges of the period-6 window; a run
-    whose motion settles (xi = 0.28 before 2026-11-28's eighth session) was not found again
-    among 275 (omega, xi) cells."""
+    and dt/4 are periodic 6 over 200-300 s: a verdict that moves with its window
+    (docs/classify-map-report.md, "Fate of the motion"). Found by scanning xi at the edges of
+    the period-6 window; a run whose motion settles (xi = 0.28 before 2026-11-28's eighth
+    session) was not found again among 275 (omega, xi) cells."""
     kw = dict(duration=20.0, transient=10.0, fate=100.0, workers=1)
     omega = Axis("omega", (Params().omega,))
     return {e: regime_map(Axis("xi", (0.3459,)), omega, engine=e, **kw)

@@ -1,6 +1,6 @@
 """The direct perturbation test (chaoscam.tangent.kick_test): finite kicks on the map itself,
-which decide stability where chattering ends in sticking and no tangent can (README, "Tangent
-dynamics checked independently")."""
+which decide stability where chattering ends in sticking and no tangent can (docs/findings.md,
+"Tangent dynamics checked independently")."""
 
 from __future__ import annotations
 
