@@ -1,6 +1,6 @@
 """Convergence of the tangent exponent and of a sticking orbit's Floquet multipliers.
 
-Prints two tables (README, "Verdicts through the impacts"):
+Prints two tables (docs/verdicts.md, "Tangent exponent and multipliers under step halving"):
 
 1. the largest Lyapunov exponent of the default model (Table 1, chaotic, 8 narrow bands) from
    the tangent dynamics, per step ``dt`` and integrator: the mean of runs from two initial

@@ -1,12 +1,12 @@
 """Fate audit of a report's chaotic verdicts: does the chaos last, or settle, or leave?
 
 A label describes the recorded window, and chaos can be transient. The full report continues
-its (omega, xi) map and xi sweep to a fate horizon (``fate=300``: README "Fate of the
-motion"), but not its figure diagrams and its other sensitivity sweeps. This script does the
-same for those: every chaotic (and undetermined) verdict of the deterministic model in the
-stages named (reports/paper-data, written by ``chaoscam paper``; not in the repository) is
-simulated again alone to ``--horizon`` seconds with the tangent (the sweep's parameters, seed
-and index: the same motion, bit for bit) by the sweeps' own fate run
+its (omega, xi) map and xi sweep to a fate horizon (``fate=300``:
+docs/classify-map-report.md, "Fate of the motion"), but not its figure diagrams and its other
+sensitivity sweeps. This script does the same for those: every chaotic (and undetermined) verdict of
+the deterministic model in the stages named (reports/paper-data, written by ``chaoscam paper``; not
+in the repository) is simulated again alone to ``--horizon`` seconds with the tangent (the sweep's
+parameters, seed and index: the same motion, bit for bit) by the sweeps' own fate run
 (``chaoscam.sweep._tasks._fate``: the status at the horizon, and for a run that stayed the
 model's verdict on the run's last half, certificate included, at the run's own step).
 Prints one line per run and the counts: still chaotic, settled on a period, left the cam's

@@ -5,7 +5,7 @@ Figs. 7-10's map), draws K decided runs from each (seeded), replays each alone
 (``chaoscam.sweep.replay``) and classifies it with ``check_step=True``; prints one line per
 run and the report's sentence. The full report runs the same audit with K = 5. With
 --ladder 2,4,8: each drawn run (any label) classified at dt, dt/2, dt/4 and dt/8 and compared
-with the finest (README "The figures' step": --figures 6 --per-sweep 100 --ladder 2,4,8).
+with the finest (docs/findings.md, "The figures' step": --figures 6 --per-sweep 100 --ladder 2,4,8).
 Writes nothing.
 
 Usage: python analyses/step_audit.py [--figures 4,6,7] [--per-sweep K] [--seed N]

@@ -1,6 +1,6 @@
 """The two tangents through located events: the flow's saltation matrix and the grid map's own.
 
-Prints the tables behind README, "Tangent dynamics checked independently":
+Prints the tables behind docs/findings.md, "Tangent dynamics checked independently":
 
 1. the largest Lyapunov exponent lambda_1 [1/s] from the tangent dynamics, per configuration,
    with the flow's tangent at events (``tangent_events="flow"``, the default) at dt, the grid
@@ -76,8 +76,8 @@ def multiplier_table() -> None:
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
 KICK_CASES = {  # (changes, label from kicks and long runs at dt, period)
-    # (32.5, 0.5) is periodic 6 at dt and periodic 12 at dt/2 (README, "Fate of the motion":
-    # the 275-cell map at dt and dt/2); the kicks test the dt orbit.
+    # (32.5, 0.5) is periodic 6 at dt and periodic 12 at dt/2 (docs/classify-map-report.md,
+    # "Fate of the motion": the 275-cell map at dt and dt/2); the kicks test the dt orbit.
     "(32.5, 0.5)": ({"omega": 32.5, "xi": 0.5}, "periodic", 6),
     "xi = 0.525": ({"xi": 0.525}, "periodic", 8),
     "(45, 0.4)": ({"omega": 45.0, "xi": 0.4}, "chaotic", None),

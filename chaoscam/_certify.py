@@ -352,7 +352,7 @@ def _kicked(p: Params, points: np.ndarray, n: int, extra: dict) -> tuple[bool, s
     sticking that map is not smooth below the ~1e-8 rad of its event jitter (ξ = 0.525: the
     grid tangent's |μ|max is 5.9, central differences at 1e-9 give 5.1, at 1e-8 0.41, and the
     flow tangent 0.05), so an attracting orbit can read unstable. Kicks of 1e-7 and more lie
-    above that scale. Measured (README, "Tangent dynamics checked independently"):
+    above that scale. Measured (docs/findings.md, "Tangent dynamics checked independently"):
     ``kick_test`` agrees with all 24 deterministic settled labels of the labelled and holdout
     sets. At half the step it refuses what is the grid's alone: at ξ = 0.525 kicks return at
     dt (1e-3 of themselves) and not at dt/2 (0.58), where 300 s runs keep 8 bands whose twins

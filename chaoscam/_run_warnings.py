@@ -28,7 +28,7 @@ def resolution_warning(p: Params) -> str | None:
         f"dt = {p.dt:g} s resolves the contact oscillation (period {period:.3g} s) with "
         f"{few}; use dt <= {period / 40:.2g} s (40 steps), and check the verdict "
         "at half the step (classify_trajectory(..., check_step=True)): where chattering "
-        "dominates, 40 steps can still overstate the exponent (README)"
+        "dominates, 40 steps can still overstate the exponent (docs/findings.md)"
     )
 
 

@@ -197,7 +197,7 @@ def _rk4_tangent_run(traj: Trajectory, duration: float) -> Trajectory:
             "unless the run carried one, the orbit certificate, any extension, and the section "
             "unless the run kept a series), which the adaptive tolerances do not refine: to "
             "converge the verdict, refine dt "
-            '(README "The figures\' step")',
+            '(docs/findings.md, "The figures\' step")',
         )
     return simulate(
         traj.params.replace(integrator="rk4"),

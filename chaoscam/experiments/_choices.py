@@ -89,7 +89,7 @@ def choices_finding(
         + paper_regimes(found, "among them")
         + (
             f" Not swept: the chattering limit (v_min = {p.v_min:g}, v_chatter = "
-            f"{p.v_chatter:g} m/s; numerical, its convergence measured in the README) and, "
+            f"{p.v_chatter:g} m/s; numerical, its convergence measured in docs/verdicts.md) and, "
             f"for a random line length (σ > 0, not Table 1's), when a length is drawn "
             f"(resample = {p.resample})."
         )

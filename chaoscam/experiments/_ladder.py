@@ -5,7 +5,7 @@ halved once. The ladder follows each drawn run (any label, undetermined too) dow
 halvings, each rung the same realization (:func:`chaoscam.sweep.replay` with ``refine``)
 classified as the sweeps classify (``classify_trajectory``, undetermined verdicts extended),
 and compares every rung with the finest: how many labels agree and how far the tangent
-exponent moves. Measured with it (README "The figures' step"): Fig. 6 at 40 RK4 steps per
+exponent moves. Measured with it (docs/findings.md, "The figures' step"): Fig. 6 at 40 RK4 steps per
 contact period, 20 of its 42 labels differ from dt/8's; at 160 steps, 9.
 
 ``python analyses/step_audit.py --ladder 2,4,8`` runs it on a report's data folder.

@@ -2,8 +2,8 @@
 
 The model's default ``dt`` (2e-6 s) resolves the Hertz contact oscillation with 46 RK4 steps
 at l_λ = 8 mm and 30 at 18 mm. Followed down a ladder of steps (``analyses/step_audit.py
---ladder``, README "The figures' step"), that is enough for most labels but not for all, and
-not for the exponent:
+--ladder``, docs/findings.md, "The figures' step"), that is enough for most labels but not
+for all, and not for the exponent:
 
 * Fig. 4 (18 values of l_λ, one initial condition): at dt the three period-8 windows at
   8.75, 13.5 and 15.25 mm read chaotic; at dt/4 and dt/8 all three are certified period 8,
@@ -47,7 +47,7 @@ FIG6_STEPS = {True: 40, False: FULL_STEPS}
 
 FIGS7_10_STEP_NOTE = (
     "; the model's default dt, whose labels hold when it is refined (measured: 100 of 100 runs "
-    "at dt/2, 39 of 39 at dt/4: README), though its exponent is about 2.5x dt/4's"
+    "at dt/2, 39 of 39 at dt/4: docs/findings.md), though its exponent is about 2.5x dt/4's"
 )
 """Figs. 7-10's comparison, on their step (the default)."""
 
@@ -81,7 +81,7 @@ def fig4_step_note(stiffest: Params, dt: float) -> str:
     here = f"; dt = {dt:g} s ({steps:.0f} RK4 steps per contact period {at}"
     measured = (
         "measured at the default 2e-6 s (30 steps), the period-8 windows at 8.75, 13.5 and "
-        "15.25 mm read chaotic and the exponent is about twice dt/8's (README)"
+        "15.25 mm read chaotic and the exponent is about twice dt/8's (docs/findings.md)"
     )
     if steps < FULL_STEPS * 0.9:
         coarse = "a step at which labels are not converged"
@@ -94,7 +94,7 @@ def fig6_step_note(stiffest: Params, quick: bool) -> str:
     here = f"; {FIG6_STEPS[quick]} RK4 steps per contact period at D = {stiffest.D:g}"
     measured = (
         "measured: at 40 the exponent is overstated up to 5x and 20 of 42 labels differ from "
-        "dt/8's, at 160 9 of 42 (README)"
+        "dt/8's, at 160 9 of 42 (docs/findings.md)"
     )
     if quick:
         coarse = "a step at which labels are not converged"

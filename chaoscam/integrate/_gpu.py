@@ -37,7 +37,7 @@ member-seconds a second, 11.3x 2 CPU threads of that machine (the targets ask 3,
 trajectories a second and 200x). One launch ran 2.4 of a warp's 32 threads at a time, not
 waiting on memory: members of a warp take different branches. (The earlier sessions'
 "as slow as 2 CPU cores" was the host's quadratic set-up of a batch, since fixed.)
-See the README's "Ensembles and the GPU" and benchmarks/PROFILE.md.
+See docs/speed.md, "The GPU", and benchmarks/PROFILE.md.
 
 numba-cuda is imported lazily, on first use: ``import chaoscam`` never imports it.
 """

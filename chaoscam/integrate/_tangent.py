@@ -17,8 +17,8 @@ tangents (``Params.tangent_events``):
   but not in its derivative; the grid map then depends on the event time (sensitivity
   l1/v, 2e5 s/rad at a 2.5e-6 m/s closing) in a way the saltation matrix does not carry:
   1-30 % too much growth a chatter cycle on the xi = 0.45 period 6 at dt = 2e-6 s (a
-  factor ~3 over the period), shrinking as h^2 (README, "Tangent dynamics checked
-  independently").
+  factor ~3 over the period), shrinking as h^2 (docs/findings.md, "Tangent dynamics
+  checked independently").
 - ``"grid"``: V is the derivative of the RK4 grid map itself: each stage's Jacobian on the
   side its stage lies on, and at each event the event time's derivative through the
   locating substep's own velocity, the jump's derivatives, and the next substep's

@@ -203,7 +203,7 @@ class Params:
             "chattering sequence and replaced by its accumulation point, a plastic closure "
             "(gap rate 0; Nordmark & Piiroinen 2009). Bounces slower than this last "
             "< 2 xi v / ((1 - xi) |delta''|) ~ 1e-7 s in all; 0 = simulate every bounce "
-            "(Zeno: the count then depends on dt). Measured convergence: README",
+            "(Zeno: the count then depends on dt). Measured convergence: docs/verdicts.md",
             "m/s",
             _NONNEG,
         ),

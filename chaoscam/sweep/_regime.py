@@ -323,9 +323,9 @@ def regime_map(
         see whether it stays in the cam's reach and what it is at the end: transient chaos,
         which a label over ``duration`` cannot see (at (omega, xi) = (42.5 rad/s, 0.40) the
         motion is chaotic for 174 s and then leaves; at xi = 0.3459 a period-6 orbit in bands
-        of ~5e-7 rad reads chaotic over 10-20 s and periodic 6 over 50-100 s, README "Fate
-        of the motion"). Its row gets ``fate`` (the status at the horizon:
-        ``"OK"``, ``"LEFT_REACH"``, ...), ``left_at`` (the last section time before it
+        of ~5e-7 rad reads chaotic over 10-20 s and periodic 6 over 50-100 s,
+        docs/classify-map-report.md, "Fate of the motion"). Its row gets ``fate`` (the status at the
+        horizon: ``"OK"``, ``"LEFT_REACH"``, ...), ``left_at`` (the last section time before it
         stopped, NaN if it stayed) and, if it stayed, ``fate_label`` and ``fate_period``
         (the model's verdict on the continued run's last half, certificate included;
         :func:`chaoscam.sweep._tasks.fate_fields`), and each cell ``n_transient`` (how many

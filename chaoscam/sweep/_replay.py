@@ -5,7 +5,7 @@ that fixes its realization: the base parameters, the swept values, the window (d
 transient), the seed and the simulate index, and for a diagram the initial state (which a
 continued branch took from the previous value's run). :func:`replay` simulates that
 realization with :func:`chaoscam.simulate`, the run the sweep classified bit for bit (every
-engine runs the same compiled kernel per member, README "Compilation"), so one cell or value
+engine runs the same compiled kernel per member, docs/speed.md, "Compilation"), so one cell or value
 can be looked at, plotted, or classified again with other options, for instance at half the
 step (``classify_trajectory(replay(rm, row), check_step=True)``).
 """
