@@ -11,9 +11,12 @@ loaded: a fingerprint of all its ``.py`` files is kept beside numba's cache file
 it differs the package's cache files are removed, so that every function compiles from the
 current sources (on a fresh install that is what happens anyway).
 
-Only the cache beside the sources is handled (``__pycache__``, where numba writes when that
-folder is writable: an editable install, a checkout); where numba has to use its per-user
-cache folder instead, nothing is removed.
+The cache handled is the one numba uses for the package's folder: ``NUMBA_CACHE_DIR`` when it
+is set (numba then writes there even for a checkout), else ``__pycache__`` beside the sources
+when that folder is writable (an editable install, a checkout), else numba's per-user cache
+folder (a read-only install); numba's own cache locators say which (:func:`cache_folder`).
+Until 2026-11-28's ninth session only ``__pycache__`` was handled, and a checkout run with
+``NUMBA_CACHE_DIR`` set kept a stale callee (tested).
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ import hashlib
 import os
 from pathlib import Path
 
-__all__ = ["STAMP", "fingerprint", "guard"]
+__all__ = ["STAMP", "cache_folder", "fingerprint", "guard"]
 
 STAMP = "chaoscam-sources.sha256"
 """The fingerprint's file, in the package's ``__pycache__``."""
@@ -38,14 +41,34 @@ def fingerprint(folder: Path) -> str:
     return h.hexdigest()
 
 
-def guard(folder: str | os.PathLike) -> bool:
-    """Remove numba's cache files (``*.nbi``, ``*.nbc``) from ``folder/__pycache__`` when
-    ``folder``'s sources differ from those they were compiled from, and record the new
-    fingerprint. Returns whether any file was removed. Processes that import the package at
-    the same moment may both remove the files; neither has compiled anything yet, so
-    nothing is lost. A folder that cannot be written is left as it is."""
+def cache_folder(folder: str | os.PathLike) -> Path:
+    """The folder where numba keeps the cache of functions defined in ``folder``'s modules:
+    the path of the first of numba's cache locators that accepts a file of ``folder`` (the
+    order numba itself tries them in), or ``folder/__pycache__`` when numba's locators cannot
+    be asked (they are not public API)."""
     folder = Path(folder)
-    cache = folder / "__pycache__"
+    try:
+        from numba.core.caching import CacheImpl
+
+        probe = str((folder / "__init__.py").resolve())
+        for locator in CacheImpl._locator_classes:
+            found = locator.from_function(cache_folder, probe)
+            if found is not None:
+                return Path(found.get_cache_path())
+    except (ImportError, AttributeError, TypeError, OSError):
+        pass
+    return folder / "__pycache__"
+
+
+def guard(folder: str | os.PathLike) -> bool:
+    """Remove numba's cache files (``*.nbi``, ``*.nbc``) for ``folder``'s modules from the
+    folder numba keeps them in (:func:`cache_folder`) when ``folder``'s sources differ from
+    those they were compiled from, and record the new fingerprint there. Returns whether any
+    file was removed. Processes that import the package at the same moment may both remove
+    the files; neither has compiled anything yet, so nothing is lost. A cache folder that
+    cannot be written is left as it is."""
+    folder = Path(folder)
+    cache = cache_folder(folder)
     stamp = cache / STAMP
     now = fingerprint(folder)
     try:
@@ -55,7 +78,7 @@ def guard(folder: str | os.PathLike) -> bool:
         pass  # no fingerprint yet: whatever is cached may be from any sources
     removed = False
     try:
-        cache.mkdir(exist_ok=True)
+        cache.mkdir(parents=True, exist_ok=True)
         for path in [*cache.glob("*.nbi"), *cache.glob("*.nbc")]:
             try:
                 path.unlink()
