@@ -297,9 +297,8 @@ def kick_test(
     The tangent (either: ``Params.tangent_events``) is an infinitesimal derivative, and where
     chattering ends in sticking the grid map is not differentiable at the scale of its event
     jitter: at ξ = 0.525 the grid tangent's |μ|max is 5.9 while kicks of 1e-9 to 1e-6 return
-    to a 1e-8 floor (docs/findings.md, "Tangent dynamics checked
-    independently"). This test measures at
-    finite sizes instead. Measured at dt from the last section point of a 130 s run (100 s
+    to a 1e-8 floor (docs/findings.md, "Tangent dynamics checked independently"). This test
+    measures at finite sizes. Measured at dt from the last section point of a 130 s run (100 s
     transient), n the period (8 for chaos): ``returns`` agrees with the label of all 24
     deterministic settled configurations of the labelled and holdout sets (tests/data: 15
     periodic, largest final separation over kick 3e-4; 9 chaotic, 0.67 to 5e6), returns on
