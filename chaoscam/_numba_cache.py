@@ -28,7 +28,7 @@ from pathlib import Path
 __all__ = ["STAMP", "cache_folder", "fingerprint", "guard"]
 
 STAMP = "chaoscam-sources.sha256"
-"""The fingerprint's file, in the package's ``__pycache__``."""
+"""The fingerprint's file, in the folder numba caches the package in (:func:`cache_folder`)."""
 
 
 def fingerprint(folder: Path) -> str:
