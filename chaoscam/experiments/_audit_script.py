@@ -4,7 +4,8 @@ The full report audits 5 runs per sweep (:mod:`._step_audit`); this reads the sw
 wrote into its data folder and audits as many as asked (``--per-sweep``, every decided run of
 a sweep with a large number), printing one line per run and the report's sentence. With
 ``--ladder 2,4,8`` it follows the drawn runs (any label) down several halvings of the step
-instead (:mod:`._ladder`). It writes nothing.
+instead (:mod:`._ladder`); ``--label undetermined`` follows only the runs a report left
+undetermined, and ``--figures s`` reads the sensitivity sweeps too. It writes nothing.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from pathlib import Path
 from ._paper import FULL_EXTEND_TO, G_FIG6, _fig6_tag
 from ._step_audit import AUDIT_SEED, PER_SWEEP, step_audit, sweep_names
 
-__all__ = ["SWEEP_FILES", "read_sweeps", "audit_script"]
+__all__ = ["SENSITIVITY_KEY", "SWEEP_FILES", "read_sweeps", "audit_script"]
 
 SWEEP_FILES = {
     4: ("Fig. 4", ["fig4.parquet"]),
@@ -23,26 +24,62 @@ SWEEP_FILES = {
 }
 """The paper figures that are sweeps: number -> (name, their files in the data folder)."""
 
+SENSITIVITY_KEY = "s"
+"""``--figures`` names the sensitivity stage's sweeps so: every ``sensitivity-*.parquet``
+of the folder (diagrams and the (ω, ξ) map), each named by its file."""
+
 
 def read_sweeps(folder: Path, figures) -> list[tuple[str, object]]:
-    """``(name, sweep)`` for each sweep of ``figures`` in the report's data ``folder``; a
-    missing file is a FileNotFoundError that names it and the command that writes it."""
-    from ..sweep import read_bifurcation, read_regime_map
-
+    """``(name, sweep)`` for each sweep of ``figures`` (numbers of :data:`SWEEP_FILES`, or
+    :data:`SENSITIVITY_KEY`) in the report's data ``folder``; a missing file is a
+    FileNotFoundError that names it and the command that writes it."""
     out = []
     for number in figures:
+        if number == SENSITIVITY_KEY:
+            out += _sensitivity_sweeps(folder)
+            continue
         name, files = SWEEP_FILES[number]
         found = []
         for file in files:
             path = folder / file
             if not path.is_file():
-                how = f"`python analyses/fig{number}.py {folder}`"
-                if folder.name == "paper-data":  # where chaoscam paper writes its data
-                    how = f"`chaoscam paper --out {folder.parent}/paper.html` or {how}"
-                raise FileNotFoundError(f"{path} is missing: write it with {how}")
-            found.append(read_regime_map(path) if number == 7 else read_bifurcation(path))
+                raise FileNotFoundError(f"{path} is missing: write it with {_how(folder, number)}")
+            found.append(_read_sweep(path))
         out += zip(sweep_names(name, found), found, strict=True)
     return out
+
+
+def _how(folder: Path, number) -> str:
+    """The command that writes figure ``number``'s data (or the sensitivity sweeps') into
+    ``folder``."""
+    script = "sensitivity" if number == SENSITIVITY_KEY else f"fig{number}"
+    how = f"`python analyses/{script}.py {folder}`"
+    if folder.name == "paper-data":  # where chaoscam paper writes its data
+        how = f"`chaoscam paper --out {folder.parent}/paper.html` or {how}"
+    return how
+
+
+def _read_sweep(path: Path):
+    """The diagram or regime map in ``path``, as its sweep record says it is."""
+    from ..sweep import read_bifurcation, read_regime_map
+    from ..sweep._checkpoint import read_sweep_metadata
+
+    kind = ((read_sweep_metadata(path) or {}).get("config") or {}).get("kind")
+    return read_regime_map(path) if kind == "regime_map" else read_bifurcation(path)
+
+
+def _sensitivity_sweeps(folder: Path) -> list[tuple[str, object]]:
+    """``(file stem, sweep)`` for every sensitivity sweep in ``folder``, by name."""
+    paths = sorted(
+        p
+        for p in folder.glob("sensitivity-*.parquet")
+        if not p.name.endswith((".verdicts.parquet", ".cells.parquet"))
+    )
+    if not paths:
+        raise FileNotFoundError(
+            f"{folder}: no sensitivity-*.parquet: write them with {_how(folder, SENSITIVITY_KEY)}"
+        )
+    return [(p.stem, _read_sweep(p)) for p in paths]
 
 
 def audit_script(argv: list[str] | None = None) -> int:
@@ -50,6 +87,8 @@ def audit_script(argv: list[str] | None = None) -> int:
     with one line; Ctrl-C: exit 130 with one line. Returns 0 when it finishes."""
     import argparse
     import sys
+
+    from ..sweep._stats import LABEL_ORDER
 
     ap = argparse.ArgumentParser(
         prog="analyses/step_audit.py",
@@ -67,7 +106,8 @@ def audit_script(argv: list[str] | None = None) -> int:
         "--figures",
         default=",".join(map(str, SWEEP_FILES)),
         metavar="N,N",
-        help="which figures' sweeps, comma-separated (default: 4,6,7; 7 stands for Figs. 7-10)",
+        help="which figures' sweeps, comma-separated (default: 4,6,7; 7 stands for Figs. 7-10, "
+        f"{SENSITIVITY_KEY} for every sensitivity-*.parquet of the folder)",
     )
     ap.add_argument(
         "--per-sweep",
@@ -94,13 +134,20 @@ def audit_script(argv: list[str] | None = None) -> int:
         "for each K, powers of two >= 2 in increasing order (e.g. 2,4,8), and compared with "
         "the finest",
     )
+    ap.add_argument(
+        "--label",
+        default=None,
+        choices=LABEL_ORDER,
+        help="with --ladder: follow only the runs the sweep labelled so (e.g. undetermined)",
+    )
     ap.add_argument("--workers", type=int, default=None, help="cores (default: all)")
     args = ap.parse_args(sys.argv[1:] if argv is None else argv)
     from ..sweep._backends import local_workers
 
     figures = [f.strip() for f in args.figures.split(",")]
-    if not all(f in map(str, SWEEP_FILES) for f in figures):
-        ap.error(f"--figures {args.figures}: choose among {', '.join(map(str, SWEEP_FILES))}")
+    keys = [*map(str, SWEEP_FILES), SENSITIVITY_KEY]
+    if not all(f in keys for f in figures):
+        ap.error(f"--figures {args.figures}: choose among {', '.join(keys)}")
     if args.per_sweep < 1:
         ap.error(f"--per-sweep {args.per_sweep}: must be at least 1")
     if not 0 < args.extend_to < float("inf"):
@@ -110,10 +157,13 @@ def audit_script(argv: list[str] | None = None) -> int:
     halvings = _halvings(args.ladder) if args.ladder is not None else None
     if halvings == ():
         ap.error(f"--ladder {args.ladder}: give powers of two >= 2 in increasing order, e.g. 2,4,8")
+    if args.label is not None and halvings is None:
+        ap.error(f"--label {args.label}: only with --ladder (the audit takes decided runs)")
     try:
         if args.workers is not None:
             local_workers(args.workers)
-        sweeps = read_sweeps(Path(args.folder), dict.fromkeys(map(int, figures)))
+        wanted = (f if f == SENSITIVITY_KEY else int(f) for f in figures)
+        sweeps = read_sweeps(Path(args.folder), dict.fromkeys(wanted))
     except (OSError, ValueError) as err:
         ap.error(str(err))  # exit 2
     try:
@@ -153,7 +203,13 @@ def _ladder(sweeps, halvings: tuple[int, ...], args) -> int:
     from ._ladder import ladder_sentence, step_ladder, step_name
 
     rows = step_ladder(
-        sweeps, halvings, args.per_sweep, args.extend_to, workers=args.workers, seed=args.seed
+        sweeps,
+        halvings,
+        args.per_sweep,
+        args.extend_to,
+        workers=args.workers,
+        seed=args.seed,
+        label=args.label,
     )
     for r in rows:
         rungs = " | ".join(f"{step_name(h)}: {tag} ({lam:+.3f})" for h, tag, lam in r.rungs)

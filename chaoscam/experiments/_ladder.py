@@ -3,7 +3,8 @@
 The step audit (:mod:`._step_audit`) asks whether a decided label holds when the step is
 halved once. The ladder follows each drawn run (any label, undetermined too) down several
 halvings, each rung the same realization (:func:`chaoscam.sweep.replay` with ``refine``)
-classified as the sweeps classify (``classify_trajectory``, undetermined verdicts extended),
+classified as the sweeps classify (``classify_trajectory``, undetermined verdicts extended;
+a run that leaves the cam's reach or diverges labelled by its status, as the sweeps label it),
 and compares every rung with the finest: how many labels agree and how far the tangent
 exponent moves. Measured with it (docs/findings.md, "The figures' step"): Fig. 6 at 40 RK4 steps per
 contact period, 20 of its 42 labels differ from dt/8's; at 160 steps, 9.
@@ -24,7 +25,14 @@ import numpy as np
 from ._sensitivity import verdict_tag
 from ._step_audit import AUDIT_SEED, _where, draw_rows, run_jobs, sampled_rows
 
-__all__ = ["LadderRow", "ladder_sample", "ladder_sentence", "step_ladder", "step_name"]
+__all__ = [
+    "LadderRow",
+    "ladder_sample",
+    "ladder_sentence",
+    "settled",
+    "step_ladder",
+    "step_name",
+]
 
 
 @dataclass(frozen=True)
@@ -55,6 +63,7 @@ def _exponent(verdict) -> float:
 def _ladder_one(job: tuple) -> LadderRow:
     """Classify one run at each rung (a pool task: plain arguments)."""
     from ..classify import classify_trajectory
+    from ..integrate import Status
     from ..sweep import replay
 
     figure, settings, row, halvings, extend_to = job
@@ -63,7 +72,11 @@ def _ladder_one(job: tuple) -> LadderRow:
     with warnings.catch_warnings():  # the model's warnings came with the sweep's own run
         warnings.simplefilter("ignore", RuntimeWarning)
         for h in (0, *halvings):
-            v = classify_trajectory(replay(settings, row, refine=h), extend_to=extend_to)
+            traj = replay(settings, row, refine=h)
+            if traj.status != Status.OK:  # "left_reach" or "diverged"
+                rungs.append((h, traj.status.label, math.nan))
+                continue
+            v = classify_trajectory(traj, extend_to=extend_to)
             rungs.append((h, verdict_tag(v.label, v.period), _exponent(v)))
     return LadderRow(
         figure,
@@ -82,14 +95,19 @@ def step_ladder(
     workers=None,
     *,
     seed: int = AUDIT_SEED,
+    label: str | None = None,
 ) -> list[LadderRow]:
     """``per_sweep`` runs of each ``(figure name, sweep)`` drawn with ``seed``
-    (:func:`ladder_sample`), each classified at the sweep's step and at ``dt / 2**h`` for
-    each ``h`` in ``halvings`` (increasing, >= 1), an undetermined verdict extended up to
-    ``extend_to`` seconds recorded, on ``workers`` local processes."""
+    (:func:`ladder_sample`; only those the sweep labelled ``label`` when given, e.g.
+    "undetermined"), each classified at the sweep's step and at ``dt / 2**h`` for each ``h``
+    in ``halvings`` (increasing, >= 1), an undetermined verdict extended up to ``extend_to``
+    seconds recorded, on ``workers`` local processes."""
+
+    def sample(table, k, seed):
+        return ladder_sample(table if label is None else table[table["label"] == label], k, seed)
+
     jobs = [
-        (*job, tuple(halvings), extend_to)
-        for job in sampled_rows(sweeps, ladder_sample, per_sweep, seed)
+        (*job, tuple(halvings), extend_to) for job in sampled_rows(sweeps, sample, per_sweep, seed)
     ]
     return run_jobs(_ladder_one, jobs, workers)
 
@@ -124,5 +142,32 @@ def ladder_sentence(rows: list[LadderRow]) -> str:
         f"Step ladder: {len(rows)} runs of {figures} classified at "
         f"{', '.join(map(step_name, steps))} ({work:.0f} s of work). Against {step_name(finest)}: "
         + "; ".join(parts)
+        + "."
+        + _settled_sentence(rows, steps)
+    )
+
+
+def settled(row: LadderRow) -> str | None:
+    """The label ``row`` keeps at every halved step (every rung but the sweep's own), when
+    that label is a decision (not "undetermined"); None when the halved rungs disagree or
+    the ladder has none. A run settled so has an answer that the step no longer moves; one
+    that is not sits where the step decides (a window's edge, an escape time)."""
+    tags = {tag for h, tag, _ in row.rungs if h > 0}
+    if len(tags) != 1:
+        return None
+    (tag,) = tags
+    return None if tag == "undetermined" else tag
+
+
+def _settled_sentence(rows: list[LadderRow], steps: list[int]) -> str:
+    """ " Settled at dt/2 ... dt/8: k of n (chaotic 6, period 12 2)." ("" with no halving)."""
+    if len(steps) < 2:
+        return ""
+    found = [t for t in map(settled, rows) if t is not None]
+    counts = ", ".join(f"{t} {found.count(t)}" for t in sorted(set(found), key=found.index))
+    halved = ", ".join(map(step_name, steps[1:]))
+    return (
+        f" Settled (one decided label at {halved}): {len(found)} of {len(rows)}"
+        + (f" ({counts})" if found else "")
         + "."
     )

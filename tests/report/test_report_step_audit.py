@@ -148,7 +148,10 @@ def test_audit_script_reads_a_reports_data_and_refuses_bad_input(tmp_path, capsy
         (["--extend-to", "-1", str(tmp_path)], "--extend-to -1.0: must be"),
         (["--extend-to", "inf", str(tmp_path)], "--extend-to inf: must be a finite"),
         (["--seed", "-1", str(tmp_path)], "--seed -1: must be an integer >= 0"),
-        (["--figures", "4,5", str(tmp_path)], "--figures 4,5: choose among 4, 6, 7"),
+        (["--figures", "4,5", str(tmp_path)], "--figures 4,5: choose among 4, 6, 7, s"),
+        (["--figures", "s", str(tmp_path)], "sensitivity-*.parquet: write them with"),
+        (["--label", "chaotic", str(tmp_path)], "--label chaotic: only with --ladder"),
+        (["--ladder", "2", "--label", "odd", str(tmp_path)], "invalid choice: 'odd'"),
         (["--ladder", "3", str(tmp_path)], "--ladder 3: give powers of two >= 2"),
         (["--ladder", "4,2", str(tmp_path)], "--ladder 4,2: give powers of two >= 2"),
         (["--ladder", "1,2", str(tmp_path)], "--ladder 1,2: give powers of two >= 2"),
@@ -157,6 +160,64 @@ def test_audit_script_reads_a_reports_data_and_refuses_bad_input(tmp_path, capsy
         with pytest.raises(SystemExit) as stop:
             audit_script(bad)
         assert stop.value.code == 2 and says in capsys.readouterr().err
+
+
+def test_audit_reads_the_sensitivity_sweeps_and_a_ladder_follows_one_label(
+    tmp_path, monkeypatch, small_diagram
+):
+    """--figures s: every sensitivity-*.parquet of the folder (not its companions), each
+    named by its file, read as the kind its record says; --label: the ladder draws only rows
+    with that label (the jobs it would run, captured instead of run)."""
+    from chaoscam.experiments import _ladder
+    from chaoscam.experiments._audit_script import read_sweeps
+
+    small_diagram.to_parquet(tmp_path / "sensitivity-e.parquet")
+    small_diagram.to_parquet(tmp_path / "fig4.parquet")
+    got = read_sweeps(tmp_path, ["s", 4])
+    assert [name for name, _ in got] == ["sensitivity-e", "Fig. 4"]
+    assert got[0][1].verdicts.equals(small_diagram.verdicts)
+    monkeypatch.setattr(_ladder, "run_jobs", lambda task, jobs, workers: jobs)
+    table = small_diagram.verdicts
+    mixed = table.assign(label=["undetermined", "periodic", "undetermined"][: len(table)])
+    sweep = type("Sweep", (), {"config": small_diagram.config, "verdicts": mixed})()
+    jobs = _ladder.step_ladder([("S", sweep)], (1,), 5, None, label="undetermined")
+    assert [job[2]["label"] for job in jobs] == ["undetermined"] * 2
+    assert len(_ladder.step_ladder([("S", sweep)], (1,), 5, None)) == len(table)
+    # a rung whose run leaves the cam's reach is labelled so, as a sweep labels it, with no
+    # exponent (not "undetermined" with the verdict's reason)
+    import chaoscam.sweep
+    from chaoscam.integrate import Status
+
+    left = type("Run", (), {"status": Status.LEFT_REACH})()
+    monkeypatch.setattr(chaoscam.sweep, "replay", lambda settings, row, refine: left)
+    job = jobs[0][:3] + ((1,), None)
+    row = _ladder._ladder_one(job)
+    assert [tag for _, tag, _ in row.rungs] == ["left_reach", "left_reach"]
+    assert all(lam != lam for _, _, lam in row.rungs)  # NaN
+
+
+def test_a_ladder_counts_the_runs_the_step_no_longer_moves():
+    """settled: one decided label at every halved step (dt/2 down), not the sweep's own
+    step; "undetermined" everywhere, or labels that differ, are not settled."""
+    from chaoscam.experiments._ladder import LadderRow, ladder_sentence, settled
+
+    def row(*tags):
+        return LadderRow("F", "x", tags[0], tuple((h, t, 0.1) for h, t in enumerate(tags)), 1.0)
+
+    rows = [
+        row("undetermined", "chaotic", "chaotic", "chaotic"),  # settled: chaotic
+        row("period 6", "period 12", "period 12", "period 12"),  # settled: period 12
+        row("chaotic", "undetermined", "undetermined", "period 8"),  # not
+        row("chaotic", "left_reach", "chaotic", "left_reach"),  # not
+        row("chaotic", "undetermined", "undetermined", "undetermined"),  # not: no decision
+        row("undetermined", "chaotic", "chaotic", "chaotic"),  # settled: chaotic
+    ]
+    assert [settled(r) for r in rows] == ["chaotic", "period 12", None, None, None, "chaotic"]
+    text = ladder_sentence(rows)
+    assert text.endswith(
+        "Settled (one decided label at dt/2, dt/4, dt/8): 3 of 6 (chaotic 2, period 12 1)."
+    )
+    assert settled(row("chaotic")) is None and "Settled" not in ladder_sentence([row("x")])
 
 
 @pytest.mark.slow  # 9 s: the ladder (an analysis tool); the audit is tested by default
