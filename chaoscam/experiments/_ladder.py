@@ -53,18 +53,13 @@ ladder_sample = draw_rows
 """Up to ``k`` rows of a sweep's table, whatever their label (:func:`._step_audit.draw_rows`)."""
 
 
-def _exponent(verdict) -> float:
-    """The tangent exponent as a sweep's table keeps it (``ev_exponent``; NaN without one)."""
-    from ..sweep._tasks import verdict_fields
-
-    return verdict_fields(verdict)["evidence"].get("exponent", math.nan)
-
-
 def _ladder_one(job: tuple) -> LadderRow:
-    """Classify one run at each rung (a pool task: plain arguments)."""
+    """Classify one run at each rung (a pool task: plain arguments), into the fields a
+    sweep's table keeps (``verdict_fields``, or ``status_fields`` for a run that did not end
+    normally): the tag and the tangent exponent (``ev_exponent``; NaN without one)."""
     from ..classify import classify_trajectory
-    from ..integrate import Status
     from ..sweep import replay
+    from ..sweep._tasks import status_fields, verdict_fields
 
     figure, settings, row, halvings, extend_to = job
     t0 = time.perf_counter()
@@ -73,11 +68,13 @@ def _ladder_one(job: tuple) -> LadderRow:
         warnings.simplefilter("ignore", RuntimeWarning)
         for h in (0, *halvings):
             traj = replay(settings, row, refine=h)
-            if traj.status != Status.OK:  # "left_reach" or "diverged"
-                rungs.append((h, traj.status.label, math.nan))
-                continue
-            v = classify_trajectory(traj, extend_to=extend_to)
-            rungs.append((h, verdict_tag(v.label, v.period), _exponent(v)))
+            fields = (
+                verdict_fields(classify_trajectory(traj, extend_to=extend_to))
+                if traj.ok
+                else status_fields(traj.status)
+            )
+            tag = verdict_tag(fields["label"], fields["period"])
+            rungs.append((h, tag, fields["evidence"].get("exponent", math.nan)))
     return LadderRow(
         figure,
         _where(settings.config, row),

@@ -188,7 +188,7 @@ def test_audit_reads_the_sensitivity_sweeps_and_a_ladder_follows_one_label(
     import chaoscam.sweep
     from chaoscam.integrate import Status
 
-    left = type("Run", (), {"status": Status.LEFT_REACH})()
+    left = type("Run", (), {"status": Status.LEFT_REACH, "ok": False})()
     monkeypatch.setattr(chaoscam.sweep, "replay", lambda settings, row, refine: left)
     job = jobs[0][:3] + ((1,), None)
     row = _ladder._ladder_one(job)
