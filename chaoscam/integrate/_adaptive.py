@@ -145,7 +145,7 @@ def surface_mode(g, rate, surf):
     return g > 0.0, False
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def locate_on_interpolant(h, th, tr, co, s_lo, g_lo, s_hi, g_hi, c):
     """The fraction s in (s_lo, s_hi] of the step at which the gap changes sign, on the
     interpolant (s_lo = 0 but for a micro-flight from the surface, whose bracket starts at
@@ -174,7 +174,7 @@ def locate_on_interpolant(h, th, tr, co, s_lo, g_lo, s_hi, g_hi, c):
     return b
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def turning_point(h, th, tr, co, rate0, rate1, c):
     """The fraction s of the step where the gap rate l_1 theta' - dC/dt.n changes sign.
 
@@ -194,7 +194,7 @@ def turning_point(h, th, tr, co, rate0, rate1, c):
     return 0.5 * (a + b)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side):
     """With the tangent on, carry it over the accepted step [t, t + s_end h_step] whose
     state runs from (th, om) to (th1, om1), the inner points taken from the interpolant
@@ -246,7 +246,7 @@ def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side
         thb, omb = the, ome
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def leave(y, cnt, th, om, t, h, events, window, surface, code, c):
     """Store the state, the time, the next step size, the event count and the surface flags
     (``surface``: 1 jumped, 2 settled, as ``cnt[I_SURFACE]``); return ``code``.
@@ -265,7 +265,7 @@ def leave(y, cnt, th, om, t, h, events, window, surface, code, c):
     return code
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
     """Advance one trajectory from ``y[Y_TIME]`` to ``n_stop * dt`` with adaptive steps.
 

@@ -17,7 +17,7 @@ from ._adaptive import run_chunk_adaptive
 __all__ = ["advance"]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def advance(y, cnt, c, n_stop, lam, series, section, impacts):
     """Advance one trajectory towards grid step ``n_stop`` with the integrator ``c[C_METHOD]``.
 

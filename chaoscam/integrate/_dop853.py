@@ -112,7 +112,7 @@ E3_12 = 0.02265179219836082
 ERROR_ORDER = 7  # the step-size controller's exponent is -1 / (ERROR_ORDER + 1)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def dop853_step(th, om, a1, h, tr, K, c, flight):
     """One DOP853 step of length h from (th, om) at t, with a1 = theta''(t, th, om).
 
@@ -252,7 +252,7 @@ def dop853_step(th, om, a1, h, tr, K, c, flight):
     return th_new, om_new, abs(h) * e5 / math.sqrt(2.0 * (e5 + 0.01 * e3))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def theta_at(co, s):
     """theta at the fraction s of the step ``co`` = (theta0, w0, a0, theta1, w1, a1, h).
 
@@ -270,7 +270,7 @@ def theta_at(co, s):
     return th0 + (th1 - th0) * h3 + h * (w0 * h1 + w1 * h4) + h * h * (a0 * h2 + a1 * h5)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def omega_at(co, s):
     """theta' at the fraction s of the step ``co``: the cubic Hermite interpolant of the
     values and first derivatives at the ends (error O(h^4))."""

@@ -35,7 +35,7 @@ MAX_GRAZE_STEPS = 200
 """Passes of the search for the gap rate's turn at most."""
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def gap_after(t, th, om, tau, K, c, trig):
     """The geometry at the end of one RK4 substep of length tau from (t, th, om):
     ``(delta, l_1, dC/dt.n, theta_f')`` there.
@@ -81,7 +81,7 @@ def illinois_update(a, fa, b, fb, m, fm, side):
     return a, fa, b, fb, side
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight, trig):
     """The substep length tau in (a, h] at which the gap delta changes sign.
 
@@ -171,7 +171,7 @@ def model_root(x, fx, dx, xp, fp):
     return x + u
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _gap_at(t, th, om, m, K, c, flight, trig, s):
     """``s`` times the gap and its rate ``l_1 theta' - dC/dt.n`` after a substep of length m
     from (t, th, om): the free pendulum's, or the full equations' (:func:`gap_after`)."""
@@ -188,7 +188,7 @@ def _gap_at(t, th, om, m, K, c, flight, trig, s):
 ON_SURFACE = 1e-300
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def graze_point(t, th, om, h, rate0, rate1, K, c, trig):
     """The substep length tau in (0, h) at which the gap rate l_1 theta' - dC/dt.n turns.
 

@@ -34,6 +34,13 @@ and the tangent restarts from the identity. The state is the same with and witho
 The model's equations live in :mod:`._physics`, the array layout in :mod:`._layout` (whose
 names this module re-exports for its callers), the location of events inside a step in
 :mod:`._events`.
+
+Compiled without numba's reference counting. Every function of the kernels' modules that
+numba compiles on its own (not inlined into its caller) says ``_nrt=False`` (numba's option
+for a function that needs no runtime; none allocates an array). With the runtime on, each
+call that passed an array took a reference and let it go again, two atomic operations: 8 %
+of a regime map's samples. Without it a run is the same bits and the kernels' time shorter
+(``benchmarks/PROFILE.md``). ``tests/integrate/test_no_refcount.py`` keeps it so.
 """
 
 from __future__ import annotations
@@ -171,7 +178,7 @@ def shift_from_event(y, t, th, om, h, K, c, first, trig, f, w):
     return d
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def leave(y, cnt, th, om, t, safe_n, code):
     """Store the state and the flight horizon before returning ``code`` to the driver."""
     y[Y_THETA] = th
@@ -181,7 +188,7 @@ def leave(y, cnt, th, om, t, safe_n, code):
     return code
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     """Advance one trajectory from step ``cnt[I_STEP]`` towards ``n_stop``.
 

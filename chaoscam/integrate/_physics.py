@@ -37,7 +37,7 @@ from ._layout import (
 )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def stiffness(lam, c):
     """K_n for line length ``lam``: Hertz (18) unless a fixed (fractal) value is set."""
     return c[C_K_FIXED] if c[C_K_FIXED] > 0.0 else c[C_HERTZ] * lam
@@ -131,14 +131,14 @@ def cam_trig_near(t, s, cc, sc, c):
     return _turn(cc, sc, b)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def geometry(t, th, c):
     """Gap delta, lever arm l_1 and normal cam speed dC/dt . n at time t and angle th."""
     thc = cam_angle(t, c)
     return geometry_trig(math.cos(thc), math.sin(thc), math.cos(th), math.sin(th), c)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def geometry_at(t, th, c):
     """:func:`geometry` and the trigonometry it used: ``(delta, l_1, dC/dt.n, cc, sc, ct,
     st)``, with (cc, sc) the cam angle's cos/sin at t and (ct, st) theta_f's.
@@ -151,7 +151,7 @@ def geometry_at(t, th, c):
     return delta, l1, cdn, cc, sc, ct, st
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def geometry_trig(cc, sc, ct, st, c):
     """:func:`geometry` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st)."""
     dx = c[C_XO] - c[C_E] * cc
@@ -163,7 +163,7 @@ def geometry_trig(cc, sc, ct, st, c):
     return delta, l1, cdn
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def acceleration(t, th, om, K, c):
     """theta_f'' from (1)–(3): gravity, Hunt–Crossley normal force, friction torque."""
     thc = cam_angle(t, c)
@@ -261,7 +261,7 @@ def _equations(cc, sc, ct, st, om, K, c, jac, side):
     return torque * inv_j, d_th * inv_j, d_om * inv_j, d_t * inv_j
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def acceleration_trig(cc, sc, ct, st, om, K, c):
     """:func:`acceleration` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st).
 
@@ -271,7 +271,7 @@ def acceleration_trig(cc, sc, ct, st, om, K, c):
     return _equations(cc, sc, ct, st, om, K, c, False, JAC_NATURAL)[0]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, side):
     """:func:`acceleration_jacobian` given cos/sin of the cam angle (cc, sc) and of theta_f
     (ct, st)."""
@@ -279,14 +279,14 @@ def acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, side):
     return a, d_th, d_om
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def acceleration_jacobian_time_trig(cc, sc, ct, st, om, K, c, side):
     """:func:`acceleration_jacobian_trig` and ``d theta''/d t``, the explicit time dependence
     through the cam angle: ``(theta'', d/d theta, d/d theta', d/d t)``."""
     return _equations(cc, sc, ct, st, om, K, c, True, side)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def acceleration_jacobian(t, th, om, K, c, side=JAC_NATURAL):
     """(theta_f'', d theta_f''/d theta_f, d theta_f''/d theta_f') at (t, th, om) [1/s^2, 1/s],
     the Jacobian taken on ``side`` of the contact surface (see :func:`_equations`)."""
@@ -296,7 +296,7 @@ def acceleration_jacobian(t, th, om, K, c, side=JAC_NATURAL):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def rk4(t, th, om, h, K, c):
     """One classical fourth-order Runge–Kutta step of length h for (theta_f, theta_f')."""
     cc, sc = cam_trig(t, c)
@@ -304,7 +304,7 @@ def rk4(t, th, om, h, K, c):
     return r[0], r[1]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def rk4_trig(t, th, om, h, K, c, cc, sc, ct, st):
     """:func:`rk4` given the trigonometry at its start (cam angle at t: cc, sc; theta_f:
     ct, st), e.g. from :func:`geometry_at`; returns ``(th, om, cc4, sc4)``, the last two the
@@ -338,7 +338,7 @@ def rk4_trig(t, th, om, h, K, c, cc, sc, ct, st):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def rk4_flight(th, om, h, c):
     """RK4 step of the free pendulum J theta'' = -(m g l/2) cos theta (no contact force).
 
@@ -364,7 +364,7 @@ def rk4_flight(th, om, h, c):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def gap_accel_bound(om, c):
     """A bound on |delta''| in flight while |theta'| stays below |om| + 1 rad/s [m/s^2].
 
@@ -378,7 +378,7 @@ def gap_accel_bound(om, c):
     return ew * c[C_OMEGA] + 2.0 * ew * w + rho * (c[C_GRAV] * c[C_INV_J] + w * w)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def closing_bound(l1, cdn, om, h, c):
     """An upper bound on how much the gap can shrink within a time h <= J / (m g l / 2) [m].
 
@@ -389,7 +389,7 @@ def closing_bound(l1, cdn, om, h, c):
     return 2.0 * (h * abs(l1 * om - cdn) + 0.5 * h * h * gap_accel_bound(om, c))
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def safe_horizon(g, l1, cdn, om, c):
     """The time over which a positive gap g certainly stays positive [s].
 

@@ -18,7 +18,7 @@ from ._kernel import C_GRAV, C_INV_J, C_OMEGA
 from ._physics import rotate as _rotate_inline
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def rotate(a, ca, sa, b):
     """:func:`._physics.rotate` as a function of its own for the adaptive path's stages:
     inlined (numba's ``inline="always"``, as the RK4 steps take it) into every DOP853 stage,
@@ -26,7 +26,7 @@ def rotate(a, ca, sa, b):
     return _rotate_inline(a, ca, sa, b)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def accel_trig(tr, om, K, c, flight):
     """theta_f'' at the base ``tr`` (:func:`trig_at`): the free pendulum in flight, else
     the full (1)–(3)."""
@@ -35,14 +35,14 @@ def accel_trig(tr, om, K, c, flight):
     return k.acceleration_trig(tr[1], tr[2], tr[3], tr[4], om, K, c)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def trig_at(t, th, c):
     """(cam angle, its cos, its sin, cos th, sin th) at (t, th): a step's trigonometric base."""
     thc = k.cam_angle(t, c)
     return (thc, math.cos(thc), math.sin(thc), math.cos(th), math.sin(th))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def geometry_near(s_i, th_i, th, tr, c):
     """:func:`_kernel.geometry` at (t + s_i, th_i), rotated from the base ``tr`` at (t, th)."""
     ct, st = rotate(th, tr[3], tr[4], th_i - th)
@@ -50,7 +50,7 @@ def geometry_near(s_i, th_i, th, tr, c):
     return k.geometry_trig(cc, sc, ct, st, c)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, _nrt=False, error_model="numpy")
 def accel_stage(th_i, om_i, s_i, th, tr, K, c, flight):
     """theta_f'' at the stage (t + s_i, th_i, om_i) of a step from (t, th).
 

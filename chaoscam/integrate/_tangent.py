@@ -75,7 +75,7 @@ def _column(x, y, h, p1, q1, p2, q2, p3, q3, p4, q4):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, first, rest, cc, sc, ct, st):
     """One RK4 step of the state and of its tangent matrix V (columns (v11, v21), (v12, v22)).
 
@@ -124,7 +124,7 @@ def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, first, rest, cc, sc
     )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def rk4_time_derivatives(t, th, om, h, K, c, first, cc, sc, ct, st, f_th, f_om):
     """How an RK4 substep's end moves with its start time and with its length.
 
@@ -184,7 +184,7 @@ def rk4_time_derivatives(t, th, om, h, K, c, first, cc, sc, ct, st, f_th, f_om):
     return e_th, e_om, b_th, b_om
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def rk4_flight_tangent(th, om, h, c, v11, v21, v12, v22):
     """:func:`._physics.rk4_flight` (the free pendulum) with its tangent matrix.
 
@@ -223,7 +223,7 @@ def rk4_flight_tangent(th, om, h, c, v11, v21, v12, v22):
     )
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def jump_derivatives(t, th, l1, cdn, c):
     """``(q_theta, q_t)``: the derivatives of ``q = (dC/dt.n) / l_1`` in the restitution law
     ``theta'+ = -xi theta'- + (1 + xi) q(t, theta)`` (4)–(5) at (t, th)."""
@@ -243,7 +243,7 @@ def jump_derivatives(t, th, l1, cdn, c):
     return q_th, q_t
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def saltation(t, th, om_before, om_after, l1, cdn, xi, c):
     """The saltation matrix S of a restitution jump at a located closing (t, th).
 
@@ -272,7 +272,7 @@ def saltation(t, th, om_before, om_after, l1, cdn, xi, c):
     return 1.0 + w1 * l1 / rate, g_th + w2 * l1 / rate, -xi
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def rk4_tangent_along(t, h, th0, om0, thm, omm, th1, om1, K, c, v11, v21, v12, v22, side):
     """One RK4 step of the tangent matrix alone along a known state: its start (th0, om0), its
     midpoint (thm, omm) and its end (th1, om1), e.g. from an adaptive step and its
