@@ -1,32 +1,41 @@
 """One timed regime map with whichever chaoscam is installed: to compare versions.
 
 Run: python benchmarks/bench_regime_versions.py ENGINE [TABLE.parquet]
+     python benchmarks/bench_regime_versions.py --against PYTHON [--pairs N]
+     python benchmarks/bench_regime_versions.py --make-filed DIR
 
 The map of ``bench_regime_engine.py`` (3x3 cells of (l_lambda, l_lambda_sigma) x 6
 realizations x 20 s, seed 1, 2 workers), warmed first like it, timed once. ENGINE is
 "process" or "ensemble", or "default" for a version whose ``regime_map`` has no ``engine``
 (before the ensemble engine: one process task per realization). Prints the time, the
 trajectories per second, the CPU time (pool included) and the labels, and writes the
-realizations' table if asked. To measure another commit, install it in its own virtual
-environment and run this file with that environment's python, e.g.::
+realizations' table if asked.
 
-    git worktree add /tmp/filed ed91016 && python3 -m venv /tmp/filedenv
-    /tmp/filedenv/bin/pip install -e /tmp/filed
-    /tmp/filedenv/bin/python benchmarks/bench_regime_versions.py default
-
-Alternate the versions on one idle machine and compare the best of each.
+``--against PYTHON`` is issue 13's 2-core target (>= 1.8x "against today's process-based
+sweep at equal settings", read as the sweep when the issue was filed, ed91016): it runs the
+map N times (default 3) with another environment's python and ``default``, alternated with
+this checkout's ``ensemble`` engine, each in its own process started from an empty folder,
+and prints each pair's ratio and the ratio of the best times. ``--make-filed DIR`` makes
+that environment: a worktree of ed91016 in DIR/src and a virtual environment in DIR/venv
+with it installed (needs the package index), then prints the ``--against`` line to run.
+Run on an idle machine: both use both cores.
 """
 
 from __future__ import annotations
 
+import argparse
 import os
 import resource
+import subprocess
 import sys
+import tempfile
 import time
 
 from chaoscam.sweep import Axis, regime_map
 
 ENGINES = ("process", "ensemble", "default")
+FILED = "ed91016"  # the commit at which issue 13 was filed: its sweep, one process a run
+GOAL = 1.8
 
 
 def _cpu() -> float:
@@ -37,10 +46,8 @@ def _cpu() -> float:
     return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
 
 
-def main() -> None:
-    if len(sys.argv) not in (2, 3) or sys.argv[1] not in ENGINES:
-        sys.exit(f"usage: {sys.argv[0]} {{{','.join(ENGINES)}}} [TABLE.parquet]")
-    engine = sys.argv[1]
+def one_map(engine: str, table_path: str | None = None) -> None:
+    """The timed map with ``engine``; prints its line."""
     extra = {} if engine == "default" else {"engine": engine}
     regime_map(  # warm: numba caches, imports
         Axis("l_lambda", (0.008,)),
@@ -56,13 +63,82 @@ def main() -> None:
     runs = regime_map(x, y, realizations=6, seed=1, duration=20.0, workers=2, **extra)
     wall, cpu = time.perf_counter() - t0, _cpu() - c0
     table = runs.realizations
-    if len(sys.argv) == 3:
-        table.to_parquet(sys.argv[2])
+    if table_path is not None:
+        table.to_parquet(table_path)
     print(
         f"{engine}: {wall:.2f} s, {len(table) / wall:.2f} traj/s, CPU {cpu:.1f} s, "
         f"load {os.getloadavg()[0]:.2f}; labels {table['label'].value_counts().to_dict()}; "
         f"median impacts a run {table['n_impacts'].median():.0f}"
     )
+
+
+def _timed(python: str, engine: str) -> tuple[float, str]:
+    """One map in its own process (``python``, an empty working folder, so that neither
+    version imports the other from it): its time and its line."""
+    with tempfile.TemporaryDirectory() as here:
+        out = subprocess.run(
+            [python, os.path.abspath(__file__), engine],
+            cwd=here,
+            capture_output=True,
+            text=True,
+        )
+    line = out.stdout.strip().splitlines()[-1] if out.stdout.strip() else ""
+    if out.returncode != 0 or not line.startswith(f"{engine}: "):
+        sys.exit(f"{python} {engine} failed:\n{out.stderr[-2000:]}")
+    return float(line.split()[1]), line
+
+
+def compare(other: str, pairs: int) -> None:
+    """``pairs`` alternated maps, ``other``'s default sweep then this one's ensemble engine;
+    prints each pair's ratio and the best times' ratio against GOAL."""
+    theirs, ours = [], []
+    for i in range(pairs):
+        t, line = _timed(other, "default")
+        theirs.append(t)
+        print(f"pair {i + 1}, other  {line}", flush=True)
+        t, line = _timed(sys.executable, "ensemble")
+        ours.append(t)
+        print(f"pair {i + 1}, this   {line}; ratio {theirs[-1] / t:.2f}x", flush=True)
+    ratio = min(theirs) / min(ours)
+    print(
+        f"best of {pairs}: other {min(theirs):.2f} s, this {min(ours):.2f} s: ratio "
+        f"{ratio:.2f}x (goal >= {GOAL}: {'met' if ratio >= GOAL else 'not met'}); pair by "
+        f"pair {', '.join(f'{a / b:.2f}x' for a, b in zip(theirs, ours, strict=True))}"
+    )
+
+
+def make_filed(folder: str) -> None:
+    """A worktree of FILED and a virtual environment with it installed, under ``folder``."""
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    src, venv = os.path.join(folder, "src"), os.path.join(folder, "venv")
+    for cmd in (
+        ["git", "-C", root, "worktree", "add", "--detach", src, FILED],
+        [sys.executable, "-m", "venv", venv],
+        [os.path.join(venv, "bin", "pip"), "install", "-q", "-e", src],
+    ):
+        subprocess.run(cmd, check=True)
+    print(f"now: python {__file__} --against {os.path.join(venv, 'bin', 'python')}")
+
+
+def main() -> None:
+    if len(sys.argv) > 1 and sys.argv[1] in ENGINES:
+        if len(sys.argv) > 3:
+            sys.exit(f"usage: {sys.argv[0]} {{{','.join(ENGINES)}}} [TABLE.parquet]")
+        one_map(sys.argv[1], sys.argv[2] if len(sys.argv) == 3 else None)
+        return
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--against", metavar="PYTHON", help="another environment's python")
+    ap.add_argument("--pairs", type=int, default=3, help="alternated pairs (default 3)")
+    ap.add_argument("--make-filed", metavar="DIR", help=f"make an environment of {FILED}")
+    args = ap.parse_args()
+    if args.make_filed:
+        make_filed(args.make_filed)
+    elif args.against:
+        if args.pairs < 1:
+            ap.error("--pairs: at least 1")
+        compare(args.against, args.pairs)
+    else:
+        ap.error(f"give ENGINE ({', '.join(ENGINES)}), --against PYTHON or --make-filed DIR")
 
 
 if __name__ == "__main__":
