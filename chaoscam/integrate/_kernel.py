@@ -37,10 +37,12 @@ names this module re-exports for its callers), the location of events inside a s
 
 Compiled without numba's reference counting. Every function of the kernels' modules that
 numba compiles on its own (not inlined into its caller) says ``_nrt=False`` (numba's option
-for a function that needs no runtime; none allocates an array). With the runtime on, each
-call that passed an array took a reference and let it go again, two atomic operations: 8 %
-of a regime map's samples. Without it a run is the same bits and the kernels' time shorter
-(``benchmarks/PROFILE.md``). ``tests/integrate/test_no_refcount.py`` keeps it so.
+for a function that needs no runtime; none allocates an array). With the runtime on, such a
+function took a reference to its array arguments on entry and let it go on return, and
+:func:`run_chunk` did the same around the code it inlines (``NRT_incref`` / ``NRT_decref``,
+atomic operations): 8 % of a regime map's samples. Without it a run is the same bits and the
+kernels' time shorter (``benchmarks/PROFILE.md``). ``tests/integrate/test_no_refcount.py``
+keeps it so.
 """
 
 from __future__ import annotations
