@@ -8,7 +8,7 @@ cache keeps no function list, so numba compiles the kernels, about 30 s), writes
 ``/tmp/perf-PID.map`` (perf's format for code made at run time: start, size, name) from
 numba's compiled libraries, with each function's address from its execution engine and its
 size up to the next one's start, then records itself with ``perf record`` while it runs the
-map of ``bench_regime_engine.py`` (3x3 cells x 6 realizations x 20 s, ensemble engine, 2
+map of ``bench_regime_versions.py`` (3x3 cells x 6 realizations x 20 s, ensemble engine, 2
 workers), warmed first, and prints the top of ``perf report`` with numba's names shortened
 to ``module.function``. Functions numba inlined into their callers count in the callers.
 The share of ``NRT_incref`` / ``NRT_decref`` (numba's reference counting) is how
@@ -28,7 +28,7 @@ import sys
 import tempfile
 import time
 
-from chaoscam.sweep import Axis, regime_map
+from bench_regime_versions import benchmark_map, warm
 
 
 def _short(name: str) -> str:
@@ -82,9 +82,7 @@ def main() -> None:
         with tempfile.TemporaryDirectory() as cache:
             env = {**os.environ, "NUMBA_CACHE_DIR": cache, "CHAOSCAM_PERF_MAP": "compiled"}
             sys.exit(subprocess.run([sys.executable, *sys.argv], env=env).returncode)
-    run = dict(workers=2, engine="ensemble")
-    regime_map(Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.001,)), realizations=2,
-               duration=1.0, **run)  # fmt: skip
+    warm(engine="ensemble")
     perf_map = f"/tmp/perf-{os.getpid()}.map"
     print(f"{write_perf_map(perf_map)} compiled functions mapped", flush=True)
     data = args.keep or os.path.join(tempfile.mkdtemp(), "perf.data")
@@ -95,9 +93,7 @@ def main() -> None:
     )
     time.sleep(1.0)  # perf attaches
     t0 = time.perf_counter()
-    x = Axis.linspace("l_lambda", 0.008, 0.014, 3)
-    y = Axis.linspace("l_lambda_sigma", 0.001, 0.002, 3)
-    regime_map(x, y, realizations=6, seed=1, duration=20.0, **run)
+    benchmark_map(engine="ensemble")
     wall = time.perf_counter() - t0
     rec.send_signal(signal.SIGINT)
     rec.wait()

@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
+from collections import Counter
 from dataclasses import dataclass
 from typing import Any
 
@@ -160,11 +161,11 @@ def _settled_sentence(rows: list[LadderRow], steps: list[int]) -> str:
     """ " Settled at dt/2 ... dt/8: k of n (chaotic 6, period 12 2)." ("" with no halving)."""
     if len(steps) < 2:
         return ""
-    found = [t for t in map(settled, rows) if t is not None]
-    counts = ", ".join(f"{t} {found.count(t)}" for t in sorted(set(found), key=found.index))
+    found = Counter(t for t in map(settled, rows) if t is not None)  # in order of appearance
+    counts = ", ".join(f"{t} {n}" for t, n in found.items())
     halved = ", ".join(map(step_name, steps[1:]))
     return (
-        f" Settled (one decided label at {halved}): {len(found)} of {len(rows)}"
+        f" Settled (one decided label at {halved}): {found.total()} of {len(rows)}"
         + (f" ({counts})" if found else "")
         + "."
     )
