@@ -100,6 +100,15 @@ def settled(rows, kind: str):
     return best[0], best[1], start == 0
 
 
+QUALIFIED = {
+    (True, False): ("at most ", ""),
+    (False, True): ("at least ", ""),
+    (True, True): ("", " (both at their ladders' coarsest rung: not settled)"),
+}
+"""How a ratio is read when (RK4's, the adaptive path's) cheapest setting is its ladder's
+coarsest rung: a coarser RK4 step could lower the ratio, a coarser tolerance raise it."""
+
+
 def report(title: str, rows, ref_error: float) -> None:
     print(f"\n{title}")
     for kind, setting, sec, err in rows:
@@ -124,17 +133,14 @@ def report(title: str, rows, ref_error: float) -> None:
         )
     if best["adaptive"] is None:
         return
-    ad, ad_edge = best["adaptive"][1], best["adaptive"][2]
+    _, ad, ad_edge = best["adaptive"]
     for kind in ("rk4 fixed", "rk4 merged"):
         if best[kind] is None:
             continue
-        rk, rk_edge = best[kind][1], best[kind][2]
-        bound = {(True, False): "at most ", (False, True): "at least "}.get((rk_edge, ad_edge), "")
-        unsure = (
-            " (both at their ladders' coarsest rung: not settled)" if rk_edge and ad_edge else ""
-        )
+        _, rk, rk_edge = best[kind]
+        before, after = QUALIFIED.get((rk_edge, ad_edge), ("", ""))
         print(
-            f"  ratio {kind} / adaptive at equal accuracy: {bound}{rk / ad:.1f}x{unsure}"
+            f"  ratio {kind} / adaptive at equal accuracy: {before}{rk / ad:.1f}x{after}"
             + ("  (target >= 10x)" if kind == "rk4 fixed" else "")
         )
 
