@@ -68,7 +68,7 @@ for again (from the same section point): where chattering dominates, the tangent
 grid (dt = 2e-6 s) overstates the dominant multiplier and λ₁ with the flow's tangent at events,
 the default (its error is in the RK4 substep after each located event of a chatter cycle,
 whose near-grazing event times are very sensitive: see integrate/_tangent.py; the grid map's
-own tangent, ``Params(tangent_events="grid")``, does not). Measured with the flow's: ξ = 0.45,
+own tangent does not). Measured with the flow's: ξ = 0.45,
 period 6: |μ|max = 2.97 at dt, 0.0047 at dt/2, 0.072 at dt/4, 0.026 at dt/8, from one orbit
 point (from others an independent referee got 1.9–3.6 at dt, while kicks of 1e-4 to 1e-9 decay
 on the grid: the grid's tangent errs, not its motion); λ₁ from the run: +0.63 at dt, −2.53 at

@@ -294,7 +294,7 @@ def kick_test(
     by ± each of ``kicks`` and θ̇_f by ± ``omega_scale`` times as much, iterate ``periods`` × n
     cam periods (:func:`iterate_map`) and compare with the unkicked run.
 
-    The tangent (either: ``Params.tangent_events``) is an infinitesimal derivative, and where
+    The tangent is an infinitesimal derivative, and where
     chattering ends in sticking the grid map is not differentiable at the scale of its event
     jitter: at ξ = 0.525 the grid tangent's |μ|max is 5.9 while kicks of 1e-9 to 1e-6 return
     to a 1e-8 floor (docs/findings.md, "Tangent dynamics checked independently"). This test

@@ -58,10 +58,6 @@ CLI_CASES = {
     "output-dt nan": ([*SIM, "--output-dt", "nan"], "output_dt"),
     "omega 1e300": ([*SIM, "--set", "omega=1e300"], "omega"),
     "omega 1_0 (Python would read 10)": ([*SIM, "--set", "omega=1_0"], "omega = '1_0'"),
-    "tangent_events grid on the adaptive path": (
-        [*SIM, "--set", "integrator=adaptive", "--set", "tangent_events=grid"],
-        "tangent_events",
-    ),
     "l 1e308": ([*SIM, "--set", "l=1e308"], "l ="),
     "flight_merge 1e9": ([*SIM, "--set", "flight_merge=1000000000"], "flight_merge"),
     "max_events 1e12": (

@@ -460,7 +460,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
                     return leave(y, cnt, th, om, t, h_next, events, window, surf, LEFT_REACH, c)
                 om_before = om
                 plastic = cdn - l1 * om < c[C_V_CHATTER]  # a chattering end, if applied
-                om, K = steps.impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c, True)
+                om, K = steps.impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
                 if om != om_before:
                     # after a rebound the point still lies on the surface, moving out
                     if plastic:

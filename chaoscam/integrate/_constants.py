@@ -73,8 +73,7 @@ def kernel_constants(
     c[k.C_RTOL] = p.rtol
     c[k.C_ATOL] = p.atol
     c[k.C_H_MAX] = p.h_max
-    # 1: the flow's saltation at events; 2: the grid map's own derivative (Params.tangent_events)
-    c[k.C_TANGENT] = (2.0 if p.tangent_events == "grid" else 1.0) if tangent else 0.0
+    c[k.C_TANGENT] = 1.0 if tangent else 0.0
     c[k.C_V_CHATTER] = p.v_chatter
     c[k.C_V_MICRO] = p.v_micro
     c[k.C_RESAMPLE_EVERY] = 1.0 if p.resample == "impact" else 0.0

@@ -26,8 +26,7 @@ length is rounded so that its end is the double the kernel stamps it with
 
 With ``c[C_TANGENT]`` set, the tangent matrix is integrated with the state (:mod:`._tangent`)
 from shortly before the recording starts (:func:`._steps.tangent_on`) and carried through each
-located event by the flow's saltation matrix or, with ``Params.tangent_events = "grid"``, as
-the grid map's own derivative (:func:`._steps.event_tangent`); at each section time the
+located event by the flow's saltation matrix (:func:`._steps.impact`); at each section time the
 Jacobian of the stroboscopic map over the last period is written beside the section point
 and the tangent restarts from the identity. The state is the same with and without it.
 
@@ -58,8 +57,6 @@ from ._layout import (
     C_CALL_STEPS,
     C_DT,
     C_FLIGHT_MERGE,
-    C_GRAV,
-    C_INV_J,
     C_MAX_EVENTS,
     C_PERIOD,
     C_RCAM,
@@ -67,9 +64,7 @@ from ._layout import (
     C_ROD_L,
     C_STRIDE,
     C_T_RECORD,
-    C_TANGENT,
     C_V_CHATTER,
-    C_XI,
     I_CHATTER,
     I_CONTACT_STEPS,
     I_COUNTED_STEPS,
@@ -120,12 +115,11 @@ from ._physics import (  # noqa: F401 (re-exported: the adaptive kernel and test
 from ._steps import (
     at_scheduled,
     commit_tangent,
-    event_tangent,
     impact,
     next_scheduled,
     tangent_on,
 )
-from ._tangent import rk4_flight_tangent, rk4_tangent_trig, rk4_time_derivatives
+from ._tangent import rk4_flight_tangent, rk4_tangent_trig
 
 
 @njit(cache=True, inline="always")
@@ -162,22 +156,6 @@ def step_flight(t, th, om, h, c, y, commit):
         return r[0], r[1], r[2], r[3], r[4], r[5], 0.0
     th1, om1 = rk4_flight(th, om, h, c)
     return th1, om1, 0.0, 0.0, 0.0, 0.0, 0.0
-
-
-@njit(cache=True, inline="always")
-def shift_from_event(y, t, th, om, h, K, c, first, trig, f, w):
-    """For an RK4 substep from (t, th, om) of length h whose tangent is already in ``y``:
-    when it starts at a located event (``w`` the event time's derivative along V's columns,
-    ``f`` the velocity V left the event with; w = 0 otherwise), add how its end moves with
-    the event's time, ``V += e w`` (:func:`._tangent.rk4_time_derivatives`). Returns the
-    derivatives ``(e_th, e_om, b_th, b_om)``, b the end's velocity in the substep's length."""
-    cc, sc, ct, st = trig
-    d = rk4_time_derivatives(t, th, om, h, K, c, first, cc, sc, ct, st, f[0], f[1])
-    y[Y_J11] += d[0] * w[0]
-    y[Y_J12] += d[0] * w[1]
-    y[Y_J21] += d[1] * w[0]
-    y[Y_J22] += d[1] * w[1]
-    return d
 
 
 @njit(cache=True, _nrt=False)
@@ -242,15 +220,6 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     # grid step exactly) so that a resumed run is bit-identical to one not interrupted.
     jumped = (cnt[I_SURFACE] & 1) != 0  # a rebound was just applied: the opening is flight's
     settled = (cnt[I_SURFACE] & 2) != 0  # a plastic closure: the point stays in contact
-    grid = c[C_TANGENT] > 1.5  # the tangent of the grid's map, not the flow's (see _tangent)
-    # After a located event at time t_e, the next substep's end depends on t_e through its
-    # start (V carries that) and through its start time and length (it ends at a fixed time):
-    # the event time's row w = dt_e/d(V's columns) is kept for that one substep. A substep
-    # from an event that ends the grid step starts the next one: there the term is dropped
-    # (a hand-back may come between, and a resumed run must be the same bits). Grid only.
-    shift = False
-    w = (0.0, 0.0)  # the event time's derivative along V's columns
-    f = (0.0, 0.0)  # the velocity V leaves the event with (f+)
     budget = np.int64(c[C_CALL_STEPS])  # steps before a hand-back (Ctrl-C is seen between)
     taken = np.int64(0)
     while cnt[I_STEP] < n_stop:
@@ -311,8 +280,6 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
         t_end = (n + 1) * h
         events = 0
         while t < t_end:
-            from_event = shift  # this segment starts at a located event
-            shift = False
             # The segment ends at the step's end or at the next scheduled time inside it.
             seg_end, is_section, is_resample = next_scheduled(t_end, cnt, c)
             hs = seg_end - t
@@ -344,8 +311,9 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     trial_side = JAC_FLIGHT if gs > 0.0 else JAC_CONTACT
                 trial_full = not (g > 0.0 and g > closing_bound(l1, cdn, om, hs, c))
                 if trial_full:
-                    rest = JAC_NATURAL if grid else trial_side
-                    trial, cam1 = step_rk4(t, th, om, hs, K, c, y, False, trial_side, rest, trig0)
+                    trial, cam1 = step_rk4(
+                        t, th, om, hs, K, c, y, False, trial_side, trial_side, trig0
+                    )
                     if t + hs != seg_end:  # (the cam at t + hs, seg_end - t rounded)
                         cam1 = cam_trig(seg_end, c)
                 else:
@@ -404,22 +372,13 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                         if free:
                             g_hi = g_f
                     tau = locate_crossing(t, th, om, tau_lo, g_lo, tau_hi, g_hi, K, c, free, trig0)
-                    tangent = tangent_on(t, c)
-                    b_th, b_om = 0.0, 0.0
-                    if not from_event:
-                        w = (0.0, 0.0)
                     if free:
                         th, om, _, _, _, _, _ = step_flight(t, th, om, tau, c, y, True)
-                        b_th, b_om = om, -c[C_GRAV] * c[C_INV_J] * math.cos(th)
                     else:
                         # The flow's tangent takes every stage on the side the substep comes
                         # from (flight before a closing and just after a jump, else contact).
                         side = JAC_FLIGHT if closing or jumped else JAC_CONTACT
-                        first, rest = (trial_side, JAC_NATURAL) if grid else (side, side)
-                        r, _ = step_rk4(t, th, om, tau, K, c, y, True, first, rest, trig0)
-                        if tangent and grid:  # how the end moves with its length and start
-                            e = shift_from_event(y, t, th, om, tau, K, c, trial_side, trig0, f, w)
-                            b_th, b_om = e[2], e[3]
+                        r, _ = step_rk4(t, th, om, tau, K, c, y, True, side, side, trig0)
                         th, om = r[0], r[1]
                     jumped = False
                     settled = False
@@ -431,20 +390,13 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     if closing:
                         if not (0.0 < l1 < c[C_ROD_L]):
                             return leave(y, cnt, th, om, t, safe_n, LEFT_REACH)
-                        om, K = impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c, not grid)
+                        om, K = impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
                         # after a rebound the point still lies on the surface, moving out
                         jumped = om != om_before and not plastic and l1 * om - cdn > 0.0
                         settled = om != om_before and plastic
-                    if tangent and grid:
-                        xi = 0.0 if plastic else c[C_XI]
-                        f = (om, acceleration_trig(cc0, sc0, ct0, st0, om, K, c))
-                        w = event_tangent(y, t, th, om_before, om, xi, l1, cdn, b_th, b_om, f[1], c)
-                        shift = True
                     continue
                 if tangent_on(t, c):
                     commit_tangent(y, trial[2], trial[3], trial[4], trial[5], trial[6])
-                    if from_event and trial_full:  # (a flight substep's term is O(h^5))
-                        shift_from_event(y, t, th, om, hs, K, c, trial_side, trig0, f, w)
                 jumped = False
                 settled = False
                 th = th_new
@@ -457,7 +409,6 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             K = at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)
 
         # End of the grid step: checks and outputs. Here g and l1 belong to (t_end, th).
-        shift = False  # an event that ended the step: its start-time term is dropped (above)
         cnt[I_STEP] = n + 1
         if not (math.isfinite(th) and math.isfinite(om)):
             return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, NON_FINITE)

@@ -180,15 +180,12 @@ JAC_CONTACT = 2  # the contact force's continuation, e.g. on a substep ending at
 def _equations(cc, sc, ct, st, om, K, c, jac, side):
     """The one home of equations (1)–(3), and, when ``jac``, of their Jacobian.
 
-    Returns ``(theta'', d theta''/d theta, d theta''/d theta', d theta''/d t)`` (the
-    derivatives are 0 unless ``jac``; the last is the explicit time dependence through the
-    cam angle, ``w d theta''/d th_c``). With ``delta = (O - C).n - (R + r)``,
+    Returns ``(theta'', d theta''/d theta, d theta''/d theta')`` (the derivatives are 0
+    unless ``jac``). With ``delta = (O - C).n - (R + r)``,
     ``l_1 = (C - O).u`` and ``dC/dt.n = e w (sin th_c sin th + cos th_c cos th)``:
 
     - ``d delta/d theta = l_1``, ``d l_1/d theta = -(delta + R + r)``,
       ``d(dC/dt.n)/d theta = e w (sin th_c cos th - cos th_c sin th)``;
-    - ``d delta/d th_c = -(C_x cos th + C_y sin th)``, ``d l_1/d th_c = C_x sin th - C_y cos
-      th``, ``d(dC/dt.n)/d th_c = e w (cos th_c sin th - sin th_c cos th)``;
     - ``F_n = K p (1 + s beta p')`` with ``p = -delta``, ``p' = dC/dt.n - l_1 theta'``
       (s = +1 Hunt–Crossley, -1 the paper's literal signs), clamped at F_n >= 0;
     - friction torque ``-mu_f a F_n sgn(v_r)`` with the slip speed at ``B_c = C + R n``,
@@ -209,7 +206,6 @@ def _equations(cc, sc, ct, st, om, K, c, jac, side):
     torque = -c[C_GRAV] * ct
     d_th = c[C_GRAV] * st if jac else 0.0
     d_om = 0.0
-    d_t = 0.0
     in_contact = delta < 0.0
     if in_contact or (jac and side == JAC_CONTACT):
         l1 = -(dx * ct + dy * st)
@@ -250,15 +246,8 @@ def _equations(cc, sc, ct, st, om, K, c, jac, side):
                 vr_th = -c[C_OMEGA] * (cx * ct + cy * st)
                 d_th += f_th * arm + force * (l1_th - c[C_MU_ARM] * dsgn * vr_th)
                 d_om += f_om * arm - force * c[C_MU_ARM] * dsgn * c[C_RROD]
-                # the cam angle's part (the explicit time dependence), w d/d th_c
-                pen_c = cx * ct + cy * st
-                l1_c = cx * st - cy * ct
-                rate_c = ew * (cc * st - sc * ct) - l1_c * om
-                f_c = K * (pen_c * shape + pen * damp * rate_c)
-                vr_c = c[C_OMEGA] * pen_c
-                d_t = c[C_OMEGA] * (f_c * arm + force * (l1_c - c[C_MU_ARM] * dsgn * vr_c))
     inv_j = c[C_INV_J]
-    return torque * inv_j, d_th * inv_j, d_om * inv_j, d_t * inv_j
+    return torque * inv_j, d_th * inv_j, d_om * inv_j
 
 
 @njit(cache=True, _nrt=False)
@@ -275,14 +264,6 @@ def acceleration_trig(cc, sc, ct, st, om, K, c):
 def acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, side):
     """:func:`acceleration_jacobian` given cos/sin of the cam angle (cc, sc) and of theta_f
     (ct, st)."""
-    a, d_th, d_om, _ = _equations(cc, sc, ct, st, om, K, c, True, side)
-    return a, d_th, d_om
-
-
-@njit(cache=True, _nrt=False)
-def acceleration_jacobian_time_trig(cc, sc, ct, st, om, K, c, side):
-    """:func:`acceleration_jacobian_trig` and ``d theta''/d t``, the explicit time dependence
-    through the cam angle: ``(theta'', d/d theta, d/d theta', d/d t)``."""
     return _equations(cc, sc, ct, st, om, K, c, True, side)
 
 

@@ -47,7 +47,7 @@ def _callees():
     u4 = types.UniTuple(f, 4)  # a step's shared trigonometry
     return [
         (_tangent.saltation, (f, f, f, f, f, f, f, a)),
-        (_tangent.rk4_time_derivatives, (f, f, f, f, f, a, i, f, f, f, f, f, f)),
+        (_tangent.rk4_tangent_trig, (f, f, f, f, f, a, f, f, f, f, i, i, f, f, f, f)),
         (_events.locate_crossing, (f, f, f, f, f, f, f, f, a, b, u4)),
         (_events.graze_point, (f, f, f, f, f, f, f, a, u4)),
         (_physics.rk4_trig, (f, f, f, f, f, a, f, f, f, f)),

@@ -41,12 +41,11 @@ from ._layout import (
     Y_J22,
 )
 from ._physics import stiffness
-from ._tangent import jump_derivatives, saltation
+from ._tangent import saltation
 
 __all__ = [
     "at_scheduled",
     "commit_tangent",
-    "event_tangent",
     "impact",
     "next_scheduled",
     "reset_tangent",
@@ -141,7 +140,7 @@ def reset_tangent(y):
 
 
 @njit(cache=True, inline="always")
-def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c, salt):
+def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c):
     """The impact law (4)–(5) at a located closing at (t, th) with lever arm l1 and dC/dt.n.
 
     The approach speed is ``v = -(l1 theta' - dC/dt.n)``. When ``v > v_min`` (0 by default:
@@ -151,9 +150,8 @@ def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c, salt):
     chattering sequence (the infinitely many ever shorter bounces whose speeds fall by ``xi``
     each, Nordmark & Piiroinen 2009, Nonlinear Dyn. 58): it is replaced by its accumulation
     point, a plastic closure ``theta'+ = (dC/dt.n) / l1`` (gap rate 0), after which the
-    compliant contact carries the motion. With ``salt``, each applied jump multiplies the
-    tangent by its saltation matrix (the adaptive kernel; the RK4 kernel calls
-    :func:`event_tangent` at every located event instead). Each applied jump is recorded
+    compliant contact carries the motion. With the tangent on, each applied jump multiplies
+    it by its saltation matrix (:func:`._tangent.saltation`). Each applied jump is recorded
     (after the transient) with its kind: macro, micro (slower than ``v_micro``) or chatter
     end, as a row of ``impacts``, or only counted when that buffer has no rows (an ensemble
     that keeps no impacts then never stops to empty them). Under impact resampling a macro
@@ -174,7 +172,7 @@ def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c, salt):
         xi = c[C_XI]
         kind = IMPACT_MICRO if -rate < c[C_V_MICRO] else IMPACT_MACRO
     om_after = -xi * om + (1.0 + xi) * cdn / l1
-    if salt and tangent_on(t, c):
+    if tangent_on(t, c):
         s11, s21, s22 = saltation(t, th, om, om_after, l1, cdn, xi, c)
         v11, v21, v12, v22 = y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22]
         y[Y_J11] = s11 * v11
@@ -197,48 +195,6 @@ def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c, salt):
             impacts[i, 7] = kind
         cnt[I_N_IMPACT] += 1
     return om_after, K
-
-
-@njit(cache=True, inline="always")
-def event_tangent(y, t, th, om_before, om_after, xi, l1, cdn, b_th, b_om, a_after, c):
-    """The tangent V through a located event of the RK4 kernel: a closing (with its jump
-    when ``om_after != om_before``, restitution ``xi``) or an opening.
-
-    V arrives as the derivative of the state at the event *time held fixed*, and ``b`` is the
-    velocity of the substep that located it (its end's derivative in its length,
-    :func:`._tangent.rk4_time_derivatives`; for a free-flight substep the flight field at its
-    end, O(h^4) from that). The event time moves by ``w V`` with
-    ``w = -h_x / (h_t + h_x b)``, ``h_x = (l_1, 0)``, ``h_t = -dC/dt.n``; the state there by
-    ``(V + b w)``; the jump maps that by its derivatives in state and time; and V leaves
-    again with the time held fixed, along ``f+ = (om_after, a_after)``:
-
-    ``V <- g_x (V + b w) + g_t w - f+ w``.
-
-    With ``b = f-`` this is Müller's saltation matrix (:func:`._tangent.saltation`); the RK4
-    substep's own b differs from f- where a stage changes side of the surface. Returns w's
-    two entries (the kernel adds their term for the substep that starts here,
-    :func:`._tangent.rk4_time_derivatives`), both 0 where the event time does not move
-    (a tangential event, ``h_t + h_x b = 0``).
-    """
-    rate = l1 * b_th - cdn
-    if rate == 0.0:
-        return 0.0, 0.0
-    w1 = -l1 * y[Y_J11] / rate
-    w2 = -l1 * y[Y_J12] / rate
-    v11 = y[Y_J11] + b_th * w1
-    v12 = y[Y_J12] + b_th * w2
-    v21 = y[Y_J21] + b_om * w1
-    v22 = y[Y_J22] + b_om * w2
-    if om_after != om_before:
-        q_th, q_t = jump_derivatives(t, th, l1, cdn, c)
-        g_th = (1.0 + xi) * q_th
-        g_t = (1.0 + xi) * q_t
-        v21, v22 = g_th * v11 - xi * v21 + g_t * w1, g_th * v12 - xi * v22 + g_t * w2
-    y[Y_J11] = v11 - om_after * w1
-    y[Y_J12] = v12 - om_after * w2
-    y[Y_J21] = v21 - a_after * w1
-    y[Y_J22] = v22 - a_after * w2
-    return w1, w2
 
 
 @njit(cache=True, inline="always")

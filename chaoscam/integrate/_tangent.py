@@ -3,27 +3,18 @@
 The linearised flow ``V' = A(t) V`` with ``A = [[0, 1], [d theta''/d theta,
 d theta''/d theta']]`` is integrated with the state by the *same* RK4 stages
 (:func:`rk4_tangent_trig`), so between events V is the exact derivative of the RK4 steps and
-the state is bit-identical to :func:`._physics.rk4`'s. Through a located event there are two
-tangents (``Params.tangent_events``):
+the state is bit-identical to :func:`._physics.rk4`'s. Through a located event V is
+multiplied by the flow's saltation matrix (:func:`saltation`; Müller 1995, Chaos Solitons
+Fractals 5(9); Leine & Nijmeijer 2004, *Dynamics and Bifurcations of Non-smooth Mechanical
+Systems*, sec. 3.5; Dankowicz & Nordmark 2000, Physica D 136), and every stage of a substep
+that starts or ends on the surface takes that substep's side.
 
-- ``"flow"`` (the default): V is multiplied by the flow's saltation matrix at the event
-  (:func:`saltation`; Müller 1995, Chaos Solitons Fractals 5(9); Leine & Nijmeijer 2004,
-  *Dynamics and Bifurcations of Non-smooth Mechanical Systems*, sec. 3.5; Dankowicz &
-  Nordmark 2000, Physica D 136) and every stage of a substep that starts or ends on the
-  surface takes that substep's side. It is the flow's tangent, but not the grid map's where
-  chattering ends in sticking: the RK4 substep that follows a located event in a chatter
-  cycle (a rebound, an opening) starts on the surface, and one of its stages dips ~1e-12 m
-  into the cam (the stage extrapolation), where the Hertz force is negligible in the state
-  but not in its derivative; the grid map then depends on the event time (sensitivity
-  l1/v, 2e5 s/rad at a 2.5e-6 m/s closing) in a way the saltation matrix does not carry:
-  1-30 % too much growth a chatter cycle on the xi = 0.45 period 6 at dt = 2e-6 s (a
-  factor ~3 over the period), shrinking as h^2 (docs/findings.md, "Tangent dynamics
-  checked independently").
-- ``"grid"``: V is the derivative of the RK4 grid map itself: each stage's Jacobian on the
-  side its stage lies on, and at each event the event time's derivative through the
-  locating substep's own velocity, the jump's derivatives, and the next substep's
-  dependence on its start time (:func:`rk4_time_derivatives`, :func:`._steps.event_tangent`).
-  With the flow's velocities in place of the substeps' this is the saltation matrix.
+Limits: this is the flow's tangent, not the derivative of the RK4 grid map. Where chattering
+ends in sticking, the RK4 substep after a located event starts on the surface and one of its
+stages dips ~1e-12 m into the cam, where the Hertz force is negligible in the state but not in
+its derivative; the grid map then depends on the event time in a way the saltation matrix does
+not carry, and the tangent overstates the growth there by up to tens of percent a chatter
+cycle at dt = 2e-6 s, shrinking as dt^2 (docs/verdicts.md).
 
 Contact onset and separation need no saltation matrix:
 the contact force vanishes at delta = 0, so the vector field is continuous there (its Jacobian
@@ -42,9 +33,7 @@ from numba import njit
 
 from ._layout import C_E, C_GRAV, C_INV_J, C_OMEGA, C_XO, C_YO, SECTION_NAMES
 from ._physics import (
-    JAC_NATURAL,
     acceleration_jacobian,
-    acceleration_jacobian_time_trig,
     acceleration_jacobian_trig,
     cam_angle,
     cam_trig,
@@ -84,11 +73,7 @@ def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, first, rest, cc, sc
     does. The first stage's Jacobian is taken on side ``first`` of the contact surface, the
     others' on side ``rest`` (:data:`._physics.JAC_NATURAL`: the side each stage lies on). A
     substep that starts on the surface has its first stage at delta = 0 to rounding and takes
-    the side the motion leaves it on. With ``rest`` natural, V is the derivative of the RK4
-    map itself: the later stages of a substep that leaves the surface can dip ~1e-12 m into
-    the cam (the stage extrapolation), where the contact force is negligible in the state but
-    its Jacobian is not (``Params.tangent_events = "grid"``); with the flow's tangent
-    (``"flow"``) every stage takes the side the substep starts or ends on. As
+    the side the motion leaves it on, as do its other stages. As
     :func:`._physics.rk4_trig`, it takes the trigonometry at its start (cam angle at t: cc,
     sc; theta_f: ct, st) and hands on the cam angle's cos/sin at ``t + h`` (cc4, sc4).
     """
@@ -122,66 +107,6 @@ def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, first, rest, cc, sc
         c4,
         s4,
     )
-
-
-@njit(cache=True, _nrt=False)
-def rk4_time_derivatives(t, th, om, h, K, c, first, cc, sc, ct, st, f_th, f_om):
-    """How an RK4 substep's end moves with its start time and with its length.
-
-    For the substep of :func:`rk4_tangent_trig` (same stages, same sides) from (t, x) to
-    ``t + h``, returns ``(e_th, e_om, b_th, b_om)``:
-
-    - ``e = D_x Phi f + d Phi/d t_start`` with the end fixed: the end's derivative when the
-      start moves along ``f = (f_th, f_om)`` in state and by 1 in time. A substep that
-      starts at a located event and ends at a grid or scheduled time needs it: V already
-      moves the start state along the flow (``f`` = f+ of the event), and e adds what is
-      left, O(h^5) for a smooth field but not where a stage dips into the cam;
-    - ``b = d Phi/d h`` with the start fixed: the end's velocity along a substep that ends
-      at a located event, f- to O(h^4) for a smooth field, but not where a stage changes
-      side, whose Jacobian then jumps by ~K l_1^2 / J.
-
-    Both differentiate the stages ``X_i = x + h sum_j a_ij k_j``, ``k_i = f(t + c_i h, X_i)``
-    along the direction given: ``dk_i = f_t dT_i + f_x dX_i`` with f_t the explicit time
-    dependence (:func:`._physics.acceleration_jacobian_time_trig`).
-    """
-    a1, p1, q1, r1 = acceleration_jacobian_time_trig(cc, sc, ct, st, om, K, c, first)
-    cm, sm = cam_trig_near(t, 0.5 * h, cc, sc, c)
-    th2 = th + 0.5 * h * om
-    om2 = om + 0.5 * h * a1
-    ct2, st2 = rotate(th, ct, st, th2 - th)
-    a2, p2, q2, r2 = acceleration_jacobian_time_trig(cm, sm, ct2, st2, om2, K, c, JAC_NATURAL)
-    th3 = th + 0.5 * h * om2
-    om3 = om + 0.5 * h * a2
-    ct3, st3 = rotate(th, ct, st, th3 - th)
-    a3, p3, q3, r3 = acceleration_jacobian_time_trig(cm, sm, ct3, st3, om3, K, c, JAC_NATURAL)
-    c4, s4 = cam_trig(t + h, c)
-    th4 = th + h * om3
-    om4 = om + h * a3
-    ct4, st4 = rotate(th, ct, st, th4 - th)
-    a4, p4, q4, r4 = acceleration_jacobian_time_trig(c4, s4, ct4, st4, om4, K, c, JAC_NATURAL)
-    # the start moved: dX_1 = f, dT_i = 1 - c_i, dh = -1 (so dX_i = f - sum_j a_ij k_j + ...)
-    x, y = f_th, f_om
-    d1x, d1y = y, r1 + p1 * x + q1 * y
-    x, y = f_th - 0.5 * om + 0.5 * h * d1x, f_om - 0.5 * a1 + 0.5 * h * d1y
-    d2x, d2y = y, 0.5 * r2 + p2 * x + q2 * y
-    x, y = f_th - 0.5 * om2 + 0.5 * h * d2x, f_om - 0.5 * a2 + 0.5 * h * d2y
-    d3x, d3y = y, 0.5 * r3 + p3 * x + q3 * y
-    x, y = f_th - om3 + h * d3x, f_om - a3 + h * d3y
-    d4x, d4y = y, p4 * x + q4 * y
-    e_th = f_th - (om + 2.0 * om2 + 2.0 * om3 + om4) / 6.0
-    e_th += h / 6.0 * (d1x + 2.0 * d2x + 2.0 * d3x + d4x)
-    e_om = f_om - (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0
-    e_om += h / 6.0 * (d1y + 2.0 * d2y + 2.0 * d3y + d4y)
-    # the length grew: dX_1 = 0, dT_i = c_i (so dX_i = sum_j a_ij k_j + h sum_j a_ij dk_j)
-    x, y = 0.5 * om, 0.5 * a1
-    d2x, d2y = y, 0.5 * r2 + p2 * x + q2 * y
-    x, y = 0.5 * om2 + 0.5 * h * d2x, 0.5 * a2 + 0.5 * h * d2y
-    d3x, d3y = y, 0.5 * r3 + p3 * x + q3 * y
-    x, y = om3 + h * d3x, a3 + h * d3y
-    d4x, d4y = y, r4 + p4 * x + q4 * y
-    b_th = (om + 2.0 * om2 + 2.0 * om3 + om4) / 6.0 + h / 6.0 * (2.0 * d2x + 2.0 * d3x + d4x)
-    b_om = (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0 + h / 6.0 * (2.0 * d2y + 2.0 * d3y + d4y)
-    return e_th, e_om, b_th, b_om
 
 
 @njit(cache=True, _nrt=False)
@@ -256,10 +181,8 @@ def saltation(t, th, om_before, om_after, l1, cdn, xi, c):
     ``f+- = (theta'+-, theta''_flight)``: the contact force vanishes on the surface, so both
     sides share the free pendulum's acceleration. ``xi`` = 0 gives the plastic closure that
     ends a complete chattering (a singular S). Whatever the geometry,
-    ``det S = -xi (h_t + h_x f+)/(h_t + h_x f-) = xi^2``. The adaptive kernel applies it, and
-    so does the RK4 kernel with the flow's tangent (``Params.tangent_events = "flow"``, the
-    default); the grid map's tangent applies the same law with its substeps' own rates
-    (:func:`._steps.event_tangent`).
+    ``det S = -xi (h_t + h_x f+)/(h_t + h_x f-) = xi^2``. Both kernels apply it at every
+    applied jump.
 
     Returns ``(s11, s21, s22)``; ``s12`` is 0.
     """

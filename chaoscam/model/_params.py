@@ -24,7 +24,6 @@ STIFFNESS_MODELS = ("hertz", "fractal")
 DAMPING_FORMS = ("hunt_crossley", "paper_literal")
 RESAMPLE_MODES = ("contact", "impact", "interval")
 INTEGRATORS = ("rk4", "adaptive")
-TANGENT_EVENTS = ("flow", "grid")
 
 # (lower, upper, lower_inclusive, upper_inclusive); None = unbounded.
 _POS = (0.0, None, False, None)
@@ -267,21 +266,6 @@ class Params:
             INTEGRATORS,
         ),
     )
-    tangent_events: str = field(
-        default="flow",
-        metadata=_meta(
-            "the RK4 grid's tangent through a located event: 'flow' (default), the flow's "
-            "saltation matrix (Müller 1995), exact for the flow, but the grid's map moves "
-            "with the event time where a substep's stage dips into the cam (chattering: its "
-            "growth overstated 1-30 % a chatter cycle at dt = 2e-6 s); 'grid', the derivative "
-            "of the grid's own map, each stage's Jacobian on its side and the event times' "
-            "dependence (integrate/_tangent.py; checked against finite differences of the "
-            "map). The motion is the same either way; the adaptive path carries the flow's",
-            "-",
-            None,
-            TANGENT_EVENTS,
-        ),
-    )
     dt: float = field(
         default=2e-6,
         metadata=_meta(
@@ -350,12 +334,6 @@ class Params:
             if kind and value is not None and type(value) is not kind:  # equal Params, records
                 value = kind(value)
             object.__setattr__(self, f.name, value)
-        if self.tangent_events == "grid" and self.integrator != "rk4":
-            raise ParameterError(
-                "tangent_events = 'grid' is the RK4 grid's own derivative: it needs "
-                f"integrator = 'rk4' (got {self.integrator!r}; the adaptive path's tangent "
-                "is the flow's)"
-            )
         if self.stiffness == "fractal":  # a ParameterError naming D or G where (15)/(17) fail
             from ._stiffness import fractal_stiffness
 

@@ -166,14 +166,14 @@ cases = {
     "periodic": (Params(xi=0.2), 0.5, 0.0),
     "adaptive": (Params(l_lambda_sigma=0.002, integrator="adaptive"), 0.5, 0.0),
     "impacts": (Params(l_lambda_sigma=0.002, v_min=0.0), 0.5, 0.0),
-    "grid tangent": (Params(xi=0.45, tangent_events="grid"), 0.5, 0.0),
+    "tangent": (Params(xi=0.45), 0.5, 0.0),
 }
 for name, (p, duration, transient) in cases.items():
     runs = [simulate_ensemble(p, range(5), seed=2, duration=duration, transient=transient,
                               backend=b, batch=3, keep_impacts=True,
-                              tangent=name == "grid tangent") for b in ("gpu", "cpu")]
+                              tangent=name == "tangent") for b in ("gpu", "cpu")]
     a, b = (r.sections.to_numpy() for r in runs)
-    if name == "grid tangent":  # the Jacobians beside the section points too
+    if name == "tangent":  # the Jacobians beside the section points too
         a, b = (np.column_stack([a, r.jacobians.reshape(len(a), -1)]) for r in runs)
     ia, ib = (r.impacts.to_numpy() for r in runs)
     out[name] = {"backend": runs[0].settings["backend"], "shape": a.shape == b.shape,

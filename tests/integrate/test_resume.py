@@ -33,9 +33,9 @@ def test_a_resumable_run_is_the_same_run():
         CHAOTIC,
         Params(l_lambda_sigma=0.002, resample="interval"),  # draws on a clock, not per impact
         Params(xi=0.2),  # deterministic, periodic
-        Params(xi=0.45, tangent_events="grid"),  # chattering to sticking, the grid's tangent
+        Params(xi=0.45),  # chattering to sticking
     ],
-    ids=["chaotic", "interval-draws", "periodic", "grid-tangent"],
+    ids=["chaotic", "interval-draws", "periodic", "sticking"],
 )
 def test_extended_members_equal_runs_made_long(params):
     """Two rounds of continuation (3 -> 5 -> 9 s), a subset in a new order, equal runs made

@@ -20,7 +20,7 @@ def _settled_point(p):
     ("changes", "n", "returns"),
     [
         ({"xi": 0.45}, 6, True),  # sticking period 6: every tangent-free measure attracts
-        ({"omega": 32.5, "xi": 0.5}, 6, True),  # period 6 the grid tangent leaves undetermined
+        ({"omega": 32.5, "xi": 0.5}, 6, True),  # period 6 the tangent leaves undetermined
         ({"l_lambda": 0.015}, 8, False),  # 8-band chaos: 1e-8 kicks grow ~250x in 12 periods
     ],
     ids=["xi=0.45", "(32.5, 0.5)", "l_lambda=15mm"],
