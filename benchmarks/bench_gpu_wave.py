@@ -73,7 +73,7 @@ def main() -> None:
         if args.legs > 1:
             _in_legs(p, args.members, d, args.legs, cpu_rate[d])
             continue
-        wall, clock, ens = measure(p, args.members, d, _ensemble._ROOM["gpu"], "C")
+        wall, clock, ens = measure(p, args.members, d, _ensemble._ROOM["gpu"])
         inside, launches = clock.launch, clock.launches
         _report(f"{args.members:,} x {d:g} s", args.members * d, wall, inside, launches,
                 cpu_rate[d], ens)  # fmt: skip

@@ -61,7 +61,6 @@ from ._driver import drive_members
 
 __all__ = [
     "GPU_BATCH",
-    "GPU_LAYOUT",
     "GPU_TOLERANCE",
     "AUTO_GPU_MIN",
     "GPUFallbackWarning",
@@ -74,14 +73,6 @@ __all__ = [
 GPU_BATCH = 65_536  # members per device batch: ~19 kB each for 20 s runs, 42 kB with impacts kept
 GPU_TOLERANCE = 1e-6  # rad and rad/s: GPU against CPU sections, first period or periodic
 _BLOCK = 64  # threads per block: 202 registers a thread on an H200 (196 from ptxas 12.9)
-GPU_LAYOUT = "C"
-"""The members' memory order on the device. "C": a member's row contiguous, as on the CPU
-(what the H200 ran, 2026-11-27). "F": one field of consecutive members contiguous, so that a
-warp's 32 reads of the same field (a constant, a counter, the state, each step) fall in 2
-cache lines instead of 32; it is the same arithmetic through other strides (bit-identical
-under the CUDA simulator, tested); it takes 255 registers a thread with spills for RK4 against
-196 without (ptxas 12.9), and its speed on a device is not yet measured
-(``benchmarks/bench_gpu_profile.py`` compares the two)."""
 _SMALL_GRID = r".*Grid size \d+ will likely result in GPU under-utilization"
 """numba-cuda's NumbaPerformanceWarning for a launch configured with few blocks (message,
 with its ANSI codes). A small batch is expected; a sweep would otherwise record the warning
@@ -199,8 +190,7 @@ def _step_function(method: int | None):
     either (ptxas 12.9 for sm_90 on :func:`kernel_ptx`'s PTX with contiguous rows, as
     :func:`run_on_gpu` launches it, 2026-11-27: RK4 196 registers a thread, the adaptive path
     184, ``advance`` with both 236, no spills; the H200's driver gave RK4 202 registers and
-    40 B of local memory. Members in the "F" order: RK4 255, with 92 B of spill stores and 244
-    B of spill loads. For arrays of any strides, RK4 255 with 164 / 488 B.)
+    40 B of local memory; for arrays of any strides, RK4 255 with 164 / 488 B of spills.)
     """
     if method == k.METHOD_RK4:
         return k.run_chunk
@@ -235,14 +225,11 @@ def _batch_method(c: np.ndarray) -> int | None:
     return int(methods[0]) if methods.size == 1 else None
 
 
-def kernel_ptx(
-    cc: tuple[int, int] = (9, 0), method: int | None = None, layout: str | None = None
-) -> str:
+def kernel_ptx(cc: tuple[int, int] = (9, 0), method: int | None = None) -> str:
     """PTX of the ensemble kernel for compute capability ``cc``; needs NVVM, not a device.
 
     ``method``: ``_kernel.METHOD_RK4``, ``METHOD_ADAPTIVE`` or None (the kernel that takes
-    both). ``layout``: the arrays' memory order as :func:`run_on_gpu` launches them ("C" or
-    "F"), or None for arrays of any strides. numba-cuda asks the current device for the
+    both), for the C-ordered arrays :func:`run_on_gpu` launches. numba-cuda asks the current device for the
     compute capability of device functions even when ``compile_ptx`` is given one, so a
     stand-in device with ``cc`` is put in its place for the compilation.
     """
@@ -251,12 +238,7 @@ def kernel_ptx(
     import numba.cuda.dispatcher as dispatcher
     from numba import cuda, float64, int64
 
-    if layout == "C":
-        a2, a3, i2 = float64[:, ::1], float64[:, :, ::1], int64[:, ::1]
-    elif layout == "F":
-        a2, a3, i2 = float64[::1, :], float64[::1, :, :], int64[::1, :]
-    else:
-        a2, a3, i2 = float64[:, :], float64[:, :, :], int64[:, :]
+    a2, a3, i2 = float64[:, ::1], float64[:, :, ::1], int64[:, ::1]
     sig = (a2, i2, a2, int64, a2, a3, a3, a3, int64[::1])
     device = types.SimpleNamespace(compute_capability=cc)
     with mock.patch.object(dispatcher, "get_current_device", lambda: device):
@@ -291,9 +273,7 @@ def _configured(kern, blocks: int):
     return configured
 
 
-def run_on_gpu(
-    y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts=False, layout=None
-) -> None:
+def run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts=False):
     """Run stacked members to ``n_stop`` on the GPU; arrays as in ``_ensemble._run_batch``.
     One call at a time in this process (:data:`DEVICE_LOCK`).
 
@@ -303,40 +283,31 @@ def run_on_gpu(
     Updates ``y``, ``cnt``, ``lam``, ``section`` and ``status`` in place; ``impacts`` is
     brought back from the device only with ``keep_impacts`` (otherwise only counted).
     ``hand_back(j, lam_j, n)`` empties member ``j``'s impact rows and returns its draws with
-    the used ones dropped and ``n`` new ones appended. ``layout``: the members' memory order
-    on the device, "C" or "F" (default :data:`GPU_LAYOUT`).
+    the used ones dropped and ``n`` new ones appended.
     """
-    order = GPU_LAYOUT if layout is None else layout
-    if order not in ("C", "F"):
-        raise ValueError(f"layout = {order!r} must be 'C' or 'F'")
     with DEVICE_LOCK:
-        _run_on_gpu(
-            y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts, order
-        )
+        _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts)
 
 
-def _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts, order):
+def _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts):
     from numba import cuda
 
     kern = _kernel(_batch_method(c))
     n = y.shape[0]
 
     def put(a):
-        return cuda.to_device(np.asarray(a, order=order))
+        return cuda.to_device(np.ascontiguousarray(a))
 
     def get(d, host) -> None:
-        if order == "C":
-            d.copy_to_host(host)
-        else:  # copy_to_host(host) wants the device's strides
-            host[...] = d.copy_to_host()
+        d.copy_to_host(host)
 
     d_y, d_cnt, d_c, d_lam, d_status = (put(a) for a in (y, cnt, c, lam, status))
-    d_series = cuda.device_array((n, 1, k.SERIES_COLS), order=order)
+    d_series = cuda.device_array((n, 1, k.SERIES_COLS))
     if cnt[:, k.I_N_SECTION].any():  # rows of an earlier launch (a resumable run's first)
         d_section = put(section)
     else:
-        d_section = cuda.device_array(section.shape, order=order)
-    d_impacts = cuda.device_array(impacts.shape, order=order)
+        d_section = cuda.device_array(section.shape)
+    d_impacts = cuda.device_array(impacts.shape)
     blocks = (n + _BLOCK - 1) // _BLOCK
     configured = _configured(kern, blocks)
 
@@ -348,13 +319,8 @@ def _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, kee
 
     def impact_rows(need: np.ndarray) -> None:
         """The filled impact rows of the members in ``need``, brought to ``impacts``."""
-        if order == "C":
-            for j in need:
-                d_impacts[j].copy_to_host(impacts[j])
-            return
-        m = int(cnt[need, k.I_N_IMPACT].max())  # F: a column of the used rows is contiguous
-        for col in range(impacts.shape[2]):
-            impacts[need, :m, col] = d_impacts[:, :m, col].copy_to_host()[need]
+        for j in need:
+            d_impacts[j].copy_to_host(impacts[j])
 
     def refill(need: np.ndarray) -> None:
         get(d_cnt, cnt)
@@ -362,12 +328,12 @@ def _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, kee
             impact_rows(need)
         for j in need:  # the same width again: as many new draws as were used
             lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
-        d_cnt.copy_to_device(np.asarray(cnt, order=order))
-        if order == "C" and 8 * need.size < n:
+        d_cnt.copy_to_device(np.ascontiguousarray(cnt))
+        if 8 * need.size < n:
             for j in need:
                 d_lam[j].copy_to_device(lam[j])
         else:
-            d_lam.copy_to_device(np.asarray(lam, order=order))
+            d_lam.copy_to_device(np.ascontiguousarray(lam))
 
     drive_members(n, launch, refill, np.flatnonzero(status == k.NEED_BUFFER))
     get(d_y, y)

@@ -158,7 +158,6 @@ _SIMULATED = """
 import json, sys, numpy as np
 from chaoscam import Params
 from chaoscam.integrate import _ensemble, _gpu, simulate_ensemble
-_gpu.GPU_LAYOUT = sys.argv[1]  # the members' memory order on the device
 _ensemble._ROOM.update(gpu=(64, 256), cpu=(64, 256))  # many refills: relaunches on the device
 out = {}
 cases = {
@@ -203,14 +202,13 @@ print(json.dumps(out))
 
 
 @needs_numba_cuda
-@pytest.mark.parametrize("layout", ["C", "F"])
-def test_simulated_gpu_equals_cpu(layout):
+def test_simulated_gpu_equals_cpu():
     """Under the CUDA simulator the GPU driver (batches, relaunch after refills) equals the CPU
-    path bit for bit, in either memory order of the members (GPU_LAYOUT): the kernel there
-    runs the compiled CPU code, through the device arrays' strides."""
+    path bit for bit: the kernel there runs the compiled CPU code, through the device
+    arrays."""
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
     out = subprocess.run(
-        [sys.executable, "-c", _SIMULATED, layout],
+        [sys.executable, "-c", _SIMULATED],
         check=True,
         capture_output=True,
         text=True,
@@ -243,16 +241,12 @@ def test_a_small_launch_is_not_warned_about():
 
 
 @needs_numba_cuda
-@pytest.mark.parametrize(
-    "method, layout",
-    [(None, None), (0, None), (1, None), (0, "F")],
-    ids=["both", "rk4", "adaptive", "rk4-members-minor"],
-)
-def test_kernel_compiles_to_ptx_for_h100(method, layout):
+@pytest.mark.parametrize("method", [None, 0, 1], ids=["both", "rk4", "adaptive"])
+def test_kernel_compiles_to_ptx_for_h100(method):
     """The ensemble kernels (each integrator, and advance with both) compile to PTX for sm_90,
-    without a device; the RK4 kernel also for members in the "F" memory order."""
+    without a device."""
     try:
-        ptx = _gpu.kernel_ptx((9, 0), method, layout)
+        ptx = _gpu.kernel_ptx((9, 0), method)
     except Exception as exc:  # NVVM missing: nothing to check here
         if "NVVM" in str(exc) or "nvvm" in str(exc):
             pytest.skip(f"NVVM unavailable: {exc}")
@@ -264,15 +258,12 @@ def test_kernel_compiles_to_ptx_for_h100(method, layout):
 @pytest.mark.gpu
 @pytest.mark.skipif(not _on_device(), reason="no CUDA device")
 @pytest.mark.parametrize(
-    "params, duration, transient, layout",
-    [(Params(l_lambda_sigma=0.002), 0.25, 0.0, "C"), (Params(xi=0.2), 20.0, 10.0, "C"),
-     (Params(l_lambda_sigma=0.002), 0.25, 0.0, "F")],
-    ids=["first-period", "periodic", "first-period-members-minor"],
+    "params, duration, transient",
+    [(Params(l_lambda_sigma=0.002), 0.25, 0.0), (Params(xi=0.2), 20.0, 10.0)],
+    ids=["first-period", "periodic"],
 )  # fmt: skip
-def test_device_equals_cpu_within_tolerance(monkeypatch, params, duration, transient, layout):
-    """On a GPU, sections of the first cam period and of a periodic orbit equal the CPU's
-    (the first period also with the members' arrays in the "F" order)."""
-    monkeypatch.setattr(_gpu, "GPU_LAYOUT", layout)
+def test_device_equals_cpu_within_tolerance(params, duration, transient):
+    """On a GPU, sections of the first cam period and of a periodic orbit equal the CPU's."""
     runs = [
         simulate_ensemble(
             params, range(8), seed=3, duration=duration, transient=transient, backend=b
