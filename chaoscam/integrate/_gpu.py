@@ -229,9 +229,9 @@ def kernel_ptx(cc: tuple[int, int] = (9, 0), method: int | None = None) -> str:
     """PTX of the ensemble kernel for compute capability ``cc``; needs NVVM, not a device.
 
     ``method``: ``_kernel.METHOD_RK4``, ``METHOD_ADAPTIVE`` or None (the kernel that takes
-    both), for the C-ordered arrays :func:`run_on_gpu` launches. numba-cuda asks the current device for the
-    compute capability of device functions even when ``compile_ptx`` is given one, so a
-    stand-in device with ``cc`` is put in its place for the compilation.
+    both), for the C-ordered arrays :func:`run_on_gpu` launches. numba-cuda asks the current
+    device for the compute capability of device functions even when ``compile_ptx`` is given
+    one, so a stand-in device with ``cc`` is put in its place for the compilation.
     """
     from unittest import mock
 

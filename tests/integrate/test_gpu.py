@@ -122,12 +122,6 @@ def test_auto_backend_keeps_a_small_ensemble_on_the_cpu(monkeypatch, fake_gpu):
     ]
 
 
-def test_an_unknown_layout_is_refused():
-    """run_on_gpu takes the members' memory order "C" or "F" and names the field otherwise."""
-    with pytest.raises(ValueError, match=r"layout = 'X' must be 'C' or 'F'"):
-        _gpu.run_on_gpu(*([None] * 9), layout="X")
-
-
 @pytest.mark.parametrize("version", ["2.5.0", "2.5.0rc1", "3.0.0.dev0+git123"])
 def test_numpy_2_5_rules_the_backend_out(monkeypatch, version):
     """Under numpy >= 2.5 (numba-cuda cannot compile there) the status says why and how to fix."""
