@@ -6,7 +6,7 @@ The public face; every name is defined in a submodule and re-exported here. Heav
 
 from __future__ import annotations
 
-from ._lazy import lazy_face
+from ._util import lazy_face
 from ._version import __version__
 
 # Public names and the submodule that defines each: imported on first use (PEP 562),

@@ -17,11 +17,11 @@ _MIN_HALF = 8
 def birkhoff_weights(n: int) -> np.ndarray:
     """Normalised bump weights ``w(t) = exp(-1 / (t (1 - t)))`` at ``t = k / (n + 1)``.
 
-    The weights of the weighted Birkhoff average ``WB_n(f) = Σ_k ŵ_k f(x_k)`` (Das, Saiki,
-    Sander & Yorke 2017; Das & Yorke 2018), ``ŵ_k = w(k / (n + 1)) / Σ_j w(j / (n + 1))``
-    for k = 1 .. n. All derivatives of w vanish at both ends, which is what makes the
-    average of a smooth function on a quasiperiodic orbit converge faster than any power
-    of 1/n (instead of as 1/n for the plain average).
+    ``ŵ_k = w(k / (n + 1)) / Σ_j w(j / (n + 1))``, k = 1 .. n, the weights of the weighted
+    Birkhoff average ``WB_n(f) = Σ_k ŵ_k f(x_k)`` (Das, Saiki, Sander & Yorke 2017; Das &
+    Yorke 2018). All derivatives of w vanish at both ends, so the average of a smooth
+    function on a quasiperiodic orbit converges faster than any power of 1/n (the plain
+    average as 1/n).
     """
     check_settings("birkhoff_weights", n=(n, "int>=1"))
     t = np.arange(1, n + 1) / (n + 1.0)
@@ -88,16 +88,15 @@ def weighted_birkhoff(points) -> BirkhoffResult:
     an observable f over h iterates starting at x_m is ``WB_h(f)(x_m) = Σ_{k=1}^{h} ŵ_k
     f(x_{m+k-1})``. On a quasiperiodic orbit (a smooth torus with a Diophantine rotation)
     and a smooth f it converges faster than any power of 1/h; on a chaotic orbit only as
-    h^{-1/2}. The number of converged digits compares the first h iterates with the next
-    h (the measure of Das, Saiki, Sander & Yorke 2017),
+    h^{-1/2}. The converged digits compare the first h iterates with the next h (Das,
+    Saiki, Sander & Yorke 2017),
 
         dig = -log10 |WB_h(f)(x_0) - WB_h(f)(x_h)|,
 
-    here with f scaled by its range so that dig does not depend on units. Observables:
-    each coordinate, cos and sin of the angle φ about the centroid, and the increment
+    with f scaled by its range so that dig does not depend on units. Observables: each
+    coordinate, cos and sin of the angle φ about the centroid, and the increment
     Δφ_k = φ_{k+1} - φ_k (lifted: cut opposite its circular mean), whose average in turns
-    is the rotation number ρ of a closed curve (Das et al. 2017); ``digits`` is
-    the smallest over these.
+    is the rotation number ρ of a closed curve; ``digits`` is the smallest over these.
 
     Parameters
     ----------
@@ -111,14 +110,13 @@ def weighted_birkhoff(points) -> BirkhoffResult:
 
     Notes
     -----
-    Measured (N = 200 .. 4000 points): rotation by the golden mean 8-15 digits, sine circle
-    map at K = 0.5 6-14, torus section 8-13, chaotic logistic (r = 4) and Hénon 1.2-2.3.
-    A periodic orbit converges as fast as a quasiperiodic one (test the period first);
-    jitter or noise of relative size ε caps the digits near -log10 ε (a period-8 orbit
-    with jitter 1e-4 of its extent: ~5), so a noisy torus reads like weak chaos. The angle
-    about the centroid is a coordinate along the curve only when the curve winds once
-    around the centroid (star-shaped); otherwise ρ is not the rotation number, while the
-    digits stay meaningful.
+    With 200-4000 points, quasiperiodic test orbits give 6-15 digits, chaotic ones
+    (logistic r = 4, Hénon) 1.2-2.3.
+
+    Limits: a periodic orbit converges as fast as a quasiperiodic one (test the period
+    first); jitter or noise of relative size ε caps the digits near -log10 ε, so a noisy
+    torus reads like weak chaos. ρ is the rotation number only when the curve winds once
+    around its centroid (star-shaped); the digits stay meaningful otherwise.
 
     References: S. Das, Y. Saiki, E. Sander, J. A. Yorke, "Quantitative quasiperiodicity",
     Nonlinearity 30 (2017) 4111; S. Das, E. Sander, J. A. Yorke, "Quasiquasiperiodicity"

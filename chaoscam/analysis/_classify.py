@@ -134,41 +134,35 @@ def classify_signal(
 ) -> Verdict:
     """Classify a uniformly sampled signal of a flow (with optional section points).
 
-    Evidence gathered:
+    Evidence gathered (every number is an entry of `Thresholds`, except the spectrum's
+    own, `spectrum_options`, whose broadband tolerance is recorded in
+    ``settings["broadband_tol"]``):
 
     * ``spectrum`` (`spectrum_analysis`, forcing frequency 1 / `forcing_period`): a harmonic
-      comb votes periodic (with the period in forcing periods when forced), two
-      incommensurate bases quasiperiodic, a broadband fraction >= 1 % chaotic, and a
-      smaller unexplained remainder "not_periodic".
-    * ``zero_one`` (`zero_one_test`) on a map-like sequence, never on the oversampled
-      signal: for a forced system, the signal sampled `zero_one_per_period` times per
-      forcing period (linear interpolation) minus its forcing-synchronous mean (which is
-      periodic and only slows the test's convergence); without forcing, the successive
-      local maxima (`local_maxima`). It votes only where valid (`zero_one_evidence`: at
-      least zero_one_min_points samples, K of the first half and of the whole on the same
-      side of zero_one_chaotic = 0.8 / zero_one_regular = 0.2 and within
-      zero_one_max_change). A sequence with nothing left (all maxima equal, or a signal
-      that repeats every forcing period) is K = 0. A chaotic K is not used when the
-      spectrum is a line spectrum whose slowest base period is longer than a fifth of the
-      largest lag (N / 10; zero_one_line_periods = 5): a periodic
-      sequence with a long period makes the displacement grow over every lag the test sees
-      (for a period-8 cam response sampled 4 times per forcing period over 20 s, K ≈ 0.9).
+      comb votes periodic (the period in forcing periods when forced), two incommensurate
+      bases quasiperiodic, a broadband fraction >= 1 % chaotic, a smaller unexplained
+      remainder "not_periodic".
+    * ``zero_one`` (`zero_one_test`, voting where `zero_one_evidence` finds it valid) on a
+      map-like sequence, never the oversampled signal: forced, the signal interpolated
+      `zero_one_per_period` times per forcing period minus its forcing-synchronous mean
+      (which only slows convergence); unforced, the successive `local_maxima`. A sequence
+      with nothing left is K = 0. A chaotic K is not used when a line spectrum's slowest
+      base spans more than N / (10 · zero_one_line_periods) samples: a long period mimics
+      diffusion (a period-8 cam response sampled 4 times per forcing period over 20 s
+      gives K ≈ 0.9).
     * the section evidence of `classify_section`, when `section` is given (names prefixed
       ``section_``).
-    * ``lyapunov``: an externally computed largest exponent per unit time (e.g.
-      `lyapunov_benettin` on the equations): > `lyapunov_tol` chaotic, else not chaotic.
-    * ``lyapunov_series`` (when `series_lyapunov`): Rosenstein's estimate from the signal
-      (`lyapunov_from_series`); it votes only when not doubtful, chaotic when
-      λ T > series_chaotic (0.05) and not chaotic when |λ T| < series_regular (0.01), T
-      the characteristic period.
+    * ``exponent``: a largest exponent with its standard error (`exponent_evidence`).
+    * ``lyapunov``: a largest exponent per unit time computed elsewhere (e.g.
+      `lyapunov_benettin`): > `lyapunov_tol` chaotic, else not chaotic.
+    * ``lyapunov_series`` (`series_lyapunov`): Rosenstein's estimate from the signal
+      (`lyapunov_from_series`), voting only when not doubtful: chaotic when λ T >
+      series_chaotic, not chaotic when |λ T| < series_regular, T the characteristic period.
 
-    Every number above is an entry of `Thresholds`, except the spectrum's own
-    (`spectrum_options`; its broadband tolerance is recorded in
-    ``settings["broadband_tol"]``). Votes are combined by `combine`; when they disagree
-    the label is "undetermined" and `reasons` lists the votes. The period comes from the
-    section when given, else from the spectrum for a forced signal; an unforced periodic
-    signal without section gets period 1 (one period of its own fundamental), with a note
-    in `reasons`.
+    The votes are combined by `combine` (disagreement: "undetermined", with the votes in
+    `reasons`). The period comes from the section when given, else from the spectrum of a
+    forced signal; an unforced periodic signal without section gets period 1 (one period
+    of its own fundamental), with a note in `reasons`.
 
     Parameters
     ----------
@@ -183,9 +177,8 @@ def classify_signal(
     lyapunov : float, optional
         Largest Lyapunov exponent (1/s) computed elsewhere.
     lyapunov_tol : float, optional
-        |λ₁| below this counts as zero; default ``signal_lyapunov_tol / T`` (0.02 / T) with
-        T the forcing period, else
-        the fundamental period of the spectrum.
+        |λ₁| (1/s) below this counts as zero; default ``signal_lyapunov_tol / T`` with T the
+        forcing period, else the fundamental period of the spectrum.
     angle_periods, rtol, atol, max_period, min_points_aperiodic
         Passed to the section analysis (see `classify_section`).
     series_lyapunov : bool
@@ -197,15 +190,15 @@ def classify_signal(
         Extra keyword arguments of `spectrum_analysis`.
     seed : int
         Seed of the 0–1 test's c values.
-    exponent : float, (float, float), (float, float, int) or object, optional
-        A largest exponent with its standard error (e.g. the model's tangent exponent),
-        judged by its confidence interval (`exponent_evidence`); see `as_exponent`.
-    exponent_time : float
-        Multiplies λ and its error to make them per forcing period (the forcing period for
-        an exponent in 1/s).
     thresholds : Thresholds, optional
         The decision thresholds (default `Thresholds()`), recorded in
         ``settings["thresholds"]``; `rtol` and `min_points_aperiodic` override their entries.
+    exponent : float, (float, float), (float, float, int) or object, optional
+        A largest exponent with its standard error (e.g. the model's tangent exponent);
+        see `as_exponent`.
+    exponent_time : float
+        Multiplies λ and its error to make them per forcing period (the forcing period, s,
+        for an exponent in 1/s).
 
     Returns
     -------
@@ -218,11 +211,13 @@ def classify_signal(
 
     Notes
     -----
-    Choice for degenerate input: a constant signal is an equilibrium, not an oscillation,
-    and is labelled "undetermined" (even if constant section points would say period 1).
-    With ~20 s of a cam signal (~90 forcing periods), the 0–1 test runs on ~360 samples
-    and the spectrum resolves subharmonics up to order 9: a periodic call is solid, a
-    quasiperiodic versus chaotic call rests on the spectrum and the 0–1 test agreeing.
+    A constant signal is an equilibrium, not an oscillation, and is labelled
+    "undetermined" (even if constant section points would say period 1).
+
+    Limits: with ~20 s of a cam signal (~90 forcing periods) the 0–1 test runs on ~360
+    samples and the spectrum resolves subharmonics up to order 9: a periodic call is
+    solid, a quasiperiodic versus chaotic call rests on the spectrum and the 0–1 test
+    agreeing.
     """
     x = as_series(x, min_size=MIN_SERIES)
     zero_one_per_period = _check_signal_settings(locals())

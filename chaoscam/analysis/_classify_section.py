@@ -95,34 +95,30 @@ def classify_section(
 
     * ``section_period`` — bands at a fixed lag (`section_period`): periodic with the
       smallest lag n whose n bands are each narrower than ``max(atol, period_rtol ·
-      extent)``, the jitter and the extent reported; otherwise "not_periodic" (no period
-      up to N / 2), unless the points have not settled (spread of the second half over
-      the first outside [stationary_low, stationary_high]: abstains). When the section is
-      periodic, the expansion, Birkhoff and 0–1 tests abstain (only jitter is left).
+      extent)``; otherwise "not_periodic", unless the points have not settled (spread of
+      the second half over the first outside [stationary_low, stationary_high]: abstains).
+      On a periodic section the expansion, Birkhoff and 0–1 tests abstain (only jitter is
+      left).
     * ``section_rotation`` — rank-shift consistency R (`rotation_order`): R >=
-      rotation_quasi votes quasiperiodic (the points advance along a closed curve).
+      rotation_quasi votes quasiperiodic.
     * ``section_birkhoff`` — converged digits of weighted Birkhoff averages
       (`weighted_birkhoff`, N >= birkhoff_min_points): >= birkhoff_quasi_digits votes
-      quasiperiodic; the value is the rotation number.
+      quasiperiodic, unless the rotation number is within birkhoff_rational_tol of p/q.
     * ``section_expansion`` — mean one-step log growth of nearest-neighbour distances
       beyond the noise floor (`neighbour_expansion`): > expansion_chaotic votes chaotic.
     * ``section_dimension`` — correlation dimension (d >= 2, N >= dimension_min_points):
       >= dimension_chaotic votes chaotic (not a curve).
     * ``section_zero_one`` — 0–1 test on the first coordinate, where valid
-      (`zero_one_evidence`: N >= zero_one_min_points, K of the first half and of the whole
-      agree).
+      (`zero_one_evidence`).
     * ``exponent`` — a largest exponent with its standard error (`exponent_evidence`):
       chaotic when its confidence interval lies above exponent_zero, not chaotic when
       below (always for -inf), else abstains with the run length that would decide.
     * ``lyapunov`` — a bare exponent per iterate: > `lyapunov_tol` chaotic, else not.
 
-    The votes are combined by `combine` (a label only when all votes admit it and one
-    names it), then: a chaotic label needs a chaotic exponent or at least
-    min_chaotic_votes chaotic votes; a quasiperiodic label with a negative exponent is a
-    conflict (a stable periodic orbit whose period was not found). An "undetermined"
-    verdict says in `reasons` what to run (a longer run, the tangent exponent).
-    `Verdict.used` names the evidence that voted; ``settings["thresholds"]`` records the
-    table.
+    The votes are combined by `combine`; then a chaotic label needs a chaotic exponent or
+    at least min_chaotic_votes chaotic votes, and a quasiperiodic label with a negative
+    exponent is a conflict (a stable periodic orbit whose period was not found). An
+    "undetermined" verdict says in `reasons` what to run (longer, the tangent exponent).
 
     Parameters
     ----------
@@ -133,10 +129,9 @@ def classify_section(
     lyapunov_tol : float
         |λ₁| below this counts as zero (for `lyapunov` only).
     exponent : float, (float, float), (float, float, int) or object, optional
-        Largest exponent with its standard error: ``(λ, stderr)``, ``(λ, stderr,
-        n_intervals)``, or an object with attributes ``exponent``, ``stderr`` (and
-        ``n_intervals``), e.g. the model's tangent exponent. λ = -inf (a zero Floquet
-        multiplier) is decisively not chaotic. See `as_exponent`.
+        Largest exponent with its standard error (e.g. the model's tangent exponent; the
+        forms are those of `as_exponent`). λ = -inf (a zero Floquet multiplier) is
+        decisively not chaotic.
     exponent_time : float
         Multiplies λ and stderr to give them per iterate (the forcing period T for an
         exponent in 1/s and a stroboscopic section); 1 when they already are.
@@ -167,11 +162,12 @@ def classify_section(
 
     Notes
     -----
-    Choice for degenerate input: a set of identical points is a fixed point of the section
-    map and is labelled periodic with period 1 (for a stroboscopic section, a response
-    with the forcing's period). Fewer than 8 points: "undetermined". With the ~90 points
-    of a 20 s cam run a period is called reliably, but only the exponent separates
-    quasiperiodic from chaotic.
+    A set of identical points is a fixed point of the section map: periodic with period 1
+    (for a stroboscopic section, a response with the forcing's period). Fewer than 8
+    points: "undetermined".
+
+    Limits: with the ~90 points of a 20 s cam run a period is called reliably, but only
+    the exponent separates quasiperiodic from chaotic.
     """
     x = as_points(points)
     check_atol("classify_section", atol, x.shape[1])

@@ -37,17 +37,19 @@ def zero_one_evidence(
 ) -> Evidence:
     """The 0–1 test's vote, cast only where the test is valid and has converged in N.
 
-    Validity rule (Gottwald & Melbourne, "On the validity of the 0-1 test for chaos",
-    Nonlinearity 22 (2009) 1367, and "On the implementation of the 0-1 test for chaos",
-    SIAM J. Appl. Dyn. Syst. 8 (2009) 129: K separates 0 from 1 cleanly only for N ~ 1000
-    samples of a map-like, not oversampled, sequence; Melosik & Marszalek, "On the 0/1
-    test for chaos in continuous systems", Bull. Pol. Acad. Sci. Tech. Sci. 64 (2016): an
-    oversampled regular signal can give K near 1): the test votes only when (1) the
-    sequence has at least `Thresholds.zero_one_min_points` samples, (2) it is not flagged
-    as oversampled, and (3) K from the first half and K from the whole lie on the same
-    side of the thresholds (both >= `zero_one_chaotic` or both <= `zero_one_regular`) and
-    differ by at most `zero_one_max_change`. Otherwise it abstains and says which
-    condition failed.
+    `zero_one_test` on `series` votes only when (1) the sequence has at least
+    `Thresholds.zero_one_min_points` samples, (2) it is not flagged as oversampled, and
+    (3) K of the first half and K of the whole lie on the same side of the thresholds
+    (both >= `zero_one_chaotic` or both <= `zero_one_regular`) and differ by at most
+    `zero_one_max_change`. Otherwise it abstains and the detail says which condition
+    failed; `what` names the sequence in the detail.
+
+    References: K separates 0 from 1 cleanly only for N ~ 1000 samples of a map-like
+    sequence (Gottwald & Melbourne, "On the validity of the 0-1 test for chaos",
+    Nonlinearity 22 (2009) 1367; "On the implementation of the 0-1 test for chaos", SIAM
+    J. Appl. Dyn. Syst. 8 (2009) 129); an oversampled regular signal can give K near 1
+    (Melosik & Marszalek, "On the 0/1 test for chaos in continuous systems", Bull. Pol.
+    Acad. Sci. Tech. Sci. 64 (2016)).
     """
     thr = thresholds or Thresholds()
     x = np.asarray(series, dtype=float)

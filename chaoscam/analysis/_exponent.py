@@ -56,27 +56,25 @@ def exponent_evidence(
     log growths) votes
 
     * "chaotic" when ``λ - z σ > ε`` (positive beyond doubt),
-    * "not_chaotic" when ``λ + z σ < ε`` (zero within ε: quasiperiodic or a torus; or
-      negative: a stable periodic orbit), and always for λ = -inf (the tangent vector
-      was annihilated: a zero Floquet multiplier, as for a sticking or grazing-free
-      contact orbit, decisively not chaotic),
-    * and abstains otherwise, with the run length that would decide, assuming σ shrinks
-      as the inverse square root of the run length (Benettin et al. 1980, Meccanica 15,
-      9; the batch-means error of an ergodic average).
+    * "not_chaotic" when ``λ + z σ < ε`` (zero within ε: a torus; or negative: a stable
+      periodic orbit), and always for λ = -inf (the tangent vector collapsed: a zero
+      Floquet multiplier, as after sticking),
+    * and abstains otherwise, with the run length that would decide, σ taken to shrink as
+      1/sqrt(run length) (the batch-means error of an ergodic average; Benettin et al.
+      1980, Meccanica 15, 9).
 
     Parameters
     ----------
     exponent : float
-        λ₁, in the units of `unit` (the thresholds are per iterate of the section map).
+        λ₁, in the units named by `unit` (the thresholds are per iterate of the section map).
     stderr : float, optional
         Standard error of λ₁ in the same units; None or NaN abstains (unless λ₁ = -inf).
     n_intervals : int, optional
         Renormalisation intervals averaged; only used to say how many more to run.
     thresholds : Thresholds, optional
-    name : str
-        Name of the evidence.
-    unit : str
-        Written after the numbers in the detail.
+        Default `Thresholds()`.
+    name, unit : str
+        Name of the evidence; unit written after the numbers in the detail.
 
     Returns
     -------

@@ -109,15 +109,14 @@ def lyapunov_benettin(
     """Largest Lyapunov exponent of a flow by Benettin's two-trajectory method.
 
     A reference trajectory x and a companion y = x + d0 u (u a random unit vector in the
-    perturbed components) are advanced together for `renorm_time`; the separation
-    ``d_i = ||(y - x)_S||`` is recorded and y is pulled back to distance d0 along the
-    separation. The exponent is (Benettin, Galgani, Giorgilli & Strelcyn 1980, Meccanica
-    15, 9; Parker & Chua 1989, "Practical Numerical Algorithms for Chaotic Systems", §4.2)
+    perturbed components S) are advanced together for τ = `renorm_time`; the separation
+    ``d_i = ||(y - x)_S||`` is recorded and y is pulled back to distance d0 along it. After
+    `n_align` renormalisations (the separation turns to the most unstable direction),
 
-        λ₁ = 1 / (n τ) Σ_{i=1}^{n} ln(d_i / d0),
+        λ₁ = 1 / (n τ) Σ_{i=1}^{n} ln(d_i / d0)
 
-    after `n_align` renormalisations that let the separation turn to the most unstable
-    direction.
+    (Benettin, Galgani, Giorgilli & Strelcyn 1980, Meccanica 15, 9; Parker & Chua 1989,
+    "Practical Numerical Algorithms for Chaotic Systems", §4.2).
 
     Parameters
     ----------
@@ -152,24 +151,20 @@ def lyapunov_benettin(
 
     Notes
     -----
-    Zero exponents: for an autonomous flow one exponent is exactly zero, along the flow;
-    a periodic orbit of an autonomous flow therefore has λ₁ = 0 (not negative), and only
-    λ₁ > 0 signals chaos. For a forced (non-autonomous) system written with time (or the
-    forcing phase) as a state variable, the trivial zero exponent belongs to that time
-    direction; the exponents of the (x, v) dynamics — equivalently of the stroboscopic map
-    (θ, ω) -> (θ, ω) after one forcing period, divided by the period — do not contain it:
-    a periodic response then has λ₁ < 0, a quasiperiodic one λ₁ = 0 and a chaotic one
-    λ₁ > 0.
+    Zero exponents: an autonomous flow has one exponent exactly zero, along the flow, so
+    its periodic orbits have λ₁ = 0 and only λ₁ > 0 signals chaos. For a forced system
+    carried with time (or the forcing phase) as a state variable, the trivial zero
+    exponent belongs to that direction; the exponents of the (x, v) dynamics (those of the
+    stroboscopic map divided by the forcing period) do not contain it: a periodic response
+    has λ₁ < 0, a quasiperiodic one λ₁ = 0, a chaotic one λ₁ > 0.
 
-    Limits: a finite-time average; its statistical error (`stderr`) shrinks like
-    1/sqrt(total time) and is large for weakly chaotic or intermittent systems. For a
-    non-smooth system, if the two trajectories sit on either side of an impact (or of a
-    stick/slip switch) at a renormalisation instant, their separation is the size of the
-    jump, not of order d0 e^{λτ}, and one interval dominates the sum: `message` flags any
-    interval that ends with a separation above 1e-3 (1 + |x|) (out of the linear regime:
-    an impact or switch between the two, or a renormalisation time too long for d0;
-    compare `max_log_growth` with λ₁ τ). Grazing impacts make the flow's derivative
-    unbounded and the exponent ill-defined.
+    Limits: a finite-time average; `stderr` shrinks like 1/sqrt(total time) and is large
+    for weakly chaotic or intermittent systems. For a non-smooth system, two trajectories
+    on either side of an impact (or stick/slip switch) at a renormalisation instant are a
+    jump apart, not d0 e^{λτ}, and that interval dominates the sum: `message` flags any
+    interval ending with a separation above 1e-3 (1 + |x|) (an impact or switch between
+    the two, or a `renorm_time` too long for d0; compare `max_log_growth` with λ₁ τ).
+    Grazing impacts make the flow's derivative unbounded and the exponent ill-defined.
     """
     check_settings(
         "lyapunov_benettin",
@@ -335,10 +330,8 @@ def lyapunov_spectrum_map(
         ``step(x) -> x'`` and ``jacobian(x) -> (d, d) array``.
     x0 : array_like
         Initial state.
-    n : int
-        Iterates averaged.
-    transient : int
-        Iterates discarded first.
+    n, transient : int
+        Iterates averaged, and iterates discarded first.
     n_exponents : int, optional
         How many exponents (default all).
     time_per_iterate : float

@@ -75,11 +75,9 @@ def lyapunov_from_series(
     in a delay embedding, ``<ln d_j(i)> ≈ λ₁ i Δt + const`` (Rosenstein, Collins & De Luca
     1993, Physica D 65, 117), with ``nolds.lyap_r``; ``method="eckmann"`` fits local
     linear maps to the neighbourhoods and takes QR products of them (Eckmann, Kamphorst,
-    Ruelle & Ciliberto 1986, Phys. Rev. A 34, 4971), with ``nolds.lyap_e``. nolds is by
-    Schölzel (2019), https://doi.org/10.5281/zenodo.3814723.
-
-    The series is first subsampled by ``stride = ceil(N / max_points)`` (both methods
-    cost O(N²) memory and time), and the sampling interval passed to nolds is
+    Ruelle & Ciliberto 1986, Phys. Rev. A 34, 4971), with ``nolds.lyap_e`` (Schölzel 2019,
+    https://doi.org/10.5281/zenodo.3814723). The series is first subsampled by ``stride =
+    ceil(N / max_points)`` (both methods cost O(N²)) and nolds is given the interval
     ``dt * stride``, so the exponent is per unit time.
 
     Parameters
@@ -87,7 +85,7 @@ def lyapunov_from_series(
     x : array_like, shape (N,)
         Scalar observable after the transient.
     dt : float
-        Sampling interval of `x`.
+        Sampling interval of `x` (the exponent is per this unit of time).
     method : {"rosenstein", "eckmann"}
         Estimator.
     max_points : int
@@ -121,12 +119,11 @@ def lyapunov_from_series(
     (impossible for a dissipative system) or, for a flow, no exponent lies near zero
     (within 10 % of the largest magnitude), which a flow must have; nolds warned.
 
-    Limits: series estimates are biased low for weakly chaotic systems and rough on
-    short or noisy data (on 20 000 samples of Lorenz, Rössler and Ueda signals
-    Rosenstein gives 0.84, 0.052 and 0.076 where the values are 0.906, 0.071 and 0.10).
-    Eckmann's method gives spurious positive exponents on periodic signals at these
-    settings. Prefer the exponent from the equations (`lyapunov_benettin`) whenever the
-    equations are available.
+    Limits: series estimates are biased low for weakly chaotic systems and rough on short
+    or noisy data (on 20 000 samples of the Lorenz, Rössler and Ueda signals Rosenstein
+    reads 7-27 % low). Eckmann's method gives spurious positive exponents on periodic
+    signals at these settings. Prefer the exponent from the equations
+    (`lyapunov_benettin`) whenever they are available.
     """
     import nolds
 
@@ -190,7 +187,7 @@ def lyapunov_from_series(
     if y.size < min_points:
         reasons.append(f"only {y.size} samples (< {min_points})")
 
-    with recorded() as caught:  # nolds's warnings, kept as reasons (thread-safe: chaoscam._warn)
+    with recorded() as caught:  # nolds's warnings, kept as reasons (thread-safe)
         try:
             if method == "rosenstein":
                 le, (ks, div, poly) = nolds.lyap_r(

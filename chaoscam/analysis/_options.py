@@ -1,9 +1,8 @@
 """The settings a caller may pass through to the analysis classifiers.
 
 :func:`chaoscam.classify_trajectory` forwards its ``**options`` to :func:`classify_signal`
-(a run with a series) or :func:`classify_section` (a section alone); this is the list of
-what they take, without the inputs it builds from the trajectory itself (the samples, the
-section, the exponents), so that a misspelt option is refused with the list.
+(a run with a series) or :func:`classify_section` (a section alone); these are what they
+take less the inputs built from the trajectory, so that a misspelt option is refused.
 """
 
 from __future__ import annotations

@@ -114,8 +114,9 @@ class PeriodResult:
     extent : ndarray
         Per coordinate, the range of the points kept (the orbit's size).
     separation : float
-        Smallest distance between two band centres at the period found, in tolerances
-        (Chebyshev norm of the differences over tol_j); inf for period 1 or none.
+        Smallest Chebyshev distance between two band centres at the period found, in
+        units of ``max(band_separation · jitter_j, round-off_j)`` (> 1: distinct bands);
+        inf for period 1 or none.
     """
 
     period: int | None
@@ -158,66 +159,51 @@ def section_period(
     distinct: bool = True,
     band_separation: float | None = None,
 ) -> PeriodResult:
-    """Period of an orbit of section points: the smallest n whose n bands are all narrow.
+    """Period of section points by fixed-lag bands: the smallest n whose n bands are narrow.
 
     The orbit is period n when the points split, by their index modulo n, into n bands
-    ``B_r = {x_{r + kn}}`` each narrower than the tolerance in every coordinate,
+    ``B_r = {x_{r + kn}}`` each narrower than the tolerance in every coordinate j,
 
         max_k x_{r+kn, j} - min_k x_{r+kn, j} <= tol_j = max(atol_j, rtol · extent_j),
 
-    with extent_j the range of coordinate j over all the points: the size of the orbit,
-    not the spread within a band. A band's width is the jitter the orbit carries
-    (integration error, a slowly converging transient, noise); it is reported
-    (`PeriodResult.jitter`) next to the extent, so that "period 8, bands 3e-4 rad on an
-    orbit of 0.3 rad" can be read off the result. Bands whose centres lie within a few band
-    widths of each other overlap: such a lag is refused (`distinct`). The smallest n that fits is
-    returned. Looking at the bands of a lag, instead of clustering, also checks the order
-    in which the clusters are visited, and a slow drift along a curve (a quasiperiodic
-    orbit near a resonance p/n) widens the bands over the record and is refused.
+    extent_j the range of coordinate j (the orbit's size). A band's width is the jitter the
+    orbit carries (integration error, a slow transient, noise), reported as
+    `PeriodResult.jitter`. Bands of a lag, unlike clusters, also check the order of the
+    visits, and a slow drift along a curve (a torus near a resonance p/n) widens them.
 
     Parameters
     ----------
     points : array_like, shape (N,) or (N, d)
         Section points in time order (map iterates, or stroboscopic (θ, ω) points), after
-        the transient. Angular coordinates should go through `embed_angles` first.
+        the transient; angular coordinates through `embed_angles` first.
     rtol : float, optional
-        Band width allowed relative to the extent; default `Thresholds.period_rtol`
-        (3e-3). A quasiperiodic orbit whose rotation number lies within ~rtol / (π N) of
-        p/n is read as period n.
+        Band width allowed relative to the extent; default `Thresholds.period_rtol` (3e-3).
     atol : float or array_like, optional
-        Absolute floor per coordinate, in the units of the points. The default,
-        ``noise_floor · max_j max_k |x_kj|``, is what makes period 1 detectable: a fixed
-        point's extent is only round-off or integration error, and relative to it no
-        tolerance works. Pass the integrator's accuracy when coordinates have very
-        different scales.
+        Absolute floor per coordinate, in the units of the points; default
+        ``noise_floor · max_j max_k |x_kj|``, which makes period 1 detectable (a fixed
+        point's extent is only round-off). Pass the integrator's accuracy when the
+        coordinates have very different scales.
     max_period : int, optional
         Largest lag tested; default ``N // min_repeats``.
     min_repeats : int
-        The pattern must be seen at least this many times (N - transient >= min_repeats n); 2
-        means every point of one period is seen to come back at least once.
+        The pattern must be seen at least this many times (N - transient >= min_repeats n);
+        2: every point of one period is seen to come back.
     allow_transient : bool
         Also try leaving out the first 10 %, 20 %, ..., 50 % of the points (a slowly
         converging transient); the tolerance is then computed on the points kept.
     min_points : int
-        Fewer points than this: no test (period None, `message` says so).
+        Fewer points than this: no test (period None, `message` says why).
     noise_floor : float, optional
         Fraction of the largest coordinate magnitude used as `atol` when none is given;
         default `Thresholds.noise_floor` (1e-6).
+    distinct : bool
+        Refuse a lag two of whose bands overlap: centres within `band_separation` widths of
+        the widest band (or within 64 ulps of the coordinate's magnitude) in every
+        coordinate; `rtol` and `atol` bound a band's jitter, not the distance between
+        distinct points. False returns the smallest lag whose bands are all narrow: whether
+        the points keep to bands visited in order (banded chaos), not whether they repeat.
     band_separation : float, optional
         See `distinct`; default `Thresholds.band_separation` (4).
-    distinct : bool
-        Refuse a lag two of whose bands overlap (default): their centres lie within
-        `band_separation` widths of the widest band (or within round-off, 64 ulps of the
-        coordinate's magnitude) in every coordinate. Two points of a period-n orbit may lie
-        much closer together than the tolerance or the absolute floor `atol`, which bound
-        the jitter a band may carry, not the distance between distinct points: a period-12
-        orbit on the cam with two points 9e-6 rad and 2.2e-4 rad/s·T apart, and a period-30
-        orbit (ξ = 0.30) with two points 2.8e-6 rad and 1.6e-5 rad/s apart, both with bands
-        of 1e-9 rad, are still period 12 and 30 (with the floor in this test the period 30
-        was refused at every lag). False accepts
-        it: the smallest lag whose bands are all narrow, for asking whether the points are
-        confined to narrow bands visited in order (banded chaos) rather than whether they
-        repeat.
 
     Returns
     -------
@@ -226,11 +212,13 @@ def section_period(
     Notes
     -----
     A constant set of points (all within `atol`) is period 1: a fixed point of the section
-    map, which for a stroboscopic section is a response with the forcing's period.
-    Limits: periods above N / `min_repeats` cannot be seen (with 60 points, up to 30);
-    jitter wider than `rtol` × extent hides any period (raise `rtol` or `atol` for noisy
-    or stochastic data); two distinct points of an orbit closer than the tolerance are
-    read as one (right after a period doubling, period n for 2n).
+    map, for a stroboscopic section a response with the forcing's period.
+
+    Limits: periods above N / `min_repeats` cannot be seen; jitter wider than `rtol` ×
+    extent hides any period (raise `rtol` or `atol` for noisy data); a quasiperiodic orbit
+    whose rotation number lies within ~rtol / (π N) of p/n is read as period n; two
+    distinct points closer than the tolerance are read as one (right after a period
+    doubling, period n for 2n).
     """
     check_settings(
         "section_period",
@@ -350,16 +338,16 @@ def _curve_angles(z: np.ndarray) -> np.ndarray:
 
 
 def rotation_order(z) -> RotationResult:
-    """Does the orbit move along a closed curve like a rotation? Rank-shift statistic.
+    """Rank-shift consistency: does the orbit advance along a closed curve like a rotation?
 
     The points are ordered around the curve — by value for d = 1 (the interval read as a
     circle), else by the angle about the centroid after whitening by the principal axes
     (the two leading ones when d > 2). With r_k the rank of point k, the shift
     ``s_k = (r_{k+1} - r_k) mod N`` of a rotation by an irrational ρ (or of any circle
-    homeomorphism conjugate to one) stays within O(log N) of ρN (the three-gap theorem
-    and the discrepancy of irrational rotations; Weyl 1916), so the resultant length
-    ``R = |<exp(2πi s_k / N)>|`` is close to 1, while a chaotic map scrambles the order and
-    gives R ~ 1/sqrt(N).
+    homeomorphism conjugate to one) stays within O(log N) of ρN (three-gap theorem and the
+    discrepancy of irrational rotations; Weyl 1916), so the resultant length
+    ``R = |<exp(2πi s_k / N)>|`` is close to 1; a chaotic map scrambles the order and gives
+    R ~ 1/sqrt(N).
 
     Parameters
     ----------

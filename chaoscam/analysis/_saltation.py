@@ -1,15 +1,7 @@
 """The saltation matrix of a state jump at an event surface (generic, numpy).
 
-For a flow ``x' = f(t, x)`` that jumps ``x+ = g(t, x-)`` where ``h(t, x) = 0``, a
-perturbation is mapped across the event by
-
-``S = g_x + (f+ - g_x f- - g_t) h_x^T / (h_t + h_x . f-)``
-
-(Müller 1995, Chaos Solitons Fractals 5(9), eq. 16; Leine & Nijmeijer 2004, *Dynamics and
-Bifurcations of Non-smooth Mechanical Systems*, sec. 3.5). The model's kernel writes this
-formula out for the restitution law (``chaoscam.integrate._tangent.saltation``); this
-generic form is the reference its tests compare it with, and the one checked on the bouncing
-ball's analytic Floquet multipliers.
+The model's kernel writes the formula out for its restitution law (``_tangent.saltation``);
+this generic form is the reference it is tested against.
 """
 
 from __future__ import annotations
@@ -20,7 +12,14 @@ __all__ = ["saltation_matrix"]
 
 
 def saltation_matrix(g_x, g_t, f_minus, f_plus, h_x, h_t: float) -> np.ndarray:
-    """``S = g_x + (f+ - g_x f- - g_t) h_x^T / (h_t + h_x . f-)`` (Müller 1995).
+    """Saltation matrix S: maps a perturbation across a state jump (Müller 1995).
+
+    For a flow ``x' = f(t, x)`` that jumps ``x+ = g(t, x-)`` where ``h(t, x) = 0``,
+
+        S = g_x + (f+ - g_x f- - g_t) h_x^T / (h_t + h_x · f-)
+
+    (Müller 1995, Chaos Solitons Fractals 5(9), eq. 16; Leine & Nijmeijer 2004, *Dynamics
+    and Bifurcations of Non-smooth Mechanical Systems*, sec. 3.5).
 
     Parameters
     ----------
@@ -31,12 +30,18 @@ def saltation_matrix(g_x, g_t, f_minus, f_plus, h_x, h_t: float) -> np.ndarray:
     f_minus, f_plus : array_like, shape (n,)
         The vector field before and after the jump, at the event.
     h_x : array_like, shape (n,)
-        Gradient of the event function; ``h_t`` its time derivative.
+        Gradient of the event function with respect to the state.
+    h_t : float
+        Its derivative with respect to time.
+
+    Returns
+    -------
+    ndarray, shape (n, n)
 
     Raises
     ------
     ValueError
-        For a grazing event (``h_t + h_x . f- = 0``): no saltation matrix exists there.
+        For a grazing event (``h_t + h_x · f- = 0``): no saltation matrix exists there.
     """
     g_x = np.asarray(g_x, dtype=float)
     h_x = np.asarray(h_x, dtype=float)

@@ -58,12 +58,10 @@ def crossing_section(
         Sample times.
     states : array_like, shape (N, d)
         Sampled states.
-    index : int
-        Component that defines the section.
-    level : float
-        Section level.
+    index, level : int, float
+        The section is ``states[:, index] = level``.
     direction : int
-        +1, -1 or 0.
+        +1 (upwards), -1 (downwards) or 0 (both).
 
     Returns
     -------

@@ -89,8 +89,18 @@ def correlation_dimension(
     """Grassberger–Procaccia correlation dimension of a set of section points.
 
     ``C(r) = 2 / (N (N - 1)) #{i < j : |x_i - x_j| < r}`` and ``D₂ = d ln C / d ln r``
-    (Grassberger & Procaccia 1983, Physica D 9, 189), fitted by least squares over radii
-    between the `quantiles` of the pair distances (coordinates scaled by their extent).
+    (Grassberger & Procaccia 1983, Physica D 9, 189), fitted by least squares over 12
+    radii between the `quantiles` of the pair distances (coordinates scaled by their
+    extent).
+
+    Parameters
+    ----------
+    z : array_like, shape (N,) or (N, d)
+        Section points.
+    max_points : int
+        Only the first `max_points` points are used (the cost is O(N²)).
+    quantiles : (float, float)
+        Fractions of the pair distances bounding the fit window, 0 < low < high <= 1.
 
     Returns
     -------
@@ -102,12 +112,12 @@ def correlation_dimension(
     -----
     The default window (1 % to 10 % of the pairs) skips the smallest distances, where the
     evenly spread points of a quasiperiodic orbit (no pair closer than ~ length / N) bias
-    the slope upwards. Measured with 500–2000 points: closed curves (torus section, circle
-    map) 1.02–1.09, Hénon 1.17–1.19 (literature 1.21), Ueda's section 1.53–1.60.
+    the slope upwards; with 500–2000 points it gives 1.02–1.09 on closed curves and
+    1.17–1.19 on the Hénon attractor (literature 1.21).
 
-    Limits: needs several hundred points at least (about 10^{D₂} per decade of scaling);
-    the fixed quantile window stands in for a scaling region chosen by eye, which biases
-    D₂ for sets whose scaling region lies elsewhere. Use it as supporting evidence only.
+    Limits: needs several hundred points (about 10^{D₂} per decade of scaling); the fixed
+    window stands in for a scaling region chosen by eye and biases D₂ for sets whose
+    scaling region lies elsewhere. Use it as supporting evidence only.
     """
     from scipy.spatial.distance import pdist
 
@@ -134,11 +144,11 @@ def correlation_dimension(
 
 
 def stationarity_ratio(z) -> float:
-    """Spread of the second half of the points over that of the first half.
+    """Stationarity ratio: spread of the second half of the points over that of the first.
 
-    RMS distance to the centroid of each half (coordinates scaled by their extent). A
-    stationary set gives about 1; a transient converging to an orbit gives a small
-    value (it shrinks), one escaping gives a large value.
+    Spread is the RMS distance to each half's centroid (coordinates scaled by their
+    extent). A stationary set gives about 1, a transient converging to an orbit a small
+    value, one escaping a large value; NaN for fewer than 8 points.
     """
     x = _scaled(as_points(z))
     h = x.shape[0] // 2

@@ -194,9 +194,8 @@ def spectrum_analysis(
 
     What neither explains, ``1 - line_fraction``, is the broadband measure: a chaotic
     signal has a continuous spectrum, so a residual >= `broadband_tol` reads as broadband.
-    Spectral entropy ``-Σ p_k ln p_k / ln K`` and flatness (geometric over arithmetic mean)
-    are reported too; they are not used for the decision because they depend on how far
-    the sampling rate exceeds the signal's bandwidth.
+    Spectral entropy ``-Σ p_k ln p_k / ln K`` and flatness are reported but not used: they
+    depend on how far the sampling rate exceeds the signal's bandwidth.
 
     Parameters
     ----------
@@ -208,9 +207,8 @@ def spectrum_analysis(
         Forcing frequency (Hz) of a forced system.
     max_period : int, optional
         Largest subharmonic order n (forced) or harmonic rank k of the strongest peak
-        (unforced). Default: for a forced signal every n whose comb the record resolves,
-        ``n <= f_F N dt / min_cycles`` (9 for 20 s of the cam at 28.7 rad/s), at most 64;
-        unforced, 8.
+        (unforced). Default: forced, every n whose comb the record resolves, ``n <= f_F N
+        dt / min_cycles`` (9 for 20 s of the cam at 28.7 rad/s), at most 64; unforced, 8.
     half_width : int
         Half width of a line, in bins.
     line_tol : float
@@ -237,16 +235,12 @@ def spectrum_analysis(
     Vidal (1984), "Order within Chaos", ch. 2–3 (spectra of periodic, quasiperiodic and
     chaotic motion); Powell & Percival (1979), J. Phys. A 12, 2053 (spectral entropy).
 
-    Limits: a transient left in the signal, measurement noise or slow drifts add broadband
-    power; two lines closer than about `peak_tol` bins are one line, so a quasiperiodic
-    signal whose second base lies within that distance of a low-order subharmonic of the
-    first is read as periodic (the resolution is 1/(N dt)); with few cycles of the
-    fundamental in the record (< `min_cycles`) the candidate is not tried. Lines are judged
-    by the power they hold, so a periodic orbit whose subharmonics hold less than
-    `line_tol` of the power is reported with the smaller period. A forced periodic
-    response whose period exceeds what the record resolves (`max_period`) has lines that
-    two bases can also explain: it is then reported as quasiperiodic, and a section that
-    sees the period directly disagrees (the classifier then says "undetermined").
+    Limits: a transient, noise or slow drifts add broadband power. Two lines closer than
+    about `peak_tol` bins (of 1/(N dt)) are one, so a quasiperiodic signal whose second
+    base lies that close to a low-order subharmonic of the first reads as periodic.
+    Subharmonics holding less than `line_tol` of the power are missed (a smaller period is
+    reported). A forced periodic response whose period exceeds `max_period` has lines two
+    bases also explain: it reads as quasiperiodic, against a section that sees the period.
     """
     x = as_series(x)
     n = x.size

@@ -1,8 +1,5 @@
-"""Lyapunov exponents from a sequence of map Jacobians by repeated QR.
-
-The model computes the Jacobians of its stroboscopic map through the impacts
-(:mod:`chaoscam.tangent`); this module only sees the arrays.
-"""
+"""Lyapunov exponents from a sequence of map Jacobians by repeated QR (the Jacobians of
+the model's stroboscopic map through the impacts come from :mod:`chaoscam.tangent`)."""
 
 from __future__ import annotations
 
@@ -76,6 +73,10 @@ def spectrum_from_jacobians(
         Time per map iterate [s].
     n_batches : int
         Batches (at least 2) for the standard error of the mean of the per-period growths.
+
+    Returns
+    -------
+    TangentSpectrum
     """
     check_settings(
         "spectrum_from_jacobians", period=(period, "real>0"), n_batches=(n_batches, "int>=2")

@@ -13,41 +13,34 @@ __all__ = ["Thresholds"]
 class Thresholds:
     """Every number at which `classify_section` and `classify_signal` change a vote.
 
-    Pass one to either classifier (``thresholds=Thresholds(period_rtol=1e-2)``) to change
-    a decision; the verdict records the table it used in ``settings["thresholds"]``.
-    Exponents are per iterate of the section map (λ T for a stroboscopic section of a
-    flow forced with period T); lengths are relative to the orbit's extent unless said.
+    Pass one to either classifier (``thresholds=Thresholds(period_rtol=1e-2)``); the verdict
+    records the table it used in ``settings["thresholds"]``. Exponents are per iterate of
+    the section map (λ T for a stroboscopic section of a flow forced with period T);
+    lengths are relative to the orbit's extent unless said.
 
     Attributes
     ----------
     period_rtol : float
         A period n is accepted when each of its n bands (the points k ≡ r mod n) is
         narrower than ``max(atol_j, period_rtol · extent_j)`` in every coordinate j,
-        extent_j the range of the section points. 3e-3 accepts bands up to 0.3 % of the
-        orbit's size, three times the 0.1 % that integration jitter and a slowly
-        converging transient leave on a cam section, and still refuses noise of 1 % of
-        the extent (a sizeable fraction: not a period).
+        extent_j the range of the section points. 3e-3 is three times the ~0.1 % jitter
+        that integration error and a slow transient leave on a cam section, and refuses
+        noise of 1 % of the extent.
     noise_floor : float
-        Absolute floor of the period tolerance (and of the distances the expansion test
-        uses), as a fraction of the largest coordinate magnitude ``max_j max_k |x_kj|``:
-        differences below ``noise_floor · max|x|`` are round-off or integration error.
-        1e-6 is far above double round-off and below any dynamics worth resolving. It is
-        what makes a fixed point (period 1, no extent to speak of) detectable.
+        Absolute floor of the period tolerance and of the expansion test's distances, as a
+        fraction of ``max_j max_k |x_kj|``: 1e-6, far above double round-off and below any
+        dynamics worth resolving. It makes a fixed point (no extent) detectable.
     band_separation : float
-        Two bands of a period n are distinct (the period is not a repeat of a shorter one
-        or noise around it) when their centres lie more than this many widths of the
-        widest band apart in some coordinate: 4 widths leave a gap of at least 3 between
-        them. Neither the tolerance nor the absolute floor is the measure: a period-12 orbit
-        of the cam model (Y_f = 3.16e5 Pa) repeats to 1e-9 rad while two of its points lie
-        9e-6 rad (θ) and 2.2e-4 rad (θ̇·T) apart, within 3e-3 of the extent, and a period 30
-        (ξ = 0.30) has two points 2.8e-6 rad and 1.6e-5 rad/s apart, below the model's floor.
+        Two bands of a period are distinct when their centres lie more than this many
+        widths of the widest band apart in some coordinate (4: a gap of at least 3
+        widths). Neither the tolerance nor the floor is the measure: a period-12 cam orbit
+        repeats to 1e-9 rad while two of its points lie 9e-6 rad apart.
     stationary_low, stationary_high : float
-        Spread of the second half of the points over that of the first half: outside
-        [0.5, 2] the points are still converging or escaping and the section abstains.
+        Spread of the second half of the points over that of the first: outside [0.5, 2]
+        the points are still converging or escaping and the section abstains.
     min_points_aperiodic : int
-        Fewest section points for the rotation-order and expansion votes: 40-90 points
-        show a period up to N / 2, but a quasiperiodic/chaotic call from fewer than 100 is
-        weak.
+        Fewest section points for the rotation-order and expansion votes; a period up to
+        N / 2 shows on fewer, a quasiperiodic/chaotic call from fewer than 100 is weak.
     rotation_quasi : float
         Rank-shift consistency R (`rotation_order`) at or above which the points advance
         along a closed curve like a rotation (R ~ 1 / sqrt(N) for chaos).
@@ -55,38 +48,35 @@ class Thresholds:
         Mean one-step log growth of nearest-neighbour distances (`neighbour_expansion`)
         above which neighbours separate: 0.1 per iterate, a tenth of an e-fold.
     dimension_chaotic : float
-        Correlation dimension at or above which the set is not a curve (measured: closed
-        curves 1.02-1.09, Hénon 1.17-1.19, Ueda 1.53-1.60).
+        Correlation dimension at or above which the set is not a curve (closed curves give
+        1.02-1.09, the Hénon attractor 1.17-1.19, Ueda's section 1.53-1.60).
     dimension_min_points : int
         Fewest points for the correlation dimension to vote (10^{D₂} per scaling decade).
     zero_one_chaotic, zero_one_regular : float
-        0-1 test: K at or above 0.8 votes chaotic, at or below 0.2 not chaotic
-        (Gottwald & Melbourne 2009: K separates cleanly only with N ~ 1000).
+        0-1 test: K >= 0.8 votes chaotic, K <= 0.2 not chaotic (Gottwald & Melbourne 2009).
     zero_one_min_points : int
-        Fewest samples for the 0-1 test to vote. 200, so that its first half still has the
+        Fewest samples for the 0-1 test to vote: 200, so that its first half still has the
         100 samples `zero_one_test` needs.
     zero_one_max_change : float
-        Largest |K(first half) - K(whole)| for which K is taken as converged in N; above
-        it (or when the two lie on different sides of a threshold) the test abstains. On a
-        cam attractor K went from 0.94 (229 points) to 0.16 (914 points).
+        Largest |K(first half) - K(whole)| for which K is taken as converged in N; above it
+        (or when the two lie on different sides of a threshold) the test abstains. On a cam
+        attractor K can fall from 0.94 at 229 points to 0.16 at 914.
     birkhoff_quasi_digits : float
         Converged digits of the weighted Birkhoff averages (`weighted_birkhoff`) at or
-        above which the orbit is quasiperiodic, when no period was found. Measured from
-        N = 200 to 4000 points: rotation by the golden mean 8-15, sine circle map (K = 0.5)
-        6.2-13.6, torus section 8-13; logistic r = 4 and Hénon 1.3-2.3; a period-8
-        orbit with jitter 1e-4 of its extent 4.6-4.9 (noise caps the digits).
+        above which an orbit with no period found is quasiperiodic: with 200-4000 points,
+        tori give 6-15 digits, chaotic orbits (logistic r = 4, Hénon) below 2.5, and noise
+        of 1e-4 of the extent caps the digits near 5.
     birkhoff_min_points : int
         Fewest points for the Birkhoff evidence to vote (two halves of 100).
     exponent_zero : float
         A largest exponent per iterate whose confidence interval lies above this is
-        positive (chaotic), below it not positive. 0.01 per iterate: a separation growing
-        e-fold in 100 iterates is below what a finite run resolves.
+        positive (chaotic), below it not positive: 0.01, an e-fold in 100 iterates, is below
+        what a finite run resolves.
     exponent_z : float
         Half-width of the exponent's confidence interval in standard errors (3: ~99.7 %).
     min_chaotic_votes : int
-        Without a decisive exponent, a section is called chaotic only when at least this
-        many independent methods vote chaotic (one method alone is fooled by noise or a
-        long transient).
+        Without a decisive exponent, a section is chaotic only when at least this many
+        independent methods vote chaotic (one alone is fooled by noise or a long transient).
     signal_repeat : float
         `classify_signal`: a sequence whose spread is below this fraction of the signal's
         (all maxima equal, or a signal that repeats every forcing period) is K = 0.
@@ -104,11 +94,9 @@ class Thresholds:
         `classify_signal`: a signal whose range is below this fraction of its magnitude is
         constant (an equilibrium).
     birkhoff_rational_tol : float
-        A converged rotation number within this of a rational p/q with q <= N/2 is not a
-        torus vote: a period-q orbit the period test did not resolve has one too (the cam
-        model at ξ = 0.30, period 30: 0.6000000004 = 3/5 + 4e-10). 1e-8 sits far below the
-        1/Q² spacing of the rationals tried (Q = N/2, 2e-5 at N = 450), so a torus is
-        mistaken for one with probability ~1e-8 Q² (5e-4).
+        A converged rotation number within this of a rational p/q, q <= N/2, is not a
+        torus vote: an unresolved period-q orbit has one too (the cam at ξ = 0.30, period
+        30: 3/5 + 4e-10). 1e-8 mistakes a torus for one with probability ~1e-8 (N/2)².
     """
 
     period_rtol: float = 3e-3
@@ -135,7 +123,7 @@ class Thresholds:
     series_chaotic: float = 0.05
     series_regular: float = 0.01
     constant_signal: float = 1e-12
-    # last: positional tables of earlier versions keep their meaning
+    # kept last, so that positional arguments keep mapping to the fields above
     band_separation: float = 4.0
     birkhoff_rational_tol: float = 1e-8
 

@@ -85,8 +85,8 @@ def check_settings(fn: str, **settings: tuple[Any, str]) -> None:
 
 def check_atol(fn: str, atol: Any, d: int) -> None:
     """Refuse an ``atol`` that is not None, one finite number >= 0, or ``d`` of them (one
-    per coordinate): a string failed deep inside numpy, NaN found no period and inf made
-    any set of points periodic 1."""
+    per coordinate): a string would fail deep inside numpy, NaN would find no period and
+    inf would make any set of points period 1."""
     if atol is None:
         return
     items = atol if isinstance(atol, list | tuple | np.ndarray) else [atol]

@@ -90,7 +90,7 @@ class Verdict:
     settings : dict
         The settings used by each method; ``settings["thresholds"]`` is the
         `Thresholds` table the classifier used (as a dict). Read-only at its top level
-        (:class:`chaoscam._frozen.FrozenDict`), as a Trajectory's settings are.
+        (a ``FrozenDict``), as a Trajectory's settings are.
     """
 
     label: str

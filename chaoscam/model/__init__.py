@@ -1,5 +1,6 @@
 """The model: parameters, geometry, forces, stiffness and the line-length process."""
 
+from .._util import ParameterError
 from ._forces import angular_acceleration, friction_torque, normal_force, stiffness_array
 from ._geometry import (
     cam_angle,
@@ -14,7 +15,7 @@ from ._geometry import (
     slip_speed,
 )
 from ._linelength import LineLengthStream, realization_rng, realizations_identical, truncated_mass
-from ._params import FIELD_DOCS, ParameterError, Params, field_names, parse_value
+from ._params import FIELD_DOCS, Params, field_names, params_arg, parse_value
 from ._stiffness import composite_modulus, fractal_areas, fractal_stiffness, hertz_line_stiffness
 
 __all__ = [
@@ -39,6 +40,7 @@ __all__ = [
     "lever_arm",
     "normal_cam_speed",
     "normal_force",
+    "params_arg",
     "parse_value",
     "realization_rng",
     "realizations_identical",

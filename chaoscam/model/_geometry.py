@@ -16,7 +16,8 @@ import numbers
 
 import numpy as np
 
-from ._params import ParameterError, Params
+from .._util import ParameterError
+from ._params import Params
 
 __all__ = [
     "cam_angle",

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._params import ParameterError, Params
+from .._util import ParameterError
+from ._params import Params
 
 __all__ = ["realization_rng", "realizations_identical", "truncated_mass", "LineLengthStream"]
 

@@ -1,7 +1,7 @@
 """The parameter set: Table 1 of the paper plus every decision of shared/MODEL.md.
 
 This module is the single home of physics choices. A kernel never holds a constant of its
-own; it receives the numbers assembled here (see :meth:`Params.kernel_constants`).
+own; it receives the numbers assembled from here (``chaoscam.kernel.kernel_constants``).
 
 Reference: "Effect of Surface Morphology on Dynamic Characteristics of Cam-Follower Oblique
 Impact System", Table 1 (SI units throughout).
@@ -10,31 +10,25 @@ Impact System", Table 1 (SI units throughout).
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 from dataclasses import dataclass, field, fields
 from typing import Any
 
-from ._fieldcheck import ParameterError, validate_field
+from .._util import NON_NEGATIVE, POSITIVE, check_fields, parse_field, strict_init
+from .._util import meta as _meta
 
-__all__ = ["Params", "ParameterError", "FIELD_DOCS"]
+__all__ = ["FIELD_DOCS", "Params", "field_names", "params_arg", "parse_value"]
 
 
 STIFFNESS_MODELS = ("hertz", "fractal")
 DAMPING_FORMS = ("hunt_crossley", "paper_literal")
 RESAMPLE_MODES = ("contact", "impact", "interval")
-INTEGRATORS = ("rk4", "adaptive")
 
-# (lower, upper, lower_inclusive, upper_inclusive); None = unbounded.
-_POS = (0.0, None, False, None)
-_NONNEG = (0.0, None, True, None)
-_TO_1 = (0.0, 1.0, False, True)
+_POS = POSITIVE
+_NONNEG = NON_NEGATIVE
 
 
-def _meta(doc: str, unit: str, rng: tuple | None = _POS, choices: tuple | None = None) -> dict:
-    return {"doc": doc, "unit": unit, "range": rng, "choices": choices}
-
-
+@strict_init
 @dataclass(frozen=True, slots=True)
 class Params:
     """Frozen, validated parameters of the cam-follower oblique impact model.
@@ -46,7 +40,10 @@ class Params:
 
     Derived quantities (``J``, ``y_O``, the composite modulus, the stiffness) are computed by
     properties so that a value left as ``None`` always means "the documented default rule".
+    The integrator and its settings are not here: see :class:`chaoscam.Numerics`.
     """
+
+    _WHAT = "parameter"
 
     # --- Table 1 -------------------------------------------------------------------------
     l: float = field(
@@ -249,91 +246,9 @@ class Params:
         metadata=_meta("interval between draws when resample = 'interval'", "s"),
     )
 
-    # --- Numerics ------------------------------------------------------------------------
-    integrator: str = field(
-        default="rk4",
-        metadata=_meta(
-            "'rk4' (default): the paper's fixed-step RK4 on the grid n dt, the reference; "
-            "'adaptive': DOP853 with error control (rtol, atol), long steps in flight, events "
-            "located on the step's interpolant and re-stepped. At equal accuracy (20-s sections "
-            "of periodic responses to 1e-6 rad) the adaptive path is 5.5-10x cheaper than "
-            "plain fixed-step RK4 and 1.1-1.2x cheaper than the default merged RK4 "
-            "(bench_work_precision.py); at the default settings both take about the same time "
-            "and the adaptive path is the more accurate. RK4 stays the default as "
-            "the paper's method and the one the published results were validated with",
-            "-",
-            None,
-            INTEGRATORS,
-        ),
-    )
-    dt: float = field(
-        default=2e-6,
-        metadata=_meta(
-            "RK4 step; resolves the Hertz contact oscillation (period ~9e-5 s) with ~45 steps",
-            "s",
-        ),
-    )
-    event_tol: float = field(
-        default=1e-12,
-        metadata=_meta(
-            "located impact time's tolerance, at most 1e-9 s (1e-8 merged micro-impacts)",
-            "s",
-            (0.0, 1e-9, False, True),
-        ),
-    )
-    max_events_per_step: int = field(
-        default=8,
-        metadata=_meta(
-            "chattering guard: impacts handled inside one step before the rest of the step is "
-            "left to the compliant contact (at most 1024: buffers are sized by it)",
-            "-",
-            (1, 1024, True, True),
-        ),
-    )
-
-    flight_merge: int = field(
-        default=16,
-        metadata=_meta(
-            "most grid steps taken as one RK4 step where a bound on the gap's curvature proves "
-            "no contact can occur (free pendulum); 1 = plain RK4. Default 16: 6x faster, equal "
-            "to plain RK4 within 5e-9 s / 1e-8 rad (tests). At most 1024 (buffers)",
-            "-",
-            (1, 1024, True, True),
-        ),
-    )
-    rtol: float = field(
-        default=1e-12,
-        metadata=_meta(
-            "adaptive integrator: relative tolerance of the local error of (theta_f, theta_f'); "
-            "1e-12: periodic sections within 1e-6 rad of converged RK4 (tests)",
-            "-",
-            (0.0, 1e-2, False, True),
-        ),
-    )
-    atol: float = field(
-        default=1e-13,
-        metadata=_meta(
-            "adaptive integrator: absolute tolerance of the local error, for theta_f [rad] and "
-            "theta_f' [rad/s]",
-            "rad, rad/s",
-        ),
-    )
-    h_max: float = field(
-        default=0.005,
-        metadata=_meta("adaptive integrator: largest step (flight), at most 1 s", "s", _TO_1),
-    )
-
     # ------------------------------------------------------------------------------------
     def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if type(value).__module__ == "numpy" and getattr(value, "size", 0) == 1:
-                value = value.item()  # numpy scalars: stored as Python numbers
-            validate_field(f, value)
-            kind = {"int": int, "float": float, "float | None": float}.get(f.type)  # 30 -> 30.0
-            if kind and value is not None and type(value) is not kind:  # equal Params, records
-                value = kind(value)
-            object.__setattr__(self, f.name, value)
+        check_fields(self)
         if self.stiffness == "fractal":  # a ParameterError naming D or G where (15)/(17) fail
             from ._stiffness import fractal_stiffness
 
@@ -375,29 +290,9 @@ class Params:
         """Forcing period 2 pi / omega [s]: the stroboscopic section's interval."""
         return 2.0 * math.pi / self.omega
 
-    def refined(self) -> Params:
-        """The same model integrated about twice as finely: the convergence check's partner.
-
-        Fixed-step RK4: ``dt / 2``. Adaptive: ``rtol`` and ``atol`` / 32, the error reduction
-        of a fifth-order method whose steps halve (its near-cam step cap ``dt`` is halved
-        too). "A result must not change when the step is halved" (shared/MODEL.md).
-        """
-        if self.integrator == "adaptive":
-            return self.replace(dt=self.dt / 2, rtol=self.rtol / 32, atol=self.atol / 32)
-        return self.replace(dt=self.dt / 2)
-
-    def describe_step(self) -> str:
-        """The integrator's resolution in words, e.g. ``dt = 2e-06 s``."""
-        if self.integrator == "adaptive":
-            return f"adaptive, rtol = {self.rtol:g}"
-        return f"dt = {self.dt:g} s"
-
     # --- conveniences --------------------------------------------------------------------
     def replace(self, **changes: Any) -> Params:
         """A copy with ``changes`` applied and validated."""
-        unknown = set(changes) - set(field_names())
-        if unknown:
-            raise ParameterError(_unknown_message(sorted(unknown)[0]))
         return dataclasses.replace(self, **changes)
 
     def to_dict(self) -> dict[str, Any]:
@@ -411,49 +306,32 @@ class Params:
         return base.replace(**{k: parse_value(k, v) for k, v in assignments.items()})
 
 
-_dataclass_init = Params.__init__
-
-
-@functools.wraps(_dataclass_init)
-def _checked_init(self, *args: Any, **kwargs: Any) -> None:
-    """The dataclass's __init__, an unknown keyword refused as by .replace."""
-    unknown = set(kwargs) - set(field_names())
-    if unknown:
-        raise ParameterError(_unknown_message(sorted(unknown)[0]))
-    _dataclass_init(self, *args, **kwargs)
-
-
-Params.__init__ = _checked_init  # type: ignore[method-assign]
-
-
 def field_names() -> tuple[str, ...]:
+    """The fields of :class:`Params`, in order (the ``--set`` names)."""
     return tuple(f.name for f in fields(Params))
 
 
 FIELD_DOCS: dict[str, dict] = {f.name: dict(f.metadata) for f in fields(Params)}
 
 
-def _unknown_message(name: str) -> str:
-    from ._names import unknown_message
-
-    return unknown_message(name, field_names())
-
-
 def parse_value(name: str, text: str) -> Any:
     """Convert the string ``text`` to the type of field ``name``."""
-    if name not in FIELD_DOCS:
-        raise ParameterError(_unknown_message(name))
-    f = next(f for f in fields(Params) if f.name == name)
-    if text.strip().lower() == "none":
-        if f.default is not None:
-            raise ParameterError(f"{name} cannot be None")
-        return None
-    if FIELD_DOCS[name]["choices"] is not None:
-        return text.strip()
-    kind = "an integer" if f.type == "int" else "a number"
-    if "_" in text:  # Python reads "1_0" as 10: a typo, not a number
-        raise ParameterError(f"{name} = {text!r} must be {kind} (no '_' in it)")
-    try:
-        return int(text) if f.type == "int" else float(text)
-    except ValueError:
-        raise ParameterError(f"{name} = {text!r} must be {kind}") from None
+    return parse_field(Params, name, text)
+
+
+def params_arg(params: Any, name: str = "params") -> Params:
+    """An API function's ``params`` argument (or another argument ``name`` holding a model,
+    a sweep's ``base``): a :class:`Params`, or None for the defaults."""
+    if params is None:
+        return Params()
+    if isinstance(params, Params):
+        return params
+    if isinstance(params, dict):
+        keywords = ", or pass the fields as keywords, e.g. simulate(omega=30.0)"
+        raise TypeError(
+            f"{name} must be a chaoscam.Params, got a dict: use Params(**d)"
+            + (keywords if name == "params" else "")
+        )
+    raise TypeError(
+        f"{name} must be a chaoscam.Params or None, got {type(params).__name__} {params!r}"
+    )

@@ -47,7 +47,7 @@ def fractal_stiffness(E: float, D: float, G: float, k: float, phi: float, A_r: f
     Valid for 1 < D < 2 and a_c < a_1; outside that a :class:`ParameterError` names the
     offending field. The paper's Fig. 5 shows K_n rising with D and falling with G.
     """
-    from ._params import ParameterError
+    from .._util import ParameterError
 
     if not 1.0 < D < 2.0:
         raise ParameterError(f"D = {D!r} is outside the allowed range (1, 2) of the fractal model")

@@ -288,9 +288,15 @@ def period_one_orbit(
 
     Parameters
     ----------
+    gamma, e : float
+        Γ and the coefficient of restitution, as in `bouncing_ball`.
+    n : int
+        Table periods per flight.
     guess : (phase, v), optional
         Starting point; by default the best phase on a 64-point grid with v = nπ (the speed
         giving a flight of n periods at a fixed height).
+    tol, max_iter, fd_step : float, int, float
+        Newton's tolerance on the residual norm, its iterations, the difference step.
 
     Returns
     -------
@@ -358,15 +364,25 @@ def period_one_thresholds(
     gamma_start: float,
     rel_tol: float = 1e-7,
 ) -> tuple[float, float]:
-    """Locate, numerically, where the period-one orbit appears and where it period-doubles.
+    """Saddle-node and period-doubling Γ of the period-one orbit, by continuation.
 
-    Start from the state simulations at `gamma_start` settle on (launches at 8 phases with
-    speed nπ; this Γ must lie where the period-one orbit attracts, which a classifier sweep
-    finds), refine it by Newton and
-    follow the orbit by continuation:
-    downwards until Newton finds no orbit, then bisect on existence (the saddle-node at
-    which it is born); upwards until the characteristic polynomial of the Jacobian at -1,
-    ``1 + tr J + det J``, changes sign, then bisect (the flip / period-doubling).
+    From the state that simulations at `gamma_start` settle on (launches at 8 phases with
+    speed nπ), refined by Newton (`period_one_orbit`), the orbit is followed downwards in
+    Γ until Newton finds none, then bisected on existence (the saddle-node where it is
+    born); and upwards until ``1 + tr J + det J`` (the characteristic polynomial of the
+    Jacobian at -1) changes sign, then bisected (the flip, period doubling).
+
+    Parameters
+    ----------
+    e : float
+        Coefficient of restitution.
+    n : int
+        Table periods per flight.
+    gamma_start : float
+        A Γ where the period-one orbit attracts (e.g. found by a classifier sweep);
+        ValueError if none is found there.
+    rel_tol : float
+        Relative precision of both thresholds.
 
     Returns
     -------

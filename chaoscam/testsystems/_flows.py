@@ -1,10 +1,9 @@
 """Continuous-time test systems: Lorenz, Rössler and the Ueda (forced Duffing) oscillator.
 
-The vector fields are compiled with numba and integrated with the classical fourth-order
-Runge–Kutta method at a fixed step; `flow_reference` integrates the same equations with
-scipy's DOP853 at tight tolerances, an independent path the tests compare against.
-Non-autonomous systems are written autonomously with time as the last state component
-(``t' = 1``), so one ``advance(state, duration)`` covers both kinds.
+The vector fields are compiled with numba and integrated by classical fixed-step RK4;
+`flow_reference` integrates them with scipy's DOP853 at tight tolerances (an independent
+path). Forced systems carry time as the last state component (``t' = 1``), so one
+``advance(state, duration)`` covers both kinds.
 """
 
 from __future__ import annotations
@@ -134,8 +133,8 @@ def ueda(k: float = 0.05, b: float = 7.5) -> FlowSystem:
     """Ueda oscillator ``x'' + k x' + x³ = B cos t``, state ``(x, x', t)``.
 
     At k = 0.05, B = 7.5 (Ueda 1979, J. Stat. Phys. 20, 181) the motion is chaotic with
-    largest Lyapunov exponent ≈ 0.0999 per unit time (the value issue 3 quotes) for the
-    (x, x') directions; the time direction contributes the trivial zero exponent.
+    largest Lyapunov exponent ≈ 0.0999 per unit time in the (x, x') directions; the time
+    direction contributes the trivial zero exponent.
     """
     return FlowSystem("ueda", UEDA, (k, b), 3, forcing_period=2.0 * math.pi)
 
@@ -193,8 +192,8 @@ def flow_trajectory(
 def flow_advance(system: FlowSystem, dt: float) -> Callable[[np.ndarray, float], np.ndarray]:
     """Return ``advance(state, duration) -> state`` integrating `system` with RK4.
 
-    The step is ``duration / ceil(duration / dt)``, so any duration is reached exactly.
-    This is the callable the Benettin routine in `chaoscam.analysis` expects.
+    The step is ``duration / ceil(duration / dt)``, so any duration is reached exactly;
+    the callable `lyapunov_benettin` expects.
     """
     p = np.asarray(system.params, dtype=float)
     kind = system.kind

@@ -1,8 +1,7 @@
 """Discrete-time test systems: logistic map, Hénon map, sine circle map.
 
 Each system comes as a one-step function, its Jacobian (where it is smooth) and an orbit
-generator that discards a transient. They exist to validate the analysis layer against
-values known from the literature; they never depend on the cam-follower model.
+generator that discards a transient; each documents its values from the literature.
 """
 
 from __future__ import annotations
@@ -24,20 +23,8 @@ __all__ = [
 
 
 def logistic_step(x: np.ndarray, r: float) -> np.ndarray:
-    """One step of the logistic map ``x -> r x (1 - x)``.
-
-    Parameters
-    ----------
-    x : ndarray, shape (1,)
-        State in [0, 1].
-    r : float
-        Growth parameter in (0, 4].
-
-    Returns
-    -------
-    ndarray, shape (1,)
-        The image of `x`.
-    """
+    """One step of the logistic map ``x -> r x (1 - x)``: state x, shape (1,), in [0, 1];
+    growth parameter r in (0, 4]."""
     x = np.asarray(x, dtype=float)
     return r * x * (1.0 - x)
 

@@ -13,9 +13,9 @@ import math
 
 from numba import njit
 
-from . import _kernel as k
-from ._kernel import C_GRAV, C_INV_J, C_OMEGA
+from . import _physics as ph
 from ._physics import rotate as _rotate_inline
+from .layout import C_GRAV, C_INV_J, C_OMEGA
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
@@ -32,13 +32,13 @@ def accel_trig(tr, om, K, c, flight):
     the full (1)–(3)."""
     if flight:
         return -c[C_GRAV] * c[C_INV_J] * tr[3]
-    return k.acceleration_trig(tr[1], tr[2], tr[3], tr[4], om, K, c)
+    return ph.acceleration_trig(tr[1], tr[2], tr[3], tr[4], om, K, c)
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def trig_at(t, th, c):
     """(cam angle, its cos, its sin, cos th, sin th) at (t, th): a step's trigonometric base."""
-    thc = k.cam_angle(t, c)
+    thc = ph.cam_angle(t, c)
     return (thc, math.cos(thc), math.sin(thc), math.cos(th), math.sin(th))
 
 
@@ -47,7 +47,7 @@ def geometry_near(s_i, th_i, th, tr, c):
     """:func:`_kernel.geometry` at (t + s_i, th_i), rotated from the base ``tr`` at (t, th)."""
     ct, st = rotate(th, tr[3], tr[4], th_i - th)
     cc, sc = rotate(tr[0], tr[1], tr[2], c[C_OMEGA] * s_i)
-    return k.geometry_trig(cc, sc, ct, st, c)
+    return ph.geometry_trig(cc, sc, ct, st, c)
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
@@ -61,4 +61,4 @@ def accel_stage(th_i, om_i, s_i, th, tr, K, c, flight):
     if flight:
         return -c[C_GRAV] * c[C_INV_J] * ct
     cc, sc = rotate(tr[0], tr[1], tr[2], c[C_OMEGA] * s_i)
-    return k.acceleration_trig(cc, sc, ct, st, om_i, K, c)
+    return ph.acceleration_trig(cc, sc, ct, st, om_i, K, c)

@@ -26,8 +26,7 @@ from __future__ import annotations
 import math
 import os
 
-from ._warn import warn
-from .model import ParameterError
+from .._util import ParameterError, warn
 
 __all__ = [
     "estimate",
@@ -100,6 +99,7 @@ def available_memory() -> float:
 
 def estimate(
     params,
+    num,
     *,
     duration: float,
     transient: float = 0.0,
@@ -112,9 +112,9 @@ def estimate(
     """Estimated (bytes, seconds) of ``runs`` realizations, ``in_memory`` of them held at once."""
     kept = max(0.0, float(duration) - float(transient))
     rows = kept / params.cam_period
-    rows_series = kept / max(float(output_dt), params.dt) if series else 0.0
+    rows_series = kept / max(float(output_dt), num.dt) if series else 0.0
     per_run = rows_series * SERIES_BYTES_PER_ROW + rows * SECTION_BYTES_PER_ROW
-    seconds = runs * run_seconds(params, duration, rows_series) / max(1, int(workers))
+    seconds = runs * run_seconds(params, num, duration, rows_series) / max(1, int(workers))
     return JobEstimate((per_run * in_memory, seconds))
 
 
@@ -126,14 +126,14 @@ def persistent_contact(params) -> bool:
     initial contact). Above it the follower rides the cam (contact fraction ~1, measured);
     below it the response is flights and impacts (contact fractions 0.002-0.5, measured).
     """
-    from .model import contact_angle, lever_arm
+    from ..model import contact_angle, lever_arm
 
     l1 = float(lever_arm(params, 0.0, contact_angle(params, 0.0)))
     gravity = params.m * params.g * params.l / (2.0 * params.inertia)
     return gravity * l1 >= params.e * params.omega**2
 
 
-def adaptive_seconds(params, duration: float) -> float:
+def adaptive_seconds(params, num, duration: float) -> float:
     """Wall time [s] the adaptive path needs to follow the contact for ``duration`` [s].
 
     ``t_wall = duration * s * ADAPTIVE_COST * (1e-12 / rtol)^ADAPTIVE_RTOL_EXPONENT / T_c^2``
@@ -152,7 +152,7 @@ def adaptive_seconds(params, duration: float) -> float:
     Limits: an order of magnitude either way; chattering between contact and micro-flights
     can cost more.
     """
-    from .model import contact_period
+    from ..model import contact_period
 
     try:
         tc = contact_period(params)
@@ -161,25 +161,25 @@ def adaptive_seconds(params, duration: float) -> float:
         return 0.0
     if not (math.isfinite(tc) and tc > 0.0):
         return 0.0
-    tolerance = (1e-12 / params.rtol) ** ADAPTIVE_RTOL_EXPONENT
+    tolerance = (1e-12 / num.rtol) ** ADAPTIVE_RTOL_EXPONENT
     return float(duration) * share * ADAPTIVE_COST * tolerance / (tc * tc)
 
 
-def run_seconds(params, duration: float, series_rows: float = 0.0) -> float:
+def run_seconds(params, num, duration: float, series_rows: float = 0.0) -> float:
     """Estimated wall time [s] of one run of ``duration`` [s] keeping ``series_rows``: grid
     steps at :data:`NS_PER_STEP` and rows at :data:`NS_PER_SERIES_ROW`, or for the adaptive
     path the larger of that and :func:`adaptive_seconds`."""
-    return max(_costs(params, duration, series_rows))
+    return max(_costs(params, num, duration, series_rows))
 
 
-def _steps(params, duration: float) -> tuple[float, str, str]:
+def _steps(params, num, duration: float) -> tuple[float, str, str]:
     """(the least number of steps a run takes, why, what shortens it): grid steps of dt, the
     adaptive path's steps of at most h_max, and a step cut at every interval resampling."""
     duration = float(duration)
-    found = [(duration / params.dt, f"steps of dt = {params.dt:g} s", "raise dt")]
-    if params.integrator == "adaptive":
+    found = [(duration / num.dt, f"steps of dt = {num.dt:g} s", "raise dt")]
+    if num.integrator == "adaptive":
         found.append(
-            (duration / params.h_max, f"steps of at most h_max = {params.h_max:g} s", "raise h_max")
+            (duration / num.h_max, f"steps of at most h_max = {num.h_max:g} s", "raise h_max")
         )
     if params.resample == "interval":
         found.append(
@@ -192,15 +192,17 @@ def _steps(params, duration: float) -> tuple[float, str, str]:
     return max(found)
 
 
-def _costs(params, duration: float, series_rows: float = 0.0) -> tuple[float, float]:
+def _costs(params, num, duration: float, series_rows: float = 0.0) -> tuple[float, float]:
     """(grid steps and series rows, following the contact) estimates of one run [s]."""
-    steps = _steps(params, duration)[0]
+    steps = _steps(params, num, duration)[0]
     grid = (steps * NS_PER_STEP + series_rows * NS_PER_SERIES_ROW) * 1e-9
-    adaptive = params.integrator == "adaptive"
-    return grid, adaptive_seconds(params, duration) if adaptive else 0.0
+    adaptive = num.integrator == "adaptive"
+    return grid, adaptive_seconds(params, num, duration) if adaptive else 0.0
 
 
-def check_run(params, duration: float, *, what: str = "one run", series_rows: float = 0.0) -> bool:
+def check_run(
+    params, num, duration: float, *, what: str = "one run", series_rows: float = 0.0
+) -> bool:
     """Refuse one run estimated beyond :data:`RUN_REFUSE_SECONDS`, warn beyond
     :data:`RUN_WARN_SECONDS`; the message names the fields that set the cost.
 
@@ -214,24 +216,24 @@ def check_run(params, duration: float, *, what: str = "one run", series_rows: fl
     ParameterError
         For a run that would take hours.
     """
-    grid, contact = _costs(params, duration, series_rows)
+    grid, contact = _costs(params, num, duration, series_rows)
     seconds = max(grid, contact)
     if seconds <= RUN_WARN_SECONDS:
         return False
     text = f"{what} (duration = {float(duration):g} s) will take about {_human_seconds(seconds)}"
     if contact > grid:
-        from .model import contact_period
+        from ..model import contact_period
 
         text += (
             f" with integrator = 'adaptive': the contact's period 2 pi sqrt(J / (K_n l_1^2))"
             f" = {contact_period(params):.2g} s (J = {params.inertia:.3g} kg m^2, K_n = "
             f"{params.stiffness_at(params.l_lambda):.3g} N/m) forces steps that short at "
-            f"rtol = {params.rtol:g}"
+            f"rtol = {num.rtol:g}"
         )
         remedy = "raise J, lower the stiffness (l_lambda, stiffness), loosen rtol or shorten "
         remedy += "duration"
     else:
-        steps, why, raise_ = _steps(params, duration)
+        steps, why, raise_ = _steps(params, num, duration)
         text += f": {steps:.3g} {why}"
         remedy = f"shorten duration or {raise_}"
         if series_rows:

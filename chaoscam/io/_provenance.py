@@ -15,11 +15,11 @@ import functools
 import hashlib
 from pathlib import Path
 
-from ._version import __version__
+from .._version import __version__
 
 __all__ = ["DRIVERS", "code_identity", "code_rows"]
 
-DRIVERS = ("cli", "report", "experiments")
+DRIVERS = ("cli", "report", "paper")
 """Subpackages left out of the fingerprint: they run and draw, they compute no result."""
 
 
@@ -31,7 +31,7 @@ def code_identity() -> dict[str, str]:
     import numba
     import numpy
 
-    root = Path(__file__).resolve().parent
+    root = Path(__file__).resolve().parents[1]
     digest = hashlib.sha256()
     for path in sorted(root.rglob("*.py")):
         rel = path.relative_to(root)

@@ -13,7 +13,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._layout import (
+from ._physics import stiffness
+from ._tangent import saltation
+from .layout import (
     C_PERIOD,
     C_RESAMPLE_DT,
     C_RESAMPLE_EVERY,
@@ -40,8 +42,6 @@ from ._layout import (
     Y_J21,
     Y_J22,
 )
-from ._physics import stiffness
-from ._tangent import saltation
 
 __all__ = [
     "at_scheduled",

@@ -30,9 +30,8 @@ located event by the flow's saltation matrix (:func:`._steps.impact`); at each s
 Jacobian of the stroboscopic map over the last period is written beside the section point
 and the tangent restarts from the identity. The state is the same with and without it.
 
-The model's equations live in :mod:`._physics`, the array layout in :mod:`._layout` (whose
-names this module re-exports for its callers), the location of events inside a step in
-:mod:`._events`.
+The model's equations live in :mod:`._physics`, the array layout in :mod:`.layout`, the
+location of events inside a step in :mod:`._events`.
 
 Compiled without numba's reference counting. Every function of the kernels' modules that
 numba compiles on its own (not inlined into its caller) says ``_nrt=False`` (numba's option
@@ -52,8 +51,29 @@ import numpy as np
 from numba import njit
 
 from ._events import ON_SURFACE, gap_after, graze_point, locate_crossing
-from ._layout import *  # noqa: F403 (the layout's names are part of this module's face)
-from ._layout import (
+from ._physics import (
+    JAC_CONTACT,
+    JAC_FLIGHT,
+    JAC_NATURAL,
+    cam_trig,
+    closing_bound,
+    geometry,
+    geometry_at,
+    geometry_trig,
+    rk4_flight,
+    rk4_trig,
+    safe_horizon,
+    stiffness,
+)
+from ._steps import (
+    at_scheduled,
+    commit_tangent,
+    impact,
+    next_scheduled,
+    tangent_on,
+)
+from ._tangent import rk4_flight_tangent, rk4_tangent_trig
+from .layout import (
     C_CALL_STEPS,
     C_DT,
     C_FLIGHT_MERGE,
@@ -91,35 +111,6 @@ from ._layout import (
     Y_THETA,
     Y_TIME,
 )
-from ._physics import (  # noqa: F401 (re-exported: the adaptive kernel and tests use them)
-    JAC_CONTACT,
-    JAC_FLIGHT,
-    JAC_NATURAL,
-    acceleration,
-    acceleration_jacobian,
-    acceleration_trig,
-    cam_angle,
-    cam_trig,
-    closing_bound,
-    gap_accel_bound,
-    geometry,
-    geometry_at,
-    geometry_trig,
-    on_clock,
-    rk4,
-    rk4_flight,
-    rk4_trig,
-    safe_horizon,
-    stiffness,
-)
-from ._steps import (
-    at_scheduled,
-    commit_tangent,
-    impact,
-    next_scheduled,
-    tangent_on,
-)
-from ._tangent import rk4_flight_tangent, rk4_tangent_trig
 
 
 @njit(cache=True, inline="always")

@@ -1,6 +1,7 @@
-"""Assemble the kernel's constants vector from a :class:`~chaoscam.model.Params`.
+"""Assemble the kernel's constants vector from a model (:class:`~chaoscam.model.Params`) and
+its integrator settings (:class:`~chaoscam.numerics.Numerics`).
 
-This is the only bridge between the documented parameter set and the compiled kernels: every
+This is the only bridge between the documented settings and the compiled kernels: every
 number a kernel uses is put here, by name.
 """
 
@@ -11,7 +12,8 @@ import math
 import numpy as np
 
 from ..model import Params, contact_angle, contact_angle_rate
-from . import _kernel as k
+from ..numerics import Numerics
+from . import layout as k
 
 __all__ = ["CALL_STEPS", "initial_counters", "initial_state", "kernel_constants"]
 
@@ -24,14 +26,21 @@ not be stopped for minutes. 2^21 RK4 contact steps take ~0.4 s, 2^18 adaptive on
 
 
 def kernel_constants(
-    p: Params, *, t_record: float = 0.0, stride: int = 0, tangent: bool = False
+    p: Params,
+    num: Numerics,
+    *,
+    t_record: float = 0.0,
+    stride: int = 0,
+    tangent: bool = False,
 ) -> np.ndarray:
-    """The float64 constants vector indexed by ``_kernel.C_*``.
+    """The float64 constants vector indexed by ``layout.C_*``.
 
     Parameters
     ----------
     p : Params
         The model.
+    num : Numerics
+        The integrator and its settings.
     t_record : float
         Outputs (series, section, impacts, contact fraction) are kept from this time [s].
     stride : int
@@ -61,28 +70,28 @@ def kernel_constants(
     c[k.C_VMIN] = p.v_min
     c[k.C_XI] = p.xi
     c[k.C_ROD_L] = p.l
-    c[k.C_DT] = p.dt
-    c[k.C_EVENT_TOL] = p.event_tol
+    c[k.C_DT] = num.dt
+    c[k.C_EVENT_TOL] = num.event_tol
     c[k.C_PERIOD] = p.cam_period
     c[k.C_T_RECORD] = t_record
     c[k.C_RESAMPLE_DT] = p.resample_dt if p.resample == "interval" else 0.0
-    c[k.C_MAX_EVENTS] = p.max_events_per_step
+    c[k.C_MAX_EVENTS] = num.max_events_per_step
     c[k.C_STRIDE] = stride
-    c[k.C_FLIGHT_MERGE] = p.flight_merge
-    c[k.C_METHOD] = k.METHOD_ADAPTIVE if p.integrator == "adaptive" else k.METHOD_RK4
-    c[k.C_RTOL] = p.rtol
-    c[k.C_ATOL] = p.atol
-    c[k.C_H_MAX] = p.h_max
+    c[k.C_FLIGHT_MERGE] = num.flight_merge
+    c[k.C_METHOD] = k.METHOD_ADAPTIVE if num.integrator == "adaptive" else k.METHOD_RK4
+    c[k.C_RTOL] = num.rtol
+    c[k.C_ATOL] = num.atol
+    c[k.C_H_MAX] = num.h_max
     c[k.C_TANGENT] = 1.0 if tangent else 0.0
     c[k.C_V_CHATTER] = p.v_chatter
     c[k.C_V_MICRO] = p.v_micro
     c[k.C_RESAMPLE_EVERY] = 1.0 if p.resample == "impact" else 0.0
-    c[k.C_CALL_STEPS] = CALL_STEPS[p.integrator]
+    c[k.C_CALL_STEPS] = CALL_STEPS[num.integrator]
     return c
 
 
 def initial_state(p: Params) -> np.ndarray:
-    """The state vector ``y`` (slots ``_kernel.Y_*``) at t = 0.
+    """The state vector ``y`` (slots ``layout.Y_*``) at t = 0.
 
     theta_f(0) and theta_f'(0) are ``p.theta_f0`` / ``p.omega_f0``, or in contact with the cam
     (theta_fc(0) and its rate) when those are None (shared/MODEL.md, decision).
@@ -94,13 +103,12 @@ def initial_state(p: Params) -> np.ndarray:
     return y
 
 
-def initial_counters(p: Params, *, transient: float = 0.0) -> np.ndarray:
-    """The integer counters (indices ``_kernel.I_*``) at t = 0 for a run recording from
-    ``transient``: the first section index 0 (sections are scheduled through the transient,
-    where they are not recorded, so that a realization's steps do not depend on the
-    transient and the tangent restarts every period), and the first series sample and
-    resampling index 1 (their index-0 points are the initial state)."""
-    del transient  # the recording starts at kernel_constants' t_record
+def initial_counters() -> np.ndarray:
+    """The integer counters (indices ``layout.I_*``) at t = 0: the first section index 0
+    (sections are scheduled through the transient, where they are not recorded, so that a
+    realization's steps do not depend on the transient and the tangent restarts every
+    period), and the first series sample and resampling index 1 (their index-0 points are
+    the initial state). The recording starts at ``kernel_constants``' ``t_record``."""
     cnt = np.zeros(k.N_COUNTERS, dtype=np.int64)
     cnt[k.I_RESAMPLE_J] = 1
     cnt[k.I_SERIES_J] = 1

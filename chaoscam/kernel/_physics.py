@@ -12,7 +12,7 @@ import math
 
 from numba import njit
 
-from ._layout import (
+from .layout import (
     C_BETA,
     C_DAMP_SIGN,
     C_E,

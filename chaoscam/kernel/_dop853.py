@@ -19,8 +19,8 @@ import math
 
 from numba import njit
 
-from ._kernel import C_ATOL, C_RTOL
 from ._stages import accel_stage
+from .layout import C_ATOL, C_RTOL
 
 # fmt: off
 C2 = 0.05260015195876773

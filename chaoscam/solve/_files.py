@@ -1,9 +1,9 @@
 """The one reader of trajectory files for every command (``classify``, ``report``).
 
-A trajectory file is what ``chaoscam simulate --out FILE.parquet`` (``Trajectory.to_parquet``)
-writes. :func:`load_trajectory` rebuilds it (checking the metadata and columns), and
-:func:`read_trajectory` also refuses a file that holds too little data to classify, so both
-commands accept and refuse the same files with the same messages.
+A trajectory file is what ``chaoscam simulate --out FILE.parquet`` (``Solution.to_parquet``
+of a one-member solution) writes. :func:`load_trajectory` rebuilds it (checking the metadata
+and columns), and :func:`read_trajectory` also refuses a file that holds too little data to
+classify, so every command accepts and refuses the same files with the same messages.
 """
 
 from __future__ import annotations
@@ -16,9 +16,17 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ._simulate import IMPACT_COLUMNS, IMPACT_KINDS, SECTION_COLUMNS, SERIES_COLUMNS, Trajectory
-from .integrate import Status
-from .model import Params
+from ..kernel import Status
+from ..model import Params
+from ..numerics import Numerics
+from ._solution import (
+    IMPACT_COLUMNS,
+    IMPACT_KINDS,
+    MEMBER_COLUMNS,
+    SECTION_COLUMNS,
+    SERIES_COLUMNS,
+    Solution,
+)
 
 __all__ = [
     "MIN_POINTS",
@@ -50,7 +58,8 @@ def check_enough(n: int, what: str, where: str | Path, hint: str = SIMULATE_LONG
 
 
 def read_trajectory(path: str | Path, *, need_data: bool = True):
-    """A :class:`chaoscam.Trajectory` from ``path``; :class:`TrajectoryFileError` if not.
+    """A one-member :class:`chaoscam.Solution` from ``path``; :class:`TrajectoryFileError`
+    if not.
 
     With ``need_data``, a file with fewer than :data:`MIN_POINTS` section points and series
     samples is refused ("too little data").
@@ -82,16 +91,15 @@ def _check_finite(path: Path, status: Status, tables) -> None:
                 )
 
 
-def load_trajectory(path) -> Trajectory:
-    """Rebuild a :class:`Trajectory` from a Parquet file written by ``Trajectory.to_parquet``.
+def load_trajectory(path) -> Solution:
+    """Rebuild a one-member :class:`Solution` from a trajectory file (``Solution.to_parquet``).
 
     The table holds the series (or, for a run without one, the section); the metadata keys
-    ``chaoscam.trajectory`` (params, settings, status, stats), ``chaoscam.section`` and
-    ``chaoscam.impacts`` (JSON, pandas "split" orientation, floats exact; files written
-    before 2026-11-26 kept 15 significant digits) hold the rest, read back with their dtypes.
-    Not stored: the Jacobians of a ``tangent=True`` run (``lyapunov_spectrum`` says so;
-    ``classify_trajectory`` simulates the tangent again) and ``final_state``, taken from the
-    last row of the table (with ``series=False``, the last section point, not the run's end).
+    ``chaoscam.trajectory`` (params, numerics, settings, status, stats), ``chaoscam.section``
+    and ``chaoscam.impacts`` (JSON, pandas "split" orientation, floats exact) hold the rest,
+    read back with their dtypes. Not stored: the Jacobians of a ``tangent=True`` run
+    (:func:`chaoscam.classify` simulates the tangent again) and the copy a resumable run
+    keeps (:func:`chaoscam.extend` runs it again from t = 0).
 
     Raises
     ------
@@ -102,7 +110,7 @@ def load_trajectory(path) -> Trajectory:
     """
     import pyarrow as pa
 
-    from ._parquet import DamagedFileError, read_table
+    from ..io import DamagedFileError, read_table
 
     path = Path(path)
     if path.is_dir():
@@ -125,11 +133,12 @@ def load_trajectory(path) -> Trajectory:
         raise ValueError(
             f"{path}: not a chaoscam trajectory file (metadata "
             f"{', '.join(m.decode() for m in missing)} missing; write one with "
-            "`chaoscam simulate --out FILE.parquet` or Trajectory.to_parquet)"
+            "`chaoscam simulate --out FILE.parquet` or Solution.to_parquet)"
         )
     try:
         prov = json.loads(meta[b"chaoscam.trajectory"])
         params = Params(**prov["params"])
+        numerics = Numerics(**prov["numerics"])
         status = Status[prov["status"]]
         section, impacts = (
             pd.read_json(StringIO(meta[key].decode()), orient="split", precise_float=True)
@@ -168,19 +177,32 @@ def load_trajectory(path) -> Trajectory:
         floats = {c: np.float64 for c in impacts.columns if c != "kind"}
         impacts = impacts.astype(floats)
         impacts["kind"] = pd.Categorical(impacts["kind"], categories=list(IMPACT_KINDS))
+    return _solution(params, numerics, settings, status, stats, frame, series, section, impacts)
+
+
+def _solution(params, numerics, settings, status, stats, frame, series, section, impacts):
+    """The one-member Solution of a file's tables; where it stopped is the table's last row
+    (with ``series=False``, the last section point, not the run's end)."""
     last = frame.iloc[-1] if len(frame) else None
-    final = (
+    end = (
         (float(last["t"]), float(last["theta_f"]), float(last["omega_f"]))
         if last is not None
         else (math.nan, math.nan, math.nan)
     )
-    return Trajectory(
-        params=params,
+    row = (
+        0, int(settings.pop("index", 0)), status.name, int(stats.get("n_impacts", 0)),
+        float(stats.get("contact_fraction", math.nan)), int(stats.get("slow_closings", 0)),
+        int(stats.get("chatter_handovers", 0)), *end,
+    )  # fmt: skip
+    settings.setdefault("impacts", True)
+    return Solution(
+        models=(params,),
+        numerics=numerics,
         settings=settings,
-        status=status,
-        series=series,
-        section=section,
-        impacts=impacts,
-        stats=stats,
-        final_state=final,
+        members=pd.DataFrame([row], columns=list(MEMBER_COLUMNS)),
+        sections=section.assign(member=0)[["member", *SECTION_COLUMNS]],
+        impacts=impacts.assign(member=0)[["member", *impacts.columns]]
+        if len(impacts.columns)
+        else None,
+        series=None if series is None else series.assign(member=0)[["member", *SERIES_COLUMNS]],
     )

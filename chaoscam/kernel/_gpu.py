@@ -1,6 +1,6 @@
 """Ensembles on an NVIDIA GPU with numba-cuda: one CUDA thread per trajectory.
 
-The kernel is the CPU kernel. :func:`_advance.advance` and everything it calls are
+The kernel is the CPU kernel. :func:`._driver.advance` and everything it calls are
 ``@numba.njit`` functions, and numba-cuda compiles such a function for the CUDA target when a
 ``@cuda.jit`` kernel calls it (``CUDATypingContext.resolve_value_type`` wraps the CPU
 dispatcher in a device dispatcher built from the same Python source). So the physics has one
@@ -27,7 +27,7 @@ Those are refilled on the host exactly as on the CPU path (the impact count move
 member's total, the used draws replaced by the next ones of the same stream, keeping the
 row width) and the kernel is launched again for them only; the
 other threads return at once. A run resumed after a hand-back is bit-identical to one that
-was not interrupted (see :func:`_kernel.run_chunk`), so this relaunch changes nothing.
+was not interrupted (see :func:`._rk4.run_chunk`), so this relaunch changes nothing.
 
 Measured on an NVIDIA H200 (2026-11-27, ``benchmarks/bench_gpu_wave.py``): the tolerance
 tests pass; the RK4 kernel takes 202-216 registers and 40 B of local memory a thread. One
@@ -53,11 +53,11 @@ import warnings
 
 import numpy as np
 
-from .._warn import recorded
-from . import _kernel as k
+from .._util import recorded
+from . import layout as k
 from ._adaptive import run_chunk_adaptive
-from ._advance import advance
-from ._driver import drive_members
+from ._driver import advance, drive_members
+from ._rk4 import run_chunk
 
 __all__ = [
     "GPU_BATCH",
@@ -193,7 +193,7 @@ def _step_function(method: int | None):
     40 B of local memory; for arrays of any strides, RK4 255 with 164 / 488 B of spills.)
     """
     if method == k.METHOD_RK4:
-        return k.run_chunk
+        return run_chunk
     if method == k.METHOD_ADAPTIVE:
         return run_chunk_adaptive
     return advance
@@ -228,7 +228,7 @@ def _batch_method(c: np.ndarray) -> int | None:
 def kernel_ptx(cc: tuple[int, int] = (9, 0), method: int | None = None) -> str:
     """PTX of the ensemble kernel for compute capability ``cc``; needs NVVM, not a device.
 
-    ``method``: ``_kernel.METHOD_RK4``, ``METHOD_ADAPTIVE`` or None (the kernel that takes
+    ``method``: ``layout.METHOD_RK4``, ``METHOD_ADAPTIVE`` or None (the kernel that takes
     both), for the C-ordered arrays :func:`run_on_gpu` launches. numba-cuda asks the current
     device for the compute capability of device functions even when ``compile_ptx`` is given
     one, so a stand-in device with ``cc`` is put in its place for the compilation.
@@ -264,7 +264,7 @@ def _configured(kern, blocks: int):
     """``kern[blocks, _BLOCK]`` without numba-cuda's low-occupancy warning (a launch of few
     blocks: a small batch is the caller's choice, and a sweep would record it against every
     run of the batch); any other warning is raised again. Thread-safe
-    (:func:`chaoscam._warn.recorded`, not ``catch_warnings``: a sweep labels on a thread)."""
+    (:func:`chaoscam._util.recorded`, not ``catch_warnings``: a sweep labels on a thread)."""
     with recorded() as said:
         configured = kern[blocks, _BLOCK]
     for w in said:

@@ -28,7 +28,7 @@ import threading
 import warnings
 from collections.abc import Iterator
 
-_PACKAGE = os.path.dirname(os.path.abspath(__file__)) + os.sep
+_PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
 
 
 def _inside(filename: str) -> bool:

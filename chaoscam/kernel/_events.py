@@ -14,8 +14,8 @@ import math
 
 from numba import njit
 
-from ._layout import C_EVENT_TOL
 from ._physics import geometry, geometry_trig, on_clock, rk4_flight, rk4_trig
+from .layout import C_EVENT_TOL
 
 MAX_BRACKET_STEPS = 400
 """Passes of a crossing search at most. Every three passes at least halve the bracket (a

@@ -25,6 +25,7 @@ import numpy as np
 import pandas as pd
 from scipy.integrate import solve_ivp
 
+from ..kernel.layout import IMPACT_NAMES
 from ..model import (
     LineLengthStream,
     Params,
@@ -35,7 +36,6 @@ from ..model import (
     lever_arm,
     normal_cam_speed,
 )
-from ._layout import IMPACT_NAMES
 
 __all__ = ["simulate_reference", "ReferenceResult"]
 
@@ -162,7 +162,7 @@ def simulate_reference(
     Parameters
     ----------
     p : Params
-        The model; ``p.dt`` is not used.
+        The model.
     duration : float
         End time [s].
     seed, index : int
@@ -177,8 +177,8 @@ def simulate_reference(
     max_pieces : int
         Guard on the number of restarts (chattering); a RuntimeError past it.
     """
-    from .._checks import params_arg, real, whole
-    from ..model import contact_angle, contact_angle_rate
+    from .._util import real, whole
+    from ..model import contact_angle, contact_angle_rate, params_arg
 
     p = params_arg(p)
     duration = real("duration", duration, low=0.0, strict=True, unit="s")

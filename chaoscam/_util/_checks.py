@@ -1,6 +1,6 @@
 """Checks of the plain settings a caller passes (seeds, indices, counts, intervals).
 
-Each raises :class:`~chaoscam.model.ParameterError` naming the setting, what was expected and
+Each raises :class:`ParameterError` naming the setting, what was expected and
 what was given; numpy scalars are accepted and returned as Python numbers.
 """
 
@@ -10,9 +10,9 @@ import math
 import numbers
 from typing import Any
 
-from .model import ParameterError
+from ._fields import ParameterError
 
-__all__ = ["COUNT_MAX", "flag", "whole", "real", "params_arg", "with_overrides"]
+__all__ = ["COUNT_MAX", "flag", "of_type", "real", "whole"]
 
 COUNT_MAX = 2**63 - 1
 """Largest seed or realization index: the tables store them as 64-bit integers (a seed of
@@ -77,49 +77,3 @@ def of_type(name: str, value: Any, cls: type, made_by: str) -> Any:
             f"{name} must be a chaoscam {cls.__name__} ({made_by}), got {type(value).__name__}"
         )
     return value
-
-
-def params_arg(params: Any, name: str = "params"):
-    """The ``params`` argument of an API function (or another argument ``name`` holding a
-    model, a sweep's ``base``): a :class:`Params`, or None for defaults."""
-    from .model import Params
-
-    if params is None:
-        return Params()
-    if isinstance(params, Params):
-        return params
-    if isinstance(params, dict):
-        keywords = ", or pass the fields as keywords, e.g. simulate(omega=30.0)"
-        raise TypeError(
-            f"{name} must be a chaoscam.Params, got a dict: use Params(**d)"
-            + (keywords if name == "params" else "")
-        )
-    raise TypeError(
-        f"{name} must be a chaoscam.Params or None, got {type(params).__name__} {params!r}"
-    )
-
-
-def with_overrides(p, overrides: dict, caller) -> Any:
-    """``p.replace(**overrides)`` for an API function's ``**overrides``: a keyword that is
-    neither one of ``caller``'s settings nor a model parameter is refused naming both lists
-    and what it was probably meant to be (``simulate(duraton=1)`` -> duration)."""
-    import inspect
-
-    from .model._names import close_names
-    from .model._params import field_names
-
-    unknown = [k for k in overrides if k not in field_names()]
-    if unknown:
-        own = [
-            n
-            for n, a in inspect.signature(caller).parameters.items()
-            if a.kind is inspect.Parameter.KEYWORD_ONLY
-        ]
-        close = close_names(unknown[0], own + list(field_names()))
-        hint = f" Did you mean {', '.join(close)}?" if close else ""
-        raise ParameterError(
-            f"{caller.__name__}() got an unknown keyword {unknown[0]!r}: neither one of its "
-            f"settings nor a model parameter.{hint} Its settings: {', '.join(own)}; the "
-            f"parameters: {', '.join(field_names())}"
-        )
-    return p.replace(**overrides)

@@ -1,22 +1,23 @@
 """The warnings a run gets before it starts: settings that run but do not do what they say.
 
-Used by :func:`chaoscam.simulate` (as ``RuntimeWarning``) and by the sweeps (in each
+Used by :func:`chaoscam.solve` (as ``RuntimeWarning``) and by the sweeps (in each
 realization's ``warnings`` column).
 """
 
 from __future__ import annotations
 
-from .model import Params, contact_period
+from ..model import Params, contact_period
+from ..numerics import Numerics
 
 __all__ = ["ignored_sigma_warning", "resolution_warning", "run_warnings"]
 
 
-def resolution_warning(p: Params) -> str | None:
+def resolution_warning(p: Params, num: Numerics) -> str | None:
     """The warning for a fixed step too coarse for the contact oscillation (fewer than 20
     steps per contact period), or None. The adaptive path's steps follow the contact."""
     period = contact_period(p)
-    steps = period / p.dt
-    if steps >= 20 or p.integrator != "rk4":
+    steps = period / num.dt
+    if steps >= 20 or num.integrator != "rk4":
         return None
     if steps >= 1:
         few = f"only {steps:.1f} steps"
@@ -25,10 +26,10 @@ def resolution_warning(p: Params) -> str | None:
     else:  # a period that rounds to zero
         few = "a step longer than the period"
     return (
-        f"dt = {p.dt:g} s resolves the contact oscillation (period {period:.3g} s) with "
+        f"dt = {num.dt:g} s resolves the contact oscillation (period {period:.3g} s) with "
         f"{few}; use dt <= {period / 40:.2g} s (40 steps), and check the verdict "
-        "at half the step (classify_trajectory(..., check_step=True)): where chattering "
-        "dominates, 40 steps can still overstate the exponent (docs/findings.md)"
+        "at half the step (classify(..., check_step=True)): where chattering "
+        "dominates, 40 steps can still overstate the exponent"
     )
 
 
@@ -46,7 +47,7 @@ def ignored_sigma_warning(p: Params) -> str | None:
     )
 
 
-def run_warnings(p: Params) -> list[str]:
+def run_warnings(p: Params, num: Numerics) -> list[str]:
     """Every warning a run of ``p`` gets before it starts (:func:`resolution_warning`,
     :func:`ignored_sigma_warning`)."""
-    return [w for w in (resolution_warning(p), ignored_sigma_warning(p)) if w]
+    return [w for w in (resolution_warning(p, num), ignored_sigma_warning(p)) if w]

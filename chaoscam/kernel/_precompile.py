@@ -8,7 +8,7 @@ numba compiles :func:`._kernel.run_chunk` once per install (``cache=True``), in 
 on one core: 22-25 s on the 2-core machine, most of it numba's own Python (type inference
 and lowering of each callee, each compiled on its own as the caller's typing reaches it),
 while the other core waits. :func:`start_beside` starts ``python -m
-chaoscam.integrate._precompile``, which compiles the callees that the kernel's typing
+chaoscam.kernel._precompile``, which compiles the callees that the kernel's typing
 reaches last (:func:`_callees`, in the reverse order) into numba's cache; when the kernel's
 compilation in this process reaches one of them, numba loads it from that cache instead of
 compiling it, as every later process does. The machine code is the same, so the results are
@@ -73,7 +73,7 @@ def start_beside() -> subprocess.Popen | None:
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
     return subprocess.Popen(
-        [sys.executable, "-m", "chaoscam.integrate._precompile"],
+        [sys.executable, "-m", "chaoscam.kernel._precompile"],
         env=env,
         stdin=subprocess.DEVNULL,
         stdout=subprocess.DEVNULL,

@@ -1,7 +1,7 @@
 """The one loop that drives trajectories through the compiled kernel, and the checks of a
 run's time window.
 
-The kernel (:func:`run_members` → :func:`._advance.advance`) advances each member until the
+The kernel (:func:`run_members` → :func:`advance`) advances each member until the
 end step or until an output buffer or the line-length draws need attention, and returns
 ``NEED_BUFFER`` then. :func:`drive_members` is the loop every run goes through: launch the
 members still to run, let the caller empty the buffers and refill the draws of those that
@@ -23,8 +23,6 @@ everything it needs in ``y`` and ``cnt``), so how often the loop pauses changes 
 from __future__ import annotations
 
 import contextlib
-import math
-import numbers
 import os
 import signal
 import threading
@@ -34,14 +32,14 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
-from ..model import ParameterError
-from . import _kernel as k
-from ._advance import advance
+from . import layout as k
+from ._adaptive import run_chunk_adaptive
+from ._rk4 import run_chunk
 
 __all__ = [
     "Buffers",
+    "advance",
     "advance_pair",
-    "check_window",
     "contact_fraction",
     "drive",
     "drive_members",
@@ -65,29 +63,21 @@ __all__ = [
 _OUTPUTS = (("series", k.I_N_SERIES), ("section", k.I_N_SECTION), ("impacts", k.I_N_IMPACT))
 
 
-def check_window(duration, transient, *, dt: float | None = None) -> tuple[float, float]:
-    """The run's time window validated: ``duration`` > 0 (and at least one step ``dt``),
-    ``transient`` in [0, duration); both [s], returned as floats. Every run's entry point
-    (simulate, ensembles, the exponents, the sweeps) checks its window here."""
-    if isinstance(duration, bool) or not (
-        isinstance(duration, numbers.Real) and math.isfinite(duration) and duration > 0
-    ):
-        raise ParameterError(f"duration = {duration!r} s must be a finite number > 0")
-    if isinstance(transient, bool) or not (
-        isinstance(transient, numbers.Real) and 0 <= transient < duration
-    ):
-        raise ParameterError(f"transient = {transient!r} s must be in [0, duration = {duration})")
-    if dt is not None and round(duration / dt) < 1:
-        raise ParameterError(
-            f"duration = {duration!r} s is shorter than one step dt = {dt!r} s: nothing "
-            "would be simulated"
-        )
-    return float(duration), float(transient)
+@njit(cache=True, _nrt=False)
+def advance(y, cnt, c, n_stop, lam, series, section, impacts):
+    """Advance one trajectory towards grid step ``n_stop`` with the integrator ``c[C_METHOD]``:
+    the fixed-step RK4 reference (:func:`._rk4.run_chunk`) or the adaptive Dormand–Prince
+    path (:func:`._adaptive.run_chunk_adaptive`). Same arguments and status codes as
+    :func:`._rk4.run_chunk`; every CPU and GPU entry point goes through it, so a realization
+    is the same on every path."""
+    if c[k.C_METHOD] == k.METHOD_ADAPTIVE:
+        return run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts)
+    return run_chunk(y, cnt, c, n_stop, lam, series, section, impacts)
 
 
 @njit(parallel=True, cache=True)
 def run_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
-    """:func:`_advance.advance` for each member ``i`` of stacked arrays, in parallel.
+    """:func:`advance` for each member ``i`` of stacked arrays, in parallel.
 
     The compiled entry point of every CPU simulation (a single trajectory is a batch of
     one), so that a realization is bit-identical on every path and thread count; a batch
@@ -102,14 +92,12 @@ def run_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
 def run_members_rk4(y, cnt, c, n_stop, lam, series, section, impacts, status):
     """:func:`run_members` for members that all use the fixed-step RK4 kernel.
 
-    The same compiled :func:`._kernel.run_chunk` that :func:`_advance.advance` calls for them
+    The same compiled :func:`._rk4.run_chunk` that :func:`advance` calls for them
     (so the same bits; ``analyses/hash_check.py`` compares), without the adaptive path: a
     fresh install that runs only RK4 compiles about 7 s less.
     """
     for i in prange(y.shape[0]):
-        status[i] = k.run_chunk(
-            y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i]
-        )
+        status[i] = run_chunk(y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i])
 
 
 @njit(cache=True)
@@ -118,7 +106,7 @@ def advance_pair(y1, cnt1, y2, cnt2, c, lam, bufs1, bufs2, lead, wait, n_stop):
     have applied as many impacts, ``wait`` steps have passed or step ``n_stop`` is reached.
 
     The two-trajectory exponent's postponed renormalisation (:mod:`chaoscam.lyapunov`),
-    compiled: each step is the :func:`._advance.advance` call a :func:`drive` to the next
+    compiled: each step is the :func:`advance` call a :func:`drive` to the next
     step makes, without a Python round trip per step (a run that chatters can wait a
     hundredth of a period, 1,000 steps, at each of many renormalisations). ``bufs1`` and
     ``bufs2`` are the (series, section, impacts) buffers; impact rows stay in them, so the
@@ -130,7 +118,7 @@ def advance_pair(y1, cnt1, y2, cnt2, c, lam, bufs1, bufs2, lead, wait, n_stop):
     ``code`` (``NEED_BUFFER``, or a failure) on the way to the next step; the first has
     then made that step when ``which`` is 2.
 
-    RK4 trajectories only (:func:`._kernel.run_chunk`; the exponent is always taken on the
+    RK4 trajectories only (:func:`._rk4.run_chunk`; the exponent is always taken on the
     RK4 grid), so that a fresh install does not compile the adaptive kernel for it.
     """
     steps = 0
@@ -140,10 +128,10 @@ def advance_pair(y1, cnt1, y2, cnt2, c, lam, bufs1, bufs2, lead, wait, n_stop):
         and cnt1[k.I_STEP] < n_stop
     ):
         n1 = cnt1[k.I_STEP] + 1
-        code = k.run_chunk(y1, cnt1, c, n1, lam, bufs1[0], bufs1[1], bufs1[2])
+        code = run_chunk(y1, cnt1, c, n1, lam, bufs1[0], bufs1[1], bufs1[2])
         if code != k.OK:
             return steps, code, 1
-        code = k.run_chunk(y2, cnt2, c, n1, lam, bufs2[0], bufs2[1], bufs2[2])
+        code = run_chunk(y2, cnt2, c, n1, lam, bufs2[0], bufs2[1], bufs2[2])
         if code != k.OK:
             return steps, code, 2
         steps += 1
@@ -214,7 +202,7 @@ def run_one(y, cnt, c, n_stop, lam, series, section, impacts) -> int:
 
 @njit(nogil=True, cache=True)
 def run_alone(y, cnt, c, n_stop, lam, series, section, impacts):
-    """:func:`._advance.advance` for one trajectory on the calling thread, without the GIL.
+    """:func:`advance` for one trajectory on the calling thread, without the GIL.
 
     For callers that run single trajectories from several Python threads at once (the
     periodic-orbit shooting of :mod:`chaoscam.tangent`, run per member by the ensemble
@@ -227,9 +215,9 @@ def run_alone(y, cnt, c, n_stop, lam, series, section, impacts):
 @njit(nogil=True, cache=True)
 def run_alone_rk4(y, cnt, c, n_stop, lam, series, section, impacts):
     """:func:`run_alone` for a trajectory on the fixed-step RK4 kernel: the same compiled
-    :func:`._kernel.run_chunk` that :func:`._advance.advance` calls for it (the same bits),
+    :func:`._rk4.run_chunk` that :func:`advance` calls for it (the same bits),
     without compiling the adaptive path (:func:`alone_kernel` picks)."""
-    return k.run_chunk(y, cnt, c, n_stop, lam, series, section, impacts)
+    return run_chunk(y, cnt, c, n_stop, lam, series, section, impacts)
 
 
 _here = threading.local()
@@ -250,7 +238,7 @@ def members_on_this_thread(stop: threading.Event | None = None):
     For callers that run several ensembles at once from their own threads (the sweeps'
     thread backend, one batch per core): numba's workqueue layer takes one parallel launch
     at a time, and a batch on one thread leaves no core waiting for its slowest member while
-    other batches run. The members are the same compiled :func:`._kernel.run_chunk`, so the
+    other batches run. The members are the same compiled :func:`._rk4.run_chunk`, so the
     same bits. ``stop``: when set, the next call raises :class:`StopRequested` (a prompt
     Ctrl-C; a compiled call itself cannot be interrupted).
     """
@@ -401,7 +389,7 @@ def drive(
     emptied. When the kernel stops for room, ``more_draws(lam)`` returns the draws to go on
     with, and must leave ``cnt[I_LAM_POS]`` pointing at the draw in use in them. ``run`` is
     the compiled call (:func:`run_one`; the two-trajectory exponent passes
-    :func:`._kernel.run_chunk`, the same RK4 kernel without the one-member batch, and the
+    :func:`._rk4.run_chunk`, the same RK4 kernel without the one-member batch, and the
     periodic-orbit shooting :func:`alone_kernel`'s pick). On a sweep's thread asked to stop
     (:func:`members_on_this_thread`), the next call raises :class:`StopRequested`: a
     verdict's shooting and kicks stop within one call, not at the end of the member.

@@ -31,7 +31,6 @@ import math
 import numpy as np
 from numba import njit
 
-from ._layout import C_E, C_GRAV, C_INV_J, C_OMEGA, C_XO, C_YO, SECTION_NAMES
 from ._physics import (
     acceleration_jacobian,
     acceleration_jacobian_trig,
@@ -40,6 +39,7 @@ from ._physics import (
     cam_trig_near,
     rotate,
 )
+from .layout import C_E, C_GRAV, C_INV_J, C_OMEGA, C_XO, C_YO, SECTION_NAMES
 
 
 @njit(cache=True, inline="always")

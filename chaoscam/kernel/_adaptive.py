@@ -1,7 +1,7 @@
 """Adaptive, event-driven Dormand–Prince 8(5,3) with located impacts: the fast path.
 
 The same model and the same call signature as the fixed-step reference
-(:func:`chaoscam.integrate._kernel.run_chunk`); :func:`chaoscam.integrate._advance.advance`
+(:func:`._rk4.run_chunk`); :func:`._driver.advance`
 picks one by ``Params.integrator``. What differs is how time is cut:
 
 - **Steps** are DOP853 steps (Dormand–Prince 8(5,3); Hairer, Nørsett & Wanner, *Solving
@@ -14,7 +14,7 @@ picks one by ``Params.integrator``. What differs is how time is cut:
 - **In flight** (gap > 0 at the step's start) the step integrates the free pendulum
   ``J theta'' = -(m g l/2) cos theta``, which *is* the motion until the gap closes, so its
   interpolant is exact up to the crossing even when the step ends past it. A step longer
-  than the time over which the gap provably stays open (:func:`_kernel.safe_horizon`) is cut
+  than the time over which the gap provably stays open (:func:`._physics.safe_horizon`) is cut
   to ``dt``, the grid step, so that it cannot hold several crossings.
 - **In contact** (gap <= 0) the step integrates (1)–(3) with the compliant force; the error
   control resolves the contact oscillation (period ~1e-4 s) only as finely as the tolerance
@@ -69,11 +69,15 @@ import math
 import numpy as np
 from numba import njit
 
-from . import _kernel as k
+from . import _physics as ph
 from . import _steps as steps
+from . import layout as k
 from ._dop853 import ERROR_ORDER, dop853_step, omega_at, theta_at
 from ._events import MAX_BRACKET_STEPS, ON_SURFACE, illinois_point, illinois_update
-from ._kernel import (
+from ._physics import JAC_CONTACT, JAC_FLIGHT, JAC_NATURAL
+from ._stages import accel_trig, geometry_near, trig_at
+from ._tangent import rk4_tangent_along
+from .layout import (
     C_CALL_STEPS,
     C_DT,
     C_EVENT_TOL,
@@ -109,9 +113,6 @@ from ._kernel import (
     Y_TIME,
     Y_WINDOW,
 )
-from ._physics import JAC_CONTACT, JAC_FLIGHT, JAC_NATURAL
-from ._stages import accel_trig, geometry_near, trig_at
-from ._tangent import rk4_tangent_along
 
 # Step-size control (Hairer et al. sec. II.4 and their dop853 code): after a step with
 # error norm err, h_new = h * SAFETY * err^(-1/8), limited to [SHRINK_MIN, GROW_MAX] h.
@@ -210,11 +211,11 @@ def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side
     """
     if not steps.tangent_on(t, c):  # off, or in the transient
         return
-    _, p0, q0 = k.acceleration_jacobian(t, th, om, K, c, side_first)
-    _, p1, q1 = k.acceleration_jacobian(
+    _, p0, q0 = ph.acceleration_jacobian(t, th, om, K, c, side_first)
+    _, p1, q1 = ph.acceleration_jacobian(
         t + 0.5 * h, theta_at(co, 0.5 * s_end), omega_at(co, 0.5 * s_end), K, c, side
     )
-    _, p2, q2 = k.acceleration_jacobian(t + h, th1, om1, K, c, side)
+    _, p2, q2 = ph.acceleration_jacobian(t + h, th1, om1, K, c, side)
     rate = max(math.sqrt(max(abs(p0), abs(p1), abs(p2))), max(abs(q0), abs(q1), abs(q2)))
     m = max(1, np.int64(math.ceil(h * rate / k.TANGENT_STEP_RATE)))
     hm = h / m
@@ -270,7 +271,7 @@ def leave(y, cnt, th, om, t, h, events, window, surface, code, c):
 def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
     """Advance one trajectory from ``y[Y_TIME]`` to ``n_stop * dt`` with adaptive steps.
 
-    Arguments, buffers and status codes as :func:`chaoscam.integrate._kernel.run_chunk`;
+    Arguments, buffers and status codes as :func:`._rk4.run_chunk`;
     ``cnt[I_STEP]`` is kept as the last grid step passed, and ``y[Y_STEP]`` carries the step
     size across calls, so a run resumed after a buffer hand-back is bit-identical to one that
     was not interrupted.
@@ -286,9 +287,9 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
     th = y[Y_THETA]
     om = y[Y_OMEGA]
     h = y[Y_STEP] if y[Y_STEP] > 0.0 else min(dt, c[C_H_MAX])
-    K = k.stiffness(lam[cnt[I_LAM_POS]], c)
+    K = ph.stiffness(lam[cnt[I_LAM_POS]], c)
     tr = trig_at(t, th, c)  # trigonometric base of the next step; renewed when (t, th) move
-    g, l1, cdn = k.geometry_trig(tr[1], tr[2], tr[3], tr[4], c)
+    g, l1, cdn = ph.geometry_trig(tr[1], tr[2], tr[3], tr[4], c)
     # The surface flags, kept in the counters across a buffer hand-back like the fixed-step
     # kernel's: JUMPED (a rebound was just applied), SETTLED (a plastic closure).
     surf = cnt[I_SURFACE]
@@ -317,14 +318,14 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         if flight and hs > dt:
             # Near the cam a long step could hold several crossings, of which the search
             # might find a later one: steps there are cut to dt (see module doc).
-            safe = k.safe_horizon(max(g, 0.0), l1, cdn, om, c)
+            safe = ph.safe_horizon(max(g, 0.0), l1, cdn, om, c)
             if hs > safe:
                 hs = max(dt, safe)
         clipped = t + hs >= t_next
         if clipped:
             hs = t_next - t
         else:
-            hs = k.on_clock(t, hs)  # the step ends exactly at the time t1 it is stamped with
+            hs = ph.on_clock(t, hs)  # the step ends exactly at the time t1 it is stamped with
 
         th1, om1, err = dop853_step(th, om, a1, hs, tr, K, c, flight)
         fac = SAFETY * max(err, ERR_FLOOR) ** EXPONENT
@@ -340,7 +341,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         # The step's end, with directly computed trigonometry: what the next step starts from.
         t1 = t_next if clipped else t + hs
         tr1 = trig_at(t1, th1, c)
-        g1, l1_1, cdn1 = k.geometry_trig(tr1[1], tr1[2], tr1[3], tr1[4], c)
+        g1, l1_1, cdn1 = ph.geometry_trig(tr1[1], tr1[2], tr1[3], tr1[4], c)
         a_end = accel_trig(tr1, om1, K, c, flight)  # in the step's mode: the interpolant's
         co = (th, om, a1, th1, om1, a_end, hs)  # data: ends, their rates and accelerations
         s_end = 1.0
@@ -435,10 +436,10 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             # the length grows by 2, 4, 8, ... event tolerances until it is.
             reach = c[C_EVENT_TOL] / hs
             for _ in range(MAX_EVENT_GROWTH):
-                h_event = k.on_clock(t, s_end * hs)
+                h_event = ph.on_clock(t, s_end * hs)
                 r2 = dop853_step(th, om, a1, h_event, tr, K, c, flight)
                 tr2 = trig_at(t + h_event, r2[0], c)
-                g2, _, _ = k.geometry_trig(tr2[1], tr2[2], tr2[3], tr2[4], c)
+                g2, _, _ = ph.geometry_trig(tr2[1], tr2[2], tr2[3], tr2[4], c)
                 if (g2 <= 0.0) if closing else (g2 >= 0.0):
                     break
                 reach *= 2.0
@@ -453,7 +454,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             t = t + h_event
             events += 1
             tr = tr2
-            g, l1, cdn = k.geometry_trig(tr[1], tr[2], tr[3], tr[4], c)
+            g, l1, cdn = ph.geometry_trig(tr[1], tr[2], tr[3], tr[4], c)
             surf = 0
             if closing:
                 if not (0.0 < l1 < c[C_ROD_L]):

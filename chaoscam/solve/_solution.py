@@ -1,0 +1,385 @@
+"""The result of :func:`chaoscam.solve`: members' sections, impacts, series and statuses, with
+the settings that made them.
+
+One type for one run and for an ensemble: a run is a solution of one member. Tables are tidy
+(one row per sample, a ``member`` column); the per-member conveniences (``section``,
+``status``, ``stats``, ...) read the only member of a one-member solution, and
+``solution[i]`` is member ``i`` as a solution of its own.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .._util import freeze_fields
+from ..kernel import Status, contact_fraction, section_jacobians
+from ..kernel import layout as k
+from ..model import Params, contact_angle, contact_period, gap, normal_force, truncated_mass
+from ..numerics import Numerics
+from ._batch import Batch, Resume
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+__all__ = [
+    "IMPACT_COLUMNS",
+    "IMPACT_KINDS",
+    "MEMBER_COLUMNS",
+    "SECTION_COLUMNS",
+    "SERIES_COLUMNS",
+    "Solution",
+    "assemble",
+]
+
+SECTION_COLUMNS = k.SECTION_NAMES
+IMPACT_COLUMNS = k.IMPACT_NAMES
+IMPACT_KINDS = k.IMPACT_KINDS
+SERIES_COLUMNS = ("t", "theta_f", "omega_f", "theta_fc", "gap", "contact", "F_n", "l_lambda")
+MEMBER_COLUMNS = (
+    "member",
+    "index",
+    "status",
+    "n_impacts",
+    "contact_fraction",
+    "slow_closings",
+    "chatter_handovers",
+    "t_end",
+    "theta_f_end",
+    "omega_f_end",
+)
+
+
+@dataclass(frozen=True)
+class Solution:
+    """Members simulated with their settings: what :func:`chaoscam.solve` returns.
+
+    Attributes
+    ----------
+    models : tuple of Params
+        Each member's model (one object shared by members of one model).
+    numerics : Numerics
+        The integrator and its settings.
+    settings : dict
+        duration, transient [s], seed, tangent, output_dt (None without a series), impacts
+        (kept or only counted), backend and device, batch, threads, version, wall_time_s;
+        after :func:`chaoscam.extend` also ``continued_from`` (the grid step its members went
+        on from, None when run again from t = 0) and ``backends`` (where each leg ran).
+        Read-only.
+    members : pandas.DataFrame
+        One row per member (:data:`MEMBER_COLUMNS`): its realization ``index``, ``status``
+        (a :class:`Status` name), impacts applied after the transient, the fraction of the
+        recorded time in contact, closings slower than ``v_min``, chattering-guard
+        hand-overs, and where it stopped (``t_end`` [s], ``theta_f_end`` [rad],
+        ``omega_f_end`` [rad/s]).
+    sections : pandas.DataFrame
+        member, k, t, theta_f, omega_f, l_lambda: the stroboscopic Poincaré section at
+        t = k 2 pi / omega after the transient (the cam back at ``theta_c0``).
+    jacobians : ndarray or None
+        With ``tangent=True``: shape (len(sections), 2, 2), the Jacobian of the stroboscopic
+        map d(theta_f, theta_f')(t_k) / d(theta_f, theta_f')(t_k - T) over the period that
+        ends at each section row, through the impacts' saltation matrices. Read-only.
+    divergence : ndarray or None
+        With ``tangent=True``: the integral of the flow's divergence over each such period
+        (Liouville: ln|det J_k| = divergence_k + 2 ln(xi) per restitution jump). Read-only.
+    impacts : pandas.DataFrame or None
+        With ``impacts=True``: member and the applied restitution jumps after the transient
+        (t, theta_f, omega_before, omega_after, gap_rate_before, lever_arm, l_lambda, kind:
+        "macro", "micro" (slower than ``v_micro``) or "chatter_end", the plastic closure
+        that ends a complete chattering); else None (only counted).
+    series : pandas.DataFrame or None
+        With ``series=True``: member and the time series sampled every ``output_dt``
+        (:data:`SERIES_COLUMNS`); else None.
+    resume : Resume or None
+        With ``resumable=True`` (RK4): each member's state near its end, from which
+        :func:`chaoscam.extend` continues it bit for bit; None otherwise.
+    """
+
+    models: tuple[Params, ...]
+    numerics: Numerics
+    settings: dict[str, Any]
+    members: pd.DataFrame
+    sections: pd.DataFrame
+    jacobians: np.ndarray | None = field(default=None, repr=False)
+    divergence: np.ndarray | None = field(default=None, repr=False)
+    impacts: pd.DataFrame | None = field(default=None, repr=False)
+    series: pd.DataFrame | None = field(default=None, repr=False)
+    resume: Resume | None = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        freeze_fields(self, "settings", "jacobians", "divergence")
+
+    def __len__(self) -> int:
+        return len(self.members)
+
+    def __getitem__(self, member: int) -> Solution:
+        return self.select([member])
+
+    # --- the model(s) ---------------------------------------------------------------------
+    @property
+    def params(self) -> Params:
+        """The model of every member (a ValueError when members have different models)."""
+        first = self.models[0]
+        if any(p is not first and p != first for p in self.models):
+            raise ValueError("the members have different models: see Solution.models")
+        return first
+
+    # --- one member's view ----------------------------------------------------------------
+    def _only(self, what: str) -> int:
+        if len(self) != 1:
+            raise ValueError(
+                f"{what} is one member's; this solution has {len(self)}: use solution[i]"
+            )
+        return 0
+
+    @property
+    def status(self) -> Status:
+        """How the only member's run ended (:attr:`Status.message` says what to do)."""
+        self._only("status")
+        return Status[self.members["status"].iat[0]]
+
+    @property
+    def message(self) -> str:
+        return self.status.message
+
+    @property
+    def ok(self) -> bool:
+        return self.status is Status.OK
+
+    @property
+    def index(self) -> int:
+        """The only member's realization index."""
+        self._only("index")
+        return int(self.members["index"].iat[0])
+
+    @property
+    def section(self) -> pd.DataFrame:
+        """The only member's section (k, t, theta_f, omega_f, l_lambda)."""
+        self._only("section")
+        return self.sections.drop(columns="member")
+
+    @property
+    def final_state(self) -> tuple[float, float, float]:
+        """(t, theta_f, omega_f) where the only member's run stopped."""
+        self._only("final_state")
+        row = self.members.iloc[0]
+        return (float(row["t_end"]), float(row["theta_f_end"]), float(row["omega_f_end"]))
+
+    @property
+    def stats(self) -> dict[str, Any]:
+        """The only member's statistics: contact_fraction, n_impacts (and, with impacts kept,
+        n_macro_impacts, n_micro_impacts, n_chatter_ends), slow_closings,
+        chatter_handovers, truncated_mass, steps_per_contact_period."""
+        self._only("stats")
+        row, p = self.members.iloc[0], self.models[0]
+        out: dict[str, Any] = {
+            "contact_fraction": float(row["contact_fraction"]),
+            "n_impacts": int(row["n_impacts"]),
+        }
+        if self.impacts is not None:
+            kinds = self.impacts["kind"].astype(str)
+            for key, kind in zip(
+                ("n_macro_impacts", "n_micro_impacts", "n_chatter_ends"), IMPACT_KINDS, strict=True
+            ):
+                out[key] = int((kinds == kind).sum())
+        out["slow_closings"] = int(row["slow_closings"])
+        out["chatter_handovers"] = int(row["chatter_handovers"])
+        out["truncated_mass"] = truncated_mass(p.l_lambda, p.l_lambda_sigma, p.l_min)
+        out["steps_per_contact_period"] = contact_period(p) / self.numerics.dt
+        return out
+
+    def summary(self) -> str:
+        """A few lines for a terminal: status, time simulated, impacts, contact fraction."""
+        if len(self) != 1:
+            counts = self.members["status"].value_counts().to_dict()
+            return f"{len(self)} members: " + ", ".join(f"{v} {k_}" for k_, v in counts.items())
+        return _summary(self)
+
+    # --- selection and files --------------------------------------------------------------
+    def select(self, picks) -> Solution:
+        """Members ``picks`` (their ``member`` numbers), renumbered 0, 1, ... in that order."""
+        import pandas as pd
+
+        picks = [int(m) for m in picks]
+        renum = {m: i for i, m in enumerate(picks)}
+
+        def rows(frame):
+            if frame is None:
+                return None, None
+            pos = np.concatenate(
+                [np.flatnonzero(frame["member"].to_numpy() == m) for m in picks] or [[]]
+            ).astype(np.int64)
+            sub = frame.iloc[pos].reset_index(drop=True)
+            sub["member"] = sub["member"].map(renum).astype(np.int64)
+            return sub, pos
+
+        members = self.members.iloc[picks].reset_index(drop=True)
+        members["member"] = np.arange(len(picks), dtype=np.int64)
+        sections, pos = rows(self.sections)
+        impacts, _ = rows(self.impacts)
+        series, _ = rows(self.series)
+        return Solution(
+            models=tuple(self.models[m] for m in picks),
+            numerics=self.numerics,
+            settings=dict(self.settings),
+            members=pd.DataFrame(members),
+            sections=sections,
+            jacobians=None if self.jacobians is None else self.jacobians[pos],
+            divergence=None if self.divergence is None else self.divergence[pos],
+            impacts=impacts,
+            series=series,
+            resume=None if self.resume is None else self.resume.select(picks),
+        )
+
+    def provenance(self) -> dict[str, Any]:
+        """The only member's model, numerics, settings and statistics, JSON-serialisable."""
+        return {
+            "params": self.params.to_dict(),
+            "numerics": self.numerics.to_dict(),
+            "settings": {**self.settings, "index": self.index},
+            "status": self.status.name,
+            "stats": self.stats,
+        }
+
+    def to_parquet(self, path, *, replace: bool = False) -> None:
+        """The only member as a trajectory file (:meth:`parquet_table`), written atomically;
+        an existing file is refused unless ``replace=True``."""
+        from ..io import write_new_parquet
+
+        write_new_parquet(self.parquet_table(), path, replace=replace)
+
+    def parquet_table(self):
+        """The only member's series (or section) as a pyarrow table, its section, impacts
+        and provenance in the metadata (read back by :func:`chaoscam.load_trajectory`)."""
+        import pyarrow as pa
+
+        from ..io import exact_json
+
+        frame = self.section if self.series is None else self.series.drop(columns="member")
+        table = pa.Table.from_pandas(frame, preserve_index=False)
+        meta = dict(table.schema.metadata or {})
+        meta[b"chaoscam.trajectory"] = json.dumps(self.provenance()).encode()
+        meta[b"chaoscam.section"] = exact_json(self.section).encode()
+        impacts = self.impacts.drop(columns="member") if self.impacts is not None else None
+        if impacts is None:
+            import pandas as pd
+
+            impacts = pd.DataFrame(columns=list(IMPACT_COLUMNS))
+        meta[b"chaoscam.impacts"] = exact_json(impacts).encode()
+        return table.replace_schema_metadata(meta)
+
+
+def _summary(sol: Solution) -> str:
+    s = sol.stats
+    fraction = s["contact_fraction"]
+    contact = "n/a (no step recorded)" if math.isnan(fraction) else f"{fraction:.4f}"
+    end = sol.final_state[0]  # NaN for a run read from a file that kept no section row
+    reached = "an end time not recorded in the file" if math.isnan(end) else f"{end:.4g} s"
+    kinds = (
+        f" ({s['n_macro_impacts']} macro, {s['n_micro_impacts']} micro, "
+        f"{s['n_chatter_ends']} chattering ends)"
+        if "n_macro_impacts" in s
+        else ""
+    )
+    return (
+        f"status: {sol.status.name} - {sol.message}\n"
+        f"simulated: {reached} of {sol.settings['duration']:.4g} s "
+        f"(transient {sol.settings['transient']:.4g} s discarded), "
+        f"{sol.numerics.describe_step()}\n"
+        f"impacts: {s['n_impacts']} applied{kinds}, "
+        f"{s['slow_closings']} slow closings left to the compliant contact, "
+        f"{s['chatter_handovers']} chattering-guard hand-overs\n"
+        f"contact fraction: {contact}\n"
+        f"section points: {len(sol.sections)}"
+    )
+
+
+def series_frame(p: Params, a: np.ndarray) -> pd.DataFrame:
+    """The tidy series of one member: kernel samples (t, theta_f, omega_f, l_lambda) and the
+    observables derived from them."""
+    import pandas as pd
+
+    t, th, om, lam = a[:, 0], a[:, 1], a[:, 2], a[:, 3]
+    d = gap(p, t, th)
+    force = normal_force(p, t, th, om, lam)
+    columns = (t, th, om, contact_angle(p, t), d, d <= 0.0, force, lam)
+    return pd.DataFrame(dict(zip(SERIES_COLUMNS, columns, strict=True)))
+
+
+def _tagged(blocks: list[np.ndarray], first: int, ncol: int) -> np.ndarray:
+    """Rows of consecutive members with their member number in front."""
+    out = [np.column_stack([np.full(len(b), first + j), b]) for j, b in enumerate(blocks)]
+    return np.concatenate(out) if out else np.empty((0, 1 + ncol))
+
+
+def assemble(batches: list[Batch], plist, num, settings: dict) -> Solution:
+    """The Solution of finished batches, in order."""
+    import pandas as pd
+
+    sec = np.concatenate(
+        [_tagged(b.kept["section"], b.first, k.SECTION_COLS) for b in batches]
+        or [np.empty((0, 1 + k.SECTION_COLS))]
+    )
+    n_sec = len(SECTION_COLUMNS)
+    sections = pd.DataFrame(sec[:, : 1 + n_sec], columns=["member", *SECTION_COLUMNS])
+    sections[["member", "k"]] = sections[["member", "k"]].astype(np.int64)
+    tangent = bool(settings["tangent"])
+    members = pd.DataFrame(
+        [row for b in batches for row in _member_rows(b)], columns=list(MEMBER_COLUMNS)
+    )
+    impacts = None
+    if all(b.kept["impacts"] is not None for b in batches) and settings["impacts"]:
+        a = np.concatenate(
+            [_tagged(b.kept["impacts"], b.first, k.IMPACT_COLS) for b in batches]
+            or [np.empty((0, 1 + k.IMPACT_COLS))]
+        )
+        impacts = pd.DataFrame(a, columns=["member", *IMPACT_COLUMNS])
+        impacts["member"] = impacts["member"].astype(np.int64)
+        impacts["kind"] = pd.Categorical.from_codes(
+            impacts["kind"].to_numpy(dtype=np.int64), categories=list(IMPACT_KINDS)
+        )
+    series = None
+    if settings["output_dt"] is not None:
+        frames = [
+            series_frame(plist[b.first + j], rows).assign(member=b.first + j)
+            for b in batches
+            for j, rows in enumerate(b.kept["series"])
+        ]
+        series = pd.concat(frames, ignore_index=True) if frames else None
+        if series is not None:
+            series = series[["member", *SERIES_COLUMNS]]
+    resumes = [b.resume for b in batches]
+    resume = Resume.join(resumes) if resumes and all(r is not None for r in resumes) else None
+    return Solution(
+        models=tuple(plist),
+        numerics=num,
+        settings=settings,
+        members=members,
+        sections=sections,
+        jacobians=section_jacobians(sec[:, 1:]) if tangent else None,
+        divergence=sec[:, 1 + n_sec + 4].copy() if tangent else None,
+        impacts=impacts,
+        series=series,
+        resume=resume,
+    )
+
+
+def _member_rows(b: Batch):
+    for j in range(len(b.indices)):
+        y, cnt, c = b.y[j], b.cnt[j], b.c[j]
+        yield (
+            b.first + j,
+            b.indices[j],
+            Status(int(b.status[j])).name,
+            int(b.n_impacts[j]),
+            contact_fraction(y, cnt, c),
+            int(cnt[k.I_SLOW_CLOSINGS]),
+            int(cnt[k.I_CHATTER]),
+            float(y[k.Y_TIME]),
+            float(y[k.Y_THETA]),
+            float(y[k.Y_OMEGA]),
+        )
