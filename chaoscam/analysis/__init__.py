@@ -6,7 +6,7 @@ advances a state); nothing imports the model or the integrators.
 
 from ._birkhoff import BirkhoffResult, birkhoff_weights, weighted_birkhoff
 from ._classify import classify_signal
-from ._classify_section import classify_section
+from ._classify_section import classify_section, unsupported_chaos
 from ._evidence import zero_one_evidence
 from ._exponent import as_exponent, exponent_evidence
 from ._lyapunov import (
@@ -17,6 +17,7 @@ from ._lyapunov import (
     lyapunov_spectrum_map,
 )
 from ._lyapunov_series import DoubtfulEstimateWarning, SeriesLyapunovResult, lyapunov_from_series
+from ._options import SECTION_OPTIONS, check_options, section_options
 from ._periodicity import PeriodResult, RotationResult, embed_angles, rotation_order, section_period
 from ._saltation import saltation_matrix
 from ._sections import crossing_section, local_maxima
@@ -29,6 +30,7 @@ from ._zero_one import ZeroOneResult, zero_one_test
 
 __all__ = [
     "LABELS",
+    "SECTION_OPTIONS",
     "VOTES",
     "BirkhoffResult",
     "Thresholds",
@@ -45,6 +47,7 @@ __all__ = [
     "ZeroOneResult",
     "as_exponent",
     "birkhoff_weights",
+    "check_options",
     "classify_section",
     "classify_signal",
     "combine",
@@ -61,10 +64,12 @@ __all__ = [
     "power_spectrum",
     "rotation_order",
     "saltation_matrix",
+    "section_options",
     "section_period",
     "spectrum_analysis",
     "spectrum_from_jacobians",
     "stationarity_ratio",
+    "unsupported_chaos",
     "weighted_birkhoff",
     "zero_one_evidence",
     "zero_one_test",

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._frozen import freeze_fields
+from .._util import freeze_fields
 from ._validate import check_settings
 
 __all__ = [

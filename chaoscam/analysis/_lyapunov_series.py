@@ -7,8 +7,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._warn import recorded
-from .._warn import warn as warn_user
+from .._util import recorded
+from .._util import warn as warn_user
 from ._validate import as_series, check_settings
 
 __all__ = ["DoubtfulEstimateWarning", "SeriesLyapunovResult", "lyapunov_from_series"]

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import inspect
 
-from .._warn import warn
+from .._util import warn
 from ._classify import classify_signal
 from ._classify_section import classify_section
 from ._validate import check_atol, check_settings

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._frozen import freeze_fields
+from .._util import freeze_fields
 from ._thresholds import Thresholds
 from ._validate import as_points, check_atol, check_settings
 

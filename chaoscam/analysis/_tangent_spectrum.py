@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from .._frozen import freeze_fields
+from .._util import freeze_fields
 from ._validate import check_settings
 
 __all__ = ["TangentSpectrum", "spectrum_from_jacobians"]

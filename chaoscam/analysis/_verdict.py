@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._frozen import FrozenDict
+from .._util import FrozenDict
 
 __all__ = ["LABELS", "VOTES", "Evidence", "Verdict", "combine"]
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._frozen import freeze_fields
+from .._util import freeze_fields
 from ._validate import as_series, check_settings
 
 __all__ = ["ZeroOneResult", "zero_one_test"]

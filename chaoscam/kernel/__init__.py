@@ -19,15 +19,12 @@ from ._numba_cache import guard
 guard(Path(__file__).parent)
 
 _LAZY = {
-    "advance_pair": ("._driver", "advance_pair"),
     "alone_kernel": ("._driver", "alone_kernel"),
     "AUTO_GPU_MIN": ("._gpu", "AUTO_GPU_MIN"),
-    "Buffers": ("._driver", "Buffers"),
     "by_size": ("._gpu", "by_size"),
     "CALL_STEPS": ("._constants", "CALL_STEPS"),
     "check_stop": ("._driver", "check_stop"),
     "contact_fraction": ("._driver", "contact_fraction"),
-    "drive": ("._driver", "drive"),
     "drive_members": ("._driver", "drive_members"),
     "fork_safe_threads": ("._driver", "fork_safe_threads"),
     "GPU_BATCH": ("._gpu", "GPU_BATCH"),
@@ -43,7 +40,6 @@ _LAZY = {
     "members_on_this_thread": ("._driver", "members_on_this_thread"),
     "on_this_thread": ("._driver", "on_this_thread"),
     "run_on_gpu": ("._gpu", "run_on_gpu"),
-    "run_one": ("._driver", "run_one"),
     "runs_on_gpu": ("._gpu", "runs_on_gpu"),
     "section_jacobians": ("._tangent", "section_jacobians"),
     "Status": ("._status", "Status"),

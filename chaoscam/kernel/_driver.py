@@ -1,23 +1,16 @@
-"""The one loop that drives trajectories through the compiled kernel, and the checks of a
-run's time window.
+"""The compiled entry points of the kernel and the one loop that drives them.
 
-The kernel (:func:`run_members` → :func:`advance`) advances each member until the
-end step or until an output buffer or the line-length draws need attention, and returns
-``NEED_BUFFER`` then. :func:`drive_members` is the loop every run goes through: launch the
-members still to run, let the caller empty the buffers and refill the draws of those that
-asked, launch those again, until none asks. Its callers differ only in what a launch is and
-what they keep:
-
-- :func:`drive`, one trajectory (``chaoscam.simulate``, the periodic-orbit shooting of
-  :mod:`chaoscam.tangent`, the two-trajectory exponent of :mod:`chaoscam.lyapunov`), hands
-  every buffer's rows to the caller after each launch;
-- the CPU ensemble (:func:`._ensemble._run_on_cpu`) launches the members that asked, in
-  parallel over cores;
-- the GPU ensemble (:func:`._gpu.run_on_gpu`) launches one CUDA thread per member, those
-  that are done returning at once.
-
-A resumed member is bit-identical to one that was not interrupted (the kernel keeps
-everything it needs in ``y`` and ``cnt``), so how often the loop pauses changes no result.
+:func:`advance` picks the integrator for one trajectory; :func:`run_members` (numba
+``prange`` over members) and :func:`run_alone` (one trajectory on the calling thread, without
+the GIL) are the CPU's entry points, and the GPU launches the same :func:`advance`. The
+kernel advances each member until the end step or until an output buffer or the line-length
+draws need attention, and returns ``NEED_BUFFER`` then. :func:`drive_members` is the loop
+every run goes through: launch the members still to run, let the caller empty the buffers and
+refill the draws of those that asked, launch those again, until none asks; the CPU's and the
+GPU's runs differ only in what a launch is. A resumed member is bit-identical to one that was
+not interrupted (the kernel keeps everything it needs in ``y`` and ``cnt``), so how often the
+loop pauses changes no result. The threads' stop requests (:func:`stop_on`) and numba's
+threading layer are set up here too.
 """
 
 from __future__ import annotations
@@ -27,7 +20,6 @@ import os
 import signal
 import threading
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 from numba import njit, prange
@@ -37,11 +29,8 @@ from ._adaptive import run_chunk_adaptive
 from ._rk4 import run_chunk
 
 __all__ = [
-    "Buffers",
     "advance",
-    "advance_pair",
     "contact_fraction",
-    "drive",
     "drive_members",
     "fork_safe_threads",
     "alone_kernel",
@@ -54,14 +43,10 @@ __all__ = [
     "run_alone",
     "run_alone_rk4",
     "run_members_rk4",
-    "run_one",
     "thread_count",
     "StopRequested",
     "check_stop",
 ]
-
-_OUTPUTS = (("series", k.I_N_SERIES), ("section", k.I_N_SECTION), ("impacts", k.I_N_IMPACT))
-
 
 @njit(cache=True, _nrt=False)
 def advance(y, cnt, c, n_stop, lam, series, section, impacts):
@@ -98,44 +83,6 @@ def run_members_rk4(y, cnt, c, n_stop, lam, series, section, impacts, status):
     """
     for i in prange(y.shape[0]):
         status[i] = run_chunk(y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i])
-
-
-@njit(cache=True)
-def advance_pair(y1, cnt1, y2, cnt2, c, lam, bufs1, bufs2, lead, wait, n_stop):
-    """Advance two trajectories one grid step at a time, both to the same step, until they
-    have applied as many impacts, ``wait`` steps have passed or step ``n_stop`` is reached.
-
-    The two-trajectory exponent's postponed renormalisation (:mod:`chaoscam.lyapunov`),
-    compiled: each step is the :func:`advance` call a :func:`drive` to the next
-    step makes, without a Python round trip per step (a run that chatters can wait a
-    hundredth of a period, 1,000 steps, at each of many renormalisations). ``bufs1`` and
-    ``bufs2`` are the (series, section, impacts) buffers; impact rows stay in them, so the
-    first has applied ``lead + cnt1[I_N_IMPACT] - cnt2[I_N_IMPACT]`` more impacts than the
-    second (``lead``: the difference in rows already taken out of the buffers).
-
-    Returns ``(steps, code, which)``: the steps both made, and ``which`` = 0 when the loop
-    ended for one of the reasons above, else the trajectory (1 or 2) whose call returned
-    ``code`` (``NEED_BUFFER``, or a failure) on the way to the next step; the first has
-    then made that step when ``which`` is 2.
-
-    RK4 trajectories only (:func:`._rk4.run_chunk`; the exponent is always taken on the
-    RK4 grid), so that a fresh install does not compile the adaptive kernel for it.
-    """
-    steps = 0
-    while (
-        lead + cnt1[k.I_N_IMPACT] - cnt2[k.I_N_IMPACT] != 0
-        and steps < wait
-        and cnt1[k.I_STEP] < n_stop
-    ):
-        n1 = cnt1[k.I_STEP] + 1
-        code = run_chunk(y1, cnt1, c, n1, lam, bufs1[0], bufs1[1], bufs1[2])
-        if code != k.OK:
-            return steps, code, 1
-        code = run_chunk(y2, cnt2, c, n1, lam, bufs2[0], bufs2[1], bufs2[2])
-        if code != k.OK:
-            return steps, code, 2
-        steps += 1
-    return steps, k.OK, 0
 
 
 def _all_rk4(c: np.ndarray) -> bool:
@@ -190,14 +137,6 @@ def thread_count() -> int:
         return 1
     fork_safe_threads()
     return numba.get_num_threads()
-
-
-def run_one(y, cnt, c, n_stop, lam, series, section, impacts) -> int:
-    """One trajectory (arrays of a single member, updated in place) on the calling thread:
-    :func:`alone_kernel`'s pick, the compiled kernel the parallel entry points run for each
-    member (so the same bits), without a ``prange`` launch for a batch of one (which
-    compiled a parallel kernel and started numba's threads for every single run)."""
-    return int(alone_kernel(c)(y, cnt, c, n_stop, lam, series, section, impacts))
 
 
 @njit(nogil=True, cache=True)
@@ -349,73 +288,3 @@ def _interrupts_held():
         if held:
             signum, frame = held[0]
             before[signum](signum, frame)  # KeyboardInterrupt, from the default or the CLI's
-
-
-@dataclass
-class Buffers:
-    """The kernel's output buffers for one trajectory: rows of ``SERIES_COLS``,
-    ``SECTION_COLS`` and ``IMPACT_COLS`` columns (a series of one row when none is kept)."""
-
-    series: np.ndarray
-    section: np.ndarray
-    impacts: np.ndarray
-
-    @classmethod
-    def empty(cls, series_rows: int, section_rows: int, impact_rows: int) -> Buffers:
-        return cls(
-            np.empty((max(series_rows, 1), k.SERIES_COLS)),
-            np.empty((section_rows, k.SECTION_COLS)),
-            np.empty((impact_rows, k.IMPACT_COLS)),
-        )
-
-
-def drive(
-    y: np.ndarray,
-    cnt: np.ndarray,
-    c: np.ndarray,
-    n_stop: int,
-    lam: np.ndarray,
-    buffers: Buffers,
-    *,
-    on_rows: Callable[[str, np.ndarray], None],
-    more_draws: Callable[[np.ndarray], np.ndarray],
-    run: Callable[..., int] = run_one,
-) -> int:
-    """Advance one trajectory (``y``, ``cnt``, ``c``) to grid step ``n_stop``; returns the
-    kernel's final status code.
-
-    ``on_rows(name, rows)`` receives each buffer's filled rows ("series", "section",
-    "impacts"; a view, to be copied if kept) after every kernel call, and the buffer is
-    emptied. When the kernel stops for room, ``more_draws(lam)`` returns the draws to go on
-    with, and must leave ``cnt[I_LAM_POS]`` pointing at the draw in use in them. ``run`` is
-    the compiled call (:func:`run_one`; the two-trajectory exponent passes
-    :func:`._rk4.run_chunk`, the same RK4 kernel without the one-member batch, and the
-    periodic-orbit shooting :func:`alone_kernel`'s pick). On a sweep's thread asked to stop
-    (:func:`members_on_this_thread`), the next call raises :class:`StopRequested`: a
-    verdict's shooting and kicks stop within one call, not at the end of the member.
-    """
-    code = k.NEED_BUFFER
-    before = (0.0, 0)  # (time, draw in use) when the last call began
-    filled = False  # whether the last call filled any buffer
-
-    def launch(need: np.ndarray) -> np.ndarray:
-        nonlocal code, before, filled
-        check_stop()  # a sweep thread asked to stop: between two calls (a verdict's shooting)
-        before = (y[k.Y_TIME], cnt[k.I_LAM_POS])
-        code = run(y, cnt, c, n_stop, lam, buffers.series, buffers.section, buffers.impacts)
-        filled = False
-        for name, i in _OUTPUTS:
-            if cnt[i]:
-                on_rows(name, getattr(buffers, name)[: cnt[i]])
-                cnt[i] = 0
-                filled = True
-        return np.array([code])
-
-    def refill(need: np.ndarray) -> None:
-        nonlocal lam
-        if not filled and (y[k.Y_TIME], cnt[k.I_LAM_POS]) == before and before[1] == 0:
-            raise RuntimeError("internal: the kernel asked for buffers but made no progress")
-        lam = more_draws(lam)
-
-    drive_members(1, launch, refill)
-    return int(code)

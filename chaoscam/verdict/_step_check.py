@@ -1,47 +1,24 @@
-"""The step check of a verdict (``classify_trajectory(..., check_step=True)``).
+"""The step check of a verdict (``classify(..., check_step=True)``).
 
-MODEL.md: a result must not change when the step is halved. The realization is simulated
-again with dt / 2 (:meth:`Params.refined`; the adaptive integrator's tolerances / 32) and
-classified the same way (:mod:`chaoscam.classify` does that); here, the re-simulation and what
-the comparison makes of the two verdicts: the grid verdict with evidence ``step_check`` (1:
-unchanged), or "undetermined" with the reason (0: changed). An undetermined verdict is not
-re-run, since no half-step verdict can change it (``step_check`` without a value).
+MODEL.md: a result must not change when the step is halved. The realization is solved again
+with dt / 2 (:meth:`Numerics.refined`; the adaptive integrator's tolerances / 32) and judged
+the same way (:func:`~._classify.classify` does that); here, what the comparison makes of the
+two verdicts: the grid verdict with evidence ``step_check`` (1: unchanged), or "undetermined"
+with the reason (0: changed). An undetermined verdict is not re-run, since no half-step
+verdict can change it (``step_check`` without a value).
 """
 
 from __future__ import annotations
 
 import dataclasses
 
-from ._simulate import Trajectory, simulate
-from .analysis import Evidence, Verdict
-from .model import Params
+from ..analysis import Evidence, Verdict
+from ..numerics import Numerics
 
-__all__ = ["resimulate_half_step", "skipped", "compared"]
-
-
-def resimulate_half_step(traj: Trajectory, *, tangent: bool = False) -> Trajectory:
-    """The realization of ``traj`` with the step halved (:meth:`Params.refined`): the same
-    params otherwise, duration, transient, seed, index and output step; with ``tangent``, on
-    the RK4 grid, also its Jacobians, kept resumable (what the tangent verdict and its
-    extension read)."""
-    s = traj.settings
-    keep_series = traj.series is not None
-    fine = traj.params.refined()
-    tangent = tangent and fine.integrator == "rk4"
-    return simulate(
-        fine,
-        duration=s["duration"],
-        transient=s["transient"],
-        seed=s["seed"],
-        index=s["index"],
-        series=keep_series,
-        output_dt=s["output_dt"] if keep_series else 1e-3,
-        tangent=tangent,
-        resumable=tangent,
-    )
+__all__ = ["compared", "skipped"]
 
 
-def skipped(verdict: Verdict, fine: Params) -> Verdict:
+def skipped(verdict: Verdict, fine: Numerics) -> Verdict:
     """An undetermined ``verdict`` with evidence ``step_check`` (no value) saying why the
     realization was not re-run at ``fine``'s step."""
     check = Evidence(
@@ -73,8 +50,8 @@ def _describe(v: Verdict) -> str:
 def compared(
     verdict: Verdict,
     half: Verdict,
-    coarse: Params,
-    fine: Params,
+    coarse: Numerics,
+    fine: Numerics,
     *,
     half_recorded_s: float | None = None,
 ) -> Verdict:

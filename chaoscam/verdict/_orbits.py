@@ -1,25 +1,25 @@
-"""The tangent dynamics at work: Lyapunov spectrum and certified periodic orbits.
+"""The tangent dynamics at work: Lyapunov spectrum, periodic orbits, finite kicks.
 
-Both read the Jacobians of the stroboscopic map ``P: x(t_k) -> x(t_k + T)``, ``T = 2 pi /
-omega``, that the compiled RK4 kernel integrates through the impacts (tangent flow plus
-saltation matrices, :mod:`chaoscam.integrate._tangent`) and writes beside each section point:
+All read the stroboscopic map ``P: x(t_k) -> x(t_k + T)``, ``T = 2 pi / omega``, whose
+Jacobians the compiled kernel integrates through the impacts (tangent flow plus saltation
+matrices) and writes beside each section point:
 
 - :func:`lyapunov_spectrum` — both exponents of the non-autonomous 2-D system by repeated QR
   of the product of those Jacobians (Benettin et al. 1980; Eckmann & Ruelle 1985, Rev. Mod.
   Phys. 57, sec. IV.B), no separation ``d0`` to choose;
 - :func:`periodic_orbit` — Newton's method (shooting) on ``P^n(x) = x`` with the monodromy
-  matrix ``DP^n`` from the same Jacobians; returns the orbit, its Floquet multipliers and
-  whether it is a certified attracting orbit;
+  matrix ``DP^n`` from the same Jacobians; the orbit, its Floquet multipliers and whether it
+  is a certified attracting orbit;
 - :func:`kick_test` — the direct perturbation test, no tangent at all: kicks of finite size
   followed on the map itself, which decides stability where the map is not differentiable at
   the scale of its event jitter (chattering ending in sticking).
 
-This module sits above :mod:`chaoscam._simulate` and the kernels (it drives them); the analysis
-layer only ever sees the arrays it returns.
+The map runs are members of :func:`chaoscam.solve`'s batch runner started from a state.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 import time
@@ -28,176 +28,112 @@ from typing import Any
 
 import numpy as np
 
-from ._checks import of_type, params_arg, real, whole
-from ._frozen import freeze_fields
-from ._warn import warn
-from .analysis import TangentSpectrum, spectrum_from_jacobians
-from .integrate import Status, kernel_constants
-from .integrate import _kernel as k
-from .integrate._constants import initial_counters, initial_state
-from .integrate._driver import Buffers, alone_kernel, drive
-from .integrate._tangent import section_jacobians
-from .model import ParameterError, Params, realizations_identical
+from .._util import ParameterError, freeze_fields, real, warn, whole
+from ..analysis import TangentSpectrum, spectrum_from_jacobians
+from ..kernel import Status, section_jacobians
+from ..kernel import layout as k
+from ..model import Params, params_arg, realizations_identical
+from ..numerics import Numerics
+from ..solve import ROOM, Solution, check_run, fresh, numerics_arg, run_batch, solve
 
 __all__ = [
     "KickTest",
     "PeriodicOrbit",
-    "TangentSpectrum",
     "iterate_map",
     "kick_test",
     "lyapunov_spectrum",
     "periodic_orbit",
-    "spectrum_from_jacobians",
     "stroboscopic_map",
 ]
 
 
 def lyapunov_spectrum(
-    params: Params | None = None,
+    params: Params | Solution | None = None,
+    numerics: Numerics | None = None,
     *,
     duration: float = 120.0,
     transient: float = 60.0,
     seed: int = 0,
     index: int = 0,
-    trajectory=None,
 ) -> TangentSpectrum:
     """Lyapunov spectrum of one realization from its tangent dynamics through the impacts.
 
-    Simulates with ``tangent=True`` (or takes a ``trajectory`` simulated so) and applies
-    :func:`spectrum_from_jacobians` to the recorded stroboscopic Jacobians. Costs about 1.1×
-    a plain simulation on RK4, about 2.5× on the adaptive path (its tangent substeps; the
-    tangent is carried over the recorded half only: 1.15× and 4× over a whole run). With a
-    random line length (σ > 0) the exponents are those of the realization's random map
-    sequence.
+    Solves with ``tangent=True`` (or takes a one-member :class:`Solution` solved so, in place
+    of ``params``) and applies :func:`chaoscam.analysis.spectrum_from_jacobians` to the
+    recorded stroboscopic Jacobians. The tangent costs about 0.1 of a run on RK4 and 2.5 runs
+    on the adaptive path. With a random line length (sigma > 0) the exponents are those of
+    the realization's random map sequence (its top exponent is the random system's:
+    L. Arnold, Random Dynamical Systems, 1998).
     """
-    if trajectory is not None:
-        from ._simulate import Trajectory
-
-        of_type("trajectory", trajectory, Trajectory, "from chaoscam.simulate(tangent=True)")
-        given = {
-            k_: v
-            for k_, v, default in (
-                ("params", params, None),
-                ("duration", duration, 120.0),
-                ("transient", transient, 60.0),
-                ("seed", seed, 0),
-                ("index", index, 0),
-            )
-            if v is not default and v != default
-        }
-        if given:  # they would be silently ignored: the trajectory's own are used
-            raise ParameterError(
-                f"give a trajectory or the run's settings, not both: {', '.join(given)} "
-                "would be ignored (the trajectory's own are used)"
-            )
+    if isinstance(params, Solution):
+        run = params
+        if numerics is not None:
+            raise ParameterError("give a solution or its numerics, not both")
     else:
-        from ._simulate import simulate
-
-        trajectory = simulate(
-            params,
-            duration=duration,
-            transient=transient,
-            seed=seed,
-            index=index,
-            series=False,
-            tangent=True,
+        run = solve(params, numerics, indices=[index], seed=seed, duration=duration,
+                    transient=transient, tangent=True)  # fmt: skip
+    if run.jacobians is None:
+        raise ValueError(
+            "the solution has no Jacobians (solved without tangent=True, or read from a "
+            "file): solve it again with tangent=True"
         )
-    if trajectory.jacobians is None:
-        if trajectory.settings.get("tangent"):  # simulated with it, the Jacobians not kept
-            raise ValueError(
-                "the trajectory's Jacobians were not kept (a trajectory read from a file "
-                "has none): simulate it again with tangent=True"
-            )
-        raise ValueError("the trajectory was simulated without tangent=True")
-    if trajectory.status is not Status.OK:
-        raise ValueError(f"the run ended {trajectory.status.name}: {trajectory.message}")
-    jac = trajectory.jacobians
-    keep = trajectory.section["k"].to_numpy() > 0  # the k = 0 row is the initial state
+    if run.status is not Status.OK:
+        raise ValueError(f"the run ended {run.status.name}: {run.message}")
+    keep = run.section["k"].to_numpy() > 0  # the k = 0 row is the initial state
     if not keep.any():
         raise ValueError(
             f"the run records no section point after its start (duration "
-            f"{trajectory.settings['duration']:g} s, cam period "
-            f"{trajectory.params.cam_period:.3g} s): nothing to take exponents from"
+            f"{run.settings['duration']:g} s, cam period {run.params.cam_period:.3g} s): "
+            "nothing to take exponents from"
         )
-    spec = spectrum_from_jacobians(jac[keep], trajectory.params.cam_period)
+    spec = spectrum_from_jacobians(run.jacobians[keep], run.params.cam_period)
     if not math.isfinite(float(spec.stderr[0])):  # too few periods for the batch means
         warn(
             f"lambda_1 = {spec.exponents[0]:.3g} 1/s rests on {spec.n_periods} cam period(s), "
             "too few for its standard error (NaN): lengthen the recorded time "
             "(duration - transient)"
         )
-    return TangentSpectrum(
-        exponents=spec.exponents,
-        stderr=spec.stderr,
-        n_periods=spec.n_periods,
-        local=spec.local,
-        det_log=spec.det_log,
-        settings={
-            **spec.settings,
-            **{k_: trajectory.settings[k_] for k_ in ("duration", "transient", "seed", "index")},
-        },
-    )
+    s = run.settings
+    window = {"duration": s["duration"], "transient": s["transient"], "seed": s["seed"],
+              "index": run.index}  # fmt: skip
+    return dataclasses.replace(spec, settings={**spec.settings, **window})
 
 
 # --- periodic orbits ------------------------------------------------------------------------
 
 
-MAP_ROWS = 64
-"""Cam periods of the map at most per compiled call (then the driver hands back: the same
-bits, and a sweep asked to stop sees it; at dt = 2.5e-8 s a call is then a few seconds)."""
-
-
 class _MapRunner:
-    """n iterates of the stroboscopic map of a deterministic model, from t = 0, with DP^n."""
+    """n iterates of the stroboscopic map of a deterministic model from a state at t = 0, and
+    DP^n: one member of :func:`chaoscam.solve`'s batch runner, started from that state."""
 
-    def __init__(self, p: Params, n: int, *, tangent: bool = True) -> None:
+    def __init__(self, p: Params, num: Numerics, n: int, *, tangent: bool = True) -> None:
         if not realizations_identical(p):
             raise ParameterError(
                 f"l_lambda_sigma = {p.l_lambda_sigma} m: periodic orbits need the "
                 "deterministic model (l_lambda_sigma = 0, or the fractal stiffness)"
             )
-        if p.integrator != "rk4":
+        if num.integrator != "rk4":
             raise ParameterError("periodic orbits are computed on the RK4 grid (integrator='rk4')")
         # The fractal K_n ignores the line length: with sigma = 0 the same motion, no draws.
-        self.p = p.replace(integrator="rk4", l_lambda_sigma=0.0)
-        self.n = n
-        self.n_stop = int(math.floor(n * p.cam_period / p.dt)) + 2
-        self.lam = np.full(4096, p.l_lambda)
-        # At most MAP_ROWS section rows a call: the driver hands back (and a stop request is
-        # seen) every MAP_ROWS cam periods, even on an orbit with few impacts.
-        self.buffers = Buffers.empty(1, min(n, MAP_ROWS) + 4 + int(p.dt / p.cam_period), 4096)
-        self.c = kernel_constants(self.p, tangent=tangent)
+        self.p, self.num, self.n = p.replace(l_lambda_sigma=0.0), num, n
+        self.duration = (int(math.floor(n * p.cam_period / num.dt)) + 2) * num.dt
+        self.start = fresh([self.p], num, [0], 0, self.duration, 0.0, tangent=tangent, stride=0,
+                           room=ROOM["cpu"])  # fmt: skip
         self.calls = 0
 
     def _rows(self, x: np.ndarray) -> tuple[np.ndarray, int]:
         """The section rows of n cam periods from x (row 0: x itself), and the status."""
-        y = initial_state(self.p)
-        y[k.Y_THETA], y[k.Y_OMEGA] = x
-        cnt = initial_counters(self.p)
+        s = self.start
+        y = s.y.copy()
+        y[0, k.Y_THETA], y[0, k.Y_OMEGA] = x
+        start = dataclasses.replace(
+            s, y=y, cnt=s.cnt.copy(), lam=s.lam.copy(), kept={"section": [[]], "impacts": [[]],
+                                                              "series": [[]]},
+            status=s.status.copy(),
+        )  # fmt: skip
         self.calls += 1
-        kept: list[np.ndarray] = []
-
-        def on_rows(name: str, rows: np.ndarray) -> None:
-            if name == "section":
-                kept.append(rows.copy())
-
-        def same_draws(lam: np.ndarray) -> np.ndarray:
-            cnt[k.I_LAM_POS] = 0  # deterministic: every draw is l_lambda
-            return lam
-
-        code = drive(
-            y,
-            cnt,
-            self.c,
-            self.n_stop,
-            self.lam,
-            self.buffers,
-            on_rows=on_rows,
-            more_draws=same_draws,
-            run=alone_kernel(self.c),  # this thread: verdicts shoot several members at once
-        )
-        rows = np.concatenate(kept) if kept else np.empty((0, k.SECTION_COLS))
-        return rows, int(code)
+        out = run_batch([self.p], self.num, [0], start, 0, self.duration, room=ROOM["cpu"])
+        return out.kept["section"][0], int(out.status[0])
 
     def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
         """(P^n(x), DP^n(x), status)."""
@@ -218,21 +154,24 @@ class _MapRunner:
         return out
 
 
-def iterate_map(params: Params, x, n: int) -> np.ndarray:
+def iterate_map(params: Params, x, n: int, numerics: Numerics | None = None) -> np.ndarray:
     """The section points ``x, P(x), ..., P^n(x)`` (shape (n + 1, 2)) of the deterministic
     model, from the state x = (θ_f, θ̇_f) at t = 0: a direct perturbation test at a chosen
     step (does a point near an orbit settle on it?). Rows after a run that stopped (left
     the cam's reach) are NaN."""
     # No tangent: the state is bit-identical without it, and the points are all we need.
-    return _MapRunner(params, int(n), tangent=False).points(np.asarray(x, dtype=float))
+    run = _MapRunner(params, numerics_arg(numerics), int(n), tangent=False)
+    return run.points(np.asarray(x, dtype=float))
 
 
-def stroboscopic_map(params: Params, x, n: int = 1) -> tuple[np.ndarray, np.ndarray]:
+def stroboscopic_map(
+    params: Params, x, n: int = 1, numerics: Numerics | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """``(P^n(x), DP^n(x))``: n cam periods from the state x = (θ_f, θ̇_f) at t = 0.
 
     The deterministic model only (σ = 0); DP^n through the impacts' saltation matrices.
     """
-    xn, m, code = _MapRunner(params, int(n))(np.asarray(x, dtype=float))
+    xn, m, code = _MapRunner(params, numerics_arg(numerics), int(n))(np.asarray(x, dtype=float))
     if code != k.OK:
         raise ValueError(f"the map could not be iterated: {Status(code).message}")
     return xn, m
@@ -285,6 +224,7 @@ def kick_test(
     x,
     n: int = 1,
     *,
+    numerics: Numerics | None = None,
     kicks: tuple = KICKS,
     periods: int = 40,
     omega_scale: float = 30.0,
@@ -310,19 +250,19 @@ def kick_test(
     (``returns`` is then False and the rows of the kicks not run are NaN): the answer for a
     fraction of the cost, as the kick certificate asks it. Returns a :class:`KickTest`.
     """
-    params = params_arg(params)
+    params, num = params_arg(params), numerics_arg(numerics)
     n = whole("n", n, low=1)
     periods = whole("periods", periods, low=1)
     omega_scale = real("omega_scale", omega_scale, low=0.0, strict=True)
     sizes = tuple(real("kicks", v, low=0.0, strict=True) for v in kicks)
     x = np.asarray(x, dtype=float)
     scale = np.array([1.0, omega_scale])
-    points = iterate_map(params, x, periods * n)
+    points = iterate_map(params, x, periods * n, num)
     base = points[::n] / scale
     directions = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
     growth = np.full((len(sizes), len(directions), periods + 1), np.nan)
     for i, j in itertools.product(range(len(sizes)), range(len(directions))):
-        kicked = iterate_map(params, x + sizes[i] * scale * directions[j], periods * n)
+        kicked = iterate_map(params, x + sizes[i] * scale * directions[j], periods * n, num)
         growth[i, j] = np.abs(kicked[::n] / scale - base).max(axis=1) / sizes[i]
         if until_refused and sizes[i] >= KICK_DECIDES and not growth[i, j, -1] <= KICK_RETURN:
             break  # refused: the kicks not run stay NaN
@@ -397,6 +337,7 @@ def periodic_orbit(
     x0,
     period: int,
     *,
+    numerics: Numerics | None = None,
     tol: float = 1e-7,
     max_iter: int = 20,
 ) -> PeriodicOrbit:
@@ -423,10 +364,42 @@ def periodic_orbit(
     jump), so Newton may fail where the orbit grazes; ``converged`` then stays False.
     """
     t0 = time.perf_counter()
-    params = params_arg(params)
+    params, num = params_arg(params), numerics_arg(numerics)
     n = whole("period", period, low=1)
     tol = real("tol", tol, low=0.0, strict=True, unit="rad")
     max_iter = whole("max_iter", max_iter, low=0)
+    x = _state(x0)
+    # Each Newton iteration runs n cam periods: at most max_iter + 1 of them, judged as one
+    # run (refused past the run limit, as solve is; a warning past a minute).
+    most = (max_iter + 1) * n
+    check_run(params, num, most * params.cam_period, what=f"the shooting (up to {most} periods)")
+    run = _MapRunner(params, num, n)
+    x, m, res, it, first = _newton(run, x, params.cam_period, tol, max_iter)
+    one = _MapRunner(params, num, 1)
+    least, pts, m = _least_period(params, num, one, x, n, m, res, tol)
+    # A map that left the model (the seed off the cam's reach) has no Jacobian: NaN.
+    mult = np.linalg.eigvals(m) if np.isfinite(m).all() else np.full(2, np.nan + 0j)
+    return PeriodicOrbit(
+        period=least,
+        points=pts,
+        multipliers=mult,
+        residual=res,
+        converged=res <= tol,
+        iterations=it,
+        wall_time=time.perf_counter() - t0,
+        settings={
+            "tol": tol,
+            "max_iter": max_iter,
+            "map_calls": run.calls + one.calls,
+            "cam_period": params.cam_period,
+            "seed_period": n,
+            "seed_status": first.name,  # e.g. LEFT_REACH: the map from x0 left the model
+        },
+    )
+
+
+def _state(x0) -> np.ndarray:
+    """``x0`` as a finite state (theta_f [rad], omega_f [rad/s]), else a ParameterError."""
     try:
         x = np.array(x0, dtype=float)
     except (TypeError, ValueError):
@@ -435,14 +408,13 @@ def periodic_orbit(
         raise ParameterError(
             f"x0 = {x0!r}: must be two finite numbers (theta_f [rad], omega_f [rad/s])"
         )
-    from ._budget import check_run
+    return x
 
-    # Each Newton iteration runs n cam periods: at most max_iter + 1 of them, judged as one
-    # run (refused past the run limit, as simulate is; a warning past a minute).
-    most = (max_iter + 1) * n
-    check_run(params, most * params.cam_period, what=f"the shooting (up to {most} periods)")
-    run = _MapRunner(params, n)
-    w = np.array([1.0, params.cam_period])
+
+def _newton(run: _MapRunner, x: np.ndarray, period: float, tol: float, max_iter: int):
+    """Damped Newton on ``P^n(x) = x``: (x, DP^n(x), residual, iterations, the status of the
+    map from the seed)."""
+    w = np.array([1.0, period])
     fx, m, code = run(x)
     first = Status(code)  # how the map from the seed ended (not OK: no orbit from there)
     res = float(np.linalg.norm((fx - x) * w)) if code == k.OK else math.inf
@@ -464,37 +436,17 @@ def periodic_orbit(
         else:
             break
         x, fx, m, res = x_new, f_new, m_new, r_new
-    converged = res <= tol
-    # The orbit's points, and the least period among the divisors of n.
-    one = _MapRunner(params, 1)
+    return x, m, res, it, first
+
+
+def _least_period(params, num, one: _MapRunner, x, n: int, m, res: float, tol: float):
+    """(the least period among the divisors of n, the orbit's points, its monodromy)."""
+    w = np.array([1.0, params.cam_period])
     pts = [x]
     for _ in range(n - 1):
         pts.append(one(pts[-1])[0])
     pts = np.array(pts)
-    least = n
     for d in range(1, n):
         if n % d == 0 and np.linalg.norm((pts[d] - pts[0]) * w) <= max(0.01 * tol, 10 * res):
-            least = d
-            break
-    if least < n:
-        m = stroboscopic_map(params, x, least)[1]
-        pts = pts[:least]
-    # A map that left the model (the seed off the cam's reach) has no Jacobian: NaN.
-    mult = np.linalg.eigvals(m) if np.isfinite(m).all() else np.full(2, np.nan + 0j)
-    return PeriodicOrbit(
-        period=least,
-        points=pts,
-        multipliers=mult,
-        residual=res,
-        converged=converged,
-        iterations=it,
-        wall_time=time.perf_counter() - t0,
-        settings={
-            "tol": tol,
-            "max_iter": max_iter,
-            "map_calls": run.calls + one.calls,
-            "cam_period": params.cam_period,
-            "seed_period": n,
-            "seed_status": first.name,  # e.g. LEFT_REACH: the map from x0 left the model
-        },
-    )
+            return d, pts[:d], stroboscopic_map(params, x, d, num)[1]
+    return n, pts, m

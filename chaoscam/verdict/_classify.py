@@ -1,0 +1,316 @@
+"""classify(solution) -> a verdict per member: periodic (with its period), quasiperiodic,
+chaotic or undetermined, with its evidence.
+
+Each member is judged from its stroboscopic section (theta_f, theta_f') at t = k 2 pi / omega
+and its tangent dynamics through the impacts: :func:`chaoscam.analysis.classify_section`
+with the tangent exponent lambda_1 +- its standard error (QR on the section map's
+Jacobians), then the model-level rules (:data:`~._rules.RULES`: n-band chaos, the
+periodic-orbit certificate of the deterministic model). An undetermined member is run longer
+(4x its recorded time a round, up to ``extend_to`` seconds recorded), continued bit for bit
+from where it stopped, until its verdict settles; ``check_step`` judges the same
+realizations at half the step and keeps a verdict only where both agree (MODEL.md: a result
+must not change when the step is halved).
+"""
+
+from __future__ import annotations
+
+import contextvars
+import dataclasses
+import time
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any
+
+import numpy as np
+
+from .._util import ParameterError, flag, real, warn
+from ..analysis import (
+    Evidence,
+    Verdict,
+    check_options,
+    classify_section,
+    section_options,
+    spectrum_from_jacobians,
+)
+from ..kernel import Status, check_stop
+from ..model import realizations_identical
+from ..solve import Solution, extend, solve
+from ._certificate import MODEL_ATOL
+from ._rules import (
+    Context,
+    apply_rules,
+    extensible,
+    extension_stopped,
+    overflow_evidence,
+    tangent_record,
+)
+from ._step_check import compared, skipped
+
+__all__ = ["EXTEND_TO", "classify", "judge_member"]
+
+EXTEND_TO = 120.0
+"""Longest recorded time [s] an undetermined verdict is extended to: the labelled sets are
+settled from 120 s runs, and the tangent exponent's standard error falls as the inverse
+square root of the run (~0.15 1/s after 60 s on the default model)."""
+
+_COORDS = ["theta_f", "omega_f"]
+
+
+def classify(
+    solution: Solution,
+    *,
+    extend_to: float | None = EXTEND_TO,
+    check_step: bool = False,
+    discard: float = 0.0,
+    progress: Callable | None = None,
+    **options: Any,
+) -> list[Verdict]:
+    """The verdict of every member of ``solution``, in the order of its ``members``.
+
+    Parameters
+    ----------
+    solution : Solution
+        The runs (from :func:`chaoscam.solve`, :func:`chaoscam.simulate` or
+        :func:`chaoscam.load_trajectory`). Without its Jacobians (solved without
+        ``tangent=True``) the same realizations are solved again with the tangent, on the
+        RK4 grid at the solution's ``dt`` (for an adaptive run a RuntimeWarning says so).
+    extend_to : float or None
+        Longest recorded time [s] an undetermined verdict is extended to (not one whose
+        tangent overflowed, nor one whose periodic orbit is the step's); None: never.
+        ``settings["extended"]`` records the time used.
+    check_step : bool
+        Judge the same realizations at half the step (:meth:`Numerics.refined`), with the
+        same extension; a verdict that changes becomes "undetermined" with the reason
+        (evidence ``step_check``: 1 unchanged, 0 changed; not a vote).
+    discard : float
+        Extra time after the transient left out of the classification [s].
+    progress : callable, optional
+        Called as ``progress(0, extending=m, recorded_s=r)`` before each extension round and
+        ``progress(n)`` after each of its batches (a progress bar's total can grow).
+    **options
+        Passed to :func:`chaoscam.analysis.classify_section` (``rtol``, ``atol``,
+        ``thresholds``, ``seed``, ...).
+
+    Returns
+    -------
+    list of Verdict
+        One per member. A member whose run did not end normally (it left the cam's reach,
+        diverged) is "undetermined" with a ``status`` evidence item and the reason.
+        ``settings`` records the options, the member's run, the tangent spectrum and the
+        certificate's shootings.
+    """
+    if not isinstance(solution, Solution):
+        raise TypeError(
+            f"solution must be a chaoscam Solution (from chaoscam.solve or simulate), got "
+            f"{type(solution).__name__}"
+        )
+    check_options(options, "classify", series=False, tangent=True)
+    check_step = flag("check_step", check_step)
+    discard = real("discard", discard, low=0.0, unit="s")
+    if extend_to is not None:
+        extend_to = real("extend_to", extend_to, low=0.0, unit="s")
+    s = solution.settings
+    recorded = s["duration"] - s["transient"]
+    if discard >= recorded:
+        raise ParameterError(
+            f"discard = {discard!r} s must be in [0, {recorded:g}) s: the run records "
+            f"{recorded:g} s after its transient"
+        )
+    how = {"check_step": check_step, "discard": discard, "extend_to": extend_to, **options}
+    run = _tangent_solution(solution)
+    verdicts = _extended(run, _judge_all(run, discard, options), extend_to, discard, options,
+                         progress)  # fmt: skip
+    if check_step:
+        verdicts = _step_checked(run, verdicts, extend_to, discard, options)
+    return [_with_run(v, solution, j, how) for j, v in enumerate(verdicts)]
+
+
+def _with_run(v: Verdict, sol: Solution, j: int, how: dict) -> Verdict:
+    """``v`` with the options and member ``j``'s run recorded in its settings."""
+    row = sol.members.iloc[j]
+    record = {
+        "params": sol.models[j].to_dict(),
+        "numerics": sol.numerics.to_dict(),
+        "settings": {**sol.settings, "index": int(row["index"])},
+        "status": str(row["status"]),
+    }
+    return dataclasses.replace(v, settings={**v.settings, "classify": how, "trajectory": record})
+
+
+def _tangent_solution(sol: Solution) -> Solution:
+    """The run whose Jacobians the verdicts read: ``sol`` when solved with the tangent, else
+    the same realizations on the RK4 grid with it, kept resumable (so that an extension goes
+    on from it)."""
+    if sol.jacobians is not None:
+        return sol
+    num = sol.numerics
+    if num.integrator != "rk4":
+        warn(
+            f"the verdict of this {num.describe_step()} run is taken on the same realization "
+            f"on the RK4 grid at dt = {num.dt:g} s (its tangent exponent, the orbit "
+            "certificate and any extension), which the adaptive tolerances do not refine: to "
+            "converge the verdict, refine dt"
+        )
+    s = sol.settings
+    return solve(
+        list(sol.models), num.replace(integrator="rk4"),
+        indices=[int(i) for i in sol.members["index"]], seed=s["seed"],
+        duration=s["duration"], transient=s["transient"], tangent=True, resumable=True,
+    )  # fmt: skip
+
+
+def _judge_all(sol: Solution, discard: float, options: dict) -> list[Verdict]:
+    """Each member's verdict; those of a deterministic model on as many threads as the
+    solution ran on (their shootings run compiled without the GIL), the others on the
+    calling thread meanwhile (numpy and Python under the GIL, which threads only contend
+    for). A verdict is a pure function of its member: the threads change nothing but the
+    time."""
+    transient = float(sol.settings["transient"]) + discard
+    rows_of = sol.sections.groupby("member").indices
+    sec, empty = sol.sections, np.empty(0, dtype=np.int64)
+    t, kk, xy = sec["t"].to_numpy(), sec["k"].to_numpy(), sec[_COORDS].to_numpy(dtype=float)
+
+    def verdict(m: int) -> Verdict:
+        check_stop()  # a labelling thread asked to stop: before each member (a prompt Ctrl-C)
+        pick = rows_of.get(m, empty)
+        status = Status[sol.members["status"].iat[m]]
+        return judge_member(status, t[pick], kk[pick], xy[pick], sol.jacobians[pick],
+                            sol.models[m], sol.numerics, transient, options)  # fmt: skip
+
+    order = list(range(len(sol)))
+    shoot = [realizations_identical(sol.models[m]) for m in order]
+    pooled = [m for m, s in zip(order, shoot, strict=True) if s]
+    here = [m for m, s in zip(order, shoot, strict=True) if not s]
+    a, b = _threaded(verdict, pooled, int(sol.settings.get("threads", 1)), here)
+    done_a, done_b = iter(a), iter(b)
+    return [next(done_a) if s else next(done_b) for s in shoot]
+
+
+def judge_member(status, t, kk, xy, jac, p, num, transient: float, options: dict) -> Verdict:
+    """One member's verdict from its status, section rows (times ``t``, indices ``kk``,
+    points ``xy``) and their Jacobians, recording from ``transient`` [s]."""
+    if status is not Status.OK:
+        return _status_verdict(status, float(t[-1]) if len(t) else float("nan"))
+    period = p.cam_period
+    keep = (t >= transient - 1e-9 * period) & (kk > 0)
+    if keep.sum() < 2:
+        why = (
+            f"{int(keep.sum())} section point(s) after the transient: too few to judge; "
+            "run longer than the transient by several cam periods"
+        )
+        return Verdict("undetermined", None, (), (why,))
+    points, jacobians = xy[keep], jac[keep]
+    opts = section_options(options)
+    opts.setdefault("atol", (MODEL_ATOL, MODEL_ATOL / period))
+    ev = overflow_evidence(jacobians, p, num)
+    if ev is not None:
+        v = classify_section(points, **opts)
+        return Verdict("undetermined", None, v.evidence + (ev,), (ev.detail,))
+    spec = spectrum_from_jacobians(jacobians, period)
+    exponent = (spec.exponent, float(spec.stderr[0]), spec.n_periods)
+    v = classify_section(points, exponent=exponent, exponent_time=period, **opts)
+    extra = {"tangent": tangent_record(spec)}
+    v = apply_rules(v, Context(p, num.replace(integrator="rk4"), points, spec, extra))
+    return dataclasses.replace(v, settings={**v.settings, **extra})
+
+
+def _status_verdict(st: Status, t_end: float) -> Verdict:
+    label = st.label or st.name.lower()
+    e = Evidence(
+        "status",
+        int(st),
+        None,
+        f"the run ended with status {st.name} at t = {t_end:.6g} s: {st.message}",
+    )
+    why = (
+        f"the run did not end normally ({label}, t = {t_end:.6g} s): the motion is not "
+        "described by the model after that, so it is not classified"
+    )
+    return Verdict("undetermined", None, (e,), (why,), {"status": st.name})
+
+
+def _extended(sol, verdicts, extend_to, discard, options, progress) -> list[Verdict]:
+    """The undetermined members run 4x longer (section and tangent only), continued from
+    their last run, until their verdicts settle or the recorded time reaches ``extend_to``:
+    all of them in one call each round."""
+    s = sol.settings
+    start = s["transient"] + discard
+    recorded = s["duration"] - start
+    t_wall = time.perf_counter()
+    pending = [j for j, v in enumerate(verdicts) if extensible(v)]
+    last, at = sol, list(range(len(sol)))  # the latest run, and whose members it holds
+    while pending and extend_to is not None and recorded < extend_to:
+        recorded = min(extend_to, 4.0 * recorded)
+        if progress is not None:
+            progress(0, extending=len(pending), recorded_s=recorded)
+        where = {j: i for i, j in enumerate(at)}
+        longer = extend(last, start + recorded, members=[where[j] for j in pending],
+                        resumable=True, progress=progress, backend=_extend_backend(last))
+        note = {"recorded_s": recorded, "wall_time_s": time.perf_counter() - t_wall,
+                "why": "the verdict on the run as given was undetermined",
+                "backend": longer.settings["backend"]}  # fmt: skip
+        judged = _judge_all(longer, discard, options)
+        for i, j in enumerate(pending):
+            verdicts[j] = _after_extension(verdicts[j], judged[i], longer, i, note, recorded)
+        last, at = longer, list(pending)
+        pending = [j for j in pending if extensible(verdicts[j])]
+    return verdicts
+
+
+def _extend_backend(sol: Solution) -> str:
+    """Where an extension runs: a CPU run's on the CPU (the same bits as a longer CPU run);
+    a GPU run's few members by size (``"auto"``: one GPU thread is slow, and a few hundred
+    members run sooner on the host's cores)."""
+    return "cpu" if sol.settings["backend"] == "cpu" else "auto"
+
+
+def _after_extension(before: Verdict, after: Verdict, longer: Solution, i, note, recorded):
+    """The verdict after an extension round: the longer run's, or, when that run ended early,
+    the first verdict kept and saying so."""
+    status = Status[longer.members["status"].iat[i]]
+    if status is Status.OK:
+        return dataclasses.replace(after, settings={**after.settings, "extended": note})
+    t = longer.sections["t"].to_numpy()[longer.sections["member"].to_numpy() == i]
+    return extension_stopped(before, status, float(t.max()) if len(t) else np.nan, recorded)
+
+
+def _step_checked(sol, verdicts, extend_to, discard, options) -> list[Verdict]:
+    """The verdicts checked at half the step: the same realizations solved at
+    :meth:`Numerics.refined` and judged the same way (extension included)."""
+    fine = sol.numerics.refined()
+    asked = [j for j, v in enumerate(verdicts) if v.label != "undetermined"]
+    out = [skipped(v, fine) if v.label == "undetermined" else v for v in verdicts]
+    if not asked:
+        return out
+    s = sol.settings
+    half = solve(
+        [sol.models[j] for j in asked], fine,
+        indices=[int(sol.members["index"].iat[j]) for j in asked], seed=s["seed"],
+        duration=s["duration"], transient=s["transient"], tangent=True, resumable=True,
+    )  # fmt: skip
+    fine_verdicts = _extended(half, _judge_all(half, discard, options), extend_to, discard,
+                              options, None)  # fmt: skip
+    recorded = s["duration"] - s["transient"] - discard
+    for i, j in enumerate(asked):
+        hv = fine_verdicts[i]
+        seconds = hv.settings.get("extended", {}).get("recorded_s", recorded)
+        out[j] = compared(verdicts[j], hv, sol.numerics, fine, half_recorded_s=seconds)
+    return out
+
+
+def _threaded(fn: Callable, items: list, threads: int, here: list = ()) -> tuple[list, list]:
+    """``([fn(x) for x in items], [fn(x) for x in here])``: ``items`` on up to ``threads``
+    threads, ``here`` on the calling thread meanwhile, each in order. An exception (a Ctrl-C
+    in the waiting thread too) cancels the calls not yet started."""
+    if threads <= 1 or len(items) <= 1:
+        return [fn(x) for x in items], [fn(x) for x in here]
+    # each call in a copy of this thread's context: a warning it raises is recorded where
+    # this thread's are (chaoscam._util.recorded, the sweeps' batches)
+    ctx = contextvars.copy_context()
+    pool = ThreadPoolExecutor(min(threads, len(items)), thread_name_prefix="chaoscam-verdict")
+    try:
+        futures = [pool.submit(ctx.copy().run, fn, x) for x in items]
+        mine = [fn(x) for x in here]
+        return [f.result() for f in futures], mine
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)

@@ -1,0 +1,392 @@
+"""The model-level rules on top of the analysis layer's verdict: an ordered list of named rules.
+
+The analysis layer (:func:`chaoscam.analysis.classify_section`) judges the section's arrays
+with the tangent exponent; these rules add what only the model knows. They run in the order
+of :data:`RULES`; each either leaves the verdict to the next, changes it and passes it on, or
+decides (the last word). Each says what it checks and the measurement behind it; the tests
+named with each rule check it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..analysis import Evidence, Verdict, section_period, unsupported_chaos
+from ..model import Params, realizations_identical
+from ..numerics import Numerics
+from ._certificate import MODEL_ATOL, ORBIT_REFINE, certify
+
+__all__ = [
+    "BAND_RTOL",
+    "EXTENSION_STOPPED",
+    "OVERFLOW",
+    "RULES",
+    "STEP_DEPENDENT",
+    "Context",
+    "Rule",
+    "apply_rules",
+    "extensible",
+    "extension_stopped",
+    "overflow_evidence",
+]
+
+BAND_RTOL = 0.05
+"""Bands narrower than this fraction of the section's extent count as n narrow bands for the
+n-band chaos rule: the 0-1 test sees a chaotic component of relative size w on top of a
+periodic sequence only on N >~ 1/w^2 samples, so narrow chaotic bands read regular to it (at
+(omega, xi) = (42.5, 0.15): 4 bands of 1.4e-2 of the extent, lambda_1 = 0.317 +- 0.014 per
+iterate; 600 s runs at dt and dt/2 show 8-band chaos)."""
+
+STEP_DEPENDENT = "step_dependent"
+"""The evidence of a verdict whose periodic orbit is the grid's alone."""
+
+OVERFLOW = "tangent_overflow"
+"""The evidence of a verdict whose Jacobians are not finite (:func:`overflow_evidence`)."""
+
+EXTENSION_STOPPED = "extension_stopped"
+"""``Verdict.settings`` key of :func:`extension_stopped`."""
+
+
+@dataclass(frozen=True)
+class Context:
+    """What the rules know of a member: its model, numerics, section points, tangent spectrum,
+    and the record (``extra``) the certificate writes its shootings to."""
+
+    p: Params
+    num: Numerics
+    points: np.ndarray
+    spec: object
+    extra: dict
+
+    @property
+    def deterministic(self) -> bool:
+        return realizations_identical(self.p)
+
+
+@dataclass(frozen=True)
+class Rule:
+    """One model-level rule: its name, what it checks, and ``apply(verdict, context)``, which
+    returns None (not for this verdict), or ``(verdict, final)``: the verdict passed on, or
+    the last word when ``final``."""
+
+    name: str
+    checks: str
+    apply: Callable[[Verdict, Context], tuple[Verdict, bool] | None]
+
+
+def _votes(v: Verdict) -> dict[str, str | None]:
+    return {e.name: e.vote for e in v.evidence}
+
+
+def _undetermined(v: Verdict, reason: str, *more: Evidence) -> Verdict:
+    return Verdict("undetermined", None, v.evidence + more, v.reasons + (reason,), v.settings)
+
+
+def _torus_needs_zero_exponent(v: Verdict, ctx: Context):
+    if v.label != "quasiperiodic" or _votes(v).get("exponent") == "not_chaotic":
+        return None
+    reason = (
+        "quasiperiodic evidence, but the tangent exponent does not confirm lambda_1 = 0 "
+        "within its interval: run longer"
+    )
+    return _undetermined(v, reason), False
+
+
+def _chaos_needs_two_methods(v: Verdict, ctx: Context):
+    need = int(v.settings.get("thresholds", {}).get("min_chaotic_votes", 2))
+    chaotic = unsupported_chaos(v.evidence, need) if v.label == "chaotic" else None
+    if chaotic is None:
+        return None
+    reason = (
+        f"only {', '.join(chaotic)} votes chaotic; {need} independent methods or a "
+        "positive tangent exponent are needed: run longer"
+    )
+    return _undetermined(v, reason), False
+
+
+def _random_period_needs_contraction(v: Verdict, ctx: Context):
+    if (
+        v.label != "periodic"
+        or ctx.deterministic
+        or _votes(v).get("exponent") in ("not_chaotic", "periodic")
+    ):
+        return None
+    reason = (
+        f"the section repeats with period {v.period} to the band tolerance, but the line "
+        "length is random (no periodic orbit to certify) and the tangent exponent does "
+        "not confirm lambda_1 < 0 within its interval: run longer"
+    )
+    return _undetermined(v, reason), False
+
+
+def _banded_chaos(v: Verdict, ctx: Context):
+    if v.label != "undetermined":
+        return None
+    n = _banded_period(v, ctx)
+    if n is None:
+        return None
+    return _banded_verdict(v, ctx, n), True
+
+
+def _periodic_orbit(v: Verdict, ctx: Context):
+    candidate = v.period if v.label == "periodic" else _disputed_period(v)
+    if candidate is None or not ctx.deterministic:
+        return None
+    return _certified_verdict(v, ctx, int(candidate)), True
+
+
+RULES: tuple[Rule, ...] = (
+    Rule(
+        "torus_needs_zero_exponent",
+        "a quasiperiodic verdict needs lambda_1 = 0 within the tangent exponent's interval "
+        "(a torus has a zero top exponent); else undetermined",
+        _torus_needs_zero_exponent,
+    ),
+    Rule(
+        "chaos_needs_two_methods",
+        "a chaotic verdict needs two independent methods or a positive tangent exponent "
+        "(a broadband spectrum of 1.5 s with 11 section points called a period 11 chaotic)",
+        _chaos_needs_two_methods,
+    ),
+    Rule(
+        "random_period_needs_contraction",
+        "with a random line length there is no orbit to certify: n bands are periodic only "
+        "when the tangent exponent confirms lambda_1 < 0 (8 bands of 1e-3 rad at sigma = "
+        "1.5 mm, lambda_1 = 0.53 +- 0.22 after 46 periods, were chaotic on a longer run)",
+        _random_period_needs_contraction,
+    ),
+    Rule(
+        "banded_chaos",
+        "n narrow bands with lambda_1 > 0 beyond its interval: n-band chaos unless an "
+        "attracting period-n orbit the run converges to lies in them (BAND_RTOL)",
+        _banded_chaos,
+    ),
+    Rule(
+        "periodic_orbit",
+        "a periodic (or disputed periodic) section of the deterministic model is certified "
+        "by Newton shooting, refined steps and kicks (the certificate), or not",
+        _periodic_orbit,
+    ),
+)
+"""The model-level rules, in the order they apply."""
+
+
+def apply_rules(v: Verdict, ctx: Context) -> Verdict:
+    """The verdict after :data:`RULES`, in order, until one decides."""
+    for rule in RULES:
+        out = rule.apply(v, ctx)
+        if out is None:
+            continue
+        v, final = out
+        if final:
+            break
+    return v
+
+
+def tangent_record(spec) -> dict:
+    """What a verdict's settings keep of the tangent spectrum."""
+    return {
+        "exponents": [float(x) for x in spec.exponents],
+        "stderr": [float(x) for x in spec.stderr],
+        "n_periods": spec.n_periods,
+        "method": "tangent dynamics through the impacts, QR (chaoscam.lyapunov_spectrum)",
+    }
+
+
+def _disputed_period(v: Verdict) -> int | None:
+    """n when an undetermined verdict's section is periodic (n) and the exponent does not say
+    chaotic: the case a periodic-orbit certificate settles."""
+    votes = {e.name: e for e in v.evidence}
+    sp, ex = votes.get("section_period"), votes.get("exponent")
+    if v.label != "undetermined" or sp is None or sp.vote != "periodic":
+        return None
+    if ex is not None and ex.vote == "chaotic":
+        return None
+    return int(sp.value)
+
+
+def _banded_period(v: Verdict, ctx: Context) -> int | None:
+    """n when the tangent exponent is positive beyond its interval while the section keeps n
+    narrow bands: periodic to the band tolerance, or n bands each narrower than
+    ``BAND_RTOL`` of the extent; else None."""
+    votes = {e.name: e for e in v.evidence}
+    sp, ex = votes.get("section_period"), votes.get("exponent")
+    if sp is None or ex is None or ex.vote != "chaotic":
+        return None
+    if sp.vote == "periodic":
+        return int(sp.value)
+    atol = (MODEL_ATOL, MODEL_ATOL / ctx.p.cam_period)
+    bands = section_period(
+        ctx.points, rtol=BAND_RTOL, atol=atol, allow_transient=False, distinct=False
+    )
+    return bands.period
+
+
+def _certified_verdict(v: Verdict, ctx: Context, n: int) -> Verdict:
+    """The verdict a period-n certificate gives a periodic or disputed section."""
+    cert = certify(ctx.p, ctx.num, ctx.points, n, ctx.extra)
+    if cert.certified:
+        e = Evidence("periodic_orbit", cert.period, "periodic", "certified: " + cert.detail)
+        if v.label == "periodic" and cert.period == v.period:
+            return dataclasses.replace(v, evidence=v.evidence + (e,))
+        # The certificate decides what the section and the exponent left open: an attracting
+        # orbit the run converges to outweighs a spectral or 0-1 vote on a short series.
+        return Verdict("periodic", cert.period, v.evidence + (e,), (), v.settings)
+    why = {"off orbit": "the run is not on it", "period differs": "its least period differs"}
+    why = why.get(cert.status, cert.status)
+    e = Evidence("periodic_orbit", cert.orbit.period, None, f"not certified ({why}): {cert.detail}")
+    if cert.status == "step-dependent":
+        return _step_dependent(v, ctx, cert, e)
+    if cert.status in ("unstable", "not converged") and cert.orbit.converged:
+        reason = (
+            f"the section looks periodic but the orbit found is unstable ({cert.detail}): run "
+            "longer, to see whether the exponent is positive (chaos near an unstable orbit)"
+        )
+        return _undetermined(v, reason, e)
+    if v.label == "periodic" and _votes(v).get("exponent") != "not_chaotic":
+        reason = (
+            f"the section repeats with period {v.period} but no attracting orbit is "
+            f"certified ({why}) and the tangent exponent does not confirm lambda_1 < 0: "
+            "run longer"
+        )
+        return _undetermined(v, reason, e)
+    return dataclasses.replace(v, evidence=v.evidence + (e,))
+
+
+def _banded_verdict(v: Verdict, ctx: Context, n: int) -> Verdict:
+    """Resolve "n narrow bands but lambda_1 > 0": chaotic when no attracting period-n orbit
+    the run converges to lies in the bands (or the model is random: it has none), periodic
+    when the orbit is attracting only at refined steps or by kicks (the grid's exponent is
+    then its error in the chattering phases), still undetermined when the grid certifies one
+    (a genuine conflict) or refined steps disagree."""
+    if not ctx.deterministic:
+        e = Evidence(
+            "periodic_orbit", None, None, "random line length: no periodic orbit to shoot for"
+        )
+        return _band_chaos(v, n, e)
+    # No flip doubling here: only a section that itself repeats with period 2n sends the
+    # shooting to 2n (shooting 2n and 4n in the default's 8 chaotic bands doubled Fig. 4's cost).
+    cert = certify(ctx.p, ctx.num, ctx.points, n, ctx.extra, flips_double=False)
+    detail = f"from the bands: {cert.detail}"
+    if cert.certified and not cert.refined:
+        e = Evidence("periodic_orbit", cert.period, "periodic", "certified " + detail)
+        conflict = (
+            "an attracting orbit is certified inside the bands, yet the tangent exponent is "
+            "positive"
+        )
+        return dataclasses.replace(v, evidence=v.evidence + (e,), reasons=v.reasons + (conflict,))
+    if cert.certified:
+        e = Evidence("periodic_orbit", cert.period, "periodic", detail)
+        where = (
+            "finite kicks return to it at the run's step and at half of it"
+            if cert.kicked
+            else "it is attracting at every refined step"
+        )
+        note = (
+            f"the tangent exponent on the run's grid is positive, but the run lies on the "
+            f"period-{cert.period} orbit in the bands and {where}: the exponent's sign is "
+            "the grid's error in the chattering phases"
+        )
+        return Verdict("periodic", cert.period, v.evidence + (e,), (note,), v.settings)
+    if cert.status == "step-dependent":
+        return _step_dependent(v, ctx, cert, Evidence("periodic_orbit", n, None, detail))
+    if cert.status == "mixed":
+        reason = (
+            f"the period-{n} orbit in the bands changes stability with the step "
+            f"({cert.detail}): run with dt = {ctx.num.dt / ORBIT_REFINE[-1]:.3g} s"
+        )
+        return _undetermined(v, reason, Evidence("periodic_orbit", n, None, detail))
+    e = Evidence("periodic_orbit", cert.orbit.period, "not_periodic", f"{cert.status}: {detail}")
+    return _band_chaos(v, n, e)
+
+
+def _band_chaos(v: Verdict, n: int, e: Evidence) -> Verdict:
+    band = Evidence(
+        "banded_chaos",
+        n,
+        "chaotic",
+        f"the section keeps {n} narrow bands while the tangent exponent is positive beyond "
+        "its confidence interval and no attracting period-n orbit lies in them that the run "
+        f"converges to: chaos confined to {n} bands (n-band chaos){_outweighed(v)}",
+    )
+    return Verdict("chaotic", None, v.evidence + (e, band), (), v.settings)
+
+
+def _outweighed(v: Verdict) -> str:
+    """The clause naming the votes n-band chaos outweighs, or ""."""
+    names = [e.name for e in v.evidence if e.vote in ("periodic", "quasiperiodic")]
+    if not names:
+        return ""
+    return (
+        f"; it outweighs the {', '.join(names)} vote(s), which see the narrow bands (a "
+        "recurrence to the band tolerance, or the lines of a spectrum) but not the "
+        "stretching inside them"
+    )
+
+
+def _step_dependent(v: Verdict, ctx: Context, cert, e: Evidence) -> Verdict:
+    """Undetermined, not extended: the run's grid certifies a period-n orbit that is not
+    attracting at half the step, so the answer is the step's."""
+    dt = ctx.num.dt
+    why = (
+        f"the period-{cert.period} orbit is certified on the run's grid (dt = {dt:g} s) "
+        f"but not at dt/2 ({cert.detail}): the period is the step's; rerun with dt = "
+        f"{dt / ORBIT_REFINE[-1]:.3g} s"
+    )
+    step = Evidence(STEP_DEPENDENT, cert.period, None, why)
+    return _undetermined(v, why, e, step)
+
+
+def overflow_evidence(jacobians, p: Params, num: Numerics) -> Evidence | None:
+    """The evidence (abstaining, with the reason) that the tangent overflowed: a Jacobian that
+    is not finite, RK4 past its stability limit in the contact; None when every Jacobian is
+    finite. A verdict holding it is undetermined and not extended: a longer run overflows
+    too."""
+    from ..solve import resolution_warning
+
+    jac = np.asarray(jacobians, dtype=float)
+    if jac.ndim != 3 or not len(jac):
+        return None  # a malformed shape: spectrum_from_jacobians says what it expects
+    bad = ~np.isfinite(jac).all(axis=(1, 2))
+    if not bad.any():
+        return None
+    cause = resolution_warning(p, num) or f"dt = {num.dt:g} s; try a smaller dt"
+    why = (
+        f"the tangent overflowed: {int(bad.sum())} of {len(bad)} cam periods' Jacobians are "
+        f"not finite, so there is no exponent ({cause})"
+    )
+    return Evidence(OVERFLOW, int(bad.sum()), None, why)
+
+
+def extensible(v: Verdict) -> bool:
+    """Whether an undetermined verdict may settle on a longer run (not after an overflow, nor
+    when its periodic orbit is the step's, nor when a longer run stopped early)."""
+    return (
+        v.label == "undetermined"
+        and EXTENSION_STOPPED not in v.settings
+        and not any(e.name in (OVERFLOW, STEP_DEPENDENT) for e in v.evidence)
+    )
+
+
+def extension_stopped(v: Verdict, status, stopped_at: float, wanted_s: float) -> Verdict:
+    """``v``, the verdict of the recorded window, kept when the longer run that was to settle
+    it ended early (it left the cam's reach at ``stopped_at`` [s], its last section time, or
+    diverged): its advice to run longer goes, since no longer window exists, and a reason says
+    so; ``settings["extension_stopped"]`` records the status, the time and the seconds
+    wanted, and the extension is not tried again."""
+    what = status.message.split(":")[0].split(". ")[0]  # "The follower left the cam's reach"
+    why = (
+        f"no longer window exists: extended to {wanted_s:g} s recorded, the run stopped "
+        f"after t = {stopped_at:.4g} s ({status.name}: {what[0].lower() + what[1:]}), so "
+        "the verdict is the recorded window's"
+    )
+    reasons = tuple(r for r in v.reasons if not r.startswith("to decide:"))
+    settings = {
+        **v.settings,
+        EXTENSION_STOPPED: {"status": status.name, "at_s": stopped_at, "wanted_s": wanted_s},
+    }
+    return dataclasses.replace(v, reasons=(*reasons, why), settings=settings)
