@@ -2,8 +2,8 @@
 
 A restructuring of the kernels, drivers or sweeps must leave every result bit for bit as it
 was. This script simulates a fixed set of realizations (both integrators, tangent on and
-off, a random line length, an ensemble, a small regime map on both sweep engines) and
-prints one SHA-256 per run of its section and impact tables (and, for the map, its table).
+off, a random line length, a periodic orbit, an ensemble, a small regime map) and prints one
+SHA-256 per run of its section and impact tables (and, for the map, its table and labels).
 
 Usage:
     python analyses/hash_check.py --write    # before the change: store the hashes
@@ -49,57 +49,35 @@ def _digest(*frames: pd.DataFrame) -> str:
 
 def hashes() -> dict[str, str]:
     """The digest of every run of the fixed set."""
-    from chaoscam import Params, simulate
-    from chaoscam.integrate import simulate_ensemble
-    from chaoscam.sweep import Axis, regime_map
+    from chaoscam import Numerics, Params, periodic_orbit, regime_map, simulate, solve
 
+    steps = set(Numerics.field_names())
     out = {}
     for name, spec in RUNS.items():
         spec = dict(spec)
         index, tangent = spec.pop("index", 0), spec.pop("tangent", False)
-        tr = simulate(
-            Params(**spec),
-            duration=6.0,
-            transient=2.0,
-            seed=1,
-            index=index,
-            series=False,
-            tangent=tangent,
-        )
-        imp = tr.impacts.assign(kind=tr.impacts["kind"].cat.codes)
-        frames = [tr.section, imp]
+        num = Numerics(**{k: v for k, v in spec.items() if k in steps})
+        p = Params(**{k: v for k, v in spec.items() if k not in steps})
+        tr = simulate(p, num, duration=6.0, transient=2.0, seed=1, index=index, series=False,
+                      tangent=tangent)  # fmt: skip
+        imp = tr.impacts.drop(columns="member")
+        frames = [tr.section, imp.assign(kind=imp["kind"].cat.codes)]
         if tangent:
             frames.append(pd.DataFrame(tr.jacobians.reshape(len(tr.jacobians), 4)))
         out[name] = _digest(*frames)
-    from chaoscam import lyapunov_model, periodic_orbit
-
     orbit = periodic_orbit(Params(xi=0.2), (0.0, 0.0), 1)
     out["periodic orbit xi=0.2"] = hashlib.sha256(
         np.concatenate([np.ravel(orbit.points), np.abs(orbit.multipliers)]).tobytes()
     ).hexdigest()
-    lm = lyapunov_model(Params(), duration=4.0, transient=1.0, seed=1)
-    out["lyapunov_model default"] = hashlib.sha256(
-        np.array([lm.exponent, lm.stderr, lm.n_intervals], dtype=float).tobytes()
-    ).hexdigest()
-    ens = simulate_ensemble(
-        Params(l_lambda_sigma=0.002), range(4), seed=2, duration=4.0, transient=1.0
-    )
+    ens = solve(Params(l_lambda_sigma=0.002), indices=range(4), seed=2, duration=4.0,
+                transient=1.0)  # fmt: skip
     out["ensemble sigma=2mm x4"] = _digest(ens.sections, ens.members[["n_impacts"]])
-    for engine in ("ensemble", "process"):
-        m = regime_map(
-            Axis("xi", (0.2, 0.45)),
-            Axis("l_lambda_sigma", (0.0, 0.002)),
-            realizations=2,
-            seed=3,
-            duration=4.0,
-            transient=2.0,
-            engine=engine,
-            workers=1,
-        )
-        cols = ["cell", "index", "n_section", "n_impacts", "contact_fraction"]
-        out[f"regime map ({engine} engine)"] = (
-            _digest(m.realizations[cols]) + " " + ",".join(m.realizations["label"])
-        )
+    m = regime_map(
+        "xi=0.2,0.45", "l_lambda_sigma=0,0.002", realizations=2, seed=3, duration=4.0,
+        transient=2.0, workers=1, progress=False,
+    )  # fmt: skip
+    cols = ["cell", "index", "n_section", "n_impacts", "contact_fraction"]
+    out["regime map"] = _digest(m.realizations[cols]) + " " + ",".join(m.realizations["label"])
     return out
 
 

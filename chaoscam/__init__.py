@@ -1,7 +1,10 @@
 """chaoscam: stochastic dynamics of a cam-follower oblique impact system.
 
-The public face; every name is defined in a submodule and re-exported here. Heavy layers
-(sweeps, reports) are imported from their subpackages: ``chaoscam.sweep``, ``chaoscam.report``.
+The public face; every name is defined in a subpackage and resolved on first use, so that
+``import chaoscam`` stays cheap. The pipeline, down the folders: ``model`` (the physics) and
+``numerics`` (the integrator) -> ``kernel`` (compiled) -> ``solve`` (a batch of runs, one
+:class:`Solution`) -> ``analysis`` (arrays in, evidence out) -> ``verdict`` (the model's
+verdict) -> ``sweep`` (maps, diagrams, ensembles) -> ``report`` / ``paper`` -> ``cli``.
 """
 
 from __future__ import annotations
@@ -9,44 +12,29 @@ from __future__ import annotations
 from ._util import lazy_face
 from ._version import __version__
 
-# Public names and the submodule that defines each: imported on first use (PEP 562),
-# so that importing the package stays cheap.
 _LAZY = {
-    "ParameterError": (".model", "ParameterError"),
+    "Numerics": (".numerics", "Numerics"),
+    "ParameterError": ("._util", "ParameterError"),
     "Params": (".model", "Params"),
-    "Status": (".integrate", "Status"),
-    "Trajectory": ("._simulate", "Trajectory"),
-    "contact_period": ("._simulate", "contact_period"),
-    "lyapunov_spectrum": (".tangent", "lyapunov_spectrum"),
-    "periodic_orbit": (".tangent", "periodic_orbit"),
-    "classify_ensemble": ("._ensemble_verdicts", "classify_ensemble"),
-    "classify_file": (".classify", "classify_file"),
-    "classify_trajectory": (".classify", "classify_trajectory"),
-    "extend_trajectory": ("._extend", "extend_trajectory"),
-    "load_trajectory": (".classify", "load_trajectory"),
-    "lyapunov_model": (".lyapunov", "lyapunov_model"),
-    "simulate": ("._simulate", "simulate"),
-    "simulate_reference": (".integrate", "simulate_reference"),
+    "Solution": (".simulation", "Solution"),
+    "Status": (".kernel", "Status"),
+    "Verdict": (".analysis", "Verdict"),
+    "bifurcation": (".sweep", "bifurcation"),
+    "classify": (".verdict", "classify"),
+    "contact_period": (".model", "contact_period"),
+    "ensemble": (".sweep", "ensemble"),
+    "extend": (".simulation", "extend"),
+    "kick_test": (".verdict", "kick_test"),
+    "load_trajectory": (".simulation", "load_trajectory"),
+    "lyapunov_spectrum": (".verdict", "lyapunov_spectrum"),
+    "periodic_orbit": (".verdict", "periodic_orbit"),
+    "regime_map": (".sweep", "regime_map"),
+    "replay": (".sweep", "replay"),
+    "simulate": (".simulation", "simulate"),
+    "simulate_reference": (".simulation", "simulate_reference"),
+    "solve": (".simulation", "solve"),
 }
 
-__all__ = [
-    "ParameterError",
-    "Params",
-    "Status",
-    "Trajectory",
-    "__version__",
-    "classify_ensemble",
-    "classify_file",
-    "contact_period",
-    "classify_trajectory",
-    "extend_trajectory",
-    "load_trajectory",
-    "lyapunov_model",
-    "lyapunov_spectrum",
-    "periodic_orbit",
-    "simulate",
-    "simulate_reference",
-]
-
+__all__ = ["__version__", *sorted(_LAZY)]
 
 __getattr__, __dir__ = lazy_face(__name__, _LAZY)

@@ -138,6 +138,11 @@ class Numerics:
         return tuple(f.name for f in dataclasses.fields(cls))
 
     @classmethod
+    def field_docs(cls) -> dict[str, dict]:
+        """Each field's metadata: doc, unit, range, choices."""
+        return {f.name: dict(f.metadata) for f in dataclasses.fields(cls)}
+
+    @classmethod
     def parse(cls, name: str, text: str) -> Any:
         """``text`` as the type of field ``name`` (``--set NAME=VALUE``)."""
         return parse_field(cls, name, text)

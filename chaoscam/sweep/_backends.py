@@ -1,21 +1,15 @@
-"""Execution backends: in-process, local worker processes, Dask distributed.
+"""Where a sweep's batches run: in this process, on its threads, a GPU's pipeline, or Dask.
 
-Each backend offers the same four verbs to the engine (``submit``, ``wait_any``, ``result``,
-``close``); a record never depends on which backend or how many workers computed it.
+Each backend offers the same verbs to the engine (``submit``, ``wait_any``, ``result``,
+``cancel``, ``close``); a record never depends on which backend or how many workers ran it.
 
-* :class:`SerialBackend` — one worker, in this process (no start-up cost).
-* :class:`ThreadBackend` — ``workers`` threads of this process, each running its tasks'
-  ensembles one member at a time through the compiled call without the GIL (the ensemble
-  engine's local backend): a task's slowest member no longer leaves the other cores
-  waiting, as a ``prange`` launch over one batch does.
-* :class:`ProcessBackend` — ``concurrent.futures.ProcessPoolExecutor``, workers ignoring
-  SIGINT so that Ctrl-C reaches the driver alone. On Linux the workers are forked from the
-  driver after it has loaded the compiled kernels, so they start in milliseconds instead of
-  the ~1.3 s a ``spawn`` start spends importing chaoscam and loading numba's cache (which
-  would cost a short 2-core map much of its speed-up). The workers are all forked when the
-  backend is made, before the pool's own thread starts, and only from a driver running a
-  single thread; a driver holding threads (a Dask client, say) gets ``spawn``. A worker
-  that dies breaks the pool: the pool is started again and the lost tasks resubmitted.
+* :class:`SerialBackend` — one batch at a time, in this process.
+* :class:`ThreadBackend` — ``workers`` threads of this process, each running its batches'
+  members one at a time through the compiled call without the GIL: a batch's slowest member
+  leaves no other core waiting, as a ``prange`` launch over one batch would.
+* :class:`PipelineBackend` — a local GPU: a batch is launched at submission in the driver's
+  thread and labelled on one labelling thread, so the device runs the next batch while the
+  host labels the last.
 * :class:`DaskBackend` — a ``distributed.Client`` on a scheduler address, on an existing
   client, or on a ``LocalCluster`` of worker processes bound to 127.0.0.1. Dask itself
   reschedules the tasks of a lost worker. A lost scheduler, or no worker connected for
@@ -26,20 +20,19 @@ Each backend offers the same four verbs to the engine (``submit``, ``wait_any``,
 from __future__ import annotations
 
 import concurrent.futures as cf
-import multiprocessing
 import os
-import signal
 import threading
 from collections.abc import Callable, Iterable
 from typing import Any
 
 __all__ = [
+    "BackendLost",
+    "DaskBackend",
+    "PipelineBackend",
     "SerialBackend",
     "ThreadBackend",
-    "ProcessBackend",
-    "DaskBackend",
     "WorkerLost",
-    "BackendLost",
+    "local_workers",
     "make_backend",
 ]
 
@@ -122,14 +115,13 @@ class SerialBackend:
 class ThreadBackend:
     """Tasks on ``workers`` threads of this process (the ensemble engine's local backend).
 
-    Each task runs inside :func:`chaoscam.integrate._driver.members_on_this_thread`: its
+    Each task runs inside :func:`chaoscam.kernel.members_on_this_thread`: its
     ensembles' members one after another through the compiled call, which releases the GIL,
     so ``workers`` tasks simulate at once and a task's slow member delays only its own
     thread (numba's workqueue layer takes one parallel launch at a time, and a launch over a
     batch waits for its slowest member). The members are the same compiled kernel, so the
     records are the same bits as on one thread. ``cancel`` asks the running tasks to stop
-    between two compiled calls (a prompt Ctrl-C); ``close`` joins the threads, so that a
-    process pool forked later in this process forks a single-threaded driver.
+    between two compiled calls (a prompt Ctrl-C); ``close`` joins the threads.
     """
 
     name = "threads"
@@ -140,7 +132,7 @@ class ThreadBackend:
         self._pool = cf.ThreadPoolExecutor(self.workers, thread_name_prefix=prefix)
 
     def _run(self, fn: Callable, arg: Any) -> Any:
-        from ..integrate._driver import members_on_this_thread
+        from ..kernel import members_on_this_thread
 
         with members_on_this_thread(self._stop):
             return fn(arg)
@@ -161,135 +153,6 @@ class ThreadBackend:
 
     def close(self) -> None:
         self._stop.set()  # tasks still running stop at their next compiled call
-        self._pool.shutdown(wait=True, cancel_futures=True)
-
-
-def _worker_init(parent: int) -> None:
-    """Start-up of a pool worker: Ctrl-C reaches the driver alone, the worker dies with its
-    driver (even one killed with SIGKILL), and it drops the driver's output locks."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    _die_with_parent(parent)
-    from .._outputs import OutputLock
-
-    for fd, _ in OutputLock._held.values():  # a forked worker holds copies of the lock files
-        try:
-            os.close(fd)
-        except OSError:
-            pass
-    OutputLock._held.clear()
-    OutputLock._table = threading.Lock()  # a fork may have copied it held
-
-
-def _die_with_parent(parent: int) -> None:
-    """Ask Linux for SIGKILL when the parent exits (``prctl(PR_SET_PDEATHSIG)``); elsewhere
-    a daemon thread that polls the parent pid does the same."""
-    try:
-        import ctypes
-
-        libc = ctypes.CDLL(None, use_errno=True)
-        if libc.prctl(1, signal.SIGKILL, 0, 0, 0) != 0:  # PR_SET_PDEATHSIG = 1
-            raise OSError(ctypes.get_errno(), "prctl")
-    except (OSError, AttributeError):  # pragma: no cover - not Linux
-        threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
-    if os.getppid() != parent:  # the driver died before the request took effect
-        os._exit(1)
-
-
-def _watch_parent(parent: int) -> None:  # pragma: no cover - not Linux
-    import time
-
-    while os.getppid() == parent:
-        time.sleep(1.0)
-    os._exit(1)
-
-
-def _warm_kernels() -> None:
-    """Load the compiled kernels (numba cache) in this process: a run of a few steps."""
-    from .._simulate import simulate
-    from ..model import Params
-
-    simulate(Params(), duration=1e-4, series=False)
-
-
-class ProcessBackend:
-    """A pool of ``workers`` local processes.
-
-    Parameters
-    ----------
-    workers : int
-        Worker processes.
-    start_method : str, optional
-        ``"fork"``, ``"spawn"`` or ``"forkserver"``. Default: ``"fork"`` where available
-        and the driver runs a single thread (the workers inherit the loaded kernels),
-        else ``"spawn"``.
-    """
-
-    name = "processes"
-
-    def __init__(self, workers: int, start_method: str | None = None) -> None:
-        self.workers = int(workers)
-        self._requested = start_method
-        self._pool = self._start()
-        self._pool.submit(int).result()  # start the workers now, before any other thread
-
-    def _method(self) -> str:
-        if self._requested is not None:
-            return self._requested
-        # Fork only a single-threaded driver: a lock held by another thread at the fork
-        # would stay held in the child forever.
-        single = threading.active_count() == 1
-        return "fork" if single and "fork" in multiprocessing.get_all_start_methods() else "spawn"
-
-    def _start(self) -> cf.ProcessPoolExecutor:
-        self.start_method = self._method()
-        if self.start_method == "fork":
-            _warm_kernels()
-        return cf.ProcessPoolExecutor(
-            max_workers=self.workers,
-            mp_context=multiprocessing.get_context(self.start_method),
-            initializer=_worker_init,
-            initargs=(os.getpid(),),
-        )
-
-    def submit(self, fn: Callable, arg: Any) -> cf.Future:
-        try:
-            return self._pool.submit(fn, arg)
-        except cf.process.BrokenProcessPool:
-            self.recover()
-            return self._pool.submit(fn, arg)
-
-    def wait_any(self, futures: Iterable[cf.Future], timeout: float | None = None) -> set:
-        return cf.wait(list(futures), timeout=timeout, return_when=cf.FIRST_COMPLETED).done
-
-    def result(self, fut: cf.Future) -> Any:
-        try:
-            return fut.result()
-        except cf.process.BrokenProcessPool as err:
-            raise WorkerLost(str(err)) from err
-
-    def recover(self) -> None:
-        """Start a fresh pool if the current one is broken (a worker died)."""
-        if getattr(self._pool, "_broken", False):
-            self._pool.shutdown(wait=False, cancel_futures=True)
-            self._pool = self._start()
-
-    def cancel(self, futures: Iterable[cf.Future]) -> None:
-        for fut in futures:
-            fut.cancel()
-        self._terminate()
-
-    def _terminate(self) -> None:
-        # Running tasks are abandoned: their records would be recomputed on --resume.
-        processes = list((getattr(self._pool, "_processes", None) or {}).values())
-        self._pool.shutdown(wait=False, cancel_futures=True)
-        for proc in processes:
-            if proc.is_alive():
-                proc.terminate()
-        for proc in processes:
-            proc.join(timeout=5)
-
-    def close(self) -> None:
         self._pool.shutdown(wait=True, cancel_futures=True)
 
 
@@ -483,18 +346,47 @@ def _quiet_lost_connection_log() -> None:
 
 
 def make_backend(workers: int | None = None, scheduler: Any = None):
-    """The backend for ``workers`` local processes, or Dask when ``scheduler`` is given.
+    """The Dask backend of ``scheduler`` ("local", "tcp://HOST:PORT" or a client), with
+    ``workers`` local Dask workers for "local"."""
+    if not isinstance(scheduler, str) and not hasattr(scheduler, "submit"):
+        from ._grid import SweepError
 
-    ``workers`` = None uses every core; 1 runs in this process.
-    """
-    if scheduler is not None:
-        if not isinstance(scheduler, str) and not hasattr(scheduler, "submit"):
-            from ._grid import SweepError
+        raise SweepError(
+            f"scheduler = {scheduler!r} is not a Dask scheduler: give 'local', the "
+            "address of a running one ('tcp://HOST:PORT') or a distributed.Client"
+        )
+    return DaskBackend(scheduler, workers)
 
-            raise SweepError(
-                f"scheduler = {scheduler!r} is not a Dask scheduler: give 'local', the "
-                "address of a running one ('tcp://HOST:PORT') or a distributed.Client"
-            )
-        return DaskBackend(scheduler, workers)
-    n = local_workers(workers)
-    return SerialBackend() if n == 1 else ProcessBackend(n)
+
+class PipelineBackend(ThreadBackend):
+    """A local GPU's batches: launched at submission in the driver's thread (numba-cuda is
+    used from that thread only, and Ctrl-C stops a launch when it returns), labelled on one
+    labelling thread; the engine keeps two batches in flight, so the next launch runs while
+    the last is labelled. ``threads``: numba's thread count for the labelling thread's CPU
+    work. The records are those of the serial backend, bit for bit (a record depends on its
+    member only)."""
+
+    name = "pipeline"
+
+    def __init__(self, threads: int | None = None) -> None:
+        # the engine keeps 2 x workers tasks in flight: one labelled, one launched
+        super().__init__(1, prefix="chaoscam-labels")
+        self.threads = threads
+
+    def _label(self, task: Any, launched: Any) -> Any:
+        import numba
+
+        from ..kernel import fork_safe_threads, stop_on
+
+        if self.threads is not None:
+            fork_safe_threads()  # set_num_threads starts the threads: the layer first
+            numba.set_num_threads(self.threads)  # numba's count is per thread
+        with stop_on(self._stop):  # stops between two compiled calls when cancelled
+            return task.label(launched)
+
+    def submit(self, fn: Callable, arg: Any) -> cf.Future:
+        now = SerialBackend()  # runs a call here, as a finished future
+        launched = now.submit(type(arg).launch, arg)  # here: the driver's thread, the device's
+        if launched.exception() is not None:
+            return launched
+        return self._pool.submit(self._label, arg, launched.result())

@@ -19,23 +19,28 @@ from typing import Any, ClassVar
 import numpy as np
 import pandas as pd
 
-from .._checks import flag, params_arg, whole
-from .._frozen import freeze_fields
-from .._provenance import code_identity
+from .._util import ParameterError, flag, freeze_fields, whole
 from .._version import __version__
-from ..model import ParameterError, Params, contact_angle
-from ._batch import engine_device, run_sweep, sweep_engine
+from ..io import code_identity
+from ..kernel import by_size
+from ..model import Params, contact_angle, params_arg
+from ..numerics import Numerics
+from ..simulation import numerics_arg
+from ..verdict import EXTEND_TO
 from ._common import (
     TwoTables,
     check_fate,
     check_sweep_budget,
     evidence_columns,
+    make_judge,
     period_column,
     read_tables,
     run_settings,
+    show_progress,
 )
-from ._grid import Axis, SweepError, realization_index, validate_grid
-from ._tasks import BranchTask, fate_columns
+from ._engine import resolve_engine, run_sweep
+from ._grid import Axis, SweepError, cell_params, realization_index, validate_grid
+from ._runs import Realization, fate_columns
 
 __all__ = ["Bifurcation", "bifurcation", "read_bifurcation", "initial_offsets"]
 
@@ -138,10 +143,10 @@ class _BranchPlan:
         self.done += 1
         v, j = key
         if v >= self.last.get(j, (-1, None))[0]:
-            self.last[j] = (v, record["next_state"])
+            self.last[j] = (v, next_state(record))
         return True
 
-    def start(self) -> Iterator[BranchTask]:
+    def start(self) -> Iterator[Realization]:
         if not self.continuation:
             return (
                 self.make_task(v, j, None)
@@ -156,13 +161,23 @@ class _BranchPlan:
                 tasks.append(self.make_task(v + 1, j, state))
         return iter(tasks)
 
-    def on_record(self, record: dict[str, Any]) -> list[BranchTask]:
+    def on_record(self, record: dict[str, Any]) -> list[Realization]:
         if not self.restore(record):
             return []
         v, j = record["value_index"], record["ic"]
         if self.continuation and v + 1 < self.nvalues:
-            return [self.make_task(v + 1, j, record["next_state"])]
+            return [self.make_task(v + 1, j, next_state(record))]
         return []
+
+
+def next_state(record: dict[str, Any]) -> list[float] | None:
+    """The state the next value of a continued chain starts from: the run's last section
+    point (at cam phase theta_c0, so the cam phase carries over), or None for a run that did
+    not end normally (the condition's own initial state is taken)."""
+    sec = record.get("section") or {}
+    if record["status"] != "OK" or not sec.get("theta_f"):
+        return None
+    return [float(sec["theta_f"][-1]), float(sec["omega_f"][-1])]
 
 
 def _tables(records: list[dict], axis: Axis) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -180,7 +195,7 @@ def _tables(records: list[dict], axis: Axis) -> tuple[pd.DataFrame, pd.DataFrame
             "status": [r["status"] for r in records],
             "label": [r["label"] for r in records],
             "period": period_column(records),
-            "n_points": np.array([r["n_points"] for r in records], dtype=np.int64),
+            "n_points": np.array([r["n_section"] for r in records], dtype=np.int64),
             "recorded_s": np.array([r["recorded_s"] for r in records], dtype=float),
             "reasons": [r["reasons"] for r in records],
             "warnings": [r["warnings"] for r in records],
@@ -260,6 +275,7 @@ def bifurcation(
     values: Sequence[float] | str | None = None,
     *,
     base: Params | None = None,
+    numerics: Numerics | None = None,
     duration: float = 20.0,
     transient: float | None = None,
     seed: int = 0,
@@ -268,14 +284,14 @@ def bifurcation(
     classify: Callable | None = None,
     lyapunov: bool = False,
     check_step: bool = False,
+    extend_to: float | None = EXTEND_TO,
     workers: int | None = None,
     scheduler: Any = None,
     out: str | Path | None = None,
     resume: bool = False,
-    progress: bool = False,
+    progress: bool | None = None,
     flush_interval: float = 1.0,
     force: bool = False,
-    engine: str = "auto",
     device: str = "cpu",
     fate: float | None = None,
 ) -> Bifurcation:
@@ -291,7 +307,9 @@ def bifurcation(
         ``bifurcation("l_lambda", "0.001:0.018:69")``.
     base : Params, optional
         Everything not swept; for Fig. 6 ``Params(stiffness="fractal", G=1e-9)`` (the
-        fractal stiffness needs a smaller ``dt``; simulate warns when it is too coarse).
+        fractal stiffness needs a smaller ``dt``: a warning says when it is too coarse).
+    numerics : Numerics, optional
+        The integrator and its settings (the swept field may be one of its fields).
     duration, transient : float
         Simulated time and the discarded start [s]; transient None = duration / 2.
     seed : int
@@ -307,13 +325,12 @@ def bifurcation(
         phase theta_c0, so the cam phase carries over); a run that did not end normally
         hands over the condition's own initial state instead. Values run in order along
         each chain, so only the conditions run in parallel.
-    classify, lyapunov, check_step, workers, scheduler, out, resume, progress, flush_interval
+    classify, lyapunov, check_step, extend_to, workers, scheduler, out, resume, progress
         As for :func:`regime_map`; the verdicts go to ``FILE.verdicts.parquet``.
-    engine, device
-        As for :func:`regime_map`: by default the ensemble engine runs the conditions of a
-        value (and, without continuation, many values) as one batch of members; a batch
-        holds members of one omega and dt, so a sweep over ``omega`` or ``dt`` batches the
-        conditions of each value.
+    flush_interval, device
+        As for :func:`regime_map`: the conditions of a value (and, without continuation,
+        many values) run as one batch of members; a batch holds members of one omega and
+        numerics, so a sweep over ``omega`` or ``dt`` batches the conditions of each value.
     fate : float, optional
         As for :func:`regime_map`: runs labelled chaotic, quasiperiodic or undetermined are
         continued to this time [s] to see whether they stay in the cam's reach and what they
@@ -325,136 +342,98 @@ def bifurcation(
     -------
     Bifurcation
     """
-    if isinstance(param, Axis) and values is not None:  # the values were ignored
-        raise SweepError(f"the Axis {param.name} has its values: give values=None")
-    if isinstance(param, Axis):
-        axis = param
-    elif values is None:
-        raise SweepError(f"give the values of {param} to sweep (or an Axis)")
-    elif isinstance(values, str):
-        axis = Axis.parse(values, name=param)
-    else:
-        axis = Axis(param, values)
-    base = params_arg(base, "base")
+    axis = _axis(param, values)
+    base, num = params_arg(base, "base"), numerics_arg(numerics)
     duration, transient = run_settings(duration, transient, seed)
     fate = check_fate(fate, duration)
-    lyapunov, check_step = flag("lyapunov", lyapunov), flag("check_step", check_step)
     resume, force = flag("resume", resume), flag("force", force)
     continuation = flag("continuation", continuation)
-    validate_grid(base, [axis])
+    validate_grid(base, num, [axis])
     counted = isinstance(initial_conditions, numbers.Integral) and not isinstance(
         initial_conditions, bool
     )
     _check_state_axis(axis.name, initial_conditions if counted else None, continuation)
-    specs: list[tuple[str, float | None, float | None]] = []
-    if counted:
-        initial_conditions = whole("initial conditions", initial_conditions, low=1)
-        n_specs = initial_conditions  # built after the budget check: a huge count is refused
-    else:
-        specs = [("absolute", *_state(s)) for s in _states(initial_conditions)]
-        if not specs:
-            raise SweepError("initial conditions: the list is empty")
-        for i, (_, th, om) in enumerate(specs):  # before any run (and any checkpoint)
-            try:
-                base.replace(theta_f0=th, omega_f0=om)
-            except ParameterError as err:
-                raise ParameterError(f"initial_conditions[{i}] = ({th}, {om}): {err}") from None
-            if specs.index(specs[i]) < i:  # as an axis value twice: the same runs again
-                raise SweepError(f"initial_conditions[{i}] = ({th}, {om}) is given twice")
-        n_specs = len(specs)
-    from ..integrate._gpu import by_size
-
-    device = by_size(device, len(axis) * n_specs)  # "auto": the CPU for a small sweep
-    classify, eng, series = sweep_engine(
-        classify,
-        lyapunov,
-        check_step,
-        engine,
-        device,
-        base,
-        (duration, transient),
-        workers,
-        scheduler,
-    )
-    check_sweep_budget(
-        base,
-        runs=len(axis) * n_specs,
-        duration=duration,
-        transient=transient,
-        series=series,
-        workers=workers,
-        keeps_sections=True,
-        what="this bifurcation diagram",
-        fate=fate,
-        classify=classify,
-        # the fate runs as if every run were continued: an upper bound
-        factor=1 + 2 * lyapunov + check_step + (fate / duration if fate else 0.0),
-        reduce="the values, the initial conditions or the duration",
-    )
-    if counted:
+    n_specs, specs = _conditions(base, initial_conditions, counted)
+    judge = make_judge(classify, flag("lyapunov", lyapunov), flag("check_step", check_step),
+                       extend_to)  # fmt: skip
+    runs = len(axis) * n_specs
+    eng = resolve_engine(judge, by_size(device, runs), base, num, (duration, transient),
+                         workers, scheduler)  # fmt: skip
+    check_sweep_budget(base, num, runs=runs, duration=duration, transient=transient,
+                       judge=judge, workers=workers, keeps_sections=True,
+                       what="this bifurcation diagram", fate=fate,
+                       reduce="the values, the initial conditions or the duration")  # fmt: skip
+    if counted:  # built after the budget check: a huge count is refused first
         specs = [("base", base.theta_f0, base.omega_f0)] + [
             ("offset", a, b) for a, b in initial_offsets(initial_conditions)
         ]
     config = {
-        "kind": "bifurcation",
-        "version": __version__,
-        "base": base.to_dict(),
-        "axis": axis.to_dict(),
-        "seed": int(seed),
-        "duration": duration,
-        "transient": transient,
-        "initial_conditions": [list(s) for s in specs],
-        "continuation": bool(continuation),
-        "classifier": eng.identity,
-        "engine": eng.name,
-        "device": engine_device(eng, device),
-        "code": code_identity(),
-        "index_scheme": "cantor(value_index, ic)",
-        "fate": fate,
-    }
+        "kind": "bifurcation", "version": __version__, "base": base.to_dict(),
+        "numerics": num.to_dict(), "axis": axis.to_dict(), "seed": int(seed),
+        "duration": duration, "transient": transient,
+        "initial_conditions": [list(s) for s in specs], "continuation": bool(continuation),
+        "classifier": judge.identity(), "device": eng.device, "code": code_identity(),
+        "index_scheme": "cantor(value_index, ic)", "fate": fate,
+    }  # fmt: skip
 
-    def make_task(v: int, j: int, state) -> BranchTask:
+    def make_task(v: int, j: int, state) -> Realization:
         value = axis.values[v]
-        p = base.replace(**{axis.name: value})
-        kind, a, b = specs[j]
-        if state is not None:
-            th, om = state
-        elif kind == "offset":
-            th, om = float(contact_angle(p, 0.0)) + a, b
-        elif kind == "base":  # the base's state, with the swept value if the axis is one
-            th, om = p.theta_f0, p.omega_f0
-        else:
-            th, om = a, b
+        p, n = cell_params(base, num, {axis.name: value})
+        th, om = _start_state(p, specs[j], state)
         p = p.replace(theta_f0=th, omega_f0=om)
-        return BranchTask(
-            v,
-            j,
-            value,
-            int(seed),
-            realization_index(v, j),
-            p,
-            duration,
-            transient,
-            classify,
-            continued=state is not None,
-            series=series,
-            fate=fate,
-        )
+        extra = {"value_index": v, "ic": j, "value": value, "continued": state is not None,
+                 "theta_f0": math.nan if th is None else float(th),
+                 "omega_f0": math.nan if om is None else float(om)}  # fmt: skip
+        return Realization((v, j), p, n, int(seed), realization_index(v, j), duration,
+                           transient, fate, extra, sections=True)  # fmt: skip
 
     return run_sweep(
-        _BranchPlan(make_task, len(axis), len(specs), bool(continuation)),
-        eng,
-        out=None if out is None else Path(out),
-        second="verdicts",
-        config=config,
-        keys=("value_index", "ic"),
-        read=read_bifurcation,
-        build=lambda records: Bifurcation(*_tables(records, axis), config),
-        resume=resume,
-        force=force,
-        flush_interval=flush_interval,
-        workers=workers,
-        scheduler=scheduler,
-        progress=progress,
-        desc=f"bifurcation {axis.name}",
-    )
+        _BranchPlan(make_task, len(axis), len(specs), bool(continuation)), eng,
+        out=None if out is None else Path(out), second="verdicts", config=config,
+        keys=("value_index", "ic"), read=read_bifurcation,
+        build=lambda records: Bifurcation(*_tables(records, axis), config), resume=resume,
+        force=force, flush_interval=flush_interval, workers=workers, scheduler=scheduler,
+        progress=show_progress(progress), desc=f"bifurcation {axis.name}",
+    )  # fmt: skip
+
+
+def _axis(param, values) -> Axis:
+    if isinstance(param, Axis) and values is not None:  # the values were ignored
+        raise SweepError(f"the Axis {param.name} has its values: give values=None")
+    if isinstance(param, Axis):
+        return param
+    if values is None:
+        raise SweepError(f"give the values of {param} to sweep (or an Axis)")
+    if isinstance(values, str):
+        return Axis.parse(values, name=param)
+    return Axis(param, values)
+
+
+def _conditions(base: Params, given, counted: bool) -> tuple[int, list]:
+    """(how many initial conditions, the explicit ones as specs), checked before any run."""
+    if counted:
+        return whole("initial conditions", given, low=1), []
+    specs = [("absolute", *_state(s)) for s in _states(given)]
+    if not specs:
+        raise SweepError("initial conditions: the list is empty")
+    for i, (_, th, om) in enumerate(specs):  # before any run (and any checkpoint)
+        try:
+            base.replace(theta_f0=th, omega_f0=om)
+        except ParameterError as err:
+            raise ParameterError(f"initial_conditions[{i}] = ({th}, {om}): {err}") from None
+        if specs.index(specs[i]) < i:  # as an axis value twice: the same runs again
+            raise SweepError(f"initial_conditions[{i}] = ({th}, {om}) is given twice")
+    return len(specs), specs
+
+
+def _start_state(p: Params, spec, state):
+    """The initial state of a condition at a value: the chain's carried state, the base's
+    (with the swept value if the axis is one), an offset from contact, or an explicit one."""
+    kind, a, b = spec
+    if state is not None:
+        return state
+    if kind == "offset":
+        return float(contact_angle(p, 0.0)) + a, b
+    if kind == "base":
+        return p.theta_f0, p.omega_f0
+    return a, b

@@ -1,4 +1,4 @@
-"""Pieces shared by the sweep drivers: run settings, the classifier, outputs, tables."""
+"""Pieces shared by the sweep plans: run settings, the judge, outputs, tables, the budget."""
 
 from __future__ import annotations
 
@@ -11,12 +11,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .._checks import whole
-from .._parquet import read_frame
-from .._warn import warn
-from ..integrate._driver import check_window
-from ._backends import make_backend
-from ._checkpoint import (
+from .._util import real, warn, whole
+from ..io import check_output, lock_all, read_frame
+from ..simulation import check_window
+from ._grid import Axis, SweepError
+from ._runs import Judge
+from ._store import (
     CheckpointStore,
     MemoryStore,
     checkpoint_dir,
@@ -26,17 +26,19 @@ from ._checkpoint import (
     remove_leftovers,
     write_parquet,
 )
-from ._grid import Axis, SweepError
-from ._tasks import DefaultClassifier, classifier_identity
 
 __all__ = [
-    "run_settings",
+    "TwoTables",
+    "as_axis",
     "check_fate",
-    "resolve_classifier",
+    "check_sweep_budget",
     "companion",
-    "open_store",
     "evidence_columns",
+    "make_judge",
+    "open_store",
     "read_tables",
+    "run_settings",
+    "show_progress",
     "write_tables",
 ]
 
@@ -48,6 +50,15 @@ def run_settings(duration: float, transient: float | None, seed: int) -> tuple[f
     duration, transient = check_window(duration, transient)
     whole("seed", seed)
     return float(duration), float(transient)
+
+
+def show_progress(progress) -> bool:
+    """Whether to show a progress bar: as asked, or (None) when stderr is a terminal."""
+    import sys
+
+    if progress is None:
+        return bool(getattr(sys.stderr, "isatty", lambda: False)())
+    return bool(progress)
 
 
 def check_fate(fate: float | None, duration: float) -> float | None:
@@ -64,13 +75,16 @@ def check_fate(fate: float | None, duration: float) -> float | None:
     return float(fate)
 
 
-def resolve_classifier(classify, lyapunov: bool, check_step: bool = False):
-    """The classifier to use and its identity; None = the package classifier."""
-    if classify is None:
-        classify = DefaultClassifier(lyapunov=bool(lyapunov), check_step=bool(check_step))
-    elif lyapunov or check_step:
-        raise SweepError("lyapunov and check_step apply to the default classifier only")
-    return classify, classifier_identity(classify)
+def make_judge(classify, lyapunov: bool, check_step: bool, extend_to, labels=True) -> Judge:
+    """The sweep's :class:`~._runs.Judge`: the package's verdict (``classify`` None) or a
+    classifier of one's own, with the Lyapunov and step-check adapters."""
+    if classify is not None and not callable(classify):
+        raise SweepError(f"classify = {classify!r} must be callable (or None: the default)")
+    if classify is not None and check_step:
+        raise SweepError("check_step (--check-step) applies to the package's verdict only")
+    if extend_to is not None:
+        extend_to = real("extend_to", extend_to, low=0.0, unit="s")
+    return Judge(classify, bool(lyapunov), bool(check_step), extend_to, labels)
 
 
 def as_axis(axis: Axis | str | tuple) -> Axis:
@@ -97,8 +111,6 @@ def companion(out: Path, what: str) -> Path:
 def check_pair(path: str | Path, second: str, replace: bool) -> None:
     """Refuse, before writing, a sweep's ``FILE.parquet`` or ``FILE.<second>.parquet`` that
     exists (unless ``replace``), a folder, or a missing folder, naming the file."""
-    from .._outputs import check_output
-
     path = Path(path)
     for name in (path, companion(path, second)):
         check_output(name, flag="path", force=replace, force_hint="pass replace=True")
@@ -139,7 +151,11 @@ def write_tables(
     write_parquet(other, companion(path, second), config, replace=replace)
 
 
-_KIND_NAMES = {"bifurcation": "bifurcation diagram", "regime_map": "regime map"}
+_KIND_NAMES = {
+    "bifurcation": "bifurcation diagram",
+    "regime_map": "regime map",
+    "ensemble": "ensemble",
+}
 
 
 def read_tables(
@@ -180,8 +196,6 @@ def lock_outputs(out: Path | None, second: str):
     output: nothing to lock."""
     import contextlib
 
-    from .._outputs import lock_all
-
     return contextlib.nullcontext() if out is None else lock_all([out, companion(out, second)])
 
 
@@ -198,9 +212,6 @@ def open_store(
     Call it holding :func:`lock_outputs`. ``force`` starts over: an existing output is
     replaced at the end and an existing checkpoint is discarded.
     """
-    from .._checks import real
-    from .._outputs import check_output
-
     flush_interval = real("flush_interval", flush_interval, low=0.0, unit="s")
     if out is None:
         return MemoryStore(), False
@@ -230,51 +241,48 @@ RECORD_BYTES = 4096
 
 def check_sweep_budget(
     base,
+    num,
     *,
     runs: int,
     duration: float,
     transient: float,
-    series: bool,
+    judge: Judge,
     workers,
     keeps_sections: bool,
     what: str,
     reduce: str,
-    factor: float = 1.0,
     fate: float | None = None,
-    classify=None,
 ) -> None:
     """Refuse a sweep that cannot fit in memory, warn about one that takes hours.
 
-    ``runs`` realizations of ``base`` (``factor`` times the cost each: the Lyapunov and
-    step checks run more), one per worker in memory at a time, their records (and, with
-    ``keeps_sections``, their section points) all kept by the driver. With a ``fate``
-    horizon a worker may hold a run continued to it (its section from ``duration`` on).
-    ``classify`` (the sweep's classifier; its :func:`extension_cap`) adds a warning when the
-    extensions of undetermined runs, which the estimate does not count, could take more than
-    an hour and more than 10 times the estimate: runs that record far less than the cap (a
-    map of 0.5 s runs was estimated at 5.6 h and took ~83 h: nearly every run extended).
+    ``runs`` realizations of ``base`` (the step check runs each twice, a ``fate`` horizon at
+    most ``fate / duration`` times more), one batch per worker in memory at a time, their
+    records (and, with ``keeps_sections``, their section points) all kept by the driver. A
+    warning when the extensions of undetermined runs, which the estimate does not count,
+    could take more than an hour and more than 10 times the estimate (runs that record far
+    less than the cap).
     """
-    from .._budget import WARN_SECONDS, JobEstimate, check_budget, estimate
-    from .._budget import _human_seconds as human_seconds
+    from ..simulation import WARN_SECONDS, JobEstimate, check_budget, estimate, human_seconds
     from ._backends import default_workers
 
     n = default_workers() if workers is None else max(1, int(workers))
-    one = estimate(base, duration=duration, transient=transient, series=series)
+    one = estimate(base, num, duration=duration, transient=transient, series=judge.series)
     if fate is not None:
-        longer = estimate(base, duration=fate, transient=duration)
+        longer = estimate(base, num, duration=fate, transient=duration)
         one = JobEstimate((max(one.bytes, longer.bytes), one.seconds))
         reduce = f"{reduce}, or the fate horizon"
-    kept = estimate(base, duration=duration, transient=transient) if keeps_sections else None
+    kept = estimate(base, num, duration=duration, transient=transient) if keeps_sections else None
     memory = one.bytes * n + runs * (RECORD_BYTES + (kept.bytes / 3 if kept else 0.0))
+    factor = 1 + judge.check_step + (fate / duration if fate else 0.0)  # fate: a bound
     seconds = one.seconds * runs * factor / n
     check_budget(
         JobEstimate((memory, seconds)),
         what=what,
         reduce=reduce,
-        run=dict(params=base, duration=duration, what="each run of the base model"),
+        run=dict(params=base, num=num, duration=duration, what="each run of the base model"),
     )
-    recorded, extend_to = duration - transient, extension_cap(classify)
-    if extend_to is not None and recorded < extend_to:
+    recorded, extend_to = duration - transient, judge.extend_to
+    if judge.custom is None and extend_to is not None and recorded < extend_to:
         more = one.seconds * runs / n * (extend_to - recorded) / duration
         if more > max(WARN_SECONDS, 10 * seconds):
             warn(
@@ -283,22 +291,6 @@ def check_sweep_budget(
                 f"most are, about {human_seconds(more)} more. Record more per run (duration "
                 "- transient) for fewer extensions"
             )
-
-
-def extension_cap(classify) -> float | None:
-    """The recorded time [s] a sweep's classifier extends an undetermined run to, or None
-    when it never extends (the tangent verdict alone extends: not with ``tangent=False`` or
-    ``lyapunov=True``, nor a classifier of one's own)."""
-    extends = getattr(classify, "needs_tangent", False)
-    return getattr(classify, "extend_to", None) if extends else None
-
-
-def backend_for(workers: int | None, scheduler: Any):
-    try:
-        return make_backend(workers, scheduler)
-    except (ValueError, ConnectionError) as err:
-        where = "" if scheduler is None or "scheduler" in str(err) else f"scheduler {scheduler!r}: "
-        raise SweepError(f"{where}{err}") from None
 
 
 def unique_sorted(records, key_fields: tuple[str, str]) -> list[dict]:

@@ -1,35 +1,49 @@
-"""The loop every sweep runs: submit tasks, collect records, checkpoint, follow up.
+"""The one engine of every sweep: submit batches, collect records, checkpoint, follow up.
 
 A *plan* decides which tasks exist (a regime map's realizations, a bifurcation diagram's
-values); the engine feeds them to a backend with a bounded number in flight (so memory does
-not grow with the grid), stores each record as it completes, and asks the plan for
+values and initial conditions, an ensemble's members); the engine packs them into batches
+(:class:`._runs.Batch`), feeds those to a backend with a bounded number in flight (so memory
+does not grow with the grid), stores each record as it completes, and asks the plan for
 follow-up tasks (continuation to the next value, more realizations for an adaptive cell).
 Plans decide from finished records only, never from their completion order, so the set of
-records is the same for any backend and worker count.
+records is the same for any backend, batch size and worker count. Locally the batches run
+one per core on threads (each member through the compiled call without the GIL), or, on a
+GPU, the next batch launched while the last is labelled; on Dask each worker runs whole
+batches.
 """
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import sys
 from collections import Counter, deque
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Protocol
 
-from ..integrate._driver import StopRequested, check_stop, stops_here
-from ._backends import BackendLost, SerialBackend, WorkerLost
+from ..kernel import StopRequested, check_stop, fork_safe_threads, runs_on_gpu, stops_here
+from ._backends import (
+    BackendLost,
+    PipelineBackend,
+    SerialBackend,
+    ThreadBackend,
+    WorkerLost,
+    make_backend,
+)
 from ._grid import SweepError
-from ._tasks import run_task
+from ._runs import Batch, Judge
 
-__all__ = ["SweepInterrupted", "TaskFailed", "execute"]
+__all__ = ["Engine", "SweepInterrupted", "TaskFailed", "execute", "resolve_engine", "run_sweep"]
 
 MAX_RETRIES = 3
 """Times a task may lose its worker before the run stops with an error."""
 
 STOP_POLL_S = 0.1
 """How often [s] a sweep whose thread can be asked to stop (inside
-:func:`chaoscam.integrate._driver.stop_on`: a sweep run beside another,
-:func:`chaoscam.experiments._side_by_side.beside`) looks whether it was, while it waits for
-its tasks. Only the main thread gets Ctrl-C; another thread learns of it this way."""
+:func:`chaoscam.kernel.stop_on`: a sweep run beside another) looks whether it was, while it
+waits for its tasks. Only the main thread gets Ctrl-C; another thread learns of it this way."""
 
 
 class TaskFailed(RuntimeError):
@@ -189,7 +203,7 @@ def execute(
                 task = _next_task(queue, source, pack, _share(plan, saved, inflight, size, spread))
                 if task is None:
                     break
-                inflight[backend.submit(run_task, task)] = task
+                inflight[backend.submit(run_batch, task)] = task
             if not inflight:
                 break
             for fut in _finished(backend, list(inflight)):
@@ -237,3 +251,222 @@ def execute(
     finally:
         bar.close()
     store.flush()
+
+
+def run_batch(batch: Batch) -> list[dict[str, Any]]:
+    """Run one batch (the function every backend calls)."""
+    return batch.run()
+
+
+BATCH_SECONDS = 2.0
+"""Target wall time of one CPU batch [s]: short enough for a prompt Ctrl-C and frequent
+checkpoints, long enough that every thread has several members to balance."""
+
+MAX_BATCH = 256
+"""Members per CPU batch at most (bounds the memory of one compiled call)."""
+
+GPU_BATCH = 8_192
+"""Members per batch when a sweep's batches run on a GPU: one thread is slow and the device's
+rate comes from many in flight (on an H200, 0.25-s runs: 64 members took 1.09 s of launch,
+8,448 took 1.80 s, a full wave of 33,792 took 5.1 s), so batches must be large; a quarter
+of an H200's wave keeps a checkpoint every few minutes."""
+
+
+@dataclass(frozen=True)
+class Engine:
+    """Where and how a sweep's batches run: ``pack`` makes a batch of up to ``size`` tasks;
+    ``threads`` numba threads in this process (local; None: leave it), ``batch_threads``
+    batches at once on threads, ``pipeline`` a local GPU's batches launched while the last
+    is labelled; ``device`` "gpu" or "cpu"."""
+
+    judge: Judge
+    device: str
+    size: int
+    threads: int | None = None
+    batch_threads: int = 1
+    pipeline: bool = False
+
+    def pack(self, tasks: tuple) -> Batch:
+        return Batch(tasks, self.judge, self.device)
+
+
+def batch_size(base, num, duration: float, transient: float, threads: int) -> int:
+    """Members per CPU batch: about :data:`BATCH_SECONDS` of work on ``threads`` threads,
+    from the run-time estimate (at least one per thread)."""
+    from ..simulation import estimate
+
+    per_run = max(estimate(base, num, duration=duration, transient=transient).seconds, 1e-3)
+    n = int(threads * BATCH_SECONDS / per_run)
+    return max(threads, min(n, MAX_BATCH))
+
+
+def resolve_engine(judge: Judge, device: str, base, num, run, workers, scheduler) -> Engine:
+    """The engine of a sweep of ``base`` and ``num`` with ``run`` = (duration, transient):
+    one batch per core on threads, a GPU's pipeline, or batches on Dask workers."""
+    from ..kernel import GPUFallbackWarning, gpu_status
+    from ._backends import local_workers
+
+    if device not in ("cpu", "gpu", "auto"):
+        raise SweepError(f"device = {device!r} must be one of cpu, gpu, auto")
+    threads = None
+    if scheduler is None:
+        try:
+            threads = local_workers(workers)
+        except ValueError as err:
+            raise SweepError(str(err)) from None
+    gpu = scheduler is None and runs_on_gpu(device) and not judge.series
+    if device == "gpu" and scheduler is None and not gpu:
+        import warnings
+
+        why = "a classifier that reads the series" if judge.series else gpu_status()[1]
+        warnings.warn(f"GPU backend unavailable: {why}; the sweep runs on the CPU",
+                      GPUFallbackWarning, stacklevel=4)  # fmt: skip
+    if gpu:
+        return Engine(judge, "gpu", GPU_BATCH, threads, pipeline=True)
+    if scheduler is not None:  # Dask workers: whole batches, on their GPUs when asked
+        size = GPU_BATCH if device == "gpu" else batch_size(base, num, *run, 1)
+        return Engine(judge, device, size)
+    by_batch = threads if threads > 1 else 1
+    size = batch_size(base, num, run[0], run[1], 1 if by_batch > 1 else threads)
+    return Engine(judge, "cpu", size, None if by_batch > 1 else threads, by_batch)
+
+
+def _numba_threads(n: int | None):
+    """A context in which numba runs ``n`` threads (None: leave it), restored after."""
+    if n is None:
+        return contextlib.nullcontext()
+
+    @contextlib.contextmanager
+    def scope():
+        import numba
+
+        fork_safe_threads()  # numba's threads start here, fixing the layer: fork-safe first
+        before = numba.get_num_threads()
+        numba.set_num_threads(max(1, min(int(n), numba.config.NUMBA_NUM_THREADS)))
+        try:
+            yield
+        finally:
+            numba.set_num_threads(before)
+
+    return scope()
+
+
+def run_plan(plan, eng: Engine, store, *, workers, scheduler, progress: bool, desc: str) -> None:
+    """Execute a sweep's plan on its engine's backend."""
+    if scheduler is not None:
+        try:
+            backend = make_backend(workers, scheduler)
+        except (ValueError, ConnectionError) as err:
+            where = "" if "scheduler" in str(err) else f"scheduler {scheduler!r}: "
+            raise SweepError(f"{where}{err}") from None
+    elif eng.pipeline:
+        backend = PipelineBackend(eng.threads)
+    elif eng.batch_threads > 1:
+        backend = ThreadBackend(eng.batch_threads)
+    else:
+        backend = SerialBackend()
+    try:
+        with _numba_threads(eng.threads):
+            spread = eng.batch_threads if isinstance(backend, ThreadBackend) else 1
+            execute(plan, backend, store, progress=progress, desc=desc, pack=eng.pack,
+                    pack_size=eng.size, spread=spread)  # fmt: skip
+    finally:
+        backend.close()
+
+
+def run_sweep(
+    plan,
+    eng: Engine,
+    *,
+    out: Path | None,
+    second: str,
+    config: dict[str, Any],
+    keys: tuple[str, str],
+    read: Callable[[Path], Any],
+    build: Callable[[list[dict[str, Any]]], Any],
+    resume: bool,
+    force: bool,
+    flush_interval: float,
+    workers,
+    scheduler,
+    progress: bool,
+    desc: str,
+):
+    """The steps every sweep takes around its plan, in one place.
+
+    Lock the output ``out`` (FILE.parquet, with FILE.<second>.parquet beside it; None: kept
+    in memory), open its checkpoint (a finished output of the same ``config`` is reused
+    through ``read`` under ``resume``), run the plan (:func:`run_plan`), sort the records by
+    ``keys`` (one per key), warn once per message the runs raised, ``build`` the result
+    from the records, write it to ``out`` and remove the checkpoint.
+    """
+    from ._common import companion, lock_outputs, open_store
+
+    with lock_outputs(out, second):
+        store, reuse = open_store(out, second, config, resume, flush_interval, force)
+        if reuse:
+            try:
+                result = read(out)
+            except (OSError, ValueError) as err:  # pyarrow's errors are among them
+                raise SweepError(
+                    f"{out} is this configuration's finished run, but it or its companion "
+                    f"cannot be read back ({err}); pass --force without --resume (force=True "
+                    "in Python) to compute it again"
+                ) from None
+            if progress:
+                print(
+                    f"already finished: {out} (same configuration); read, nothing run",
+                    file=sys.stderr,
+                )
+            return result
+        # Outputs there now are this configuration's (a resumed run's) or --force's; any
+        # other that appears while the plan runs is not replaced at the end.
+        replace = force or (
+            out is not None and any(p.exists() for p in (out, companion(out, second)))
+        )
+        try:
+            run_plan(
+                plan, eng, store, workers=workers, scheduler=scheduler, progress=progress,
+                desc=desc,
+            )  # fmt: skip
+            return _finish(plan, store, out, keys, build, replace)
+        except OSError as err:  # a full disk: say what is kept, and where
+            if out is None or err.errno not in SAVE_ERRNOS:
+                raise  # not a failure to save (a lost connection, a file that appeared)
+            raise type(err)(
+                err.errno,
+                f"{err.strerror or err} while saving the results of {out}"
+                + (f" ({err.filename})" if err.filename else "")
+                + f"; the runs finished and saved so far are kept in {store.path}: fix the "
+                "cause (free space) and run the same command with --resume",
+            ) from None
+        except Exception:
+            # A run that failed before finishing any (a bad initial condition, a classifier
+            # that cannot be pickled) keeps no checkpoint: it would only block the corrected
+            # command ("holds the checkpoint of an interrupted run").
+            if next(iter(store.records()), None) is None:
+                store.remove()
+            raise
+
+
+SAVE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EROFS})
+"""The errors of a disk that takes no more (full, over quota, failing, read-only): a sweep
+stopped by one says where its finished runs are kept and to --resume once it is fixed."""
+
+
+def _finish(plan, store, out: Path | None, keys, build, replace: bool):
+    """The result from the finished records, written to ``out`` (its checkpoint removed)."""
+    from ._common import reemit_warnings, unique_sorted
+    try:
+        records = unique_sorted(store.records(), keys)
+        reemit_warnings(records)
+        result = build(records)
+        if out is not None:
+            result._write(out, replace=replace)
+            store.remove()
+    except KeyboardInterrupt:
+        # Every record is in the checkpoint; a resume writes the tables from it.
+        if out is None:
+            raise
+        raise SweepInterrupted(plan.total, plan.total, store.path) from None
+    return result

@@ -1,7 +1,9 @@
 """Sweep axes (``START:STOP:NUM``), grid validation and the realization-index scheme.
 
-A sweep never changes a kernel: it only builds validated :class:`~chaoscam.Params` for each
-point of a grid and asks :func:`chaoscam.simulate` for realizations ``(seed, index)``.
+A sweep never changes a kernel: it only builds a validated model (:class:`~chaoscam.Params`)
+and integrator settings (:class:`~chaoscam.Numerics`) for each point of a grid and asks
+:func:`chaoscam.solve` for realizations ``(seed, index)``. An axis is any numeric field of
+either.
 """
 
 from __future__ import annotations
@@ -13,10 +15,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import whole
-from ..model import FIELD_DOCS, LineLengthStream, ParameterError, Params, field_names
+from .._util import ParameterError, whole
+from ..model import FIELD_DOCS, LineLengthStream, Params, field_names
+from ..numerics import Numerics
 
-__all__ = ["Axis", "SweepError", "parse_range", "realization_index", "cell_params"]
+__all__ = ["Axis", "SweepError", "cell_params", "parse_range", "realization_index"]
+
+_DOCS = {**FIELD_DOCS, **{f: dict(m) for f, m in Numerics.field_docs().items()}}
+"""The sweepable fields' metadata: the model's and the numerics'."""
 
 
 class SweepError(ValueError):
@@ -75,12 +81,13 @@ def parse_range(text: str, what: str = "range") -> tuple[float, float, int]:
 
 @dataclass(frozen=True)
 class Axis:
-    """One swept model parameter and its values.
+    """One swept field and its values.
 
     Attributes
     ----------
     name : str
-        A numeric field of :class:`~chaoscam.Params` (the ``--set`` name), e.g. ``l_lambda``.
+        A numeric field of :class:`~chaoscam.Params` or :class:`~chaoscam.Numerics` (the
+        ``--set`` name), e.g. ``l_lambda`` or ``dt``.
     values : tuple of float
         The values in sweep order, in the field's SI unit.
     """
@@ -91,9 +98,11 @@ class Axis:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
             raise SweepError(f"axis name {self.name!r}: must be a Params field's name (a str)")
-        if self.name not in field_names():
-            Params().replace(**{self.name: 0.0})  # raises with a "did you mean"
-        if FIELD_DOCS[self.name]["choices"] is not None:
+        if self.name not in _DOCS:
+            from .._util import unknown_message
+
+            raise ParameterError(unknown_message(self.name, tuple(_DOCS), "field"))
+        if _DOCS[self.name]["choices"] is not None:
             raise SweepError(f"{self.name} is not numeric and cannot be swept")
         if isinstance(self.values, str | bytes) or not hasattr(self.values, "__iter__"):
             raise SweepError(
@@ -161,7 +170,7 @@ class Axis:
     @property
     def unit(self) -> str:
         """SI unit of the swept field."""
-        return FIELD_DOCS[self.name]["unit"]
+        return _DOCS[self.name]["unit"]
 
     def __len__(self) -> int:
         return len(self.values)
@@ -187,18 +196,20 @@ def realization_index(cell: int, index: int) -> int:
     return s * (s + 1) // 2 + i
 
 
-def cell_params(base: Params, changes: dict[str, float]) -> Params:
-    """``base`` with ``changes`` applied, validated as a simulation would need it.
-
-    Beyond the field ranges (a :class:`~chaoscam.ParameterError` naming the field), the
-    random line length must keep some mass above ``l_min``.
-    """
-    p = base.replace(**changes)
+def cell_params(
+    base: Params, num: Numerics, changes: dict[str, float]
+) -> tuple[Params, Numerics]:
+    """``base`` and ``num`` with ``changes`` applied (each field to its owner), validated as
+    a run would need them: beyond the field ranges (a :class:`~chaoscam.ParameterError`
+    naming the field), the random line length must keep some mass above ``l_min``."""
+    model = {k: v for k, v in changes.items() if k in field_names()}
+    steps = {k: v for k, v in changes.items() if k not in model}
+    p = base.replace(**model) if model else base
     LineLengthStream(p, 0, 0)  # raises ParameterError when the truncation keeps no mass
-    return p
+    return p, (num.replace(**steps) if steps else num)
 
 
-def validate_grid(base: Params, axes: Sequence[Axis]) -> None:
+def validate_grid(base: Params, num: Numerics, axes: Sequence[Axis]) -> None:
     """Raise before any work if a grid point gives invalid parameters (names the point)."""
     names = [a.name for a in axes]
     if len(set(names)) != len(names):
@@ -212,7 +223,7 @@ def validate_grid(base: Params, axes: Sequence[Axis]) -> None:
     for point in zip(*[g.ravel().tolist() for g in grids], strict=True):
         changes = dict(zip(names, point, strict=True))
         try:
-            cell_params(base, changes)
+            cell_params(base, num, changes)
         except ParameterError as err:
             where = ", ".join(f"{k} = {v!r}" for k, v in changes.items())
             raise ParameterError(f"at {where}: {err}") from None

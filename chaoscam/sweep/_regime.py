@@ -19,25 +19,30 @@ from typing import Any, ClassVar
 import numpy as np
 import pandas as pd
 
-from .._checks import flag, params_arg, whole
-from .._frozen import freeze_fields
-from .._provenance import code_identity
+from .._util import ParameterError, flag, freeze_fields, whole
 from .._version import __version__
-from ..model import ParameterError, Params, realizations_identical
-from ._batch import engine_device, run_sweep, sweep_engine
+from ..io import code_identity
+from ..kernel import by_size
+from ..model import Params, params_arg, realizations_identical
+from ..numerics import Numerics
+from ..simulation import numerics_arg
+from ..verdict import EXTEND_TO
 from ._common import (
     TwoTables,
     as_axis,
     check_fate,
     check_sweep_budget,
     evidence_columns,
+    make_judge,
     period_column,
     read_tables,
     run_settings,
+    show_progress,
 )
-from ._grid import Axis, SweepError, realization_index, validate_grid
+from ._engine import resolve_engine, run_sweep
+from ._grid import Axis, SweepError, cell_params, realization_index, validate_grid
+from ._runs import Realization, fate_columns
 from ._stats import max_halfwidth, summarize_cells
-from ._tasks import RealizationTask, fate_columns
 
 __all__ = ["RegimeMap", "regime_map", "read_regime_map"]
 
@@ -63,13 +68,12 @@ class RegimeMap(TwoTables):
         there, when the run stopped, and the verdict at the end of one that stayed; None /
         NaN for runs not continued) and one ``ev_<name>`` column per evidence value
         (NaN where a run has none; ``ev_exponent`` is the tangent exponent per iterate of
-        the section map, λ₁·T, and
-        ``ev_lyapunov_model`` is in 1/s).
+        the section map, λ₁·T; with ``lyapunov``, ``ev_lyapunov_1`` is λ₁ in 1/s).
     cells : DataFrame
         The per-cell summary of :func:`summarize_cells`.
     config : dict
-        Everything that fixes the result (base parameters, axes, seed, realizations,
-        duration, transient, classifier, adaptive settings, version).
+        Everything that fixes the result (base parameters and numerics, axes, seed,
+        realizations, duration, transient, classifier, adaptive settings, code).
     """
 
     _tables: ClassVar[tuple[str, str]] = ("realizations", "cells")
@@ -154,19 +158,19 @@ class _RegimePlan:
             # n > n_target: the earlier run already decided to extend.
             self.n_target[c] = min(self.n_target[c] + self.batch, self.caps[c])
 
-    def start(self) -> Iterator[RealizationTask]:
+    def start(self) -> Iterator[Realization]:
         if self.target is not None:
             for c in range(len(self.n_target)):
                 self._settle(c)
         return self._initial()
 
-    def _initial(self) -> Iterator[RealizationTask]:
+    def _initial(self) -> Iterator[Realization]:
         for c, n in enumerate(self.n_target):
             for i in range(n):
                 if i not in self.finished[c]:
                     yield self.make_task(c, i)
 
-    def on_record(self, record: dict[str, Any]) -> list[RealizationTask]:
+    def on_record(self, record: dict[str, Any]) -> list[Realization]:
         if not self._add(record):
             return []
         c = record["cell"]
@@ -225,13 +229,15 @@ def regime_map(
     y: Axis | str | tuple,
     *,
     base: Params | None = None,
-    realizations: int = 1,
+    numerics: Numerics | None = None,
+    realizations: int | None = None,
     seed: int = 0,
     duration: float = 20.0,
     transient: float | None = None,
     classify: Callable | None = None,
     lyapunov: bool = False,
     check_step: bool = False,
+    extend_to: float | None = EXTEND_TO,
     target_halfwidth: float | None = None,
     max_realizations: int | None = None,
     confidence: float = 0.95,
@@ -239,10 +245,9 @@ def regime_map(
     scheduler: Any = None,
     out: str | Path | None = None,
     resume: bool = False,
-    progress: bool = False,
+    progress: bool | None = None,
     flush_interval: float = 1.0,
     force: bool = False,
-    engine: str = "auto",
     device: str = "cpu",
     fate: float | None = None,
 ) -> RegimeMap:
@@ -255,28 +260,34 @@ def regime_map(
         ``"l_lambda_sigma=0:0.004:5"`` (sigma [m]). Cell ``c = ix * len(y) + iy``.
     base : Params, optional
         The model for everything not swept (Table 1 defaults).
-    realizations : int
-        N, realizations per cell (the first batch under adaptive sampling).
+    numerics : Numerics, optional
+        The integrator and its settings for everything not swept (an axis may be one of its
+        fields, e.g. ``dt``).
+    realizations : int, optional
+        N, realizations per cell (the first batch under adaptive sampling); default 20 when
+        some cell has a random line length, else 1 (a deterministic cell runs once anyway).
     seed : int
-        Master seed. Realization ``i`` of cell ``c`` is ``simulate(params_c, seed=seed,
-        index=realization_index(c, i))``: its line-length stream is
+        Master seed. Realization ``i`` of cell ``c`` is ``solve(params_c, seed=seed,
+        indices=[realization_index(c, i)])``: its line-length stream is
         ``SeedSequence(seed, spawn_key=(realization_index(c, i),))``, whatever the backend,
         the worker count or an interruption.
     duration, transient : float
         Simulated time and the discarded start [s]; transient None = duration / 2.
     classify : callable, optional
-        ``classify(trajectory) -> verdict`` (``label``, ``period``, ``evidence``,
-        ``reasons``), picklable for worker processes; default
-        ``chaoscam.classify.classify_trajectory``. Runs that did not end normally are not
+        A classifier of one's own, ``classify(solution) -> verdict`` (``label``, ``period``,
+        ``evidence``, ``reasons``) on each run as a one-member solution (with its series
+        unless it declares ``needs_series = False``); picklable for Dask. Default: the
+        package's verdict, :func:`chaoscam.classify`. Runs that did not end normally are not
         classified: their label is the status's (``left_reach``, ``diverged``).
     lyapunov : bool
-        Classify with the model's two-trajectory Lyapunov exponent (evidence
-        ``lyapunov_model`` [1/s], about twice the cost of a run) and the series-based
-        evidence, instead of the default tangent verdict (no orbit certificate, no
-        extension), as :func:`chaoscam.classify_trajectory` does with ``lyapunov=True``.
+        Also record each run's tangent Lyapunov spectrum (evidence ``lyapunov_1`` with
+        ``lyapunov_1_stderr``, and ``lyapunov_2``, in 1/s), summarised per cell as
+        ``lyapunov_mean`` / ``lyapunov_std``: the random system's top exponent.
     check_step : bool
-        Ask the default classifier to re-run each realization with dt / 2 and call it
-        undetermined when the verdict changes (twice the cost).
+        Judge each realization at half the step too and call it undetermined when the
+        verdict changes (twice the cost; the package's verdict only).
+    extend_to : float or None
+        Longest recorded time [s] an undetermined verdict is extended to (default 120 s).
     target_halfwidth : float, optional
         Adaptive sampling: add ``realizations`` more to a cell while the widest Wilson
         half-width (at ``confidence``) of its label fractions exceeds this, up to
@@ -287,54 +298,40 @@ def regime_map(
         Level of the Wilson intervals, in (0, 1) (default 0.95); the report and the figures
         name it.
     workers : int, optional
-        Local worker processes (default: every core; 1 runs in this process), or the worker
-        count of a local Dask cluster when ``scheduler="local"``.
+        Local threads, one batch each (default: every core), or the worker count of a local
+        Dask cluster when ``scheduler="local"``.
     scheduler : str or distributed.Client, optional
-        Run on Dask: ``"tcp://HOST:PORT"``, ``"local"`` (a LocalCluster on 127.0.0.1) or a
-        client.
+        Run the batches on Dask: ``"tcp://HOST:PORT"``, ``"local"`` (a LocalCluster on
+        127.0.0.1) or a client.
     out : path, optional
         ``FILE.parquet``: realizations there, cells in ``FILE.cells.parquet``, and a
         checkpoint ``FILE.parquet.ckpt/`` while running (removed at the end).
     resume : bool
         Continue an interrupted run of the same configuration (or reuse a finished one).
         Without it an existing output or checkpoint is an error; nothing is overwritten.
-    progress : bool
-        Show a progress bar with ETA on stderr.
+    progress : bool, optional
+        Show a progress bar with ETA on stderr; default: when stderr is a terminal.
     flush_interval : float
         Seconds between checkpoint parts [s].
-    engine : {"auto", "ensemble", "process"}
-        ``"ensemble"``: the realizations run in batches through the compiled ensemble call
-        (numba threads over ``workers`` cores in this process, or batches on Dask workers)
-        with the tangent dynamics, each labelled from its section and tangent exponent by
-        :func:`chaoscam.classify_ensemble`. ``"process"``: one task per realization in
-        worker processes, classified from its trajectory by ``classify``. ``"auto"``
-        (default): the ensemble engine for the default classifier (no ``lyapunov``, no
-        ``check_step``) and the RK4 integrator, else the process engine. Either way a
-        realization is bit-identical to ``chaoscam.simulate`` of it; ``config["engine"]``
-        records the one used.
     device : {"cpu", "gpu", "auto"}
-        Where the ensemble engine runs its batches: ``"gpu"`` uses an NVIDIA GPU
-        (numba-cuda), equal to the CPU only within ``GPU_TOLERANCE`` (chaotic members part
-        after a few periods); default ``"cpu"``, bit-identical everywhere; ``"auto"``: the
-        GPU where one runs and the map has ``_gpu.AUTO_GPU_MIN`` (4,096) runs or more.
+        Where the batches run: ``"gpu"`` uses an NVIDIA GPU (numba-cuda), equal to the CPU
+        only within ``GPU_TOLERANCE`` (chaotic members part after a few periods); default
+        ``"cpu"``, bit-identical everywhere; ``"auto"``: the GPU where one runs and the map
+        has ``AUTO_GPU_MIN`` (4,096) runs or more.
     fate : float, optional
         Horizon [s]: each realization labelled chaotic, quasiperiodic or undetermined is
-        simulated again to this time, with the tangent (the same motion, bit for bit), to
-        see whether it stays in the cam's reach and what it is at the end: transient chaos,
-        which a label over ``duration`` cannot see (at (omega, xi) = (42.5 rad/s, 0.40) the
-        motion is chaotic for 174 s and then leaves; at xi = 0.3459 a period-6 orbit in bands
-        of ~5e-7 rad reads chaotic over 10-20 s and periodic 6 over 50-100 s,
-        docs/classify-map-report.md, "Fate of the motion"). Its row gets ``fate`` (the status at the
-        horizon: ``"OK"``, ``"LEFT_REACH"``, ...), ``left_at`` (the last section time before it
-        stopped, NaN if it stayed) and, if it stayed, ``fate_label`` and ``fate_period``
-        (the model's verdict on the continued run's last half, certificate included;
-        :func:`chaoscam.sweep._tasks.fate_fields`), and each cell ``n_transient`` (how many
-        left before the horizon), ``n_settled`` and ``settled_period`` (how many were
-        periodic there, and their period). Labels are not changed: they describe the
-        recorded window. Must exceed
-        ``duration``; None (default) continues nothing. The time estimate (a warning
-        beyond an hour) counts it for every run, an upper bound: only the runs not labelled
-        periodic are continued.
+        run on to this time, with the tangent (the same motion, bit for bit), to see whether
+        it stays in the cam's reach and what it is at the end: transient chaos, which a label
+        over ``duration`` cannot see (at (omega, xi) = (42.5 rad/s, 0.40) the motion is
+        chaotic for 174 s and then leaves; at xi = 0.3459 a period-6 orbit in bands of ~5e-7
+        rad reads chaotic over 10-20 s and periodic 6 over 50-100 s). Its row gets ``fate``
+        (the status at the horizon: ``"OK"``, ``"LEFT_REACH"``, ...), ``left_at`` (the last
+        section time before it stopped, NaN if it stayed) and, if it stayed, ``fate_label``
+        and ``fate_period`` (the model's verdict on the continued run's last half,
+        certificate included), and each cell ``n_transient`` (how many left before the
+        horizon), ``n_settled`` and ``settled_period`` (how many were periodic there, and
+        their period). Labels are not changed: they describe the recorded window. Must
+        exceed ``duration``; None (default) continues nothing.
 
     Returns
     -------
@@ -352,141 +349,110 @@ def regime_map(
         Ctrl-C; the message says how to resume.
     """
     x, y = as_axis(x), as_axis(y)
-    base = params_arg(base, "base")
+    base, num = params_arg(base, "base"), numerics_arg(numerics)
     duration, transient = run_settings(duration, transient, seed)
     fate = check_fate(fate, duration)
-    lyapunov, check_step = flag("lyapunov", lyapunov), flag("check_step", check_step)
     resume, force = flag("resume", resume), flag("force", force)
-    realizations = whole("realizations", realizations, low=1)
-    adaptive = None
-    if target_halfwidth is not None:
-        if isinstance(target_halfwidth, bool) or not (
-            isinstance(target_halfwidth, numbers.Real) and 0.0 < target_halfwidth < 0.5
-        ):
-            raise SweepError(f"target half-width = {target_halfwidth!r} must be in (0, 0.5)")
-        cap = (
-            DEFAULT_CAP
-            if max_realizations is None
-            else whole("max realizations", max_realizations, low=1)
-        )
-        if cap < realizations:
-            raise SweepError(f"max realizations = {cap} is below realizations = {realizations}")
-        adaptive = {
-            "target_halfwidth": float(target_halfwidth),
-            "max_realizations": cap,
-            "batch": realizations,
-        }
-    elif max_realizations is not None:
-        raise SweepError(
-            "max_realizations (--max-realizations) applies only with target_halfwidth "
-            "(--target-halfwidth)"
-        )
-    if isinstance(confidence, bool) or not (
-        isinstance(confidence, numbers.Real) and 0.0 < confidence < 1.0
-    ):
-        # before any run: summarize_cells would refuse it only at the end
-        raise SweepError(f"confidence = {confidence!r}: the intervals' level, in (0, 1), e.g. 0.95")
-    validate_grid(base, [x, y])
-    from ..integrate._gpu import by_size
-
-    runs = len(x) * len(y) * (adaptive["max_realizations"] if adaptive else realizations)
-    device = by_size(device, runs)  # "auto": the CPU for a small sweep
-    classify, eng, series = sweep_engine(
-        classify, lyapunov, check_step, engine, device, base, (duration, transient), workers,
-        scheduler,
-    )  # fmt: skip
-    check_sweep_budget(
-        base,
-        runs=runs,
-        duration=duration,
-        transient=transient,
-        series=series,
-        workers=workers,
-        keeps_sections=False,
-        what="this regime map",
-        fate=fate,
-        classify=classify,
-        factor=1 + 2 * lyapunov + check_step + (fate / duration if fate else 0.0),  # fate: bound
-        reduce="the grid, the realizations or the duration",
-    )
-    config = {
-        "kind": "regime_map",
-        "version": __version__,
-        "base": base.to_dict(),
-        "x": x.to_dict(),
-        "y": y.to_dict(),
-        "realizations": realizations,
-        "seed": int(seed),
-        "duration": duration,
-        "transient": transient,
-        "classifier": eng.identity,
-        "engine": eng.name,
-        "device": engine_device(eng, device),
-        "code": code_identity(),
-        "adaptive": adaptive,
-        "confidence": float(confidence),
-        "index_scheme": "cantor(cell, index)",
-        "deterministic_cells": "run once (sigma = 0, or the fractal stiffness)",
-        "fate": fate,
-    }
+    validate_grid(base, num, [x, y])
     cells = _cells_frame(x, y)
-    xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
-    # A cell with sigma = 0 (or the fractal stiffness, which the line length does not
-    # change) is deterministic: its realizations would all be the same run,
-    # so it is computed once and reported as such (no interval over identical runs).
-    once = frozenset(
-        c
-        for c in range(len(cells))
-        if realizations_identical(base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])}))
-    )
+    once = _deterministic_cells(base, num, cells, x, y)
+    realizations = _realizations(realizations, len(once) < len(cells))
+    adaptive = _adaptive(target_halfwidth, max_realizations, realizations)
+    _check_confidence(confidence)
+    judge = make_judge(classify, flag("lyapunov", lyapunov), flag("check_step", check_step),
+                       extend_to)  # fmt: skip
+    runs = len(cells) * (adaptive["max_realizations"] if adaptive else realizations)
+    eng = resolve_engine(judge, by_size(device, runs), base, num, (duration, transient),
+                         workers, scheduler)  # fmt: skip
+    check_sweep_budget(base, num, runs=runs, duration=duration, transient=transient,
+                       judge=judge, workers=workers, keeps_sections=False,
+                       what="this regime map", fate=fate,
+                       reduce="the grid, the realizations or the duration")  # fmt: skip
+    config = {
+        "kind": "regime_map", "version": __version__, "base": base.to_dict(),
+        "numerics": num.to_dict(), "x": x.to_dict(), "y": y.to_dict(),
+        "realizations": realizations, "seed": int(seed), "duration": duration,
+        "transient": transient, "classifier": judge.identity(), "device": eng.device,
+        "code": code_identity(), "adaptive": adaptive, "confidence": float(confidence),
+        "index_scheme": "cantor(cell, index)",
+        "deterministic_cells": "run once (sigma = 0, or the fractal stiffness)", "fate": fate,
+    }  # fmt: skip
     cells["deterministic"] = [c in once for c in range(len(cells))]
+    xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
 
-    def make_task(c: int, i: int) -> RealizationTask:
-        p = base.replace(**{x.name: float(xs[c]), y.name: float(ys[c])})
-        return RealizationTask(
-            c,
-            i,
-            int(seed),
-            realization_index(c, i),
-            p,
-            duration,
-            transient,
-            classify,
-            series,
-            fate,
-        )
+    def make_task(c: int, i: int) -> Realization:
+        p, n = cell_params(base, num, {x.name: float(xs[c]), y.name: float(ys[c])})
+        return Realization((c, i), p, n, int(seed), realization_index(c, i), duration,
+                           transient, fate, {"cell": c, "index": i})  # fmt: skip
 
     def build(records: list[dict[str, Any]]) -> RegimeMap:
         rows = _rows(records, cells, x, y)
         return RegimeMap(rows, summarize_cells(rows, cells, confidence=confidence), config)
 
-    plan = _RegimePlan(
-        make_task,
-        len(cells),
-        realizations,
-        batch=realizations,
-        cap=adaptive["max_realizations"] if adaptive else realizations,
-        target=adaptive["target_halfwidth"] if adaptive else None,
-        confidence=confidence,
-        once=once,
-    )
+    cap = adaptive["max_realizations"] if adaptive else realizations
+    target = adaptive["target_halfwidth"] if adaptive else None
+    plan = _RegimePlan(make_task, len(cells), realizations, realizations, cap, target,
+                       confidence, once)  # fmt: skip
     return run_sweep(
-        plan,
-        eng,
-        out=None if out is None else Path(out),
-        second="cells",
-        config=config,
-        keys=("cell", "index"),
-        read=read_regime_map,
-        build=build,
-        resume=resume,
-        force=force,
-        flush_interval=flush_interval,
-        workers=workers,
-        scheduler=scheduler,
-        progress=progress,
-        desc="regime map",
+        plan, eng, out=None if out is None else Path(out), second="cells", config=config,
+        keys=("cell", "index"), read=read_regime_map, build=build, resume=resume,
+        force=force, flush_interval=flush_interval, workers=workers, scheduler=scheduler,
+        progress=show_progress(progress), desc="regime map",
+    )  # fmt: skip
+
+
+RANDOM_REALIZATIONS = 20
+"""Realizations per cell by default when some cell has a random line length."""
+
+
+def _realizations(given, random: bool) -> int:
+    if given is None:
+        return RANDOM_REALIZATIONS if random else 1
+    return whole("realizations", given, low=1)
+
+
+def _deterministic_cells(base, num, cells, x: Axis, y: Axis) -> frozenset[int]:
+    """Cells whose realizations are all the same run (sigma = 0, or the fractal stiffness,
+    which the line length does not change): computed once and reported as such."""
+    xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
+    return frozenset(
+        c
+        for c in range(len(cells))
+        if realizations_identical(
+            cell_params(base, num, {x.name: float(xs[c]), y.name: float(ys[c])})[0]
+        )
     )
+
+
+def _adaptive(target_halfwidth, max_realizations, realizations: int) -> dict | None:
+    """The adaptive sampling settings, checked; None without a target."""
+    if target_halfwidth is None:
+        if max_realizations is not None:
+            raise SweepError(
+                "max_realizations (--max-realizations) applies only with target_halfwidth "
+                "(--target-halfwidth)"
+            )
+        return None
+    if isinstance(target_halfwidth, bool) or not (
+        isinstance(target_halfwidth, numbers.Real) and 0.0 < target_halfwidth < 0.5
+    ):
+        raise SweepError(f"target half-width = {target_halfwidth!r} must be in (0, 0.5)")
+    cap = (
+        DEFAULT_CAP
+        if max_realizations is None
+        else whole("max realizations", max_realizations, low=1)
+    )
+    if cap < realizations:
+        raise SweepError(f"max realizations = {cap} is below realizations = {realizations}")
+    return {"target_halfwidth": float(target_halfwidth), "max_realizations": cap,
+            "batch": realizations}  # fmt: skip
+
+
+def _check_confidence(confidence) -> None:
+    if isinstance(confidence, bool) or not (
+        isinstance(confidence, numbers.Real) and 0.0 < confidence < 1.0
+    ):  # before any run: summarize_cells would refuse it only at the end
+        raise SweepError(f"confidence = {confidence!r}: the intervals' level, in (0, 1), e.g. 0.95")
 
 
 def mu_sigma_axes(mu: str, sigma: str) -> tuple[Axis, Axis]:

@@ -1,13 +1,12 @@
 """One realization of a finished sweep, run again alone.
 
 A regime map's or a bifurcation diagram's table row, with the sweep's ``config``, records all
-that fixes its realization: the base parameters, the swept values, the window (duration,
-transient), the seed and the simulate index, and for a diagram the initial state (which a
-continued branch took from the previous value's run). :func:`replay` simulates that
-realization with :func:`chaoscam.simulate`, the run the sweep classified bit for bit (every
-engine runs the same compiled kernel per member, docs/speed.md, "Compilation"), so one cell or value
-can be looked at, plotted, or classified again with other options, for instance at half the
-step (``classify_trajectory(replay(rm, row), check_step=True)``).
+that fixes its realization: the base model and numerics, the swept values, the window
+(duration, transient), the seed and the solve index, and for a diagram the initial state
+(which a continued branch took from the previous value's run). :func:`replay` solves that
+realization alone, the run the sweep classified bit for bit, so one cell or value can be
+looked at, plotted, or classified again with other options, for instance at half the step
+(``classify(replay(rm, 3), check_step=True)``).
 """
 
 from __future__ import annotations
@@ -16,10 +15,14 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from .._checks import flag
-from .._simulate import Trajectory, simulate
+from .._util import flag
 from ..model import Params
-from ._tasks import OUTPUT_DT
+from ..numerics import Numerics
+from ..simulation import Solution, simulate
+from ._grid import cell_params
+
+OUTPUT_DT = 1e-3
+"""Series sampling of a replayed run [s], or dt where dt is coarser."""
 
 __all__ = ["replay", "replay_params"]
 
@@ -58,63 +61,74 @@ def _sweep_config(sweep: Any) -> dict[str, Any]:
     return {**cfg, "kind": kind}
 
 
-def replay_params(sweep: Any, row: Any) -> Params:
-    """The parameters of ``row``'s realization: the sweep's base with the row's axis values
-    (and, for a diagram, its initial state; NaN = in contact with the cam)."""
+def replay_params(sweep: Any, row: Any) -> tuple[Params, Numerics]:
+    """The model and numerics of ``row``'s realization: the sweep's base with the row's axis
+    values (and, for a diagram, its initial state; NaN = in contact with the cam)."""
     cfg = _sweep_config(sweep)
-    base = Params(**cfg["base"])
+    row = _row(sweep, cfg, row)
+    base, num = Params(**cfg["base"]), Numerics(**cfg.get("numerics", {}))
     if cfg["kind"] == "regime_map":
         names = (cfg["x"]["name"], cfg["y"]["name"])
-        return base.replace(**{n: float(_field(row, n)) for n in names})
+        return cell_params(base, num, {n: float(_field(row, n)) for n in names})
+    p, num = cell_params(base, num, {cfg["axis"]["name"]: float(_field(row, "value"))})
     th, om = (float(_field(row, k)) for k in ("theta_f0", "omega_f0"))
-    return base.replace(
-        **{cfg["axis"]["name"]: float(_field(row, "value"))},
-        theta_f0=None if math.isnan(th) else th,
-        omega_f0=None if math.isnan(om) else om,
-    )
+    p = p.replace(theta_f0=None if math.isnan(th) else th, omega_f0=None if math.isnan(om) else om)
+    return p, num
 
 
-def replay(sweep: Any, row: Any, *, tangent: bool = True, refine: int = 0) -> Trajectory:
-    """Simulate ``row``'s realization alone, as the sweep ran it.
+def _row(sweep: Any, cfg: dict, row: Any) -> Any:
+    """``row`` itself, or for a whole number the table's row at that position."""
+    import numbers
+
+    if isinstance(row, numbers.Integral) and not isinstance(row, bool):
+        table = sweep.realizations if cfg["kind"] == "regime_map" else sweep.verdicts
+        if not 0 <= int(row) < len(table):
+            raise IndexError(f"row {row}: the table has {len(table)} rows")
+        return table.iloc[int(row)]
+    return row
+
+
+def replay(sweep: Any, row: Any, *, tangent: bool = True, refine: int = 0) -> Solution:
+    """Solve ``row``'s realization alone, as the sweep ran it.
 
     Parameters
     ----------
     sweep : RegimeMap or Bifurcation
         The finished sweep (``regime_map``, ``bifurcation``, ``read_regime_map``,
         ``read_bifurcation``).
-    row : pandas row, namedtuple or mapping
-        One row of ``sweep.realizations`` (regime map) or ``sweep.verdicts`` (diagram).
+    row : int, pandas row, namedtuple or mapping
+        A row number or one row of ``sweep.realizations`` (regime map) or ``sweep.verdicts``
+        (diagram).
     tangent : bool
-        Also integrate the tangent dynamics, and keep the run resumable, as the sweeps do for
-        the default classifier (RK4 only): ``classify_trajectory`` then reads its Jacobians
-        and extends it without simulating it again.
+        Also integrate the tangent dynamics, and keep the run resumable, as the sweeps do
+        (RK4 only): :func:`chaoscam.classify` then reads its Jacobians and extends it without
+        solving it again.
     refine : int
-        Halve the step this many times (:meth:`Params.refined`: RK4's ``dt / 2**refine``;
-        the adaptive path's tolerances / 32 each time), the same realization otherwise: the
-        rungs of a step ladder (``analyses/step_audit.py --ladder``). 0: the sweep's run.
+        Halve the step this many times (:meth:`Numerics.refined`), the same realization
+        otherwise: the rungs of a step ladder. 0: the sweep's run.
 
     Returns
     -------
-    Trajectory
-        Duration, transient, seed and index of the sweep; the series sampled every 1 ms (or
-        every dt where dt is coarser), as in the default classifier's runs. The motion does
-        not depend on it (asking for a series never changes a run), but a sweep run with a
-        classifier that declared ``needs_series = False`` classified its runs without one.
+    Solution
+        Of one member: duration, transient, seed and index of the sweep, the series sampled
+        every 1 ms (or every dt where dt is coarser). The motion does not depend on it.
     """
     cfg = _sweep_config(sweep)
-    p = replay_params(sweep, row)
+    row = _row(sweep, cfg, row)
+    p, num = replay_params(sweep, row)
     if isinstance(refine, bool) or not isinstance(refine, int) or refine < 0:
         raise ValueError(f"refine = {refine!r}: must be an integer >= 0 (step halvings)")
     for _ in range(refine):
-        p = p.refined()
-    tangent = flag("tangent", tangent) and p.integrator == "rk4"
+        num = num.refined()
+    tangent = flag("tangent", tangent) and num.integrator == "rk4"
     return simulate(
         p,
+        num,
         duration=float(cfg["duration"]),
         transient=float(cfg["transient"]),
         seed=int(_field(row, "seed")),
         index=int(_field(row, "sim_index")),
-        output_dt=max(OUTPUT_DT, p.dt),
+        output_dt=max(OUTPUT_DT, num.dt),
         tangent=tangent,
         resumable=tangent,
     )

@@ -36,8 +36,9 @@ A run that leaves the cam's reach or diverges is labelled by its status and coun
 any other label; it is never dropped. Ties for the dominant label go to the earlier one.
 """
 
-LYAPUNOV_EVIDENCE = "lyapunov_model"
-"""Name of the evidence item holding the model's largest Lyapunov exponent [1/s]."""
+LYAPUNOV_EVIDENCE = "lyapunov_1"
+"""Name of the evidence item holding a run's largest Lyapunov exponent [1/s] (the tangent
+spectrum's, recorded with ``lyapunov=True``)."""
 
 
 def wilson_interval(k, n, confidence: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
@@ -114,7 +115,7 @@ def summarize_cells(
     ----------
     rows : DataFrame
         One row per realization with columns ``cell``, ``label``, ``truncated_mass`` and,
-        when the classifier gave it, ``ev_lyapunov_model``.
+        with ``lyapunov=True``, ``ev_lyapunov_1``.
     cells : DataFrame
         One row per cell: ``cell``, ``ix``, ``iy`` and the two axis values; with a boolean
         column ``deterministic``, such cells (one run standing for identical realizations)

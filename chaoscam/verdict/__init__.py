@@ -5,7 +5,7 @@ tangent dynamics' own results (:func:`lyapunov_spectrum`, :func:`periodic_orbit`
 :func:`kick_test`, the stroboscopic map) live here too."""
 
 from ._certificate import MODEL_ATOL, Certificate, certify, on_orbit
-from ._classify import EXTEND_TO, classify, judge_member
+from ._classify import EXTEND_TO, classify, judge_member, judge_points
 from ._orbits import (
     KickTest,
     PeriodicOrbit,
@@ -32,6 +32,7 @@ __all__ = [
     "extension_stopped",
     "iterate_map",
     "judge_member",
+    "judge_points",
     "kick_test",
     "lyapunov_spectrum",
     "on_orbit",

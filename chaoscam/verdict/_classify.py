@@ -34,7 +34,7 @@ from ..analysis import (
 )
 from ..kernel import Status, check_stop
 from ..model import realizations_identical
-from ..solve import Solution, extend, solve
+from ..simulation import Solution, extend, solve
 from ._certificate import MODEL_ATOL
 from ._rules import (
     Context,
@@ -46,7 +46,7 @@ from ._rules import (
 )
 from ._step_check import compared, skipped
 
-__all__ = ["EXTEND_TO", "classify", "judge_member"]
+__all__ = ["EXTEND_TO", "classify", "judge_member", "judge_points"]
 
 EXTEND_TO = 120.0
 """Longest recorded time [s] an undetermined verdict is extended to: the labelled sets are
@@ -199,7 +199,14 @@ def judge_member(status, t, kk, xy, jac, p, num, transient: float, options: dict
             "run longer than the transient by several cam periods"
         )
         return Verdict("undetermined", None, (), (why,))
-    points, jacobians = xy[keep], jac[keep]
+    return judge_points(xy[keep], jac[keep], p, num, options)
+
+
+def judge_points(points, jacobians, p, num, options: dict) -> Verdict:
+    """The verdict on section ``points`` (theta_f, theta_f') and the Jacobians of the periods
+    ending at them (one per point) of a run of model ``p``: the section with the tangent
+    exponent, then the model-level rules."""
+    period = p.cam_period
     opts = section_options(options)
     opts.setdefault("atol", (MODEL_ATOL, MODEL_ATOL / period))
     ev = overflow_evidence(jacobians, p, num)

@@ -34,7 +34,7 @@ from ..kernel import Status, section_jacobians
 from ..kernel import layout as k
 from ..model import Params, params_arg, realizations_identical
 from ..numerics import Numerics
-from ..solve import ROOM, Solution, check_run, fresh, numerics_arg, run_batch, solve
+from ..simulation import ROOM, Solution, check_run, fresh, numerics_arg, run_batch, solve
 
 __all__ = [
     "KickTest",

@@ -346,7 +346,7 @@ def overflow_evidence(jacobians, p: Params, num: Numerics) -> Evidence | None:
     is not finite, RK4 past its stability limit in the contact; None when every Jacobian is
     finite. A verdict holding it is undetermined and not extended: a longer run overflows
     too."""
-    from ..solve import resolution_warning
+    from ..simulation import resolution_warning
 
     jac = np.asarray(jacobians, dtype=float)
     if jac.ndim != 3 or not len(jac):

@@ -29,6 +29,9 @@ import os
 from .._util import ParameterError, warn
 
 __all__ = [
+    "WARN_SECONDS",
+    "human_bytes",
+    "human_seconds",
     "estimate",
     "check_budget",
     "check_run",
@@ -220,7 +223,7 @@ def check_run(
     seconds = max(grid, contact)
     if seconds <= RUN_WARN_SECONDS:
         return False
-    text = f"{what} (duration = {float(duration):g} s) will take about {_human_seconds(seconds)}"
+    text = f"{what} (duration = {float(duration):g} s) will take about {human_seconds(seconds)}"
     if contact > grid:
         from ..model import contact_period
 
@@ -245,7 +248,7 @@ def check_run(
     return True
 
 
-def _human_bytes(n: float) -> str:
+def human_bytes(n: float) -> str:
     for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
         if n < 1024 or unit == "PiB":
             return f"{n:.3g} {unit}"
@@ -253,7 +256,7 @@ def _human_bytes(n: float) -> str:
     return f"{n:.3g} PiB"  # pragma: no cover
 
 
-def _human_seconds(s: float) -> str:
+def human_seconds(s: float) -> str:
     if s < 120:
         return f"{s:.3g} s"
     if s < 3600:
@@ -283,14 +286,14 @@ def check_budget(job: JobEstimate, *, what: str, reduce: str, run: tuple | None 
     free = available_memory()
     if not math.isfinite(job.bytes) or job.bytes > free:
         raise ParameterError(
-            f"{what} needs about {_human_bytes(job.bytes)} of memory and this machine has "
-            f"{_human_bytes(free)} available: reduce {reduce}"
+            f"{what} needs about {human_bytes(job.bytes)} of memory and this machine has "
+            f"{human_bytes(free)} available: reduce {reduce}"
         )
     if run is not None and check_run(**run):
         return
     if job.seconds > WARN_SECONDS:
         warn(
-            f"{what} will take about {_human_seconds(job.seconds)} (a coarse estimate: "
+            f"{what} will take about {human_seconds(job.seconds)} (a coarse estimate: "
             f"{NS_PER_STEP:g} ns per step of dt, more on the adaptive path in contact); "
             f"reduce {reduce} for a shorter run"
         )

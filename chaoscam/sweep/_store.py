@@ -76,7 +76,7 @@ def checkpoint_dir(out: Path) -> Path:
 
 
 def _atomic_write(path: Path, data: bytes) -> None:
-    from .._outputs import atomic_write_bytes
+    from ..io import atomic_write_bytes
 
     atomic_write_bytes(path, data)
 
@@ -357,12 +357,12 @@ def write_parquet(
     (``replace=False``: never over a file that exists; :func:`chaoscam._outputs.atomic_path`)."""
     import pyarrow as pa
 
-    from .._parquet import write_table
+    from ..io import write_table
 
     table = pa.Table.from_pandas(frame, preserve_index=False)
     meta = dict(table.schema.metadata or {})
     meta[_META_KEY] = json.dumps({"hash": config_hash(config), "config": config}).encode()
-    from .._outputs import atomic_path
+    from ..io import atomic_path
 
     with atomic_path(path, replace=replace) as tmp:
         write_table(table.replace_schema_metadata(meta), tmp)
