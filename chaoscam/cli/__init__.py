@@ -22,6 +22,7 @@ if TYPE_CHECKING:
     import argparse
 
     from ..model import Params
+    from ..numerics import Numerics
 
 __all__ = ["entry", "main", "parse_assignments", "show_warning", "stop_word", "UsageError"]
 
@@ -39,9 +40,11 @@ class UsageError(Exception):
     """Bad command-line input: printed as ``chaoscam: error: ...`` with exit code 2."""
 
 
-def parse_assignments(items: list[str] | None, base: Params | None = None) -> Params:
-    """Params from ``--set NAME=VALUE`` items."""
-    from ..model import Params
+def parse_assignments(items: list[str] | None) -> tuple[Params, Numerics]:
+    """The model and numerics of ``--set NAME=VALUE`` items (each name a field of one of them)."""
+    from .._util import ParameterError, unknown_message
+    from ..model import Params, field_names, parse_value
+    from ..numerics import Numerics
 
     pairs: dict[str, str] = {}
     for item in items or []:
@@ -54,7 +57,13 @@ def parse_assignments(items: list[str] | None, base: Params | None = None) -> Pa
                 "give each parameter once"
             )
         pairs[name.strip()] = value
-    return Params.from_strings(pairs, base=base)
+    steps = Numerics.field_names()
+    for name in pairs:
+        if name not in field_names() and name not in steps:
+            raise ParameterError(unknown_message(name, (*field_names(), *steps)))
+    model = {k: parse_value(k, v) for k, v in pairs.items() if k not in steps}
+    numerics = {k: Numerics.parse(k, v) for k, v in pairs.items() if k in steps}
+    return Params(**model), Numerics(**numerics)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -287,8 +296,8 @@ def _mute_stdout() -> None:
 def _dispatch(argv: list[str] | None) -> int:
     import warnings
 
-    from .._outputs import OutputError
-    from ..model import ParameterError
+    from .._util import ParameterError
+    from ..io import OutputError
 
     parser = build_parser()
     args, extra = parser.parse_known_args(

@@ -15,34 +15,22 @@ def register(sub) -> None:
     p = sub.add_parser(
         "classify",
         help="classify a simulated trajectory (Parquet) as periodic/quasiperiodic/chaotic",
-        description="Classify a trajectory written by `chaoscam simulate --out FILE.parquet`: "
-        "evidence from its stroboscopic section and theta_f(t) series, printed as JSON "
+        description="Classify a trajectory written by `chaoscam simulate --out FILE.parquet` "
+        "from its stroboscopic section and the tangent exponent through the impacts (with "
+        "the periodic-orbit certificate for the deterministic model), printed as JSON "
         "(label, period, evidence, reasons; and, when an undetermined verdict was settled "
         "by running the realization longer, extended: the recorded time it took).",
     )
     p.add_argument("trajectory", type=path_arg, metavar="TRAJ.parquet")
-    p.add_argument(
-        "--no-tangent",
-        action="store_true",
-        help="classify from the section and series alone, without the tangent exponent "
-        "through the impacts and the periodic-orbit certificate (the default uses both)",
-    )
     p.add_argument(
         "--no-extend",
         action="store_true",
         help="do not run an undetermined realization longer (default: up to 120 s recorded)",
     )
     p.add_argument(
-        "--lyapunov",
-        action="store_true",
-        help="use the two-trajectory exponent and the series-based evidence instead of the "
-        "tangent verdict (no orbit certificate, no extension; kept for comparison, about "
-        "twice the run's cost)",
-    )
-    p.add_argument(
         "--check-step",
         action="store_true",
-        help="re-simulate with dt/2 and report undetermined if the verdict changes",
+        help="judge the realization at dt/2 too and report undetermined if the verdict changes",
     )
     p.add_argument(
         "--discard",
@@ -89,26 +77,24 @@ def _print(verdict) -> None:
 
 
 def run_classify(args: argparse.Namespace) -> int:
-    from .._trajectory_io import TrajectoryFileError, read_trajectory
-    from ..classify import classify_trajectory
+    from ..simulation import TrajectoryFileError, read_trajectory
+    from ..verdict import EXTEND_TO, classify
     from . import UsageError
 
     try:
         traj = read_trajectory(args.trajectory)
     except TrajectoryFileError as err:
         raise UsageError(str(err)) from None
-    verdict = classify_trajectory(
+    (verdict,) = classify(
         traj,
-        tangent=not args.no_tangent,
-        extend_to=None if args.no_extend else 120.0,
-        lyapunov=args.lyapunov,
+        extend_to=None if args.no_extend else EXTEND_TO,
         check_step=args.check_step,
         discard=args.discard,
     )
     out = verdict.to_dict()
     extended = verdict.settings.get("extended")
     if extended:  # the evidence is that of the longer run: say how long (not the wall time)
-        out["extended"] = {k: extended[k] for k in ("recorded_s", "continued_from_s", "why")}
+        out["extended"] = {k: extended[k] for k in ("recorded_s", "why")}
     print(json.dumps(out, indent=2, ensure_ascii=False))
     return 0
 
@@ -176,7 +162,7 @@ def run_classify_series(args: argparse.Namespace) -> int:
             f"{path}: {rows.size} row(s) with NaN or infinite values in "
             f"{', '.join(args.column)} (first at data row {int(rows[0]) + 1}); remove them"
         )
-    from .._trajectory_io import TrajectoryFileError, check_enough
+    from ..simulation import TrajectoryFileError, check_enough
 
     try:
         check_enough(len(data), "rows", path, "record a longer signal")

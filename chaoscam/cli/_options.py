@@ -9,7 +9,14 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-__all__ = ["add_run_options", "path_arg"]
+__all__ = [
+    "add_engine_options",
+    "add_run_options",
+    "add_sweep_options",
+    "engine_settings",
+    "path_arg",
+    "sweep_settings",
+]
 
 
 def path_arg(text: str) -> Path:
@@ -32,7 +39,8 @@ def add_run_options(p, *, transient: float | None) -> None:
         action="append",
         metavar="NAME=VALUE",
         default=[],
-        help="override a model parameter (repeatable), e.g. --set omega=30",
+        help="override a model parameter or numerics setting (repeatable), e.g. --set "
+        "omega=30 or --set dt=1e-6; `chaoscam params` lists them",
     )
     p.add_argument("--duration", type=float, default=20.0, help="simulated time [s] (default 20)")
     p.add_argument(
@@ -43,3 +51,119 @@ def add_run_options(p, *, transient: float | None) -> None:
         + ("half the duration)" if transient is None else f"{transient:g})"),
     )
     p.add_argument("--seed", type=int, default=0, help="master seed of the line-length process")
+
+
+def add_engine_options(p) -> None:
+    """How a sweep (or an ensemble) judges its runs and where its batches run."""
+    p.add_argument(
+        "--lyapunov",
+        action="store_true",
+        help="also record each run's tangent Lyapunov spectrum (lambda_1 with its standard "
+        "error, lambda_2; 1/s): a regime map's per-cell top exponent",
+    )
+    p.add_argument(
+        "--check-step",
+        action="store_true",
+        help="judge each realization at dt/2 too; a changed verdict becomes undetermined",
+    )
+    p.add_argument(
+        "--classifier",
+        metavar="MODULE:NAME",
+        default=None,
+        help="a classifier of one's own instead of chaoscam.classify: a function, or a class "
+        "instantiated without arguments, taking one run (a chaoscam.Solution)",
+    )
+    p.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="threads, one batch each (default: every core); with --scheduler local, the "
+        "local Dask cluster's workers",
+    )
+    p.add_argument(
+        "--device",
+        choices=("cpu", "gpu", "auto"),
+        default="cpu",
+        help="where the batches run (gpu: NVIDIA, numba-cuda; equal to the CPU only within "
+        "GPU_TOLERANCE; auto: the GPU where one runs and there are 4,096 runs or more); "
+        "default cpu",
+    )
+
+
+def engine_settings(args) -> dict:
+    """The keyword arguments of :func:`add_engine_options`' options for a sweep."""
+    from . import UsageError
+
+    classify = None
+    if args.classifier is not None:
+        from ..sweep import load_classifier
+
+        try:
+            classify = load_classifier(args.classifier)
+        except (ValueError, ImportError, AttributeError) as err:
+            raise UsageError(f"--classifier {args.classifier}: {err}") from None
+    return dict(
+        classify=classify,
+        lyapunov=args.lyapunov,
+        check_step=args.check_step,
+        workers=args.workers,
+        device=args.device,
+    )
+
+
+def add_sweep_options(p) -> None:
+    """Where a sweep's outputs go, and how it is checkpointed, resumed and shown."""
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        default=None,
+        help="run on Dask: tcp://HOST:PORT of a running scheduler, or 'local' for a local "
+        "cluster on 127.0.0.1",
+    )
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="finish an interrupted run of the same command from its checkpoint",
+    )
+    p.add_argument(
+        "--checkpoint-interval",
+        type=float,
+        default=1.0,
+        metavar="S",
+        help="seconds between checkpoint writes (default 1; 0 = after every run)",
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="start over: replace existing outputs and discard an existing checkpoint",
+    )
+    p.add_argument("--out", type=path_arg, required=True, help="output FILE.parquet")
+
+
+def sweep_settings(args) -> dict:
+    """The keyword arguments of :func:`add_sweep_options`' options, checked."""
+    import math
+
+    from . import UsageError
+
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers {args.workers}: must be >= 1")
+    if args.scheduler not in (None, "local") and args.workers is not None:
+        raise UsageError("--workers applies to local runs and --scheduler local only")
+    if args.out.suffix != ".parquet":
+        raise UsageError(f"--out {args.out}: the output must end in .parquet")
+    if not (math.isfinite(args.checkpoint_interval) and args.checkpoint_interval >= 0):
+        raise UsageError(
+            f"--checkpoint-interval {args.checkpoint_interval}: must be a finite number >= 0"
+        )
+    if args.force and args.resume:
+        raise UsageError("--force starts over and --resume continues: give one of them")
+    return dict(
+        scheduler=args.scheduler,
+        out=args.out,
+        resume=args.resume,
+        progress=not args.quiet,
+        flush_interval=args.checkpoint_interval,
+        force=args.force,
+    )

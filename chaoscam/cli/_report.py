@@ -35,7 +35,7 @@ def register(sub) -> None:
     p = sub.add_parser(
         "paper",
         help="reproduce the paper's Figs. 3-10 and write the comparison report",
-        description="Run the figure scripts (chaoscam.experiments: Figs. 3-10 and the "
+        description="Run the figure scripts (chaoscam.paper: Figs. 3-10 and the "
         "sensitivity sweeps), write each "
         "figure's data and PNG next to the report (DIR/paper-data/), and build the HTML "
         "report comparing the paper's statements with what this run finds.",
@@ -62,7 +62,7 @@ def register(sub) -> None:
         "--workers",
         type=int,
         default=None,
-        help="worker processes for the sweeps (default: every core)",
+        help="threads for the sweeps (default: every core)",
     )
     p.add_argument(
         "--force",
@@ -79,14 +79,13 @@ def register(sub) -> None:
 
 
 def _check_out(out: Path, force: bool) -> None:
-    from .._outputs import check_output
+    from ..io import check_output
 
     check_output(out, force=force, suffixes=(".html",))
 
 
 def run_report(args: argparse.Namespace) -> int:
-    from ..report._html import build_report, write_report
-    from ..report._inputs import InputError, load_inputs
+    from ..report import InputError, build_report, load_inputs, write_report
     from . import UsageError
 
     _check_out(args.out, args.force)
@@ -105,9 +104,9 @@ def run_report(args: argparse.Namespace) -> int:
 
 
 def run_paper(args: argparse.Namespace) -> int:
-    from ..experiments import FIGURES
-    from ..experiments import run_paper as _run
-    from ..sweep._backends import local_workers
+    from ..paper import FIGURES
+    from ..paper import run_paper as _run
+    from ..sweep import local_workers
     from . import UsageError
 
     if args.force and args.resume:
@@ -149,7 +148,7 @@ def run_paper(args: argparse.Namespace) -> int:
             resume=args.resume,
         )
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM: say what is kept and how to go on, once
-        from ..experiments._run import RESUME_HINT
+        from ..paper import RESUME_HINT
         from . import stop_word
 
         print(f"chaoscam: {stop_word()}; {RESUME_HINT}", file=sys.stderr)

@@ -29,7 +29,7 @@ def register(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from .._outputs import check_output, lock_all
+    from ..io import check_output, lock_all
 
     out = check_output(args.out, force=args.force, suffixes=(".parquet", ".csv"))
     section = check_output(args.section, flag="--section", force=args.force, suffixes=(".csv",))
@@ -58,11 +58,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace, out, section, impacts, written: list) -> int:
-    from .._outputs import atomic_path
-    from .._simulate import raw_run
+    from ..io import atomic_path
+    from ..simulation import simulate
     from . import parse_assignments, show_warning
 
-    params = parse_assignments(args.set)
+    params, numerics = parse_assignments(args.set)
     settings = dict(
         duration=args.duration,
         transient=args.transient,
@@ -80,15 +80,13 @@ def _run(args: argparse.Namespace, out, section, impacts, written: list) -> int:
     with warnings.catch_warnings():
         warnings.simplefilter("always")
         warnings.showwarning = note
-        run_ = raw_run(params, **settings)
-    print(run_.summary())
-    if out is None and section is None and impacts is None:
-        return _exit_code(run_, notes)  # nothing to write: no tables (and no pandas) needed
-    traj = run_.trajectory()
+        traj = simulate(params, numerics, **settings)
+    print(traj.summary())
+    impact_rows = traj.impacts.drop(columns="member")
     for path, label, write in (
         (out, "series", _series_writer(traj, out)),
         (section, "section", lambda tmp: traj.section.to_csv(tmp, index=False)),
-        (impacts, "impacts", lambda tmp: traj.impacts.to_csv(tmp, index=False)),
+        (impacts, "impacts", lambda tmp: impact_rows.to_csv(tmp, index=False)),
     ):
         if path is not None:
             try:
@@ -109,7 +107,7 @@ def _run(args: argparse.Namespace, out, section, impacts, written: list) -> int:
 def _distinct(*named) -> None:
     """Refuse two outputs of one run that name the same file (the second would replace the
     first)."""
-    from .._outputs import OutputError
+    from ..io import OutputError
 
     seen: dict = {}
     for flag, path in named:
@@ -123,16 +121,16 @@ def _distinct(*named) -> None:
 
 def _series_writer(traj, out):
     if out is not None and out.suffix.lower() == ".parquet":
-        from .._parquet import write_table
+        from ..io import write_table
 
         return lambda tmp: write_table(traj.parquet_table(), tmp)
-    return lambda tmp: traj.series.to_csv(tmp, index=False)
+    return lambda tmp: traj.series.drop(columns="member").to_csv(tmp, index=False)
 
 
 def _exit_code(traj, notes: list[str]) -> int:
     """0 when the run simulated what was asked; else 1, with the cause on stderr (and the
     step-size warning first when there was one: it is then the likely cause)."""
-    from ..integrate import Status
+    from ..kernel import Status
 
     if traj.status is Status.OK:
         return 0

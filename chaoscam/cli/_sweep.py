@@ -3,11 +3,17 @@
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
-from ._options import add_run_options, path_arg
+from ._options import (
+    add_engine_options,
+    add_run_options,
+    add_sweep_options,
+    engine_settings,
+    path_arg,
+    sweep_settings,
+)
 
 __all__ = ["register"]
 
@@ -16,69 +22,7 @@ _PLOT_SUFFIXES = (".png", ".pdf", ".svg")
 
 def _common(p: argparse.ArgumentParser) -> None:
     add_run_options(p, transient=None)
-    p.add_argument(
-        "--lyapunov",
-        action="store_true",
-        help="classify with the model's two-trajectory Lyapunov exponent and the "
-        "series-based evidence instead of the default tangent verdict (no orbit certificate, "
-        "no extension; kept for comparison, about twice the cost)",
-    )
-    p.add_argument(
-        "--check-step",
-        action="store_true",
-        help="re-run each realization with dt/2; a changed verdict becomes undetermined",
-    )
-    p.add_argument(
-        "--classifier",
-        metavar="MODULE:NAME",
-        default=None,
-        help="a classifier other than chaoscam.classify.classify_trajectory: a function, or "
-        "a class instantiated without arguments, importable by the workers",
-    )
-    p.add_argument(
-        "--workers",
-        type=int,
-        default=None,
-        help="cores: worker processes, or the ensemble engine's threads (default: every "
-        "core; 1 = this process, one thread); with --scheduler local, the local Dask "
-        "cluster's workers",
-    )
-    p.add_argument(
-        "--engine",
-        choices=("auto", "ensemble", "process"),
-        default="auto",
-        help="ensemble: realizations in batches through the compiled ensemble call (threads "
-        "over the cores), labelled from section and tangent exponent; process: one worker "
-        "process per core, one task per realization, any classifier; auto (default): "
-        "ensemble for the default classifier, else process",
-    )
-    p.add_argument(
-        "--device",
-        choices=("cpu", "gpu", "auto"),
-        default="cpu",
-        help="where the ensemble engine runs its batches (gpu: NVIDIA, numba-cuda; equal to "
-        "the CPU only within GPU_TOLERANCE; auto: the GPU where one runs and the sweep has "
-        "4,096 runs or more); default cpu",
-    )
-    p.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        default=None,
-        help="run on Dask: tcp://HOST:PORT of a running scheduler, or 'local' for a local "
-        "cluster on 127.0.0.1",
-    )
-    p.add_argument(
-        "--resume",
-        action="store_true",
-        help="finish an interrupted run of the same command from its checkpoint",
-    )
-    p.add_argument(
-        "--checkpoint-interval",
-        type=float,
-        default=1.0,
-        metavar="S",
-        help="seconds between checkpoint writes (default 1; 0 = after every run)",
-    )
+    add_engine_options(p)
     p.add_argument(
         "--fate",
         type=float,
@@ -95,13 +39,7 @@ def _common(p: argparse.ArgumentParser) -> None:
         default=None,
         help="also draw the figure to FILE (.png, .pdf or .svg)",
     )
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument(
-        "--force",
-        action="store_true",
-        help="start over: replace existing outputs and discard an existing checkpoint",
-    )
-    p.add_argument("--out", type=path_arg, required=True, help="output FILE.parquet")
+    add_sweep_options(p)
 
 
 def register(sub) -> None:
@@ -151,7 +89,12 @@ def register(sub) -> None:
         "--y", metavar="NAME=START:STOP:NUM|V1,V2,...", help="second axis (instead of --sigma)"
     )
     r.add_argument(
-        "--realizations", type=int, default=1, metavar="N", help="realizations per cell (default 1)"
+        "--realizations",
+        type=int,
+        default=None,
+        metavar="N",
+        help="realizations per cell (default 20 where a cell has a random line length, "
+        "else 1)",
     )
     r.add_argument(
         "--target-halfwidth",
@@ -173,45 +116,15 @@ def register(sub) -> None:
 
 
 def _execution(args) -> dict:
-    from .._outputs import check_output
-    from ..sweep._tasks import load_classifier
-    from . import UsageError
+    from ..io import check_output
 
-    if args.workers is not None and args.workers < 1:
-        raise UsageError(f"--workers {args.workers}: must be >= 1")
-    if args.scheduler not in (None, "local") and args.workers is not None:
-        raise UsageError("--workers applies to local runs and --scheduler local only")
-    if args.out.suffix != ".parquet":
-        raise UsageError(f"--out {args.out}: the output must end in .parquet")
-    if not (math.isfinite(args.checkpoint_interval) and args.checkpoint_interval >= 0):
-        raise UsageError(
-            f"--checkpoint-interval {args.checkpoint_interval}: must be a finite number >= 0"
-        )
-    if args.force and args.resume:
-        raise UsageError("--force starts over and --resume continues: give one of them")
     check_output(args.plot, flag="--plot", force=args.force, suffixes=_PLOT_SUFFIXES)
-    classify = None
-    if args.classifier is not None:
-        try:
-            classify = load_classifier(args.classifier)
-        except (ValueError, ImportError, AttributeError) as err:
-            raise UsageError(f"--classifier {args.classifier}: {err}") from None
     return dict(
         duration=args.duration,
         transient=args.transient,
         seed=args.seed,
-        classify=classify,
-        lyapunov=args.lyapunov,
-        check_step=args.check_step,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        engine=args.engine,
-        device=args.device,
-        out=args.out,
-        resume=args.resume,
-        progress=not args.quiet,
-        flush_interval=args.checkpoint_interval,
-        force=args.force,
+        **engine_settings(args),
+        **sweep_settings(args),
         fate=args.fate,
     )
 
@@ -219,7 +132,7 @@ def _execution(args) -> dict:
 def _transient(table) -> str:
     """The summary line of a sweep with a fate horizon: how many runs left later, and how
     many settled on a periodic orbit."""
-    from ..sweep._stats import continued_labels, fate_settled, fate_split
+    from ..sweep import continued_labels, fate_settled, fate_split
 
     checked, left = fate_split(table)
     if not len(checked):
@@ -245,8 +158,7 @@ def _call(fn, **kwargs):
     """Run a sweep; bad settings become usage errors (exit 2); a stopped run returns its
     exit code (130 Ctrl-C, 1 a lost Dask scheduler or a failed task) after saying how to
     resume or reproduce it."""
-    from ..sweep._engine import SweepInterrupted, TaskFailed
-    from ..sweep._grid import SweepError
+    from ..sweep import SweepError, SweepInterrupted, TaskFailed
     from . import UsageError, stop_word
 
     try:
@@ -280,12 +192,11 @@ def _not_set(items: list[str] | None, swept: dict[str, str]) -> None:
 
 
 def run_bifurcation(args: argparse.Namespace) -> int:
-    from ..sweep._bifurcation import bifurcation
-    from ..sweep._common import companion
+    from ..sweep import bifurcation, companion
     from . import parse_assignments
 
     _not_set(args.set, {args.param: "--param"})
-    base = parse_assignments(args.set)
+    base, numerics = parse_assignments(args.set)
     if args.initial_conditions < 1:
         from . import UsageError
 
@@ -295,6 +206,7 @@ def run_bifurcation(args: argparse.Namespace) -> int:
         param=args.param,
         values=args.values,
         base=base,
+        numerics=numerics,
         initial_conditions=args.initial_conditions,
         continuation=args.continuation,
         **_execution(args),
@@ -309,7 +221,7 @@ def run_bifurcation(args: argparse.Namespace) -> int:
         f"points: {args.out}\nverdicts: {companion(args.out, 'verdicts')}"
     )
     if args.plot is not None:
-        from ..report._sweep_figures import sweep_diagram
+        from ..report import sweep_diagram
 
         _save_figure(sweep_diagram(res), args.plot)
         print(f"figure: {args.plot}")
@@ -317,9 +229,7 @@ def run_bifurcation(args: argparse.Namespace) -> int:
 
 
 def run_regime_map(args: argparse.Namespace) -> int:
-    from ..sweep._common import companion
-    from ..sweep._grid import Axis, SweepError
-    from ..sweep._regime import mu_sigma_axes, regime_map
+    from ..sweep import Axis, SweepError, companion, mu_sigma_axes, regime_map
     from . import UsageError, parse_assignments
 
     try:
@@ -337,12 +247,13 @@ def run_regime_map(args: argparse.Namespace) -> int:
     _not_set(
         args.set, {x.name: "--mu" if args.mu else "--x", y.name: "--sigma" if args.sigma else "--y"}
     )
-    base = parse_assignments(args.set)
+    base, numerics = parse_assignments(args.set)
     res = _call(
         regime_map,
         x=x,
         y=y,
         base=base,
+        numerics=numerics,
         realizations=args.realizations,
         target_halfwidth=args.target_halfwidth,
         max_realizations=args.max_realizations,
@@ -361,7 +272,7 @@ def run_regime_map(args: argparse.Namespace) -> int:
         f"realizations: {args.out}\ncells: {companion(args.out, 'cells')}"
     )
     if args.plot is not None:
-        from ..report._sweep_figures import regime_map_figure
+        from ..report import regime_map_figure
 
         _save_figure(
             regime_map_figure(c, x=res.x, y=res.y, confidence=res.config["confidence"]),
@@ -372,7 +283,7 @@ def run_regime_map(args: argparse.Namespace) -> int:
 
 
 def _save_figure(fig, path: Path) -> None:
-    from .._outputs import atomic_path
+    from ..io import atomic_path
 
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=150)
