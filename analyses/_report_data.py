@@ -27,16 +27,16 @@ def sweep_rows(data: Path, stage: str):
 
 
 def deterministic_rows(data: Path, stages, labels):
-    """(stage, sweep, row, params, what) for each row labelled one of ``labels`` in the
-    stages' files, of the deterministic model only (σ = 0: kicks and certificates ask it);
-    ``what`` names the row's axis values (and initial condition) in words."""
+    """(stage, sweep, row, params, numerics, what) for each row labelled one of ``labels`` in
+    the stages' files, of the deterministic model only (σ = 0: kicks and certificates ask
+    it); ``what`` names the row's axis values (and initial condition) in words."""
     for stage in stages:
         sweep, rows, names = sweep_rows(data, stage)
         for _, row in rows[rows.label.isin(labels)].iterrows():
-            p = replay_params(sweep, row)
+            p, num = replay_params(sweep, row)
             if p.l_lambda_sigma > 0:
                 continue
             what = ", ".join(f"{n} = {row[n]:.4g}" for n in names)
             if "ic" in row:
                 what += f", ic {row.ic}"
-            yield stage, sweep, row, p, what
+            yield stage, sweep, row, p, num, what

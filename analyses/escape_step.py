@@ -44,12 +44,13 @@ def main() -> None:
     print("|---|---|")
     window = later = stayed = total = 0
     for name, sweep, row in _rows():
-        p = replay_params(sweep, row)
+        p, num = replay_params(sweep, row)
         cfg = sweep.config
         left = []
         for f in STEPS:
             tr = simulate(
-                p.replace(dt=p.dt / f),
+                p,
+                num.replace(dt=num.dt / f),
                 duration=HORIZON,
                 transient=cfg["transient"],
                 seed=cfg["seed"],

@@ -5,7 +5,7 @@ Usage: python analyses/fig6.py [--quick] [--force] [--workers N] [OUTDIR]
 (default OUTDIR: reports/paper-data; its existing files are replaced only with --force)
 """
 
-from chaoscam.experiments import figure_script
+from chaoscam.paper import figure_script
 
 if __name__ == "__main__":
     figure_script(6)

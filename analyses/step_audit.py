@@ -15,7 +15,7 @@ Usage: python analyses/step_audit.py [--figures 4,6,7,s] [--per-sweep K] [--seed
        (default DATA: reports/paper-data)
 """
 
-from chaoscam.experiments._audit_script import audit_script
+from chaoscam.paper import audit_script
 
 if __name__ == "__main__":
     raise SystemExit(audit_script())

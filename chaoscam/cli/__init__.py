@@ -33,6 +33,7 @@ _COMMAND_MODULES = (
     "chaoscam.cli._classify",
     "chaoscam.cli._sweep",
     "chaoscam.cli._report",
+    "chaoscam.cli._params",
 )
 
 

@@ -1,23 +1,27 @@
-"""Experiments: the paper's figures reproduced, and the sweeps that explain the differences.
+"""The paper: its figures reproduced, and the sweeps that explain the differences.
 
 The computations behind ``chaoscam paper``: one function per paper figure (:mod:`._paper`,
-``figN(quick, outdir) -> FigureResult``), the sensitivity sweeps (:mod:`._sensitivity`), and
-the run that executes them and hands the results to :mod:`chaoscam.report` to render
-(:mod:`._run`). This layer sits above ``report/`` (it uses its figures and HTML), which only
-renders. In Python::
+``figN(quick, outdir) -> FigureResult``), the sensitivity sweeps (:mod:`._sensitivity`), the
+step audit (:mod:`._step_audit`, :mod:`._ladder`), and the run that executes them and hands
+the results to :mod:`chaoscam.report` to render (:mod:`._run`). This layer sits above
+``report/`` (it uses its figures and HTML), which only renders. In Python::
 
-    from chaoscam.experiments import run_paper
+    from chaoscam.paper import run_paper
     run_paper(quick=True, out="out/paper.html")
 """
 
 from __future__ import annotations
 
-from .._lazy import lazy_face
+from .._util import lazy_face
 
 _LAZY = {
     "FIGURES": ("._paper", "FIGURES"),
-    "FigureResult": ("._paper", "FigureResult"),
+    "RESUME_HINT": ("._run", "RESUME_HINT"),
     "SENSITIVITY": ("._paper", "SENSITIVITY"),
+    "FigureResult": ("._stage", "FigureResult"),
+    "PaperRun": ("._run", "PaperRun"),
+    "audit_script": ("._audit_script", "audit_script"),
+    "check_paper_outputs": ("._run", "check_paper_outputs"),
     "data_files": ("._paper", "data_files"),
     "figure_script": ("._run", "figure_script"),
     "run_paper": ("._run", "run_paper"),

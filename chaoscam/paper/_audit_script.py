@@ -12,7 +12,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._paper import FULL_EXTEND_TO, G_FIG6, _fig6_tag
+from ._paper import G_FIG6, _fig6_tag
+from ._stage import FULL_EXTEND_TO
 from ._step_audit import AUDIT_SEED, PER_SWEEP, step_audit, sweep_names
 
 __all__ = ["SENSITIVITY_KEY", "SWEEP_FILES", "read_sweeps", "audit_script"]
@@ -61,11 +62,12 @@ def _how(folder: Path, number) -> str:
 
 def _read_sweep(path: Path):
     """The diagram or regime map in ``path``, as its sweep record says it is."""
-    from ..sweep import read_bifurcation, read_regime_map
-    from ..sweep._checkpoint import read_sweep_metadata
+    from ..sweep import SweepError, read_bifurcation, read_regime_map
 
-    kind = ((read_sweep_metadata(path) or {}).get("config") or {}).get("kind")
-    return read_regime_map(path) if kind == "regime_map" else read_bifurcation(path)
+    try:
+        return read_regime_map(path)
+    except SweepError:  # another kind: a diagram, or read_bifurcation says what it is
+        return read_bifurcation(path)
 
 
 def _sensitivity_sweeps(folder: Path) -> list[tuple[str, object]]:
@@ -85,23 +87,49 @@ def _sensitivity_sweeps(folder: Path) -> list[tuple[str, object]]:
 def audit_script(argv: list[str] | None = None) -> int:
     """The body of ``analyses/step_audit.py``. Bad arguments or a missing data file: exit 2
     with one line; Ctrl-C: exit 130 with one line. Returns 0 when it finishes."""
-    import argparse
     import sys
 
-    from ..sweep._stats import LABEL_ORDER
+    from ..sweep import local_workers
+    from ._step_audit import audit_sentence
+
+    ap = _parser()
+    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    figures, halvings = _checked(ap, args)
+    try:
+        if args.workers is not None:
+            local_workers(args.workers)
+        sweeps = read_sweeps(Path(args.folder), dict.fromkeys(figures))
+    except (OSError, ValueError) as err:
+        ap.error(str(err))  # exit 2
+    try:
+        if halvings:
+            return _ladder(sweeps, halvings, args)
+        rows = step_audit(
+            sweeps, args.per_sweep, args.extend_to, workers=args.workers, seed=args.seed
+        )
+    except KeyboardInterrupt:
+        print(f"{ap.prog}: interrupted; nothing was written", file=sys.stderr)
+        raise SystemExit(130) from None
+    for r in rows:
+        mark = "holds" if r.held else "CHANGES"
+        print(f"{r.figure} | {r.where} | recorded {r.recorded} | dt: {r.replayed} | "
+              f"dt/2: {r.half} | {mark} | {r.seconds:.1f} s")  # fmt: skip
+    print(audit_sentence(rows) or "no decided run to audit")
+    return 0
+
+
+def _parser():
+    import argparse
+
+    from ..sweep import LABEL_ORDER
 
     ap = argparse.ArgumentParser(
         prog="analyses/step_audit.py",
         description="Replay sampled runs of a report's figure sweeps and classify them again "
         "with the step halved (the full report's step audit, at any size).",
     )
-    ap.add_argument(
-        "folder",
-        nargs="?",
-        default="reports/paper-data",
-        metavar="DATA",
-        help="the report's data folder (default: reports/paper-data)",
-    )
+    ap.add_argument("folder", nargs="?", default="reports/paper-data", metavar="DATA",
+                    help="the report's data folder (default: reports/paper-data)")  # fmt: skip
     ap.add_argument(
         "--figures",
         default=",".join(map(str, SWEEP_FILES)),
@@ -134,16 +162,16 @@ def audit_script(argv: list[str] | None = None) -> int:
         "for each K, powers of two >= 2 in increasing order (e.g. 2,4,8), and compared with "
         "the finest",
     )
-    ap.add_argument(
-        "--label",
-        default=None,
-        choices=LABEL_ORDER,
-        help="with --ladder: follow only the runs the sweep labelled so (e.g. undetermined)",
-    )
+    ap.add_argument("--label", default=None, choices=LABEL_ORDER,
+                    help="with --ladder: follow only the runs the sweep labelled so (e.g. "
+                    "undetermined)")  # fmt: skip
     ap.add_argument("--workers", type=int, default=None, help="cores (default: all)")
-    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
-    from ..sweep._backends import local_workers
+    return ap
 
+
+def _checked(ap, args) -> tuple[list, tuple[int, ...] | None]:
+    """(the figures asked, as numbers and :data:`SENSITIVITY_KEY`; the ladder's halvings or
+    None), or exit 2 with one line naming the bad argument."""
     figures = [f.strip() for f in args.figures.split(",")]
     keys = [*map(str, SWEEP_FILES), SENSITIVITY_KEY]
     if not all(f in keys for f in figures):
@@ -159,30 +187,7 @@ def audit_script(argv: list[str] | None = None) -> int:
         ap.error(f"--ladder {args.ladder}: give powers of two >= 2 in increasing order, e.g. 2,4,8")
     if args.label is not None and halvings is None:
         ap.error(f"--label {args.label}: only with --ladder (the audit takes decided runs)")
-    try:
-        if args.workers is not None:
-            local_workers(args.workers)
-        wanted = (f if f == SENSITIVITY_KEY else int(f) for f in figures)
-        sweeps = read_sweeps(Path(args.folder), dict.fromkeys(wanted))
-    except (OSError, ValueError) as err:
-        ap.error(str(err))  # exit 2
-    try:
-        if halvings:
-            return _ladder(sweeps, halvings, args)
-        rows = step_audit(
-            sweeps, args.per_sweep, args.extend_to, workers=args.workers, seed=args.seed
-        )
-    except KeyboardInterrupt:
-        print(f"{ap.prog}: interrupted; nothing was written", file=sys.stderr)
-        raise SystemExit(130) from None
-    from ._step_audit import audit_sentence
-
-    for r in rows:
-        mark = "holds" if r.held else "CHANGES"
-        print(f"{r.figure} | {r.where} | recorded {r.recorded} | dt: {r.replayed} | "
-              f"dt/2: {r.half} | {mark} | {r.seconds:.1f} s")  # fmt: skip
-    print(audit_sentence(rows) or "no decided run to audit")
-    return 0
+    return [f if f == SENSITIVITY_KEY else int(f) for f in figures], halvings
 
 
 def _halvings(text: str) -> tuple[int, ...]:

@@ -5,10 +5,10 @@ At Table 1 otherwise: the rod's inertia J over 0.5–2 times the solid steel rod
 gives the mass, not J), the pivot height y_O over R + r ± 1 cm (the paper draws the rod but
 gives no pivot), the friction torque's arm over 0–16 r (equation (1) writes a force where a
 torque belongs; the default arm is the rod radius r), and one run with the paper's literal
-damping signs (``damping =
-"paper_literal"``; docs/model.md and the README's decisions table give the reasons for the
-defaults). The sentence is computed from the verdicts, on the sensitivity sweeps' step and
-classifier; the choices not swept are named with the values the runs used.
+damping signs (``damping = "paper_literal"``; docs/model.md and the README's decisions table
+give the reasons for the defaults). The sentence is computed from the verdicts, on the
+sensitivity sweeps' step and classifier; the choices not swept are named with the values the
+runs used.
 """
 
 from __future__ import annotations
@@ -28,6 +28,7 @@ from ._findings import (
     runs_text,
     step_finding,
 )
+from ._stage import SWEEP_FATE_S, save
 from ._store import stored
 
 __all__ = ["ARM_FACTORS", "J_FACTORS", "PIVOT_SPAN", "choices_finding", "open_choices"]
@@ -96,14 +97,13 @@ def choices_finding(
     )
 
 
-def open_choices(quick: bool, outdir: Path, workers, classify, hertz_tags: list[str]):
-    """Run the sweeps; returns (the sentence, [(data file, bifurcation, its figure)] for the
-    J, y_O and friction-arm diagrams). The literal-damping run is kept as data only."""
+def open_choices(quick: bool, outdir: Path, workers, judge: dict, hertz_tags: list[str]):
+    """Run the sweeps (``judge``: their verdict keywords); returns (the sentence, [(data
+    file, bifurcation, its figure)] for the J, y_O and friction-arm diagrams). The
+    literal-damping run is kept as data only."""
     from ..model import Params
-    from ..report._sweep_figures import sweep_diagram
+    from ..report import sweep_diagram
     from ..sweep import bifurcation
-    from ._paper import _save
-    from ._sensitivity import SWEEP_FATE_S
 
     p = Params()
     runs, figures = {}, []
@@ -116,12 +116,12 @@ def open_choices(quick: bool, outdir: Path, workers, classify, hertz_tags: list[
     for name, values, base, stem in plan:
         path = outdir / f"{stem}.parquet"
         bif = bifurcation(
-            name, values, base=base, duration=20.0, transient=10.0, classify=classify,
-            workers=workers, fate=SWEEP_FATE_S[quick], **stored(path),
+            name, values, base=base, duration=20.0, transient=10.0, workers=workers,
+            fate=SWEEP_FATE_S[quick], **judge, **stored(path),
         )  # fmt: skip
         runs[name] = first_ic(bif)
         if name != "xi":
-            figures.append((str(path), bif, _save(outdir, stem, sweep_diagram, bif)))
+            figures.append((str(path), bif, save(outdir, stem, sweep_diagram, bif)))
     text = choices_finding(runs["J"], runs["y_O"], runs["friction_arm"], runs["xi"], hertz_tags)
     rows = pd.concat([runs[name].assign(what=name) for name in ("J", "y_O", "friction_arm")])
     return text + step_finding(rows, lambda r: f"{r.what} = {r.value:.3g}"), figures

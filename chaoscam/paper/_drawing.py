@@ -11,11 +11,8 @@ and returns the PNG.
 
 All of a report's Matplotlib work goes through :func:`draw`, so one thread does it all:
 Matplotlib is not thread-safe, and the figures are built there too, not only rendered.
-
-Why: rendering is single-threaded Python (about 0.5 s a figure, 20 figures in the quick
-report), and the sweeps' threads waited for it between sweeps. Measured on 2 cores: the quick
-report without any rendering took 70 s against 81 s with it (the same machine, minutes
-apart).
+Rendering is single-threaded Python (about 0.5 s a figure, 20 figures in the quick report),
+which the sweeps' threads would otherwise wait for between sweeps.
 """
 
 from __future__ import annotations
@@ -47,8 +44,8 @@ class Drawing:
 def _draw_now(path: Path, dpi: int, build: Callable, args: tuple, kwargs: dict) -> bytes:
     """Build the figure, render it once at ``dpi`` and write it to ``path`` (atomically);
     returns the PNG, which the report embeds as it is."""
-    from .._outputs import atomic_write_bytes
-    from ..report._figures import png_bytes
+    from ..io import atomic_write_bytes
+    from ..report import png_bytes
 
     png = png_bytes(build(*args, **kwargs), dpi=dpi)
     atomic_write_bytes(path, png)
@@ -87,17 +84,17 @@ def png_of(png) -> bytes:
 
 
 def uri_of(png):
-    """A figure's data URI for a :class:`chaoscam.report._html.FigureItem`: now for a PNG,
-    at :func:`settle` for a :class:`Drawing` (which stands in the item until then)."""
-    from ..report._figures import png_uri
+    """A figure's data URI for a :class:`chaoscam.report.FigureItem`: now for a PNG, at
+    :func:`settle` for a :class:`Drawing` (which stands in the item until then)."""
+    from ..report import png_uri
 
     return png if isinstance(png, Drawing) else png_uri(png)
 
 
 def settle(result) -> None:
-    """Wait for the drawings of ``result`` (a :class:`._paper.FigureResult`) and put their
+    """Wait for the drawings of ``result`` (a :class:`._stage.FigureResult`) and put their
     PNGs (and the figure items' URIs) in their place, in place."""
-    from ..report._figures import png_uri
+    from ..report import png_uri
 
     for name in ("bifurcations", "regime_maps", "trajectories"):
         rows = getattr(result, name)

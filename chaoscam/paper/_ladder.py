@@ -3,11 +3,11 @@
 The step audit (:mod:`._step_audit`) asks whether a decided label holds when the step is
 halved once. The ladder follows each drawn run (any label, undetermined too) down several
 halvings, each rung the same realization (:func:`chaoscam.sweep.replay` with ``refine``)
-classified as the sweeps classify (``classify_trajectory``, undetermined verdicts extended;
-a run that leaves the cam's reach or diverges labelled by its status, as the sweeps label it),
-and compares every rung with the finest: how many labels agree and how far the tangent
-exponent moves. Measured with it (docs/findings.md, "The figures' step"): Fig. 6 at 40 RK4 steps per
-contact period, 20 of its 42 labels differ from dt/8's; at 160 steps, 9.
+classified as the sweeps classify (:func:`chaoscam.classify`, undetermined verdicts
+extended; a run that leaves the cam's reach or diverges labelled by its status, as the
+sweeps label it), and compares every rung with the finest: how many labels agree and how far
+the tangent exponent moves (docs/findings.md, "The figures' step": Fig. 6 at 40 RK4 steps
+per contact period, 20 of its 42 labels differ from dt/8's; at 160 steps, 9).
 
 ``python analyses/step_audit.py --ladder 2,4,8`` runs it on a report's data folder.
 """
@@ -23,8 +23,9 @@ from typing import Any
 
 import numpy as np
 
-from ._sensitivity import verdict_tag
-from ._step_audit import AUDIT_SEED, _where, draw_rows, run_jobs, sampled_rows
+from ._findings import verdict_tag
+from ._side_by_side import side_by_side
+from ._step_audit import AUDIT_SEED, _where, draw_rows, sampled_rows
 
 __all__ = [
     "LadderRow",
@@ -55,30 +56,28 @@ ladder_sample = draw_rows
 
 
 def _ladder_one(job: tuple) -> LadderRow:
-    """Classify one run at each rung (a pool task: plain arguments), into the fields a
-    sweep's table keeps (``verdict_fields``, or ``status_fields`` for a run that did not end
-    normally): the tag and the tangent exponent (``ev_exponent``; NaN without one)."""
-    from ..classify import classify_trajectory
-    from ..sweep import replay
-    from ..sweep._tasks import status_fields, verdict_fields
+    """Classify one run at each rung, into the fields a sweep's table keeps: the tag (the
+    status's label for a run that did not end normally) and the tangent exponent
+    (``ev_exponent``; NaN without one)."""
+    from ..sweep import replay, verdict_fields
+    from ..verdict import classify
 
-    figure, settings, row, halvings, extend_to = job
+    figure, sweep, row, halvings, extend_to = job
     t0 = time.perf_counter()
     rungs = []
     with warnings.catch_warnings():  # the model's warnings came with the sweep's own run
         warnings.simplefilter("ignore", RuntimeWarning)
         for h in (0, *halvings):
-            traj = replay(settings, row, refine=h)
-            fields = (
-                verdict_fields(classify_trajectory(traj, extend_to=extend_to))
-                if traj.ok
-                else status_fields(traj.status)
-            )
+            run = replay(sweep, row, refine=h)
+            if not run.ok:
+                rungs.append((h, run.status.label, math.nan))
+                continue
+            fields = verdict_fields(classify(run, extend_to=extend_to)[0])
             tag = verdict_tag(fields["label"], fields["period"])
             rungs.append((h, tag, fields["evidence"].get("exponent", math.nan)))
     return LadderRow(
         figure,
-        _where(settings.config, row),
+        _where(sweep.config, row),
         verdict_tag(row["label"], row["period"]),
         tuple(rungs),
         time.perf_counter() - t0,
@@ -99,7 +98,7 @@ def step_ladder(
     (:func:`ladder_sample`; only those the sweep labelled ``label`` when given, e.g.
     "undetermined"), each classified at the sweep's step and at ``dt / 2**h`` for each ``h``
     in ``halvings`` (increasing, >= 1), an undetermined verdict extended up to ``extend_to``
-    seconds recorded, on ``workers`` local processes."""
+    seconds recorded, on ``workers`` local threads."""
 
     def sample(table, k, seed):
         return ladder_sample(table if label is None else table[table["label"] == label], k, seed)
@@ -107,7 +106,7 @@ def step_ladder(
     jobs = [
         (*job, tuple(halvings), extend_to) for job in sampled_rows(sweeps, sample, per_sweep, seed)
     ]
-    return run_jobs(_ladder_one, jobs, workers)
+    return side_by_side(_ladder_one, jobs, workers, prefix="chaoscam-ladder")
 
 
 def step_name(h: int) -> str:

@@ -10,23 +10,31 @@ tuned to agree.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from ..report._figures import response_figure
-from ..report._html import Comparison, FigureItem
+from ..model import Params
+from ..numerics import Numerics
+from ..report import Comparison, FigureItem
 from . import _steps
-from ._drawing import draw, uri_of
+from ._drawing import uri_of
+from ._findings import first_ic
 from ._paper_figures import fig3_figure, fig5_figure
-from ._sensitivity import SWEEP_FATE_S
 from ._side_by_side import beside, side_by_side
+from ._stage import (
+    CHECK_STEP,
+    FULL_EXTEND_TO,
+    SWEEP_FATE_S,
+    FigureResult,
+    judging,
+    save,
+    write_file,
+)
 from ._store import stored
 
-__all__ = ["FIGURES", "FigureResult", "data_files"]
+__all__ = ["FIGURES", "SENSITIVITY", "data_files"]
 
 MU_PAPER = (0.008, 0.015, 0.023)
 """The mean line lengths of the paper's Figs. 7-10 [m]."""
@@ -75,45 +83,6 @@ def data_files(number: int) -> list[str]:
     return names
 
 
-@dataclass
-class FigureResult:
-    """What one figure script produced."""
-
-    number: int
-    title: str = ""
-    figures: list[FigureItem] = field(default_factory=list)
-    comparisons: list[Comparison] = field(default_factory=list)
-    # (data file, result, its figure rendered by _save) for the report to embed
-    bifurcations: list[tuple[str, Any, bytes]] = field(default_factory=list)
-    regime_maps: list[tuple[str, Any, bytes]] = field(default_factory=list)
-    # (data file, trajectory, its figure, its verdict)
-    trajectories: list[tuple[str, Any, bytes, Any]] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
-    why: list[str] = field(default_factory=list)
-    why_figures: list[FigureItem] = field(default_factory=list)
-    seconds: float = 0.0
-
-    @property
-    def name(self) -> str:
-        return self.title or f"Fig. {self.number}"
-
-
-def _save(outdir: Path, name: str, build, *args, **kwargs):
-    """The figure ``build(*args, **kwargs)`` rendered once to ``outdir/name.png``
-    (:func:`._drawing.draw`: its PNG, which the report embeds as it is, or within
-    ``chaoscam paper`` a drawing on the drawing thread that :func:`._drawing.settle`
-    collects once every stage has run)."""
-    return draw(outdir / f"{name}.png", build, *args, **kwargs)
-
-
-def _write(path: Path, write) -> None:
-    """``write(tmp)`` to a temporary name, then moved into place (whole or absent)."""
-    from .._outputs import atomic_path
-
-    with atomic_path(path) as tmp:
-        write(tmp)
-
-
 def _runs(labels: list[str]) -> list[tuple[str, int]]:
     """Consecutive runs of equal labels: [(label, length), ...]."""
     out: list[tuple[str, int]] = []
@@ -139,16 +108,15 @@ def _is_subsequence(wanted: list[str], seq: list[str]) -> bool:
 
 def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 3: the random contact-line length resampled every ``resample_dt`` (a time series)."""
-    from .._simulate import simulate
-    from ..model import Params
+    from ..simulation import simulate
 
     res = FigureResult(3)
     mu, sigma = 0.008, 0.002
     p = Params(l_lambda=mu, l_lambda_sigma=sigma, resample="interval")
     traj = simulate(p, duration=4.0 if quick else 20.0, seed=3)
     s = traj.series[["t", "l_lambda"]]
-    _write(outdir / "fig3.csv", lambda tmp: s.to_csv(tmp, index=False))
-    png = _save(outdir, "fig3", fig3_figure, s, mu, p.resample_dt)
+    write_file(outdir / "fig3.csv", lambda tmp: s.to_csv(tmp, index=False))
+    png = save(outdir, "fig3", fig3_figure, s, mu, p.resample_dt)
     draws = s["l_lambda"].to_numpy()[:: max(1, int(round(p.resample_dt / 1e-3)))]
     m, sd, n = float(draws.mean()), float(draws.std(ddof=1)), len(draws)
     res.figures.append(
@@ -184,10 +152,8 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
 def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 4: bifurcation of θ_f over l_λ ∈ [0.001, 0.018] m (Hertz line stiffness)."""
-    from ..model import Params
-    from ..report._sweep_figures import sweep_diagram
-    from ..sweep import bifurcation
-    from ..sweep._grid import parse_range
+    from ..report import sweep_diagram
+    from ..sweep import bifurcation, parse_range
 
     res = FigureResult(4)
     values = "0.001:0.018:25" if quick else "0.001:0.018:69"  # the paper's step, 0.00025 m
@@ -196,18 +162,18 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     bif = bifurcation(
         "l_lambda",
         values,
-        base=Params(dt=dt),
+        numerics=Numerics(dt=dt),
         duration=20.0,
         transient=10.0,
         initial_conditions=1 if quick else 3,
-        classify=_classifier(quick),
         workers=workers,
         fate=SWEEP_FATE_S[quick],
+        **judging(quick),
         **stored(path := outdir / "fig4.parquet"),
     )
-    png = _save(outdir, "fig4", sweep_diagram, bif)
+    png = save(outdir, "fig4", sweep_diagram, bif)
     res.bifurcations.append((str(path), bif, png))
-    v = bif.verdicts[bif.verdicts["ic"] == 0].sort_values("value")
+    v = first_ic(bif)
     labels = [
         "periodic-2" if (lab == "periodic" and pd.notna(per) and int(per) == 2) else lab
         for lab, per in zip(v["label"], v["period"].astype("Int64").astype(object), strict=True)
@@ -252,7 +218,7 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
 def fig5(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 5: fractal joint stiffness K_n against D for G ∈ {1e-9, 1e-10, 1e-11} m."""
-    from ..model import ParameterError, Params, fractal_stiffness
+    from ..model import ParameterError, fractal_stiffness
 
     res = FigureResult(5)
     p = Params()
@@ -266,8 +232,8 @@ def fig5(quick: bool, outdir: Path, workers=None) -> FigureResult:
                 kn = float("nan")
             rows.append({"G": g, "D": float(d), "K_n": kn})
     df = pd.DataFrame(rows)
-    _write(outdir / "fig5.csv", lambda tmp: df.to_csv(tmp, index=False))
-    png = _save(outdir, "fig5", fig5_figure, df)
+    write_file(outdir / "fig5.csv", lambda tmp: df.to_csv(tmp, index=False))
+    png = save(outdir, "fig5", fig5_figure, df)
     hertz = p.stiffness_at(p.l_lambda)
     res.figures.append(
         FigureItem(
@@ -304,11 +270,8 @@ def fig5(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
 def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 6: bifurcation over D with the fractal stiffness, G = 1e-9 and 1e-10 m."""
-    from ..model import Params
-    from ..report._sweep_figures import sweep_diagram
-    from ..sweep import bifurcation
-    from ..sweep._grid import parse_range
-    from ..sweep._tasks import DefaultClassifier
+    from ..report import sweep_diagram
+    from ..sweep import bifurcation, parse_range
 
     res = FigureResult(6)
     duration, transient = (8.0, 4.0) if quick else (20.0, 10.0)
@@ -317,20 +280,20 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     for g in G_FIG6:
         stiffest = Params(stiffness="fractal", D=parse_range(values)[1], G=g)
         dt = _steps.figure_dt(stiffest, _steps.FIG6_STEPS[quick])
-        base = Params(stiffness="fractal", G=g, dt=dt)
         tag = _fig6_tag(g)
         path = outdir / f"{tag}.parquet"
         bif = bifurcation(
             "D",
             values,
-            base=base,
+            base=Params(stiffness="fractal", G=g),
+            numerics=Numerics(dt=dt),
             duration=duration,
             transient=transient,
-            classify=DefaultClassifier(extend_to=None if quick else FULL_EXTEND_TO),
+            extend_to=None if quick else FULL_EXTEND_TO,
             workers=workers,
             **stored(path),
         )
-        png = _save(outdir, tag, sweep_diagram, bif, note=f"G = {g:g} m")
+        png = save(outdir, tag, sweep_diagram, bif, note=f"G = {g:g} m")
         res.bifurcations.append((str(path), bif, png))
         counts = bif.verdicts["label"].value_counts().to_dict()
         found.append(f"G = {g:g} m (dt = {dt:g} s): " + _counts(counts))
@@ -359,86 +322,94 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
 
 def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Figs. 7-10: the random line length at μ = 0.008, 0.015, 0.023 m, σ from 0 to 0.004 m."""
-    from .._simulate import simulate
-    from ..model import Params
-    from ..report._classify import classify
-    from ..report._sweep_figures import regime_map_figure
+    from ..report import regime_map_figure, response_figure
     from ..sweep import Axis, regime_map
 
     res = FigureResult(7, title="Figs. 7–10")
     sigmas = tuple(np.round(np.linspace(0.0, SIGMA_MAX, 3 if quick else 9), 6))
     n = 8 if quick else 40
     cases = [(mu, sigma) for mu in MU_PAPER for sigma in (0.0, max(sigmas))]
-
-    def response(case):
-        """One response of Figs. 7–10 and the report's verdict on it (classified here, on a
-        thread, not one after another when the report is written: 2.6 s at one core)."""
-        traj = simulate(
-            Params(l_lambda=case[0], l_lambda_sigma=case[1]), duration=20.0, transient=10.0, seed=7
-        )
-        return traj, classify(traj)
-
     # the six responses run beside the map, in its last runs' idle core
-    with beside(workers, side_by_side, response, cases, workers) as responses:
+    with beside(workers, side_by_side, _response, cases, workers) as responses:
         rm = regime_map(
             Axis("l_lambda", MU_PAPER),
             Axis("l_lambda_sigma", sigmas),
             realizations=n,
             duration=20.0,
             transient=10.0,
-            classify=_classifier(quick),
             workers=workers,
+            **judging(quick),
             **stored(path := outdir / "fig7-10.parquet"),
         )
-        png = _save(
-            outdir, "fig7-10", regime_map_figure, rm.cells, x="l_lambda", y="l_lambda_sigma"
-        )
+        png = save(outdir, "fig7-10", regime_map_figure, rm.cells, x="l_lambda", y="l_lambda_sigma")
         res.regime_maps.append((str(path), rm, png))
         done = responses.result()
-    for (mu, sigma), (traj, verdict) in zip(cases, done, strict=True):
+    for (mu, sigma), (run, verdict) in zip(cases, done, strict=True):
         name = _fig7_trajectory(mu, sigma)
-        _write(outdir / f"{name}.parquet", traj.to_parquet)
-        png = _save(outdir, name, response_figure, traj, title=f"μ = {mu} m, σ = {sigma} m")
-        res.trajectories.append((str(outdir / f"{name}.parquet"), traj, png, verdict))
-    c = rm.cells.set_index(["l_lambda", "l_lambda_sigma"])
+        run.to_parquet(outdir / f"{name}.parquet", replace=True)
+        png = save(outdir, name, response_figure, run, title=f"μ = {mu} m, σ = {sigma} m")
+        res.trajectories.append((str(outdir / f"{name}.parquet"), run, png, verdict))
+    res.comparisons += _fig7_10_comparisons(rm.cells, max(sigmas), n, quick)
+    return res
 
-    def cell(mu, sigma):
-        r = c.loc[(mu, sigma)]
-        if bool(r.get("deterministic", False)):
-            return r, f"σ = {sigma:g}: {r['dominant']} (deterministic: one run)"
-        return r, (
-            f"σ = {sigma:g}: dominant {r['dominant']}, P(chaotic) {r['p_chaotic']:.2f} "
-            f"[{r['p_chaotic_lo']:.2f}, {r['p_chaotic_hi']:.2f}], "
-            f"P(quasiperiodic) {r['p_quasiperiodic']:.2f}, "
-            f"P(undetermined) {r.get('p_undetermined', 0.0):.2f}"
-        )
 
-    smax = max(sigmas)
-    claims = {
-        0.008: (
-            "Figs. 7–8",
-            "μ = 0.008 m: quasiperiodic at σ = 0, chaotic as σ grows to 0.004 m",
-            "quasiperiodic",
-            "chaotic",
-        ),
-        0.015: (
-            "Fig. 9",
-            "μ = 0.015 m: chaotic at σ = 0; the random deviation suppresses chaos "
-            "into quasiperiod 2",
-            "chaotic",
-            "quasiperiodic",
-        ),
-        0.023: (
-            "Fig. 10",
-            "μ = 0.023 m: chaotic at σ = 0; the random deviation suppresses chaos "
-            "into quasiperiod 2",
-            "chaotic",
-            "quasiperiodic",
-        ),
-    }
-    for mu, (figname, paper, want0, want1) in claims.items():
-        r0, t0 = cell(mu, 0.0)
-        r1, t1 = cell(mu, smax)
+def _response(case: tuple[float, float]):
+    """One response of Figs. 7–10 (μ, σ) and its verdict (classified here, on a thread
+    beside the others, not one after another when the report is written)."""
+    from ..simulation import simulate
+    from ..verdict import classify
+
+    mu, sigma = case
+    run = simulate(Params(l_lambda=mu, l_lambda_sigma=sigma), duration=20.0, transient=10.0,
+                   seed=7)  # fmt: skip
+    (verdict,) = classify(run)
+    return run, verdict
+
+
+_FIG7_10_CLAIMS = {
+    0.008: (
+        "Figs. 7–8",
+        "μ = 0.008 m: quasiperiodic at σ = 0, chaotic as σ grows to 0.004 m",
+        "quasiperiodic",
+        "chaotic",
+    ),
+    0.015: (
+        "Fig. 9",
+        "μ = 0.015 m: chaotic at σ = 0; the random deviation suppresses chaos into quasiperiod 2",
+        "chaotic",
+        "quasiperiodic",
+    ),
+    0.023: (
+        "Fig. 10",
+        "μ = 0.023 m: chaotic at σ = 0; the random deviation suppresses chaos into quasiperiod 2",
+        "chaotic",
+        "quasiperiodic",
+    ),
+}
+"""μ -> (figure, the paper's claim, its dominant label at σ = 0, at the largest σ)."""
+
+
+def _cell_text(c: pd.DataFrame, mu: float, sigma: float):
+    """(the cell's row, its words in the comparison) of the map's cell (μ, σ)."""
+    r = c.loc[(mu, sigma)]
+    if bool(r.get("deterministic", False)):
+        return r, f"σ = {sigma:g}: {r['dominant']} (deterministic: one run)"
+    return r, (
+        f"σ = {sigma:g}: dominant {r['dominant']}, P(chaotic) {r['p_chaotic']:.2f} "
+        f"[{r['p_chaotic_lo']:.2f}, {r['p_chaotic_hi']:.2f}], "
+        f"P(quasiperiodic) {r['p_quasiperiodic']:.2f}, "
+        f"P(undetermined) {r.get('p_undetermined', 0.0):.2f}"
+    )
+
+
+def _fig7_10_comparisons(cells: pd.DataFrame, smax: float, n: int, quick: bool):
+    """The comparison of each of Figs. 7–10 with the map's dominant labels at σ = 0 and at
+    the largest σ."""
+    c = cells.set_index(["l_lambda", "l_lambda_sigma"])
+    out = []
+    for mu, (figname, paper, want0, want1) in _FIG7_10_CLAIMS.items():
+        r0, t0 = _cell_text(c, mu, 0.0)
+        r1, t1 = _cell_text(c, mu, smax)
         got0, got1 = r0["dominant"], r1["dominant"]
         if "undetermined" in (got0, got1):
             verdict = "not comparable"
@@ -460,30 +431,17 @@ def fig7_10(quick: bool, outdir: Path, workers=None) -> FigureResult:
         why += _steps.FIGS7_10_STEP_NOTE
         if quick:
             why += f"; quick run: {n} realizations per cell, wide intervals"
-        res.comparisons.append(Comparison(figname, paper, f"{t0}; {t1}", verdict, why))
-    return res
+        out.append(Comparison(figname, paper, f"{t0}; {t1}", verdict, why))
+    return out
 
 
-def _sensitivity_stage(quick: bool, outdir: Path, workers=None) -> FigureResult:
+def sensitivity_stage(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """The sweeps that explain the differences (:mod:`._sensitivity`; the full run checks
     their verdicts at half the step)."""
-    from ._sensitivity import sensitivity, step_checked
+    from ._sensitivity import sensitivity
 
-    classify = step_checked(_classifier(quick), quick)
-    return sensitivity(quick, outdir, workers=workers, classify=classify)
-
-
-def _classifier(quick: bool):
-    """The sweeps' classifier: the default; the quick run extends an undetermined run to
-    40 s recorded instead of 120 s (and says so in the report)."""
-    from ..sweep._tasks import DefaultClassifier
-
-    return DefaultClassifier(extend_to=QUICK_EXTEND_TO if quick else FULL_EXTEND_TO)
-
-
-QUICK_EXTEND_TO, FULL_EXTEND_TO = 40.0, 120.0
-"""Recorded time [s] the quick and the full report extend an undetermined run to (the full
-one's Fig. 6 included)."""
+    judge = judging(quick, check_step=CHECK_STEP[quick])
+    return sensitivity(quick, outdir, workers=workers, judge=judge)
 
 
 FIGURES = {3: fig3, 4: fig4, 5: fig5, 6: fig6, 7: fig7_10, 8: fig7_10, 9: fig7_10, 10: fig7_10}

@@ -1,6 +1,6 @@
-"""The drawings of the paper's Figs. 3 and 5 (the sweeps' figures are in
-:mod:`chaoscam.report._sweep_figures`). Each builds a Matplotlib figure from a figure
-script's data; :func:`._drawing.draw` renders it, on the report's drawing thread."""
+"""The drawings of the paper's Figs. 3 and 5 (the sweeps' figures are :mod:`chaoscam.report`'s).
+Each builds a Matplotlib figure from a figure script's data; :func:`._drawing.draw` renders
+it, on the report's drawing thread."""
 
 from __future__ import annotations
 

@@ -17,19 +17,12 @@ from pathlib import Path
 import pandas as pd
 
 from ._drawing import drawing, settle
-from ._paper import (
-    FIGURES,
-    FULL_EXTEND_TO,
-    QUICK_EXTEND_TO,
-    SENSITIVITY,
-    _sensitivity_stage,
-    data_files,
-)
-from ._sensitivity import FATE_S
+from ._paper import FIGURES, SENSITIVITY, data_files, sensitivity_stage
+from ._stage import FATE_S, FULL_EXTEND_TO, QUICK_EXTEND_TO
 from ._step_audit import PER_SWEEP, audit_sentence, step_audit, sweep_names
 from ._steps import FIG6_STEPS, FULL_STEPS
 
-__all__ = ["PaperRun", "check_paper_outputs", "figure_script", "run_paper"]
+__all__ = ["RESUME_HINT", "PaperRun", "check_paper_outputs", "figure_script", "run_paper"]
 
 
 @dataclass(frozen=True)
@@ -59,9 +52,9 @@ def check_paper_outputs(out: str | Path, figures=None, *, force: bool = False) -
     The report ``out`` (``.html``) and, in ``OUT_DIR/paper-data``, each file of
     :func:`data_files`: an existing one is refused unless ``force``, naming it; a missing or
     read-only folder, or a ``paper-data`` that is not a folder, is refused too. Returns the
-    data folder. Raises :class:`chaoscam._outputs.OutputError`.
+    data folder. Raises :class:`chaoscam.io.OutputError`.
     """
-    from .._outputs import OutputError, check_output
+    from ..io import OutputError, check_output
 
     out = Path(out)
     check_output(out, force=force, suffixes=(".html",))
@@ -91,10 +84,10 @@ def check_paper_outputs(out: str | Path, figures=None, *, force: bool = False) -
 def _check_data_file(
     outdir: Path, name: str, force: bool, holds: str, elsewhere: str, what: str = ""
 ) -> None:
-    """:func:`chaoscam._outputs.check_output` for a figure's data file, whose name the user
-    cannot choose: an existing one is refused saying where else to write (``elsewhere``),
-    not "choose another name"."""
-    from .._outputs import OutputError, check_output
+    """:func:`chaoscam.io.check_output` for a figure's data file, whose name the user cannot
+    choose: an existing one is refused saying where else to write (``elsewhere``), not
+    "choose another name"."""
+    from ..io import OutputError, check_output
 
     if (outdir / name).exists() and not force:
         raise OutputError(f"{holds} {name}{what}; nothing was overwritten: {elsewhere}")
@@ -120,21 +113,20 @@ def run_paper(
     duration go to stderr and the findings, figure by figure, to stdout. A stage that raises
     is reported in the report's "What is missing" and in :attr:`PaperRun.failed`; the
     others still run. Where the RK4 kernel is not compiled yet (a fresh install), a second
-    process compiles some of its callees meanwhile
-    (:func:`chaoscam.integrate._precompile.start_once`, at its first RK4 run).
+    process compiles some of its callees meanwhile (at its first RK4 run).
 
     ``resume`` continues an interrupted report in the same folder: each sweep whose output
     is there and finished (same configuration) is read back, the one under way finishes from
     its checkpoint, the rest run (:mod:`._store`); the report is then written over the old
     one, if any. A second run into the same folder (the same ``paper-data``) is refused while
-    this one works (:class:`chaoscam._outputs.OutputLock`), and without ``force`` the report
+    this one works (:class:`chaoscam.io.OutputLock`), and without ``force`` the report
     is put in place only if its name is still free: a file that appeared there meanwhile is
     kept, and this run's report goes beside it with an ``OutputError`` naming both. When
     every stage failed, an existing report is kept and this run's page, which holds only
     what failed, goes to ``NAME.failed.html`` beside it (:attr:`PaperRun.path`).
     """
-    from .._outputs import OutputLock
-    from ..sweep._backends import local_workers
+    from ..io import OutputLock
+    from ..sweep import local_workers
     from ._store import store_mode
 
     if figures is not None:
@@ -158,57 +150,36 @@ def run_paper(
             return _run_stages(quick, out, outdir, figures, workers, command, echo, force)
 
 
-def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> PaperRun:
-    """The body of :func:`run_paper`, holding the report folder's lock."""
-    import sys
-
-    def say(text: str) -> None:
-        if echo:
-            print(text, file=sys.stderr, flush=True)
-
-    from ..report._html import (
-        ReportParts,
-        add_bifurcation,
-        add_regime_map,
-        add_trajectory,
-        write_report,
-    )
-
-    wanted = sorted(set(figures or FIGURES))
-    stages: dict = {}  # function -> its first figure number (Figs. 7-10 share one)
-    for number in wanted:
+def _stage_functions(figures) -> dict:
+    """The stages to run: function -> its first figure number (Figs. 7-10 share one), in
+    figure order; with ``figures`` None the sensitivity sweeps too."""
+    stages: dict = {}
+    for number in sorted(set(figures or FIGURES)):
         stages.setdefault(FIGURES[number], min(n for n in FIGURES if FIGURES[n] is FIGURES[number]))
     if figures is None:  # the whole report: also the sweeps that explain the differences
-        stages[_sensitivity_stage] = SENSITIVITY
-    funcs = list(stages)
-    parts = ReportParts()
-    t_all = time.perf_counter()
-    results = []
-    failed: list[str] = []
-    ran = set()
-    # Each stage's figures are drawn on one thread while the stages go on (._drawing): a
-    # stage's seconds are its own work, its figures are settled once every stage has run, and
-    # a drawing's error fails its stage then.
-    drawn = []
+        stages[sensitivity_stage] = SENSITIVITY
+    return stages
 
-    def fail(stage: int, title: str, err: Exception) -> None:  # reported, not hidden
-        failed.append(f"{title}: failed with {type(err).__name__}: {err}")
-        parts.missing.append(failed[-1])
-        say(f"[{stage}/{len(funcs)}] {failed[-1]}")
 
+def _run_each(stages: dict, quick, outdir, workers, say, fail) -> tuple[list, set]:
+    """Run each stage, its time on stderr; (the results, the functions that ran). Each
+    stage's figures are drawn on one thread while the stages go on (:mod:`._drawing`): a
+    stage's seconds are its own work, its figures are settled once every stage has run, and
+    a drawing's error fails its stage then."""
+    n, drawn, results, ran = len(stages), [], [], set()
     with drawing(), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        for stage, fn in enumerate(funcs, 1):
+        for stage, fn in enumerate(stages, 1):
             t0 = time.perf_counter()
             title = STAGE_TITLES.get(stages[fn], fn.__name__)
-            say(f"[{stage}/{len(funcs)}] {title} ...")
+            say(f"[{stage}/{n}] {title} ...")
             try:
                 r = fn(quick, outdir, workers=workers)
             except Exception as err:
                 fail(stage, title, err)
                 continue
             r.seconds = time.perf_counter() - t0
-            say(f"[{stage}/{len(funcs)}] {title}: {r.seconds:.0f} s")
+            say(f"[{stage}/{n}] {title}: {r.seconds:.0f} s")
             drawn.append((stage, title, fn, r))
         for stage, title, fn, r in drawn:
             try:
@@ -218,23 +189,65 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
                 continue
             ran.add(fn)
             results.append(r)
+    return results, ran
+
+
+def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> PaperRun:
+    """The body of :func:`run_paper`, holding the report folder's lock."""
+    import sys
+
+    from ..report import ReportParts, write_report
+
+    def say(text: str) -> None:
+        if echo:
+            print(text, file=sys.stderr, flush=True)
+
+    stages, parts, failed = _stage_functions(figures), ReportParts(), []
+
+    def fail(stage: int, title: str, err: Exception) -> None:  # reported, not hidden
+        failed.append(f"{title}: failed with {type(err).__name__}: {err}")
+        parts.missing.append(failed[-1])
+        say(f"[{stage}/{len(stages)}] {failed[-1]}")
+
+    t_all = time.perf_counter()
+    results, ran = _run_each(stages, quick, outdir, workers, say, fail)
     audit, audit_s = _audit_stage(results, quick, workers, say, parts)
-    total = time.perf_counter() - t_all
-    done = [n for n in wanted if FIGURES[n] in ran]
+    done = [n for n in sorted(set(figures or FIGURES)) if FIGURES[n] in ran]
     if done == sorted(FIGURES):
         done_text = "Figs. 3–10"
     else:
         done_text = (
             f"{'Fig.' if len(done) == 1 else 'Figs.'} {', '.join(map(str, done)) or '(none)'}"
         )
+    failures = f" {len(failed)} of {len(stages)} stages failed (see What is missing)."
     parts.summary.append(
         f"{'Quick' if quick else 'Full'} reproduction of the paper's {done_text} "
-        f"in {total:.0f} s "
+        f"in {time.perf_counter() - t_all:.0f} s "
         f"({', '.join(f'{r.name}: {r.seconds:.0f} s' for r in results)}"
         + (f", step audit: {audit_s:.0f} s" if audit else "")
         + ")."
-        + (f" {len(failed)} of {len(funcs)} stages failed (see What is missing)." if failed else "")
+        + (failures if failed else "")
     )
+    _add_results(parts, results)
+    head = _findings(parts, results, audit)
+    if echo:
+        print("\n".join([parts.summary[0], *head]), flush=True)
+    if quick:
+        parts.missing.append(QUICK_NOTE)
+    title = f"chaoscam: the paper's {done_text} reproduced" + (" (quick run)" if quick else "")
+    if failed:
+        title += f" (incomplete: {len(failed)} of {len(stages)} stages failed)"
+    if not results and out.exists():  # nothing ran: keep the report there, put this one beside
+        out, force = out.with_name(f"{out.stem}.failed{out.suffix}"), True
+    written = write_report(parts, out, title=title, command=command, replace=force)
+    return PaperRun(written, tuple(failed))
+
+
+def _add_results(parts, results) -> None:
+    """Each stage's figures, sweeps, runs, comparisons and findings into the report parts;
+    a comparison without an anchor points to its stage's first figure."""
+    from ..report import add_bifurcation, add_regime_map, add_trajectory
+
     for r in results:
         before = (len(parts.paper_figures), len(parts.regime_maps), len(parts.bifurcations))
         parts.paper_figures.extend(r.figures)
@@ -242,8 +255,8 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
             add_regime_map(parts, path, rm, png=png)
         for path, bif, png in r.bifurcations:
             add_bifurcation(parts, path, bif, png=png)
-        for path, traj, png, verdict in r.trajectories:
-            add_trajectory(parts, path, traj, png=png, verdict=verdict)
+        for path, run, png, verdict in r.trajectories:
+            add_trajectory(parts, path, run, png=png, verdict=verdict)
         new = (
             [f.id for f in parts.paper_figures[before[0] :]]
             + [m["figure"].id for m in parts.regime_maps[before[1] :]]
@@ -255,6 +268,11 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
         parts.missing.extend(r.notes)
         parts.why.extend(r.why)
         parts.why_figures.extend(r.why_figures)
+
+
+def _findings(parts, results, audit) -> list[str]:
+    """The summary's findings, put after its first line: in short, the audit, the tally of
+    the comparisons and each of them, and why the paper differs; returned too."""
     tally = pd.Series([c.verdict for c in parts.comparison]).value_counts()
     counted = ", ".join(f"{k}: {v}" for k, v in tally.items())
     head = [line for line in (_in_short(results), audit_sentence(audit)) if line]
@@ -262,30 +280,24 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
     head += [f"{c.figure}: {c.verdict} — {c.found}" for c in parts.comparison]
     head += [f"Why the paper differs: {line}" for line in parts.why]
     parts.summary[1:1] = head
-    if echo:
-        print("\n".join([parts.summary[0], *head]), flush=True)
-    if quick:
-        parts.missing.append(
-            "This is a quick run: coarse grids, few realizations, shorter fractal runs, "
-            f"undetermined runs extended to {QUICK_EXTEND_TO:g} s recorded "
-            f"({FULL_EXTEND_TO:g} s in the full report) except Fig. 6's, which are not "
-            "extended (its labels are those of 8 s runs, 4 s recorded); Figs. 4 and 6 at coarser "
-            "steps, at which their labels are not converged (the default dt and "
-            f"{FIG6_STEPS[True]} RK4 steps per contact period, {FULL_STEPS} in the full report); "
-            "the ξ sweep's and "
-            f"(ω, ξ) map's chaotic or undetermined runs continued to {FATE_S[True]:g} s "
-            f"({FATE_S[False]:g} s) to see whether they stay in the cam's reach; "
-            "the sensitivity sweeps' verdicts not checked at half the step and no step "
-            "audit of the figures (both in the full report); "
-            "run `chaoscam paper` without --quick for the full grids."
-        )
-    title = f"chaoscam: the paper's {done_text} reproduced" + (" (quick run)" if quick else "")
-    if failed:
-        title += f" (incomplete: {len(failed)} of {len(funcs)} stages failed)"
-    if not results and out.exists():  # nothing ran: keep the report there, put this one beside
-        out, force = out.with_name(f"{out.stem}.failed{out.suffix}"), True
-    written = write_report(parts, out, title=title, command=command, replace=force)
-    return PaperRun(written, tuple(failed))
+    return head
+
+
+QUICK_NOTE = (
+    "This is a quick run: coarse grids, few realizations, shorter fractal runs, "
+    f"undetermined runs extended to {QUICK_EXTEND_TO:g} s recorded "
+    f"({FULL_EXTEND_TO:g} s in the full report) except Fig. 6's, which are not "
+    "extended (its labels are those of 8 s runs, 4 s recorded); Figs. 4 and 6 at coarser "
+    "steps, at which their labels are not converged (the default dt and "
+    f"{FIG6_STEPS[True]} RK4 steps per contact period, {FULL_STEPS} in the full report); "
+    "the ξ sweep's and "
+    f"(ω, ξ) map's chaotic or undetermined runs continued to {FATE_S[True]:g} s "
+    f"({FATE_S[False]:g} s) to see whether they stay in the cam's reach; "
+    "the sensitivity sweeps' verdicts not checked at half the step and no step "
+    "audit of the figures (both in the full report); "
+    "run `chaoscam paper` without --quick for the full grids."
+)
+"""What a quick report says it left out ("What is missing")."""
 
 
 def _audit_stage(results, quick, workers, say, parts):
@@ -387,13 +399,24 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     with one line (SIGTERM: 143), saying how to resume. Returns the exit code (0) when it
     finishes.
     """
-    import argparse
-    import contextlib
-    import signal
     import sys
 
-    from .._outputs import OutputError, OutputLock
-    from ._store import store_mode
+    ap = _script_parser(number)
+    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    outdir = Path(args.outdir)
+    held = _script_outputs(ap, args, number)
+    fn = sensitivity_stage if number == SENSITIVITY else FIGURES[number]
+    result = _script_run(ap.prog, held, args, fn, outdir)
+    for c in result.comparisons:
+        print(f"{c.figure}: {c.verdict} - {c.found} ({c.reason})")
+    for line in result.why:
+        print(f"Why the paper differs: {line}")
+    print(f"wrote {', '.join(data_files(number))} in {outdir}")
+    return 0
+
+
+def _script_parser(number: int):
+    import argparse
 
     name = "sensitivity" if number == SENSITIVITY else f"fig{number}"
     what = "the sensitivity sweeps" if number == SENSITIVITY else f"Fig. {number}"
@@ -412,10 +435,18 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     ap.add_argument("--force", action="store_true", help="replace this stage's files in OUTDIR")
     ap.add_argument("--resume", action="store_true", help="continue an interrupted run")
     ap.add_argument("--workers", type=int, default=None, help="cores (default: all)")
-    args = ap.parse_args(sys.argv[1:] if argv is None else argv)
-    outdir = Path(args.outdir)
-    from ..sweep._backends import local_workers
+    return ap
 
+
+def _script_outputs(ap, args, number: int):
+    """The checks of a figure script's arguments and outputs, before any work: OUTDIR locked
+    (an ExitStack holding its lock), or exit 2 with one line."""
+    import contextlib
+
+    from ..io import OutputError, OutputLock
+    from ..sweep import local_workers
+
+    outdir = Path(args.outdir)
     held = contextlib.ExitStack()  # OUTDIR's lock, as chaoscam paper takes it
     try:
         if args.workers is not None:
@@ -440,8 +471,18 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     except (OutputError, OSError, ValueError) as err:
         held.close()
         ap.error(str(err))  # exit 2
-    fn = _sensitivity_stage if number == SENSITIVITY else FIGURES[number]
-    stopped = {}  # SIGTERM is handled as Ctrl-C, as the chaoscam command handles it
+    return held
+
+
+def _script_run(prog: str, held, args, fn, outdir: Path):
+    """Run a figure script's stage holding OUTDIR's lock; SIGTERM is handled as Ctrl-C, as
+    the chaoscam command handles it: exit 130 (143) with one line saying how to resume."""
+    import signal
+    import sys
+
+    from ._store import store_mode
+
+    stopped = {}
 
     def on_term(signum, frame):
         stopped["term"] = True
@@ -451,16 +492,10 @@ def figure_script(number: int, argv: list[str] | None = None) -> int:
     try:
         with held, store_mode(force=args.force, resume=args.resume), warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            result = fn(args.quick, outdir, workers=args.workers)
+            return fn(args.quick, outdir, workers=args.workers)
     except KeyboardInterrupt:
         word = "terminated" if stopped else "interrupted"
-        print(f"{ap.prog}: {word}; {RESUME_HINT}", file=sys.stderr)
+        print(f"{prog}: {word}; {RESUME_HINT}", file=sys.stderr)
         raise SystemExit(143 if stopped else 130) from None
     finally:
         signal.signal(signal.SIGTERM, before)
-    for c in result.comparisons:
-        print(f"{c.figure}: {c.verdict} - {c.found} ({c.reason})")
-    for line in result.why:
-        print(f"Why the paper differs: {line}")
-    print(f"wrote {', '.join(data_files(number))} in {outdir}")
-    return 0

@@ -15,18 +15,17 @@
   pivot height, the damping signs), against the same Hertz range.
 
 Every sentence of the findings is computed from the sweeps; nothing is written in advance.
-The full run checks every verdict at half the step (:data:`CHECK_STEP`).
+The full run checks every verdict at half the step (:data:`._stage.CHECK_STEP`).
 """
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from ..report._html import FigureItem
+from ..report import FigureItem
 from ._choices import open_choices
 from ._findings import (
     band_counts,
@@ -40,6 +39,7 @@ from ._findings import (
     step_finding,
     verdict_tag,
 )
+from ._stage import FATE_S, SWEEP_FATE_S, FigureResult, save
 from ._store import stored
 
 __all__ = ["PAPER_K_N", "PAPER_L_LAMBDA", "label_runs", "sensitivity", "stiffness_finding"]
@@ -54,35 +54,6 @@ HERTZ_VALUES = {True: 6, False: 18}
 """How many l_λ the stiffness finding samples across :data:`PAPER_L_LAMBDA` (quick, full), at
 the ξ sweep's step and classifier, so that the two ranges are compared on equal terms (Fig. 4
 samples the same range at a finer step)."""
-
-
-FATE_S = {True: 100.0, False: 300.0}
-"""The fate horizon [s] of the restitution sweep and the (omega, xi) map, quick and full:
-runs labelled chaotic, quasiperiodic or undetermined go on to it, to see whether they stay in
-the cam's reach (the full one covers (42.5 rad/s, 0.40), chaotic for 229 s and then out of
-reach)."""
-
-SWEEP_FATE_S = {True: None, False: FATE_S[False]}
-"""The fate horizon [s] of Fig. 4 and the other sensitivity diagrams (J, y_O, friction arm,
-literal damping, both stiffness sweeps), quick and full: the full report only (the quick
-one keeps its 90 s). Measured before it was added (analyses/fate_audit.py, at ca8da29): of
-245 chaotic verdicts of these sweeps, 4 of Fig. 4's settle on a period 8 by 300 s and one
-(J = 0.08823) leaves the cam's reach at 102 s; the full report found the same at a93e02f,
-in about 14 minutes more (Fig. 4 982 s instead of 228 s; the sensitivity sweeps 546 s, 479).
-Figs. 6 and 7-10 keep none (their steps and realizations would cost hours)."""
-
-CHECK_STEP = {True: False, False: True}
-"""Whether the sweeps re-run each periodic, quasiperiodic or chaotic verdict at half the step
-and call it undetermined when it changes there (``check_step``; quick, full). The full run
-does: one period certificate halves the step already, but a chaotic label had no such check,
-and (ω, ξ) maps hold cells whose label is the step's (measured at ξ = 0.375, Table 1
-otherwise: chaotic at dt = 2e-6 s, period 32 at dt/2, chaotic at dt/4). The quick run does
-not: it would take its sweeps from 24 to 56 s, and the quick report past its 90 s."""
-
-
-def step_checked(classify, quick: bool):
-    """The sweeps' classifier (a ``DefaultClassifier``) with :data:`CHECK_STEP`'s choice."""
-    return dataclasses.replace(classify, check_step=CHECK_STEP[quick])
 
 
 XI_WINDOW = 0.05
@@ -193,7 +164,7 @@ def _settled_finding(rows: pd.DataFrame, name=None) -> str:
     """The clause on the continued runs that are periodic on the fate run's last half: the
     chaotic ones settle after the recorded window (transient chaos); the undetermined ones
     needed the longer window for a verdict."""
-    from ..sweep._stats import fate_settled
+    from ..sweep import fate_settled
 
     settled = fate_settled(rows)
     if not len(settled):
@@ -217,7 +188,7 @@ def _settled_finding(rows: pd.DataFrame, name=None) -> str:
 
 def _left_finding(rows: pd.DataFrame, horizon: float, what: str, where=None) -> str:
     """The sentence's part on the continued runs that stop before the horizon."""
-    from ..sweep._stats import continued_labels, fate_split
+    from ..sweep import continued_labels, fate_split
 
     checked, left = fate_split(rows)
     if not len(checked):
@@ -245,7 +216,7 @@ def _left_finding(rows: pd.DataFrame, horizon: float, what: str, where=None) -> 
     )
 
 
-def _stiffness(quick: bool, outdir: Path, workers, classify):
+def _stiffness(quick: bool, outdir: Path, workers, judge: dict):
     """The two stiffness sweeps: Y_f over nine decades and l_λ across the paper's range;
     each returns (bifurcation, path, {value: K_n})."""
     from ..model import Params
@@ -262,8 +233,8 @@ def _stiffness(quick: bool, outdir: Path, workers, classify):
     ):
         path = outdir / f"sensitivity-{'stiffness' if name == 'Y_f' else 'hertz'}.parquet"
         bif = bifurcation(
-            name, values, duration=20.0, transient=10.0, classify=classify, workers=workers,
-            fate=SWEEP_FATE_S[quick], **stored(path),
+            name, values, duration=20.0, transient=10.0, workers=workers,
+            fate=SWEEP_FATE_S[quick], **judge, **stored(path),
         )  # fmt: skip
         out.append((bif, path, {v: k_of(v) for v in values}))
     return out
@@ -274,7 +245,7 @@ def _stiffness_figure(sweeps):
     left no section point (diverged, out of reach) is an x on the top edge."""
     from matplotlib.figure import Figure
 
-    from ..report._sweep_figures import LABEL_COLORS, mark_without_points
+    from ..report import LABEL_COLORS, mark_without_points
 
     fig = Figure(figsize=(10, 5.5), layout="constrained")
     ax = fig.subplots()
@@ -295,7 +266,7 @@ def _stiffness_figure(sweeps):
     return fig
 
 
-def _omega_xi_map(quick: bool, outdir: Path, workers, classify):
+def _omega_xi_map(quick: bool, outdir: Path, workers, judge: dict):
     """The (ω, ξ) regime map, one deterministic run a cell continued to the fate horizon;
     returns (the map, its data file)."""
     from ..sweep import Axis, regime_map
@@ -308,44 +279,53 @@ def _omega_xi_map(quick: bool, outdir: Path, workers, classify):
         realizations=1,
         duration=20.0,
         transient=10.0,
-        classify=classify,
         workers=workers,
         fate=FATE_S[quick],
+        **judge,
         **stored(path := outdir / "sensitivity-omega-xi.parquet"),
     )
     return rm, path
 
 
-def sensitivity(quick: bool, outdir: Path, workers=None, classify=None):
-    """The sweeps, their figures and the findings (a FigureResult titled "Sensitivity");
-    ``classify`` as for the sweeps (the report's quick run caps the extension of
-    undetermined runs). The (ω, ξ) map, the longest sweep, runs beside the others
-    (:func:`._side_by_side.beside`, where ``workers`` is every core), so no sweep's last
-    runs leave a core idle."""
+def sensitivity(quick: bool, outdir: Path, workers=None, judge: dict | None = None):
+    """The sweeps, their figures and the findings (a FigureResult titled "Sensitivity").
+
+    ``judge``: the sweeps' verdict keywords (``extend_to``, ``check_step``; the report's
+    :func:`._stage.judging`), None for the sweeps' defaults. The (ω, ξ) map, the longest
+    sweep, runs beside the others (:func:`._side_by_side.beside`, where ``workers`` is every
+    core), so no sweep's last runs leave a core idle."""
     from ._side_by_side import beside
 
-    with beside(workers, _omega_xi_map, quick, outdir, workers, classify) as omega_xi:
-        return _sensitivity(quick, outdir, workers, classify, omega_xi)
+    judge = dict(judge or {})
+    with beside(workers, _omega_xi_map, quick, outdir, workers, judge) as omega_xi:
+        res = FigureResult(0, title="Sensitivity (why the paper differs)")
+        hertz_tags = _stiffness_part(res, quick, outdir, workers, judge)
+        _restitution_part(res, quick, outdir, workers, judge, hertz_tags)
+        # the last sweeps first, then the (ω, ξ) map, under way since the stage began
+        choices, bifs = open_choices(quick, outdir, workers, judge, hertz_tags)
+        rm, path_m = omega_xi.result()
+    png_m = _save_map(outdir, rm)
+    res.regime_maps.append((str(path_m), rm, png_m))
+    res.why += [omega_xi_finding(rm, FATE_S[quick]), choices]
+    res.bifurcations.extend(bifs)
+    return res
 
 
-def _sensitivity(quick: bool, outdir: Path, workers, classify, omega_xi):
-    """:func:`sensitivity` while ``omega_xi`` (a future of :func:`_omega_xi_map`) runs."""
-    from ..model import Params
-    from ..report._sweep_figures import (
-        SETTLED_MARK,
-        TRANSIENT_MARK,
-        regime_map_figure,
-        sweep_diagram,
-    )
-    from ..sweep import bifurcation
+def _save_map(outdir: Path, rm):
+    from ..report import regime_map_figure
+
+    return save(outdir, "sensitivity-omega-xi", regime_map_figure, rm.cells, x="omega", y="xi")
+
+
+def _stiffness_part(res, quick: bool, outdir: Path, workers, judge: dict) -> list[str]:
+    """The stiffness sweeps, their figures and sentence into ``res``; returns the tags across
+    the paper's Hertz range, which the other findings compare with."""
+    from ..report import sweep_diagram
     from ._drawing import uri_of
-    from ._paper import FigureResult, _save
 
-    res = FigureResult(0, title="Sensitivity (why the paper differs)")
-    # 1. stiffness
-    sweeps = _stiffness(quick, outdir, workers, classify)
-    png_k = _save(outdir, "sensitivity-stiffness", _stiffness_figure, sweeps)
-    (bif_k, path_k, k_yf), (bif_h, path_h, k_h) = sweeps
+    sweeps = _stiffness(quick, outdir, workers, judge)
+    png_k = save(outdir, "sensitivity-stiffness", _stiffness_figure, sweeps)
+    (bif_k, path_k, _), (bif_h, path_h, _) = sweeps
     yf, hertz = (
         first_ic(b).assign(K_n=lambda f, k=k: f["value"].map(k)).sort_values("K_n")
         for b, _, k in sweeps
@@ -362,27 +342,35 @@ def _sensitivity(quick: bool, outdir: Path, workers, classify, omega_xi):
             f"{len(yf)} stiffnesses through Y_f and {len(hertz)} through l_λ across the "
             "paper's range, 20 s runs (10 s transient), one initial condition; labels from "
             "the default classifier"
-            + (", each checked at half the step" if getattr(classify, "check_step", False) else "")
+            + (", each checked at half the step" if judge.get("check_step") else "")
             + f". Data: {path_k.name}, {path_h.name}.",
         )
     )
     res.bifurcations.append(
-        (str(path_k), bif_k, _save(outdir, "sensitivity-yf", sweep_diagram, bif_k))
+        (str(path_k), bif_k, save(outdir, "sensitivity-yf", sweep_diagram, bif_k))
     )
-    png_h = _save(outdir, "sensitivity-hertz", sweep_diagram, bif_h)
+    png_h = save(outdir, "sensitivity-hertz", sweep_diagram, bif_h)
     res.bifurcations.append((str(path_h), bif_h, png_h))
-    # 2. restitution
+    return hertz_tags
+
+
+def _restitution_part(res, quick, outdir: Path, workers, judge: dict, hertz_tags) -> None:
+    """The restitution sweep, its figure and sentence into ``res``."""
+    from ..model import Params
+    from ..report import sweep_diagram
+    from ..sweep import bifurcation
+
     bif_x = bifurcation(
         "xi",
         xi_values(quick),
         duration=20.0,
         transient=10.0,
-        classify=classify,
         workers=workers,
         fate=FATE_S[quick],
+        **judge,
         **stored(path_x := outdir / "sensitivity-xi.parquet"),
     )
-    png_x = _save(outdir, "sensitivity-xi", sweep_diagram, bif_x)
+    png_x = save(outdir, "sensitivity-xi", sweep_diagram, bif_x)
     res.bifurcations.append((str(path_x), bif_x, png_x))
     v_x = first_ic(bif_x)
     res.why.append(
@@ -396,11 +384,14 @@ def _sensitivity(quick: bool, outdir: Path, workers, classify, omega_xi):
         )
         + step_finding(v_x, lambda r: f"ξ = {r.value:.3g}")
     )
-    # 3. (omega, xi) map, under way since the stage began; the last sweeps first
-    choices, bifs = open_choices(quick, outdir, workers, classify, hertz_tags)
-    rm, path_m = omega_xi.result()
-    png_m = _save(outdir, "sensitivity-omega-xi", regime_map_figure, rm.cells, x="omega", y="xi")
-    res.regime_maps.append((str(path_m), rm, png_m))
+
+
+def omega_xi_finding(rm, horizon: float) -> str:
+    """The (ω, ξ) map's sentence: its regimes and periods, where the follower escapes, how
+    often the label changes along ω at Table 1's ξ, and its transient motion."""
+    from ..model import Params
+    from ..report import SETTLED_MARK, TRANSIENT_MARK
+
     cells = rm.cells
     tags = pd.Series(
         [verdict_tag(a, b) for a, b in zip(cells["dominant"], cells["period"], strict=True)]
@@ -415,7 +406,7 @@ def _sensitivity(quick: bool, outdir: Path, workers, classify, omega_xi):
     def cell_name(r) -> str:
         return f"({r.omega:.3g}, {r.xi:.3g})"
 
-    res.why.append(
+    return (
         f"(ω, ξ) map, {len(cells)} deterministic cells (one run each): "
         + ", ".join(f"{k} {n}" for k, n in tags.value_counts().sort_index().items())
         + f"; periods found: {', '.join(map(str, periods)) or 'none'}"
@@ -432,13 +423,10 @@ def _sensitivity(quick: bool, outdir: Path, workers, classify, omega_xi):
             if changes
             else "."
         )
-        + transient_finding(rm.realizations, FATE_S[quick], "cell", cell_name, cell_name)
+        + transient_finding(rm.realizations, horizon, "cell", cell_name, cell_name)
         .replace("transient chaos,", f"transient chaos (marked {TRANSIENT_MARK}),")
         .replace(
             "continued run's last half (", f"continued run's last half (marked {SETTLED_MARK}Pn; "
         )
         + step_finding(rm.realizations, lambda r: f"(ω, ξ) = ({r.omega:.3g}, {r.xi:.3g})")
     )
-    res.why.append(choices)
-    res.bifurcations.extend(bifs)
-    return res

@@ -28,8 +28,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..model import Params
-from ._sensitivity import verdict_tag
+from ._findings import verdict_tag
+from ._side_by_side import side_by_side
 
 __all__ = [
     "PER_SWEEP",
@@ -37,7 +37,6 @@ __all__ = [
     "audit_sample",
     "audit_sentence",
     "draw_rows",
-    "run_jobs",
     "sampled_rows",
     "step_audit",
     "sweep_names",
@@ -79,13 +78,15 @@ class AuditRow:
 
 def sweep_names(name: str, sweeps: list) -> list[str]:
     """``name`` for each of a figure's sweeps, with the base parameters in which they differ
-    when there are several (Fig. 6: "Fig. 6 (G = 1e-09, dt = 3.9e-07)") and with their step
-    when it is not the model's default (Fig. 4: "Fig. 4 (dt = 3.8e-07)"): what the audit
-    halves is that step."""
+    and numerics when there are several (Fig. 6: "Fig. 6 (G = 1e-09, dt = 3.9e-07)") and
+    with their step when it is not the default (Fig. 4: "Fig. 4 (dt = 3.8e-07)"): what the
+    audit halves is that step."""
+    from ..numerics import Numerics
+
     if not sweeps:  # Figs. 3 and 5 have no sweep
         return []
-    default_dt = Params().dt
-    bases = [s.config["base"] for s in sweeps]
+    default_dt = Numerics().dt
+    bases = [{**s.config["base"], **s.config.get("numerics", {})} for s in sweeps]
     keys = [k for k in bases[0] if len({repr(b.get(k)) for b in bases}) > 1]
     if "dt" not in keys and bases[0].get("dt", default_dt) != default_dt:
         keys.append("dt")  # the same step for all, not the default
@@ -118,22 +119,13 @@ def audit_sample(table: pd.DataFrame, k: int, seed: int = AUDIT_SEED) -> pd.Data
 
 
 def sampled_rows(sweeps: list[tuple[str, Any]], sample, k: int, seed: int):
-    """``(figure name, settings, row)`` for the rows ``sample(table, k, seed)`` draws from
-    each ``(figure name, sweep)``'s table (a map's realizations, a diagram's verdicts): what
-    a pool task of the audit or the ladder starts from."""
+    """``(figure name, sweep, row)`` for the rows ``sample(table, k, seed)`` draws from each
+    ``(figure name, sweep)``'s table (a map's realizations, a diagram's verdicts): what a job
+    of the audit or the ladder starts from."""
     for figure, sweep in sweeps:
         table = sweep.realizations if sweep.config["kind"] == "regime_map" else sweep.verdicts
-        settings = _Settings(sweep.config)
         for row in sample(table, k, seed).to_dict("records"):
-            yield figure, settings, row
-
-
-@dataclass(frozen=True)
-class _Settings:
-    """What :func:`chaoscam.sweep.replay` reads of a sweep (its ``config``), without its
-    tables: what a pool task carries."""
-
-    config: dict
+            yield figure, sweep, row
 
 
 def _where(cfg: dict, row: dict) -> str:
@@ -145,22 +137,21 @@ def _where(cfg: dict, row: dict) -> str:
 
 
 def _audit_one(job: tuple) -> AuditRow:
-    """Replay one run and check it at half the step (a pool task: plain arguments)."""
-    from ..classify import classify_trajectory
+    """Replay one run and check it at half the step."""
     from ..sweep import replay
+    from ..verdict import classify
 
-    figure, settings, row, extend_to = job
+    figure, sweep, row, extend_to = job
     t0 = time.perf_counter()
     with warnings.catch_warnings():  # the model's warnings came with the sweep's own run
         warnings.simplefilter("ignore", RuntimeWarning)
-        traj = replay(settings, row)
-        v = classify_trajectory(traj, check_step=True, extend_to=extend_to)
+        (v,) = classify(replay(sweep, row), check_step=True, extend_to=extend_to)
     check = v.settings.get("step_check", {})
     grid = verdict_tag(check.get("grid_label", v.label), check.get("grid_period", v.period))
     half = verdict_tag(check["label"], check["period"]) if "label" in check else "not re-run"
     return AuditRow(
         figure,
-        _where(settings.config, row),
+        _where(sweep.config, row),
         verdict_tag(row["label"], row["period"]),
         grid,
         half,
@@ -180,28 +171,9 @@ def step_audit(
     """Audit ``per_sweep`` runs (the report: :data:`PER_SWEEP`) of each ``(figure name,
     sweep)`` (a RegimeMap or a Bifurcation), drawn with ``seed``: each replayed and checked at
     half the step, an undetermined verdict extended up to ``extend_to`` seconds recorded (the
-    sweeps' own cap), on ``workers`` local processes (:func:`chaoscam.sweep.local_workers`)."""
+    sweeps' own cap), on ``workers`` local threads (:func:`chaoscam.sweep.local_workers`)."""
     jobs = [(*job, extend_to) for job in sampled_rows(sweeps, audit_sample, per_sweep, seed)]
-    return run_jobs(_audit_one, jobs, workers)
-
-
-def run_jobs(task, jobs: list, workers=None) -> list:
-    """``[task(job) for job in jobs]`` on ``workers`` local processes (no more than jobs),
-    in order; Ctrl-C or a failed job stops the workers at once, not after their runs."""
-    from ..sweep._backends import ProcessBackend, local_workers
-
-    if not jobs:
-        return []
-    pool = ProcessBackend(min(local_workers(workers), len(jobs)))
-    futures = []
-    try:
-        futures = [pool.submit(task, job) for job in jobs]
-        rows = [pool.result(f) for f in futures]
-    except BaseException:
-        pool.cancel(futures)
-        raise
-    pool.close()
-    return rows
+    return side_by_side(_audit_one, jobs, workers, prefix="chaoscam-audit")
 
 
 def _count(n: int, one: str, many: str) -> str:

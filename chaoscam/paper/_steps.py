@@ -21,7 +21,8 @@ Fig. 6, and says its labels are not converged there.
 
 from __future__ import annotations
 
-from ..model import Params
+from ..model import Params, contact_period
+from ..numerics import Numerics
 
 __all__ = [
     "FIG4_STEPS",
@@ -54,23 +55,19 @@ FIGS7_10_STEP_NOTE = (
 
 def figure_dt(stiffest: Params, steps: int | None) -> float:
     """The step giving ``steps`` RK4 steps per contact period of ``stiffest`` (the figure's
-    stiffest point, :func:`chaoscam.contact_period`), rounded to two significant
-    digits (as Fig. 6 always was); ``stiffest.dt`` when ``steps`` is None.
+    stiffest point, :func:`chaoscam.contact_period`), rounded to two significant digits;
+    the default ``Numerics().dt`` when ``steps`` is None.
 
     Examples: Fig. 4 at l_λ = 0.018 m and 160 steps, 3.8e-7 s; Fig. 6 at D = 1.56,
     G = 1e-9 m and 160 steps, 9.6e-8 s.
     """
-    from .._simulate import contact_period
-
     if steps is None:
-        return stiffest.dt
+        return Numerics().dt
     return float(f"{contact_period(stiffest) / steps:.1e}")
 
 
 def steps_per_period(p: Params, dt: float) -> float:
     """How many steps of ``dt`` [s] one contact period of ``p`` spans."""
-    from .._simulate import contact_period
-
     return contact_period(p) / dt
 
 

@@ -3,8 +3,8 @@
 Every sweep of a stage writes its tables straight into the data folder through the sweep's
 own output (``out=``): it checkpoints its finished runs as it goes (``FILE.parquet.ckpt/``),
 and a resumed sweep reuses a finished output of the same configuration or finishes an
-interrupted one from its checkpoint (:func:`chaoscam.sweep._checkpoint.guard_outputs`; an
-output of another configuration, e.g. other code, is refused by name). So ``chaoscam paper
+interrupted one from its checkpoint (``resume=True``; an output of another configuration,
+e.g. other code, is refused by name). So ``chaoscam paper
 --resume`` after a Ctrl-C, a SIGTERM or a SIGKILL redoes only the sweep that was under way,
 from its checkpoint, and what is cheap (figures, single runs, the step audit) again.
 

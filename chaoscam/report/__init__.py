@@ -1,8 +1,8 @@
-"""Reports: figures (seaborn/matplotlib) and HTML for simulations, regime maps, diagrams
-and ensembles.
+"""Reports: figures (seaborn/matplotlib) and HTML for runs, regime maps, diagrams and
+ensembles.
 
 ``chaoscam report INPUT... --out FILE.html`` drives this layer, and ``chaoscam paper``
-(:mod:`chaoscam.experiments`) renders through it; it only renders. In Python::
+(:mod:`chaoscam.paper`) renders through it; it only renders. In Python::
 
     from chaoscam.report import build_report, load_inputs, write_report
     write_report(build_report(load_inputs(["run.parquet"])), "run.html", title="run")
@@ -12,35 +12,34 @@ matplotlib and jinja2 are imported only when a figure is drawn or a page rendere
 
 from __future__ import annotations
 
-from .._lazy import lazy_face
+from .._util import lazy_face
 
-# Public names and the submodule that defines each: imported on first use (PEP 562),
-# so that importing the package stays cheap.
 _LAZY = {
+    "LABEL_COLORS": ("._sweep_figures", "LABEL_COLORS"),
+    "SETTLED_MARK": ("._sweep_figures", "SETTLED_MARK"),
+    "TRANSIENT_MARK": ("._sweep_figures", "TRANSIENT_MARK"),
     "Comparison": ("._html", "Comparison"),
     "FigureItem": ("._html", "FigureItem"),
     "InputError": ("._inputs", "InputError"),
-    "ReportClassifier": ("._classify", "ReportClassifier"),
+    "Inputs": ("._inputs", "Inputs"),
     "ReportParts": ("._html", "ReportParts"),
+    "add_bifurcation": ("._html", "add_bifurcation"),
+    "add_ensemble": ("._html", "add_ensemble"),
+    "add_regime_map": ("._html", "add_regime_map"),
+    "add_trajectory": ("._html", "add_trajectory"),
+    "bifurcation_figure": ("._sweep_figures", "bifurcation_figure"),
     "build_report": ("._html", "build_report"),
-    "classify": ("._classify", "classify"),
+    "ensemble_figure": ("._ensemble", "ensemble_figure"),
     "load_inputs": ("._inputs", "load_inputs"),
-    "load_trajectory": ("._inputs", "load_trajectory"),
+    "mark_without_points": ("._sweep_figures", "mark_without_points"),
+    "png_bytes": ("._figures", "png_bytes"),
+    "png_uri": ("._figures", "png_uri"),
+    "regime_map_figure": ("._sweep_figures", "regime_map_figure"),
+    "response_figure": ("._figures", "response_figure"),
+    "sweep_diagram": ("._sweep_figures", "sweep_diagram"),
     "write_report": ("._html", "write_report"),
 }
 
-__all__ = [
-    "Comparison",
-    "FigureItem",
-    "InputError",
-    "ReportClassifier",
-    "ReportParts",
-    "build_report",
-    "classify",
-    "load_inputs",
-    "load_trajectory",
-    "write_report",
-]
-
+__all__ = sorted(_LAZY)
 
 __getattr__, __dir__ = lazy_face(__name__, _LAZY)

@@ -1,12 +1,11 @@
-"""An ensemble (``chaoscam ensemble --out``) in the report: its members' section, the share
-of each label with its 95 % Wilson interval, why members stayed undetermined, and the run's
-record.
+"""An ensemble (:func:`chaoscam.ensemble`, ``chaoscam ensemble --out``) in the report: its
+members' section, the share of each label with its 95 % Wilson interval, why members stayed
+undetermined, and the run's configuration.
 
-A member's label is its verdict (``--classify``) or, unclassified, its run status. With
-``l_lambda_sigma = 0``, or the fractal stiffness, every member is the same deterministic run
-(the members differ only in their realization index, whose draws change nothing), so the
-shares are those of one run and get no sampling interval, as a regime map's deterministic
-cells (:mod:`chaoscam.sweep._regime`).
+A member's label is its verdict or, unclassified, its run status. With ``l_lambda_sigma =
+0``, or the fractal stiffness, every member is the same deterministic run (the members
+differ only in their realization index, whose draws change nothing), so the shares are those
+of one run and get no sampling interval, as a regime map's deterministic cells.
 """
 
 from __future__ import annotations
@@ -18,54 +17,55 @@ from typing import Any
 
 import numpy as np
 
-from .._provenance import code_rows
+from ..io import code_rows
+from ..sweep import LABEL_ORDER, wilson_interval
 from ._figures import png_bytes, png_uri
 
-__all__ = ["deterministic", "ensemble_entry", "ensemble_figure", "label_shares"]
+__all__ = ["classified", "deterministic", "ensemble_entry", "ensemble_figure", "label_shares"]
 
 TOP_REASONS = 8
 """Most distinct reasons for an undetermined label listed in the report (the rest counted)."""
 
 
+def classified(members) -> bool:
+    """Whether the members carry verdicts (an ensemble run with ``classify``)."""
+    return "label" in members and bool(members["label"].notna().any())
+
+
 def _labels(members) -> list[str]:
     """Each member's label: its verdict, or its status when the run was not classified; a
     periodic verdict with its period ("periodic (period 2)")."""
-    if "label" not in members:
+    if not classified(members):
         return [str(s) for s in members["status"]]
     import pandas as pd
 
-    periods = members["period"] if "period" in members else [None] * len(members)
     return [
         f"periodic (period {int(p)})" if lab == "periodic" and not pd.isna(p) else str(lab)
-        for lab, p in zip(members["label"], periods, strict=True)
+        for lab, p in zip(members["label"], members["period"], strict=True)
     ]
 
 
 def _order(label: str) -> tuple[int, int, str]:
-    from ..sweep._stats import LABEL_ORDER
-
     head = label.partition(" ")[0]
     rank = LABEL_ORDER.index(head) if head in LABEL_ORDER else len(LABEL_ORDER)
     period = re.search(r"period (\d+)", label)
     return rank, int(period.group(1)) if period else 0, label
 
 
-def deterministic(record: dict) -> bool:
-    """True when the record says every member is the same run: ``l_lambda_sigma = 0``, or
-    the fractal stiffness (:func:`chaoscam.model.realizations_identical`)."""
+def deterministic(config: dict) -> bool:
+    """True when the configuration says every member is the same run: ``l_lambda_sigma =
+    0``, or the fractal stiffness (:func:`chaoscam.model.realizations_identical`)."""
     from ..model import Params, realizations_identical
 
     try:
-        return realizations_identical(Params(**record["params"]))
-    except (KeyError, TypeError, ValueError):  # no record, or one this version cannot read
+        return realizations_identical(Params(**config["params"]))
+    except (KeyError, TypeError, ValueError):  # a configuration this version cannot read
         return False
 
 
 def label_shares(members, *, confidence: float = 0.95) -> list[dict[str, Any]]:
     """One row per label, in display order: label, count, share, and the share's Wilson
     interval (``lo``, ``hi``) over the members."""
-    from ..sweep._stats import wilson_interval
-
     counts = Counter(_labels(members))
     n = sum(counts.values())
     rows = []
@@ -106,7 +106,7 @@ def ensemble_figure(ens, *, title: str = ""):
     x = np.arange(len(rows))
     share = np.array([r["share"] for r in rows])
     colors = [LABEL_COLORS.get(r["label"].partition(" ")[0], _OTHER) for r in rows]
-    if deterministic(ens.record):
+    if deterministic(ens.config):
         b.bar(x, share, color=colors)
         b.set_title("share of members (one deterministic run)")
     else:
@@ -125,7 +125,7 @@ def ensemble_figure(ens, *, title: str = ""):
 
 def _reasons(members) -> list[tuple[str, int]]:
     """Why members are undetermined: each reason and how many members give it."""
-    if "label" not in members or "reasons" not in members:
+    if not classified(members):
         return []
     undetermined = members[members["label"] == "undetermined"]
     counts = Counter(
@@ -134,34 +134,33 @@ def _reasons(members) -> list[tuple[str, int]]:
     return counts.most_common()
 
 
-def _settings(record: dict, ens) -> dict[str, Any]:
-    if not record:
-        return {"record": "not kept (written by chaoscam before ensembles recorded their run)"}
-    p = record.get("params") or {}
-    last = record.get("first", 0) + record.get("members", len(ens.members)) - 1
+def _settings(cfg: dict, ens) -> dict[str, Any]:
+    """The provenance rows of an ensemble's configuration."""
+    p, num = cfg.get("params") or {}, cfg.get("numerics") or {}
+    first = cfg.get("first", 0)
     rows = {
         "kind": "ensemble",
-        "package version": record.get("version"),
-        "backends": ", ".join(record.get("backends", [])),
-        "seed": record.get("seed"),
-        "realization indices": f"{record.get('first')} .. {last}",
-        "duration [s]": record.get("duration"),
-        "transient [s]": record.get("transient"),
-        "classified": record.get("classify"),
+        "package version": cfg.get("version"),
+        "device": cfg.get("device"),
+        "seed": cfg.get("seed"),
+        "realization indices": f"{first} .. {first + cfg.get('members', len(ens.members)) - 1}",
+        "duration [s]": cfg.get("duration"),
+        "transient [s]": cfg.get("transient"),
+        "classifier": cfg.get("classifier"),
     }
-    rows.update(code_rows(record.get("code")))
-    for k, unit in (
-        ("stiffness", ""),
-        ("integrator", ""),
-        ("dt", " [s]"),
-        ("l_lambda", " [m]"),
-        ("l_lambda_sigma", " [m]"),
-        ("resample", ""),
-        ("omega", " [rad/s]"),
-        ("xi", ""),
+    rows.update(code_rows(cfg.get("code")))
+    for source, k, unit in (
+        (num, "integrator", ""),
+        (num, "dt", " [s]"),
+        (p, "stiffness", ""),
+        (p, "l_lambda", " [m]"),
+        (p, "l_lambda_sigma", " [m]"),
+        (p, "resample", ""),
+        (p, "omega", " [rad/s]"),
+        (p, "xi", ""),
     ):
-        if k in p:
-            rows[f"{k}{unit}"] = p[k]
+        if k in source:
+            rows[f"{k}{unit}"] = source[k]
     return rows
 
 
@@ -172,7 +171,7 @@ def ensemble_entry(path: str, ens, *, png: bytes | None = None) -> dict[str, Any
     already rendered, else drawn here)."""
     name = Path(path).name
     rows = label_shares(ens.members)
-    fixed = deterministic(ens.record)
+    fixed = deterministic(ens.config)
     if png is None:
         png = png_bytes(ensemble_figure(ens, title=name))
     n = len(ens.members)
@@ -181,7 +180,7 @@ def ensemble_entry(path: str, ens, *, png: bytes | None = None) -> dict[str, Any
     rest = sum(c for _, c in reasons[TOP_REASONS:])
     if rest:
         shown.append((f"{len(reasons) - TOP_REASONS} other reasons", rest))
-    what = "verdicts" if "label" in ens.members else "run statuses (not classified)"
+    what = "verdicts" if classified(ens.members) else "run statuses (not classified)"
     counts = "; ".join(f"{r['label']}: {r['count']}" for r in rows)
     return {
         "figure": {
@@ -208,7 +207,7 @@ def ensemble_entry(path: str, ens, *, png: bytes | None = None) -> dict[str, Any
             for r in rows
         ],
         "reasons": shown,
-        "settings": _settings(ens.record, ens),
+        "settings": _settings(ens.config, ens),
         "summary": f"{name}: ensemble of {n} members, {what}: {counts}"
         + (" (σ = 0: one deterministic run)." if fixed else "."),
     }

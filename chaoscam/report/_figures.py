@@ -1,4 +1,4 @@
-"""Figures of single trajectories (paper Figs. 7-10) and the PNG data URIs the HTML embeds.
+"""Figures of single runs (paper Figs. 7-10) and the PNG data URIs the HTML embeds.
 
 Built with matplotlib's object API (no pyplot: nothing opens a window, the Agg canvas
 renders), scatter layers rasterised so that thousands of points stay light.
@@ -30,8 +30,9 @@ def png_uri(png: bytes) -> str:
     return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
 
 
-def response_figure(traj, title: str = ""):
-    """Four panels of one run: θ_f and θ_fc over time, phase portrait, section, spectrum.
+def response_figure(run, title: str = ""):
+    """Four panels of one run (a one-member :class:`chaoscam.Solution`): θ_f and θ_fc over
+    time, phase portrait, section, spectrum.
 
     The time panel shows the last 2 s of the kept series; the phase portrait the whole kept
     series; the Poincaré panel the stroboscopic section at t = k 2π/ω; the spectrum the
@@ -44,9 +45,9 @@ def response_figure(traj, title: str = ""):
 
     fig = Figure(figsize=(11, 7.5), layout="constrained")
     (a, b), (c, d) = fig.subplots(2, 2)
-    s = traj.series
-    sec = traj.section
-    f_cam = traj.params.omega / (2 * np.pi)
+    s = run.series
+    sec = run.section
+    f_cam = run.params.omega / (2 * np.pi)
     if s is not None and len(s) > 2:
         last = s[s["t"] >= s["t"].iloc[-1] - 2.0]
         a.plot(last["t"], last["theta_f"], lw=0.8, color="#0072B2", label="θ_f (follower)")

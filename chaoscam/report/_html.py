@@ -14,13 +14,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .._provenance import code_rows
-from ..sweep._stats import fate_clause
+from ..io import code_rows
+from ..sweep import fate_clause
 from ._figures import png_bytes, png_uri, response_figure
 from ._inputs import require_inputs
 
-__all__ = ["Comparison", "FigureItem", "add_ensemble", "build_report", "git_commit", "render"]
+__all__ = ["Comparison", "FigureItem", "ReportParts", "add_bifurcation", "add_ensemble"]
+__all__ += ["add_regime_map", "add_trajectory", "build_report", "git_commit", "render"]
 __all__ += ["uncommitted_sources", "write_report"]
+
+CLASSIFIER = "chaoscam.classify() (tangent exponent, orbit certificate)"
+"""The classifier the report's runs are labelled with, in words."""
 
 SECTIONS = (
     ("summary", "Summary of findings"),
@@ -160,58 +164,65 @@ def _provenance_rows(source: str, kind: str, rows: dict[str, Any]) -> dict[str, 
     return {"source": source, "kind": kind, "rows": [(k, _fmt(v)) for k, v in rows.items()]}
 
 
-def add_trajectory(
-    parts: ReportParts,
-    path: str,
-    traj,
-    *,
-    caption: str = "",
-    png: bytes | None = None,
-    verdict=None,
-) -> None:
-    """A trajectory's response figure, its classification and its provenance.
+def classifier_fingerprint() -> str:
+    """:data:`CLASSIFIER` and the sha256 (12 hex digits) of the verdict package's source, for
+    provenance."""
+    import hashlib
 
-    ``png``: the response figure already rendered (:func:`._figures.png_bytes`, the paper's
-    stages render each figure once, for its file and for the report); without it the figure
-    is drawn here, titled with the file name and the label. ``verdict``: ``traj``'s verdict
-    by :func:`._classify.classify`, already computed (the paper's stage classifies its
-    responses side by side); without it the trajectory is classified here.
+    from .. import verdict
+
+    digest = hashlib.sha256()
+    try:
+        for f in sorted(Path(verdict.__file__).parent.glob("*.py")):
+            digest.update(f.read_bytes())
+        text = digest.hexdigest()[:12]
+    except (OSError, TypeError):
+        text = "unknown"
+    return f"{CLASSIFIER} (source sha256 {text})"
+
+
+def add_trajectory(
+    parts: ReportParts, path: str, run, *, caption: str = "", png: bytes | None = None,
+    verdict=None,
+) -> None:  # fmt: skip
+    """A run's response figure, its verdict and its provenance (``run``: a one-member
+    :class:`chaoscam.Solution`).
+
+    ``png``: the response figure already rendered (:func:`._figures.png_bytes`); without it
+    the figure is drawn here, titled with the file name and the label. ``verdict``: the run's
+    verdict by :func:`chaoscam.classify`, already computed; without it the run is classified
+    here.
     """
-    from ._classify import classifier_name, classify
+    from ..verdict import classify
 
     name = Path(path).name
-    p = traj.params
-    verdict = classify(traj) if verdict is None else verdict
-    s = traj.settings
+    p, s = run.params, run.settings
+    if verdict is None:
+        (verdict,) = classify(run)
     parts.provenance.append(
-        _provenance_rows(
-            path,
-            "trajectory",
-            {
-                "status": traj.status.name,
-                "seed": s.get("seed"),
-                "realization index": s.get("index"),
-                "solver": s.get("solver"),
-                "integration": p.describe_step(),
-                "duration [s]": s.get("duration"),
-                "transient [s]": s.get("transient"),
-                "package version": s.get("version"),
-                "stiffness": p.stiffness,
-                "l_lambda (mean) [m]": p.l_lambda,
-                "l_lambda_sigma [m]": p.l_lambda_sigma,
-                "resample": p.resample,
-                "impacts applied": traj.stats.get("n_impacts"),
-                "contact fraction": traj.stats.get("contact_fraction"),
-            },
-        )
-    )
+        _provenance_rows(path, "trajectory", {
+            "status": run.status.name,
+            "seed": s.get("seed"),
+            "realization index": run.index,
+            "integrator": run.numerics.integrator,
+            "integration": run.numerics.describe_step(),
+            "duration [s]": s.get("duration"),
+            "transient [s]": s.get("transient"),
+            "package version": s.get("version"),
+            "stiffness": p.stiffness,
+            "l_lambda (mean) [m]": p.l_lambda,
+            "l_lambda_sigma [m]": p.l_lambda_sigma,
+            "resample": p.resample,
+            "impacts applied": run.stats.get("n_impacts"),
+            "contact fraction": run.stats.get("contact_fraction"),
+        })
+    )  # fmt: skip
     label = verdict.label + (f" (period {verdict.period})" if verdict.period else "")
     if png is None:
-        png = png_bytes(response_figure(traj, title=f"{name}: {label}"))
-    fid = f"resp-{len(parts.responses) + 1}"
+        png = png_bytes(response_figure(run, title=f"{name}: {label}"))
     parts.responses.append(
         FigureItem(
-            fid,
+            f"resp-{len(parts.responses) + 1}",
             f"Response of {name}",
             png_uri(png),
             f"Four panels for {name}: follower angle and persistent-contact angle over the "
@@ -228,13 +239,13 @@ def add_trajectory(
             "label": verdict.label,
             "period": verdict.period,
             "reasons": list(verdict.reasons),
-            "classifier": classifier_name(),
+            "classifier": CLASSIFIER,
             "rows": [
                 (e.name, _fmt(e.value), e.vote or "abstains", e.detail) for e in verdict.evidence
             ],
         }
     )
-    parts.summary.append(f"{name}: {label} ({traj.status.name}).")
+    parts.summary.append(f"{name}: {label} ({run.status.name}).")
 
 
 def add_bifurcation(
@@ -377,7 +388,6 @@ def _sweep_settings(cfg: dict[str, Any]) -> dict[str, Any]:
         "transient": "transient [s]",
         "realizations": "realizations per cell",
         "classifier": "classifier",
-        "engine": "engine",
         "device": "device",
         "confidence": "confidence of the intervals",
         "adaptive": "adaptive sampling",
@@ -394,25 +404,40 @@ def _sweep_settings(cfg: dict[str, Any]) -> dict[str, Any]:
                 if vals
                 else a.get("name")
             )
-    from ..model import FIELD_DOCS, Params
+    return rows | _base_rows(cfg.get("base", {}), cfg.get("numerics", {}))
 
-    base, default = cfg.get("base", {}), Params().to_dict()
-    for k, v in base.items():  # the integrator and step always, else what differs from Params()
-        if k in ("integrator", "dt") or v != default.get(k, v):
-            unit = "" if isinstance(v, str) else FIELD_DOCS.get(k, {}).get("unit", "")
-            rows[f"base {k}" + (f" [{unit}]" if unit else "")] = v
+
+def _base_rows(base: dict[str, Any], numerics: dict[str, Any]) -> dict[str, Any]:
+    """The sweep's base model where it differs from ``Params()``, and its integrator and step
+    always (other numerics where they differ from ``Numerics()``)."""
+    from ..model import FIELD_DOCS, Params
+    from ..numerics import Numerics
+
+    rows = {}
+    for values, default, docs, always in (
+        (numerics, Numerics().to_dict(), Numerics.field_docs(), ("integrator", "dt")),
+        (base, Params().to_dict(), FIELD_DOCS, ()),
+    ):
+        for k, v in values.items():
+            if k in always or v != default.get(k, v):
+                unit = "" if isinstance(v, str) else docs.get(k, {}).get("unit", "")
+                rows[f"base {k}" + (f" [{unit}]" if unit else "")] = v
     return rows
 
 
 def model_rows() -> list[tuple[str, Any, str, str]]:
-    """(name, value, unit, meaning) of each field of ``Params()``, where every run starts."""
+    """(name, value, unit, meaning) of each field of ``Params()`` and ``Numerics()``, where
+    every run starts."""
     from ..model import FIELD_DOCS, Params
+    from ..numerics import Numerics
 
     def short(doc: str) -> str:  # the first ~150 characters of a long field doc
         return doc if len(doc) < 160 else doc[:150].rsplit(" ", 1)[0] + " …"
 
-    docs = {k: (d.get("unit") or "", short(d.get("doc") or "")) for k, d in FIELD_DOCS.items()}
-    return [(k, v, *docs.get(k, ("", ""))) for k, v in Params().to_dict().items()]
+    docs = {**FIELD_DOCS, **Numerics.field_docs()}
+    docs = {k: (d.get("unit") or "", short(d.get("doc") or "")) for k, d in docs.items()}
+    values = {**Params().to_dict(), **Numerics().to_dict()}
+    return [(k, v, *docs.get(k, ("", ""))) for k, v in values.items()]
 
 
 def _sections(parts: ReportParts) -> tuple[tuple[str, str], ...]:
@@ -429,7 +454,6 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
     import jinja2
 
     from .._version import __version__
-    from ._classify import classifier_fingerprint
 
     env = jinja2.Environment(
         loader=jinja2.PackageLoader("chaoscam.report", "templates"),
@@ -458,7 +482,7 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
 
 
 def build_report(inputs, parts: ReportParts | None = None) -> ReportParts:
-    """Add every input (an :class:`~chaoscam.report._inputs.Inputs`) to the report parts."""
+    """Add every input (:func:`load_inputs`' :class:`~._inputs.Inputs`) to the report parts."""
     inputs, parts = require_inputs(inputs), parts or ReportParts()
     for path, rm in inputs.regime_maps:
         add_regime_map(parts, path, rm)
@@ -487,9 +511,9 @@ def write_report(
     """Render and write the report atomically into an existing folder; returns the path.
 
     Never over an existing file unless ``replace=True``: the report then goes beside it
-    (``NAME.PID.html``) with an :class:`chaoscam._outputs.OutputError` naming both.
+    (``NAME.PID.html``) with an :class:`chaoscam.io.OutputError` naming both.
     """
-    from .._outputs import atomic_write_bytes, check_output
+    from ..io import atomic_write_bytes, check_output
 
     out = check_output(out, flag="out", force=True, suffixes=(".html", ".htm"))
     data = render(parts, title=title, command=command).encode("utf-8")

@@ -107,8 +107,6 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
     reach later carry :data:`TRANSIENT_MARK`."""
     import seaborn as sns
     from matplotlib.colors import ListedColormap
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
 
     present = [lab for lab in cells["dominant"].unique() if lab]
     order = [lab for lab in LABEL_COLORS if lab in present] + sorted(
@@ -118,28 +116,7 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
     coded = cells.assign(_code=cells["dominant"].map(code).astype(float))
     m = _grid(coded, x, y, "_code")
     colors = [LABEL_COLORS.get(lab, _OTHER) for lab in order] or ["#FFFFFF"]
-    annot = False
-    if m.size <= ANNOTATE_PERIODS:
-        text = np.full(m.shape, "", dtype=object)
-        dom = _grid(cells, x, y, "dominant").to_numpy()
-
-        def grid_of(name: str) -> np.ndarray:  # a cell column on the map's grid, as floats
-            return _grid(cells.assign(_v=cells[name].astype(float)), x, y, "_v").to_numpy()
-
-        if "period" in cells:
-            per = grid_of("period")
-            periodic = (dom == "periodic") & np.isfinite(per)
-            text[periodic] = ["P" + str(int(v)) for v in per[periodic]]
-        if "n_transient" in cells:
-            later = grid_of("n_transient") > 0
-            text[later] = [t + TRANSIENT_MARK for t in text[later]]
-        if "settled_period" in cells:  # a transient that settles: the period it settles on
-            per = grid_of("settled_period")
-            late = np.isfinite(per) & (dom != "periodic")
-            text[late] = [
-                f"{t}{SETTLED_MARK}P{int(v)}" for t, v in zip(text[late], per[late], strict=True)
-            ]
-        annot = text.astype(str)
+    annot = _dominant_text(cells, x, y, m.shape) if m.size <= ANNOTATE_PERIODS else False
     sns.heatmap(
         m,
         ax=ax,
@@ -163,34 +140,59 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
             t.set_fontsize(1.6 * t.get_fontsize())
     _ticks(ax, m, x, y, _role(x, y))
     shown = annot is not False and bool(np.any(np.char.startswith(annot, "P")))
-    marked = annot is not False and bool(np.any(np.char.endswith(annot, TRANSIENT_MARK)))
-    settles = annot is not False and bool(np.any(np.char.find(annot, SETTLED_MARK) >= 0))
     ax.set_title("dominant label (Pn: periodic, period n)" if shown else "dominant label")
-    handles = [Patch(color=LABEL_COLORS.get(lab, _OTHER), label=lab) for lab in order]
-    if marked:
-        handles.append(
-            Line2D(
-                [],
-                [],
-                ls="",
-                marker=f"${TRANSIENT_MARK}$",
-                color="#000000",
-                markersize=9,
-                label="stops later: leaves the\ncam's reach or diverges\n(transient)",
-            )
-        )
-    if settles:
-        handles.append(
-            Line2D([], [], ls="", marker=f"${SETTLED_MARK}$", color="#000000", markersize=9,
-                   label="→Pn: runs periodic (n)\nlater (transient)")
-        )  # fmt: skip
     ax.legend(
-        handles=handles,
+        handles=_dominant_handles(order, annot),
         loc="upper left",
         bbox_to_anchor=(1.01, 1.0),
         frameon=False,
         fontsize="small",
     )
+
+
+def _dominant_text(cells: pd.DataFrame, x: str, y: str, shape) -> np.ndarray:
+    """The text of each cell of a dominant-label map: ``Pn`` for a periodic cell,
+    :data:`TRANSIENT_MARK` after it where runs stop later, ``→Pn`` where they settle."""
+    text = np.full(shape, "", dtype=object)
+    dom = _grid(cells, x, y, "dominant").to_numpy()
+
+    def grid_of(name: str) -> np.ndarray:  # a cell column on the map's grid, as floats
+        return _grid(cells.assign(_v=cells[name].astype(float)), x, y, "_v").to_numpy()
+
+    if "period" in cells:
+        per = grid_of("period")
+        periodic = (dom == "periodic") & np.isfinite(per)
+        text[periodic] = ["P" + str(int(v)) for v in per[periodic]]
+    if "n_transient" in cells:
+        later = grid_of("n_transient") > 0
+        text[later] = [t + TRANSIENT_MARK for t in text[later]]
+    if "settled_period" in cells:  # a transient that settles: the period it settles on
+        per = grid_of("settled_period")
+        late = np.isfinite(per) & (dom != "periodic")
+        text[late] = [
+            f"{t}{SETTLED_MARK}P{int(v)}" for t, v in zip(text[late], per[late], strict=True)
+        ]
+    return text.astype(str)
+
+
+def _dominant_handles(order: list[str], annot) -> list:
+    """The legend of a dominant-label map: a patch per label, and the marks its cells use."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    handles = [Patch(color=LABEL_COLORS.get(lab, _OTHER), label=lab) for lab in order]
+    if annot is False:
+        return handles
+    for mark, label, used in (
+        (TRANSIENT_MARK, "stops later: leaves the\ncam's reach or diverges\n(transient)",
+         np.char.endswith(annot, TRANSIENT_MARK)),
+        (SETTLED_MARK, "→Pn: runs periodic (n)\nlater (transient)",
+         np.char.find(annot, SETTLED_MARK) >= 0),
+    ):  # fmt: skip
+        if np.any(used):
+            handles.append(Line2D([], [], ls="", marker=f"${mark}$", color="#000000",
+                                  markersize=9, label=label))  # fmt: skip
+    return handles
 
 
 def _role(x: str, y: str) -> str | None:
@@ -265,7 +267,7 @@ def plot_interval_width(
     """Heatmap of the width hi - lo of the Wilson interval of P(label) (at ``confidence``).
 
     A deterministic cell (sigma = 0: one run) has no interval: it is left blank and marked
-    "one run", not coloured as a width (it was drawn as a width of ~0, the narrowest)."""
+    "one run", not coloured as a width (a width of ~0 would read as the narrowest)."""
     import seaborn as sns
 
     det = cells["deterministic"].fillna(False).astype(bool) if "deterministic" in cells else None

@@ -26,6 +26,7 @@ _LAZY = {
     "companion": ("._common", "companion"),
     "continued_labels": ("._stats", "continued_labels"),
     "default_workers": ("._backends", "default_workers"),
+    "fate_clause": ("._stats", "fate_clause"),
     "fate_settled": ("._stats", "fate_settled"),
     "fate_split": ("._stats", "fate_split"),
     "local_workers": ("._backends", "local_workers"),
