@@ -1,7 +1,7 @@
 """Warnings that point at the user's line.
 
 A fixed ``stacklevel`` is right for one call path only: ``simulate`` warns about its model at
-level 3 when a user calls it, but the same warning raised while :func:`chaoscam.classify_trajectory`
+level 3 when a user calls it, but the same warning raised while :func:`chaoscam.classify`
 re-simulates would name a line of chaoscam. :func:`warn` walks the stack past every frame of
 this package, so the warning names the first line outside it (the user's script, the test,
 the console script) whatever the depth. A stack that is chaoscam all the way (``python -m

@@ -6,7 +6,7 @@ advances a state); nothing imports the model or the integrators.
 
 from ._birkhoff import BirkhoffResult, birkhoff_weights, weighted_birkhoff
 from ._classify import classify_signal
-from ._classify_section import classify_section, unsupported_chaos
+from ._classify_section import classify_section
 from ._evidence import zero_one_evidence
 from ._exponent import as_exponent, exponent_evidence
 from ._lyapunov import (
@@ -69,7 +69,6 @@ __all__ = [
     "spectrum_analysis",
     "spectrum_from_jacobians",
     "stationarity_ratio",
-    "unsupported_chaos",
     "weighted_birkhoff",
     "zero_one_evidence",
     "zero_one_test",

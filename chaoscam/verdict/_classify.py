@@ -104,7 +104,7 @@ def classify(
             f"solution must be a chaoscam Solution (from chaoscam.solve or simulate), got "
             f"{type(solution).__name__}"
         )
-    check_options(options, "classify", series=False, tangent=True)
+    check_options(options, "classify")
     check_step = flag("check_step", check_step)
     discard = real("discard", discard, low=0.0, unit="s")
     if extend_to is not None:

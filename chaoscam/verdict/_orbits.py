@@ -346,7 +346,8 @@ def periodic_orbit(
     ``x ← x - (DP^n(x) - I)^{-1} (P^n(x) - x)``, with a step halved while it does not lower
     the residual (a damped Newton, Deuflhard 2004, *Newton Methods for Nonlinear Problems*,
     sec. 3). The residual is measured in the scaled norm ``|(Δθ, T Δθ̇)|`` [rad]. Seed it with
-    a section point of a run that looks periodic (:func:`chaoscam.classify_trajectory` does).
+    a section point of a run that looks periodic (the certificate of :func:`chaoscam.classify`
+    does).
 
     ``tol`` [rad]: P is smooth only to the event tolerance (a located time jitters by
     ~``event_tol``, which moves the state by ~1e-11 after a jump) and to the chattering

@@ -3,8 +3,10 @@
 The analysis layer (:func:`chaoscam.analysis.classify_section`) judges the section's arrays
 with the tangent exponent; these rules add what only the model knows. They run in the order
 of :data:`RULES`; each either leaves the verdict to the next, changes it and passes it on, or
-decides (the last word). Each says what it checks and the measurement behind it; the tests
-named with each rule check it.
+decides (the last word). Each says what it checks and the measurement behind it;
+``tests/verdict/test_rules.py`` shows each one's verdict and the one it overturns. (That a
+chaotic label needs two independent methods or a positive exponent is the analysis layer's
+own rule, ``classify_section``'s.)
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis import Evidence, Verdict, section_period, unsupported_chaos
+from ..analysis import Evidence, Verdict, section_period
 from ..model import Params, realizations_identical
 from ..numerics import Numerics
 from ._certificate import MODEL_ATOL, ORBIT_REFINE, certify
@@ -96,18 +98,6 @@ def _torus_needs_zero_exponent(v: Verdict, ctx: Context):
     return _undetermined(v, reason), False
 
 
-def _chaos_needs_two_methods(v: Verdict, ctx: Context):
-    need = int(v.settings.get("thresholds", {}).get("min_chaotic_votes", 2))
-    chaotic = unsupported_chaos(v.evidence, need) if v.label == "chaotic" else None
-    if chaotic is None:
-        return None
-    reason = (
-        f"only {', '.join(chaotic)} votes chaotic; {need} independent methods or a "
-        "positive tangent exponent are needed: run longer"
-    )
-    return _undetermined(v, reason), False
-
-
 def _random_period_needs_contraction(v: Verdict, ctx: Context):
     if (
         v.label != "periodic"
@@ -145,12 +135,6 @@ RULES: tuple[Rule, ...] = (
         "a quasiperiodic verdict needs lambda_1 = 0 within the tangent exponent's interval "
         "(a torus has a zero top exponent); else undetermined",
         _torus_needs_zero_exponent,
-    ),
-    Rule(
-        "chaos_needs_two_methods",
-        "a chaotic verdict needs two independent methods or a positive tangent exponent "
-        "(a broadband spectrum of 1.5 s with 11 section points called a period 11 chaotic)",
-        _chaos_needs_two_methods,
     ),
     Rule(
         "random_period_needs_contraction",

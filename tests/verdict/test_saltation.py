@@ -1,4 +1,5 @@
-"""Saltation matrices: the generic formula on the bouncing ball, and the model's kernel form."""
+"""Saltation matrices (the tangent's jump at an impact): the generic formula on the bouncing
+ball, and the model's kernel form (chaoscam/kernel/_tangent.py)."""
 
 from __future__ import annotations
 
@@ -7,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from chaoscam import Params
+from chaoscam import Numerics, Params
 from chaoscam.analysis import saltation_matrix
-from chaoscam.integrate import kernel_constants
-from chaoscam.integrate._tangent import saltation
+from chaoscam.kernel import kernel_constants
+from chaoscam.kernel._tangent import saltation
 from chaoscam.model import contact_angle, gap, lever_arm, normal_cam_speed
 from chaoscam.testsystems import ball_period_one_theory, period_one_orbit
 
@@ -59,7 +60,7 @@ def test_kernel_saltation_equals_the_generic_formula(xi):
     model's own derivatives (central differences of the numpy model functions), for a
     restitution jump and for the plastic closure of a chattering end (xi = 0)."""
     p = Params(xi=0.42)
-    c = kernel_constants(p)
+    c = kernel_constants(p, Numerics())
     t = 0.031
     th = float(contact_angle(p, t))
     l1 = float(lever_arm(p, t, th))

@@ -5,8 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from chaoscam import Params, simulate
-from chaoscam.classify import classify_trajectory
+from chaoscam import Params, classify, simulate
 
 
 def _bands(tr, n=8):
@@ -39,7 +38,7 @@ def test_bands_converge_as_v_min_goes_to_zero(runs):
 def test_verdict_is_the_same_across_the_hand_over_threshold(runs):
     """The verdict does not depend on v_chatter: chaotic (8 narrow bands, lambda_1 > 0) for
     each, and the chattering ends become rare as v_chatter -> 0 (micro-impacts take over)."""
-    labels = {k: classify_trajectory(runs[k], extend_to=None).label for k in runs}
+    labels = {k: classify(runs[k], extend_to=None)[0].label for k in runs}
     assert set(labels.values()) == {"chaotic"}
     ends = [
         runs[k].stats["n_chatter_ends"]

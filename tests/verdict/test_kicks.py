@@ -1,4 +1,4 @@
-"""The direct perturbation test (chaoscam.tangent.kick_test): finite kicks on the map itself,
+"""The direct perturbation test (chaoscam.verdict.kick_test): finite kicks on the map itself,
 which decide stability where chattering ends in sticking and no tangent can (docs/findings.md,
 "Tangent dynamics checked independently")."""
 
@@ -7,8 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from chaoscam import ParameterError, Params, simulate
-from chaoscam.tangent import kick_test
+from chaoscam import ParameterError, Params, kick_test, simulate
 
 
 def _settled_point(p):
@@ -46,6 +45,7 @@ def test_kicks_tell_attracting_orbits_from_chaos(changes, n, returns):
 
 
 def test_bad_arguments_name_themselves():
+    """A kick of size 0 and n = 0 are ParameterErrors naming the argument."""
     with pytest.raises(ParameterError, match="kicks"):
         kick_test(Params(), (0.0, 1.0), kicks=(0.0,))
     with pytest.raises(ParameterError, match="n ="):

@@ -1,16 +1,18 @@
-"""The periodic-orbit certificate (chaoscam._certify) on cells of the (omega, xi) map whose
-truth was settled by 600 s runs, step halving and shooting (docs/findings.md, "The (omega, xi) map
-checked against the model"): each case is one the classifier got wrong before this module."""
+"""The periodic-orbit certificate (chaoscam/verdict/_certificate.py) on cells of the (omega, xi)
+map whose truth was settled by 600 s runs, step halving and shooting (docs/findings.md, "The
+(omega, xi) map checked against the model"): each case is one the classifier got wrong before
+the certificate's rule for it."""
 
 import dataclasses
 
 import numpy as np
 
-from chaoscam import Params, simulate
-from chaoscam._certify import APPROACH, MODEL_ATOL, _sharp_doubling, on_orbit
+from chaoscam import Numerics, Params, classify, simulate
 from chaoscam.analysis import section_period
-from chaoscam.classify import classify_trajectory
-from chaoscam.tangent import PeriodicOrbit
+from chaoscam.verdict import KickTest, PeriodicOrbit, _certificate, iterate_map, stroboscopic_map
+from chaoscam.verdict._certificate import APPROACH, MODEL_ATOL, _Run, _sharp_doubling, on_orbit
+
+DT = Numerics().dt
 
 
 def _map_cell(omega, xi, **kw):
@@ -23,7 +25,8 @@ def _map_cell(omega, xi, **kw):
         tangent=True,
         resumable=True,
     )
-    return classify_trajectory(traj, **kw)
+    (v,) = classify(traj, **kw)
+    return v
 
 
 def _orbit(points, period_s=0.1):
@@ -38,6 +41,11 @@ def _orbit(points, period_s=0.1):
         wall_time=0.0,
         settings={"cam_period": period_s},
     )
+
+
+def _run(points, extra=None):
+    """The certificate's view of a run of the default model at the default step."""
+    return _Run(Params(), Numerics(), points, {} if extra is None else extra)
 
 
 def test_a_run_that_keeps_its_distance_is_not_on_the_orbit():
@@ -144,20 +152,23 @@ def test_chaos_in_bands_the_zero_one_test_cannot_see_is_banded_chaos():
     assert band.vote == "chaotic" and band.value in (4, 8)
 
 
+def _dt(kw):
+    """The step a stand-in for the shooting was called at."""
+    return kw["numerics"].dt
+
+
 def test_an_orbit_that_fails_at_the_last_refined_step_is_not_certified(monkeypatch):
     """Attracting at dt/2, unstable at dt/4: "mixed", never "certified" (the loop stopped at
     the failing last step and counted two steps as two certificates)."""
-    from chaoscam import _certify
-
     run = np.column_stack([np.zeros(40), np.zeros(40)])
 
     def shoot(p, x, n, **kw):
-        mu = [0.5, 0.1] if p.dt == Params().dt / 2 else [1.02, 0.1]
+        mu = [0.5, 0.1] if _dt(kw) == DT / 2 else [1.02, 0.1]
         return dataclasses.replace(_orbit([[0.0, 0.0]]), multipliers=np.array(mu))
 
-    monkeypatch.setattr(_certify, "periodic_orbit", shoot)
-    monkeypatch.setattr(_certify, "iterate_map", lambda p, x, n: np.zeros((n + 1, 2)))
-    status, best, orbits, summary = _certify._refined(Params(), run, 1, {}, run[-1])
+    monkeypatch.setattr(_certificate, "periodic_orbit", shoot)
+    monkeypatch.setattr(_certificate, "iterate_map", lambda p, x, n, num: np.zeros((n + 1, 2)))
+    status, best, orbits, summary = _certificate._refined(_run(run), 1, run[-1])
     assert status == "mixed" and best is None and len(orbits) == 2, summary
 
 
@@ -177,33 +188,29 @@ def test_a_refined_newton_that_stalls_at_the_band_tolerance_still_certifies(monk
     Newton now stalls at dt/2 and converges unstable at dt/4 (|mu|max 2.8): "mixed", so
     undetermined; 600 s runs: 6 bands, lambda_1 > 0 on the grid's tangent at dt, < 0 at
     dt/2.)"""
-    from chaoscam import _certify
-
     run = np.zeros((40, 2))
 
     def shooter(residual):
         def shoot(p, x, n, **kw):
             o = _orbit([[0.0, 0.0]])
-            if p.dt == Params().dt / 4:  # stalls at the finest step
+            if _dt(kw) == DT / 4:  # stalls at the finest step
                 o = dataclasses.replace(o, converged=False, residual=residual)
             return o
 
         return shoot
 
-    monkeypatch.setattr(_certify, "iterate_map", lambda p, x, n: np.zeros((n + 1, 2)))
-    monkeypatch.setattr(_certify, "periodic_orbit", shooter(4e-7))
-    status, best, orbits, summary = _certify._refined(Params(), run, 1, {}, run[-1])
+    monkeypatch.setattr(_certificate, "iterate_map", lambda p, x, n, num: np.zeros((n + 1, 2)))
+    monkeypatch.setattr(_certificate, "periodic_orbit", shooter(4e-7))
+    status, best, orbits, summary = _certificate._refined(_run(run), 1, run[-1])
     assert status == "certified" and best is orbits[-1] and len(orbits) == 2, summary
     assert "(residual 4e-07)" in summary
-    monkeypatch.setattr(_certify, "periodic_orbit", shooter(10 * _certify.MODEL_ATOL))
-    status, best, _, summary = _certify._refined(Params(), run, 1, {}, run[-1])
+    monkeypatch.setattr(_certificate, "periodic_orbit", shooter(10 * MODEL_ATOL))
+    status, best, _, summary = _certificate._refined(_run(run), 1, run[-1])
     assert status == "mixed" and best is None, summary
 
 
 def test_iterate_map_ends_where_the_map_does():
     """iterate_map's last point is P^n(x), and its first is x."""
-    from chaoscam.tangent import iterate_map, stroboscopic_map
-
     p = Params(xi=0.2)
     x = np.array([0.05, -0.3])
     seq = iterate_map(p, x, 3)
@@ -232,7 +239,7 @@ def test_a_period_30_with_two_points_closer_than_the_floor_is_periodic():
     refused and the run was "undetermined", its Birkhoff average voting a torus on the
     rotation number 3/5 (found by an independent referee)."""
     run = simulate(Params(xi=0.30), duration=300.0, transient=280.0, series=False, tangent=True)
-    v = classify_trajectory(run)
+    (v,) = classify(run)
     assert (v.label, v.period) == ("periodic", 30), v.reasons
     orbit = next(e for e in v.evidence if e.name == "periodic_orbit")
     assert orbit.vote == "periodic" and orbit.detail.startswith("certified")
@@ -244,10 +251,8 @@ def test_an_orbit_of_the_grid_alone_is_step_dependent_and_not_extended():
     dt/4 keep 8 bands whose twins separate at +0.17 1/s): undetermined, with the reason and
     the step to use, and not extended (a longer run at this step says the same). It was
     "periodic 8"."""
-    from chaoscam import Params, classify_trajectory, simulate
-
     traj = simulate(Params(xi=0.525), duration=130.0, transient=10.0, tangent=True)
-    v = classify_trajectory(traj)
+    (v,) = classify(traj)
     assert v.label == "undetermined"
     step = {e.name: e for e in v.evidence}["step_dependent"]
     assert (
@@ -280,14 +285,13 @@ def test_kicks_certify_a_period_2_the_refined_step_leaves_open():
 
 
 def test_banded_chaos_names_the_votes_it_outweighs():
-    """Fig. 8's run (mu = 8 mm, sigma = 4 mm, seed 7, the paper's 20 s): the spectrum votes
-    quasiperiodic and the section period 8 on 8 narrow bands, the exponent chaotic; the
-    evidence of the chaotic verdict says why those two votes lose (a reader saw them stand
-    next to it unexplained)."""
+    """Fig. 8's run (mu = 8 mm, sigma = 4 mm, seed 7, the paper's 20 s): the section period
+    votes 8 on 8 narrow bands, the exponent chaotic; the evidence of the chaotic verdict says
+    why the periodic votes lose (a reader saw them stand next to it unexplained)."""
     traj = simulate(
         Params(l_lambda=0.008, l_lambda_sigma=0.004), duration=20.0, transient=10.0, seed=7
     )
-    v = classify_trajectory(traj)
+    (v,) = classify(traj)
     votes = {e.name: e.vote for e in v.evidence}
     assert v.label == "chaotic" and votes["exponent"] == "chaotic"
     band = next(e for e in v.evidence if e.name == "banded_chaos")
@@ -298,10 +302,9 @@ def test_banded_chaos_names_the_votes_it_outweighs():
 def _kicks(returns_at):
     """A stand-in for kick_test: returns (or not) at the steps in ``returns_at`` (dt
     divisors), the unkicked motion periodic."""
-    from chaoscam.tangent import KickTest
 
     def kick(p, x, n, **kw):
-        f = round(Params().dt / p.dt)
+        f = round(DT / _dt(kw))
         growth = np.full((2, 4, 41), 0.01 if f in returns_at else 0.5)
         pts = np.tile([[0.1, 2.0]], (40 * n + 1, 1))
         return KickTest(kw["kicks"], n, 40, 30.0, growth, f in returns_at, pts)
@@ -310,16 +313,20 @@ def _kicks(returns_at):
 
 
 def _unstable_everywhere(monkeypatch, returns_at):
-    from chaoscam import _certify
-
     def shoot(p, x, n, **kw):
         return dataclasses.replace(_orbit([[0.1, 2.0]]), multipliers=np.array([2.0, 0.1]))
 
-    monkeypatch.setattr(_certify, "periodic_orbit", shoot)
-    monkeypatch.setattr(_certify, "iterate_map", lambda p, x, n: np.tile([0.1, 2.0], (n + 1, 1)))
-    monkeypatch.setattr(_certify, "kick_test", _kicks(returns_at))
+    monkeypatch.setattr(_certificate, "periodic_orbit", shoot)
+    monkeypatch.setattr(
+        _certificate, "iterate_map", lambda p, x, n, num: np.tile([0.1, 2.0], (n + 1, 1))
+    )
+    monkeypatch.setattr(_certificate, "kick_test", _kicks(returns_at))
     rng = np.random.default_rng(1)
     return np.array([0.1, 2.0]) + 1e-9 * rng.standard_normal((40, 2))
+
+
+def _certify(run, extra):
+    return _certificate.certify(Params(), Numerics(), run, 1, extra)
 
 
 def test_kicks_that_return_at_both_steps_certify_an_orbit_the_multipliers_call_unstable(
@@ -328,24 +335,20 @@ def test_kicks_that_return_at_both_steps_certify_an_orbit_the_multipliers_call_u
     """Newton's orbit is unstable on the grid and at every refined step, the run lies on it,
     and finite kicks return at dt and dt/2: certified, by kicks (the map's derivative is not
     the judge below its event jitter), with a record per step."""
-    from chaoscam import _certify
-
     run = _unstable_everywhere(monkeypatch, returns_at=(1, 2))
     extra: dict = {}
-    cert = _certify.certify(Params(), run, 1, extra)
+    cert = _certify(run, extra)
     assert cert.certified and cert.kicked and cert.refined, cert.detail
-    assert [r["dt"] for r in extra["kick_test"]] == [Params().dt, Params().dt / 2]
+    assert [r["dt"] for r in extra["kick_test"]] == [DT, DT / 2]
     assert "kicks of 1e-07, 1e-06 rad return" in cert.detail
 
 
 def test_kicks_that_return_on_the_grid_alone_certify_nothing(monkeypatch):
     """Kicks return at dt but not at dt/2: the attraction is the grid's (as at xi = 0.525),
     and the orbit stays unstable."""
-    from chaoscam import _certify
-
     run = _unstable_everywhere(monkeypatch, returns_at=(1,))
     extra: dict = {}
-    cert = _certify.certify(Params(), run, 1, extra)
+    cert = _certify(run, extra)
     assert cert.status == "unstable" and not cert.kicked
     assert [r["returns"] for r in extra["kick_test"]] == [True, False]
     assert "do not return" in cert.detail
@@ -353,38 +356,33 @@ def test_kicks_that_return_on_the_grid_alone_certify_nothing(monkeypatch):
 
 def test_no_kicks_for_a_run_that_keeps_away_from_the_orbit(monkeypatch):
     """Chaotic bands around an unstable orbit (the run 1e-4 rad from it) cost no kicks."""
-    from chaoscam import _certify
-
     run = _unstable_everywhere(monkeypatch, returns_at=(1, 2)) + np.array([1e-4, 0.0])
     extra: dict = {}
-    cert = _certify.certify(Params(), run, 1, extra)
+    cert = _certify(run, extra)
     assert not cert.certified and "kick_test" not in extra
 
 
 def test_kicks_decide_an_orbit_certified_on_the_grid_alone(monkeypatch):
     """Newton certifies the orbit at dt but not at dt/2 ("step-dependent"): kicks that return
     at both steps certify it; kicks that return at dt only leave it step-dependent."""
-    from chaoscam import _certify
 
     def shoot(p, x, n, **kw):
-        mu = [0.5, 0.1] if p.dt == Params().dt else [2.0, 0.1]
+        mu = [0.5, 0.1] if _dt(kw) == DT else [2.0, 0.1]
         return dataclasses.replace(_orbit([[0.1, 2.0]]), multipliers=np.array(mu))
 
     run = _unstable_everywhere(monkeypatch, returns_at=(1, 2))
-    monkeypatch.setattr(_certify, "periodic_orbit", shoot)
-    cert = _certify.certify(Params(), run, 1, {})
+    monkeypatch.setattr(_certificate, "periodic_orbit", shoot)
+    cert = _certify(run, {})
     assert cert.certified and cert.kicked, cert.detail
-    monkeypatch.setattr(_certify, "kick_test", _kicks((1,)))
-    assert _certify.certify(Params(), run, 1, {}).status == "step-dependent"
+    monkeypatch.setattr(_certificate, "kick_test", _kicks((1,)))
+    assert _certify(run, {}).status == "step-dependent"
 
 
 def test_a_run_shorter_than_8_orbit_periods_asks_no_kicks(monkeypatch):
     """Kicks follow 40 orbit periods at dt and dt/2: a run of fewer than 8 orbit periods
     (KICK_MIN_PERIODS) is not kicked; it stays unstable (a classifier that extends asks them
     on the longer run)."""
-    from chaoscam import _certify
-
     run = _unstable_everywhere(monkeypatch, returns_at=(1, 2))[:7]
     extra: dict = {}
-    cert = _certify.certify(Params(), run, 1, extra)
+    cert = _certify(run, extra)
     assert cert.status == "unstable" and "kick_test" not in extra

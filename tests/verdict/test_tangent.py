@@ -1,4 +1,5 @@
-"""The tangent dynamics through the impacts: Jacobians, invariants, spectrum, periodic orbits."""
+"""The tangent dynamics through the impacts: Jacobians, invariants, spectrum, periodic orbits
+(chaoscam/verdict/_orbits.py and the kernel's tangent it reads)."""
 
 from __future__ import annotations
 
@@ -7,16 +8,13 @@ import math
 import numpy as np
 import pytest
 
-from chaoscam import Params, simulate
-from chaoscam.tangent import (
-    _MapRunner,
-    lyapunov_spectrum,
-    periodic_orbit,
-    spectrum_from_jacobians,
-    stroboscopic_map,
-)
+from chaoscam import Numerics, ParameterError, Params, simulate
+from chaoscam.analysis import spectrum_from_jacobians
+from chaoscam.verdict import lyapunov_spectrum, periodic_orbit, stroboscopic_map
+from chaoscam.verdict._orbits import _MapRunner
 
 SMOOTH = Params(xi=0.2)  # one macro impact a period, no chattering: a period-1 response
+ADAPTIVE = Numerics(integrator="adaptive")
 
 
 def _fd_jacobian(run, x, eps):
@@ -33,7 +31,7 @@ def test_map_jacobian_matches_finite_differences(params):
     which moves the state by ~5e-12 after a jump, so a difference quotient with step eps
     carries noise ~5e-12/eps; eps = 1e-6 keeps it near 1e-5 of J."""
     tr = simulate(params, duration=25.0, transient=20.0, series=False)
-    run = _MapRunner(params, 1)
+    run = _MapRunner(params, Numerics(), 1)
     checked = 0
     for x in tr.section[["theta_f", "omega_f"]].to_numpy()[:8]:
         _, jac, _ = run(x)
@@ -77,20 +75,21 @@ def test_tangent_does_not_change_the_motion():
 
 
 @pytest.mark.parametrize(
-    "params",
-    [Params(flight_merge=1), Params(integrator="adaptive")],
+    "numerics",
+    [Numerics(flight_merge=1), ADAPTIVE],
     ids=["rk4 unmerged", "adaptive"],
 )
 @pytest.mark.parametrize("periods", [20.0, 20.37, 20.999], ids=["on", "inside", "just before"])
-def test_tangent_skipped_in_the_transient_changes_no_recorded_jacobian(params, periods):
+def test_tangent_skipped_in_the_transient_changes_no_recorded_jacobian(numerics, periods):
     """The tangent is carried only from shortly before the recording starts: the Jacobians
     written at recorded sections are those of a run that records (so carries the tangent)
     from t = 0, to the bit, whether the recording starts on a section time, inside a period
     or just before a section. (Flight is not merged on RK4 here: a merged block may not
     cross the recording's start, so with merging the states themselves depend on it.)"""
-    T = params.cam_period
-    full = simulate(params, duration=25 * T, tangent=True, series=False)
-    late = simulate(params, duration=25 * T, transient=periods * T, tangent=True, series=False)
+    p = Params()
+    T = p.cam_period
+    full = simulate(p, numerics, duration=25 * T, tangent=True, series=False)
+    late = simulate(p, numerics, duration=25 * T, transient=periods * T, tangent=True, series=False)
     k0 = int(late.section["k"].iloc[0])
     assert len(late.section) >= 3
     same = full.section["k"].to_numpy() >= k0
@@ -108,6 +107,47 @@ def test_spectrum_of_known_matrices():
     assert math.isfinite(spec.exponents[0]) and spec.exponents[1] == -math.inf
 
 
+def test_a_periodic_response_has_a_negative_exponent():
+    """A period-1 response (e = 0.02 m) contracts: lambda_1 < 0, clearly below the zero band
+    (the classifier's is 0.01 per iterate, 0.05 1/s); the default (8-band chaos) has
+    lambda_1 > 0 beyond 2 standard errors."""
+    periodic = lyapunov_spectrum(Params(e=0.02), duration=20.0, transient=10.0)
+    assert periodic.exponents[0] < -1.0
+    chaotic = lyapunov_spectrum(Params(), duration=60.0, transient=20.0)
+    assert chaotic.exponents[0] > 2.0 * chaotic.stderr[0] > 0
+
+
+def test_the_spectrum_of_a_solution_is_that_of_its_realization():
+    """Given a one-member solution solved with the tangent, the spectrum is the one
+    lyapunov_spectrum solves for the same realization, to the bit, with its window and
+    realization recorded; a solution without Jacobians, or with numerics besides, is refused."""
+    p = Params(l_lambda_sigma=0.002)
+    run = simulate(p, duration=20.0, transient=10.0, seed=3, index=1, tangent=True)
+    a = lyapunov_spectrum(run)
+    b = lyapunov_spectrum(p, duration=20.0, transient=10.0, seed=3, index=1)
+    assert np.array_equal(a.exponents, b.exponents) and np.array_equal(a.local, b.local)
+    assert (a.settings["seed"], a.settings["index"]) == (3, 1)
+    c = lyapunov_spectrum(p, duration=20.0, transient=10.0, seed=3, index=2)
+    assert not np.array_equal(c.exponents, a.exponents)  # another realization
+    with pytest.raises(ValueError, match="no Jacobians"):
+        lyapunov_spectrum(simulate(p, duration=2.0))
+    with pytest.raises(ParameterError, match="not both"):
+        lyapunov_spectrum(run, Numerics())
+
+
+def test_a_failed_or_too_short_run_says_so():
+    """A run that leaves the cam's reach has no spectrum: a ValueError naming its status;
+    one too short for the batch means warns and says to lengthen the recorded time; a
+    transient longer than the run names the field."""
+    with pytest.raises(ValueError, match="LEFT_REACH"):
+        lyapunov_spectrum(Params(x_O=-0.58), duration=1.0, transient=0.0)
+    with pytest.warns(RuntimeWarning, match="lengthen the recorded time"):
+        spec = lyapunov_spectrum(Params(), duration=2.0, transient=0.0)
+    assert math.isnan(spec.stderr[0])
+    with pytest.raises(ParameterError, match="transient"):
+        lyapunov_spectrum(Params(), duration=1.0, transient=2.0)
+
+
 def test_periodic_orbit_certified_for_period_one():
     """xi = 0.2 settles on a period-1 orbit: Newton converges from a section point, the
     multipliers lie inside the unit circle and equal the eigenvalues of a finite-difference
@@ -116,7 +156,7 @@ def test_periodic_orbit_certified_for_period_one():
     pts = tr.section[["theta_f", "omega_f"]].to_numpy()
     orbit = periodic_orbit(SMOOTH, pts[-1], 1)
     assert orbit.converged and orbit.certified and orbit.period == 1
-    run = _MapRunner(SMOOTH, 1)
+    run = _MapRunner(SMOOTH, Numerics(), 1)
     fd = _fd_jacobian(run, orbit.points[0], 1e-6)  # eps: see the test above
     assert np.sort(np.abs(orbit.multipliers)) == pytest.approx(
         np.sort(np.abs(np.linalg.eigvals(fd))), rel=1e-4
@@ -144,14 +184,14 @@ def test_adaptive_path_carries_the_tangent_where_the_map_is_smooth():
     flight-and-impact response (xi = 0.2). Where chattering dominates the two disagree
     (measured on the default: -21 against +3.2 1/s), which is why the classifier takes the
     exponent on the RK4 grid."""
-    p = SMOOTH.replace(integrator="adaptive")
-    tr = simulate(p, duration=25.0, transient=20.0, series=False)
+    p = SMOOTH
+    tr = simulate(p, ADAPTIVE, duration=25.0, transient=20.0, series=False)
     x0 = tr.section[["theta_f", "omega_f"]].to_numpy()[0]
     period = p.cam_period
 
     def strobe(x, tangent=False):
         q = p.replace(theta_f0=float(x[0]), omega_f0=float(x[1]))
-        r = simulate(q, duration=period + 1e-5, series=False, tangent=tangent)
+        r = simulate(q, ADAPTIVE, duration=period + 1e-5, series=False, tangent=tangent)
         i = r.section.index[r.section["k"] == 1][0]
         point = r.section.loc[i, ["theta_f", "omega_f"]].to_numpy(float)
         return point, (r.jacobians[i] if tangent else None)
@@ -162,22 +202,8 @@ def test_adaptive_path_carries_the_tangent_where_the_map_is_smooth():
     )
     assert np.abs(jac - fd).max() <= 1e-4 * np.abs(fd).max()
     a = lyapunov_spectrum(SMOOTH, duration=60.0, transient=30.0)
-    b = lyapunov_spectrum(p, duration=60.0, transient=30.0)
+    b = lyapunov_spectrum(SMOOTH, ADAPTIVE, duration=60.0, transient=30.0)
     assert b.exponents == pytest.approx(a.exponents, rel=1e-2)
-
-
-@pytest.mark.parametrize("changes", [{}, {"x_O": -0.45}], ids=["default", "pivot"])
-def test_agrees_with_the_two_trajectory_estimate_where_that_is_valid(changes):
-    """Where the twin-trajectory estimate is valid (no chattering ends: v_min = 1e-3, both
-    trajectories apply the same impacts), it and the tangent exponent agree within three
-    combined standard errors (measured: 3.61 +- 0.30 vs 3.47 +- 0.23 1/s; 1.74 vs 1.90)."""
-    from chaoscam.lyapunov import lyapunov_model
-
-    p = Params(v_min=1e-3, **changes)
-    twin = lyapunov_model(p, duration=60.0, transient=20.0)
-    tang = lyapunov_spectrum(p, duration=60.0, transient=20.0)
-    assert twin.unsynced == 0 and twin.exponent > 0 and tang.exponent > 0
-    assert abs(twin.exponent - tang.exponent) <= 3.0 * math.hypot(twin.stderr, tang.stderr[0])
 
 
 def test_floquet_multipliers_converge_under_step_refinement():
@@ -197,7 +223,7 @@ def test_floquet_multipliers_converge_under_step_refinement():
             seed_x = x[["theta_f", "omega_f"]].to_numpy()[-1]
         mu = []
         for dt in (2e-6, 1e-6, 5e-7, 2.5e-7):
-            orbit = periodic_orbit(p.replace(dt=dt), seed_x, 1, tol=1e-9)
+            orbit = periodic_orbit(p, seed_x, 1, numerics=Numerics(dt=dt), tol=1e-9)
             assert orbit.certified
             mu.append(float(np.abs(orbit.multipliers).max()))
         steps = np.abs(np.diff(mu))
@@ -215,7 +241,7 @@ def test_impacts_per_period_converge_under_step_refinement():
     micro-flights shorter than a step were stepped over)."""
     p = Params(e=0.02, theta_f0=-3.7812e-09, omega_f0=1.1038714)
     counts = [
-        len(simulate(p.replace(dt=dt), duration=p.cam_period, series=False).impacts)
+        len(simulate(p, Numerics(dt=dt), duration=p.cam_period, series=False).impacts)
         for dt in (1e-6, 5e-7, 2.5e-7)
     ]
     assert max(counts) - min(counts) <= 0.02 * max(counts)
@@ -225,9 +251,10 @@ STICKING_SEED = (-3.7812e-09, 1.1038714)  # the e = 0.02 m sticking period 1's s
 
 
 def _adaptive_period(p, x):
-    """(P(x), the stroboscopic Jacobian over that period, the impacts in it) on p's integrator."""
+    """(P(x), the stroboscopic Jacobian over that period, the impacts in it) on the adaptive
+    integrator."""
     q = p.replace(theta_f0=float(x[0]), omega_f0=float(x[1]))
-    tr = simulate(q, duration=1.5 * q.cam_period, series=False, tangent=True)
+    tr = simulate(q, ADAPTIVE, duration=1.5 * q.cam_period, series=False, tangent=True)
     assert len(tr.section) == 2  # the sections at t = 0 and t = T
     impacts = tr.impacts[tr.impacts["t"] <= q.cam_period]
     return tr.section[["theta_f", "omega_f"]].to_numpy()[1], tr.jacobians[1], impacts
@@ -240,8 +267,9 @@ def test_adaptive_path_locates_the_sticking_orbits_micro_flights():
     taken as flight it applied 273 (5/198/70): a zero-length opening after each rebound
     filled the chattering guard, which then stepped over the rest."""
     p = Params(e=0.02, theta_f0=STICKING_SEED[0], omega_f0=STICKING_SEED[1])
-    ref = len(simulate(p.replace(dt=2.5e-7), duration=p.cam_period, series=False).impacts)
-    _, _, impacts = _adaptive_period(p.replace(integrator="adaptive"), STICKING_SEED)
+    fine = Numerics(dt=2.5e-7)
+    ref = len(simulate(p, fine, duration=p.cam_period, series=False).impacts)
+    _, _, impacts = _adaptive_period(p, STICKING_SEED)
     assert abs(len(impacts) - ref) <= 0.02 * ref
 
 
@@ -257,16 +285,15 @@ def test_adaptive_stroboscopic_jacobian_on_the_sticking_orbit():
     1e-9 rad on this contact (sticking) section point changes the impacts of the period
     from 294 to 135...1275, so the map is not differentiable at any resolvable scale there."""
     p = Params(e=0.02)
-    orbit = periodic_orbit(p.replace(dt=2.5e-7), STICKING_SEED, 1, tol=1e-9)
+    orbit = periodic_orbit(p, STICKING_SEED, 1, numerics=Numerics(dt=2.5e-7), tol=1e-9)
     assert orbit.certified
     mu_rk4 = float(np.abs(orbit.multipliers).max())
     x = np.asarray(orbit.points[0], dtype=float)
-    q = p.replace(integrator="adaptive")
-    px, jac, _ = _adaptive_period(q, x)
+    px, jac, _ = _adaptive_period(p, x)
     assert np.abs(px - x).max() < 1e-8
     eps = 1e-6
     e2 = np.array([0.0, eps])
-    fd = (_adaptive_period(q, x + e2)[0] - _adaptive_period(q, x - e2)[0]) / (2 * eps)
+    fd = (_adaptive_period(p, x + e2)[0] - _adaptive_period(p, x - e2)[0]) / (2 * eps)
     assert np.all(np.abs(jac[:, 1] - fd) <= 0.05 * np.abs(fd))
     mu = float(np.abs(np.linalg.eigvals(jac)).max())
     assert abs(mu - mu_rk4) <= 0.05 * mu_rk4
@@ -281,9 +308,10 @@ def test_default_exponent_converges_under_step_halving():
     dt = 5e-7 and 2.5e-7 agree within three combined standard errors, and so do dt = 2.5e-7
     and the adaptive path (with the naive clock RK4 gave 2.45, 2.26, 2.06 at 5e-7 ... 1.25e-7
     and the adaptive path 1.48)."""
-    a = lyapunov_spectrum(Params(dt=5e-7), duration=360.0, transient=60.0)
-    b = lyapunov_spectrum(Params(dt=2.5e-7), duration=360.0, transient=60.0)
-    c = lyapunov_spectrum(Params(integrator="adaptive"), duration=360.0, transient=60.0)
+    p, window = Params(), dict(duration=360.0, transient=60.0)
+    a = lyapunov_spectrum(p, Numerics(dt=5e-7), **window)
+    b = lyapunov_spectrum(p, Numerics(dt=2.5e-7), **window)
+    c = lyapunov_spectrum(p, ADAPTIVE, **window)
     assert a.exponents[0] > 0 and b.exponents[0] > 0 and c.exponents[0] > 0
     for x, y in ((a, b), (b, c)):
         gap = abs(x.exponents[0] - y.exponents[0])
@@ -295,7 +323,7 @@ def test_least_period_keeps_a_freshly_doubled_orbit():
     apart (just past a flip) is period 16, not the period 8 a bound of 10 tol (1e-6 rad)
     read it as; 160 s runs at dt and dt/2 repeat every 16 periods to 1e-7 rad, every 8 only
     to 2e-6."""
-    p = Params(stiffness="fractal", G=1e-9, D=1.4, dt=3.9e-7)
-    tr = simulate(p, duration=20.0, transient=10.0, series=False)
-    orbit = periodic_orbit(p, tr.section[["theta_f", "omega_f"]].to_numpy()[-1], 16)
+    p, num = Params(stiffness="fractal", G=1e-9, D=1.4), Numerics(dt=3.9e-7)
+    tr = simulate(p, num, duration=20.0, transient=10.0, series=False)
+    orbit = periodic_orbit(p, tr.section[["theta_f", "omega_f"]].to_numpy()[-1], 16, numerics=num)
     assert orbit.converged and orbit.period == 16
