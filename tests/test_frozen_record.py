@@ -1,6 +1,7 @@
-"""A Trajectory's settings and stats are read-only (chaoscam._frozen.FrozenDict): they are
-the record of how the run was made, and extend_trajectory re-runs from them; an edited seed
-was accepted and the extension simulated another realization as if it were this one."""
+"""A Solution's settings are read-only (chaoscam._util.FrozenDict) and its stats cannot be
+changed through the dict they are read as: they are the record of how the run was made, and
+extend re-runs from them; an edited seed was accepted and the extension simulated another
+realization as if it were this one."""
 
 import copy
 import json
@@ -24,22 +25,38 @@ def run():
         lambda r: r.settings.__setitem__("seed", 99),
         lambda r: r.settings.update(seed=99),
         lambda r: r.settings.pop("seed"),
-        lambda r: r.stats.__setitem__("n_impacts", -1),
-        lambda r: r.stats.clear(),
     ],
 )
 def test_the_record_cannot_be_changed(run, change):
+    """Editing the settings in place is refused."""
     with pytest.raises(TypeError, match="read-only"):
         change(run)
     assert run.settings["seed"] == 1 and run.stats["n_impacts"] > 0
 
 
+@pytest.mark.parametrize(
+    "change",
+    [lambda s: s.__setitem__("n_impacts", -1), lambda s: s.clear()],
+)
+def test_the_stats_read_from_the_record_do_not_change_it(run, change):
+    """The stats are read from the members table each time: a change to the dict read
+    leaves the record (and the next read) as it was."""
+    before = dict(run.stats)
+    stats = run.stats
+    try:
+        change(stats)
+    except TypeError:  # a read-only dict: as good
+        pass
+    assert run.stats == before and run.stats["n_impacts"] > 0
+
+
 def test_the_record_reads_like_a_dict(run):
+    """The record serialises, copies, pickles and is what an extension re-runs from."""
     assert json.loads(json.dumps(run.provenance()))["settings"]["seed"] == 1
     assert {**run.settings, "seed": 2}["seed"] == 2  # a changed copy
     for again in (pickle.loads(pickle.dumps(run)), copy.deepcopy(run)):
         assert again.settings == run.settings and again.stats == run.stats
-    longer = chaoscam.extend_trajectory(run, 2.0)
+    longer = chaoscam.extend(run, 2.0)
     want = chaoscam.simulate(Params(l_lambda_sigma=0.002), duration=2.0, seed=1, series=False)
     assert longer.section.equals(want.section)
 
@@ -58,13 +75,13 @@ def test_a_verdicts_settings_are_read_only():
 
 @pytest.mark.filterwarnings("ignore:lambda_1.*too few")  # 2 s: enough to hold arrays
 def test_a_results_arrays_are_read_only():
-    """A result's arrays are read-only views (chaoscam._frozen.freeze_fields): a Trajectory's
+    """A result's arrays are read-only views (chaoscam._util.freeze_fields): a Solution's
     Jacobians, the spectrum from them and the 0-1 test's K_c could be changed in place on a
     frozen result, and a later spectrum or report would read the changed numbers."""
     from chaoscam.analysis import section_period, zero_one_test
 
     run = chaoscam.simulate(duration=2.0, series=False, tangent=True)
-    spectrum = chaoscam.lyapunov_spectrum(trajectory=run)
+    spectrum = chaoscam.lyapunov_spectrum(run)
     zero_one = zero_one_test(np.sin(0.3 * np.arange(400)))
     period = section_period(np.tile([[0.1, 0.2], [0.3, 0.4]], (20, 1)))
     arrays = {
@@ -80,7 +97,7 @@ def test_a_results_arrays_are_read_only():
         assert not a.flags.writeable, name
     with pytest.raises(TypeError, match="read-only"):
         spectrum.settings["n"] = 1
-    assert np.isfinite(chaoscam.lyapunov_spectrum(trajectory=run).exponents).all()  # still readable
+    assert np.isfinite(chaoscam.lyapunov_spectrum(run).exponents).all()  # still readable
 
 
 def test_nested_records_are_frozen_too():
@@ -104,7 +121,7 @@ def test_freezing_keeps_namedtuples_and_reaches_lists_of_lists():
     list of lists stayed writable."""
     from collections import namedtuple
 
-    from chaoscam._frozen import FrozenDict
+    from chaoscam._util import FrozenDict
 
     Point = namedtuple("Point", "x y")
     rec = FrozenDict({"p": Point(1, {"a": 1}), "deep": [[{"b": 2}]]})

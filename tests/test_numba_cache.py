@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 import chaoscam
-from chaoscam import _numba_cache
+from chaoscam.kernel import _numba_cache
 
 CALLER = """
 from numba import njit
@@ -26,7 +26,7 @@ INIT = """
 import os
 from pathlib import Path
 
-from chaoscam._numba_cache import guard
+from chaoscam.kernel._numba_cache import guard
 
 if os.environ.get("GUARD") == "1":
     guard(Path(__file__).parent)
@@ -66,7 +66,9 @@ def test_a_callees_edit_reaches_a_cached_caller_through_the_guard(tmp_path, wher
     (pkg / "callee.py").write_text(_callee(1))
     cache_dir = tmp_path / "numba-cache" if where == "NUMBA_CACHE_DIR" else None
     assert _f(src, guarded=True, cache_dir=cache_dir) == "1"  # compiled, cached, stamped
-    stamps = list(tmp_path.rglob(_numba_cache.STAMP))
+    # pkg's fingerprint (importing the guard from chaoscam.kernel stamps the kernel's too)
+    ours = _numba_cache.fingerprint(pkg)
+    stamps = [s for s in tmp_path.rglob(_numba_cache.STAMP) if s.read_text() == ours]
     cached = list(tmp_path.rglob("*.nbi"))
     assert len(stamps) == 1 and cached and all(c.parent == stamps[0].parent for c in cached)
     assert (stamps[0].parent == pkg / "__pycache__") == (cache_dir is None)
@@ -76,12 +78,12 @@ def test_a_callees_edit_reaches_a_cached_caller_through_the_guard(tmp_path, wher
     assert _f(src, guarded=True, cache_dir=cache_dir) == "22"  # cached again, nothing removed
 
 
-def test_the_integrators_cache_is_guarded():
-    """Importing chaoscam.integrate records its sources' fingerprint beside numba's cache
+def test_the_kernels_cache_is_guarded():
+    """Importing chaoscam.kernel records its sources' fingerprint beside numba's cache
     (where that folder is writable, as in a checkout)."""
-    import chaoscam.integrate as integrate
+    import chaoscam.kernel as kernel
 
-    folder = Path(integrate.__file__).parent
+    folder = Path(kernel.__file__).parent
     stamp = _numba_cache.cache_folder(folder) / _numba_cache.STAMP
     if os.access(stamp.parent, os.W_OK):
         assert stamp.read_text() == _numba_cache.fingerprint(folder)

@@ -1,5 +1,5 @@
 """Every Parquet file chaoscam writes has a checksum per data page, verified on reading
-(chaoscam._parquet): bytes changed inside a file are an error naming the file, not wrong
+(chaoscam.io): bytes changed inside a file are an error naming the file, not wrong
 numbers read without a word (400 flipped bytes in a trajectory changed 50 values of
 omega_f and were read silently)."""
 
@@ -9,8 +9,8 @@ import pyarrow.parquet as pq
 import pytest
 
 import chaoscam
-from chaoscam._parquet import DamagedFileError, read_frame
 from chaoscam.cli import main
+from chaoscam.io import DamagedFileError, read_frame
 from chaoscam.sweep import read_regime_map, regime_map
 
 
@@ -38,6 +38,8 @@ def test_every_page_of_a_trajectory_file_has_a_checksum(run_file):
 
 
 def test_a_damaged_trajectory_is_refused_by_name(run_file, tmp_path, capsys):
+    """Flipped bytes in a trajectory file: load_trajectory and `chaoscam classify` refuse
+    it naming the file, without a traceback."""
     bad = tmp_path / "bad.parquet"
     bad.write_bytes(run_file.read_bytes())
     _flip(bad)
@@ -49,6 +51,7 @@ def test_a_damaged_trajectory_is_refused_by_name(run_file, tmp_path, capsys):
 
 
 def test_a_damaged_sweep_table_is_refused_by_name(tmp_path):
+    """Flipped bytes inside a regime map's cells table: reading it names that file."""
     from tests.sweep._helpers import SpreadClassifier  # cheap: the file is what is tested
 
     rm = regime_map(

@@ -1,4 +1,4 @@
-"""The code record of sweeps and ensembles (chaoscam._provenance): it changes with the
+"""The code record of sweeps and ensembles (chaoscam.io.code_identity): it changes with the
 sources that decide results and not with the drivers, and a checkpoint or output made by
 other code is not resumed, with a message that says so."""
 
@@ -11,15 +11,15 @@ from pathlib import Path
 
 import pytest
 
-from chaoscam._provenance import code_identity
+from chaoscam.io import code_identity
 from chaoscam.sweep import SweepError
-from chaoscam.sweep._checkpoint import CheckpointStore as Checkpoint
+from chaoscam.sweep._store import CheckpointStore as Checkpoint
 
 PACKAGE = Path(__file__).resolve().parents[1] / "chaoscam"
 
 
 def _identity_of(root: Path) -> dict:
-    code = "import json, chaoscam._provenance as p; print(json.dumps(p.code_identity()))"
+    code = "import json, chaoscam.io as p; print(json.dumps(p.code_identity()))"
     out = subprocess.run(
         [sys.executable, "-c", code], cwd=root, capture_output=True, text=True, timeout=120
     )
@@ -39,7 +39,7 @@ def test_the_fingerprint_follows_the_kernels_not_the_drivers(tmp_path):
     with (copy / "cli" / "_report.py").open("a") as f:
         f.write("\n# a driver's comment\n")
     assert _identity_of(tmp_path)["sources"] == first["sources"]
-    with (copy / "integrate" / "_kernel.py").open("a") as f:
+    with (copy / "kernel" / "_rk4.py").open("a") as f:
         f.write("\n# a kernel's comment\n")
     assert _identity_of(tmp_path)["sources"] != first["sources"]
 

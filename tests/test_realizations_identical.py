@@ -8,7 +8,7 @@ import warnings
 
 import numpy as np
 
-from chaoscam import Params, classify_trajectory, simulate
+from chaoscam import Params, classify, simulate
 from chaoscam.model import realizations_identical
 from chaoscam.sweep import Axis, regime_map
 
@@ -16,6 +16,7 @@ FRACTAL = Params(stiffness="fractal", xi=0.2)
 
 
 def test_which_models_are_deterministic():
+    """sigma = 0 and the fractal stiffness are deterministic; a Hertz spread is not."""
     assert realizations_identical(Params())  # sigma = 0
     assert not realizations_identical(Params(l_lambda_sigma=0.002))
     assert realizations_identical(FRACTAL.replace(l_lambda_sigma=0.002))
@@ -60,11 +61,11 @@ def test_a_fractal_periodic_orbit_is_certified_with_sigma():
     same certified period 1 as at sigma = 0 (before, sigma > 0 skipped it)."""
     verdicts = [
         _quiet(
-            classify_trajectory,
+            classify,
             _quiet(
                 simulate, FRACTAL.replace(l_lambda_sigma=s), duration=10.0, series=False, index=3
             ),
-        )
+        )[0]
         for s in (0.0, 0.002)
     ]
     for v in verdicts:

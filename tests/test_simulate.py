@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chaoscam import ParameterError, Params, Status, simulate
+from chaoscam import Numerics, ParameterError, Params, Status, simulate
 from chaoscam.model import gap, gap_rate
 
 
@@ -53,6 +53,7 @@ def test_default_run_outputs(default_run):
     tr = default_run
     assert tr.status is Status.OK
     assert list(tr.series.columns) == [
+        "member",
         "t",
         "theta_f",
         "omega_f",
@@ -123,7 +124,7 @@ def test_contact_resampling_makes_the_realization_independent_of_the_step():
     dt; under 'impact' resampling that count shifts the draws."""
 
     def lines(p, dt):
-        tr = simulate(p.replace(dt=dt), duration=2.0, seed=5, series=False)
+        tr = simulate(p, dt=dt, duration=2.0, seed=5, series=False)
         imp = tr.impacts
         return imp.l_lambda[imp["kind"] == "macro"].to_numpy(), tr.section.l_lambda.to_numpy()
 
@@ -169,7 +170,7 @@ def test_unresolved_step_warns_and_ends_labelled():
     or (since grazes inside a step are located, the run may survive) the steps per contact
     period in its stats."""
     with pytest.warns(RuntimeWarning, match="dt"):
-        tr = simulate(Params(dt=2e-4), duration=2.0)
+        tr = simulate(dt=2e-4, duration=2.0)
     assert tr.status in (Status.LEFT_REACH, Status.NON_FINITE, Status.PENETRATION) or (
         tr.stats["steps_per_contact_period"] < 1.0
     )
@@ -199,7 +200,7 @@ def test_bad_run_settings_are_refused(kwargs, field):
 def test_compilation_is_cached_across_processes():
     """A second process loads the kernel from numba's cache instead of compiling it."""
     code = (
-        "import chaoscam; from chaoscam.integrate._driver import run_alone_rk4; "
+        "import chaoscam; from chaoscam.kernel._driver import run_alone_rk4; "
         "chaoscam.simulate(duration=0.01); print(sum(run_alone_rk4.stats.cache_hits.values()))"
     )
     subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)
@@ -246,12 +247,12 @@ def test_no_gravity_is_a_run_not_a_crash():
 def test_a_spread_the_fractal_stiffness_ignores_is_warned():
     """With stiffness = 'fractal' (K_n independent of l_lambda) a positive l_lambda_sigma
     gets one warning naming the field; without a spread there is none."""
-    p = Params(stiffness="fractal", dt=4e-7)
+    p, num = Params(stiffness="fractal"), Numerics(dt=4e-7)
     with pytest.warns(RuntimeWarning, match="l_lambda_sigma = 0.002 m has no effect"):
-        simulate(p.replace(l_lambda_sigma=0.002), duration=0.01, series=False)
+        simulate(p.replace(l_lambda_sigma=0.002), num, duration=0.01, series=False)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        simulate(p, duration=0.01, series=False)
+        simulate(p, num, duration=0.01, series=False)
 
 
 def test_unknown_field_in_params_names_it_like_replace():
@@ -273,7 +274,7 @@ def test_runs_that_would_take_hours_for_other_fields_than_dt_are_refused(changes
     cuts of interval resampling, not only steps of dt: such runs are refused with the field
     named, instead of starting and never finishing."""
     with pytest.raises(ParameterError, match=rf"refused; shorten duration or raise {field}"):
-        simulate(Params(**changes), duration=0.5)
+        simulate(duration=0.5, **changes)
 
 
 def test_summary_of_a_run_with_no_recorded_step_says_so():

@@ -1,6 +1,6 @@
 """Warnings name the user's line, whatever the depth of chaoscam beneath it
-(chaoscam._warn): a fixed stacklevel named a line of chaoscam whenever the warning came
-from a nested call (simulate inside a sweep, a budget check inside classify)."""
+(chaoscam._util.user_stacklevel): a fixed stacklevel named a line of chaoscam whenever the
+warning came from a nested call (simulate inside a sweep, a budget check inside classify)."""
 
 import warnings
 
@@ -8,7 +8,7 @@ import pytest
 
 import chaoscam
 from chaoscam import Params
-from chaoscam._warn import user_stacklevel
+from chaoscam._util import user_stacklevel
 from chaoscam.sweep import bifurcation
 
 # A spread that cannot act (fractal K_n does not depend on the line length): every run of it
@@ -40,10 +40,10 @@ def test_a_warning_names_the_callers_file(call):
 
 
 def test_an_adaptive_verdict_warning_names_the_callers_file():
-    """classify_trajectory's RK4-grid warning, raised three calls down in classify.py,
-    names the line that called classify_trajectory."""
-    tr = chaoscam.simulate(Params(e=0.02, integrator="adaptive"), duration=0.2, series=False)
-    caught = _caught(lambda: chaoscam.classify_trajectory(tr))
+    """classify's RK4-grid warning, raised calls down in the verdict package, names the
+    line that called classify."""
+    tr = chaoscam.simulate(Params(e=0.02), duration=0.2, series=False, integrator="adaptive")
+    caught = _caught(lambda: chaoscam.classify(tr))
     assert any("RK4 grid" in str(w.message) for w in caught)
     assert {w.filename for w in caught} == {__file__}
 
@@ -67,7 +67,7 @@ def test_recorded_is_safe_on_threads_that_leave_out_of_order():
     warnings, a third thread's go where they went before, and the state is restored."""
     import threading
 
-    from chaoscam._warn import recorded
+    from chaoscam._util import recorded
 
     before = _printer_state()
     a_in, b_in, a_out = threading.Event(), threading.Event(), threading.Event()
@@ -108,8 +108,8 @@ def test_recorded_is_safe_on_threads_that_leave_out_of_order():
 def test_a_verdict_threads_warnings_are_recorded_with_their_batch():
     """The verdicts' pool threads run in a copy of the batch thread's context, so what they
     warn is recorded with the batch, not printed."""
-    from chaoscam._ensemble_verdicts import _threaded
-    from chaoscam._warn import recorded
+    from chaoscam._util import recorded
+    from chaoscam.verdict._classify import _threaded
 
     def judge(x: int) -> int:
         warnings.warn(f"member {x}", stacklevel=1)
@@ -126,13 +126,13 @@ def test_a_verdict_threads_warnings_are_recorded_with_their_batch():
 def test_no_library_module_swaps_the_warnings_state_itself():
     """``warnings.catch_warnings`` swaps process-wide state and is not safe where a sweep's
     batches run on threads; the library records and silences warnings through
-    chaoscam._warn.recorded / quiet. Only the top-level drivers (the command line, the
+    chaoscam._util.recorded / quiet. Only the top-level drivers (the command line, the
     paper's experiments), which run on the main thread, use it directly."""
     import ast
     from pathlib import Path
 
     root = Path(chaoscam.__file__).parent
-    drivers = ("cli", "experiments")
+    drivers = ("cli", "paper")
     found = []
     for path in sorted(root.rglob("*.py")):
         rel = path.relative_to(root)

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._util import freeze_fields
+from .._util import FrozenDict, freeze_fields
 from ..kernel import Status, contact_fraction, section_jacobians
 from ..kernel import layout as k
 from ..model import Params, contact_angle, contact_period, gap, normal_force, truncated_mass
@@ -190,7 +190,7 @@ class Solution:
         out["chatter_handovers"] = int(row["chatter_handovers"])
         out["truncated_mass"] = truncated_mass(p.l_lambda, p.l_lambda_sigma, p.l_min)
         out["steps_per_contact_period"] = contact_period(p) / self.numerics.dt
-        return out
+        return FrozenDict(out)
 
     def summary(self) -> str:
         """A few lines for a terminal: status, time simulated, impacts, contact fraction."""

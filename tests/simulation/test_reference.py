@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from chaoscam import Params, simulate, simulate_reference
+from chaoscam import Numerics, Params, simulate, simulate_reference
 
 DURATION = 0.7  # three impacts after the initial compliant contact
 
@@ -21,7 +21,7 @@ def reference():
 
 
 def first_impacts(dt, n=3):
-    tr = simulate(CHECK.replace(dt=dt), duration=DURATION, series=False)
+    tr = simulate(CHECK, Numerics(dt=dt), duration=DURATION, series=False)
     return tr.impacts.iloc[:n]
 
 
@@ -63,22 +63,22 @@ def test_halving_the_step_leaves_first_impacts_unchanged():
 
 def test_reference_and_kernel_sections_agree(reference):
     """The stroboscopic points before the first impacts agree to 1e-6 rad."""
-    ours = simulate(CHECK.replace(dt=1e-6), duration=DURATION, series=False).section
+    ours = simulate(CHECK, Numerics(dt=1e-6), duration=DURATION, series=False).section
     n = min(len(ours), len(reference.section))
     assert n >= 3
     assert np.max(np.abs(ours.theta_f.values[:n] - reference.section.theta_f.values[:n])) < 1e-6
 
 
-def fast_impacts(p, n=10):
-    imp = simulate(p, duration=20.0, series=False).impacts
+def fast_impacts(num, n=10):
+    imp = simulate(Params(), num, duration=20.0, series=False).impacts
     return imp[-imp.gap_rate_before > 0.01].iloc[:n]
 
 
 def test_flight_merging_agrees_with_plain_fixed_step_on_impacts():
     """Merged flight steps (default) match plain RK4 on the first ten impacts to 1e-6 s, rad."""
-    a = fast_impacts(Params(flight_merge=1))
-    b = fast_impacts(Params())
-    assert Params().flight_merge > 1 and len(a) == len(b) == 10
+    a = fast_impacts(Numerics(flight_merge=1))
+    b = fast_impacts(Numerics())
+    assert Numerics().flight_merge > 1 and len(a) == len(b) == 10
     assert np.max(np.abs(a.t.values - b.t.values)) < 1e-6
     assert np.max(np.abs(a.theta_f.values - b.theta_f.values)) < 1e-6
 
@@ -86,8 +86,9 @@ def test_flight_merging_agrees_with_plain_fixed_step_on_impacts():
 @pytest.mark.parametrize("changes", [{"xi": 0.2}, {"omega": 45.0}], ids=["xi0.2", "omega45"])
 def test_flight_merging_agrees_on_periodic_sections(changes):
     """On periodic responses the 20 s stroboscopic sections agree to 1e-6 rad."""
-    a = simulate(Params(flight_merge=1, **changes), duration=20.0, series=False).section
-    b = simulate(Params(**changes), duration=20.0, series=False).section
+    p = Params(**changes)
+    a = simulate(p, Numerics(flight_merge=1), duration=20.0, series=False).section
+    b = simulate(p, Numerics(), duration=20.0, series=False).section
     assert len(a) == len(b) > 90
     assert np.max(np.abs(a.theta_f.values - b.theta_f.values)) < 1e-6
     assert np.max(np.abs(a.omega_f.values - b.omega_f.values)) < 1e-5
@@ -140,7 +141,7 @@ def test_reference_follows_the_chattering_of_the_default_model(chattering, dt, t
     the kernel's 106 impacts, of the same kinds, at the same times to tol_t (measured:
     1.3e-8 s at dt = 2e-6 s, 1.4e-10 s at 1e-6 s; the reference that searched closings from
     the surface saw 29 of them)."""
-    ours = _resolved(simulate(Params(dt=dt), duration=0.002, series=False).impacts)
+    ours = _resolved(simulate(Params(), Numerics(dt=dt), duration=0.002, series=False).impacts)
     assert len(chattering) == len(ours) >= 100
     np.testing.assert_array_equal(chattering.kind.to_numpy(), ours["kind"].cat.codes.to_numpy())
     assert np.max(np.abs(chattering.t.values - ours.t.values)) < tol_t

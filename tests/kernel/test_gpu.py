@@ -15,11 +15,13 @@ import warnings
 import numpy as np
 import pytest
 
-from chaoscam import Params
-from chaoscam.integrate import _ensemble, _gpu, _members, simulate_ensemble
+from chaoscam import Params, extend, solve
+from chaoscam.kernel import _gpu
+from chaoscam.kernel import layout as k
+from chaoscam.simulation import CPU_BATCH, _batch, _solve
 
 # a chattering model (refills on the way), its run settings, and a bit-for-bit comparison
-from .test_resume import CHAOTIC, RUN, _same
+from tests.simulation.test_resume import CHAOTIC, RUN, _same
 
 HAS_NUMBA_CUDA = importlib.util.find_spec("numba_cuda") is not None
 needs_numba_cuda = pytest.mark.skipif(not HAS_NUMBA_CUDA, reason="numba-cuda not installed")
@@ -34,15 +36,21 @@ def sections(ens) -> np.ndarray:
     return ens.sections[["k", "t", "theta_f", "omega_f", "l_lambda"]].to_numpy()
 
 
+def _gpu_status_is(monkeypatch, status) -> None:
+    """What the GPU's status says, for the kernel layer and for solve, which asks it."""
+    monkeypatch.setattr(_gpu, "gpu_status", lambda: status)
+    monkeypatch.setattr(_solve, "gpu_status", lambda: status)
+
+
 @pytest.fixture
 def no_gpu(monkeypatch):
-    monkeypatch.setattr(_gpu, "gpu_status", lambda: (False, "no CUDA device (test)"))
+    _gpu_status_is(monkeypatch, (False, "no CUDA device (test)"))
 
 
 def test_unknown_backend_is_refused():
     """A backend other than cpu, gpu or auto raises a ValueError naming the allowed values."""
     with pytest.raises(ValueError, match=r"backend must be one of 'cpu', 'gpu', 'auto'"):
-        simulate_ensemble(Params(), [0], duration=0.01, backend="cuda")
+        solve(Params(), indices=[0], duration=0.01, backend="cuda")
 
 
 def test_gpu_without_device_falls_back_with_one_warning(no_gpu):
@@ -50,12 +58,12 @@ def test_gpu_without_device_falls_back_with_one_warning(no_gpu):
     p = Params(l_lambda_sigma=0.002)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        ens = simulate_ensemble(p, range(3), seed=4, duration=0.5, backend="gpu", batch=2)
+        ens = solve(p, indices=range(3), seed=4, duration=0.5, backend="gpu", batch=2)
     assert len(caught) == 1
     assert issubclass(caught[0].category, _gpu.GPUFallbackWarning)
     message = str(caught[0].message)
     assert "no CUDA device (test)" in message and "CPU" in message and "\n" not in message
-    cpu = simulate_ensemble(p, range(3), seed=4, duration=0.5, backend="cpu")
+    cpu = solve(p, indices=range(3), seed=4, duration=0.5, backend="cpu")
     assert ens.settings["backend"] == "cpu"
     np.testing.assert_array_equal(sections(ens), sections(cpu))
     assert ens.members.equals(cpu.members)
@@ -67,28 +75,29 @@ def test_real_status_without_device_is_a_fallback():
     ok, reason = _gpu.gpu_status()
     assert not ok and reason and "\n" not in reason
     with pytest.warns(_gpu.GPUFallbackWarning, match="GPU backend unavailable"):
-        simulate_ensemble(Params(), [0], duration=0.01, backend="gpu")
+        solve(Params(), indices=[0], duration=0.01, backend="gpu")
 
 
 def test_auto_backend_falls_back_silently(no_gpu):
     """backend="auto" without a GPU runs on the CPU with no warning."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        ens = simulate_ensemble(Params(), [0], duration=0.01, backend="auto")
+        ens = solve(Params(), indices=[0], duration=0.01, backend="auto")
     assert ens.settings["backend"] == "cpu"
 
 
 @pytest.fixture
 def fake_gpu(monkeypatch) -> list[int]:
     """A GPU "Fake GPU" that runs its launches on the CPU; returns the members of each."""
-    monkeypatch.setattr(_gpu, "gpu_status", lambda: (True, "Fake GPU"))
+    _gpu_status_is(monkeypatch, (True, "Fake GPU"))
     launched = []
 
-    def fake_launcher(*args):
-        launched.append(args[0].shape[0])
-        _members.run_on_cpu(*args)
+    def fake_launcher(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep=False):
+        launched.append(y.shape[0])
+        series = np.empty((y.shape[0], 1, k.SERIES_COLS))  # a GPU keeps no series
+        _batch.run_on_cpu(y, cnt, c, n_stop, lam, series, section, impacts, status, hand_back)
 
-    monkeypatch.setattr(_gpu, "run_on_gpu", fake_launcher)
+    monkeypatch.setattr(_batch, "run_on_gpu", fake_launcher)
     return launched
 
 
@@ -97,7 +106,7 @@ def test_auto_backend_uses_an_available_gpu(monkeypatch, fake_gpu):
     has AUTO_GPU_MIN members (here lowered to 3), and records it."""
     monkeypatch.setattr(_gpu, "AUTO_GPU_MIN", 3)
     launched = fake_gpu
-    ens = simulate_ensemble(Params(), range(3), duration=0.01, backend="auto")
+    ens = solve(Params(), indices=range(3), duration=0.01, backend="auto")
     assert launched == [3]
     assert ens.settings["backend"] == "gpu" and ens.settings["device"] == "Fake GPU"
     assert ens.settings["batch"] == _gpu.GPU_BATCH
@@ -110,9 +119,9 @@ def test_auto_backend_keeps_a_small_ensemble_on_the_cpu(monkeypatch, fake_gpu):
     launched = fake_gpu
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        small = simulate_ensemble(Params(), range(3), duration=0.01, backend="auto")
+        small = solve(Params(), indices=range(3), duration=0.01, backend="auto")
     assert launched == [] and small.settings["backend"] == "cpu"
-    asked = simulate_ensemble(Params(), range(3), duration=0.01, backend="gpu")
+    asked = solve(Params(), indices=range(3), duration=0.01, backend="gpu")
     assert launched == [3] and asked.settings["backend"] == "gpu"
     assert [_gpu.by_size(b, n) for b, n in [("auto", 3), ("auto", 4), ("gpu", 1), ("cpu", 9)]] == [
         "cpu",
@@ -130,7 +139,7 @@ def test_numpy_2_5_rules_the_backend_out(monkeypatch, version):
     assert not ok
     assert version in reason and "row_stack" in reason and "pip install 'numpy<2.5'" in reason
     with pytest.warns(_gpu.GPUFallbackWarning, match="row_stack"):
-        ens = simulate_ensemble(Params(), [0], duration=0.01, backend="gpu")
+        ens = solve(Params(), indices=[0], duration=0.01, backend="gpu")
     assert ens.settings["backend"] == "cpu"
 
 
@@ -142,29 +151,29 @@ def test_older_numpy_is_not_the_trap(monkeypatch, version):
 
 
 def test_import_does_not_load_numba_cuda():
-    """import chaoscam (and its ensemble path) leaves numba.cuda unimported."""
-    code = "import sys, chaoscam, chaoscam.integrate._ensemble; print('numba.cuda' in sys.modules)"
+    """import chaoscam (and its solve path) leaves numba.cuda unimported."""
+    code = "import sys, chaoscam, chaoscam.simulation._solve; print('numba.cuda' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True)
     assert out.stdout.strip() == "False"
 
 
 _SIMULATED = """
 import json, sys, numpy as np
-from chaoscam import Params
-from chaoscam.integrate import _ensemble, _gpu, simulate_ensemble
-_ensemble._ROOM.update(gpu=(64, 256), cpu=(64, 256))  # many refills: relaunches on the device
+from chaoscam import Numerics, Params, extend, solve
+from chaoscam.simulation import _batch
+_batch.ROOM.update(gpu=(64, 256), cpu=(64, 256))  # many refills: relaunches on the device
 out = {}
 cases = {
-    "refills": (Params(l_lambda_sigma=0.002, resample="interval", resample_dt=1e-4), 0.5, 0.1),
-    "periodic": (Params(xi=0.2), 0.5, 0.0),
-    "adaptive": (Params(l_lambda_sigma=0.002, integrator="adaptive"), 0.5, 0.0),
-    "impacts": (Params(l_lambda_sigma=0.002, v_min=0.0), 0.5, 0.0),
-    "tangent": (Params(xi=0.45), 0.5, 0.0),
+    "refills": (Params(l_lambda_sigma=0.002, resample="interval", resample_dt=1e-4), "rk4", 0.1),
+    "periodic": (Params(xi=0.2), "rk4", 0.0),
+    "adaptive": (Params(l_lambda_sigma=0.002), "adaptive", 0.0),
+    "impacts": (Params(l_lambda_sigma=0.002, v_min=0.0), "rk4", 0.0),
+    "tangent": (Params(xi=0.45), "rk4", 0.0),
 }
-for name, (p, duration, transient) in cases.items():
-    runs = [simulate_ensemble(p, range(5), seed=2, duration=duration, transient=transient,
-                              backend=b, batch=3, keep_impacts=True,
-                              tangent=name == "tangent") for b in ("gpu", "cpu")]
+for name, (p, integrator, transient) in cases.items():
+    runs = [solve(p, Numerics(integrator=integrator), indices=range(5), seed=2, duration=0.5,
+                  transient=transient, backend=b, batch=3, impacts=True,
+                  tangent=name == "tangent") for b in ("gpu", "cpu")]
     a, b = (r.sections.to_numpy() for r in runs)
     if name == "tangent":  # the Jacobians beside the section points too
         a, b = (np.column_stack([a, r.jacobians.reshape(len(a), -1)]) for r in runs)
@@ -176,15 +185,15 @@ for name, (p, duration, transient) in cases.items():
 # continued on the device from a copy kept on the way (two launches, then a resumed batch)
 p = Params(l_lambda_sigma=0.002)
 kw = dict(seed=2, transient=0.1, tangent=True)
-short = simulate_ensemble(p, range(5), duration=0.3, backend="gpu", batch=3, resumable=True, **kw)
-longer = _ensemble.extend_ensemble(short, p, 0.6)
-made = simulate_ensemble(p, range(5), duration=0.6, backend="cpu", **kw)
+short = solve(p, indices=range(5), duration=0.3, backend="gpu", batch=3, resumable=True, **kw)
+longer = extend(short, 0.6)
+made = solve(p, indices=range(5), duration=0.6, backend="cpu", **kw)
 a, b = longer.sections.to_numpy(), made.sections.to_numpy()
 out["continued"] = {"backend": longer.settings["backend"], "shape": a.shape == b.shape,
                     "n": len(a), "diff": float(np.abs(a - b).max()), "impacts": True,
                     "members": longer.members.equals(made.members)}
 # continued on the CPU from the device's copy (the CPU's room: refills at other points)
-on_cpu = _ensemble.extend_ensemble(short, p, 0.6, backend="cpu")
+on_cpu = extend(short, 0.6, backend="cpu")
 a = on_cpu.sections.to_numpy()
 legs = list(on_cpu.settings["backends"])
 out["continued on the cpu"] = {"backend": "gpu" if legs == ["gpu", "cpu"] else str(legs),
@@ -259,9 +268,7 @@ def test_kernel_compiles_to_ptx_for_h100(method):
 def test_device_equals_cpu_within_tolerance(params, duration, transient):
     """On a GPU, sections of the first cam period and of a periodic orbit equal the CPU's."""
     runs = [
-        simulate_ensemble(
-            params, range(8), seed=3, duration=duration, transient=transient, backend=b
-        )
+        solve(params, indices=range(8), seed=3, duration=duration, transient=transient, backend=b)
         for b in ("gpu", "cpu")
     ]
     assert runs[0].settings["backend"] == "gpu"
@@ -273,58 +280,55 @@ def test_device_equals_cpu_within_tolerance(params, duration, transient):
 
 
 def test_a_gpu_runs_continuation_of_few_members_goes_to_the_cpu(monkeypatch, fake_gpu):
-    """extend_ensemble(backend="auto") of a GPU run continues fewer than AUTO_GPU_MIN
-    members on the CPU, from the GPU's state and with the CPU's room; backend=None stays on
-    the GPU. The fake GPU runs the CPU's kernel, so all three equal a CPU run made that long,
-    bit for bit: only where they ran differs (and a real device's rounding)."""
-    from chaoscam.integrate import extend_ensemble
-
-    short = simulate_ensemble(CHAOTIC, range(3), duration=2.0, resumable=True, backend="gpu", **RUN)
+    """extend(backend="auto") of a GPU run continues fewer than AUTO_GPU_MIN members on the
+    CPU, from the GPU's state and with the CPU's room; backend=None stays on the GPU. The
+    fake GPU runs the CPU's kernel, so all three equal a CPU run made that long, bit for
+    bit: only where they ran differs (and a real device's rounding)."""
+    short = solve(CHAOTIC, indices=range(3), duration=2.0, resumable=True, backend="gpu", **RUN)
     assert short.settings["backend"] == "gpu" and len(fake_gpu) > 0
     launched = len(fake_gpu)
-    on_gpu = extend_ensemble(short, CHAOTIC, 4.0)
+    on_gpu = extend(short, 4.0)
     assert len(fake_gpu) > launched and on_gpu.settings["backend"] == "gpu"
     launched = len(fake_gpu)
-    on_cpu = extend_ensemble(short, CHAOTIC, 4.0, members=[2, 0], backend="auto")
+    on_cpu = extend(short, 4.0, members=[2, 0], backend="auto")
     assert len(fake_gpu) == launched  # not one launch
     assert on_cpu.settings["backend"] == "cpu" and list(on_cpu.settings["backends"]) == [
         "gpu",
         "cpu",
     ]
-    assert on_cpu.settings["batch"] == _ensemble._CPU_BATCH
-    _same(on_cpu, simulate_ensemble(CHAOTIC, [2, 0], duration=4.0, backend="cpu", **RUN))
-    _same(on_gpu, simulate_ensemble(CHAOTIC, range(3), duration=4.0, backend="cpu", **RUN))
+    assert on_cpu.settings["batch"] == CPU_BATCH
+    _same(on_cpu, solve(CHAOTIC, indices=[2, 0], duration=4.0, backend="cpu", **RUN))
+    _same(on_gpu, solve(CHAOTIC, indices=range(3), duration=4.0, backend="cpu", **RUN))
     monkeypatch.setattr(_gpu, "AUTO_GPU_MIN", 2)  # two members are now enough for the GPU
-    extend_ensemble(short, CHAOTIC, 4.0, members=[2, 0], backend="auto")
+    extend(short, 4.0, members=[2, 0], backend="auto")
     assert len(fake_gpu) > launched
 
 
-def test_a_gpu_ensembles_extensions_run_on_the_cpu(fake_gpu):
-    """classify_ensemble on a GPU run: its undetermined member is extended on the CPU (no
-    launch after the run's own), the extension's note says where, and the verdict is the
-    CPU run's (the fake GPU runs the CPU's kernel)."""
-    from chaoscam import classify_ensemble
-    from chaoscam._ensemble_verdicts import member_verdicts
+def test_a_gpu_solutions_extensions_run_on_the_cpu(fake_gpu):
+    """classify on a GPU run: its undetermined member is extended on the CPU (no launch
+    after the run's own), the extension's note says where, and the verdict is the CPU
+    run's (the fake GPU runs the CPU's kernel)."""
+    from chaoscam import classify
 
     p = Params(omega=26.0, xi=0.3)  # undetermined after 20 s, chaotic when extended
     run = dict(seed=1, duration=20.0, transient=10.0, tangent=True, resumable=True)
-    ens = simulate_ensemble(p, [0], backend="gpu", **run)
+    ens = solve(p, indices=[0], backend="gpu", **run)
     launched = len(fake_gpu)
-    (v,) = member_verdicts(ens, p)
+    (v,) = classify(ens)
     assert len(fake_gpu) == launched
-    assert v.label == "chaotic" and v.verdict.settings["extended"]["backend"] == "cpu"
-    cpu = classify_ensemble(simulate_ensemble(p, [0], backend="cpu", **run), p).members
-    assert cpu["label"].iat[0] == v.label and cpu["reasons"].iat[0] == v.reasons
+    assert v.label == "chaotic" and v.settings["extended"]["backend"] == "cpu"
+    (cpu,) = classify(solve(p, indices=[0], backend="cpu", **run))
+    assert cpu.label == v.label and cpu.reasons == v.reasons
 
 
 @pytest.mark.parametrize("resumable", [True, False])
 def test_a_gpu_sweeps_fate_runs_run_on_the_cpu(fake_gpu, resumable):
     """The fate runs of a GPU batch's few chaotic members go to the CPU (by size), whether
     continued from the batch's copy or run again."""
-    from chaoscam.sweep import _batch
+    from chaoscam.sweep import _runs
 
     run = dict(duration=2.0, transient=0.0, tangent=True, resumable=resumable)
-    ens = simulate_ensemble(CHAOTIC, [0], seed=1, backend="gpu", **run)
+    ens = solve(CHAOTIC, indices=[0], seed=1, backend="gpu", **run)
     launched = list(fake_gpu)
-    (fields,) = _batch._fates(ens, [CHAOTIC], [0], 1, 8.0)
+    (fields,) = _runs._fates(ens, [0], 8.0)
     assert fake_gpu == launched and fields["fate"] == "OK"

@@ -5,10 +5,11 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from chaoscam import Params
-from chaoscam.integrate import _events as ev
-from chaoscam.integrate import _kernel as k
-from chaoscam.integrate import kernel_constants
+from chaoscam import Numerics, Params
+from chaoscam.kernel import _events as ev
+from chaoscam.kernel import _physics as k
+from chaoscam.kernel import kernel_constants
+from chaoscam.kernel import layout as L
 from chaoscam.model import contact_angle
 
 T0 = 0.1
@@ -21,7 +22,7 @@ def _bracket(case):
     of a chattering sequence (~1e-5 m/s, a gap of 1e-11 m: the gap's last bits matter), and a
     lift-off from inside the cam."""
     p = Params()
-    c = kernel_constants(p)
+    c = kernel_constants(p, Numerics())
     K = k.stiffness(p.l_lambda, c)
     root = float(contact_angle(p, T0))
     rate_c = (float(contact_angle(p, T0 + 1e-7)) - float(contact_angle(p, T0 - 1e-7))) / 2e-7
@@ -61,7 +62,7 @@ def test_crossing_is_found_to_the_event_tolerance(case):
     assert s * along(tau) <= 0.0
     # the gap's rounding (~1e-17 m) blurs the crossing by that over the approach speed
     blur = 4e-17 / abs((along(root + 1e-9) - along(root - 1e-9)) / 2e-9)
-    assert abs(tau - root) <= c[k.C_EVENT_TOL] + blur
+    assert abs(tau - root) <= c[L.C_EVENT_TOL] + blur
 
 
 @pytest.mark.parametrize("case", CASES)

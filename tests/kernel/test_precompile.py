@@ -1,13 +1,30 @@
-"""The kernel's first compilation shared with a second process (integrate._precompile)."""
+"""The kernel's first compilation shared with a second process (kernel._precompile)."""
 
 import os
 import subprocess
 import sys
+import time
+from pathlib import Path
 
 import pytest
 
-from chaoscam.integrate import _precompile
-from tests.sweep.test_sw_signals import _alive
+from chaoscam.kernel import _precompile
+
+
+def _alive(pids, timeout=10.0) -> list[int]:
+    """The processes of ``pids`` still running (not zombies) after up to ``timeout`` s."""
+    t0 = time.monotonic()
+    while True:
+        left = [
+            p
+            for p in pids
+            if Path(f"/proc/{p}").exists()
+            and "Z" not in (Path(f"/proc/{p}/stat").read_text().rsplit(")", 1)[1][:3])
+        ]
+        if not left or time.monotonic() - t0 > timeout:
+            return left
+        time.sleep(0.05)
+
 
 # A run's last section point, printed exactly; PROBE adds how each of the second process's
 # callees came to this process: numba's cache hits and misses for it.
@@ -19,7 +36,7 @@ print(repr(tuple(traj.section[["theta_f", "omega_f"]].iloc[-1])))
 PROBE = (
     LAST_POINT
     + """
-from chaoscam.integrate._precompile import _callees
+from chaoscam.kernel._precompile import _callees
 for d, sig in _callees():
     print(d.py_func.__name__, sum(d.stats.cache_hits.values()), sum(d.stats.cache_misses.values()))
 """
@@ -40,11 +57,11 @@ def _run(code: str, cache, *args: str) -> str:
 
 @pytest.mark.slow
 def test_the_kernel_loads_the_second_processs_callees_and_gives_the_same_bits(tmp_path):
-    """In an empty cache, after `python -m chaoscam.integrate._precompile` the kernel's
+    """In an empty cache, after `python -m chaoscam.kernel._precompile` the kernel's
     compilation finds every one of its callees in numba's cache (their signatures are those
     the kernel asks for: a hit each, no miss), and the run equals one compiled without it.
     About 45 s: two compilations from empty caches."""
-    helped = _run(None, tmp_path / "helped", "-m", "chaoscam.integrate._precompile")
+    helped = _run(None, tmp_path / "helped", "-m", "chaoscam.kernel._precompile")
     assert helped == ""
     lines = _run(PROBE, tmp_path / "helped", "-c").splitlines()
     alone = _run(PROBE, tmp_path / "alone", "-c").splitlines()
@@ -91,7 +108,7 @@ def test_a_fresh_installs_first_simulate_starts_the_second_process(tmp_path):
     process once, before the kernel compiles, and its run is the same bits as one without
     it. About 35 s: two compilations from empty caches."""
     code = (
-        "import chaoscam.integrate._precompile as p\n"
+        "import chaoscam.kernel._precompile as p\n"
         "calls = []\n"
         "real = p.start_beside\n"
         "p.start_beside = lambda: calls.append(real()) or calls[-1]\n"
@@ -101,7 +118,7 @@ def test_a_fresh_installs_first_simulate_starts_the_second_process(tmp_path):
     )
     helped = _run(code, tmp_path / "a", "-c").splitlines()
     alone = _run(
-        "import chaoscam.integrate._precompile as p\np.start_once = lambda: None\n" + LAST_POINT,
+        "import chaoscam.kernel._precompile as p\np.start_once = lambda: None\n" + LAST_POINT,
         tmp_path / "b",
         "-c",
     ).splitlines()
@@ -113,11 +130,10 @@ def test_the_second_process_ends_when_its_parent_is_killed(tmp_path):
     """A run SIGKILLed on a fresh install leaves no compiler behind: the second process,
     compiling into an empty cache (about 10 s of work), ends within 3 s of its parent."""
     import signal
-    import time
 
     code = (
         "import subprocess, sys, time\n"
-        "p = subprocess.Popen([sys.executable, '-m', 'chaoscam.integrate._precompile'])\n"
+        "p = subprocess.Popen([sys.executable, '-m', 'chaoscam.kernel._precompile'])\n"
         "print(p.pid, flush=True)\n"
         "time.sleep(60)\n"
     )

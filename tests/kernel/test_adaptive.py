@@ -10,26 +10,25 @@ against a dt = 2.5e-7 run).
 import numpy as np
 import pytest
 
-from chaoscam import Params, simulate
-from chaoscam.integrate import Status, simulate_ensemble
-from chaoscam.model import ParameterError, gap_rate, lever_arm
+from chaoscam import Numerics, ParameterError, Params, Status, simulate, solve
+from chaoscam.model import gap_rate, lever_arm
 
 # Integrator comparisons with the withdrawn v_min = 1e-3 m/s: with v_min = 0 every closing is
 # an impact, and the chattering sequences (micro-impacts decided by rounding) amplify 1e-12 s
 # differences between the two integrators; that limit is tested in test_chattering.py.
-RK4 = Params(v_min=1e-3)
-ADAPTIVE = RK4.replace(integrator="adaptive")
+P = Params(v_min=1e-3)
+ADAPTIVE = Numerics(integrator="adaptive")
 
 
-def fast_impacts(p, duration=2.0, n=10):
-    imp = simulate(p, duration=duration, series=False).impacts
+def fast_impacts(p, num, duration=2.0, n=10):
+    imp = simulate(p, num, duration=duration, series=False).impacts
     return imp[-imp.gap_rate_before > 0.01].iloc[:n]
 
 
 def test_first_ten_impacts_agree_with_converged_rk4():
     """At rtol 3e-14 the first ten fast impacts match RK4 (dt 2.5e-7) within 1e-6 s and rad."""
-    a = fast_impacts(RK4.replace(dt=2.5e-7))
-    b = fast_impacts(ADAPTIVE.replace(rtol=3e-14, atol=1e-14))
+    a = fast_impacts(P, Numerics(dt=2.5e-7))
+    b = fast_impacts(P, ADAPTIVE.replace(rtol=3e-14, atol=1e-14))
     assert len(a) == len(b) == 10
     assert np.max(np.abs(a.t.values - b.t.values)) < 1e-6
     assert np.max(np.abs(a.theta_f.values - b.theta_f.values)) < 1e-6
@@ -38,8 +37,9 @@ def test_first_ten_impacts_agree_with_converged_rk4():
 @pytest.mark.parametrize("changes", [{"xi": 0.2}, {"omega": 45.0}], ids=["xi0.2", "omega45"])
 def test_periodic_sections_agree_with_converged_rk4(changes):
     """With the default tolerances, 20 s of sections match RK4 (dt 1e-6) within 1e-6 rad."""
-    a = simulate(RK4.replace(dt=1e-6, **changes), duration=20.0, series=False).section
-    b = simulate(ADAPTIVE.replace(**changes), duration=20.0, series=False).section
+    p = P.replace(**changes)
+    a = simulate(p, Numerics(dt=1e-6), duration=20.0, series=False).section
+    b = simulate(p, ADAPTIVE, duration=20.0, series=False).section
     assert len(a) == len(b) > 90
     assert np.array_equal(a.k.values, b.k.values)
     assert np.max(np.abs(a.theta_f.values - b.theta_f.values)) < 1e-6
@@ -59,10 +59,9 @@ def test_adaptive_agrees_with_converged_rk4_through_a_chattering_phase(rtol):
     bounces. Accuracy where the map is smooth is tested below (Jacobians, multipliers,
     impacts per period).
     """
-    p = Params()
-    ref = simulate(p.replace(dt=2.5e-7), duration=0.2, output_dt=1e-3)
+    ref = simulate(Params(), Numerics(dt=2.5e-7), duration=0.2, output_dt=1e-3)
     got = simulate(
-        p.replace(integrator="adaptive", rtol=rtol, atol=rtol / 100), duration=0.2, output_dt=1e-3
+        Params(), ADAPTIVE.replace(rtol=rtol, atol=rtol / 100), duration=0.2, output_dt=1e-3
     )
     assert len(ref.impacts) > 500
     assert np.max(np.abs(got.series.theta_f.values - ref.series.theta_f.values)) < 1e-8
@@ -71,8 +70,8 @@ def test_adaptive_agrees_with_converged_rk4_through_a_chattering_phase(rtol):
 def test_impact_law_holds_at_every_adaptive_impact():
     """Each applied jump sits on the cam (gap rate from the state) and reverses the rate by xi,
     or stops it at a chattering end (default v_min = 0)."""
-    p = Params(integrator="adaptive")
-    tr = simulate(p, duration=5.0, series=False)
+    p = Params()
+    tr = simulate(p, ADAPTIVE, duration=5.0, series=False)
     imp = tr.impacts
     assert len(imp) > 20
     before = gap_rate(p, imp.t.values, imp.theta_f.values, imp.omega_before.values)
@@ -87,21 +86,22 @@ def test_impact_law_holds_at_every_adaptive_impact():
 
 def test_series_and_buffer_hand_backs_do_not_change_the_run():
     """Sampling (from the interpolant) and buffer pauses leave the trajectory bit-identical."""
-    p = ADAPTIVE.replace(l_lambda_sigma=0.002)
-    a = simulate(p, duration=3.0, seed=3, index=5, transient=1.0, series=False)
-    b = simulate(p, duration=3.0, seed=3, index=5, transient=1.0, output_dt=p.dt)
+    p, dt = P.replace(l_lambda_sigma=0.002), ADAPTIVE.dt
+    a = simulate(p, ADAPTIVE, duration=3.0, seed=3, index=5, transient=1.0, series=False)
+    b = simulate(p, ADAPTIVE, duration=3.0, seed=3, index=5, transient=1.0, output_dt=dt)
     assert a.section.equals(b.section) and a.impacts.equals(b.impacts)
     assert a.final_state == b.final_state
-    assert len(b.series) == round(2.0 / p.dt) + 1
-    assert np.allclose(np.diff(b.series.t.values), p.dt)
+    assert len(b.series) == round(2.0 / dt) + 1
+    assert np.allclose(np.diff(b.series.t.values), dt)
 
 
-def test_ensemble_members_equal_single_adaptive_runs():
-    """The parallel ensemble runs the same adaptive kernel, member for member."""
-    p = ADAPTIVE.replace(l_lambda_sigma=0.002, resample="interval")
-    ens = simulate_ensemble(p, [4, 9], seed=3, duration=4.0)
+def test_a_member_of_a_batch_equals_the_same_adaptive_realization_solved_alone():
+    """A batch runs the same adaptive kernel in parallel, member for member: each member
+    equals its realization solved alone, bit for bit."""
+    p = P.replace(l_lambda_sigma=0.002, resample="interval")
+    ens = solve(p, ADAPTIVE, indices=[4, 9], seed=3, duration=4.0)
     for member, index in enumerate([4, 9]):
-        one = simulate(p, seed=3, index=index, duration=4.0, series=False)
+        one = simulate(p, ADAPTIVE, seed=3, index=index, duration=4.0, series=False)
         got = ens.sections[ens.sections.member == member].drop(columns="member")
         assert np.array_equal(got.to_numpy(), one.section.to_numpy())
         assert ens.members.contact_fraction[member] == one.stats["contact_fraction"]
@@ -109,16 +109,16 @@ def test_ensemble_members_equal_single_adaptive_runs():
 
 def test_contact_fraction_is_integrated_in_time():
     """The contact fraction of the adaptive path matches the fixed grid's step count."""
-    a = simulate(Params(dt=1e-6, xi=0.2), duration=20.0, transient=10.0, series=False)
-    b = simulate(ADAPTIVE.replace(xi=0.2), duration=20.0, transient=10.0, series=False)
+    a = simulate(Params(xi=0.2), Numerics(dt=1e-6), duration=20.0, transient=10.0, series=False)
+    b = simulate(P.replace(xi=0.2), ADAPTIVE, duration=20.0, transient=10.0, series=False)
     assert b.stats["contact_fraction"] == pytest.approx(a.stats["contact_fraction"], abs=1e-4)
-    assert b.settings["solver"].startswith("dop853")
+    assert b.numerics.integrator == "adaptive" and b.numerics.describe_step().startswith("adapt")
 
 
 def test_failures_are_labelled_statuses():
     """Leaving the cam ends an adaptive run with LEFT_REACH; chattering does not hang."""
-    assert simulate(ADAPTIVE.replace(x_O=-0.58), duration=1.0).status is Status.LEFT_REACH
-    tr = simulate(ADAPTIVE.replace(v_min=0.0), duration=1.0, series=False)
+    assert simulate(P.replace(x_O=-0.58), ADAPTIVE, duration=1.0).status is Status.LEFT_REACH
+    tr = simulate(P.replace(v_min=0.0), ADAPTIVE, duration=1.0, series=False)
     assert tr.ok and tr.stats["n_impacts"] > 50
 
 
@@ -130,25 +130,19 @@ def test_failures_are_labelled_statuses():
         ({"rtol": 0.1}, "rtol"),
         ({"atol": -1.0}, "atol"),
         ({"h_max": 0.0}, "h_max"),
+        ({"dt": 0.0}, "dt"),
+        ({"dt": -1e-6}, "dt"),
+        ({"max_events_per_step": 0}, "max_events_per_step"),
     ],
 )
 def test_bad_integrator_settings_name_the_field(changes, field):
-    with pytest.raises(ParameterError, match=field):
-        Params(**changes)
+    """A bad integrator setting is refused by Numerics, naming the field and its range."""
+    with pytest.raises(ParameterError, match=rf"^{field} = "):
+        Numerics(**changes)
 
 
 def test_refined_halves_the_step_or_tightens_the_tolerances():
     """The convergence check's partner run: dt / 2 for RK4, tolerances / 32 for adaptive."""
-    assert Params().refined().dt == Params().dt / 2
+    assert Numerics().refined().dt == Numerics().dt / 2
     fine = ADAPTIVE.refined()
     assert fine.rtol == ADAPTIVE.rtol / 32 and fine.atol == ADAPTIVE.atol / 32
-
-
-def test_lyapunov_exponent_is_taken_on_the_rk4_grid():
-    """lyapunov_model runs both trajectories on the fixed grid even for adaptive params."""
-    from chaoscam.lyapunov import lyapunov_model
-
-    a = lyapunov_model(RK4.replace(xi=0.2), duration=4.0)
-    b = lyapunov_model(ADAPTIVE.replace(xi=0.2), duration=4.0)
-    assert a.exponent == b.exponent
-    assert "asked: adaptive" in b.settings["integrator"]

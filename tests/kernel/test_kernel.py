@@ -6,10 +6,14 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from chaoscam import Params
-from chaoscam.integrate import _kernel as k
-from chaoscam.integrate import kernel_constants
+from chaoscam import Numerics, Params
+from chaoscam.kernel import _physics as k
+from chaoscam.kernel import kernel_constants
+from chaoscam.kernel import layout as L
+from chaoscam.kernel._events import locate_crossing
 from chaoscam.model import angular_acceleration, gap, lever_arm, normal_cam_speed
+
+NUM = Numerics()
 
 
 @pytest.mark.parametrize(
@@ -19,7 +23,7 @@ from chaoscam.model import angular_acceleration, gap, lever_arm, normal_cam_spee
 )
 def test_kernel_acceleration_matches_numpy_model(params):
     """The kernel's scalar right-hand side equals the numpy model's, in flight and in contact."""
-    c = kernel_constants(params)
+    c = kernel_constants(params, NUM)
     rng = np.random.default_rng(0)
     for _ in range(200):
         t = rng.uniform(0, 1)
@@ -40,7 +44,7 @@ def gap_root(p, t):
 def test_kernel_geometry_matches_numpy_model():
     """gap, lever arm and dC/dt.n of the kernel equal the numpy geometry."""
     p = Params()
-    c = kernel_constants(p)
+    c = kernel_constants(p, NUM)
     for t, th in [(0.0, 0.0), (0.1, 0.05), (0.37, -0.1), (1.3, 0.2)]:
         d, l1, cdn = k.geometry(t, th, c)
         assert d == pytest.approx(float(gap(p, t, th)), abs=1e-15)
@@ -51,7 +55,7 @@ def test_kernel_geometry_matches_numpy_model():
 def test_located_crossing_is_within_1e_10_s_of_the_root():
     """locate_crossing finds the zero of delta along an RK4 substep to better than 1e-10 s."""
     p = Params()
-    c = kernel_constants(p)
+    c = kernel_constants(p, NUM)
     K = k.stiffness(p.l_lambda, c)
     t0 = 0.1
     th0 = float(gap_root(p, t0)) + 2e-6  # just above the cam, falling onto it
@@ -66,7 +70,7 @@ def test_located_crossing_is_within_1e_10_s_of_the_root():
 
     root = brentq(along, 0.0, h, xtol=1e-16, rtol=4 * np.finfo(float).eps)
     trig = k.geometry_at(t0, th0, c)[3:]
-    tau = k.locate_crossing(t0, th0, om0, 0.0, g0, h, g1, K, c, False, trig)
+    tau = locate_crossing(t0, th0, om0, 0.0, g0, h, g1, K, c, False, trig)
     assert abs(tau - root) <= 1e-10
     assert along(tau) <= 0.0
 
@@ -77,8 +81,8 @@ def _textbook_rk4(t, th, om, h, K, c, side=None, rest=None, signs=None):
     Jacobian's stages too: the first on ``side``, the others on ``rest``, by default ``side``
     too). ``signs`` (12 of +-1) moves stages 2-4's cos/sin of the cam angle and of theta_f by
     two units of 2^-52 each, a rounding as large as :func:`._physics.rotate`'s."""
-    from chaoscam.integrate._physics import acceleration_jacobian_trig
-    from chaoscam.integrate._tangent import _column
+    from chaoscam.kernel._physics import acceleration_jacobian_trig
+    from chaoscam.kernel._tangent import _column
 
     def f(ts, ths, oms, stage):
         thc = k.cam_angle(ts, c)
@@ -113,7 +117,7 @@ def test_rotated_cos_and_sin_are_within_two_units_of_the_direct_calls():
     """_physics.rotate (the addition theorem with Taylor polynomials) gives cos/sin of a + b
     within 2 units of 2^-52 of math.cos/math.sin for |b| < ROTATE_MAX, and the direct calls
     beyond."""
-    from chaoscam.integrate._physics import ROTATE_MAX, rotate
+    from chaoscam.kernel._physics import ROTATE_MAX, rotate
 
     rng = np.random.default_rng(0)
     worst = 0.0
@@ -135,11 +139,11 @@ def test_steps_with_rotated_stages_are_the_textbook_steps_to_rounding(side):
     units moves the textbook step (the largest move over 8 random roundings), in flight and in
     contact. The tangent step's state is rk4_trig's, bit for bit, and gap_after is the
     geometry at rk4_trig's end."""
-    from chaoscam.integrate._events import gap_after
-    from chaoscam.integrate._tangent import rk4_tangent_trig
+    from chaoscam.kernel._events import gap_after
+    from chaoscam.kernel._tangent import rk4_tangent_trig
 
     p = Params()
-    c = kernel_constants(p)
+    c = kernel_constants(p, NUM)
     K = k.stiffness(p.l_lambda, c)
     rng = np.random.default_rng(1)
     in_contact = 0
@@ -183,10 +187,10 @@ def test_steps_with_rotated_stages_are_the_textbook_steps_to_rounding(side):
 def test_the_free_pendulums_step_is_the_same_with_and_without_its_tangent():
     """rk4_flight and rk4_flight_tangent rotate the same stages: the same state to the bit,
     and within rounding of the textbook free-pendulum step with direct cosines."""
-    from chaoscam.integrate._tangent import rk4_flight_tangent
+    from chaoscam.kernel._tangent import rk4_flight_tangent
 
-    c = kernel_constants(Params())
-    g = -c[k.C_GRAV] * c[k.C_INV_J]
+    c = kernel_constants(Params(), NUM)
+    g = -c[L.C_GRAV] * c[L.C_INV_J]
     rng = np.random.default_rng(2)
     for _ in range(200):
         th, om = float(rng.uniform(-1.5, 1.5)), float(rng.uniform(-20, 20))
@@ -212,9 +216,8 @@ def test_the_transient_changes_what_is_kept_not_the_motion(integrator, transient
     left the cam's reach at 229 s with a 10 s transient and at 505 s with 100 s."""
     from chaoscam import simulate
 
-    p = Params(integrator=integrator)
-    kw = dict(duration=6.0, output_dt=1e-3)
-    whole, part = simulate(p, transient=0.0, **kw), simulate(p, transient=transient, **kw)
+    kw = dict(duration=6.0, output_dt=1e-3, integrator=integrator)
+    whole, part = simulate(transient=0.0, **kw), simulate(transient=transient, **kw)
     for name in ("section", "impacts", "series"):
         a, b = getattr(whole, name), getattr(part, name)
         kept = a[a["t"] >= transient].reset_index(drop=True)

@@ -1,14 +1,11 @@
-"""The one buffer-refill loop (integrate/_driver.py) and the run window's checks."""
+"""The one buffer-refill loop (kernel/_driver.py) and the compiled entry points it drives."""
 
 import numpy as np
 import pytest
 
-from chaoscam import Params
-from chaoscam._simulate import raw_run, simulate
-from chaoscam.integrate import _adaptive
-from chaoscam.integrate import _kernel as k
-from chaoscam.integrate._driver import check_window, drive_members
-from chaoscam.model import ParameterError
+from chaoscam import Numerics, Params, simulate
+from chaoscam.kernel import _adaptive, _rk4, drive_members
+from chaoscam.kernel import layout as k
 
 
 def test_drive_members_relaunches_exactly_those_that_asked():
@@ -32,56 +29,21 @@ def test_drive_members_relaunches_exactly_those_that_asked():
 
 
 def test_drive_members_with_nothing_to_refill_launches_once():
+    """Members that all end in their first launch are launched once and never refilled."""
     calls = []
     drive_members(3, lambda need: calls.append(need.size) or np.zeros(need.size, int), None)
     assert calls == [3]
 
 
-@pytest.mark.parametrize(
-    ("duration", "transient", "field"),
-    [
-        (0.0, 0.0, "duration"),
-        (float("nan"), 0.0, "duration"),
-        (True, 0.0, "duration"),
-        ("20", 0.0, "duration"),
-        (20.0, 20.0, "transient"),
-        (20.0, -1.0, "transient"),
-        (20.0, None, "transient"),
-    ],
-)
-def test_check_window_names_the_field_and_its_range(duration, transient, field):
-    with pytest.raises(ParameterError, match=rf"^{field} = .* must be"):
-        check_window(duration, transient)
+RK4 = Numerics()
 
 
-def test_check_window_refuses_a_run_shorter_than_one_step():
-    with pytest.raises(ParameterError, match="shorter than one step"):
-        check_window(1e-7, 0.0, dt=2e-6)
-    assert check_window(20, 5) == (20.0, 5.0)
-
-
-def test_raw_run_is_the_trajectory_without_tables():
-    """simulate() is raw_run() plus its tables: equal stats, summary and arrays."""
-    p = Params(l_lambda_sigma=0.002)
-    raw = raw_run(p, duration=1.0, seed=3, index=2, tangent=True)
-    tr = simulate(p, duration=1.0, seed=3, index=2, tangent=True)
-    assert raw.summary() == tr.summary()
-    assert {n: v for n, v in raw.stats.items()} == tr.stats
-    assert raw.final_state == tr.final_state
-    np.testing.assert_array_equal(raw.section[:, :5], tr.section.to_numpy())
-    np.testing.assert_array_equal(raw.impacts[:, 0], tr.impacts["t"].to_numpy())
-    assert tr.stats["n_impacts"] == len(tr.impacts) > 0
-    kinds = tr.impacts["kind"].value_counts()
-    assert tr.stats["n_micro_impacts"] == kinds.get("micro", 0)
-    assert tr.stats["n_chatter_ends"] == kinds.get("chatter_end", 0)
-
-
-def _one_member(p: Params, tangent: bool):
-    from chaoscam.integrate._constants import initial_counters, initial_state, kernel_constants
+def _one_member(p: Params, tangent: bool, num: Numerics = RK4):
+    from chaoscam.kernel import initial_counters, initial_state, kernel_constants
 
     y = initial_state(p)[None].copy()
-    cnt = initial_counters(p, transient=0.0)[None].copy()
-    c = kernel_constants(p, t_record=0.0, stride=50, tangent=tangent)[None]
+    cnt = initial_counters()[None].copy()
+    c = kernel_constants(p, num, t_record=0.0, stride=50, tangent=tangent)[None]
     lam = np.full((1, 64), p.l_lambda)
     bufs = [np.zeros((1, 4096, n)) for n in (k.SERIES_COLS, k.SECTION_COLS, k.IMPACT_COLS)]
     return y, cnt, c, lam, bufs
@@ -91,21 +53,22 @@ def _one_member(p: Params, tangent: bool):
 def test_rk4_entry_point_is_the_generic_one_bit_for_bit(tangent):
     """run_members_rk4 (what an all-RK4 batch runs) gives the very bits run_members gives
     (state, counters and every buffer), over impacts and a chattering phase."""
-    from chaoscam.integrate._driver import members_kernel, run_members, run_members_rk4
+    from chaoscam.kernel._driver import members_kernel, run_members, run_members_rk4
 
     p = Params(xi=0.3)
     runs = []
     for entry in (run_members, run_members_rk4):
         y, cnt, c, lam, bufs = _one_member(p, tangent)
         status = np.zeros(1, dtype=np.int64)
-        n_stop = int(round(0.3 / p.dt))
+        n_stop = int(round(0.3 / RK4.dt))
         entry(y, cnt, c, n_stop, lam, *bufs, status)
         runs.append((y, cnt, status, *bufs))
     assert runs[1][1][0, k.I_N_IMPACT] > 10  # impacts were applied
     for a, b in zip(*runs, strict=True):
         assert np.array_equal(a, b, equal_nan=True)
     assert members_kernel(_one_member(p, tangent)[2]) is run_members_rk4
-    assert members_kernel(_one_member(p.replace(integrator="adaptive"), tangent)[2]) is run_members
+    adaptive = Numerics(integrator="adaptive")
+    assert members_kernel(_one_member(p, tangent, adaptive)[2]) is run_members
 
 
 def test_an_rk4_run_never_compiles_the_adaptive_kernel():
@@ -116,8 +79,8 @@ def test_an_rk4_run_never_compiles_the_adaptive_kernel():
 
     code = (
         "import chaoscam\n"
-        "from chaoscam.integrate._adaptive import run_chunk_adaptive\n"
-        "from chaoscam.integrate._advance import advance\n"
+        "from chaoscam.kernel._adaptive import run_chunk_adaptive\n"
+        "from chaoscam.kernel._driver import advance\n"
         "chaoscam.simulate(duration=0.05, tangent=True)\n"
         "print(len(run_chunk_adaptive.signatures), len(advance.signatures))\n"
     )
@@ -127,21 +90,20 @@ def test_an_rk4_run_never_compiles_the_adaptive_kernel():
 
 def test_rk4_verdicts_and_exponents_never_compile_the_adaptive_kernel():
     """A fresh process that classifies an RK4 run (tangent exponent, periodic-orbit shooting)
-    and takes the two-trajectory exponent compiles neither the adaptive kernel nor the
-    dispatch between both (on a fresh install that took ~10 s for nothing), nor a parallel
-    kernel: a single run is not a prange launch over a batch of one."""
+    and takes its Lyapunov spectrum compiles neither the adaptive kernel nor the dispatch
+    between both (on a fresh install that took ~10 s for nothing), nor a parallel kernel: a
+    single run is not a prange launch over a batch of one."""
     import subprocess
     import sys
 
     code = (
         "import chaoscam\n"
-        "from chaoscam.integrate._adaptive import run_chunk_adaptive\n"
-        "from chaoscam.integrate._advance import advance\n"
-        "from chaoscam.integrate._driver import run_members, run_members_rk4\n"
+        "from chaoscam.kernel._adaptive import run_chunk_adaptive\n"
+        "from chaoscam.kernel._driver import advance, run_members, run_members_rk4\n"
         "p = chaoscam.Params(xi=0.2)\n"
         "t = chaoscam.simulate(p, duration=4.0, transient=2.0, tangent=True)\n"
-        "v = chaoscam.classify_trajectory(t)\n"
-        "chaoscam.lyapunov_model(p, duration=1.0, transient=0.5)\n"
+        "v, = chaoscam.classify(t)\n"
+        "chaoscam.lyapunov_spectrum(p, duration=1.0, transient=0.5)\n"
         "print(v.label, any(e.name == 'periodic_orbit' for e in v.evidence))\n"
         "print(len(run_chunk_adaptive.signatures), len(advance.signatures), "
         "len(run_members.signatures), len(run_members_rk4.signatures))\n"
@@ -155,20 +117,21 @@ def test_rk4_verdicts_and_exponents_never_compile_the_adaptive_kernel():
 def test_single_trajectory_entry_points_pick_rk4_and_agree_bit_for_bit():
     """run_alone_rk4 (what shooting an RK4 orbit runs) gives the very bits run_alone gives,
     and alone_kernel picks it only for RK4 constants."""
-    from chaoscam.integrate._driver import alone_kernel, run_alone, run_alone_rk4
+    from chaoscam.kernel._driver import alone_kernel, run_alone, run_alone_rk4
 
     p = Params(xi=0.3)
     runs = []
     for entry in (run_alone, run_alone_rk4):
         y, cnt, c, lam, bufs = _one_member(p, True)
-        n_stop = int(round(0.3 / p.dt))
+        n_stop = int(round(0.3 / RK4.dt))
         code = entry(y[0], cnt[0], c[0], n_stop, lam[0], bufs[0][0], bufs[1][0], bufs[2][0])
         runs.append((y, cnt, np.array([code]), *bufs))
     assert runs[1][1][0, k.I_N_IMPACT] > 10
     for a, b in zip(*runs, strict=True):
         assert np.array_equal(a, b, equal_nan=True)
     assert alone_kernel(_one_member(p, True)[2][0]) is run_alone_rk4
-    assert alone_kernel(_one_member(p.replace(integrator="adaptive"), True)[2][0]) is run_alone
+    adaptive = Numerics(integrator="adaptive")
+    assert alone_kernel(_one_member(p, True, adaptive)[2][0]) is run_alone
 
 
 def test_a_ctrl_c_inside_a_c_callback_of_a_launch_is_not_lost():
@@ -197,20 +160,20 @@ def test_a_compiled_call_hands_back_after_its_step_budget(monkeypatch, integrato
     """A compiled call returns to Python after at most C_CALL_STEPS loop iterations (so that
     Ctrl-C and SIGTERM are seen between calls however many steps a cam period holds), and the
     many hand-backs change no bit of the run."""
-    from chaoscam.integrate import _constants
-    from chaoscam.integrate import _kernel as k
+    from chaoscam.kernel import _constants
 
-    p = Params(omega=10.0, integrator=integrator)  # all contact: one grid step per iteration
-    whole = simulate(p, duration=0.5, series=False)
+    p = Params(omega=10.0)  # all contact: one grid step per iteration
+    num = Numerics(integrator=integrator)
+    whole = simulate(p, num, duration=0.5, series=False)
     monkeypatch.setitem(_constants.CALL_STEPS, integrator, budget)
-    c = _constants.kernel_constants(p)
+    c = _constants.kernel_constants(p, num)
     assert c[k.C_CALL_STEPS] == budget
-    y, cnt = _constants.initial_state(p), _constants.initial_counters(p)
+    y, cnt = _constants.initial_state(p), _constants.initial_counters()
     bufs = [np.zeros((4096, n)) for n in (k.SERIES_COLS, k.SECTION_COLS, k.IMPACT_COLS)]
     lam = np.full(4096, p.l_lambda)
-    run = k.run_chunk if integrator == "rk4" else _adaptive.run_chunk_adaptive
-    code = run(y, cnt, c, int(round(0.5 / p.dt)), lam, *bufs)
+    run = _rk4.run_chunk if integrator == "rk4" else _adaptive.run_chunk_adaptive
+    code = run(y, cnt, c, int(round(0.5 / num.dt)), lam, *bufs)
     assert code == k.NEED_BUFFER and 0.0 < y[k.Y_TIME] < 0.01  # far from the end, buffers empty
     assert integrator != "rk4" or cnt[k.I_STEP] <= budget
-    chunked = simulate(p, duration=0.5, series=False)
+    chunked = simulate(p, num, duration=0.5, series=False)
     assert chunked.section.equals(whole.section) and chunked.impacts.equals(whole.impacts)
