@@ -1,8 +1,8 @@
 """GPU ensemble throughput against the CPU ensemble path, measured in one run (numba-cuda).
 
 Runs ``--members`` (default 40,000) trajectories of ``--duration`` (default 20 s) on the GPU,
-one CUDA thread each, and ``--cpu-members`` of them on the CPU ensemble path
-(``simulate_ensemble(..., backend="cpu")``, ``--cpu-threads`` numba threads, default 2: the
+one CUDA thread each (``chaoscam.solve(..., backend="gpu")``), and ``--cpu-members`` of them
+on the CPU (``backend="cpu"``, ``--cpu-threads`` numba threads, default 2: the
 2-core reference); the CPU rate is measured on that smaller sample and extrapolated (traj/s
 does not depend on the ensemble size beyond a batch). Prints both rates end to end (host
 set-up and transfers included, compilation excluded), their ratio, and the targets: >= 3,000
@@ -25,26 +25,25 @@ import time
 import numba
 import numpy as np
 
-from chaoscam import Params
-from chaoscam.integrate import _gpu, _kernel, simulate_ensemble
+import chaoscam
+from chaoscam import Numerics, Params
+from chaoscam.kernel import GPU_TOLERANCE, gpu_status, kernel_info
+from chaoscam.kernel import layout as k
 
 H100_TARGET = 3_000.0  # traj/s
 RATIO_TARGET = 200.0  # GPU / 2-core CPU
 
 
-def timed(p, members, duration, backend, **kw):
+def timed(p, num, members, duration, backend, **kw):
     t0 = time.perf_counter()
-    ens = simulate_ensemble(p, range(members), seed=1, duration=duration, backend=backend, **kw)
+    kw = dict(indices=range(members), seed=1, duration=duration, backend=backend, **kw)
+    ens = chaoscam.solve(p, num, **kw)
     return ens, time.perf_counter() - t0
 
 
-def max_diff(p, indices, duration, transient) -> float:
-    a, b = (
-        simulate_ensemble(
-            p, indices, seed=1, duration=duration, transient=transient, backend=backend
-        ).sections
-        for backend in ("gpu", "cpu")
-    )
+def max_diff(p, num, indices, duration, transient) -> float:
+    kw = dict(indices=indices, seed=1, duration=duration, transient=transient)
+    a, b = (chaoscam.solve(p, num, backend=backend, **kw).sections for backend in ("gpu", "cpu"))
     if a.shape != b.shape or not np.array_equal(a.k, b.k):
         return float("inf")
     cols = ["t", "theta_f", "omega_f", "l_lambda"]
@@ -64,16 +63,16 @@ def main() -> None:
         "--integrator",
         choices=("rk4", "adaptive"),
         default="rk4",
-        help="Params.integrator of every member (both backends)",
+        help="Numerics.integrator of every member (both backends)",
     )
     args = ap.parse_args()
-    p = Params(l_lambda_sigma=args.sigma, integrator=args.integrator)
+    p, num = Params(l_lambda_sigma=args.sigma), Numerics(integrator=args.integrator)
     print(f"model: default, l_lambda_sigma = {args.sigma:g} m, integrator = {args.integrator}")
 
     threads = min(args.cpu_threads, numba.config.NUMBA_NUM_THREADS)
     numba.set_num_threads(threads)
-    simulate_ensemble(p, range(2), seed=1, duration=0.1, backend="cpu")  # compile or load
-    cpu, cpu_wall = timed(p, args.cpu_members, args.duration, "cpu")
+    chaoscam.solve(p, num, indices=range(2), seed=1, duration=0.1)  # compile or load
+    cpu, cpu_wall = timed(p, num, args.cpu_members, args.duration, "cpu")
     cpu_rate = args.cpu_members / cpu_wall
     print(
         f"CPU ({threads} threads): {args.cpu_members} x {args.duration:g} s in "
@@ -81,7 +80,7 @@ def main() -> None:
         f"to any ensemble size)"
     )
 
-    ok, reason = _gpu.gpu_status()
+    ok, reason = gpu_status()
     if not ok or "simulator" in reason:
         print(
             f"GPU: no GPU available ({reason}); GPU rate not measured "
@@ -90,15 +89,15 @@ def main() -> None:
         return
 
     t0 = time.perf_counter()
-    simulate_ensemble(p, range(64), seed=1, duration=0.01, backend="gpu")
-    method = _kernel.METHOD_ADAPTIVE if args.integrator == "adaptive" else _kernel.METHOD_RK4
-    info = _gpu.kernel_info(method)
+    chaoscam.solve(p, num, indices=range(64), seed=1, duration=0.01, backend="gpu")
+    method = k.METHOD_ADAPTIVE if args.integrator == "adaptive" else k.METHOD_RK4
+    info = kernel_info(method)
     print(
         f"GPU: {reason}; kernel compiled in {time.perf_counter() - t0:.1f} s, "
         f"{info.get('registers')} registers and {info.get('local_bytes')} B local memory "
         f"a thread, {info.get('block')} threads a block"
     )
-    gpu, gpu_wall = timed(p, args.members, args.duration, "gpu", batch=args.batch)
+    gpu, gpu_wall = timed(p, num, args.members, args.duration, "gpu", batch=args.batch)
     gpu_rate = args.members / gpu_wall
     ratio = gpu_rate / cpu_rate
     print(
@@ -117,9 +116,9 @@ def main() -> None:
     )
 
     n = min(args.check, args.members)
-    first = max_diff(p, range(n), min(0.25, args.duration), 0.0)
-    periodic = max_diff(Params(xi=0.2, integrator=args.integrator), range(min(n, 8)), 20.0, 10.0)
-    tol = _gpu.GPU_TOLERANCE
+    first = max_diff(p, num, range(n), min(0.25, args.duration), 0.0)
+    periodic = max_diff(Params(xi=0.2), num, range(min(n, 8)), 20.0, 10.0)
+    tol = GPU_TOLERANCE
     verdict = "ok" if max(first, periodic) <= tol else "FAILED"
     print(
         f"check GPU = CPU within {tol:g} (max |difference| of sections): first cam period "

@@ -3,8 +3,11 @@
 Run: python benchmarks/bench_gpu_profile.py
 
 A member stops for a refill whenever its line-length draws or impact rows (the room,
-``_ensemble._ROOM["gpu"]``) run out, and each stop is a relaunch of the batch, in which the
-device waits for its slowest member and the host refills the draws of every member that asked.
+``chaoscam.simulation.ROOM["gpu"]``) run out, and each stop is a relaunch of the batch, in which
+the device waits for its slowest member and the host refills the draws of every member that
+asked. The launches and refills are timed by wrapping the loop the GPU host runs them in
+(``chaoscam.kernel.drive_members`` as ``chaoscam.kernel._gpu`` calls it: private, a
+benchmark's instrument).
 It measures one full wave of an H200 (132 x 256 members: 4 blocks, 8 warps, a multiprocessor),
 one block a multiprocessor and one block, each 0.25 s, then the full wave with its impacts kept
 (256 rows: every member stops for room three or four times in its first 0.05 s; not kept, the
@@ -18,8 +21,10 @@ import argparse
 import contextlib
 import time
 
+import chaoscam
 from chaoscam import Params
-from chaoscam.integrate import _ensemble, _gpu, simulate_ensemble
+from chaoscam.kernel import _gpu, gpu_status
+from chaoscam.simulation import ROOM
 
 
 class _Clock:
@@ -57,7 +62,8 @@ class _Clock:
 
 @contextlib.contextmanager
 def clocked():
-    """A :class:`_Clock` on ``_gpu.drive_members`` while inside (restored on the way out)."""
+    """A :class:`_Clock` on the GPU host's ``drive_members`` while inside (restored on the
+    way out)."""
     clock = _Clock()
     inner, _gpu.drive_members = _gpu.drive_members, clock.wrap(_gpu.drive_members)
     try:
@@ -66,28 +72,28 @@ def clocked():
         _gpu.drive_members = inner
 
 
-def measure(p, members, duration, room, keep_impacts=False):
+def measure(p, members, duration, room, impacts=False):
     """(wall time, clock, ensemble) of one GPU ensemble with this room."""
-    before, _ensemble._ROOM["gpu"] = _ensemble._ROOM["gpu"], room
+    before, ROOM["gpu"] = ROOM["gpu"], room
     try:
         with clocked() as clock:
             t0 = time.perf_counter()
-            ens = simulate_ensemble(p, range(members), seed=1, duration=duration,
-                                    backend="gpu", keep_impacts=keep_impacts)  # fmt: skip
+            ens = chaoscam.solve(p, indices=range(members), seed=1, duration=duration,
+                                 backend="gpu", impacts=impacts)  # fmt: skip
             return time.perf_counter() - t0, clock, ens
     finally:
-        _ensemble._ROOM["gpu"] = before
+        ROOM["gpu"] = before
 
 
 def main() -> None:
     argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()
-    ok, reason = _gpu.gpu_status()
-    if not ok:
+    ok, reason = gpu_status()
+    if not ok or "simulator" in reason:
         print(f"GPU: not available ({reason}); nothing measured")
         return
     print(f"GPU: {reason}")
     p = Params(l_lambda_sigma=0.002)
-    small = _ensemble._ROOM["gpu"]
+    small = ROOM["gpu"]
     full, per_sm = 132 * 256, 132 * 64  # an H200 at 8 warps, and at 2, a multiprocessor
     plan = [(full, 0.25, False), (per_sm, 0.25, False), (64, 0.25, False), (full, 0.25, True)]
     for members, duration, keep in plan:

@@ -6,22 +6,24 @@ Run: python benchmarks/bench_gpu_wave.py [--members N] [--durations 0.25,2,5] [-
 One wave fills the device once (default 132 x 256 = 33,792 members: an H200's 132
 multiprocessors at 8 warps each, what 216 registers a thread allow). For each duration it
 runs one ensemble of the default model with l_lambda_sigma = 2 mm (as bench_gpu.py) and
-prints the wall time, the time inside the kernel launches (``_gpu.drive_members``' launch
-calls) and the rest (the host: draws, set-up, copies, the result's tables), and the rate in
-member-seconds a second, against ``--cpu-members`` members of the same duration on 2 CPU
-threads of the same machine, measured in the same run.
+prints the wall time, the time inside the kernel launches (the launch calls of the GPU
+host's ``drive_members``) and the rest (the host: draws, set-up, copies, the result's
+tables), and the rate in member-seconds a second, against ``--cpu-members`` members of the
+same duration on 2 CPU threads of the same machine, measured in the same run.
 
 Why: on 2026-11-27 33,792 x 0.25 s took 142.6 s on an H200 of which 5.1 s were the launch:
-``_members.fresh`` sized every member's draws with a maximum over the whole batch, once a
-member (quadratic, 137 s at that size). Fixed; this benchmark says what a wave costs now.
+the batch set-up (now ``chaoscam.simulation.fresh``) sized every member's draws with a
+maximum over the whole batch, once a member (quadratic, 137 s at that size). Fixed; this
+benchmark says what a wave costs now.
 The first cam period of ``--check`` members is compared with the CPU's (``GPU_TOLERANCE``;
 bench_gpu.py's check); the launches are timed as bench_gpu_profile.py times them.
 With ``--legs K`` each duration runs as K legs of equal length, the first a resumable
-``simulate_ensemble`` and each next an ``extend_ensemble`` on the GPU, and a line is printed
+``chaoscam.solve`` and each next a ``chaoscam.extend`` on the GPU, and a line is printed
 after each leg: a call that runs out of time still says how far the wave got, and the legs'
 rates say whether later simulated seconds cost more than earlier ones. Each extension goes on
-from its members' last section before the leg's end (``_resume``), so it runs again up to a cam
-period (0.22 s at the default omega): the legs' rates count only the new seconds, a lower bound.
+from its members' last section before the leg's end (the solution's ``resume`` copy), so it
+runs again up to a cam period (0.22 s at the default omega): the legs' rates count only the
+new seconds, a lower bound.
 Why: on an H100 (2026-11-28) one launch of a full wave x 20 s did not end within the 250 s
 a call left it, and printed nothing.
 Without a GPU it says why on one line and exits 0.
@@ -36,8 +38,10 @@ import numba
 from bench_gpu import max_diff, timed  # run from benchmarks/, as the scripts are
 from bench_gpu_profile import clocked, measure
 
-from chaoscam import Params
-from chaoscam.integrate import _ensemble, _gpu, extend_ensemble, simulate_ensemble
+import chaoscam
+from chaoscam import Numerics, Params
+from chaoscam.kernel import GPU_TOLERANCE, gpu_status
+from chaoscam.simulation import ROOM
 
 
 def main() -> None:
@@ -49,31 +53,31 @@ def main() -> None:
     ap.add_argument("--legs", type=int, default=1, help="legs a duration, a line after each")
     args = ap.parse_args()
     durations = [float(x) for x in args.durations.split(",")]
-    p = Params(l_lambda_sigma=0.002)
+    p, num = Params(l_lambda_sigma=0.002), Numerics()
     numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
-    simulate_ensemble(p, range(2), seed=1, duration=0.01, backend="cpu")  # compile or load
+    chaoscam.solve(p, num, indices=range(2), seed=1, duration=0.01)  # compile or load
     cpu_rate = {}
     for d in durations:
-        _, wall = timed(p, args.cpu_members, d, "cpu")
+        _, wall = timed(p, num, args.cpu_members, d, "cpu")
         cpu_rate[d] = args.cpu_members * d / wall
         print(f"CPU, 2 threads: {args.cpu_members} x {d:g} s in {wall:.2f} s = "
               f"{cpu_rate[d]:,.0f} member-s/s", flush=True)  # fmt: skip
-    ok, reason = _gpu.gpu_status()
+    ok, reason = gpu_status()
     if not ok or "simulator" in reason:
         print(f"GPU: not available ({reason}); nothing measured on a GPU")
         return
     t0 = time.perf_counter()
-    simulate_ensemble(p, range(64), seed=1, duration=0.01, backend="gpu")
+    chaoscam.solve(p, num, indices=range(64), seed=1, duration=0.01, backend="gpu")
     print(f"GPU: {reason}; compiled in {time.perf_counter() - t0:.1f} s", flush=True)
-    diff = max_diff(p, range(args.check), 0.25, 0.0)
-    verdict = "ok" if diff <= _gpu.GPU_TOLERANCE else "FAILED"
+    diff = max_diff(p, num, range(args.check), 0.25, 0.0)
+    verdict = "ok" if diff <= GPU_TOLERANCE else "FAILED"
     print(f"check: first cam period of {args.check} members, max |GPU - CPU| {diff:.1e} "
-          f"(tolerance {_gpu.GPU_TOLERANCE:g}): {verdict}", flush=True)  # fmt: skip
+          f"(tolerance {GPU_TOLERANCE:g}): {verdict}", flush=True)  # fmt: skip
     for d in durations:
         if args.legs > 1:
             _in_legs(p, args.members, d, args.legs, cpu_rate[d])
             continue
-        wall, clock, ens = measure(p, args.members, d, _ensemble._ROOM["gpu"])
+        wall, clock, ens = measure(p, args.members, d, ROOM["gpu"])
         inside, launches = clock.launch, clock.launches
         _report(f"{args.members:,} x {d:g} s", args.members * d, wall, inside, launches,
                 cpu_rate[d], ens)  # fmt: skip
@@ -100,10 +104,10 @@ def _in_legs(p, members, duration, legs, cpu_rate) -> None:
             t0 = time.perf_counter()
             before, launches = clock.launch, clock.launches
             if ens is None:
-                ens = simulate_ensemble(p, range(members), seed=1, duration=end,
-                                        backend="gpu", resumable=True)  # fmt: skip
+                ens = chaoscam.solve(p, indices=range(members), seed=1, duration=end,
+                                     backend="gpu", resumable=True)  # fmt: skip
             else:
-                ens = extend_ensemble(ens, p, end, resumable=True, backend="gpu")
+                ens = chaoscam.extend(ens, end, resumable=True, backend="gpu")
             wall = time.perf_counter() - t0
             total += wall
             _report(f"{members:,} x {start:g}-{end:g} s (leg)", members * (end - start), wall,

@@ -12,7 +12,7 @@ import time
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 import chaoscam  # noqa: E402
-from chaoscam import Params  # noqa: E402
+from chaoscam import Numerics, Params  # noqa: E402
 
 
 def best_of(fn, repeat: int) -> float:
@@ -29,8 +29,8 @@ def main() -> None:
     chaoscam.simulate(p, duration=0.01)  # compile or load from cache
     full = best_of(lambda: chaoscam.simulate(p, duration=20.0, series=False), 3)
     print(f"default 20 s trajectory, compiled path: {full:.3f} s (target <= 1 s)")
-    plain = p.replace(flight_merge=1)
-    fixed = best_of(lambda: chaoscam.simulate(plain, duration=20.0, series=False), 3)
+    plain = Numerics(flight_merge=1)
+    fixed = best_of(lambda: chaoscam.simulate(p, plain, duration=20.0, series=False), 3)
     print(f"same with plain fixed-step RK4 everywhere (flight_merge=1): {fixed:.3f} s")
     short = 0.7
     kernel = best_of(lambda: chaoscam.simulate(p, duration=short, series=False), 5)

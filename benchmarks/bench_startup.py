@@ -39,11 +39,11 @@ t0 = time.perf_counter()
 import numba
 t1 = time.perf_counter()
 t = time.perf_counter(); import scipy.linalg; blas = time.perf_counter() - t
-from chaoscam._simulate import raw_run
+from chaoscam.simulation import solve
 t2 = time.perf_counter()
-raw_run(duration=0.001)
+solve(duration=0.001)
 t3 = time.perf_counter()
-raw_run(duration=20.0)
+solve(duration=20.0)
 t4 = time.perf_counter()
 print(t1 - t0, blas, t2 - t1 - blas, t3 - t2, t4 - t3)
 """
@@ -63,7 +63,7 @@ def main() -> None:
         [*cli, "simulate", "--duration", "0.01"], check=True, capture_output=True, env=first
     )
     imp = best_of([py, "-c", "import chaoscam"])
-    path = best_of([py, "-c", "import chaoscam._simulate"])
+    path = best_of([py, "-c", "from chaoscam.simulation import solve"])
     helped = best_of([*cli, "--help"])
     run = best_of([*cli, "simulate", "--duration", "20"])
     print(f"import chaoscam: {imp:.2f} s; import of the simulate path: {path:.2f} s")

@@ -19,9 +19,8 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 from bench_simulate import best_of  # noqa: E402 (benchmarks/ is on the path of a script)
 
 import chaoscam  # noqa: E402
-from chaoscam import Params  # noqa: E402
-from chaoscam._certify import certify  # noqa: E402
-from chaoscam.tangent import lyapunov_spectrum, periodic_orbit  # noqa: E402
+from chaoscam import Numerics, Params  # noqa: E402
+from chaoscam.verdict import certify, lyapunov_spectrum, periodic_orbit  # noqa: E402
 
 
 def main() -> None:
@@ -46,7 +45,7 @@ def main() -> None:
         wall = time.perf_counter() - t0
         points = tr.section[["theta_f", "omega_f"]].to_numpy()
         t0 = time.perf_counter()
-        cert = certify(q, points, n, {})
+        cert = certify(q, Numerics(), points, n, {})
         whole = time.perf_counter() - t0
         print(
             f"certified orbit ({label}): shooting {wall:.3f} s, converged {orbit.converged}, "

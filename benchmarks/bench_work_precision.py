@@ -37,18 +37,18 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 import chaoscam  # noqa: E402
-from chaoscam import Params  # noqa: E402
+from chaoscam import Numerics, Params  # noqa: E402
 
 TOL = 1e-6
 DT_LADDER = (4e-5, 2e-5, 1e-5, 8e-6, 6e-6, 5e-6, 4e-6, 2e-6, 1e-6, 7e-7, 5e-7)  # coarse to fine
 RTOL_LADDER = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13, 3e-14, 1e-14)
 
 
-def timed(p: Params, duration: float, repeat: int):
+def timed(p: Params, num: Numerics, duration: float, repeat: int):
     best, tr = float("inf"), None
     for _ in range(repeat):
         t0 = time.perf_counter()
-        tr = chaoscam.simulate(p, duration=duration, series=False)
+        tr = chaoscam.simulate(p, num, duration=duration, series=False)
         best = min(best, time.perf_counter() - t0)
     return best, tr
 
@@ -72,16 +72,18 @@ def section_error(tr, ref) -> float:
     return float(np.max(np.abs(a.theta_f.values - b.theta_f.values)))
 
 
-def ladder(base: Params, duration: float, ref, error, repeat: int):
-    """Rows (label, kind, setting, seconds, error) over the three integrators' ladders."""
+def ladder(p: Params, duration: float, ref, error, repeat: int):
+    """Rows (label, kind, setting, seconds, error) over the three integrators' ladders, on
+    the model ``p`` from the default numerics."""
+    base = Numerics()
     rows = []
     for dt in DT_LADDER:
         for kind, merge in (("rk4 fixed", 1), ("rk4 merged", base.flight_merge)):
-            sec, tr = timed(base.replace(dt=dt, flight_merge=merge), duration, repeat)
+            sec, tr = timed(p, base.replace(dt=dt, flight_merge=merge), duration, repeat)
             rows.append((kind, f"dt={dt:g}", sec, error(tr, ref)))
     for rtol in RTOL_LADDER:
-        p = base.replace(integrator="adaptive", rtol=rtol, atol=rtol / 3)
-        sec, tr = timed(p, duration, repeat)
+        num = base.replace(integrator="adaptive", rtol=rtol, atol=rtol / 3)
+        sec, tr = timed(p, num, duration, repeat)
         rows.append(("adaptive", f"rtol={rtol:g}", sec, error(tr, ref)))
     return rows
 
@@ -149,12 +151,12 @@ def main() -> None:
     # the coarse rungs resolve the contact with fewer than 40 steps, and say so each run
     warnings.simplefilter("ignore", RuntimeWarning)
     chaoscam.simulate(duration=0.01)
-    chaoscam.simulate(Params(integrator="adaptive"), duration=0.01)
-    fine = Params(dt=2.5e-7, flight_merge=1)
+    chaoscam.simulate(numerics=Numerics(integrator="adaptive"), duration=0.01)
+    fine = Numerics(dt=2.5e-7, flight_merge=1)
 
     p = Params()
-    ref = chaoscam.simulate(fine, duration=2.0, series=False)
-    half = chaoscam.simulate(fine.replace(dt=5e-7), duration=2.0, series=False)
+    ref = chaoscam.simulate(p, fine, duration=2.0, series=False)
+    half = chaoscam.simulate(p, fine.replace(dt=5e-7), duration=2.0, series=False)
     own = impact_error(half, ref)
     print(f"reference dt 2.5e-7; dt 5e-7 differs from it by {own:.1e} on the impacts")
     report(
@@ -165,8 +167,8 @@ def main() -> None:
 
     for changes in ({"xi": 0.2}, {"omega": 45.0}):
         p = Params(**changes)
-        ref = chaoscam.simulate(fine.replace(**changes), duration=20.0, series=False)
-        half = chaoscam.simulate(fine.replace(dt=5e-7, **changes), duration=20.0, series=False)
+        ref = chaoscam.simulate(p, fine, duration=20.0, series=False)
+        half = chaoscam.simulate(p, fine.replace(dt=5e-7), duration=20.0, series=False)
         own = section_error(half, ref)
         print(f"\nreference dt 2.5e-7 for {changes}; dt 5e-7 differs by {own:.1e} rad")
         report(

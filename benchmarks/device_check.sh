@@ -5,7 +5,7 @@
 #
 # WHEELS (default .whl) holds cp312 wheels of what the device's image lacks: nolds and future
 # (chaoscam's dependencies) and numpy 2.4 (numba-cuda 0.30 compiles no kernel under numpy 2.5,
-# see chaoscam.integrate._gpu); they are installed with --target, nothing else is touched.
+# see chaoscam.kernel._gpu); they are installed with --target, nothing else is touched.
 # Made where pip works (the device reaches no index), e.g.
 #   pip download --no-deps --only-binary=:all: --python-version 3.12 --implementation cp \
 #     --platform manylinux_2_28_x86_64 -d .whl nolds==0.6.2 future==1.0.0 numpy==2.4.6
@@ -33,9 +33,10 @@
 # 2,760 member-s/s, 138 twenty-second traj/s, 12x the 2 threads) and printed nothing: hence
 # LEGS. The map at MAP_RUNS=4096 did not end in 240 s; at 512 (second call,
 # CHECK_SECONDS=0 NCU_SECONDS=0 MAP_SECONDS=262 MAP_RUNS=512): 2,048 runs in 108.7 s,
-# 18.8 traj/s, 4.14x the 2-core process engine (PROFILE.md). A next session's first call can
-# be the default (about 300 s for the wave, then the profile), its second the map (above:
-# two batches of 8,192 x 10 s, about 60-90 s of launch each by these rates).
+# 18.8 traj/s, 4.14x the 2-core process engine (since removed; PROFILE.md). A next
+# session's first call can be the default (about 300 s for the wave, then the profile), its
+# second the map (above: two batches of 8,192 x 10 s, about 60-90 s of launch each by these
+# rates).
 #
 # Measured 2026-11-27 (H200, third session): after the host's quadratic set-up was fixed
 # (e7a316b), 33,792 members x 0.25 / 2 / 5 s ran at 1,073 / 2,231 / 2,954 member-seconds a
@@ -56,7 +57,7 @@ step "wheels: nolds, future, numpy 2.4 (--target, ahead of the image's)"
 python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --target /tmp/site \
     "$WHEELS"/nolds-*.whl "$WHEELS"/future-*.whl "$WHEELS"/numpy-*.whl || exit 1
 export PYTHONPATH=/tmp/site:$PWD
-python3 -c "import numpy, numba, chaoscam; from chaoscam.integrate._gpu import gpu_status; print('numpy', numpy.__version__, '| numba', numba.__version__, '|', gpu_status())"
+python3 -c "import numpy, numba, chaoscam; from chaoscam.kernel import gpu_status; print('numpy', numpy.__version__, '| numba', numba.__version__, '|', gpu_status())"
 
 OUTDIR=${OUT:-/tmp}
 if [ "${CHECK_SECONDS:-330}" != 0 ]; then
@@ -75,8 +76,8 @@ if [ "${MAP_SECONDS:-0}" != 0 ]; then
 fi
 
 if [ "${RUN_TESTS:-0}" = 1 ]; then
-    step "device tests (tests/integrate/test_gpu.py -m gpu)"
-    timeout -k 5 300 python3 -m pytest -q -p no:cacheprovider -o addopts= -m gpu tests/integrate/test_gpu.py
+    step "device tests (tests/kernel/test_gpu.py -m gpu)"
+    timeout -k 5 300 python3 -m pytest -q -p no:cacheprovider -o addopts= -m gpu tests/kernel/test_gpu.py
     echo "exit $?"
 fi
 

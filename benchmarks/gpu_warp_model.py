@@ -6,10 +6,11 @@ Run: python benchmarks/gpu_warp_model.py [DURATION]   (default 4 s; about 10 s)
 A warp runs 32 members in SIMT: in a step of the kernel's loop, a member in merged free
 flight, one in a contact step and one locating an impact take different branches, and the
 warp runs all of them. Here 32 members (the default model with ``l_lambda_sigma = 2 mm``,
-bench_gpu.py's seed) are run one loop iteration of :func:`chaoscam.integrate._kernel.run_chunk`
-at a time (``C_CALL_STEPS = 1``; a call resumes bit for bit), each call timed with the
-processor's cycle counter (``llvm.readcyclecounter``). From those costs ``c[j, i]``
-(member j, its i-th iteration):
+bench_gpu.py's seed) are run one loop iteration of the RK4 kernel at a time (the compiled
+single-member call :func:`chaoscam.kernel.alone_kernel` gives for RK4 constants, the same
+``run_chunk`` the GPU threads run; ``C_CALL_STEPS = 1``; a call resumes bit for bit), each
+call timed with the processor's cycle counter (``llvm.readcyclecounter``). From those costs
+``c[j, i]`` (member j, its i-th iteration):
 
 - **lockstep efficiency**: the warp's threads meet after every iteration and an iteration
   lasts as long as its dearest thread's: ``sum c / (32 sum_i max_j c[j, i])``, the share of
@@ -32,7 +33,7 @@ noisiest figure: one interruption moves a member's total). Nsight Compute on an 
 member also stopped for a refill at its own time (PROFILE.md).
 
 ``--tail MEMBERS [DURATION] [--keep-impacts]``: whole members' costs as GPU threads run
-them, stopping for room (``_ensemble._ROOM["gpu"]``) as they do: how long one launch waits
+them, stopping for room (``chaoscam.simulation.ROOM["gpu"]``) as they do: how long one launch waits
 for its slowest member, and how much longer the batch takes when it is relaunched at every
 stop and waits for the slowest again each time. Measured here (2026-11-27): with 256 impact
 rows kept, 20-s members stop 43-49 times and 512 of them relaunched take 2.10x one launch
@@ -50,9 +51,10 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from chaoscam import Params
-from chaoscam.integrate import _kernel as k
-from chaoscam.integrate._members import fresh
+from chaoscam import Numerics, Params
+from chaoscam.kernel import alone_kernel
+from chaoscam.kernel import layout as k
+from chaoscam.simulation import ROOM, fresh
 
 WARP = 32
 
@@ -70,10 +72,11 @@ def _cycles(typingctx):
 
 
 @njit
-def _iterations(y, cnt, c, n_stop, lam, section, impacts, cost, at, hits):
-    """Run each member one loop iteration a call; record each call's cycles (``cost``), the
-    member's time after it (``at``) and the impacts it applied (``hits``). Returns the
-    iterations per member (0 if a member ran out of draws or of ``cost``'s columns)."""
+def _iterations(run, y, cnt, c, n_stop, lam, section, impacts, cost, at, hits):
+    """Run each member one loop iteration a call of ``run`` (the compiled kernel call); record
+    each call's cycles (``cost``), the member's time after it (``at``) and the impacts it
+    applied (``hits``). Returns the iterations per member (0 if a member ran out of draws or
+    of ``cost``'s columns)."""
     series = np.empty((1, k.SERIES_COLS))
     n = y.shape[0]
     done = np.zeros(n, np.int64)
@@ -81,7 +84,7 @@ def _iterations(y, cnt, c, n_stop, lam, section, impacts, cost, at, hits):
         for i in range(cost.shape[1]):
             before = cnt[j, k.I_N_IMPACT]
             t0 = _cycles()
-            code = k.run_chunk(y[j], cnt[j], c[j], n_stop, lam[j], series, section[j], impacts[j])
+            code = run(y[j], cnt[j], c[j], n_stop, lam[j], series, section[j], impacts[j])
             cost[j, i] = _cycles() - t0
             at[j, i] = y[j, k.Y_TIME]
             hits[j, i] = cnt[j, k.I_N_IMPACT] - before
@@ -106,10 +109,11 @@ def _aligned(values: np.ndarray, inside: np.ndarray) -> np.ndarray:
 
 
 @njit
-def _between_stops(y, cnt, c, n_stop, draws, width, section, impacts, cost, stops):
-    """Each member run as a GPU thread runs it: stopping whenever its ``width`` draws or its
-    impact rows run out, refilled as ``run_batch``'s ``hand_back`` does (rows emptied, used
-    draws dropped, the stream's next ones appended: a window sliding along ``draws``).
+def _between_stops(run, y, cnt, c, n_stop, draws, width, section, impacts, cost, stops):
+    """Each member run as a GPU thread runs it (``run``: the compiled kernel call): stopping
+    whenever its ``width`` draws or its impact rows run out, refilled as ``run_batch``'s
+    ``hand_back`` does (rows emptied, used draws dropped, the stream's next ones appended: a
+    window sliding along ``draws``).
     ``cost[j, s]``: cycles of member j's s-th run between stops; ``stops[j]``: their count."""
     series = np.empty((1, k.SERIES_COLS))
     for j in range(y.shape[0]):
@@ -118,7 +122,7 @@ def _between_stops(y, cnt, c, n_stop, draws, width, section, impacts, cost, stop
         while s < cost.shape[1]:
             lam = draws[j, offset : offset + width]
             t0 = _cycles()
-            code = k.run_chunk(y[j], cnt[j], c[j], n_stop, lam, series, section[j], impacts[j])
+            code = run(y[j], cnt[j], c[j], n_stop, lam, series, section[j], impacts[j])
             cost[j, s] = _cycles() - t0
             s += 1
             if code != k.NEED_BUFFER or offset + width + cnt[j, k.I_LAM_POS] > draws.shape[1]:
@@ -131,25 +135,24 @@ def _between_stops(y, cnt, c, n_stop, draws, width, section, impacts, cost, stop
 
 def tail(members: int, duration: float = 0.5, keep_impacts: bool = False) -> None:
     """Whole members' costs as GPU threads: a launch lasts as long as its slowest member, and
-    a member stops for room (``_ensemble._ROOM["gpu"]``: its draws, and its impact rows when
-    impacts are kept) several times a run, each stop a relaunch of the batch that waits for
-    the slowest member again."""
-    from chaoscam.integrate._ensemble import _ROOM
-
-    p = Params(l_lambda_sigma=0.002)
-    draws_room, rows = _ROOM["gpu"]
+    a member stops for room (``ROOM["gpu"]``: its draws, and its impact rows when impacts are
+    kept) several times a run, each stop a relaunch of the batch that waits for the slowest
+    member again."""
+    p, num = Params(l_lambda_sigma=0.002), Numerics()
+    draws_room, rows = ROOM["gpu"]
     rows = rows if keep_impacts else 0  # as run_batch: impacts not kept are only counted
-    n_stop = int(round(duration / p.dt))
+    n_stop = int(round(duration / num.dt))
     cost = np.zeros((members, 400), np.int64)
     stops = np.zeros(members, np.int64)
     for s0 in range(0, members, 2048):
         m = min(2048, members - s0)
-        st = fresh([p] * m, list(range(s0, s0 + m)), 1, duration, 0.0, False, (100_000, rows))
+        st = fresh([p] * m, num, list(range(s0, s0 + m)), 1, duration, 0.0, tangent=False,
+                   stride=0, room=(100_000, rows))  # fmt: skip
         width = draws_room + (st.lam.shape[1] - 100_000)  # the GPU's: room and margin
         section = np.empty((m, int(duration / p.cam_period) + 8, k.SECTION_COLS))
         impacts = np.empty((m, rows + 64 if rows else 0, k.IMPACT_COLS))
-        _between_stops(st.y, st.cnt, st.c, n_stop, st.lam, width, section, impacts,
-                       cost[s0 : s0 + m], stops[s0 : s0 + m])  # fmt: skip
+        _between_stops(alone_kernel(st.c), st.y, st.cnt, st.c, n_stop, st.lam, width, section,
+                       impacts, cost[s0 : s0 + m], stops[s0 : s0 + m])  # fmt: skip
     mc = cost / 1e6
     whole = mc.sum(axis=1)
     q = np.percentile(whole, [50, 90, 99, 99.9])
@@ -175,11 +178,13 @@ def tail(members: int, duration: float = 0.5, keep_impacts: bool = False) -> Non
 
 
 def main(duration: float = 4.0) -> None:
-    p = Params(l_lambda_sigma=0.002)
-    start = fresh([p] * WARP, list(range(WARP)), 1, duration, 0.0, False, (200_000, 4096))
+    p, num = Params(l_lambda_sigma=0.002), Numerics()
+    start = fresh([p] * WARP, num, list(range(WARP)), 1, duration, 0.0, tangent=False, stride=0,
+                  room=(200_000, 4096))  # fmt: skip
     c = start.c.copy()
     c[:, k.C_CALL_STEPS] = 1.0  # one loop iteration a call
-    n_stop = int(round(duration / p.dt))
+    run = alone_kernel(c)  # the RK4 kernel's compiled single-member call
+    n_stop = int(round(duration / num.dt))
     width = int(60_000 * duration) + 10_000  # iterations: about 41,500 a simulated second
     cost = np.zeros((WARP, width), np.int64)
     at = np.zeros((WARP, width))
@@ -187,8 +192,10 @@ def main(duration: float = 4.0) -> None:
     section = np.empty((WARP, 64, k.SECTION_COLS))
     impacts = np.empty((WARP, 0, k.IMPACT_COLS))  # no rows: the kernel only counts them
     warm = [a[:1].copy() for a in (start.y, start.cnt, c, start.lam, section, impacts)]
-    _iterations(*warm[:3], 10, *warm[3:], cost[:1, :5].copy(), at[:1, :5].copy(), hits[:1, :5])
-    done = _iterations(start.y, start.cnt, c, n_stop, start.lam, section, impacts, cost, at, hits)
+    _iterations(run, *warm[:3], 10, *warm[3:], cost[:1, :5].copy(), at[:1, :5].copy(),
+                hits[:1, :5])  # fmt: skip
+    done = _iterations(run, start.y, start.cnt, c, n_stop, start.lam, section, impacts, cost, at,
+                       hits)  # fmt: skip
     if (done == 0).any():
         raise SystemExit("a member ran out of draws or of iterations: enlarge the room")
     print(f"{WARP} members x {duration:g} s: {done.min():,}-{done.max():,} iterations each")

@@ -8,8 +8,8 @@ cache keeps no function list, so numba compiles the kernels, about 30 s), writes
 ``/tmp/perf-PID.map`` (perf's format for code made at run time: start, size, name) from
 numba's compiled libraries, with each function's address from its execution engine and its
 size up to the next one's start, then records itself with ``perf record`` while it runs the
-map of ``bench_regime_versions.py`` (3x3 cells x 6 realizations x 20 s, ensemble engine, 2
-workers), warmed first, and prints the top of ``perf report`` with numba's names shortened
+map of ``bench_regime_versions.py`` (3x3 cells x 6 realizations x 20 s, 2 workers),
+warmed first, and prints the top of ``perf report`` with numba's names shortened
 to ``module.function``. Functions numba inlined into their callers count in the callers.
 The share of ``NRT_incref`` / ``NRT_decref`` (numba's reference counting) is how
 ``_nrt=False`` on the kernels was found (``benchmarks/PROFILE.md``).
@@ -32,7 +32,7 @@ from bench_regime_versions import benchmark_map, warm
 
 
 def _short(name: str) -> str:
-    """``_ZN8chaoscam9integrate7_kernel9run_chunkB2v2...`` -> ``_kernel.run_chunk``."""
+    """``_ZN8chaoscam6kernel4_rk49run_chunkB2v2...`` -> ``_rk4.run_chunk``."""
     if not name.startswith("_ZN"):
         return name
     parts, i = [], 3
@@ -82,7 +82,7 @@ def main() -> None:
         with tempfile.TemporaryDirectory() as cache:
             env = {**os.environ, "NUMBA_CACHE_DIR": cache, "CHAOSCAM_PERF_MAP": "compiled"}
             sys.exit(subprocess.run([sys.executable, *sys.argv], env=env).returncode)
-    warm(engine="ensemble")
+    warm()
     perf_map = f"/tmp/perf-{os.getpid()}.map"
     print(f"{write_perf_map(perf_map)} compiled functions mapped", flush=True)
     data = args.keep or os.path.join(tempfile.mkdtemp(), "perf.data")
@@ -93,7 +93,7 @@ def main() -> None:
     )
     time.sleep(1.0)  # perf attaches
     t0 = time.perf_counter()
-    benchmark_map(engine="ensemble")
+    benchmark_map()
     wall = time.perf_counter() - t0
     rec.send_signal(signal.SIGINT)
     rec.wait()
