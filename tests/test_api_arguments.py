@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 import chaoscam
-from chaoscam import ParameterError, Params
-from chaoscam.integrate import simulate_ensemble
+from chaoscam import Numerics, ParameterError, Params
 from chaoscam.sweep import SweepError, bifurcation, regime_map
 
 
@@ -35,18 +34,18 @@ def test_a_sweeps_base_must_be_params(sweep):
 
 
 @pytest.mark.parametrize("extend_to", [-1, math.nan, True, "x"])
-def test_classify_ensemble_checks_extend_to_as_classify_trajectory_does(extend_to):
-    p = Params()
-    ens = simulate_ensemble(p, [0], duration=1.0, tangent=True)
+def test_classify_checks_extend_to(extend_to):
+    """classify of several members checks extend_to as for one run."""
+    sol = chaoscam.solve(Params(), indices=[0, 1], duration=1.0, tangent=True)
     with pytest.raises(ParameterError, match="extend_to"):
-        chaoscam.classify_ensemble(ens, p, extend_to=extend_to)
+        chaoscam.classify(sol, extend_to=extend_to)
 
 
-def test_simulate_ensemble_names_bad_indices_and_progress_before_running():
+def test_solve_names_bad_indices_and_progress_before_running():
     with pytest.raises(TypeError, match=r"indices must be a sequence .* got int 5"):
-        simulate_ensemble(Params(), 5, duration=0.5)
+        chaoscam.solve(Params(), indices=5, duration=0.5)
     with pytest.raises(TypeError, match="progress must be callable"):
-        simulate_ensemble(Params(), [0], duration=0.5, progress=5)
+        chaoscam.solve(Params(), indices=[0], duration=0.5, progress=5)
 
 
 def test_periodic_orbit_from_a_seed_off_the_model_is_not_a_crash():
@@ -58,19 +57,36 @@ def test_periodic_orbit_from_a_seed_off_the_model_is_not_a_crash():
         assert orbit.settings["seed_status"] == status
 
 
-def test_lyapunov_spectrum_refuses_settings_it_would_ignore(tmp_path):
-    tr = chaoscam.simulate(Params(xi=0.2), duration=4.0, transient=2.0, tangent=True)
+@pytest.fixture(scope="module")
+def tangent_run():
+    return chaoscam.simulate(Params(xi=0.2), duration=4.0, transient=2.0, tangent=True)
+
+
+@pytest.mark.parametrize(
+    "kw",
+    [dict(numerics=Numerics()), dict(duration=5.0), dict(transient=1.0), dict(seed=1),
+     dict(index=3)],
+    ids=["numerics", "duration", "transient", "seed", "index"],
+)  # fmt: skip
+def test_lyapunov_spectrum_refuses_settings_it_would_ignore(tangent_run, kw):
+    """Given a solution, lyapunov_spectrum takes its exponents from that run: a run setting
+    given with it would be ignored, and is refused by name."""
+    with pytest.raises(ParameterError, match="|".join(kw)):
+        chaoscam.lyapunov_spectrum(tangent_run, **kw)
+
+
+def test_lyapunov_spectrum_says_what_a_solution_lacks(tmp_path, tangent_run):
+    """A run too short for a standard error is warned about; a run without Jacobians (a
+    file keeps none) and one without a section point after its start are refused, saying
+    so."""
     with pytest.warns(RuntimeWarning, match="too few for its standard error"):  # 9 periods
-        assert chaoscam.lyapunov_spectrum(trajectory=tr).exponents[0] < 0
-    for kw in (dict(params=Params(xi=0.3)), dict(duration=5.0), dict(seed=1)):
-        with pytest.raises(ParameterError, match="would be ignored"):
-            chaoscam.lyapunov_spectrum(trajectory=tr, **kw)
-    tr.to_parquet(tmp_path / "t.parquet")  # a file keeps no Jacobians: said so
-    with pytest.raises(ValueError, match="Jacobians were not kept"):
-        chaoscam.lyapunov_spectrum(trajectory=chaoscam.load_trajectory(tmp_path / "t.parquet"))
+        assert chaoscam.lyapunov_spectrum(tangent_run).exponents[0] < 0
+    tangent_run.to_parquet(tmp_path / "t.parquet")  # a file keeps no Jacobians: said so
+    with pytest.raises(ValueError, match="no Jacobians .* read from a file"):
+        chaoscam.lyapunov_spectrum(chaoscam.load_trajectory(tmp_path / "t.parquet"))
     short = chaoscam.simulate(duration=0.1, tangent=True)
     with pytest.raises(ValueError, match="no section point after its start"):
-        chaoscam.lyapunov_spectrum(trajectory=short)
+        chaoscam.lyapunov_spectrum(short)
 
 
 def test_load_inputs_takes_one_path(tmp_path):

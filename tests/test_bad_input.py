@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 
 import chaoscam
-from chaoscam import ParameterError, Params
+from chaoscam import Numerics, ParameterError, Params
 from chaoscam.cli import main
 from chaoscam.sweep import (
     Axis,
@@ -98,17 +98,18 @@ CLI_CASES = {
     "bifurcation seed 2**63": ([*BIF, "--seed", str(2**63), "--out", "OUT.parquet"], "seed"),
     "ensemble first 2**63-1": (
         [*ENS, "--first", str(2**63 - 1), "--out", "OUT.parquet"],
-        "--first",
+        "first = 9223372036854775807",
     ),
     "simulate index 2**63": ([*SIM, "--index", str(2**63)], "index"),
-    "process workers 99999": (
-        [*BIF[:-3], "--engine", "process", "--workers", "99999", "--out", "OUT.parquet"],
+    "bifurcation workers 99999": (
+        [*BIF[:-3], "--workers", "99999", "--out", "OUT.parquet"],
         "workers",
     ),
-    "ensemble engine workers 99999": (
+    "map workers 99999": (
         [*MAP[:-3], "--workers", "99999", "--out", "OUT.parquet"],
         "workers",
     ),
+    "ensemble workers 99999": ([*ENS, "--workers", "99999", "--out", "OUT.parquet"], "workers"),
     "initial conditions 1e10": (
         [*BIF, "--initial-conditions", "10000000000", "--out", "OUT.parquet"],
         "memory",
@@ -140,11 +141,9 @@ def test_run_that_left_the_model_exits_1_with_the_cause(capsys):
 
 
 def _empty_trajectory(path, rows):
-    traj = chaoscam.simulate(duration=0.2)
-    traj = dataclasses.replace(
-        traj, series=traj.series.iloc[:rows], section=traj.section.iloc[:rows]
-    )
-    traj.to_parquet(path)
+    run = chaoscam.simulate(duration=0.2)
+    run = dataclasses.replace(run, series=run.series.iloc[:rows], sections=run.sections.iloc[:rows])
+    run.to_parquet(path)
     return path
 
 
@@ -231,17 +230,15 @@ API_TYPE_CASES = [
     (lambda: chaoscam.periodic_orbit(Params(), [0.0, 0.0], 1, tol=-1), ParameterError, "tol"),
     (lambda: chaoscam.contact_period(Params(), -1.0), ParameterError, "l_lambda"),
     (lambda: chaoscam.contact_period(Params(), math.nan), ParameterError, "l_lambda"),
-    (lambda: chaoscam.lyapunov_model(duration=1.0, n_align=-1), ParameterError, "n_align"),
-    (lambda: chaoscam.lyapunov_model(duration=1.0, max_wait=-1), ParameterError, "max_wait"),
     (
-        lambda: chaoscam.classify_trajectory(chaoscam.simulate(duration=0.5), extend_to=-1),
+        lambda: chaoscam.classify(chaoscam.simulate(duration=0.5), extend_to=-1),
         ValueError,
         "extend_to",
     ),
     (
-        lambda: chaoscam.classify_trajectory(chaoscam.simulate(duration=0.5), bogus=1),
+        lambda: chaoscam.classify(chaoscam.simulate(duration=0.5), bogus=1),
         TypeError,
-        "classify_trajectory got an unknown option 'bogus'.*rtol",
+        "classify got an unknown option 'bogus'.*rtol",
     ),
     (lambda: Params(omega=np.array([28.0, 29.0])), ParameterError, "omega"),
     (lambda: chaoscam.simulate_reference(Params(), -1.0), ParameterError, "duration"),
@@ -260,7 +257,7 @@ API_TYPE_CASES = [
         "simulate.. got an unknown keyword 'duraton'.*Did you mean duration",
     ),
     (lambda: chaoscam.simulate(OMEGA=30.0), ParameterError, "Did you mean omega"),
-    (lambda: chaoscam.lyapunov_model(d_0=1e-8), ParameterError, "Did you mean d0"),
+    (lambda: chaoscam.simulate(DT=1e-6), ParameterError, "Did you mean dt"),  # a numerics field
 ]
 
 
@@ -273,8 +270,8 @@ def test_api_errors_say_what_was_expected(i):
 
 def test_numpy_scalars_are_accepted():
     """numpy scalars where numbers are expected: accepted and stored as Python numbers."""
-    p = Params(omega=np.float32(30), max_events_per_step=np.int64(4))
-    assert p.omega == 30.0 and type(p.omega) is float and type(p.max_events_per_step) is int
+    p, num = Params(omega=np.float32(30)), Numerics(max_events_per_step=np.int64(4))
+    assert p.omega == 30.0 and type(p.omega) is float and type(num.max_events_per_step) is int
     res = regime_map(
         ("l_lambda", [0.008]),
         ("l_lambda_sigma", [0.001]),
@@ -291,10 +288,10 @@ def test_numpy_scalars_are_accepted():
 class _Label:
     needs_series = False
 
-    def __call__(self, traj):
+    def __call__(self, run):
         from tests.sweep._helpers import SpreadClassifier
 
-        return SpreadClassifier()(traj)
+        return SpreadClassifier()(run)
 
 
 def test_simulate_csv_written_whole(tmp_path):
@@ -307,7 +304,7 @@ def test_simulate_csv_written_whole(tmp_path):
 @pytest.mark.parametrize("x", [[], [1.0]])
 def test_classify_signal_on_too_little_data(x):
     """classify_signal on an empty or one-sample signal: "too little data", not a verdict."""
-    from chaoscam.classify import classify_signal
+    from chaoscam.analysis import classify_signal
 
     with pytest.raises(ValueError, match="too little data"):
         classify_signal(np.array(x), 0.01)
@@ -317,28 +314,37 @@ def test_series_too_fine_for_its_length_is_announced_before_the_run(monkeypatch)
     """300 s sampled every 2e-6 s (1.5e8 rows, ~10 GB) on a machine with the memory for it:
     a warning with the estimate and the fields to change, given while checking the settings
     (before any step is taken)."""
-    import chaoscam._budget
-    from chaoscam._simulate import _check_run
+    from chaoscam.simulation import _budget, _solve
 
-    monkeypatch.setattr(chaoscam._budget, "available_memory", lambda: math.inf)
+    class NoStepTaken(Exception):
+        pass
 
+    def first_step(*args, **kwargs):
+        raise NoStepTaken
+
+    monkeypatch.setattr(_budget, "available_memory", lambda: math.inf)
+    monkeypatch.setattr(_solve, "fresh", first_step)  # where the run's first batch starts
     with pytest.warns(RuntimeWarning, match=r"will take about .*1.5e\+08 series rows.*output_dt"):
-        _check_run(Params(), 300.0, 0.0, 2e-6, 0, 0)
+        with pytest.raises(NoStepTaken):
+            chaoscam.simulate(duration=300.0, output_dt=2e-6)
 
 
 def test_left_the_model_labelled_alike_in_ensembles_and_sweeps():
-    """dt = 5e-3 s leaves the model (LEFT_REACH): ensemble members and regime-map runs with
-    the default (series) classifier, dt swept as an axis, both say "left_reach"."""
-    from chaoscam import classify_ensemble
-    from chaoscam.integrate import simulate_ensemble
-
+    """dt = 5e-3 s leaves the model (LEFT_REACH): ensemble members and regime-map runs (dt
+    swept as an axis) both say "left_reach"; the verdict of such a run is undetermined,
+    naming the status."""
+    num = Numerics(dt=0.005)
     with pytest.warns(RuntimeWarning, match="resolves the contact oscillation"):  # as simulate
-        ens = simulate_ensemble(Params(dt=0.005), [0, 1], duration=0.5, tangent=True)
-    ens = classify_ensemble(ens, Params(dt=0.005))
+        ens = chaoscam.ensemble(Params(), num, members=2, duration=0.5, workers=1)
     assert list(ens.members["label"]) == ["left_reach", "left_reach"]
     with pytest.warns(RuntimeWarning):
         rm = regime_map(("l_lambda", [0.008]), ("dt", [0.005]), duration=0.5, workers=1)
     assert list(rm.realizations["label"]) == ["left_reach"]
+    with pytest.warns(RuntimeWarning, match="resolves the contact oscillation"):
+        sol = chaoscam.solve(Params(), num, indices=[0, 1], duration=0.5, tangent=True)
+    verdicts = chaoscam.classify(sol)
+    assert [v.label for v in verdicts] == ["undetermined", "undetermined"]
+    assert [v.settings["status"] for v in verdicts] == ["LEFT_REACH", "LEFT_REACH"]
 
 
 def test_failing_classifier_is_one_line_exit_1(tmp_path, capsys):
@@ -355,8 +361,10 @@ def test_failing_classifier_is_one_line_exit_1(tmp_path, capsys):
     assert err.startswith("chaoscam: error: task") and "this classifier has a bug" in err
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1
     # The call that reproduces it names the run's parameters and window (it said
-    # "chaoscam.simulate(params, ...)" without them).
-    call = err.split("reproduce it with ")[1].split(", then the classifier")[0]
+    # "chaoscam.simulate(params, ...)" without them): the first run of the failed batch
+    # (this classifier fails on every run).
+    hint = err.split("reproduce it with ")[1]
+    call = "chaoscam.simulate(" + hint.split("chaoscam.simulate(")[1].split(")")[0] + ")"
     run = eval(call, {"chaoscam": chaoscam})
     assert run.params.l_lambda in (0.006, 0.008) and run.settings["duration"] == 0.5
 
@@ -389,17 +397,19 @@ def test_negative_values_may_follow_their_option(tmp_path):
 
 def test_classify_a_run_shorter_than_a_cam_period(tmp_path, capsys):
     """A saved run that records no cam period after its transient: classified undetermined
-    with the reason (the tangent exponent has no Jacobian), not a traceback; a discard
-    beyond the recorded time is refused naming discard and its range."""
+    with the reason (too few section points to judge), not a traceback; a discard beyond
+    the recorded time is refused naming discard and its range."""
     out = tmp_path / "s.parquet"
     assert main(["simulate", "--duration", "0.2", "--out", str(out)]) == 0
     capsys.readouterr()
     assert main(["classify", "--no-extend", str(out)]) == 0
     captured = capsys.readouterr()
-    assert "Traceback" not in captured.err and "no cam period" in captured.out
-    traj = chaoscam.simulate(duration=0.5, transient=0.25)
+    verdict = json.loads(captured.out)
+    assert "Traceback" not in captured.err and verdict["label"] == "undetermined"
+    assert "too few to judge" in verdict["reasons"][0]
+    run = chaoscam.simulate(duration=0.5, transient=0.25)
     with pytest.raises(ValueError, match=r"discard = 5.0 s must be in \[0, 0.25\)"):
-        chaoscam.classify_trajectory(traj, discard=5.0)
+        chaoscam.classify(run, discard=5.0)
 
 
 @pytest.mark.parametrize("damage", ["output", "manifest"])
@@ -455,26 +465,23 @@ def test_classify_discard_on_the_command_line(tmp_path, capsys):
     traceback)."""
     import json
 
-    traj = chaoscam.simulate(duration=2.0)
+    run = chaoscam.simulate(duration=2.0)
     path = tmp_path / "r.parquet"
-    traj.to_parquet(path)
+    run.to_parquet(path)
     for discard in (0.0, 1.0):
         assert main(["classify", str(path), "--discard", str(discard), "--no-extend"]) == 0
         out = json.loads(capsys.readouterr().out)
-        api = chaoscam.classify_trajectory(traj, discard=discard, extend_to=None).to_dict()
-        assert out == json.loads(json.dumps(api))
-    assert out != json.loads(
-        json.dumps(chaoscam.classify_trajectory(traj, extend_to=None).to_dict())
-    )
+        (api,) = chaoscam.classify(run, discard=discard, extend_to=None)
+        assert out == json.loads(json.dumps(api.to_dict()))
+    (whole,) = chaoscam.classify(run, extend_to=None)
+    assert out != json.loads(json.dumps(whole.to_dict()))
     assert main(["classify", str(path), "--discard", "3"]) == 2
     err = capsys.readouterr().err
     assert "discard = 3.0 s must be in [0, 2) s" in err and "Traceback" not in err
 
 
 def _tiny_ensemble():
-    from chaoscam.integrate import simulate_ensemble
-
-    return simulate_ensemble(Params(), range(2), duration=0.3, tangent=True, resumable=True)
+    return chaoscam.solve(Params(), indices=range(2), duration=0.3, tangent=True, resumable=True)
 
 
 # A review's API mistakes, each refused naming the argument (they were accepted, or failed
@@ -482,37 +489,19 @@ def _tiny_ensemble():
 API_REVIEW_CASES = [
     (lambda: chaoscam.simulate(duration=0.05, series="no"), "series = 'no' must be True or False"),
     (lambda: chaoscam.simulate(duration=0.05, tangent=1), "tangent = 1 must be True or False"),
-    (
-        lambda: chaoscam.classify_trajectory(chaoscam.simulate(duration=0.5), check_step="no"),
-        "check_step",
-    ),
+    (lambda: chaoscam.classify(chaoscam.simulate(duration=0.5), check_step="no"), "check_step"),
     (lambda: regime_map(("xi", [0.4]), ("omega", [30.0]), lyapunov="no"), "lyapunov"),
     (lambda: bifurcation("xi", [0.4], duration=0.3, workers=1.5), "workers = 1.5"),
     (lambda: bifurcation("xi", [0.4], duration=0.3, workers=True), "workers = True"),
-    (lambda: chaoscam.lyapunov_model(duration=0.5, seed=True), "seed = True"),
-    (lambda: chaoscam.lyapunov_model(duration=0.5, renorm_periods=1.5), "renorm_periods"),
+    (lambda: chaoscam.lyapunov_spectrum(duration=0.5, transient=0.0, seed=True), "seed = True"),
+    (lambda: chaoscam.extend(_tiny_ensemble(), 0.6, members=[-1]), "members = -1"),
+    (lambda: chaoscam.extend(_tiny_ensemble(), 0.6, members=[True]), "members = True"),
     (
-        lambda: chaoscam.integrate.extend_ensemble(_tiny_ensemble(), Params(), 0.6, members=[-1]),
-        "members = -1",
-    ),
-    (
-        lambda: chaoscam.integrate.extend_ensemble(_tiny_ensemble(), Params(), 0.6, members=[True]),
-        "members = True",
-    ),
-    (
-        lambda: chaoscam.integrate.extend_ensemble(_tiny_ensemble(), Params(), 0.6, backend="tpu"),
+        lambda: chaoscam.extend(_tiny_ensemble(), 0.6, backend="tpu"),
         "backend must be one of 'cpu', 'gpu', 'auto', got 'tpu'",
     ),
-    (
-        lambda: chaoscam.integrate.simulate_ensemble(Params(), range(1), duration=0.2, batch=1.5),
-        "batch = 1.5",
-    ),
-    (
-        lambda: chaoscam.integrate.simulate_ensemble(
-            Params(), range(1), duration=0.2, keep_impacts="no"
-        ),
-        "keep_impacts",
-    ),
+    (lambda: chaoscam.solve(Params(), indices=range(1), duration=0.2, batch=1.5), "batch = 1.5"),
+    (lambda: chaoscam.solve(Params(), indices=range(1), duration=0.2, impacts="no"), "impacts"),
     (lambda: chaoscam.periodic_orbit(Params(), [0.0, 0.0], 10**6), "the shooting .up to"),
     # a second review (2026-11-27): flags that took "no" as True, a string half-width
     (lambda: bifurcation("xi", [0.4], duration=0.3, continuation="no"), "continuation = 'no'"),
@@ -523,13 +512,11 @@ API_REVIEW_CASES = [
         "target half-width = '0.1'",
     ),
     (
-        lambda: chaoscam.integrate.simulate_ensemble(Params(), [0], duration=0.2, resumable="no"),
+        lambda: chaoscam.solve(Params(), indices=[0], duration=0.2, resumable="no"),
         "resumable = 'no'",
     ),
     (
-        lambda: chaoscam.extend_trajectory(
-            chaoscam.simulate(duration=0.2, resumable=True), 0.4, series="no"
-        ),
+        lambda: chaoscam.extend(chaoscam.simulate(duration=0.2, resumable=True), 0.4, series="no"),
         "series = 'no'",
     ),
 ]
@@ -540,9 +527,9 @@ def test_event_tol_and_h_max_are_bounded_and_the_longest_step_fits_its_buffers()
     in 0.5 s at 1e-5 s), and h_max = 5 s stopped with an internal error (a step's series rows
     did not fit a buffer): both are bounded, and the longest allowed step fits."""
     with pytest.raises(ParameterError, match=r"event_tol = 1e-05 \[s\] is outside"):
-        Params(event_tol=1e-5)
+        Numerics(event_tol=1e-5)
     with pytest.raises(ParameterError, match=r"h_max = 5.0 \[s\] is outside"):
-        Params(h_max=5.0)
+        Numerics(h_max=5.0)
     tr = chaoscam.simulate(duration=0.5, integrator="adaptive", h_max=1.0, output_dt=1e-5)
     assert tr.ok and len(tr.series) > 40_000
 
@@ -561,7 +548,7 @@ def test_a_bad_atol_is_refused_by_every_classifier(atol, run1):
         lambda: section_period(pts, atol=atol),
         lambda: classify_section(pts, atol=atol),
         lambda: classify_signal(x, 0.01, 1.0, section=pts, atol=atol),
-        lambda: chaoscam.classify_trajectory(run1, tangent=False, atol=atol),
+        lambda: chaoscam.classify(run1, atol=atol),
     )
     for call in calls:
         with pytest.raises(ValueError, match="atol = .* must be a finite number >= 0, or 2 of"):
@@ -573,28 +560,28 @@ def run1():
     return chaoscam.simulate(duration=1.0)
 
 
-def test_lyapunov_tol_is_checked_and_said_unused_on_the_tangent_path(run1):
+def test_lyapunov_tol_is_refused_by_the_tangent_verdict(run1):
     """lyapunov_tol=-5 was accepted, and on the tangent path any value was dropped in
-    silence (the tangent exponent is judged by its confidence interval)."""
-    with pytest.raises(ValueError, match="lyapunov_tol = -5.0"):
-        chaoscam.classify_trajectory(run1, lyapunov_tol=-5.0)
-    with pytest.warns(RuntimeWarning, match="lyapunov_tol is not used"):
-        chaoscam.classify_trajectory(run1, lyapunov_tol=0.5, extend_to=None)
+    silence (the tangent exponent is judged by its confidence interval): now the verdict,
+    which has only the tangent exponent, refuses it by name as an option it does not take."""
+    for value in (-5.0, 0.5):
+        with pytest.raises(TypeError, match="unknown option 'lyapunov_tol'"):
+            chaoscam.classify(run1, lyapunov_tol=value, extend_to=None)
 
 
 def test_review_tracebacks_are_named():
-    """lyapunov_spectrum(trajectory="run.parquet") was an AttributeError, run_paper(figures=3)
-    a TypeError from list(3), and a contact period that rounds to zero steps a
+    """lyapunov_spectrum("run.parquet") was an AttributeError, run_paper(figures=3) a
+    TypeError from list(3), and a contact period that rounds to zero steps a
     ZeroDivisionError in the step warning."""
-    from chaoscam._run_warnings import resolution_warning
-    from chaoscam.experiments import run_paper
+    from chaoscam.paper import run_paper
+    from chaoscam.simulation import resolution_warning
 
-    with pytest.raises(TypeError, match="trajectory must be a chaoscam Trajectory"):
-        chaoscam.lyapunov_spectrum(trajectory="run.parquet")
+    with pytest.raises(TypeError, match="must be a chaoscam.Params"):
+        chaoscam.lyapunov_spectrum("run.parquet")
     for figures in (99, np.array([99]), (f for f in [99])):  # one figure, or any iterable
         with pytest.raises(ValueError, match=r"figures = \[.*99\)?\]: choose from"):
             run_paper(quick=True, out="unused.html", figures=figures)
-    assert "a step longer than the period" in resolution_warning(Params(l_lambda=1e300))
+    assert "a step longer than the period" in resolution_warning(Params(l_lambda=1e300), Numerics())
 
 
 @pytest.mark.parametrize(
@@ -648,11 +635,11 @@ def test_api_review_mistakes_are_named(i):
 def test_whole_number_floats_in_integer_fields_are_stored_as_integers():
     """flight_merge = 2.0 (what START:STOP:NUM gives) is 2: an ensemble and a sweep over it
     run (they failed in numpy: 'expected a sequence of integers')."""
-    from chaoscam.integrate import simulate_ensemble
-
-    p = Params(flight_merge=2.0, max_events_per_step=4.0)
-    assert (p.flight_merge, p.max_events_per_step) == (2, 4) and type(p.flight_merge) is int
-    assert simulate_ensemble(p, range(1), duration=0.2).members["status"].tolist() == ["OK"]
+    num = Numerics(flight_merge=2.0, max_events_per_step=4.0)
+    assert (num.flight_merge, num.max_events_per_step) == (2, 4)
+    assert type(num.flight_merge) is int
+    sol = chaoscam.solve(Params(), num, indices=range(1), duration=0.2)
+    assert sol.members["status"].tolist() == ["OK"]
     res = bifurcation("flight_merge", "2:4:2", duration=0.3, workers=1)
     assert len(res.verdicts) == 2
 
@@ -666,12 +653,11 @@ def test_axis_linspace_takes_numpy_scalars():
 # The wrong kind of object where a run, an ensemble or a model goes: a TypeError naming the
 # argument and what makes one (they failed with an AttributeError from deep inside).
 WRONG_KIND_CASES = [
-    (lambda: chaoscam.classify_trajectory("run.parquet"), "traj must be a chaoscam Trajectory"),
-    (lambda: chaoscam.classify_trajectory(None), "traj must be a chaoscam Trajectory"),
-    (lambda: chaoscam.extend_trajectory(None, 10.0), "traj must be a chaoscam Trajectory"),
-    (lambda: chaoscam.lyapunov_model("x"), "params must be a chaoscam.Params"),
+    (lambda: chaoscam.classify("run.parquet"), "solution must be a chaoscam Solution"),
+    (lambda: chaoscam.classify(None), "solution must be a chaoscam Solution"),
+    (lambda: chaoscam.extend(None, 10.0), "solution must be a chaoscam Solution"),
+    (lambda: chaoscam.lyapunov_spectrum("x"), "params must be a chaoscam.Params"),
     (lambda: chaoscam.contact_period({"omega": 30.0}), "p must be a chaoscam Params"),
-    (lambda: chaoscam.classify_ensemble(None, Params()), "ens must be a chaoscam Ensemble"),
 ]
 
 
@@ -685,10 +671,10 @@ def test_the_wrong_kind_of_object_is_named(i):
 def test_a_step_longer_than_the_contact_period_is_said_so():
     """dt = 1 s against a contact period of 9.14e-5 s: a step 1.09e4 times the period, not
     "0.0 steps"."""
-    from chaoscam._run_warnings import resolution_warning
+    from chaoscam.simulation import resolution_warning
 
-    assert "with a step 1.09e+04x the period;" in resolution_warning(Params(dt=1.0))
-    assert "with only 1.8 steps" in resolution_warning(Params(dt=5e-5))
+    assert "with a step 1.09e+04x the period;" in resolution_warning(Params(), Numerics(dt=1.0))
+    assert "with only 1.8 steps" in resolution_warning(Params(), Numerics(dt=5e-5))
 
 
 @pytest.mark.parametrize(

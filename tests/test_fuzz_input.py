@@ -1,6 +1,7 @@
-"""Fuzz (Hypothesis): every generated bad input — a Params field out of its range or not a
-number, a malformed START:STOP:NUM, a file that is not what it claims — gives a message and
-exit code 2 naming the field or file; never a traceback (an uncaught exception fails)."""
+"""Fuzz (Hypothesis): every generated bad input — a Params or Numerics field (both set with
+``--set``) out of its range or not a number, a malformed START:STOP:NUM, a file that is not
+what it claims — gives a message and exit code 2 naming the field or file; never a traceback
+(an uncaught exception fails)."""
 
 import contextlib
 import dataclasses
@@ -14,7 +15,9 @@ from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 from chaoscam.cli import main  # noqa: E402
-from chaoscam.model import FIELD_DOCS, ParameterError, Params  # noqa: E402
+from chaoscam.model import FIELD_DOCS as MODEL_DOCS  # noqa: E402
+from chaoscam.model import ParameterError, Params  # noqa: E402
+from chaoscam.numerics import Numerics  # noqa: E402
 from chaoscam.sweep import Axis, SweepError  # noqa: E402
 
 QUICK = settings(
@@ -24,9 +27,11 @@ BIG = settings(
     max_examples=2000, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
 
+FIELD_DOCS = {**MODEL_DOCS, **Numerics.field_docs()}  # what --set takes
 NUMERIC = [n for n, d in FIELD_DOCS.items() if d["choices"] is None]
 CHOICE = [n for n, d in FIELD_DOCS.items() if d["choices"] is not None]
-INT_FIELDS = {f.name for f in dataclasses.fields(Params) if f.type == "int"}
+FIELDS = {f.name: f for cls in (Params, Numerics) for f in dataclasses.fields(cls)}
+INT_FIELDS = {name for name, f in FIELDS.items() if f.type == "int"}
 
 
 def _outside(name):
@@ -83,7 +88,7 @@ def _run(args):
 
 
 def _check_assignment(name, text, tmp_path):
-    if text.strip().lower() == "none" and Params.__dataclass_fields__[name].default is None:
+    if text.strip().lower() == "none" and FIELDS[name].default is None:
         return  # None is the documented default rule
     code, err = _run(["simulate", "--duration", "0.01", "--set", f"{name}={text}"])
     assert code == 2, (name, text, err)

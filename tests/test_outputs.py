@@ -10,8 +10,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from chaoscam._outputs import OutputError, OutputLock, atomic_path, check_output
 from chaoscam.cli import main
+from chaoscam.io import OutputError, OutputLock, atomic_path, check_output
 
 ROOT = Path(__file__).resolve().parents[1]
 SLOW = "tests.sweep._helpers:SlowSpreadClassifier"  # 50 ms a run
@@ -163,7 +163,7 @@ def test_atomic_path_keeps_the_old_file_on_failure(tmp_path):
 
 def _hold_lock(path: Path):
     code = (
-        "import sys, time; from chaoscam._outputs import OutputLock; "
+        "import sys, time; from chaoscam.io import OutputLock; "
         f"OutputLock({str(path)!r}).acquire(); print('held', flush=True); time.sleep(30)"
     )
     proc = subprocess.Popen(
@@ -281,7 +281,7 @@ def test_atomic_path_without_replace_keeps_a_file_that_appeared_meanwhile(tmp_pa
     """replace=False (an output checked absent, no --force): a file another process wrote
     while this one worked is kept as it is, this one's result goes beside it as NAME.PID.SUFFIX,
     and the error names both."""
-    from chaoscam._outputs import conflict_name
+    from chaoscam.io import conflict_name
 
     out = tmp_path / "x.csv"
     with pytest.raises(OutputError, match="another process wrote it while this run worked") as err:
@@ -301,16 +301,16 @@ def test_a_sweep_does_not_replace_an_output_written_during_its_run(tmp_path, mon
     """A file written at the sweep's --out while it runs (by a command that took no lock on it)
     is not replaced at the end: exit 2, the file kept, the sweep's table beside it, and the
     checkpoint kept: nothing is lost."""
-    from chaoscam.sweep import _batch
+    from chaoscam.sweep import _engine
 
     out = tmp_path / "b.parquet"
-    run_plan = _batch.run_plan
+    run_plan = _engine.run_plan
 
     def meanwhile(*args, **kwargs):
         out.write_text("theirs")
         return run_plan(*args, **kwargs)
 
-    monkeypatch.setattr(_batch, "run_plan", meanwhile)
+    monkeypatch.setattr(_engine, "run_plan", meanwhile)
     assert main(_bif(out)) == 2
     assert "another process wrote it while this run worked" in capsys.readouterr().err
     assert out.read_text() == "theirs"
@@ -405,12 +405,12 @@ def test_a_full_disk_names_the_simulation_output(tmp_path, monkeypatch, capsys):
     the file; now the file and that nothing was written there."""
     import errno
 
-    from chaoscam import Trajectory
+    from chaoscam import Solution
 
     def full(self):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(Trajectory, "parquet_table", full)
+    monkeypatch.setattr(Solution, "parquet_table", full)
     out = tmp_path / "s.parquet"
     assert main(["simulate", "--duration", "0.2", "--out", str(out)]) == 2
     err = capsys.readouterr().err
@@ -419,10 +419,10 @@ def test_a_full_disk_names_the_simulation_output(tmp_path, monkeypatch, capsys):
 
 
 def test_api_writers_refuse_an_existing_file_and_write_whole(tmp_path, monkeypatch):
-    """Trajectory.to_parquet and RegimeMap.to_parquet never replace a file without
+    """Solution.to_parquet and RegimeMap.to_parquet never replace a file without
     replace=True, and a write that fails half-way leaves the old file as it was."""
     import chaoscam
-    import chaoscam._parquet as parquet
+    import chaoscam.io._parquet as parquet
     from chaoscam.sweep import Axis, read_regime_map, regime_map
 
     traj = chaoscam.simulate(duration=0.2)
@@ -489,22 +489,29 @@ def test_a_resume_with_another_classifier_is_refused(tmp_path):
     with another one does not reuse the first one's labels."""
     import functools
 
-    from chaoscam import classify_trajectory
     from chaoscam.sweep import Axis, SweepError, regime_map
-    from chaoscam.sweep._tasks import classifier_identity
+    from chaoscam.sweep._runs import classifier_identity
 
-    a = functools.partial(classify_trajectory, tangent=False)
-    b = functools.partial(classify_trajectory, tangent=True)
+    a = functools.partial(_verdict, extend_to=None)
+    b = functools.partial(_verdict, extend_to=40.0)
     assert classifier_identity(a) != classifier_identity(b)
     assert classifier_identity(lambda t: 1) != classifier_identity(lambda t: 2)
     assert classifier_identity(a) == classifier_identity(
-        functools.partial(classify_trajectory, tangent=False)
+        functools.partial(_verdict, extend_to=None)
     )
     kw = dict(realizations=1, seed=3, duration=0.5, workers=1, out=tmp_path / "m.parquet")
     x, y = Axis("xi", (0.2,)), Axis("l_lambda_sigma", (0.0,))
     regime_map(x, y, classify=a, **kw)
     with pytest.raises(SweepError, match="differs in: classifier"):
         regime_map(x, y, classify=b, resume=True, **kw)
+
+
+def _verdict(run, **options):
+    """A classifier of one's own: the package's verdict on the one run."""
+    import chaoscam
+
+    (verdict,) = chaoscam.classify(run, **options)
+    return verdict
 
 
 def test_threads_writing_into_one_folder_do_not_collide(tmp_path):
@@ -538,21 +545,20 @@ def test_classifier_identities_tell_methods_apart_and_ignore_where_code_sits():
     a partial's argument with the default repr named an address (new in every process)."""
     import functools
 
-    from chaoscam import classify_trajectory
-    from chaoscam.sweep._tasks import classifier_identity as ident
+    from chaoscam.sweep._runs import classifier_identity as ident
 
     class Clf:
         def __init__(self, tol):
             self.tol = tol
 
-        def classify(self, traj):
-            return classify_trajectory(traj)
+        def classify(self, run):
+            return _verdict(run)
 
     assert ident(Clf(0.1).classify) != ident(Clf(0.5).classify)
     assert ident(Clf(0.1).classify) == ident(Clf(0.1).classify)
     one = eval(compile("lambda t: t", "a.py", "eval"))
     moved = eval(compile("\n\n(lambda t:\n t)", "b.py", "eval"))
     assert ident(one) == ident(moved) != ident(eval(compile("lambda t: 2", "a.py", "eval")))
-    part = functools.partial(classify_trajectory, helper=Clf(1.0))
+    part = functools.partial(_verdict, helper=Clf(1.0))
     assert " at 0x" not in ident(part)
-    assert ident(part) == ident(functools.partial(classify_trajectory, helper=Clf(1.0)))
+    assert ident(part) == ident(functools.partial(_verdict, helper=Clf(1.0)))

@@ -64,6 +64,7 @@ def run(args: argparse.Namespace) -> int:
     except SweepInterrupted as err:
         print(f"chaoscam: {err.describe(stop_word())}", file=sys.stderr)
         return 130 if err.cause is None else 1
+    _say_identical(params, args.members)
     m = res.members
     counts = m["label" if args.classify else "status"].value_counts().to_dict()
     print(
@@ -71,3 +72,22 @@ def run(args: argparse.Namespace) -> int:
         + f"\nmembers: {args.out}\nsections: {companion(args.out, 'sections')}"
     )  # fmt: skip
     return 0
+
+
+def _say_identical(params, members: int) -> None:
+    """Say, once, when the members are all the same run: an index draws only line lengths,
+    which change nothing with ``l_lambda_sigma = 0`` or the fractal stiffness (with the
+    runs' own warnings, at the end)."""
+    from ..model import realizations_identical
+    from . import show_warning
+
+    if members > 1 and realizations_identical(params):
+        why = (
+            "l_lambda_sigma = 0"
+            if params.l_lambda_sigma == 0.0
+            else "the fractal stiffness does not depend on the line length"
+        )
+        show_warning(
+            f"{why}: every member is the same deterministic run (an index draws only line "
+            "lengths); one member is enough"
+        )

@@ -236,8 +236,10 @@ def execute(
                     bar.update(1)
             store.maybe_flush()
     except (KeyboardInterrupt, StopRequested):
-        backend.cancel(list(inflight))
-        store.flush()  # a record stored but not yet counted by the plan is saved too
+        with _second_interrupt_ignored():  # the batches under way stop all the same
+            backend.cancel(list(inflight))
+            store.flush()  # a record stored but not yet counted by the plan is saved too
+            backend.close()  # they stop at their next compiled call or member
         raise SweepInterrupted(max(saved, plan.done), plan.total, store.path) from None
     except BackendLost as err:
         store.flush()
@@ -251,6 +253,25 @@ def execute(
     finally:
         bar.close()
     store.flush()
+
+
+@contextlib.contextmanager
+def _second_interrupt_ignored():
+    """A context in which a second Ctrl-C is ignored (in the main thread, where handlers
+    live): a sweep stopped by the first waits for its batches under way to stop, then says
+    once what it kept, instead of leaving with a bare KeyboardInterrupt."""
+    import signal
+    import threading
+
+    before = signal.getsignal(signal.SIGINT)
+    if threading.current_thread() is not threading.main_thread() or before is None:
+        yield  # no handler to put back (one not set from Python): left alone
+        return
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
 
 
 def run_batch(batch: Batch) -> list[dict[str, Any]]:
@@ -457,6 +478,7 @@ stopped by one says where its finished runs are kept and to --resume once it is 
 def _finish(plan, store, out: Path | None, keys, build, replace: bool):
     """The result from the finished records, written to ``out`` (its checkpoint removed)."""
     from ._common import reemit_warnings, unique_sorted
+
     try:
         records = unique_sorted(store.records(), keys)
         reemit_warnings(records)

@@ -1,5 +1,5 @@
-"""``chaoscam ensemble``: a torn part is computed again, and a run killed between its
-output files is finished by --resume (the outputs are one commit)."""
+"""``chaoscam ensemble``: a torn checkpoint part is computed again, and a run stopped between
+its output files, or before its checkpoint is removed, is finished by --resume."""
 
 import os
 
@@ -7,6 +7,7 @@ import pandas as pd
 import pytest
 
 from chaoscam.cli import main
+from chaoscam.sweep import checkpoint_dir
 
 ARGS = [
     "ensemble",
@@ -20,12 +21,11 @@ ARGS = [
     "l_lambda_sigma=0.002",
     "--seed",
     "4",
-    "--chunk",
-    "2",
+    "--workers",
+    "1",
     "--quiet",
-    "--keep-impacts",
 ]
-NAMES = ("", ".sections", ".impacts")
+NAMES = ("", ".sections")
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +38,7 @@ def whole(tmp_path_factory):
 def _same(out, whole):
     for n in NAMES:
         pd.testing.assert_frame_equal(pd.read_parquet(out.with_name(f"e{n}.parquet")), whole[n])
-    assert not out.with_suffix(".parts").exists()
+    assert not checkpoint_dir(out).exists()
 
 
 def _stop_at(monkeypatch, target):
@@ -55,35 +55,38 @@ def _stop_at(monkeypatch, target):
         monkeypatch.setattr(os, name, make)
 
 
-@pytest.mark.parametrize("stop", ["sections", "impacts", "members", "parts removal"])
-def test_killed_between_output_files_resumes(tmp_path, monkeypatch, whole, stop, capsys):
-    """A stop before any of the renames of the final commit (or before the parts are
-    removed): --resume finishes, and the outputs equal those of an uninterrupted run."""
+@pytest.mark.parametrize("stop", ["members", "sections", "checkpoint removal"])
+def test_stopped_between_output_files_resumes(tmp_path, monkeypatch, whole, stop, capsys):
+    """A stop before any of the renames that place the outputs (or before the checkpoint is
+    removed): exit 130 with every run kept, and --resume finishes to the outputs of an
+    uninterrupted run."""
     out = tmp_path / "e.parquet"
     target = {
-        "sections": out.with_name("e.sections.parquet"),
-        "impacts": out.with_name("e.impacts.parquet"),
         "members": out,
-        "parts removal": tmp_path / f".tmp-{os.getpid()}-removed-e.parts",
+        "sections": out.with_name("e.sections.parquet"),
+        "checkpoint removal": tmp_path / f".tmp-{os.getpid()}-removed-e.parquet.ckpt",
     }[stop]
     _stop_at(monkeypatch, target)
     assert main([*ARGS, "--out", str(out)]) == 130
     monkeypatch.undo()
+    assert "5 of 5 runs are saved" in capsys.readouterr().err
+    assert checkpoint_dir(out).is_dir()
     assert main([*ARGS, "--out", str(out), "--resume"]) == 0, capsys.readouterr().err
     _same(out, whole)
 
 
 def test_torn_part_is_computed_again(tmp_path, monkeypatch, whole, capsys):
-    """A part cut short after its .done marker was written is found (size and checksum in
-    the marker), computed again with a notice, and the result is the uninterrupted one."""
+    """A checkpoint part cut short (a kill while it was written, a full disk) is found, its
+    runs computed again with a notice, and the result is the uninterrupted one."""
     out = tmp_path / "e.parquet"
-    _stop_at(monkeypatch, out.with_name("e.sections.parquet"))
-    assert main([*ARGS, "--out", str(out)]) == 130
+    _stop_at(monkeypatch, out)
+    assert main([*ARGS, "--checkpoint-interval", "0", "--out", str(out)]) == 130
     monkeypatch.undo()
-    part = out.with_suffix(".parts") / "000000000002.sections.parquet"
+    part = sorted(checkpoint_dir(out).glob("part-*.jsonl"))[-1]
     part.write_bytes(part.read_bytes()[:100])
-    assert main([*ARGS, "--out", str(out), "--resume"]) == 0
-    assert "part 2" in capsys.readouterr().err
+    capsys.readouterr()
+    assert main([*ARGS, "--checkpoint-interval", "0", "--out", str(out), "--resume"]) == 0
+    assert f"{part.name} in {checkpoint_dir(out)} was torn" in capsys.readouterr().err
     _same(out, whole)
 
 
@@ -99,24 +102,25 @@ def test_force_starts_over(tmp_path, whole):
 
 def test_an_output_written_during_the_run_is_not_replaced(tmp_path, monkeypatch, whole, capsys):
     """A sections file that another process writes while the members run is kept: exit 2
-    naming it, no output placed, and the parts kept, from which --resume (once it is moved
-    away) writes the same outputs as an uninterrupted run."""
-    import chaoscam.integrate
+    naming it, this run's table beside it, and the checkpoint kept, from which --resume
+    (once that file is moved away) writes the same outputs as an uninterrupted run."""
+    from chaoscam.sweep import _engine
 
     out = tmp_path / "e.parquet"
     sections = out.with_name("e.sections.parquet")
-    run = chaoscam.integrate.simulate_ensemble
+    run_plan = _engine.run_plan
 
     def meanwhile(*args, **kwargs):
         sections.write_text("theirs")
-        return run(*args, **kwargs)
+        return run_plan(*args, **kwargs)
 
-    monkeypatch.setattr(chaoscam.integrate, "simulate_ensemble", meanwhile)
+    monkeypatch.setattr(_engine, "run_plan", meanwhile)
     assert main([*ARGS, "--out", str(out)]) == 2
-    assert "appeared while this run was working" in capsys.readouterr().err
-    assert sections.read_text() == "theirs" and not out.exists()
-    assert out.with_suffix(".parts").is_dir()
-    monkeypatch.setattr(chaoscam.integrate, "simulate_ensemble", run)
+    assert "another process wrote it while this run worked" in capsys.readouterr().err
+    assert sections.read_text() == "theirs"
+    assert len(pd.read_parquet(tmp_path / f"e.sections.{os.getpid()}.parquet")) > 0
+    assert checkpoint_dir(out).is_dir()
+    monkeypatch.setattr(_engine, "run_plan", run_plan)
     sections.unlink()
     assert main([*ARGS, "--out", str(out), "--resume"]) == 0
     _same(out, whole)

@@ -123,10 +123,9 @@ def test_import_and_run_leave_numba_threading_layer_to_first_parallel_launch():
     (it launches nothing parallel); the first parallel launch (an ensemble) picks the
     fork-safe layer (unless the user chose one)."""
     code = (
-        "import numba, chaoscam._simulate as s; print(numba.config.THREADING_LAYER); "
-        "s.raw_run(duration=0.001); print(numba.config.THREADING_LAYER); "
-        "from chaoscam.integrate import simulate_ensemble; "
-        "simulate_ensemble(s.Params(), [0, 1], duration=0.001); "
+        "import numba, chaoscam; print(numba.config.THREADING_LAYER); "
+        "chaoscam.simulate(duration=0.001, series=False); print(numba.config.THREADING_LAYER); "
+        "chaoscam.solve(chaoscam.Params(), indices=[0, 1], duration=0.001); "
         "print(numba.config.THREADING_LAYER)"
     )
     out = subprocess.run(

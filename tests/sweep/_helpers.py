@@ -1,4 +1,7 @@
-"""Small deterministic classifiers for testing the sweep machinery (not the physics)."""
+"""Small deterministic classifiers for testing the sweep machinery (not the physics).
+
+Each takes one run as a one-member :class:`chaoscam.Solution` (what a sweep hands a
+classifier of one's own) and returns an object with label, period, evidence and reasons."""
 
 from __future__ import annotations
 
@@ -33,10 +36,10 @@ class SpreadClassifier:
     high: float = 0.05
     needs_series = False  # a class attribute, not a field: the section is enough
 
-    def __call__(self, traj):
-        th = traj.section["theta_f"].to_numpy()
+    def __call__(self, run):
+        th = run.section["theta_f"].to_numpy()
         spread = float(np.ptp(th)) if th.size else float("nan")
-        lam = float(np.mean(traj.section["l_lambda"])) if th.size else float("nan")
+        lam = float(np.mean(run.section["l_lambda"])) if th.size else float("nan")
         if not np.isfinite(spread) or spread < self.low:
             label, period = "periodic", 1
         elif spread < self.high:
@@ -45,7 +48,7 @@ class SpreadClassifier:
             label, period = "chaotic", None
         ev = (
             _Evidence("spread", spread),
-            _Evidence("lyapunov_model", lam * 100.0),
+            _Evidence("lyapunov_1", lam * 100.0),  # what a cell's lyapunov_mean reads
             _Evidence("n_points", float(th.size)),
         )
         return _Verdict(label, period, ev, ("spread test",))
@@ -55,55 +58,56 @@ class SlowSpreadClassifier(SpreadClassifier):
     """SpreadClassifier taking 50 ms a run: keeps a CLI run alive long enough to be
     stopped mid-run, however fast the kernel gets."""
 
-    def __call__(self, traj):
+    def __call__(self, run):
         import time
 
         time.sleep(0.05)
-        return super().__call__(traj)
+        return super().__call__(run)
 
 
 @dataclass(frozen=True)
 class KillOnceClassifier:
     """SpreadClassifier that kills its own worker process (SIGKILL) the first time it sees
-    simulate index ``victim``: a worker lost mid-run. ``marker`` records that it happened."""
+    realization index ``victim``: a (Dask) worker lost mid-run. ``marker`` records that it
+    happened."""
 
     marker: str
     victim: int = 3
     needs_series = False
 
-    def __call__(self, traj):
-        if traj.settings["index"] == self.victim and not Path(self.marker).exists():
+    def __call__(self, run):
+        if run.index == self.victim and not Path(self.marker).exists():
             Path(self.marker).write_text(str(os.getpid()))
             os.kill(os.getpid(), 9)
-        return SpreadClassifier()(traj)
+        return SpreadClassifier()(run)
 
 
 @dataclass(frozen=True)
 class InterruptOnce:
     """SpreadClassifier that raises KeyboardInterrupt (a Ctrl-C) the first time it sees
-    simulate index ``victim`` (in-process runs, workers=1); ``marker`` records it."""
+    realization index ``victim`` (in-process runs, workers=1); ``marker`` records it."""
 
     marker: str
     victim: int
     inner: object = SpreadClassifier()
     needs_series = False
 
-    def __call__(self, traj):
-        if traj.settings["index"] == self.victim and not Path(self.marker).exists():
+    def __call__(self, run):
+        if run.index == self.victim and not Path(self.marker).exists():
             Path(self.marker).write_text("interrupted")
             raise KeyboardInterrupt
-        return self.inner(traj)
+        return self.inner(run)
 
 
 @dataclass(frozen=True)
 class ParityClassifier:
-    """Random cells (sigma > 0): label by the parity of the simulate index (mixed labels
+    """Random cells (sigma > 0): label by the parity of the realization index (mixed labels
     whatever the physics); deterministic cells: always periodic."""
 
     needs_series = False
 
-    def __call__(self, traj):
-        if traj.params.l_lambda_sigma > 0 and traj.settings["index"] % 2:
+    def __call__(self, run):
+        if run.params.l_lambda_sigma > 0 and run.index % 2:
             return _Verdict("chaotic", None, (_Evidence("parity", 1.0),))
         return _Verdict("periodic", 1, (_Evidence("parity", 0.0),))
 
@@ -121,5 +125,15 @@ class FailingClassifier:
 
     needs_series = False
 
-    def __call__(self, traj):
+    def __call__(self, run):
         raise ValueError("this classifier has a bug")
+
+
+def one_run_per_batch(monkeypatch) -> None:
+    """Batches of one realization. The engine packs about two seconds of work into a CPU
+    batch, which holds every run of these small sweeps, and a batch is stored when it ends:
+    with batches of one, each record is stored (and, with flush_interval=0, checkpointed in
+    a part of its own) as it finishes, so an interruption keeps the runs before it."""
+    from chaoscam.sweep import _engine
+
+    monkeypatch.setattr(_engine, "batch_size", lambda *a, **k: 1)

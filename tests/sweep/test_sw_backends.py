@@ -1,4 +1,4 @@
-"""Backends: the same table for any worker count, local processes or Dask, lost workers."""
+"""Backends: the same table for any thread count, local threads or Dask, lost Dask workers."""
 
 import os
 
@@ -39,8 +39,8 @@ def serial_adaptive():
     return regime_map(MU, SIGMA, **ADAPTIVE, workers=1)
 
 
-def test_two_processes_equal_one(serial, serial_adaptive):
-    """Two worker processes give the one-worker table bit for bit, adaptive cells too."""
+def test_two_threads_equal_one(serial, serial_adaptive):
+    """Two batch threads give the one-thread table bit for bit, adaptive cells too."""
     frames_equal(regime_map(MU, SIGMA, **KW, workers=2).realizations, serial.realizations)
     two = regime_map(MU, SIGMA, **ADAPTIVE, workers=2)
     frames_equal(two.realizations, serial_adaptive.realizations)
@@ -55,14 +55,6 @@ def test_adaptive_resume_replays_the_decisions(tmp_path, serial_adaptive):
         regime_map(MU, SIGMA, **{**ADAPTIVE, "classify": cls}, workers=1, out=out, flush_interval=0)
     res = regime_map(MU, SIGMA, **{**ADAPTIVE, "classify": cls}, workers=1, out=out, resume=True)
     frames_equal(res.realizations, serial_adaptive.realizations)
-
-
-def test_process_worker_lost_loses_nothing(tmp_path, serial):
-    """A worker process killed (SIGKILL) mid-task: the pool restarts, the table is whole."""
-    cls = KillOnceClassifier(str(tmp_path / "killed"), victim=realization_index(1, 1))
-    res = regime_map(MU, SIGMA, **{**KW, "classify": cls}, workers=2)
-    _assert_dead(tmp_path / "killed")
-    frames_equal(res.realizations, serial.realizations)
 
 
 @pytest.fixture(scope="module")
@@ -81,7 +73,7 @@ def dask_client():
         yield client
 
 
-def test_dask_equals_local_processes(dask_client, serial, serial_adaptive):
+def test_dask_equals_local_threads(dask_client, serial, serial_adaptive):
     """A Dask LocalCluster on loopback gives the local table bit for bit."""
     frames_equal(
         regime_map(MU, SIGMA, **KW, scheduler=dask_client).realizations, serial.realizations
@@ -91,9 +83,10 @@ def test_dask_equals_local_processes(dask_client, serial, serial_adaptive):
     )
 
 
-def test_dask_runs_the_ensemble_engine_batches_bit_for_bit(dask_client):
-    """The ensemble engine's batches on Dask workers give the in-process table."""
-    kw = dict(realizations=2, seed=3, duration=3.0, transient=1.5, engine="ensemble")
+def test_dask_runs_the_package_verdicts_batches_bit_for_bit(dask_client):
+    """Batches judged by the package's verdict (chaoscam.classify) on Dask workers give the
+    in-process table."""
+    kw = dict(realizations=2, seed=3, duration=3.0, transient=1.5)
     local = regime_map(MU, SIGMA, **kw, workers=1)
     frames_equal(
         regime_map(MU, SIGMA, **kw, scheduler=dask_client).realizations, local.realizations

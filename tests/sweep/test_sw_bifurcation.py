@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from chaoscam import Params
+from chaoscam import Numerics, Params
 from chaoscam.model import contact_angle
 from chaoscam.sweep import (
     Axis,
@@ -111,21 +111,18 @@ def test_interrupted_chain_resumes_identically(tmp_path, chained):
 def test_paper_figure_grids_validate():
     """Fig. 6's D in [1.36, 1.56] with fractal stiffness is valid for G = 1e-9 and 1e-10 m."""
     for g in (1e-9, 1e-10):
-        validate_grid(Params(stiffness="fractal", G=g), [Axis.parse("D=1.36:1.56:41")])
+        validate_grid(Params(stiffness="fractal", G=g), Numerics(), [Axis.parse("D=1.36:1.56:41")])
 
 
-@pytest.mark.parametrize(
-    "engine, name, values",
-    [("process", "theta_f0", [0.1, 0.2]), ("ensemble", "omega_f0", [-1.0, 1.0])],
-)
-def test_a_diagram_over_the_initial_state_starts_each_run_there(engine, name, values):
+@pytest.mark.parametrize("name, values", [("theta_f0", [0.1, 0.2]), ("omega_f0", [-1.0, 1.0])])
+def test_a_diagram_over_the_initial_state_starts_each_run_there(name, values):
     """A diagram over theta_f0 or omega_f0 (a slice of the basins) starts each run at the
     swept value: its section is the one simulate gives from there, not the default start's
     (the base state used to overwrite it)."""
     from chaoscam import simulate
 
     kw = dict(duration=1.0, transient=0.5, workers=1)
-    b = bifurcation(name, values, engine=engine, **kw)
+    b = bifurcation(name, values, **kw)
     assert list(b.verdicts[name]) == values
     for value in values:
         want = simulate(Params(**{name: value}), duration=1.0, transient=0.5, series=False)

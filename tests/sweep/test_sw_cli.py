@@ -52,9 +52,17 @@ def uninterrupted():
     )
 
 
-def _start(args):
+def _start(args, batch: int | None = None):
+    """The command line on ``args`` in a process of its own; ``batch``: that many runs per
+    batch (the engine's CPU batch holds about two seconds of estimated work, every run of
+    these small sweeps on one worker)."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     code = "import sys; from chaoscam.cli import main; sys.exit(main(sys.argv[1:]))"
+    if batch is not None:
+        code = (
+            f"from chaoscam.sweep import _engine; _engine.batch_size = lambda *a, **k: {batch}; "
+            + code
+        )
     return subprocess.Popen(
         [sys.executable, "-c", code, *args],
         cwd=ROOT,

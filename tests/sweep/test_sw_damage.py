@@ -4,9 +4,9 @@ a record that does not fit is refused with what to do; never a raw decoding trac
 import pytest
 
 from chaoscam.sweep import Axis, SweepError, bifurcation, checkpoint_dir, regime_map
-from chaoscam.sweep._checkpoint import DamagedPart, decode_part, encode_part
+from chaoscam.sweep._store import DamagedPart, decode_part, encode_part
 
-from ._helpers import InterruptOnce, SpreadClassifier, frames_equal
+from ._helpers import InterruptOnce, SpreadClassifier, frames_equal, one_run_per_batch
 
 GRID = dict(realizations=3, seed=3, duration=1.0, transient=0.5, workers=1)
 X, Y = Axis.parse("l_lambda=0.006:0.010:3"), Axis.parse("l_lambda_sigma=0:0.002:2")
@@ -27,8 +27,9 @@ def _dead_pid() -> str:
     return run.stdout.strip()
 
 
-def _interrupted(tmp_path, victim=11):
+def _interrupted(tmp_path, monkeypatch, victim=11):
     """A regime map stopped by Ctrl-C after several one-record parts."""
+    one_run_per_batch(monkeypatch)
     out = tmp_path / "m.parquet"
     stop = InterruptOnce(str(tmp_path / "marker"), victim)
     with pytest.raises(KeyboardInterrupt):
@@ -50,10 +51,10 @@ def test_part_round_trip_and_damage():
 
 
 @pytest.mark.parametrize("damage", ["truncated", "garbage"])
-def test_torn_last_part_is_recomputed(tmp_path, reference, damage, capsys):
+def test_torn_last_part_is_recomputed(tmp_path, monkeypatch, reference, damage, capsys):
     """A torn last part (cut short, or garbage bytes) is dropped with a one-line notice and
     --resume ends with the uninterrupted table."""
-    out, parts, stop = _interrupted(tmp_path)
+    out, parts, stop = _interrupted(tmp_path, monkeypatch)
     data = parts[-1].read_bytes()
     parts[-1].write_bytes(data[: len(data) // 2] if damage == "truncated" else b"\xff\x00" * 9)
     res = regime_map(X, Y, classify=stop, out=out, resume=True, **GRID)
@@ -62,29 +63,30 @@ def test_torn_last_part_is_recomputed(tmp_path, reference, damage, capsys):
     frames_equal(res.realizations, reference.realizations)
 
 
-def test_damaged_middle_part_is_refused(tmp_path):
+def test_damaged_middle_part_is_refused(tmp_path, monkeypatch):
     """A damaged part before the last one: refused, the message says which file to delete."""
-    out, parts, stop = _interrupted(tmp_path)
+    out, parts, stop = _interrupted(tmp_path, monkeypatch)
     parts[0].write_bytes(parts[0].read_bytes()[:-7])
     with pytest.raises(SweepError, match=f"{parts[0].name} is damaged.*delete that file"):
         regime_map(X, Y, classify=stop, out=out, resume=True, **GRID)
 
 
-def test_record_that_does_not_fit_is_refused(tmp_path):
+def test_record_that_does_not_fit_is_refused(tmp_path, monkeypatch):
     """A well-formed record for a cell the grid does not have: a message, not IndexError."""
-    out, parts, stop = _interrupted(tmp_path)
+    out, parts, stop = _interrupted(tmp_path, monkeypatch)
     record = decode_part(parts[-1].read_bytes())[0]
     parts[-1].write_bytes(encode_part([dict(record, cell=999)]))
     with pytest.raises(SweepError, match="does not fit this run"):
         regime_map(X, Y, classify=stop, out=out, resume=True, **GRID)
 
 
-def test_bifurcation_torn_last_part(tmp_path, capsys):
+def test_bifurcation_torn_last_part(tmp_path, monkeypatch, capsys):
     """The same for a bifurcation diagram: torn last part dropped, same points as a run
     that was never interrupted."""
     kw = dict(duration=1.0, transient=0.5, workers=1)
     values = "0.006:0.010:4"
     ref = bifurcation("l_lambda", values, classify=SpreadClassifier(), **kw)
+    one_run_per_batch(monkeypatch)
     out = tmp_path / "b.parquet"
     stop = InterruptOnce(str(tmp_path / "marker"), 3)
     with pytest.raises(KeyboardInterrupt):
@@ -118,12 +120,13 @@ def test_what_a_killed_deletion_left_is_removed_by_the_next_run(tmp_path, refere
     assert mine.exists()  # this process still runs
 
 
-def test_an_interrupted_force_run_over_another_output_resumes(tmp_path, reference):
+def test_an_interrupted_force_run_over_another_output_resumes(tmp_path, monkeypatch, reference):
     """--force over an output of another configuration, stopped by Ctrl-C, then --resume:
     the checkpoint is this configuration's, so the resume finishes it and replaces the
     output (what --force asked); without that checkpoint the foreign output is refused."""
     out = tmp_path / "m.parquet"
     regime_map(X, Y, classify=SpreadClassifier(), out=out, **{**GRID, "seed": 4})
+    one_run_per_batch(monkeypatch)
     stop = InterruptOnce(str(tmp_path / "marker"), 11)
     with pytest.raises(KeyboardInterrupt):
         regime_map(X, Y, classify=stop, out=out, force=True, flush_interval=0.0, **GRID)
@@ -136,7 +139,7 @@ def test_an_interrupted_force_run_over_another_output_resumes(tmp_path, referenc
         regime_map(X, Y, classify=stop, out=out, resume=True, **{**GRID, "seed": 4})
 
 
-def test_a_file_made_at_the_output_after_the_interruption_is_not_overwritten(tmp_path):
+def test_a_file_made_at_the_output_after_the_interruption_is_not_overwritten(tmp_path, monkeypatch):
     """Ctrl-C, then another command writes the free output names, then --resume: refused,
     the files kept (the resume replaced them silently: it took any foreign output beside
     its checkpoint for one a --force run had been asked to replace)."""
@@ -144,7 +147,7 @@ def test_a_file_made_at_the_output_after_the_interruption_is_not_overwritten(tmp
 
     from chaoscam.sweep._common import companion
 
-    out, _, stop = _interrupted(tmp_path)
+    out, _, stop = _interrupted(tmp_path, monkeypatch)
     made = {p: p.write_bytes(b"someone else's") for p in (out, companion(out, "cells"))}
     for path in made:
         with pytest.raises(FileExistsError, match="not there.*when the interrupted run"):
@@ -268,11 +271,11 @@ def test_a_full_disk_at_the_end_says_what_is_kept_and_resumes(tmp_path, monkeypa
 def test_an_error_that_is_not_the_disk_is_not_reworded(tmp_path, monkeypatch):
     """A lost connection (an OSError) during the runs was reported as a save failure ("fix
     the cause (free space)"), its type lost; only a disk that takes no more is reworded."""
-    from chaoscam.sweep import _batch
+    from chaoscam.sweep import _engine
 
     def lost(*args, **kwargs):
         raise ConnectionError("scheduler closed the connection")
 
-    monkeypatch.setattr(_batch, "run_plan", lost)
+    monkeypatch.setattr(_engine, "run_plan", lost)
     with pytest.raises(ConnectionError, match="^scheduler closed the connection$"):
         regime_map(X, Y, classify=SpreadClassifier(), out=tmp_path / "m.parquet", **GRID)

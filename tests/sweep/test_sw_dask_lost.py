@@ -1,6 +1,6 @@
 """A lost Dask scheduler, or no Dask worker: the finished runs saved, one line saying how to
 resume (no FuturesCancelledError traceback, no silent wait), and --resume on local
-processes ends with the table of an uninterrupted run."""
+threads ends with the table of an uninterrupted run."""
 
 import json
 import os
@@ -16,7 +16,7 @@ import pytest
 
 from chaoscam.cli import main
 from chaoscam.sweep import checkpoint_dir
-from chaoscam.sweep._checkpoint import decode_part
+from chaoscam.sweep._store import decode_part
 
 from ._helpers import frames_equal
 from .test_sw_cli import CLS, MAP, ROOT, SLOW, _start, _wait_for_parts, uninterrupted  # noqa: F401
@@ -77,12 +77,12 @@ def _dask_cluster(tmp_path, workers: int):
 def test_scheduler_killed_mid_run_saves_and_resumes_locally(tmp_path, uninterrupted):  # noqa: F811
     """SIGKILL of the Dask scheduler mid-map: exit 1 with one line naming the lost scheduler
     and --resume, no traceback; the checkpoint holds the finished runs, and --resume on
-    local processes ends with the uninterrupted table."""
+    local threads ends with the uninterrupted table."""
     out = tmp_path / "m.parquet"
     args = [*MAP, "--checkpoint-interval", "0", "--out", str(out)]
     args[args.index(CLS)] = SLOW
     with _dask_cluster(tmp_path, workers=1) as (sched, address):
-        proc = _start([*args, "--scheduler", address])
+        proc = _start([*args, "--scheduler", address], batch=1)  # a part per run
         try:
             _wait_for_parts(out, 2, proc)
             t_kill = time.monotonic()

@@ -1,7 +1,7 @@
 """A sweep's fate horizon: runs not labelled periodic go on, to see whether they stay.
 
 (omega, xi) = (25 rad/s, 0.67) is chaotic over its first 20 s and leaves the cam's reach
-at t = 23.1 s (transient chaos); (25, 0.40) is a certified period 2. Both engines must
+at t = 23.1 s (transient chaos); (25, 0.40) is a certified period 2. The engine must
 continue exactly the runs not labelled periodic, with the same bits as a direct
 ``simulate`` to the horizon, and leave the labels alone.
 """
@@ -22,8 +22,8 @@ KW = dict(duration=20.0, transient=10.0, fate=40.0, workers=2)
 
 
 @pytest.fixture(scope="module")
-def maps():
-    return {e: regime_map(OMEGA, XI, engine=e, **KW) for e in ("ensemble", "process")}
+def rmap():
+    return regime_map(OMEGA, XI, **KW)
 
 
 def _left_at(p: Params, index: int) -> float:
@@ -33,27 +33,21 @@ def _left_at(p: Params, index: int) -> float:
     return float(tr.section["t"].iloc[-1])
 
 
-def test_chaos_that_leaves_later_is_recorded_and_the_label_kept(maps):
-    for engine, rm in maps.items():
-        rows = rm.realizations.set_index("xi")
-        per, cha = rows.loc[0.4], rows.loc[0.67]
-        assert per["label"] == "periodic" and per["period"] == 2, engine
-        assert pd.isna(per["fate"]) and math.isnan(per["left_at"]), engine  # not continued
-        assert cha["label"] == "chaotic" and cha["status"] == "OK", engine  # label kept
-        assert cha["fate"] == "LEFT_REACH", engine
-        p = Params(omega=25.0, xi=0.67)
-        assert cha["left_at"] == _left_at(p, realization_index(int(cha["cell"]), 0)), engine
-        assert 22.6 < cha["left_at"] < 23.6, engine
-        cells = rm.cells.set_index("xi")
-        assert cells.loc[0.67, "n_transient"] == 1 and cells.loc[0.4, "n_transient"] == 0
-        assert rm.config["fate"] == 40.0
-
-
-def test_the_engines_agree_on_the_fate(maps):
-    cols = ["cell", "label", "fate", "left_at"]
-    a = maps["ensemble"].realizations[cols]
-    b = maps["process"].realizations[cols]
-    pd.testing.assert_frame_equal(a, b)
+def test_chaos_that_leaves_later_is_recorded_and_the_label_kept(rmap):
+    """The chaotic run is continued to the horizon and leaves where a direct run to it
+    leaves (the same bits); the periodic one is not continued; the labels are kept."""
+    rows = rmap.realizations.set_index("xi")
+    per, cha = rows.loc[0.4], rows.loc[0.67]
+    assert per["label"] == "periodic" and per["period"] == 2
+    assert pd.isna(per["fate"]) and math.isnan(per["left_at"])  # not continued
+    assert cha["label"] == "chaotic" and cha["status"] == "OK"  # label kept
+    assert cha["fate"] == "LEFT_REACH"
+    p = Params(omega=25.0, xi=0.67)
+    assert cha["left_at"] == _left_at(p, realization_index(int(cha["cell"]), 0))
+    assert 22.6 < cha["left_at"] < 23.6
+    cells = rmap.cells.set_index("xi")
+    assert cells.loc[0.67, "n_transient"] == 1 and cells.loc[0.4, "n_transient"] == 0
+    assert rmap.config["fate"] == 40.0
 
 
 def test_a_run_that_stays_is_recorded_as_staying():
@@ -77,34 +71,28 @@ def settling():
     the period-6 window; a run whose motion settles (xi = 0.28 before 2026-11-28's eighth
     session) was not found again among 275 (omega, xi) cells."""
     kw = dict(duration=20.0, transient=10.0, fate=100.0, workers=1)
-    omega = Axis("omega", (Params().omega,))
-    return {e: regime_map(Axis("xi", (0.3459,)), omega, engine=e, **kw)
-            for e in ("ensemble", "process")}  # fmt: skip
+    return regime_map(Axis("xi", (0.3459,)), Axis("omega", (Params().omega,)), **kw)
 
 
 def test_chaos_that_settles_later_gets_the_verdict_at_the_horizon(settling):
-    """The fate run's last half is classified (certificate included): periodic 6, on both
-    engines alike; the label over the recorded window is kept, the cell counts the run as
-    settled, the figure marks the cell with ->P6 and the sentence names it."""
+    """The fate run's last half is classified (certificate included): periodic 6; the label
+    over the recorded window is kept, the cell counts the run as settled, the figure marks
+    the cell with ->P6 and the sentence names it."""
     from matplotlib.figure import Figure
 
-    from chaoscam.experiments._sensitivity import transient_finding
+    from chaoscam.paper._sensitivity import transient_finding
     from chaoscam.report._sweep_figures import SETTLED_MARK, plot_dominant
 
-    cols = ["label", "fate", "left_at", "fate_label", "fate_period"]
-    for engine, rm in settling.items():
-        row = rm.realizations.iloc[0]
-        assert row["label"] == "chaotic" and row["fate"] == "OK", engine
-        assert (row["fate_label"], row["fate_period"]) == ("periodic", 6), engine
-        cell = rm.cells.iloc[0]
-        assert (cell["n_settled"], cell["settled_period"], cell["n_transient"]) == (1, 6, 0)
-    a, b = (settling[e].realizations[cols] for e in ("ensemble", "process"))
-    pd.testing.assert_frame_equal(a, b)
+    row = settling.realizations.iloc[0]
+    assert row["label"] == "chaotic" and row["fate"] == "OK"
+    assert (row["fate_label"], row["fate_period"]) == ("periodic", 6)
+    cell = settling.cells.iloc[0]
+    assert (cell["n_settled"], cell["settled_period"], cell["n_transient"]) == (1, 6, 0)
     ax = Figure().subplots()
-    plot_dominant(settling["process"].cells, "xi", "omega", ax)
+    plot_dominant(settling.cells, "xi", "omega", ax)
     assert [t.get_text() for t in ax.texts] == [f"{SETTLED_MARK}P6"]
     assert any("runs periodic (n)\nlater" in t.get_text() for t in ax.get_legend().get_texts())
-    s = transient_finding(settling["process"].realizations, 100.0, "value", name=lambda r: "here")
+    s = transient_finding(settling.realizations, 100.0, "value", name=lambda r: "here")
     assert "the 1 value labelled chaotic stays in the cam's reach." in s
     assert "1 of them is periodic on the continued run's last half (period 6;" in s
     assert "(here): 1 labelled chaotic settles later." in s
@@ -151,24 +139,24 @@ def test_resuming_with_another_horizon_is_refused(tmp_path):
         regime_map(OMEGA, Axis("xi", (0.4,)), fate=4.0, resume=True, **kw)
 
 
-def test_the_map_figure_marks_transient_cells(maps):
+def test_the_map_figure_marks_transient_cells(rmap):
     from matplotlib.figure import Figure
 
     from chaoscam.report._sweep_figures import TRANSIENT_MARK, plot_dominant
 
     ax = Figure().subplots()
-    plot_dominant(maps["ensemble"].cells, "omega", "xi", ax)
+    plot_dominant(rmap.cells, "omega", "xi", ax)
     texts = [t.get_text() for t in ax.texts]
     assert sorted(texts) == ["P2", TRANSIENT_MARK]
     assert any("transient" in t.get_text() for t in ax.get_legend().get_texts())
     ax = Figure().subplots()
-    plot_dominant(maps["ensemble"].cells.assign(n_transient=0), "omega", "xi", ax)
+    plot_dominant(rmap.cells.assign(n_transient=0), "omega", "xi", ax)
     assert [t.get_text() for t in ax.texts if t.get_text()] == ["P2"]
     assert not any("transient" in t.get_text() for t in ax.get_legend().get_texts())
 
 
 def test_the_report_sentence_is_computed_from_the_rows():
-    from chaoscam.experiments._sensitivity import transient_finding
+    from chaoscam.paper._sensitivity import transient_finding
 
     nan = np.nan
     rows = pd.DataFrame(
@@ -194,32 +182,33 @@ def test_the_report_sentence_is_computed_from_the_rows():
 
 
 def test_the_time_estimate_counts_the_horizon_for_every_run(monkeypatch):
-    """The budget check sees the fate runs as an upper bound: factor 1 + fate / duration."""
-    import chaoscam.sweep._regime as regime
+    """The budget check sees the fate runs as an upper bound: the sweep's estimated time is
+    1 + fate / duration times the one without a horizon."""
+    import chaoscam.simulation
 
-    seen = {}
+    seen = []
 
     class Stop(Exception):
         pass
 
-    def spy(base, **kw):
-        seen.update(kw)
+    def spy(job, **kw):
+        seen.append(job.seconds)
         raise Stop
 
-    monkeypatch.setattr(regime, "check_sweep_budget", spy)
+    monkeypatch.setattr(chaoscam.simulation, "check_budget", spy)
     with pytest.raises(Stop):
         regime_map(OMEGA, XI, duration=20.0, fate=300.0, workers=1)
-    assert seen["factor"] == pytest.approx(1 + 300.0 / 20.0)
     with pytest.raises(Stop):
         regime_map(OMEGA, XI, duration=20.0, workers=1)
-    assert seen["factor"] == 1
+    with_fate, without = seen
+    assert with_fate == pytest.approx((1 + 300.0 / 20.0) * without, rel=1e-12)
 
 
-def test_the_html_report_summary_counts_the_transient_runs(maps, tmp_path):
+def test_the_html_report_summary_counts_the_transient_runs(rmap, tmp_path):
     from chaoscam.cli import main
 
     path = tmp_path / "m.parquet"
-    maps["ensemble"].to_parquet(path)
+    rmap.to_parquet(path)
     out = tmp_path / "r.html"
     assert main(["report", str(path), "--out", str(out)]) == 0
     text = out.read_text()
@@ -264,11 +253,10 @@ def test_the_report_clause_is_empty_when_no_run_was_continued():
 def test_a_horizon_without_a_whole_late_period_is_not_judged():
     """A fate run whose last half holds no whole cam period (a horizon just past a short
     run) crashed the sweep in the classifier (no Jacobian); it is now left unjudged."""
-    for engine in ("process", "ensemble"):
-        rm = regime_map(Axis("omega", (42.5,)), Axis("xi", (0.3,)), duration=0.05,
-                        transient=0.0, fate=0.1, workers=1, engine=engine)  # fmt: skip
-        row = rm.realizations.iloc[0]
-        assert row["fate"] == "OK" and row["fate_label"] is None, engine
+    rm = regime_map(Axis("omega", (42.5,)), Axis("xi", (0.3,)), duration=0.05, transient=0.0,
+                    fate=0.1, workers=1)  # fmt: skip
+    row = rm.realizations.iloc[0]
+    assert row["fate"] == "OK" and row["fate_label"] is None
 
 
 def test_the_summary_says_nothing_of_settling_where_nothing_was_judged():
@@ -299,7 +287,7 @@ def test_the_sentence_tells_a_settling_from_a_verdict_that_needed_longer():
     """(omega, xi) = (45, 0.20) is undetermined over 10 s and periodic 11 (to the band
     tolerance, not certified) on 150-300 s, where it is the same motion (period 22 at dt,
     bands 4e-7 rad): the sentence said it "settles on a periodic orbit ... certified"."""
-    from chaoscam.experiments._sensitivity import transient_finding
+    from chaoscam.paper._sensitivity import transient_finding
 
     rows = pd.DataFrame(
         {
@@ -316,58 +304,26 @@ def test_the_sentence_tells_a_settling_from_a_verdict_that_needed_longer():
     assert "certified" not in s
 
 
-def test_fate_runs_continued_from_the_batch_copy_equal_runs_made_again():
-    """The ensemble engine continues a batch's fate runs from its resumable copy; their
-    fields (status, where it left, the verdict on the last half) equal those of runs made
-    again from t = 0, and a horizon whose last half would start before the transient is run
-    again (the rows judged would be missing from a continued run)."""
-    from chaoscam.integrate import simulate_ensemble
-    from chaoscam.sweep._batch_run import _continues, _fates
+def test_fate_runs_continued_from_the_batch_copy_equal_runs_made_again(monkeypatch):
+    """The engine continues a batch's fate runs from its resumable copy; their fields
+    (status, where it left, the verdict on the last half) equal those of runs made again
+    from t = 0, and a horizon whose last half would start before the transient is run again
+    (the rows judged would be missing from a continued run)."""
+    from chaoscam.sweep import _runs
 
     plist = [Params(omega=25.0, xi=0.67), Params(omega=25.0, xi=0.45)]  # leaves; stays
-    run = dict(seed=1, duration=20.0, transient=10.0, tangent=True)
-    kept = simulate_ensemble(plist, [3, 5], resumable=True, **run)
-    plain = simulate_ensemble(plist, [3, 5], **run)
-    assert _continues(kept, plist, 40.0) and not _continues(plain, plist, 40.0)
-    assert not _continues(kept, plist, 20.5)  # last half from ~10.1 s: too near the transient
-    continued = _fates(kept, plist, [0, 1], 1, 40.0)
-    again = _fates(plain, plist, [0, 1], 1, 40.0)
+    run = dict(indices=[3, 5], seed=1, duration=20.0, transient=10.0, tangent=True)
+    kept = chaoscam.solve(plist, resumable=True, **run)
+    plain = chaoscam.solve(plist, **run)
+    calls = []
+    real = _runs.extend
+    monkeypatch.setattr(_runs, "extend", lambda *a, **k: calls.append(1) or real(*a, **k))
+    continued = _runs._fates(kept, [0, 1], 40.0)
+    assert calls == [1]  # continued from the copy, not run again
+    again = _runs._fates(plain, [0, 1], 40.0)
+    assert calls == [1]  # no copy: run again
     assert continued == again
     assert continued[0]["fate"] == "LEFT_REACH" and 22.6 < continued[0]["left_at"] < 23.6
     assert continued[1]["fate"] == "OK" and continued[1]["fate_label"] == "chaotic"
-
-
-def test_the_process_engines_fate_runs_continued_equal_runs_made_again(monkeypatch):
-    """The process engine continues a task's fate run from its resumable run
-    (extend_trajectory) where fate_continues, with the fields of the run made again from
-    t = 0; without a copy, or for a horizon too near the transient, it runs it again."""
-    from types import SimpleNamespace
-
-    import chaoscam._extend
-    from chaoscam.sweep import _tasks
-
-    task = SimpleNamespace(seed=1, sim_index=3, transient=10.0, fate=40.0)
-    calls = []
-    real = chaoscam._extend.extend_trajectory
-    monkeypatch.setattr(
-        chaoscam._extend, "extend_trajectory", lambda *a, **k: calls.append(1) or real(*a, **k)
-    )
-    for p, fate in (
-        (Params(omega=25.0, xi=0.67), "LEFT_REACH"),
-        (Params(omega=25.0, xi=0.45), "OK"),
-    ):
-        run = dict(duration=20.0, transient=10.0, seed=1, index=3, series=False, tangent=True)
-        kept = chaoscam.simulate(p, resumable=True, **run)
-        plain = chaoscam.simulate(p, **run)
-        n = len(calls)
-        continued = _tasks._fate(p, task, kept)
-        assert len(calls) == n + 1  # continued, not run again
-        again = _tasks._fate(p, task, plain)
-        assert len(calls) == n + 1  # no copy: run again
-        assert continued == again and continued["fate"] == fate
-        near = SimpleNamespace(seed=1, sim_index=3, transient=10.0, fate=20.5)
-        _tasks._fate(p, near, kept)
-        assert len(calls) == n + 1  # last half from ~10.1 s: run again
-    assert _tasks.fate_continues(True, 10.0, 40.0, 0.2) and not _tasks.fate_continues(
-        False, 10.0, 40.0, 0.2
-    )
+    _runs._fates(kept, [0, 1], 20.5)
+    assert calls == [1]  # last half from ~10.1 s: too near the transient, run again

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from chaoscam import ParameterError, Params
+from chaoscam import Numerics, ParameterError, Params
 from chaoscam.sweep import Axis, SweepError, parse_range, realization_index
 from chaoscam.sweep._grid import validate_grid
 
@@ -59,11 +59,13 @@ def test_realization_index_is_a_bijection_independent_of_grid_shape():
 def test_grid_validation_names_the_bad_point():
     """sigma < 0 and mu <= 0 are refused before any run, naming the field."""
     with pytest.raises(ParameterError, match="l_lambda_sigma"):
-        validate_grid(Params(), [Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (-1e-3,))])
+        validate_grid(
+            Params(), Numerics(), [Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (-1e-3,))]
+        )
     with pytest.raises(ParameterError, match="l_lambda"):
-        validate_grid(Params(), [Axis("l_lambda", (0.0, 0.008)), Axis("xi", (0.4,))])
+        validate_grid(Params(), Numerics(), [Axis("l_lambda", (0.0, 0.008)), Axis("xi", (0.4,))])
     with pytest.raises(SweepError, match="repeat"):
-        validate_grid(Params(), [Axis("xi", (0.4,)), Axis("xi", (0.5,))])
+        validate_grid(Params(), Numerics(), [Axis("xi", (0.4,)), Axis("xi", (0.5,))])
 
 
 def test_axes_can_name_exact_values():

@@ -14,7 +14,13 @@ from chaoscam.sweep import (
     verdict_fields,
 )
 
-from ._helpers import InterruptOnce, ParityClassifier, SpreadClassifier, frames_equal
+from ._helpers import (
+    InterruptOnce,
+    ParityClassifier,
+    SpreadClassifier,
+    frames_equal,
+    one_run_per_batch,
+)
 
 MU = Axis("l_lambda", (0.006, 0.010))
 SIGMA = Axis("l_lambda_sigma", (0.0, 0.002))
@@ -100,9 +106,10 @@ def test_adaptive_sampling_adds_batches_until_target_or_cap():
     assert list(r.loc[r["cell"] == 1, "index"]) == list(range(6))
 
 
-def test_interrupt_then_resume_gives_the_uninterrupted_table(tmp_path, reference):
+def test_interrupt_then_resume_gives_the_uninterrupted_table(tmp_path, monkeypatch, reference):
     """Ctrl-C mid-run saves the finished rows; resume finishes to the identical table and
     recomputes nothing that was saved; the finished output is then reused as is."""
+    one_run_per_batch(monkeypatch)
     out = tmp_path / "m.parquet"
     cls = InterruptOnce(str(tmp_path / "marker"), victim=realization_index(3, 1))
     with pytest.raises(SweepInterrupted, match="--resume") as err:
@@ -207,3 +214,24 @@ def test_a_custom_classifier_label_outside_the_four_is_refused():
         with pytest.raises(TaskFailed, match=named):
             regime_map("xi=0.2", "l_lambda_sigma=0", classify=classify, realizations=1,
                        duration=0.3, workers=1)  # fmt: skip
+
+
+def test_the_default_realizations_are_20_in_a_random_cell_and_1_in_a_deterministic_one():
+    """realizations=None: N = 20 when some cell has a random line length (sigma > 0), and a
+    deterministic cell (sigma = 0) runs once; a grid of deterministic cells only runs each
+    once, and records N = 1."""
+    kw = dict(seed=1, duration=0.3, transient=0.1, classify=ParityClassifier(), workers=1)
+    mixed = regime_map(Axis("l_lambda", (0.008,)), SIGMA, **kw)
+    assert list(mixed.cells["n"]) == [1, 20] and mixed.config["realizations"] == 20
+    fixed = regime_map(Axis("l_lambda", (0.008,)), Axis("xi", (0.3, 0.4)), **kw)
+    assert list(fixed.cells["n"]) == [1, 1] and fixed.config["realizations"] == 1
+
+
+def test_progress_none_shows_a_bar_only_on_a_terminal(capsys):
+    """progress=None (the default) shows the bar when stderr is a terminal: not here, where
+    the tests capture it; progress=True shows it anyway."""
+    kw = dict(realizations=1, duration=0.3, transient=0.1, classify=ParityClassifier(), workers=1)
+    regime_map(Axis("l_lambda", (0.008,)), Axis("xi", (0.3,)), progress=None, **kw)
+    assert "regime map" not in capsys.readouterr().err
+    regime_map(Axis("l_lambda", (0.008,)), Axis("xi", (0.3,)), progress=True, **kw)
+    assert "regime map: 100%" in capsys.readouterr().err

@@ -4,10 +4,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chaoscam import Params, classify_trajectory
+from chaoscam import Numerics, Params, classify
 from chaoscam.sweep import (
     Axis,
-    DefaultClassifier,
     bifurcation,
     read_regime_map,
     regime_map,
@@ -20,8 +19,8 @@ BASE = Params(l_lambda_sigma=0.002)
 
 @pytest.fixture(scope="module")
 def rmap():
-    """Two cells, two realizations each (sigma > 0: different realizations), on the
-    ensemble engine (batch members), classified by the default classifier (not extended)."""
+    """Two cells, two realizations each (sigma > 0: different realizations), run as batch
+    members, classified by the package's verdict (not extended)."""
     return regime_map(
         Axis("omega", (20.0, 30.0)),
         Axis("xi", (0.42,)),
@@ -29,7 +28,7 @@ def rmap():
         realizations=2,
         duration=3.0,
         transient=2.0,
-        classify=DefaultClassifier(extend_to=None),  # no extension: a cheap test
+        extend_to=None,  # no extension: a cheap test
         workers=1,
         progress=False,
     )
@@ -38,15 +37,16 @@ def rmap():
 def test_regime_map_row_replays_its_own_run(rmap):
     """Every realization replayed alone has the sweep's section count, impact count and
     label; the two realizations of a cell are different runs."""
-    assert rmap.config["engine"] == "ensemble"
     impacts = []
     for row in rmap.realizations.itertuples():
-        p = replay_params(rmap, row)
+        p, num = replay_params(rmap, row)
         assert (p.omega, p.xi, p.l_lambda_sigma) == (row.omega, row.xi, 0.002)
+        assert num == Numerics()
         tr = replay(rmap, row)
         assert len(tr.section) == row.n_section
         assert tr.stats["n_impacts"] == row.n_impacts
-        assert classify_trajectory(tr, extend_to=None).label == row.label
+        (verdict,) = classify(tr, extend_to=None)
+        assert verdict.label == row.label
         impacts.append(tr.stats["n_impacts"])
     assert len(set(impacts)) > 1
 
@@ -105,10 +105,11 @@ def test_replay_refined_is_the_same_realization_at_a_finer_step(rmap):
 
     row = rmap.realizations.iloc[0]
     fine = replay(rmap, row, tangent=False, refine=2)
-    assert fine.params.dt == BASE.dt / 4
-    p = replay_params(rmap, row).refined().refined()
-    direct = simulate(p, duration=3.0, transient=2.0, seed=int(row["seed"]),
-                      index=int(row["sim_index"]), output_dt=1e-3)  # fmt: skip
+    assert fine.numerics.dt == Numerics().dt / 4
+    p, num = replay_params(rmap, row)
+    direct = simulate(p, num.refined().refined(), duration=3.0, transient=2.0,
+                      seed=int(row["seed"]), index=int(row["sim_index"]),
+                      output_dt=1e-3)  # fmt: skip
     np.testing.assert_array_equal(fine.section["theta_f"], direct.section["theta_f"])
     assert (
         fine.section["theta_f"].to_numpy()[-1]

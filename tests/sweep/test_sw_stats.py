@@ -51,7 +51,7 @@ def test_summary_fractions_sum_to_one_and_keep_non_regular_labels():
             "cell": [0, 0, 0, 1, 1],
             "label": ["chaotic", "chaotic", "periodic", "left_reach", "periodic"],
             "truncated_mass": [0.1] * 3 + [0.0] * 2,
-            "ev_lyapunov_model": [1.0, 3.0, np.nan, np.nan, -2.0],
+            "ev_lyapunov_1": [1.0, 3.0, np.nan, np.nan, -2.0],
         }
     )
     cells = pd.DataFrame(
