@@ -24,8 +24,8 @@ import time
 
 import numpy as np
 
-from chaoscam import Params
-from chaoscam.tangent import lyapunov_spectrum, periodic_orbit
+from chaoscam import Numerics, Params, simulate
+from chaoscam.verdict import lyapunov_spectrum, periodic_orbit
 
 STICKING = {"e": 0.02}  # the labelled set's sticking period 1
 STICKING_SEED = (-3.7812e-09, 1.1038714)  # its section point (theta_f [rad], theta_f' [rad/s])
@@ -37,17 +37,17 @@ def _kinds(tr) -> np.ndarray:
     return np.array([(kind == name).sum() for name in ("macro", "micro", "chatter_end")])
 
 
-def exponent_row(p: Params, duration: float) -> tuple[float, float, np.ndarray, float, float]:
+def exponent_row(
+    p: Params, num: Numerics, duration: float
+) -> tuple[float, float, np.ndarray, float, float]:
     """(lambda_1 mean, its standard error, impacts per second by kind, closings per second
     left without a jump, wall seconds)."""
-    from chaoscam._simulate import simulate
-
     t0 = time.perf_counter()
     lam, var, kinds, slow = [], [], np.zeros(3), 0
     for omega_f0 in (None, 0.05):  # two initial conditions on the same attractor
         q = p.replace(omega_f0=omega_f0)
-        tr = simulate(q, duration=duration, transient=60.0, series=False, tangent=True)
-        s = lyapunov_spectrum(trajectory=tr)
+        tr = simulate(q, num, duration=duration, transient=60.0, series=False, tangent=True)
+        s = lyapunov_spectrum(tr)
         lam.append(s.exponents[0])
         var.append(s.stderr[0] ** 2)
         kinds += _kinds(tr)
@@ -57,32 +57,34 @@ def exponent_row(p: Params, duration: float) -> tuple[float, float, np.ndarray, 
     return float(np.mean(lam)), se, kinds / span, slow / span, time.perf_counter() - t0
 
 
-def _table(runs: list[tuple[Params, str]], duration: float) -> None:
+def _table(runs: list[tuple[Params, Numerics, str]], duration: float) -> None:
     print("| run | lambda_1 [1/s] (+- se) | macro / micro / chatter ends per s", end="")
     print(" | closings without a jump per s | wall [s] |")
     print("|---|---|---|---|---|")
-    for p, label in runs:
-        lam, se, kinds, slow, wall = exponent_row(p, duration)
+    for p, num, label in runs:
+        lam, se, kinds, slow, wall = exponent_row(p, num, duration)
         rate = " / ".join(f"{v:.0f}" for v in kinds)
         row = f"| {label} | {lam:+.2f} +- {se:.2f} | {rate} | {slow:.2f} | {wall:.1f} |"
         print(row, flush=True)
 
 
 def main(quick: bool) -> None:
-    from chaoscam._simulate import simulate
-
     duration = 180.0 if quick else 360.0
     dts = (2e-6, 1e-6, 5e-7) if quick else (2e-6, 1e-6, 5e-7, 2.5e-7, 1.25e-7)
     print(f"Default model, lambda_1 from the tangent dynamics ({duration - 60:.0f} s x 2 runs)")
-    runs = [(Params(dt=dt), f"rk4, dt = {dt:g}") for dt in dts]
-    runs += [(Params(dt=dt, integrator="adaptive"), f"adaptive, dt = {dt:g}") for dt in dts[:3]]
+    p = Params()
+    runs = [(p, Numerics(dt=dt), f"rk4, dt = {dt:g}") for dt in dts]
+    runs += [
+        (p, Numerics(dt=dt, integrator="adaptive"), f"adaptive, dt = {dt:g}") for dt in dts[:3]
+    ]
     _table(runs, duration)
 
     print(f"\nAgainst v_chatter ({duration - 60:.0f} s x 2 runs; rk4 at dt = 5e-7 s)")
     runs = []
     for v in (1e-5, 1e-6, 1e-7):
-        runs.append((Params(dt=5e-7, v_chatter=v), f"rk4, v_chatter = {v:g}"))
-        runs.append((Params(integrator="adaptive", v_chatter=v), f"adaptive, v_chatter = {v:g}"))
+        q = Params(v_chatter=v)
+        runs.append((q, Numerics(dt=5e-7), f"rk4, v_chatter = {v:g}"))
+        runs.append((q, Numerics(integrator="adaptive"), f"adaptive, v_chatter = {v:g}"))
     _table(runs, duration)
 
     print("\nSticking period 1 (e = 0.02 m): dominant Floquet multiplier")
@@ -92,12 +94,12 @@ def main(quick: bool) -> None:
     print(" | wall [s] |")
     print("|---|---|---|---|---|")
     for dt in (4e-6, 2e-6, 1e-6, 5e-7, 2.5e-7):
-        p = Params(**STICKING).replace(dt=dt)
+        p, num = Params(**STICKING), Numerics(dt=dt)
         t0 = time.perf_counter()
-        orbit = periodic_orbit(p, STICKING_SEED, 1, tol=1e-9)
+        orbit = periodic_orbit(p, STICKING_SEED, 1, numerics=num, tol=1e-9)
         wall = time.perf_counter() - t0
         q = p.replace(theta_f0=float(orbit.points[0][0]), omega_f0=float(orbit.points[0][1]))
-        tr = simulate(q, duration=p.cam_period, series=False)
+        tr = simulate(q, num, duration=p.cam_period, series=False)
         kinds = _kinds(tr)
         mu = float(np.abs(orbit.multipliers).max())
         counts = "/".join(str(int(v)) for v in kinds)

@@ -1,13 +1,14 @@
 """Kick audit of the report's periodic verdicts: do finite perturbations agree with Newton?
 
 A periodic verdict of the deterministic model is certified by Newton's multipliers on the
-grid and at dt/2 (``chaoscam._certify.certify``); kicks (``_certify._kicked``: kicks of 1e-7
+grid and at dt/2 (``chaoscam.verdict.certify``); kicks (its ``_kicked``: kicks of 1e-7
 and 1e-6 rad in ±θ_f, 30× that in rad/s in ±θ̇_f, followed for 40 orbit periods at dt and at
 dt/2) are asked only where the multipliers leave the orbit open. This script asks the kicks
 of every periodic verdict of the full report's deterministic sweeps (reports/paper-data,
 written by ``chaoscam paper``; not in the repository): it runs each realization again alone
-to the length it was classified at (``simulate`` with the sweep's parameters, seed, index and
-transient, for the recorded seconds of the verdict: an extended run continues bit for bit),
+to the length it was classified at (``simulate`` with the sweep's parameters, numerics,
+seed, index and transient, for the recorded seconds of the verdict: an extended run continues
+bit for bit),
 applies the kick certificate's own rule from its last section point, and prints one line per
 verdict and the counts. A verdict the kicks refuse is one where the multipliers and finite
 perturbations disagree: the line gives both.
@@ -40,9 +41,9 @@ from typing import NamedTuple
 import numpy as np
 from _report_data import DATA, deterministic_rows
 
-from chaoscam import Params, simulate
-from chaoscam._certify import MODEL_ATOL, _kicked, _widest_band
-from chaoscam.tangent import kick_test, periodic_orbit
+from chaoscam import Numerics, Params, simulate
+from chaoscam.verdict import MODEL_ATOL, kick_test, periodic_orbit
+from chaoscam.verdict._certificate import _kicked, _Run, _widest_band
 
 DIAGRAMS = (
     "fig4",
@@ -65,6 +66,7 @@ class Job(NamedTuple):
     stage: str
     what: str
     params: Params
+    numerics: Numerics
     duration: float  # [s] the transient and the verdict's recorded seconds
     transient: float
     seed: int
@@ -74,12 +76,13 @@ class Job(NamedTuple):
 
 def _jobs(data: Path, stages):
     """A :class:`Job` per periodic verdict of the deterministic model."""
-    for stage, sweep, row, p, what in deterministic_rows(data, stages, ["periodic"]):
+    for stage, sweep, row, p, num, what in deterministic_rows(data, stages, ["periodic"]):
         transient = float(sweep.config["transient"])
         yield Job(
             stage,
             what,
             p,
+            num,
             transient + float(row.recorded_s),
             transient,
             int(row.seed),
@@ -88,8 +91,10 @@ def _jobs(data: Path, stages):
         )
 
 
-def _points(p, duration, transient, seed, index):
-    tr = simulate(p, duration=duration, transient=transient, seed=seed, index=index, series=False)
+def _points(p, num, duration, transient, seed, index):
+    tr = simulate(
+        p, num, duration=duration, transient=transient, seed=seed, index=index, series=False
+    )
     sec = tr.section
     return tr.status.name, sec.loc[sec["k"] > 0, ["theta_f", "omega_f"]].to_numpy(dtype=float)
 
@@ -97,9 +102,9 @@ def _points(p, duration, transient, seed, index):
 def _audit(job: Job):
     """(certified, the kick records per step, the summary in words) of the kick certificate
     from the classified run's last section point."""
-    _, points = _points(job.params, job.duration, job.transient, job.seed, job.index)
+    _, points = _points(job.params, job.numerics, job.duration, job.transient, job.seed, job.index)
     extra: dict = {}
-    ok, summary = _kicked(job.params, points, job.period, extra)
+    ok, summary = _kicked(_Run(job.params, job.numerics, points, extra), job.period)
     return ok, extra["kick_test"], summary
 
 
@@ -107,9 +112,9 @@ def _deep(args):
     """The refused verdict's realization run long at dt / f: a line in words."""
     job, f, horizon, sizes = args
     n = job.period
-    p = job.params.replace(dt=job.params.dt / f)
+    p, num = job.params, job.numerics.replace(dt=job.numerics.dt / f)
     t0 = time.perf_counter()
-    status, points = _points(p, horizon, job.transient, job.seed, job.index)
+    status, points = _points(p, num, horizon, job.transient, job.seed, job.index)
     head = f"{job.stage} {job.what} (period {n}) at dt/{f}, {horizon:g} s: "
     periods = min(DEEP_PERIODS, len(points) // (2 * n))  # at most the run's second half
     if periods < 8:
@@ -117,8 +122,8 @@ def _deep(args):
     scale = np.array([1.0, p.cam_period])
     last = points[-periods * n :] * scale
     bands = [_widest_band(last, m) for m in (n, 2 * n)]
-    orbit = periodic_orbit(p, points[-1], n)
-    test = kick_test(p, points[-1], n, kicks=sizes, periods=2 * KICK_PERIODS)
+    orbit = periodic_orbit(p, points[-1], n, numerics=num)
+    test = kick_test(p, points[-1], n, numerics=num, kicks=sizes, periods=2 * KICK_PERIODS)
     ends = [
         np.nanmax(test.growth[:, :, m], axis=1) * np.array(sizes)
         for m in (KICK_PERIODS, 2 * KICK_PERIODS)
@@ -152,7 +157,7 @@ def _audit_all(jobs, workers: int) -> list:
         for job, (ok, records, summary) in zip(jobs, pool.map(_audit, jobs), strict=True):
             steps = "; ".join(f"{r['largest_final']:.2g}, {r['bands']:.2g}" for r in records)
             print(
-                f"| {job.stage} | {job.what} | {job.period} | {job.params.dt:.3g} | {steps} "
+                f"| {job.stage} | {job.what} | {job.period} | {job.numerics.dt:.3g} | {steps} "
                 f"| {'yes' if ok else 'NO'} |",
                 flush=True,
             )
@@ -183,7 +188,7 @@ def main() -> None:
     args = ap.parse_args()
     jobs = list(_jobs(args.data, args.stages.split(",")))
     # dearest first (steps of the period over dt), so the pool ends together
-    jobs.sort(key=lambda j: -j.period * j.params.cam_period / j.params.dt)
+    jobs.sort(key=lambda j: -j.period * j.params.cam_period / j.numerics.dt)
     if args.refused_from:
         keep = _refused_in(args.refused_from)
         refused = [job for job in jobs if (job.stage, job.what) in keep]

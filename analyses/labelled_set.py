@@ -6,7 +6,7 @@ Each configuration is settled by measurements the classifier never sees:
 2. the band structure of each run's stroboscopic section: the least n for which every one of
    the n sub-sequences x_{r + k n} is narrower than BAND_RTOL of the attractor's extent (or
    than BAND_ATOL) — in both runs, with the same n;
-3. the tangent exponent λ₁ ± stderr of each run (chaoscam.tangent);
+3. the tangent exponent λ₁ ± stderr of each run (QR on its section map's Jacobians);
 4. for a candidate period of the deterministic model, Newton shooting (converged,
    |μ| < 1, the run on the orbit);
 5. a direct perturbation test: two runs from the long run's end state, one moved by
@@ -40,8 +40,9 @@ from pathlib import Path
 import numpy as np
 
 import chaoscam
-from chaoscam import Params
-from chaoscam.tangent import periodic_orbit, spectrum_from_jacobians
+from chaoscam import Numerics, Params
+from chaoscam.analysis import spectrum_from_jacobians
+from chaoscam.verdict import periodic_orbit
 
 CONFIGS: dict[str, dict] = {
     "xi=0.2": {"xi": 0.2},
@@ -110,7 +111,7 @@ def perturbation(p: Params, tr) -> tuple[float, float]:
     """(largest, last) section distance [rad] of two runs 1e-8 rad apart, over 100 s."""
     t_end, th, om = tr.final_state
     base = p.replace(theta_c0=(p.theta_c0 + p.omega * t_end) % (2 * math.pi))
-    kw = dict(duration=100.0, series=False, seed=tr.settings["seed"], index=tr.settings["index"])
+    kw = dict(duration=100.0, series=False, seed=tr.settings["seed"], index=tr.index)
     a = chaoscam.simulate(base.replace(theta_f0=th, omega_f0=om), **kw)
     b = chaoscam.simulate(base.replace(theta_f0=th + PERTURBATION, omega_f0=om), **kw)
     n = min(len(a.section), len(b.section))
@@ -127,23 +128,24 @@ def perturbation(p: Params, tr) -> tuple[float, float]:
 
 
 def measure(overrides: dict) -> dict:
-    p = Params(**overrides)
+    p, num = Params(**overrides), Numerics()
     out: dict = {"params": overrides}
     runs = {}
-    for name, q in (("dt", p), ("dt/2", p.replace(dt=p.dt / 2))):
+    for name, q in (("dt", num), ("dt/2", num.refined())):
         tr = chaoscam.simulate(
-            q, duration=TRANSIENT + RECORDED, transient=TRANSIENT, series=False, tangent=True
+            p, q, duration=TRANSIENT + RECORDED, transient=TRANSIENT, series=False, tangent=True
         )
         runs[name] = tr
         m = {"status": tr.status.name}
         if tr.ok:
             pts = tr.section[["theta_f", "omega_f"]].to_numpy()
-            n, width, extent = bands(pts, q.cam_period)
+            n, width, extent = bands(pts, p.cam_period)
             lam, se = exponent(tr)
             m.update(bands=n, band_width=width, extent=extent, lambda1=lam, stderr=se)
         out[name] = m
     tr = chaoscam.simulate(
-        p.replace(integrator="adaptive"),
+        p,
+        Numerics(integrator="adaptive"),
         duration=CROSS_TRANSIENT + CROSS_RECORDED,
         transient=CROSS_TRANSIENT,
         series=False,
@@ -160,7 +162,7 @@ def measure(overrides: dict) -> dict:
         n = out["dt"]["bands"]
         if n is not None and p.l_lambda_sigma == 0.0:
             pts = tr.section[["theta_f", "omega_f"]].to_numpy()
-            orbit = periodic_orbit(p, pts[-1], n)
+            orbit = periodic_orbit(p, pts[-1], n, numerics=num)
             out["orbit"] = {
                 "period": orbit.period,
                 "converged": orbit.converged,
@@ -263,7 +265,7 @@ def main(argv: list[str]) -> None:
     ``--force``, and it is written whole or not at all."""
     import argparse
 
-    from chaoscam._outputs import OutputError, atomic_write_bytes, check_output
+    from chaoscam.io import OutputError, atomic_write_bytes, check_output
 
     ap = argparse.ArgumentParser(
         prog="analyses/labelled_set.py", description=__doc__.splitlines()[0]

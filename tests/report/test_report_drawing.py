@@ -1,12 +1,12 @@
-"""The paper report's figures drawn on one thread beside the stages (experiments._drawing)."""
+"""The paper report's figures drawn on one thread beside the stages (paper._drawing)."""
 
 import threading
 
 import pytest
 
-from chaoscam.experiments._drawing import Drawing, draw, drawing, png_of, settle, uri_of
-from chaoscam.experiments._paper import FigureResult
-from chaoscam.report._html import FigureItem
+from chaoscam.paper import FigureResult
+from chaoscam.paper._drawing import Drawing, draw, drawing, png_of, settle, uri_of
+from chaoscam.report import FigureItem
 
 
 def _line_figure(x):
@@ -72,17 +72,17 @@ def test_a_drawings_error_is_raised_where_it_is_settled(tmp_path):
 def test_a_stage_whose_figure_fails_to_draw_is_reported_failed(tmp_path, monkeypatch):
     """In run_paper a drawing's error fails its stage, as an error of the stage itself does;
     the other stages and their figures stand."""
-    from chaoscam.experiments import run_paper
-    from chaoscam.report import _figures
+    import chaoscam.report
+    from chaoscam.paper import run_paper
 
-    real = _figures.png_bytes
+    real = chaoscam.report.png_bytes
 
     def fig5_fails(fig, dpi=96):
         if tuple(fig.get_size_inches()) == (8.0, 4.5):  # Fig. 5's size
             raise RuntimeError("no ink")
         return real(fig, dpi=dpi)
 
-    monkeypatch.setattr(_figures, "png_bytes", fig5_fails)
+    monkeypatch.setattr(chaoscam.report, "png_bytes", fig5_fails)  # what the drawing calls
     run = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 5])
     assert run.failed == ("Fig. 5: fractal stiffness: failed with RuntimeError: no ink",)
     text = run.path.read_text()
@@ -94,10 +94,10 @@ def test_a_stages_figures_are_drawn_while_the_next_stage_runs(tmp_path, monkeypa
     """Fig. 3's figure is still being built when Fig. 5's stage starts: its build waits for
     an event that stage sets, and it sees it (a stage no longer waits for its own figures,
     they are settled once every stage has run); both figures reach the report."""
-    from chaoscam.experiments import _paper, run_paper
-    from chaoscam.report import _figures
+    import chaoscam.report
+    from chaoscam.paper import _paper, run_paper
 
-    real_png, real_fig5 = _figures.png_bytes, _paper.FIGURES[5]
+    real_png, real_fig5 = chaoscam.report.png_bytes, _paper.FIGURES[5]
     next_stage, seen = threading.Event(), []
 
     def fig3_waits(fig, dpi=96):
@@ -109,7 +109,7 @@ def test_a_stages_figures_are_drawn_while_the_next_stage_runs(tmp_path, monkeypa
         next_stage.set()
         return real_fig5(*args, **kwargs)
 
-    monkeypatch.setattr(_figures, "png_bytes", fig3_waits)
+    monkeypatch.setattr(chaoscam.report, "png_bytes", fig3_waits)
     monkeypatch.setitem(_paper.FIGURES, 5, fig5_starts)
     run = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 5])
     assert seen == [True] and run.failed == ()

@@ -4,17 +4,14 @@ interval, why members stayed undetermined, and that record."""
 
 from __future__ import annotations
 
-import json
 import re
 
 import pandas as pd
-import pyarrow.parquet as pq
 import pytest
 
 from chaoscam.cli import main
 from chaoscam.report._ensemble import label_shares
-from chaoscam.report._inputs import ENSEMBLE_RECORD_KEY, EnsembleOutput
-from chaoscam.sweep._stats import wilson_interval
+from chaoscam.sweep import read_ensemble, wilson_interval
 
 
 def _ensemble(d, name, *extra):
@@ -47,13 +44,14 @@ def _rows(text: str, caption: str) -> list[list[str]]:
 
 
 def test_members_file_records_the_run(runs):
-    """The members file says what made it: parameters, seed, indices, duration, backend."""
-    meta = pq.read_schema(runs["random"]).metadata
-    record = json.loads(meta[ENSEMBLE_RECORD_KEY])
-    assert record["kind"] == "ensemble" and record["backends"] == ["cpu"]
+    """The members file says what made it: parameters, seed, indices, duration, device and
+    classifier (none without --classify)."""
+    record = read_ensemble(runs["random"]).config
+    assert record["kind"] == "ensemble" and record["device"] == "cpu"
     assert record["params"]["l_lambda_sigma"] == 0.002 and record["seed"] == 4
     assert (record["first"], record["members"], record["duration"]) == (0, 6, 2.0)
-    assert record["classify"] is True and "chunk" not in record
+    assert record["classifier"].startswith("chaoscam.classify(")
+    assert read_ensemble(runs["plain"]).config["classifier"] == "none"
 
 
 def test_report_shows_the_share_of_each_label_with_its_interval(runs, tmp_path, capsys):
@@ -98,19 +96,6 @@ def test_unclassified_members_are_counted_by_status(runs, tmp_path, capsys):
     assert [r[0] for r in _rows(text, "Members of Ensemble of 6 members")] == ["OK"]
 
 
-def test_a_file_without_its_record_is_still_read(runs, tmp_path, capsys):
-    """A members file written before the record was kept (the digest only) is reported,
-    saying that its record was not kept."""
-    table = pq.read_table(runs["random"])
-    old_keys = (ENSEMBLE_RECORD_KEY, b"chaoscam.digest")  # neither existed then
-    meta = {k: v for k, v in table.schema.metadata.items() if k not in old_keys}
-    old = tmp_path / "old.parquet"
-    pq.write_table(table.replace_schema_metadata(meta), old)
-    code, text, err = _report([old], tmp_path, capsys)
-    assert code == 0, err
-    assert "record" in text and "not kept" in text
-
-
 def test_shares_order_periods_and_undetermined_reasons():
     """Periodic members are counted per period, in the label order; undetermined members'
     reasons are counted per reason."""
@@ -136,4 +121,3 @@ def test_shares_order_periods_and_undetermined_reasons():
     ]
     assert [r["count"] for r in rows] == [1, 1, 1, 2, 1]
     assert _reasons(members) == [("too few points", 2), ("no rule", 1)]
-    assert EnsembleOutput(members, None, {}).sections is None

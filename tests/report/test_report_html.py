@@ -40,8 +40,8 @@ def _parse(text: str) -> _Collect:
 
 @pytest.fixture(scope="module")
 def outputs(tmp_path_factory):
-    """A tiny trajectory, bifurcation diagram and regime map, written as chaoscam writes them."""
-    from chaoscam.report._classify import ReportClassifier
+    """A tiny trajectory, bifurcation diagram and regime map, written as chaoscam writes them
+    (the sweeps judged by the package's verdict, as the report's runs are)."""
     from chaoscam.sweep import Axis, bifurcation, regime_map
 
     d = tmp_path_factory.mktemp("inputs")
@@ -52,7 +52,6 @@ def outputs(tmp_path_factory):
         "0.006:0.010:2",
         duration=3.0,
         transient=1.5,
-        classify=ReportClassifier(),
         workers=1,
     )
     bif.to_parquet(d / "bif.parquet")
@@ -62,7 +61,6 @@ def outputs(tmp_path_factory):
         realizations=2,
         duration=2.5,
         transient=1.0,
-        classify=ReportClassifier(),
         workers=1,
     )
     rm.to_parquet(d / "map.parquet")
@@ -113,10 +111,11 @@ def test_a_sweep_lists_every_base_field_it_changes():
     """Settings rows: every base field that differs from Params(), with its unit (a fixed
     list of nine fields hid a changed ω, ξ or e)."""
     from chaoscam.model import Params
+    from chaoscam.numerics import Numerics
     from chaoscam.report._html import _sweep_settings
 
-    base = Params(xi=0.3, omega=40.0, dt=1e-6).to_dict()
-    rows = _sweep_settings({"kind": "bifurcation", "base": base})
+    base, numerics = Params(xi=0.3, omega=40.0).to_dict(), Numerics(dt=1e-6).to_dict()
+    rows = _sweep_settings({"kind": "bifurcation", "base": base, "numerics": numerics})
     assert rows["base xi [-]"] == 0.3 and rows["base omega [rad/s]"] == 40.0
     assert rows["base dt [s]"] == 1e-6 and rows["base integrator"] == "rk4"
     assert not any("base e " in k or k == "base e [m]" for k in rows)
@@ -165,9 +164,8 @@ def test_out_must_be_html(outputs, tmp_path, capsys):
 
 def test_a_map_at_another_confidence_is_reported_at_that_level(tmp_path, capsys):
     """A map made with confidence = 0.8 says 80% where it said 95% (its intervals are at
-    80 %), and names its confidence and engine in the provenance; confidence = 95 is refused
+    80 %), and names its confidence and device in the provenance; confidence = 95 is refused
     before any run (it failed at the end, leaving a checkpoint that could not finish)."""
-    from chaoscam.report._classify import ReportClassifier
     from chaoscam.sweep import Axis, SweepError, regime_map
 
     x, y = Axis("l_lambda", (0.008,)), Axis("l_lambda_sigma", (0.002,))
@@ -175,10 +173,10 @@ def test_a_map_at_another_confidence_is_reported_at_that_level(tmp_path, capsys)
     with pytest.raises(SweepError, match=r"confidence = 95: .*\(0, 1\)"):
         regime_map(x, y, confidence=95, out=tmp_path / "bad.parquet", **kw)
     assert not list(tmp_path.iterdir())
-    rm = regime_map(x, y, confidence=0.8, classify=ReportClassifier(), **kw)
+    rm = regime_map(x, y, confidence=0.8, **kw)
     rm.to_parquet(tmp_path / "m80.parquet")
     code, text, err = _report([tmp_path / "m80.parquet"], tmp_path, capsys)
     assert code == 0, err
     assert "P(chaotic) [80% CI]" in text and "its 80% Wilson interval" in text
     assert "95%" not in text
-    assert "confidence of the intervals</td><td>0.8" in text and "<td>engine</td>" in text
+    assert "confidence of the intervals</td><td>0.8" in text and "<td>device</td><td>cpu" in text

@@ -53,7 +53,7 @@ def test_paper_rejects_an_empty_figure_list(tmp_path, capsys):
     assert main(["paper", "--quick", "--figures", "", "--out", str(tmp_path / "p.html")]) == 2
     assert "--figures '': expected numbers" in capsys.readouterr().err
     assert not (tmp_path / "p.html").exists()
-    from chaoscam.experiments import run_paper
+    from chaoscam.paper import run_paper
 
     for figures in ([], [2]):  # the API too (it ran every figure for [])
         with pytest.raises(ValueError, match="choose from"):
@@ -62,7 +62,7 @@ def test_paper_rejects_an_empty_figure_list(tmp_path, capsys):
 
 def test_sequence_rule_finds_the_papers_order_and_nothing_else():
     """The Fig. 4 rule: the paper's regimes must appear in order among the label runs."""
-    from chaoscam.experiments._paper import _is_subsequence, _runs
+    from chaoscam.paper._paper import _is_subsequence, _runs
 
     wanted = ["chaotic", "periodic-2", "quasiperiodic", "chaotic"]
     labels = ["chaotic", "chaotic", "periodic-2", "quasiperiodic", "periodic", "chaotic"]
@@ -74,13 +74,13 @@ def test_sequence_rule_finds_the_papers_order_and_nothing_else():
 def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch, capsys):
     """A figure script that raises leaves a report that names the failure, does not claim
     the figure in its summary or title, and the command exits 1 (it exited 0)."""
-    from chaoscam.experiments import _paper
+    from chaoscam.paper import _paper
 
     def boom(quick, outdir, workers=None):
         raise RuntimeError("no luck")
 
     monkeypatch.setitem(_paper.FIGURES, 3, boom)
-    from chaoscam.experiments import run_paper
+    from chaoscam.paper import run_paper
 
     run = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 5], echo=True)
     fail = "Fig. 3: line-length draws: failed with RuntimeError: no luck"
@@ -105,7 +105,7 @@ def test_a_run_where_every_stage_failed_keeps_the_report_there(tmp_path, monkeyp
     """--resume (or --force) over a finished report, every stage failing: the report there
     is kept and the failure page goes beside it (it replaced a 2.5 MB report with a 12 KB
     page of failures)."""
-    from chaoscam.experiments import _paper
+    from chaoscam.paper import _paper
 
     out = tmp_path / "p.html"
     assert main(["paper", "--quick", "--figures", "5", "--out", str(out)]) == 0
@@ -124,7 +124,7 @@ def test_a_run_where_every_stage_failed_keeps_the_report_there(tmp_path, monkeyp
 def test_force_and_resume_together_are_refused(tmp_path, capsys):
     """The sweeps and ensembles refused --force with --resume; the paper (and figN.py)
     took both and resumed."""
-    from chaoscam.experiments import figure_script
+    from chaoscam.paper import figure_script
 
     assert main(["paper", "--force", "--resume", "--out", str(tmp_path / "p.html")]) == 2
     assert "give one of them" in capsys.readouterr().err
@@ -140,7 +140,7 @@ def test_force_and_resume_together_are_refused(tmp_path, capsys):
 def test_a_stage_asked_for_by_a_later_figure_keeps_its_title(tmp_path, monkeypatch):
     """figures=[8]: the shared stage of Figs. 7-10 is titled as such (it fell back to the
     function's name, fig7_10)."""
-    from chaoscam.experiments import _paper, run_paper
+    from chaoscam.paper import _paper, run_paper
 
     def boom(quick, outdir, workers=None):
         raise RuntimeError("no luck")
@@ -162,15 +162,15 @@ def test_paper_refuses_a_worker_count_before_any_work(tmp_path, capsys):
 
 def _shrink_the_runs(monkeypatch):
     """Stand-ins for the figures' sweeps and runs: the same calls, two values, a second of
-    model time (a fate horizon of one), the test classifier, in this process; the report's
-    classifier of single runs without the tangent and extensions."""
-    import chaoscam._simulate
-    import chaoscam.report._classify
+    model time (a fate horizon of one), the test classifier, in this process; the verdict
+    of single runs without extensions."""
+    import chaoscam.simulation
     import chaoscam.sweep
-    from chaoscam import classify_trajectory
+    import chaoscam.verdict
     from tests.sweep._helpers import SpreadClassifier
 
-    bif, rmap, sim = chaoscam.sweep.bifurcation, chaoscam.sweep.regime_map, chaoscam.simulate
+    bif, rmap = chaoscam.sweep.bifurcation, chaoscam.sweep.regime_map
+    sim, judge = chaoscam.simulation.simulate, chaoscam.verdict.classify
     short = dict(duration=0.5, transient=0.25, workers=1, classify=SpreadClassifier())
 
     def small_bifurcation(param, values, **kw):
@@ -187,23 +187,25 @@ def _shrink_the_runs(monkeypatch):
     def short_simulate(params, **kw):
         return sim(params, **{**kw, "duration": 1.0, "transient": 0.0})
 
+    def quick_classify(run, **kw):
+        return judge(run, **{**kw, "extend_to": None})
+
     monkeypatch.setattr(chaoscam.sweep, "bifurcation", small_bifurcation)
     monkeypatch.setattr(chaoscam.sweep, "regime_map", small_regime_map)
-    monkeypatch.setattr(chaoscam._simulate, "simulate", short_simulate)
-    quick = lambda traj: classify_trajectory(traj, tangent=False, extend_to=None)  # noqa: E731
-    monkeypatch.setattr(chaoscam.report._classify, "classify", quick)
+    monkeypatch.setattr(chaoscam.simulation, "simulate", short_simulate)
+    monkeypatch.setattr(chaoscam.verdict, "classify", quick_classify)
 
 
 @pytest.mark.parametrize("number", [3, 4, 5, 6, 7, 0])
 def test_data_files_are_exactly_what_the_figures_write(tmp_path, monkeypatch, number):
     """data_files (what `paper` checks before the work) lists every file the figure script
     (0: the sensitivity stage) writes, and nothing it does not (runs shrunk, PNGs not drawn)."""
-    from chaoscam.experiments import _paper
-    from chaoscam.report import _figures
+    import chaoscam.report
+    from chaoscam.paper import _paper
 
     _shrink_the_runs(monkeypatch)
-    monkeypatch.setattr(_figures, "png_bytes", lambda fig, dpi=None: b"\x89PNG")
-    stage = _paper._sensitivity_stage if number == _paper.SENSITIVITY else _paper.FIGURES[number]
+    monkeypatch.setattr(chaoscam.report, "png_bytes", lambda fig, dpi=None: b"\x89PNG")
+    stage = _paper.sensitivity_stage if number == _paper.SENSITIVITY else _paper.FIGURES[number]
     res = stage(True, tmp_path, workers=1)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(_paper.data_files(number))
     # the summary's timing line names the stage as the paper does
@@ -277,15 +279,15 @@ def test_ctrl_c_in_the_sensitivity_stage_stops_the_map_beside_it_and_resume_fini
     """The (ω, ξ) map runs beside the stage's other sweeps: a Ctrl-C in the ξ sweep asks the
     map to stop too (it stops with its checkpoint), the stage raises the Ctrl-C, and a
     resumed stage gives the findings of a stage run without interruption."""
+    import chaoscam.report
     import chaoscam.sweep
-    from chaoscam.experiments import _paper
-    from chaoscam.experiments._store import store_mode
-    from chaoscam.integrate._driver import stops_here
-    from chaoscam.report import _figures
+    from chaoscam.kernel import stops_here
+    from chaoscam.paper import _paper
+    from chaoscam.paper._store import store_mode
     from chaoscam.sweep import SweepInterrupted
 
     _shrink_the_runs(monkeypatch)
-    monkeypatch.setattr(_figures, "png_bytes", lambda fig, dpi=None: b"\x89PNG")
+    monkeypatch.setattr(chaoscam.report, "png_bytes", lambda fig, dpi=None: b"\x89PNG")
     small_bif, small_map = chaoscam.sweep.bifurcation, chaoscam.sweep.regime_map
     map_ends = []
 
@@ -306,7 +308,7 @@ def test_ctrl_c_in_the_sensitivity_stage_stops_the_map_beside_it_and_resume_fini
     monkeypatch.setattr(chaoscam.sweep, "bifurcation", stopped_at_xi)
     monkeypatch.setattr(chaoscam.sweep, "regime_map", map_under_way)
     with pytest.raises(KeyboardInterrupt) as err:  # every core: the map beside (its sweeps
-        _paper._sensitivity_stage(True, tmp_path)  # run on one worker, the stand-ins')
+        _paper.sensitivity_stage(True, tmp_path)  # run on one worker, the stand-ins')
     assert not isinstance(err.value, SweepInterrupted)  # the ξ sweep's Ctrl-C, not the map's
     assert len(map_ends) == 1 and "--resume" in str(map_ends[0])
     assert (tmp_path / "sensitivity-omega-xi.parquet.ckpt").is_dir()
@@ -314,9 +316,9 @@ def test_ctrl_c_in_the_sensitivity_stage_stops_the_map_beside_it_and_resume_fini
     monkeypatch.setattr(chaoscam.sweep, "bifurcation", small_bif)
     monkeypatch.setattr(chaoscam.sweep, "regime_map", small_map)
     with store_mode(resume=True):
-        resumed = _paper._sensitivity_stage(True, tmp_path, workers=1)
+        resumed = _paper.sensitivity_stage(True, tmp_path, workers=1)
     (tmp_path / "fresh").mkdir()
-    fresh = _paper._sensitivity_stage(True, tmp_path / "fresh", workers=1)
+    fresh = _paper.sensitivity_stage(True, tmp_path / "fresh", workers=1)
     assert resumed.why == fresh.why and len(fresh.why) == 4
 
 
@@ -337,8 +339,9 @@ def test_each_figure_is_rendered_once_and_the_report_embeds_its_file(tmp_path, m
     to paper-data (rendering was a fifth of a quick report's time, each figure drawn twice)."""
     import base64
 
-    from chaoscam.experiments import run_paper
-    from chaoscam.report import _figures, _html
+    import chaoscam.report
+    from chaoscam.paper import run_paper
+    from chaoscam.report import _html
 
     _shrink_the_runs(monkeypatch)
     rendered = []
@@ -347,7 +350,7 @@ def test_each_figure_is_rendered_once_and_the_report_embeds_its_file(tmp_path, m
         rendered.append(b"\x89PNG-%d" % len(rendered))
         return rendered[-1]
 
-    for module in (_html, _figures):  # the report's own, and the stages' drawing thread's
+    for module in (_html, chaoscam.report):  # the report's own, and the drawing thread's
         monkeypatch.setattr(module, "png_bytes", stub)
     out = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 4, 5, 7]).path
     files = {p.name: p.read_bytes() for p in (tmp_path / "paper-data").glob("*.png")}
@@ -365,7 +368,7 @@ def test_the_summary_opens_with_the_labels_counted_from_the_tables():
     counts of the paper's figures and, apart, of the sensitivity sweeps (with the periods)."""
     from types import SimpleNamespace
 
-    from chaoscam.experiments._run import _in_short
+    from chaoscam.paper._run import _in_short
 
     def sweep(number, labels, periods):
         table = pd.DataFrame({"label": labels, "period": periods})
@@ -416,8 +419,8 @@ def test_a_second_run_into_the_same_folder_is_refused(tmp_path, capsys):
 def test_a_report_that_appeared_meanwhile_is_kept(tmp_path, monkeypatch):
     """Without force, a report file written by someone else during the run is not replaced:
     this run's report goes beside it, and the error names both."""
-    from chaoscam._outputs import OutputError
-    from chaoscam.experiments import _paper, run_paper
+    from chaoscam.io import OutputError
+    from chaoscam.paper import _paper, run_paper
 
     out = tmp_path / "p.html"
     fig3 = _paper.FIGURES[3]
@@ -438,9 +441,8 @@ def test_a_report_that_appeared_meanwhile_is_kept(tmp_path, monkeypatch):
 def test_write_report_keeps_an_existing_file_and_needs_its_folder(tmp_path):
     """write_report never writes over a file unless replace=True (by default its report
     goes beside it, named in the error); a missing folder is refused (it was created)."""
-    from chaoscam._outputs import OutputError
-    from chaoscam.report import write_report
-    from chaoscam.report._html import ReportParts
+    from chaoscam.io import OutputError
+    from chaoscam.report import ReportParts, write_report
 
     out = tmp_path / "r.html"
     out.write_text("theirs")

@@ -2,17 +2,15 @@
 
 import pandas as pd
 
-from chaoscam.experiments._paper import _classifier
-from chaoscam.experiments._sensitivity import (
+from chaoscam.model import Params
+from chaoscam.paper._findings import step_finding
+from chaoscam.paper._sensitivity import (
     PAPER_K_N,
     XI_WINDOW,
     restitution_finding,
-    step_checked,
-    step_finding,
     stiffness_finding,
     xi_values,
 )
-from chaoscam.model import Params
 
 
 def _verdicts(rows):
@@ -57,13 +55,22 @@ def test_restitution_equal_to_a_rich_stiffness_range_is_not_called_more_sensitiv
     assert "no more than the 2 across the paper's Hertz range (chaotic, period 3)" in text
 
 
-def test_full_sweeps_check_the_step_and_quick_ones_do_not():
+def test_full_sweeps_check_the_step_and_quick_ones_do_not(tmp_path, monkeypatch):
     """The full report's sensitivity sweeps re-run their verdicts at dt/2; the quick one
-    keeps its time; the rest of the classifier is the report's."""
+    keeps its time; the rest of the classifier is the report's (the sensitivity stage's
+    verdict keywords, caught at the call, before any run)."""
+    from chaoscam.paper import _paper, _sensitivity
+    from chaoscam.paper._stage import FULL_EXTEND_TO, QUICK_EXTEND_TO, judging
+
+    seen = {}
+    monkeypatch.setattr(
+        _sensitivity, "sensitivity", lambda quick, outdir, workers=None, judge=None: judge
+    )
     for quick in (True, False):
-        c = step_checked(_classifier(quick), quick)
-        assert c.check_step is (not quick)
-        assert c.extend_to == _classifier(quick).extend_to
+        seen[quick] = _paper.sensitivity_stage(quick, tmp_path, workers=1)
+        assert seen[quick]["check_step"] is (not quick)
+        assert seen[quick]["extend_to"] == judging(quick)["extend_to"]
+    assert (seen[True]["extend_to"], seen[False]["extend_to"]) == (QUICK_EXTEND_TO, FULL_EXTEND_TO)
 
 
 def test_step_finding_counts_checked_verdicts_and_names_the_changed():
@@ -135,7 +142,7 @@ def test_the_open_choices_sentence_is_computed_from_the_sweeps():
     """J, pivot and friction-arm sweeps and the literal damping: regimes counted together
     against the Hertz range (undetermined on neither side), the paper's period 2 looked for,
     and the choices not swept named with the values the runs used (from Params())."""
-    from chaoscam.experiments._choices import choices_finding
+    from chaoscam.paper._choices import choices_finding
 
     p = Params()
     inertia = _verdicts(

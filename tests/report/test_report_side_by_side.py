@@ -1,4 +1,4 @@
-"""A stage's single runs side by side on threads (experiments._side_by_side)."""
+"""A stage's single runs side by side on threads (paper._side_by_side)."""
 
 import threading
 import time
@@ -6,8 +6,8 @@ import time
 import pytest
 
 from chaoscam import simulate
-from chaoscam.experiments._side_by_side import side_by_side
 from chaoscam.model import Params
+from chaoscam.paper._side_by_side import beside, side_by_side
 
 
 def test_side_by_side_runs_on_threads_and_keeps_the_order():
@@ -67,8 +67,6 @@ def test_beside_runs_its_call_meanwhile_in_a_copy_of_the_context():
     context variables, and its value is the future's."""
     import contextvars
 
-    from chaoscam.experiments._side_by_side import beside
-
     var = contextvars.ContextVar("var", default="unset")
     var.set("caller's")
     both = threading.Barrier(2, timeout=10)
@@ -85,8 +83,7 @@ def test_beside_runs_its_call_meanwhile_in_a_copy_of_the_context():
 def test_beside_asks_its_call_to_stop_when_the_block_fails():
     """An error in the block (a Ctrl-C, a failed sweep) sets the call's stop request, which
     :func:`check_stop` sees; the block's error is raised, no thread is left behind."""
-    from chaoscam.experiments._side_by_side import beside
-    from chaoscam.integrate._driver import StopRequested, check_stop
+    from chaoscam.kernel import StopRequested, check_stop
 
     seen = []
 
@@ -106,8 +103,6 @@ def test_beside_asks_its_call_to_stop_when_the_block_fails():
 
 
 def test_an_error_of_the_call_beside_is_raised_when_the_block_ends():
-    from chaoscam.experiments._side_by_side import beside
-
     def fn():
         raise ValueError("the map failed")
 
@@ -118,8 +113,6 @@ def test_an_error_of_the_call_beside_is_raised_when_the_block_ends():
 def test_beside_with_fewer_workers_than_cores_runs_its_call_here_when_asked():
     """A user who leaves cores free gets no second sweep's threads: with one worker the
     call runs on the calling thread, at the block's first .result() (or at its end)."""
-    from chaoscam.experiments._side_by_side import beside
-
     ran = []
 
     def fn():

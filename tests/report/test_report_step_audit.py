@@ -3,9 +3,9 @@
 import pandas as pd
 import pytest
 
-from chaoscam.experiments import _step_audit as sa
-from chaoscam.experiments._step_audit import AuditRow, audit_sample, audit_sentence, step_audit
-from chaoscam.sweep import DefaultClassifier, bifurcation
+from chaoscam.paper import _step_audit as sa
+from chaoscam.paper._step_audit import AuditRow, audit_sample, audit_sentence, step_audit
+from chaoscam.sweep import bifurcation
 
 
 @pytest.fixture(scope="module")
@@ -16,7 +16,7 @@ def small_diagram():
         [0.02, 0.021, 0.022],
         duration=4.0,
         transient=2.0,
-        classify=DefaultClassifier(extend_to=None),
+        extend_to=None,
         workers=1,
         progress=False,
     )
@@ -58,9 +58,9 @@ def test_sentence_counts_and_names_what_did_not_hold():
     assert audit_sentence([]) == ""
 
 
-def test_audit_replays_a_diagrams_runs_in_worker_processes(small_diagram):
-    """A small diagram: two of its decided runs replayed in a process pool come back with
-    the recorded label, with their step check."""
+def test_audit_replays_a_diagrams_runs_on_worker_threads(small_diagram):
+    """A small diagram: two of its decided runs replayed on two threads come back with the
+    recorded label, with their step check."""
     bif = small_diagram
     assert bif.verdicts["label"].isin(sa.LABELS).sum() >= 2
     rows = step_audit([("Fig. X", bif)], 2, extend_to=None, workers=2)
@@ -79,8 +79,12 @@ def test_a_figures_sweeps_are_named_by_what_differs():
     sweep at a step other than the default names its step (the audit halves it)."""
     from types import SimpleNamespace
 
-    def sweep(**base):
-        return SimpleNamespace(config={"base": {"xi": 0.42, "integrator": "rk4", **base}})
+    from chaoscam import Numerics, Params
+
+    def sweep(dt=None, **base):  # a sweep's record: its base model and its numerics
+        numerics = Numerics() if dt is None else Numerics(dt=dt)
+        config = {"base": Params(**base).to_dict(), "numerics": numerics.to_dict()}
+        return SimpleNamespace(config=config)
 
     assert sa.sweep_names("Fig. 3", []) == []  # a figure without a sweep
     one = [sweep(G=1e-9, dt=3.9e-7)]
@@ -104,9 +108,9 @@ def test_audit_stage_skips_figures_without_sweeps_and_reports_a_failure(monkeypa
     (Fig. 3, Fig. 5) and the sensitivity stage are passed over, a figure's sweep is audited;
     a failure goes to "What is missing" and the report goes on."""
     bif = small_diagram
-    from chaoscam.experiments import _run
-    from chaoscam.experiments._paper import SENSITIVITY, FigureResult
-    from chaoscam.report._html import ReportParts
+    from chaoscam.paper import FigureResult, _run
+    from chaoscam.paper._paper import SENSITIVITY
+    from chaoscam.report import ReportParts
 
     results = [
         FigureResult(3),
@@ -131,7 +135,7 @@ def test_audit_script_reads_a_reports_data_and_refuses_bad_input(tmp_path, capsy
     """analyses/step_audit.py over a data folder holding a Fig. 4 diagram: one line per
     audited run and the sentence; a missing file, K < 1 or S <= 0: exit 2 naming it."""
     bif = small_diagram
-    from chaoscam.experiments._audit_script import audit_script
+    from chaoscam.paper import audit_script
 
     bif.to_parquet(tmp_path / "fig4.parquet")
     args = ["--figures", "4", "--per-sweep", "1", "--workers", "1", "--extend-to", "4"]
@@ -168,15 +172,15 @@ def test_audit_reads_the_sensitivity_sweeps_and_a_ladder_follows_one_label(
     """--figures s: every sensitivity-*.parquet of the folder (not its companions), each
     named by its file, read as the kind its record says; --label: the ladder draws only rows
     with that label (the jobs it would run, captured instead of run)."""
-    from chaoscam.experiments import _ladder
-    from chaoscam.experiments._audit_script import read_sweeps
+    from chaoscam.paper import _ladder
+    from chaoscam.paper._audit_script import read_sweeps
 
     small_diagram.to_parquet(tmp_path / "sensitivity-e.parquet")
     small_diagram.to_parquet(tmp_path / "fig4.parquet")
     got = read_sweeps(tmp_path, ["s", 4])
     assert [name for name, _ in got] == ["sensitivity-e", "Fig. 4"]
     assert got[0][1].verdicts.equals(small_diagram.verdicts)
-    monkeypatch.setattr(_ladder, "run_jobs", lambda task, jobs, workers: jobs)
+    monkeypatch.setattr(_ladder, "side_by_side", lambda fn, jobs, workers, prefix: jobs)
     table = small_diagram.verdicts
     mixed = table.assign(label=["undetermined", "periodic", "undetermined"][: len(table)])
     sweep = type("Sweep", (), {"config": small_diagram.config, "verdicts": mixed})()
@@ -186,7 +190,7 @@ def test_audit_reads_the_sensitivity_sweeps_and_a_ladder_follows_one_label(
     # a rung whose run leaves the cam's reach is labelled so, as a sweep labels it, with no
     # exponent (not "undetermined" with the verdict's reason)
     import chaoscam.sweep
-    from chaoscam.integrate import Status
+    from chaoscam.kernel import Status
 
     left = type("Run", (), {"status": Status.LEFT_REACH, "ok": False})()
     monkeypatch.setattr(chaoscam.sweep, "replay", lambda settings, row, refine: left)
@@ -199,7 +203,7 @@ def test_audit_reads_the_sensitivity_sweeps_and_a_ladder_follows_one_label(
 def test_a_ladder_counts_the_runs_the_step_no_longer_moves():
     """settled: one decided label at every halved step (dt/2 down), not the sweep's own
     step; "undetermined" everywhere, or labels that differ, are not settled."""
-    from chaoscam.experiments._ladder import LadderRow, ladder_sentence, settled
+    from chaoscam.paper._ladder import LadderRow, ladder_sentence, settled
 
     def row(*tags):
         return LadderRow("F", "x", tags[0], tuple((h, t, 0.1) for h, t in enumerate(tags)), 1.0)
@@ -225,8 +229,8 @@ def test_ladder_follows_every_drawn_run_down_the_step(tmp_path, capsys, small_di
     """--ladder 2,4: two runs of any label, each classified at dt, dt/2 and dt/4; the first
     rung is the recorded verdict (the replay is the sweep's run); the sentence compares dt
     and dt/2 with dt/4."""
-    from chaoscam.experiments._audit_script import audit_script
-    from chaoscam.experiments._ladder import ladder_sample, ladder_sentence, step_ladder
+    from chaoscam.paper import audit_script
+    from chaoscam.paper._ladder import ladder_sample, ladder_sentence, step_ladder
 
     table = pd.DataFrame({"label": ["chaotic", "undetermined"] * 5})
     assert "undetermined" in set(ladder_sample(table, 6)["label"])  # any label: 6 > 5 chaotic

@@ -5,8 +5,9 @@ import math
 import pytest
 
 from chaoscam import contact_period
-from chaoscam.experiments import _steps
 from chaoscam.model import Params
+from chaoscam.numerics import Numerics
+from chaoscam.paper import _steps
 
 FIG4_STIFFEST = Params(l_lambda=0.018)
 FIG6_STIFFEST = Params(stiffness="fractal", D=1.56, G=1e-9)
@@ -29,26 +30,26 @@ class _Stop(Exception):
 @pytest.mark.parametrize("quick", [True, False])
 @pytest.mark.parametrize("number", [4, 6])
 def test_the_figures_run_their_sweeps_at_the_rule_s_step(number, quick, monkeypatch, tmp_path):
-    """Figs. 4 and 6 hand their bifurcation sweep a base whose dt is the rule's at the sweep's
-    largest value (l_λ = 0.018 m, D = 1.56): caught at the call, before any run."""
+    """Figs. 4 and 6 hand their bifurcation sweep numerics whose dt is the rule's at the
+    sweep's largest value (l_λ = 0.018 m, D = 1.56): caught at the call, before any run."""
     import chaoscam.sweep
-    from chaoscam.experiments._paper import FIGURES
+    from chaoscam.paper._paper import FIGURES
 
     seen = []
 
-    def caught(param, values, *, base=None, **kwargs):
-        seen.append((param, base))
+    def caught(param, values, *, numerics=None, **kwargs):
+        seen.append((param, numerics))
         raise _Stop
 
     monkeypatch.setattr(chaoscam.sweep, "bifurcation", caught)
     with pytest.raises(_Stop):
         FIGURES[number](quick, tmp_path)
-    param, base = seen[0]
+    param, numerics = seen[0]
     if number == 4:
         steps, stiffest = _steps.FIG4_STEPS[quick], FIG4_STIFFEST
     else:
         steps, stiffest = _steps.FIG6_STEPS[quick], FIG6_STIFFEST
-    assert base.dt == _steps.figure_dt(stiffest, steps)
+    assert numerics.dt == _steps.figure_dt(stiffest, steps)
     assert param == ("l_lambda" if number == 4 else "D")
 
 
@@ -56,7 +57,7 @@ def test_the_full_report_refines_both_figures_and_the_quick_one_keeps_its_step()
     """Full: 160 steps for Figs. 4 and 6 (Fig. 4's dt 3.8e-7 s, about 5x finer than the
     default); quick: the model's default dt for Fig. 4 and 40 steps for Fig. 6."""
     assert _steps.FIG4_STEPS[False] == _steps.FIG6_STEPS[False] == _steps.FULL_STEPS == 160
-    assert _steps.figure_dt(FIG4_STIFFEST, _steps.FIG4_STEPS[True]) == Params().dt
+    assert _steps.figure_dt(FIG4_STIFFEST, _steps.FIG4_STEPS[True]) == Numerics().dt
     assert _steps.figure_dt(FIG4_STIFFEST, _steps.FIG4_STEPS[False]) == 3.8e-7
     assert _steps.FIG6_STEPS[True] == 40
 
@@ -64,7 +65,7 @@ def test_the_full_report_refines_both_figures_and_the_quick_one_keeps_its_step()
 def test_the_notes_state_the_step_the_figure_ran_at():
     """Fig. 4's note counts the steps of the dt it ran at (30 at the default, 160 refined)
     and says the coarse one misses the period-8 windows; Fig. 6's names its step count."""
-    coarse = _steps.fig4_step_note(FIG4_STIFFEST, Params().dt)
+    coarse = _steps.fig4_step_note(FIG4_STIFFEST, Numerics().dt)
     fine = _steps.fig4_step_note(FIG4_STIFFEST, 3.8e-7)
     assert "(30 RK4 steps per contact period at l_λ = 0.018 m, a step at which" in coarse
     assert coarse.endswith("the full report takes 160)")
