@@ -31,80 +31,39 @@ class Numerics:
 
     _WHAT = "numerics setting"
 
-    integrator: str = field(
-        default="rk4",
-        metadata=meta(
-            "'rk4': the paper's fixed-step RK4 on the grid n dt with located impacts, the "
-            "reference; 'adaptive': DOP853 with error control (rtol, atol), long steps in "
-            "flight, events located on the step's interpolant. At equal accuracy (20-s "
-            "sections of periodic responses to 1e-6 rad) the adaptive path is 5.5-10x cheaper "
-            "than plain fixed-step RK4 and about as fast as the default merged RK4 "
-            "(benchmarks/bench_work_precision.py)",
-            "-",
-            None,
-            INTEGRATORS,
-        ),
-    )
-    dt: float = field(
-        default=2e-6,
-        metadata=meta(
-            "RK4 step; resolves the Hertz contact oscillation (period ~9e-5 s) with ~45 steps; "
-            "on the adaptive path, the step cap near the cam",
-            "s",
-            (0.0, 1.0, False, True),
-        ),
-    )
-    event_tol: float = field(
-        default=1e-12,
-        metadata=meta(
-            "located impact time's tolerance, at most 1e-9 s",
-            "s",
-            (0.0, 1e-9, False, True),
-        ),
-    )
-    max_events_per_step: int = field(
-        default=8,
-        metadata=meta(
-            "chattering guard: impacts handled inside one step before the rest of the step is "
-            "left to the compliant contact (at most 1024: buffers are sized by it)",
-            "-",
-            (1, 1024, True, True),
-        ),
-    )
-    flight_merge: int = field(
-        default=16,
-        metadata=meta(
-            "most grid steps taken as one RK4 step where a bound on the gap's curvature proves "
-            "no contact can occur (free pendulum); 1 = plain RK4. Equal to plain RK4 within "
-            "5e-9 s / 1e-8 rad (tests); at most 1024 (buffers)",
-            "-",
-            (1, 1024, True, True),
-        ),
-    )
-    rtol: float = field(
-        default=1e-12,
-        metadata=meta(
-            "adaptive integrator: relative tolerance of the local error of (theta_f, theta_f'); "
-            "1e-12: periodic sections within 1e-6 rad of converged RK4 (tests)",
-            "-",
-            (0.0, 1e-2, False, True),
-        ),
-    )
-    atol: float = field(
-        default=1e-13,
-        metadata=meta(
-            "adaptive integrator: absolute tolerance of the local error, for theta_f [rad] and "
-            "theta_f' [rad/s]",
-            "rad, rad/s",
-            (0.0, 1.0, False, True),
-        ),
-    )
-    h_max: float = field(
-        default=0.005,
-        metadata=meta(
-            "adaptive integrator: largest step (flight), at most 1 s", "s", (0.0, 1.0, False, True)
-        ),
-    )
+    integrator: str = field(default="rk4", metadata=meta(
+        "'rk4': the paper's fixed-step RK4 on the grid n dt with located impacts, the "
+        "reference; 'adaptive': DOP853 with error control (rtol, atol), long steps in "
+        "flight, events located on the step's interpolant. At equal accuracy (20-s "
+        "sections of periodic responses to 1e-6 rad) the adaptive path is 5.5-10x cheaper "
+        "than plain fixed-step RK4 and about as fast as the default merged RK4 "
+        "(benchmarks/bench_work_precision.py)", "-", None, INTEGRATORS))  # fmt: skip
+    dt: float = field(default=2e-6, metadata=meta(
+        "RK4 step; resolves the Hertz contact oscillation (period ~9e-5 s) with ~45 steps; "
+        "on the adaptive path, the step cap near the cam", "s",
+        (0.0, 1.0, False, True)))  # fmt: skip
+    event_tol: float = field(default=1e-12, metadata=meta(
+        "located impact time's tolerance, at most 1e-9 s", "s",
+        (0.0, 1e-9, False, True)))  # fmt: skip
+    max_events_per_step: int = field(default=8, metadata=meta(
+        "chattering guard: impacts handled inside one step before the rest of the step is "
+        "left to the compliant contact (at most 1024: buffers are sized by it)", "-",
+        (1, 1024, True, True)))  # fmt: skip
+    flight_merge: int = field(default=16, metadata=meta(
+        "most grid steps taken as one RK4 step where a bound on the gap's curvature proves "
+        "no contact can occur (free pendulum); 1 = plain RK4. Equal to plain RK4 within "
+        "5e-9 s / 1e-8 rad (tests); at most 1024 (buffers)", "-",
+        (1, 1024, True, True)))  # fmt: skip
+    rtol: float = field(default=1e-12, metadata=meta(
+        "adaptive integrator: relative tolerance of the local error of (theta_f, theta_f'); "
+        "1e-12: periodic sections within 1e-6 rad of converged RK4 (tests)", "-",
+        (0.0, 1e-2, False, True)))  # fmt: skip
+    atol: float = field(default=1e-13, metadata=meta(
+        "adaptive integrator: absolute tolerance of the local error, for theta_f [rad] and "
+        "theta_f' [rad/s]", "rad, rad/s", (0.0, 1.0, False, True)))  # fmt: skip
+    h_max: float = field(default=0.005, metadata=meta(
+        "adaptive integrator: largest step (flight), at most 1 s", "s",
+        (0.0, 1.0, False, True)))  # fmt: skip
 
     def __post_init__(self) -> None:
         check_fields(self)

@@ -20,27 +20,8 @@ from ._lazy import lazy_face
 from ._warn import quiet, recorded, user_stacklevel, warn
 
 __all__ = [
-    "COUNT_MAX",
-    "NON_NEGATIVE",
-    "POSITIVE",
-    "FrozenDict",
-    "ParameterError",
-    "check_fields",
-    "close_names",
-    "describe_range",
-    "field_table",
-    "flag",
-    "freeze_fields",
-    "lazy_face",
-    "meta",
-    "of_type",
-    "parse_field",
-    "quiet",
-    "real",
-    "recorded",
-    "strict_init",
-    "unknown_message",
-    "user_stacklevel",
-    "warn",
-    "whole",
-]
+    "COUNT_MAX", "NON_NEGATIVE", "POSITIVE", "FrozenDict", "ParameterError", "check_fields",
+    "close_names", "describe_range", "field_table", "flag", "freeze_fields", "lazy_face", "meta",
+    "of_type", "parse_field", "quiet", "real", "recorded", "strict_init", "unknown_message",
+    "user_stacklevel", "warn", "whole",
+]  # fmt: skip

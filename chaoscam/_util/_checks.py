@@ -1,8 +1,6 @@
-"""Checks of the plain settings a caller passes (seeds, indices, counts, intervals).
-
-Each raises :class:`ParameterError` naming the setting, what was expected and
-what was given; numpy scalars are accepted and returned as Python numbers.
-"""
+"""Checks of the plain settings a caller passes (seeds, indices, counts, intervals): each raises
+:class:`ParameterError` naming the setting, what was expected and what was given; numpy scalars
+are accepted and returned as Python numbers."""
 
 from __future__ import annotations
 
@@ -15,8 +13,8 @@ from ._fields import ParameterError
 __all__ = ["COUNT_MAX", "flag", "of_type", "real", "whole"]
 
 COUNT_MAX = 2**63 - 1
-"""Largest seed or realization index: the tables store them as 64-bit integers (a seed of
-2**64 ran a whole sweep and then failed writing its table, and again on --resume)."""
+"""Largest seed or realization index: the tables store them as 64-bit integers, so a larger one
+is refused before any work (not when the table is written)."""
 
 
 def whole(name: str, value: Any, *, low: int = 0, high: int | None = None) -> int:
@@ -46,14 +44,9 @@ def flag(name: str, value: Any) -> bool:
 
 
 def real(
-    name: str,
-    value: Any,
-    *,
-    low: float | None = None,
-    strict: bool = False,
-    unit: str = "",
+    name: str, value: Any, *, low: float | None = None, strict: bool = False, unit: str = "",
     high: float | None = None,
-) -> float:
+) -> float:  # fmt: skip
     """``value`` as a finite float above ``low`` (``strict``: > low, else >= low)."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ParameterError(f"{name} = {value!r} must be a number (got {type(value).__name__})")
@@ -69,9 +62,8 @@ def real(
 
 
 def of_type(name: str, value: Any, cls: type, made_by: str) -> Any:
-    """``value`` when it is a ``cls``; else a TypeError naming ``name``, what it got and
-    what makes one (a trajectory passed where a file name goes, or None, gave an
-    AttributeError from deep inside)."""
+    """``value`` when it is a ``cls``; else a TypeError naming ``name``, what it got and what
+    makes one (not an AttributeError from deep inside)."""
     if not isinstance(value, cls):
         raise TypeError(
             f"{name} must be a chaoscam {cls.__name__} ({made_by}), got {type(value).__name__}"

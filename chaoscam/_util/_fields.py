@@ -1,11 +1,7 @@
-"""Documented, validated fields of a frozen settings dataclass (``Params``, ``Numerics``).
-
-Each field declares its meaning, unit, allowed range or choices in its metadata
-(:func:`meta`); :func:`check_fields` enforces them, so that every refusal names the field and
-the allowed range; :func:`field_table` gives the table ``chaoscam params`` prints and
-``help()`` shows; :func:`strict_init` refuses an unknown keyword with the names it was
-probably meant to be.
-"""
+"""Documented, validated fields of a frozen settings dataclass (``Params``, ``Numerics``): each
+declares its meaning, unit, allowed range or choices (:func:`meta`); :func:`check_fields`
+enforces them, naming the field and range; :func:`field_table` is the table ``chaoscam params``
+prints; :func:`strict_init` refuses an unknown keyword with the names it was probably meant as."""
 
 from __future__ import annotations
 
@@ -16,25 +12,14 @@ import math
 from typing import Any
 
 __all__ = [
-    "POSITIVE",
-    "NON_NEGATIVE",
-    "ParameterError",
-    "check_fields",
-    "close_names",
-    "describe_range",
-    "field_table",
-    "meta",
-    "parse_field",
-    "strict_init",
-    "unknown_message",
-]
+    "POSITIVE", "NON_NEGATIVE", "ParameterError", "check_fields", "close_names", "describe_range",
+    "field_table", "meta", "parse_field", "strict_init", "unknown_message",
+]  # fmt: skip
 
 
 class ParameterError(ValueError):
-    """A parameter or setting is missing, of the wrong type or outside its allowed range.
-
-    The message always names the field and the allowed range.
-    """
+    """A parameter or setting is missing, of the wrong type or outside its allowed range (the
+    message names the field and the allowed range)."""
 
 
 # (lower, upper, lower_inclusive, upper_inclusive); None = unbounded.
@@ -170,13 +155,6 @@ def field_table(cls: type) -> list[dict[str, Any]]:
             if m["choices"] is not None
             else (describe_range(m["range"]) if m["range"] is not None else "any")
         )
-        rows.append(
-            {
-                "name": f.name,
-                "unit": m["unit"],
-                "default": f.default,
-                "range": allowed,
-                "doc": m["doc"],
-            }  # fmt: skip
-        )
+        rows.append({"name": f.name, "unit": m["unit"], "default": f.default, "range": allowed,
+                     "doc": m["doc"]})  # fmt: skip
     return rows

@@ -1,15 +1,8 @@
-"""A dict that cannot be changed: the record of how a result was made.
-
-A :class:`chaoscam.Trajectory` is frozen, but its ``settings`` and ``stats`` were plain dicts:
-``traj.settings["seed"] = 99`` was accepted, and :func:`chaoscam.extend_trajectory` then
-simulated seed 99 as if it were the same run (found by an API review). :class:`FrozenDict`
-reads like a dict (``json.dumps``, ``{**d}``, ``d.get``, pickling across processes) and
-refuses every change with a TypeError saying how to make a changed copy.
-:func:`freeze_fields` does the same for a frozen result's arrays (read-only views: a
-result's exponents or Jacobians cannot be changed in place either).
-
-Imports only the standard library, so any module may use it.
-"""
+"""A dict that cannot be changed, the record of how a result was made: :class:`FrozenDict` reads
+like a dict (``json.dumps``, ``{**d}``, ``d.get``, pickling) and refuses every change with a
+TypeError saying how to make a changed copy, so a result's ``settings`` cannot be edited into
+the record of a run not made; :func:`freeze_fields` does the same for a frozen result's fields
+(arrays as read-only views). Standard library only, so any module may use it."""
 
 from __future__ import annotations
 
@@ -17,8 +10,8 @@ __all__ = ["FrozenDict", "freeze_fields"]
 
 
 class FrozenDict(dict):
-    """A read-only dict, its nested dicts too (``config["base"]["omega"] = 40`` changed what
-    a replay simulates); ``{**d, key: value}`` or ``dict(d)`` gives a changeable copy (one
+    """A read-only dict, its nested dicts too (a nested ``config["base"]["omega"]`` would change
+    what a replay simulates); ``{**d, key: value}`` or ``dict(d)`` gives a changeable copy (one
     level: copy a nested record the same way)."""
 
     def __init__(self, *args, **kwargs) -> None:

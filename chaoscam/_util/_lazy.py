@@ -1,11 +1,7 @@
-"""Lazy package faces (PEP 562): public names resolved from their submodules on first use.
-
-A package's ``__init__`` lists ``{name: (submodule, attribute)}`` and takes its
-``__getattr__`` and ``__dir__`` from :func:`lazy_face`, so ``import chaoscam`` (and the
-``chaoscam`` command's start-up) loads no numba, pandas or scipy until a name that needs them
-is used. A submodule must not share a public name of its package (the import system would
-bind the module over the name): that is why the driver module is ``_simulate``.
-"""
+"""Lazy package faces (PEP 562): a package's ``__init__`` lists ``{name: (submodule, attribute)}``
+and takes ``__getattr__`` and ``__dir__`` from :func:`lazy_face`, so ``import chaoscam`` loads no
+numba, pandas or scipy until a name needing them is used. A submodule must not share a public
+name of its package (the import system would bind the module over the name)."""
 
 from __future__ import annotations
 

@@ -1,21 +1,14 @@
-"""Warnings that point at the user's line.
+"""Warnings that point at the user's line, and warning capture that is safe on threads.
 
-A fixed ``stacklevel`` is right for one call path only: ``simulate`` warns about its model at
-level 3 when a user calls it, but the same warning raised while :func:`chaoscam.classify`
-re-simulates would name a line of chaoscam. :func:`warn` walks the stack past every frame of
-this package, so the warning names the first line outside it (the user's script, the test,
-the console script) whatever the depth. A stack that is chaoscam all the way (``python -m
-chaoscam``) names the interpreter's frame above it, as ``warnings.warn`` does for a level past
-the top.
-
-:func:`recorded` is ``warnings.catch_warnings(record=True)`` for code that runs on several
-threads at once (the sweeps' batch threads): ``catch_warnings`` swaps module-wide state, so
-two threads that enter and leave it out of order leave the process with a dead record list
-as its warning printer and an "always" filter installed (measured: after a regime map on 2
-batch threads, every later warning of the process vanished, the sweep's own step warning
-first).
-
-Imports only the standard library, so any module may use it.
+A fixed ``stacklevel`` is right for one call path only (``simulate`` warning at level 3 names a
+line of chaoscam when :func:`chaoscam.classify` re-simulates): :func:`warn` walks the stack past
+every frame of this package to the first line outside it (the user's script, the test, the
+console script); a stack that is chaoscam all the way (``python -m chaoscam``) names the
+interpreter's frame above it, as ``warnings.warn`` does past the top. :func:`recorded` is
+``warnings.catch_warnings(record=True)`` for code on several threads at once (the sweeps' batch
+threads): ``catch_warnings`` swaps module-wide state, and two threads leaving it out of order
+leave a dead record list as the process's printer and an "always" filter, so every later warning
+vanishes. Standard library only, so any module may use it.
 """
 
 from __future__ import annotations
@@ -59,10 +52,9 @@ _hub: dict = {"users": 0, "ctx": None, "show": None, "impl": None}
 
 
 def _dispatch(msg: warnings.WarningMessage) -> None:
-    """The process's warning printer while any :func:`recorded` is active: a warning goes
-    to the list of the context that raised it, or, from any other thread, where it went
-    before (a replaced ``showwarning``, as ``logging.captureWarnings`` or pytest install
-    one, or the printer)."""
+    """The process's warning printer while any :func:`recorded` is active: a warning goes to the
+    list of the context that raised it, else where it went before (a replaced ``showwarning``,
+    as ``logging.captureWarnings`` or pytest install one, or the printer)."""
     sink = _SINK.get()
     if sink is not None:
         sink.append(msg)
@@ -97,16 +89,12 @@ def _leave_hub() -> None:
 
 @contextlib.contextmanager
 def recorded() -> Iterator[list[warnings.WarningMessage]]:
-    """Every warning raised in this context (this thread, and threads that run a copy of
-    its context: :func:`contextvars.copy_context`), as ``warnings.WarningMessage`` objects,
-    none printed; other threads' warnings go where they went before.
-
-    Thread-safe where ``catch_warnings(record=True)`` with ``simplefilter("always")`` is
-    not: the module-wide state is swapped once, by the first of any number of concurrent
-    ``recorded`` contexts, and restored by the last. While any is active, every thread's
-    warnings pass an "always" filter (repeats are not folded) and the process's filters
-    are those of when the first one began.
-    """
+    """Every warning raised in this context (this thread, and threads running a copy of its
+    context: :func:`contextvars.copy_context`) as ``warnings.WarningMessage`` objects, none
+    printed; other threads' warnings go where they went before. Thread-safe: the module-wide
+    state is swapped by the first of any number of concurrent ``recorded`` contexts and
+    restored by the last; while any is active every thread's warnings pass an "always" filter
+    (repeats are not folded) under the filters of when the first began."""
     sink: list[warnings.WarningMessage] = []
     token = _SINK.set(sink)
     _enter_hub()

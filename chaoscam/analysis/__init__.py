@@ -1,7 +1,6 @@
 """Analysis of simulated motion: sections, spectrum, Lyapunov exponents, 0–1 test, verdict.
 
-Everything here takes numpy arrays (or, for the Lyapunov routines, a user callable that
-advances a state); nothing imports the model or the integrators.
+Everything here takes numpy arrays; nothing imports the model, the kernels or the simulation.
 """
 
 from ._birkhoff import BirkhoffResult, birkhoff_weights, weighted_birkhoff
@@ -9,13 +8,6 @@ from ._classify import classify_signal
 from ._classify_section import classify_section
 from ._evidence import zero_one_evidence
 from ._exponent import as_exponent, exponent_evidence
-from ._lyapunov import (
-    LyapunovResult,
-    LyapunovSpectrum,
-    lyapunov_benettin,
-    lyapunov_benettin_map,
-    lyapunov_spectrum_map,
-)
 from ._lyapunov_series import DoubtfulEstimateWarning, SeriesLyapunovResult, lyapunov_from_series
 from ._options import SECTION_OPTIONS, check_options, section_options
 from ._periodicity import PeriodResult, RotationResult, embed_angles, rotation_order, section_period
@@ -36,8 +28,6 @@ __all__ = [
     "Thresholds",
     "DoubtfulEstimateWarning",
     "Evidence",
-    "LyapunovResult",
-    "LyapunovSpectrum",
     "PeriodResult",
     "RotationResult",
     "SeriesLyapunovResult",
@@ -56,10 +46,7 @@ __all__ = [
     "embed_angles",
     "exponent_evidence",
     "local_maxima",
-    "lyapunov_benettin",
-    "lyapunov_benettin_map",
     "lyapunov_from_series",
-    "lyapunov_spectrum_map",
     "neighbour_expansion",
     "power_spectrum",
     "rotation_order",

@@ -51,6 +51,7 @@ class BirkhoffResult:
     message : str
         Why nothing was computed (too few points), else empty.
     settings : dict
+        The weight function and the half length h used.
     """
 
     digits: float
@@ -118,24 +119,17 @@ def weighted_birkhoff(points) -> BirkhoffResult:
     torus reads like weak chaos. ρ is the rotation number only when the curve winds once
     around its centroid (star-shaped); the digits stay meaningful otherwise.
 
-    References: S. Das, Y. Saiki, E. Sander, J. A. Yorke, "Quantitative quasiperiodicity",
-    Nonlinearity 30 (2017) 4111; S. Das, E. Sander, J. A. Yorke, "Quasiquasiperiodicity"
-    (2016); S. Das, J. A. Yorke, "Super convergence of ergodic averages for quasiperiodic
-    orbits", Nonlinearity 31 (2018) 491.
+    References: Das, Saiki, Sander & Yorke, "Quantitative quasiperiodicity", Nonlinearity 30
+    (2017) 4111; Das, Sander & Yorke, "Quasiquasiperiodicity" (2016); Das & Yorke, "Super
+    convergence of ergodic averages for quasiperiodic orbits", Nonlinearity 31 (2018) 491.
     """
     x = as_points(points)
     n = x.shape[0]
     h = (n - 1) // 2
     settings = dict(weight="exp(-1/(t(1-t)))", half=h)
     if h < _MIN_HALF:
-        return BirkhoffResult(
-            math.nan,
-            {},
-            math.nan,
-            n,
-            f"only {n} points; the Birkhoff averages need >= {2 * _MIN_HALF + 1}",
-            settings,
-        )
+        why = f"only {n} points; the Birkhoff averages need >= {2 * _MIN_HALF + 1}"
+        return BirkhoffResult(math.nan, {}, math.nan, n, why, settings)
     obs = {f"x{j}": x[: 2 * h, j] for j in range(x.shape[1])}
     rho = math.nan
     w = birkhoff_weights(h)

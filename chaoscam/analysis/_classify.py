@@ -7,12 +7,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ._classify_section import classify_section
-from ._evidence import (
-    lyapunov_evidence,
-    safe,
-    section_evidence,
-    zero_one_evidence,
-)
+from ._evidence import lyapunov_evidence, safe, section_evidence, zero_one_evidence
 from ._exponent import as_exponent, exponent_evidence
 from ._lyapunov_series import lyapunov_from_series
 from ._sections import local_maxima
@@ -41,36 +36,26 @@ def _zero_one_signal(x, dt, forcing_period, seed, per_period, line_freq, thr):
             "minus its forcing-synchronous mean"
         )
         if np.std(seq) <= thr.signal_repeat * np.std(y):
-            return Evidence(
-                "zero_one",
-                0.0,
-                "not_chaotic",
-                what + ": nothing left (the signal repeats every forcing period), K = 0",
-            )
+            why = ": nothing left (the signal repeats every forcing period), K = 0"
+            return Evidence("zero_one", 0.0, "not_chaotic", what + why)
     else:
         _, seq = local_maxima(x, dt)
         rate = seq.size / (x.size * dt)
         what = "0-1 test on the successive local maxima"
         if seq.size >= 8 and np.ptp(seq) <= thr.signal_repeat * np.ptp(x):
-            return Evidence(
-                "zero_one",
-                0.0,
-                "not_chaotic",
-                what + ": all maxima equal (a period-1 oscillation), K = 0",
-            )
+            why = ": all maxima equal (a period-1 oscillation), K = 0"
+            return Evidence("zero_one", 0.0, "not_chaotic", what + why)
     e = zero_one_evidence("zero_one", seq, what, seed, thr)
     if e.vote == "chaotic" and line_freq:
         period = rate / line_freq  # samples per period of the slowest line base
         n_cut = seq.size // 10
         if n_cut < thr.zero_one_line_periods * period:
-            return Evidence(
-                "zero_one",
-                e.value,
-                None,
-                e.detail + f"; not used: the spectrum is a line spectrum whose slowest base "
+            why = (
+                f"; not used: the spectrum is a line spectrum whose slowest base "
                 f"spans {period:.1f} samples, and lags up to {n_cut} cover fewer than 5 of "
-                "its periods (a long period then mimics diffusion)",
+                "its periods (a long period then mimics diffusion)"
             )
+            return Evidence("zero_one", e.value, None, e.detail + why)
     return e
 
 
@@ -134,9 +119,8 @@ def classify_signal(
 ) -> Verdict:
     """Classify a uniformly sampled signal of a flow (with optional section points).
 
-    Evidence gathered (every number is an entry of `Thresholds`, except the spectrum's
-    own, `spectrum_options`, whose broadband tolerance is recorded in
-    ``settings["broadband_tol"]``):
+    Evidence gathered (every number an entry of `Thresholds`, except the spectrum's own,
+    `spectrum_options`; its broadband tolerance is recorded in ``settings["broadband_tol"]``):
 
     * ``spectrum`` (`spectrum_analysis`, forcing frequency 1 / `forcing_period`): a harmonic
       comb votes periodic (the period in forcing periods when forced), two incommensurate
@@ -144,45 +128,42 @@ def classify_signal(
       remainder "not_periodic".
     * ``zero_one`` (`zero_one_test`, voting where `zero_one_evidence` finds it valid) on a
       map-like sequence, never the oversampled signal: forced, the signal interpolated
-      `zero_one_per_period` times per forcing period minus its forcing-synchronous mean
-      (which only slows convergence); unforced, the successive `local_maxima`. A sequence
-      with nothing left is K = 0. A chaotic K is not used when a line spectrum's slowest
-      base spans more than N / (10 · zero_one_line_periods) samples: a long period mimics
-      diffusion (a period-8 cam response sampled 4 times per forcing period over 20 s
-      gives K ≈ 0.9).
-    * the section evidence of `classify_section`, when `section` is given (names prefixed
-      ``section_``).
+      `zero_one_per_period` times per forcing period less its forcing-synchronous mean;
+      unforced, the successive `local_maxima`. A sequence with nothing left is K = 0. A
+      chaotic K is not used when a line spectrum's slowest base spans more than
+      N / (10 · zero_one_line_periods) samples: a long period mimics diffusion (a period-8
+      cam response sampled 4 times per forcing period over 20 s gives K ≈ 0.9).
+    * the section evidence of `classify_section` for `section` (names prefixed ``section_``).
     * ``exponent``: a largest exponent with its standard error (`exponent_evidence`).
-    * ``lyapunov``: a largest exponent per unit time computed elsewhere (e.g.
-      `lyapunov_benettin`): > `lyapunov_tol` chaotic, else not chaotic.
+    * ``lyapunov``: a largest exponent per unit time computed elsewhere: > `lyapunov_tol`
+      chaotic, else not chaotic.
     * ``lyapunov_series`` (`series_lyapunov`): Rosenstein's estimate from the signal
       (`lyapunov_from_series`), voting only when not doubtful: chaotic when λ T >
       series_chaotic, not chaotic when |λ T| < series_regular, T the characteristic period.
 
-    The votes are combined by `combine` (disagreement: "undetermined", with the votes in
-    `reasons`). The period comes from the section when given, else from the spectrum of a
-    forced signal; an unforced periodic signal without section gets period 1 (one period
-    of its own fundamental), with a note in `reasons`.
+    The votes are combined by `combine`. The period comes from the section when given, else
+    from the spectrum of a forced signal; an unforced periodic signal without section gets
+    period 1 (one period of its own fundamental), with a note in `reasons`.
 
     Parameters
     ----------
     x : array_like, shape (N,)
         Uniformly sampled signal after the transient (e.g. θ_f(t)).
     dt : float
-        Sampling interval (s).
+        Sampling interval [s].
     forcing_period : float, optional
-        Period of the forcing (s), e.g. 2π / ω of the cam.
+        Period of the forcing [s], e.g. 2π / ω of the cam.
     section : array_like, shape (M,) or (M, d), optional
         Section points (e.g. stroboscopic (θ, θ̇) once per forcing period).
     lyapunov : float, optional
-        Largest Lyapunov exponent (1/s) computed elsewhere.
+        Largest Lyapunov exponent [1/s] computed elsewhere.
     lyapunov_tol : float, optional
-        |λ₁| (1/s) below this counts as zero; default ``signal_lyapunov_tol / T`` with T the
+        |λ₁| [1/s] below this counts as zero; default ``signal_lyapunov_tol / T``, T the
         forcing period, else the fundamental period of the spectrum.
     angle_periods, rtol, atol, max_period, min_points_aperiodic
         Passed to the section analysis (see `classify_section`).
     series_lyapunov : bool
-        Also estimate λ₁ from the signal with nolds (slower: ~0.2–0.5 s).
+        Also estimate λ₁ from the signal with nolds (~0.2–0.5 s more).
     zero_one_per_period : int, optional
         Samples per forcing period fed to the 0–1 test of a forced signal, at most the
         signal's own; default 4, or the signal's own when it has fewer.
@@ -194,10 +175,9 @@ def classify_signal(
         The decision thresholds (default `Thresholds()`), recorded in
         ``settings["thresholds"]``; `rtol` and `min_points_aperiodic` override their entries.
     exponent : float, (float, float), (float, float, int) or object, optional
-        A largest exponent with its standard error (e.g. the model's tangent exponent);
-        see `as_exponent`.
+        A largest exponent with its standard error; see `as_exponent`.
     exponent_time : float
-        Multiplies λ and its error to make them per forcing period (the forcing period, s,
+        Multiplies λ and its error to make them per forcing period (the forcing period [s]
         for an exponent in 1/s).
 
     Returns
@@ -211,13 +191,12 @@ def classify_signal(
 
     Notes
     -----
-    A constant signal is an equilibrium, not an oscillation, and is labelled
-    "undetermined" (even if constant section points would say period 1).
+    A constant signal is an equilibrium, not an oscillation: "undetermined" (even where
+    constant section points would say period 1).
 
     Limits: with ~20 s of a cam signal (~90 forcing periods) the 0–1 test runs on ~360
-    samples and the spectrum resolves subharmonics up to order 9: a periodic call is
-    solid, a quasiperiodic versus chaotic call rests on the spectrum and the 0–1 test
-    agreeing.
+    samples and the spectrum resolves subharmonics up to order 9: a periodic call is solid,
+    a quasiperiodic versus chaotic call rests on the spectrum and the 0–1 test agreeing.
     """
     x = as_series(x, min_size=MIN_SERIES)
     zero_one_per_period = _check_signal_settings(locals())
@@ -241,13 +220,8 @@ def classify_signal(
         thresholds=thr.to_dict(),
     )
     if x.size < 2 or np.ptp(x) <= thr.constant_signal * max(1.0, float(np.max(np.abs(x)))):
-        return Verdict(
-            "undetermined",
-            None,
-            (),
-            ("constant signal: an equilibrium, not an oscillation",),
-            settings,
-        )
+        why = "constant signal: an equilibrium, not an oscillation"
+        return Verdict("undetermined", None, (), (why,), settings)
     ev: list[Evidence] = []
     periods: dict[str, int] = {}
     reasons: list[str] = []
@@ -288,30 +262,15 @@ def classify_signal(
         line_freq = min(spec.base_frequencies)
 
     # --- 0-1 test
-    e01, failed = safe(
-        "zero_one",
-        _zero_one_signal,
-        x,
-        dt,
-        forcing_period,
-        seed,
-        int(zero_one_per_period),
-        line_freq,
-        thr,
-    )
+    e01, failed = safe("zero_one", _zero_one_signal, x, dt, forcing_period, seed,
+                       int(zero_one_per_period), line_freq, thr)  # fmt: skip
     ev.append(failed or e01)
 
     # --- section
     if section is not None:
-        sev, speriods, sreasons = section_evidence(
-            section,
-            thr,
-            angle_periods=angle_periods,
-            atol=atol,
-            max_period=max_period,
-            zero_one=True,
-            seed=seed,
-        )
+        sev, speriods, sreasons = section_evidence(section, thr, angle_periods=angle_periods,
+                                                   atol=atol, max_period=max_period,
+                                                   zero_one=True, seed=seed)  # fmt: skip
         ev.extend(sev)
         periods.update(speriods)
         reasons.extend(sreasons)
@@ -325,14 +284,8 @@ def classify_signal(
         tol = thr.signal_lyapunov_tol / t_char
     if lyapunov is not None:
         if tol is None:
-            ev.append(
-                Evidence(
-                    "lyapunov",
-                    float(lyapunov),
-                    None,
-                    "no time scale to judge λ₁ against: pass lyapunov_tol",
-                )
-            )
+            why = "no time scale to judge λ₁ against: pass lyapunov_tol"
+            ev.append(Evidence("lyapunov", float(lyapunov), None, why))
         else:
             ev.append(lyapunov_evidence(lyapunov, tol, "per unit time"))
     if series_lyapunov:
@@ -341,14 +294,8 @@ def classify_signal(
             ev.append(failed)
         elif res.doubtful or t_char is None:
             why = "; ".join(res.reasons) or "no time scale"
-            ev.append(
-                Evidence(
-                    "lyapunov_series",
-                    res.exponent,
-                    None,
-                    f"Rosenstein λ₁ = {res.exponent:.4g}, doubtful: {why}",
-                )
-            )
+            txt = f"Rosenstein λ₁ = {res.exponent:.4g}, doubtful: {why}"
+            ev.append(Evidence("lyapunov_series", res.exponent, None, txt))
         else:
             lt = res.exponent * t_char
             txt = f"Rosenstein λ₁ = {res.exponent:.4g} (λ₁ T = {lt:.3f})"
@@ -361,15 +308,10 @@ def classify_signal(
     settings["lyapunov_tol_used"] = tol
     verdict = combine(ev, periods, reasons, settings)
     if verdict.label == "periodic" and forcing_period is None and section is None:
-        verdict = Verdict(
-            verdict.label,
-            1,
-            verdict.evidence,
-            verdict.reasons
-            + (
-                "no forcing period and no section: the period is counted in periods of the "
-                "signal's own fundamental (1)",
-            ),
-            verdict.settings,
+        note = (
+            "no forcing period and no section: the period is counted in periods of the "
+            "signal's own fundamental (1)"
         )
+        v = verdict
+        verdict = Verdict(v.label, 1, v.evidence, (*v.reasons, note), v.settings)
     return verdict

@@ -193,15 +193,9 @@ def classify_section(
         seed=seed,
         thresholds=thr.to_dict(),
     )
-    ev, periods, reasons = section_evidence(
-        x,
-        thr,
-        angle_periods=angle_periods,
-        atol=atol,
-        max_period=max_period,
-        zero_one=zero_one,
-        seed=seed,
-    )
+    ev, periods, reasons = section_evidence(x, thr, angle_periods=angle_periods, atol=atol,
+                                            max_period=max_period, zero_one=zero_one,
+                                            seed=seed)  # fmt: skip
     upper = math.nan
     if exponent is not None:
         lam, se, n_int = as_exponent(exponent, exponent_time)

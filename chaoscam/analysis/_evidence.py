@@ -54,14 +54,9 @@ def zero_one_evidence(
     thr = thresholds or Thresholds()
     x = np.asarray(series, dtype=float)
     if x.size < thr.zero_one_min_points:
-        return Evidence(
-            name,
-            None,
-            None,
-            f"{what}: {x.size} samples < {thr.zero_one_min_points}: the 0-1 test is not "
-            f"valid this short (run ~{math.ceil(thr.zero_one_min_points / max(x.size, 1))}x "
-            "longer)",
-        )
+        more = math.ceil(thr.zero_one_min_points / max(x.size, 1))
+        why = f"{x.size} samples < {thr.zero_one_min_points}: the 0-1 test is not valid this short"
+        return Evidence(name, None, None, f"{what}: {why} (run ~{more}x longer)")
     res, failed = safe(name, zero_one_test, x, seed=seed)
     if failed:
         return failed
@@ -77,20 +72,14 @@ def zero_one_evidence(
     side, side_half = _k_side(k, thr), _k_side(half.k, thr)
     txt += f", first half K = {half.k:.3f}"
     if side is None:
-        return Evidence(
-            name,
-            k,
-            None,
-            txt + f": between {thr.zero_one_regular} and {thr.zero_one_chaotic}, inconclusive",
-        )
+        why = f": between {thr.zero_one_regular} and {thr.zero_one_chaotic}, inconclusive"
+        return Evidence(name, k, None, txt + why)
     if side_half != side or abs(half.k - k) > thr.zero_one_max_change:
-        return Evidence(
-            name,
-            k,
-            None,
-            txt + f": K has not converged in N (|ΔK| = {abs(half.k - k):.2f}, limit "
-            f"{thr.zero_one_max_change}); not used, run longer",
+        why = (
+            f": K has not converged in N (|ΔK| = {abs(half.k - k):.2f}, limit "
+            f"{thr.zero_one_max_change}); not used, run longer"
         )
+        return Evidence(name, k, None, txt + why)
     bound = f">= {thr.zero_one_chaotic}" if side == "chaotic" else f"<= {thr.zero_one_regular}"
     return Evidence(name, k, side, txt + f", both {bound}")
 
@@ -116,12 +105,9 @@ def birkhoff_evidence(name: str, z: np.ndarray, thr: Thresholds) -> Evidence:
     """Quasiperiodic when the weighted Birkhoff averages converge fast (no period found)."""
     n = z.shape[0]
     if n < thr.birkhoff_min_points:
+        why = f"{n} points < {thr.birkhoff_min_points}: too few for the Birkhoff averages"
         return Evidence(
-            name,
-            None,
-            None,
-            f"{n} points < {thr.birkhoff_min_points}: too few for the Birkhoff averages "
-            f"(run ~{math.ceil(thr.birkhoff_min_points / n)}x longer)",
+            name, None, None, f"{why} (run ~{math.ceil(thr.birkhoff_min_points / n)}x longer)"
         )
     res, failed = safe(name, weighted_birkhoff, z)
     if failed:
@@ -138,19 +124,10 @@ def birkhoff_evidence(name: str, z: np.ndarray, thr: Thresholds) -> Evidence:
                         f"{thr.birkhoff_rational_tol:g}: a periodic orbit's rotation number "
                         "as much as a torus's at resonance, not a vote")  # fmt: skip
     if res.digits >= thr.birkhoff_quasi_digits:
-        return Evidence(
-            name,
-            value,
-            "quasiperiodic",
-            txt + f" >= {thr.birkhoff_quasi_digits:g}: a smooth invariant curve (torus)",
-        )
-    return Evidence(
-        name,
-        value,
-        None,
-        txt + f" < {thr.birkhoff_quasi_digits:g}: slow convergence (chaos, noise or a "
-        "non-smooth set), not a vote",
-    )
+        why = f" >= {thr.birkhoff_quasi_digits:g}: a smooth invariant curve (torus)"
+        return Evidence(name, value, "quasiperiodic", txt + why)
+    why = f" < {thr.birkhoff_quasi_digits:g}: slow convergence (chaos, noise or a non-smooth set)"
+    return Evidence(name, value, None, txt + why + ", not a vote")
 
 
 def _rational_near(rho: float, q_max: int, tol: float) -> str:
@@ -224,7 +201,6 @@ def section_evidence(
         ev = _periodic_evidence(prefix, pr, rtol, thr, zero_one)
         return ev, {f"{prefix}period": pr.period}, reasons
 
-    ev: list[Evidence] = []
     ratio = stationarity_ratio(z)
     settled = thr.stationary_low <= ratio <= thr.stationary_high if math.isfinite(ratio) else True
     if not settled:
@@ -232,118 +208,67 @@ def section_evidence(
             f"section: the points have not settled (second-half/first-half spread "
             f"{ratio:.2f}); discard more transient"
         )
-        ev.append(
-            Evidence(
-                f"{prefix}period",
-                None,
-                None,
-                f"no period <= {pr.max_period}, but the points are still "
-                f"converging or escaping (spread ratio {ratio:.2f})",
-            )
+        why = (
+            f"no period <= {pr.max_period}, but the points are still "
+            f"converging or escaping (spread ratio {ratio:.2f})"
         )
-        return ev, {}, reasons
-    ev.append(
-        Evidence(
-            f"{prefix}period",
-            None,
-            "not_periodic",
-            f"no lag 1..{pr.max_period} has all its bands within rtol = {rtol:g} of the "
-            f"extent (narrowest: {pr.mismatch:.3g} tol)",
-        )
+        return [Evidence(f"{prefix}period", None, None, why)], {}, reasons
+    why = (
+        f"no lag 1..{pr.max_period} has all its bands within rtol = {rtol:g} of the "
+        f"extent (narrowest: {pr.mismatch:.3g} tol)"
     )
-
-    enough = n >= min_points_aperiodic
-    few = f"; {n} points < {min_points_aperiodic}: too few to separate quasiperiodic from chaotic"
-    rot = rotation_order(z)
-    txt = (
-        f"rank-shift consistency R = {rot.consistency:.3f}, rotation number "
-        f"{rot.rotation_number:.4f}"
-    )
-    if not enough:
-        ev.append(Evidence(f"{prefix}rotation", rot.consistency, None, txt + few))
-    elif rot.consistency >= thr.rotation_quasi:
-        ev.append(
-            Evidence(
-                f"{prefix}rotation",
-                rot.consistency,
-                "quasiperiodic",
-                txt + f" >= {thr.rotation_quasi}: points turn along a closed curve",
-            )
+    ev = [Evidence(f"{prefix}period", None, "not_periodic", why)]
+    few = ""
+    if n < min_points_aperiodic:
+        few = (
+            f"; {n} points < {min_points_aperiodic}: too few to separate quasiperiodic from chaotic"
         )
-    else:
-        ev.append(
-            Evidence(
-                f"{prefix}rotation",
-                rot.consistency,
-                None,
-                txt + f" < {thr.rotation_quasi}: no rotation order",
-            )
-        )
-
+    ev.append(_rotation_evidence(f"{prefix}rotation", z, thr, few))
     ev.append(birkhoff_evidence(f"{prefix}birkhoff", z, thr))
+    ev.append(_expansion_evidence(f"{prefix}expansion", z, atol, thr, few))
+    if z.shape[1] >= 2 and n >= thr.dimension_min_points:
+        ev.append(_dimension_evidence(f"{prefix}dimension", z, thr))
+    if zero_one:
+        what = "0-1 test on the first section coordinate"
+        ev.append(zero_one_evidence(f"{prefix}zero_one", z[:, 0], what, seed, thr))
+    return ev, {}, reasons
 
-    floor = _floor(z, atol, thr.noise_floor)
-    g = neighbour_expansion(z, atol=floor)
+
+def _rotation_evidence(name: str, z: np.ndarray, thr: Thresholds, few: str) -> Evidence:
+    """Rank-shift consistency (`rotation_order`): quasiperiodic from ``rotation_quasi``; no
+    vote on fewer points than ``min_points_aperiodic`` (``few`` says so)."""
+    rot = rotation_order(z)
+    r = rot.consistency
+    txt = f"rank-shift consistency R = {r:.3f}, rotation number {rot.rotation_number:.4f}"
+    if few:
+        return Evidence(name, r, None, txt + few)
+    if r >= thr.rotation_quasi:
+        why = f" >= {thr.rotation_quasi}: points turn along a closed curve"
+        return Evidence(name, r, "quasiperiodic", txt + why)
+    return Evidence(name, r, None, txt + f" < {thr.rotation_quasi}: no rotation order")
+
+
+def _expansion_evidence(name: str, z: np.ndarray, atol, thr: Thresholds, few: str) -> Evidence:
+    """Nearest-neighbour expansion beyond the noise floor (`neighbour_expansion`): chaotic
+    above ``expansion_chaotic``; no vote on fewer points than ``min_points_aperiodic``."""
+    g = neighbour_expansion(z, atol=_floor(z, atol, thr.noise_floor))
     txt = f"mean one-step log growth of nearest-neighbour distances {g:.3f}"
     if not math.isfinite(g):
-        ev.append(
-            Evidence(
-                f"{prefix}expansion",
-                None,
-                None,
-                "too few distinct neighbours above the noise floor",
-            )
+        return Evidence(name, None, None, "too few distinct neighbours above the noise floor")
+    if few:
+        return Evidence(name, g, None, txt + few)
+    if g > thr.expansion_chaotic:
+        return Evidence(
+            name, g, "chaotic", txt + f" > {thr.expansion_chaotic}: neighbours separate"
         )
-    elif not enough:
-        ev.append(Evidence(f"{prefix}expansion", g, None, txt + few))
-    elif g > thr.expansion_chaotic:
-        ev.append(
-            Evidence(
-                f"{prefix}expansion",
-                g,
-                "chaotic",
-                txt + f" > {thr.expansion_chaotic}: neighbours separate",
-            )
-        )
-    else:
-        ev.append(
-            Evidence(
-                f"{prefix}expansion",
-                g,
-                None,
-                txt + f" <= {thr.expansion_chaotic}: no clear stretching",
-            )
-        )
+    return Evidence(name, g, None, txt + f" <= {thr.expansion_chaotic}: no clear stretching")
 
-    if z.shape[1] >= 2 and n >= thr.dimension_min_points:
-        d2 = correlation_dimension(z)
-        txt = f"correlation dimension D2 = {d2:.2f}"
-        if math.isfinite(d2) and d2 >= thr.dimension_chaotic:
-            ev.append(
-                Evidence(
-                    f"{prefix}dimension",
-                    d2,
-                    "chaotic",
-                    txt + f" >= {thr.dimension_chaotic}: not a curve",
-                )
-            )
-        else:
-            ev.append(
-                Evidence(
-                    f"{prefix}dimension",
-                    d2,
-                    None,
-                    txt + f" < {thr.dimension_chaotic}: a curve or unresolved",
-                )
-            )
-    if zero_one:
-        ev.append(
-            zero_one_evidence(
-                f"{prefix}zero_one",
-                z[:, 0],
-                "0-1 test on the first section coordinate",
-                seed,
-                thr,
-            )
-        )
-    return ev, {}, reasons
+
+def _dimension_evidence(name: str, z: np.ndarray, thr: Thresholds) -> Evidence:
+    """Correlation dimension (`correlation_dimension`): chaotic (not a curve) from
+    ``dimension_chaotic``."""
+    d2 = correlation_dimension(z)
+    txt = f"correlation dimension D2 = {d2:.2f}"
+    if math.isfinite(d2) and d2 >= thr.dimension_chaotic:
+        return Evidence(name, d2, "chaotic", txt + f" >= {thr.dimension_chaotic}: not a curve")
+    return Evidence(name, d2, None, txt + f" < {thr.dimension_chaotic}: a curve or unresolved")

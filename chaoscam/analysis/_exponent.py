@@ -15,10 +15,9 @@ def as_exponent(exponent, time_per_iterate: float = 1.0) -> tuple[float, float, 
     """``(λ, stderr, n_intervals)`` per iterate from a number, a tuple or a result object.
 
     Accepted: a float (stderr unknown: NaN), a pair ``(λ, stderr)``, a triple ``(λ, stderr,
-    n_intervals)``, or any object with attributes ``exponent`` and ``stderr`` (and
-    optionally ``n_intervals``), such as `LyapunovResult` or the model's tangent exponent.
-    λ and stderr are multiplied by `time_per_iterate` (the forcing period T for an
-    exponent in 1/s and a stroboscopic section).
+    n_intervals)``, or an object with attributes ``exponent`` and ``stderr`` (and optionally
+    ``n_intervals``). λ and stderr are multiplied by `time_per_iterate` (the forcing period
+    T for an exponent in 1/s and a stroboscopic section).
     """
     check_settings("as_exponent", time_per_iterate=(time_per_iterate, "real>0"))
     n = None
@@ -52,7 +51,7 @@ def exponent_evidence(
     """Vote of a largest Lyapunov exponent judged by its confidence interval.
 
     With z = `Thresholds.exponent_z` and ε = `Thresholds.exponent_zero`, the interval
-    ``[λ - z σ, λ + z σ]`` (σ the standard error, e.g. from batch means of the interval
+    ``[λ - z σ, λ + z σ]`` (σ the standard error, e.g. from batch means of the per-iterate
     log growths) votes
 
     * "chaotic" when ``λ - z σ > ε`` (positive beyond doubt),
@@ -60,8 +59,7 @@ def exponent_evidence(
       periodic orbit), and always for λ = -inf (the tangent vector collapsed: a zero
       Floquet multiplier, as after sticking),
     * and abstains otherwise, with the run length that would decide, σ taken to shrink as
-      1/sqrt(run length) (the batch-means error of an ergodic average; Benettin et al.
-      1980, Meccanica 15, 9).
+      1/sqrt(run length) (the batch-means error of an ergodic average).
 
     Parameters
     ----------
@@ -70,7 +68,7 @@ def exponent_evidence(
     stderr : float, optional
         Standard error of λ₁ in the same units; None or NaN abstains (unless λ₁ = -inf).
     n_intervals : int, optional
-        Renormalisation intervals averaged; only used to say how many more to run.
+        Intervals (iterates) averaged; only used to say how many more to run.
     thresholds : Thresholds, optional
         Default `Thresholds()`.
     name, unit : str
@@ -83,9 +81,8 @@ def exponent_evidence(
 
     Notes
     -----
-    Limits: σ is statistical only; the bias of a finite renormalisation distance or of
-    a too-short transient is not in it. A weakly chaotic orbit with λ₁ below ε per
-    iterate is read as not chaotic.
+    Limits: σ is statistical only; the bias of a too-short transient is not in it. A
+    weakly chaotic orbit with λ₁ below ε per iterate is read as not chaotic.
     """
     thr = thresholds or Thresholds()
     lam = float(exponent)

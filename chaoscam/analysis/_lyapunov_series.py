@@ -87,7 +87,6 @@ def lyapunov_from_series(
     dt : float
         Sampling interval of `x` (the exponent is per this unit of time).
     method : {"rosenstein", "eckmann"}
-        Estimator.
     max_points : int
         Most samples kept after subsampling.
     emb_dim : int
@@ -121,9 +120,9 @@ def lyapunov_from_series(
 
     Limits: series estimates are biased low for weakly chaotic systems and rough on short
     or noisy data (on 20 000 samples of the Lorenz, Rössler and Ueda signals Rosenstein
-    reads 7-27 % low). Eckmann's method gives spurious positive exponents on periodic
-    signals at these settings. Prefer the exponent from the equations
-    (`lyapunov_benettin`) whenever they are available.
+    reads 7-27 % low); Eckmann's method gives spurious positive exponents on periodic
+    signals at these settings. Where the map's Jacobians are known, prefer
+    `spectrum_from_jacobians`.
     """
     import nolds
 

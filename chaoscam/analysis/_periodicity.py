@@ -13,13 +13,7 @@ from .._util import freeze_fields
 from ._thresholds import Thresholds
 from ._validate import as_points, check_atol, check_settings
 
-__all__ = [
-    "PeriodResult",
-    "RotationResult",
-    "embed_angles",
-    "rotation_order",
-    "section_period",
-]
+__all__ = ["PeriodResult", "RotationResult", "embed_angles", "rotation_order", "section_period"]
 
 
 def embed_angles(points, angle_periods: Sequence[float | None] | None = None) -> np.ndarray:
@@ -37,7 +31,7 @@ def embed_angles(points, angle_periods: Sequence[float | None] | None = None) ->
 
     Returns
     -------
-    ndarray, shape (N, d')
+    ndarray, shape (N, d'), d' = d + the number of angular coordinates
     """
     x = as_points(points)
     if angle_periods is None:
@@ -108,6 +102,7 @@ class PeriodResult:
     message : str
         Why no period could be tested (too few points), else empty.
     settings : dict
+        The settings used.
     jitter : ndarray
         Per coordinate, the widest band at the period found (the measured jitter, in the
         units of the points); NaN when no period was found.
@@ -251,18 +246,9 @@ def section_period(
     d = x.shape[1]
     nan = np.full(d, math.nan)
     if n < min_points:
-        return PeriodResult(
-            None,
-            0,
-            0,
-            math.nan,
-            np.array([]),
-            False,
-            f"only {n} section points; the period test needs >= {min_points}",
-            settings,
-            nan,
-            np.ptp(x, axis=0) if n else nan,
-        )
+        why = f"only {n} section points; the period test needs >= {min_points}"
+        ext = np.ptp(x, axis=0) if n else nan
+        return PeriodResult(None, 0, 0, math.nan, np.array([]), False, why, settings, nan, ext)
     starts = [0]
     if allow_transient:
         step = max(1, n // 10)
@@ -277,18 +263,8 @@ def section_period(
         tol = _tolerance(y, rtol, atol, noise_floor)
         ext = np.ptp(y, axis=0)
         if np.all(ext <= tol):
-            return PeriodResult(
-                1,
-                k0,
-                max(1, m // min_repeats),
-                float(np.max(ext / tol)),
-                tol,
-                True,
-                "",
-                settings,
-                ext,
-                ext,
-            )
+            top, mis = max(1, m // min_repeats), float(np.max(ext / tol))
+            return PeriodResult(1, k0, top, mis, tol, True, "", settings, ext, ext)
         max_p = m // min_repeats if max_period is None else min(max_period, m // min_repeats)
         max_p_used = max(max_p_used, max_p)
         for p in range(1, max_p + 1):

@@ -1,8 +1,6 @@
-"""The saltation matrix of a state jump at an event surface (generic, numpy).
-
-The model's kernel writes the formula out for its restitution law (``_tangent.saltation``);
-this generic form is the reference it is tested against.
-"""
+"""The saltation matrix of a state jump at an event surface (generic, numpy): the reference
+the kernel's own formula for its restitution law (``chaoscam.kernel._tangent.saltation``) is
+tested against."""
 
 from __future__ import annotations
 

@@ -266,20 +266,8 @@ def spectrum_analysis(
     df = 1.0 / (n * dt) if n > 0 else nan
 
     def undetermined(msg, entropy=nan, flatness=nan, peaks=()):
-        return SpectrumResult(
-            "undetermined",
-            None,
-            (),
-            nan,
-            nan,
-            nan,
-            entropy,
-            flatness,
-            tuple(peaks),
-            df,
-            msg,
-            settings,
-        )
+        return SpectrumResult("undetermined", None, (), nan, nan, nan, entropy, flatness,
+                              tuple(peaks), df, msg, settings)  # fmt: skip
 
     if n < 64:
         return undetermined(f"only {n} samples; the spectrum needs >= 64")
@@ -305,6 +293,11 @@ def spectrum_analysis(
         for k, f in zip(kb[:n_peaks], fk[:n_peaks], strict=True)
     )
     ftol = float(peak_tol)
+
+    def result(model, period, bases, line_fraction, periodic, quasiperiodic):
+        return SpectrumResult(model, period, bases, line_fraction, periodic, quasiperiodic,
+                              entropy, flatness, peak_out, df, "", settings)  # fmt: skip
+
     min_f0 = float(min_cycles)  # in bins: f0 / df = cycles in the record
 
     def explained(on_model: np.ndarray) -> float:
@@ -332,13 +325,8 @@ def spectrum_analysis(
                 candidates.append((k, _refine_fundamental(f0, fk, pk, max(ftol, 0.5))))
     candidates = [(k, f0) for k, f0 in candidates if f0 >= min_f0]
     if not candidates:
-        return undetermined(
-            f"the record holds fewer than {min_cycles:g} cycles of the fundamental; "
-            "use a longer signal",
-            entropy,
-            flatness,
-            peak_out,
-        )
+        why = f"the record holds fewer than {min_cycles:g} cycles of the fundamental"
+        return undetermined(why + "; use a longer signal", entropy, flatness, peak_out)
     per_best, per_f0 = -1.0, nan
     for k, f0 in candidates:
         e = explained(on_comb(f0))
@@ -346,20 +334,7 @@ def spectrum_analysis(
             per_best, per_f0 = e, f0
         if e >= 1.0 - line_tol:
             period = k if forcing_frequency is not None else None
-            return SpectrumResult(
-                "periodic",
-                period,
-                (f0 * df,),
-                e,
-                e,
-                nan,
-                entropy,
-                flatness,
-                peak_out,
-                df,
-                "",
-                settings,
-            )
+            return result("periodic", period, (f0 * df,), e, e, nan)
 
     # --- two-frequency model: f1 the forcing (or strongest line), f2 the strongest off it
     if forcing_frequency is not None:
@@ -376,23 +351,8 @@ def spectrum_analysis(
         dist = np.minimum(np.abs(fk - lines[pos - 1]), np.abs(fk - lines[pos]))
         qp = explained(dist <= ftol)
         if qp >= 1.0 - line_tol:
-            return SpectrumResult(
-                "quasiperiodic",
-                None,
-                (f1 * df, f2 * df),
-                qp,
-                per_best,
-                qp,
-                entropy,
-                flatness,
-                peak_out,
-                df,
-                "",
-                settings,
-            )
+            return result("quasiperiodic", None, (f1 * df, f2 * df), qp, per_best, qp)
     best = max(per_best, -1.0 if math.isnan(qp) else qp)
     model = "broadband" if 1.0 - best >= broadband_tol else "aperiodic"
     bases = (per_f0 * df,) if best == per_best else (f1 * df, f2 * df)
-    return SpectrumResult(
-        model, None, bases, best, per_best, qp, entropy, flatness, peak_out, df, "", settings
-    )
+    return result(model, None, bases, best, per_best, qp)

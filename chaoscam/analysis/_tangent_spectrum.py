@@ -1,5 +1,5 @@
-"""Lyapunov exponents from a sequence of map Jacobians by repeated QR (the Jacobians of
-the model's stroboscopic map through the impacts come from :mod:`chaoscam.tangent`)."""
+"""Lyapunov exponents from a sequence of map Jacobians by repeated QR (for the model: the
+stroboscopic map's Jacobians through the impacts, which the kernel's tangent integrates)."""
 
 from __future__ import annotations
 
@@ -17,22 +17,23 @@ __all__ = ["TangentSpectrum", "spectrum_from_jacobians"]
 
 @dataclass(frozen=True)
 class TangentSpectrum:
-    """Lyapunov exponents from the tangent dynamics through the impacts.
+    """Lyapunov exponents of a sequence of map Jacobians (`spectrum_from_jacobians`).
 
     Attributes
     ----------
     exponents : ndarray, shape (2,)
-        λ₁ ≥ λ₂ [1/s]. λ₂ = -inf when a period held a plastic closure (the end of a complete
-        chattering: the stroboscopic map's Jacobian is singular, a Floquet multiplier 0).
+        λ₁ ≥ λ₂ per unit time of `period` [1/s for the model]. λ₂ = -inf when a Jacobian is
+        singular (for the model, a plastic closure ending a complete chattering: a Floquet
+        multiplier 0).
     stderr : ndarray, shape (2,)
-        Standard errors [1/s] from batch means of the per-period log growths (NaN with
-        fewer than `n_batches` periods, or for an infinite exponent).
+        Standard errors from batch means of the per-iterate log growths (NaN with fewer
+        than `n_batches` iterates, or for an infinite exponent).
     n_periods : int
-        Periods averaged.
+        Iterates (for the model: cam periods) averaged.
     local : ndarray, shape (n_periods, 2)
-        ln R_kk of each period's QR step (the local growth per period).
+        ln R_kk of each QR step (the local growth per iterate).
     det_log : float
-        Mean of ln|det J_k| per unit time [1/s] (equals λ₁ + λ₂).
+        Mean of ln|det J_k| per unit time (equals λ₁ + λ₂).
     settings : dict
         What the estimate used.
     """
@@ -49,11 +50,11 @@ class TangentSpectrum:
 
     @property
     def exponent(self) -> float:
-        """The largest exponent λ₁ [1/s]."""
+        """The largest exponent λ₁."""
         return float(self.exponents[0])
 
     def interval(self, z: float = 3.0) -> tuple[float, float]:
-        """λ₁ ± z standard errors [1/s]."""
+        """λ₁ ± z standard errors."""
         s = float(self.stderr[0])
         return self.exponent - z * s, self.exponent + z * s
 
@@ -63,20 +64,32 @@ def spectrum_from_jacobians(
 ) -> TangentSpectrum:
     """Lyapunov exponents of a sequence of 2×2 map Jacobians by repeated QR.
 
-    ``Q_k R_k = J_k Q_{k-1}``, ``λ_i = Σ_k ln |R_k[i, i]| / (n T)`` (Eckmann & Ruelle 1985).
+    With ``Q_0 = I`` and ``J_k Q_{k-1} = Q_k R_k`` (Gram–Schmidt, positive diagonal),
+
+        λ_i = 1 / (n T) Σ_{k=1}^{n} ln R_k[i, i]
+
+    (Benettin, Galgani, Giorgilli & Strelcyn 1980, Meccanica 15, 9; Eckmann & Ruelle 1985,
+    Rev. Mod. Phys. 57, 617, sec. IV.C); λ₁ + λ₂ is the mean of ln |det J_k| / T.
 
     Parameters
     ----------
     jacobians : ndarray, shape (n, 2, 2)
-        J_k = DP at x_{k-1}, in order.
+        J_k = DP at x_{k-1}, in order along the orbit.
     period : float
-        Time per map iterate [s].
+        Time T per map iterate (1: exponents per iterate; the cam period [s]: per second).
     n_batches : int
-        Batches (at least 2) for the standard error of the mean of the per-period growths.
+        Batches (at least 2) for the standard error of the mean of the per-iterate growths.
 
     Returns
     -------
     TangentSpectrum
+
+    Notes
+    -----
+    Limits: a finite-time average, whose standard error shrinks as 1/sqrt(n) and says
+    nothing about the bias of a too-short transient. The Jacobians must be those of the map
+    along the orbit, across a discontinuity (an impact) including its saltation matrix
+    (`saltation_matrix`). A singular J_k (a zero multiplier) gives λ₂ = -inf; λ₁ goes on.
     """
     check_settings(
         "spectrum_from_jacobians", period=(period, "real>0"), n_batches=(n_batches, "int>=2")

@@ -14,33 +14,31 @@ class Thresholds:
     """Every number at which `classify_section` and `classify_signal` change a vote.
 
     Pass one to either classifier (``thresholds=Thresholds(period_rtol=1e-2)``); the verdict
-    records the table it used in ``settings["thresholds"]``. Exponents are per iterate of
-    the section map (λ T for a stroboscopic section of a flow forced with period T);
-    lengths are relative to the orbit's extent unless said.
+    records it in ``settings["thresholds"]``. Exponents are per iterate of the section map
+    (λ T for a stroboscopic section of a flow forced with period T); lengths are relative
+    to the orbit's extent unless said.
 
     Attributes
     ----------
     period_rtol : float
         A period n is accepted when each of its n bands (the points k ≡ r mod n) is
-        narrower than ``max(atol_j, period_rtol · extent_j)`` in every coordinate j,
-        extent_j the range of the section points. 3e-3 is three times the ~0.1 % jitter
-        that integration error and a slow transient leave on a cam section, and refuses
-        noise of 1 % of the extent.
+        narrower than ``max(atol_j, period_rtol · extent_j)`` in every coordinate j: 3e-3
+        is three times the ~0.1 % jitter integration error and a slow transient leave on a
+        cam section, and refuses noise of 1 % of the extent.
     noise_floor : float
         Absolute floor of the period tolerance and of the expansion test's distances, as a
-        fraction of ``max_j max_k |x_kj|``: 1e-6, far above double round-off and below any
-        dynamics worth resolving. It makes a fixed point (no extent) detectable.
+        fraction of ``max_j max_k |x_kj|``: 1e-6, far above round-off and below any dynamics
+        worth resolving; it makes a fixed point (no extent) detectable.
     band_separation : float
         Two bands of a period are distinct when their centres lie more than this many
-        widths of the widest band apart in some coordinate (4: a gap of at least 3
-        widths). Neither the tolerance nor the floor is the measure: a period-12 cam orbit
-        repeats to 1e-9 rad while two of its points lie 9e-6 rad apart.
+        widths of the widest band apart in some coordinate (4: a gap of at least 3 widths);
+        a period-12 cam orbit repeats to 1e-9 rad while two of its points lie 9e-6 rad apart.
     stationary_low, stationary_high : float
         Spread of the second half of the points over that of the first: outside [0.5, 2]
         the points are still converging or escaping and the section abstains.
     min_points_aperiodic : int
-        Fewest section points for the rotation-order and expansion votes; a period up to
-        N / 2 shows on fewer, a quasiperiodic/chaotic call from fewer than 100 is weak.
+        Fewest section points for the rotation-order and expansion votes (a period up to
+        N / 2 shows on fewer; a quasiperiodic/chaotic call from fewer than 100 is weak).
     rotation_quasi : float
         Rank-shift consistency R (`rotation_order`) at or above which the points advance
         along a closed curve like a rotation (R ~ 1 / sqrt(N) for chaos).
@@ -58,20 +56,17 @@ class Thresholds:
         Fewest samples for the 0-1 test to vote: 200, so that its first half still has the
         100 samples `zero_one_test` needs.
     zero_one_max_change : float
-        Largest |K(first half) - K(whole)| for which K is taken as converged in N; above it
-        (or when the two lie on different sides of a threshold) the test abstains. On a cam
-        attractor K can fall from 0.94 at 229 points to 0.16 at 914.
+        Largest |K(first half) - K(whole)| for which K is taken as converged in N, else the
+        test abstains (on a cam attractor K can fall from 0.94 at 229 points to 0.16 at 914).
     birkhoff_quasi_digits : float
         Converged digits of the weighted Birkhoff averages (`weighted_birkhoff`) at or
-        above which an orbit with no period found is quasiperiodic: with 200-4000 points,
-        tori give 6-15 digits, chaotic orbits (logistic r = 4, Hénon) below 2.5, and noise
-        of 1e-4 of the extent caps the digits near 5.
+        above which an orbit with no period is quasiperiodic: on 200-4000 points tori give
+        6-15 digits, chaotic orbits (logistic r = 4, Hénon) below 2.5, noise of 1e-4 about 5.
     birkhoff_min_points : int
         Fewest points for the Birkhoff evidence to vote (two halves of 100).
     exponent_zero : float
-        A largest exponent per iterate whose confidence interval lies above this is
-        positive (chaotic), below it not positive: 0.01, an e-fold in 100 iterates, is below
-        what a finite run resolves.
+        A largest exponent whose confidence interval lies above this is positive (chaotic),
+        below it not positive: 0.01, an e-fold in 100 iterates, below what a run resolves.
     exponent_z : float
         Half-width of the exponent's confidence interval in standard errors (3: ~99.7 %).
     min_chaotic_votes : int
@@ -94,9 +89,9 @@ class Thresholds:
         `classify_signal`: a signal whose range is below this fraction of its magnitude is
         constant (an equilibrium).
     birkhoff_rational_tol : float
-        A converged rotation number within this of a rational p/q, q <= N/2, is not a
-        torus vote: an unresolved period-q orbit has one too (the cam at ξ = 0.30, period
-        30: 3/5 + 4e-10). 1e-8 mistakes a torus for one with probability ~1e-8 (N/2)².
+        A converged rotation number within this of a rational p/q, q <= N/2, is not a torus
+        vote: an unresolved period-q orbit has one too (the cam at ξ = 0.30, period 30:
+        3/5 + 4e-10); 1e-8 mistakes a torus for one with probability ~1e-8 (N/2)².
     """
 
     period_rtol: float = 3e-3

@@ -88,9 +88,8 @@ class Verdict:
     reasons : tuple of str
         Why the label is "undetermined" (disagreement, too little data), or what limits it.
     settings : dict
-        The settings used by each method; ``settings["thresholds"]`` is the
-        `Thresholds` table the classifier used (as a dict). Read-only at its top level
-        (a ``FrozenDict``), as a Trajectory's settings are.
+        The settings used by each method; ``settings["thresholds"]`` is the `Thresholds`
+        table the classifier used (as a dict). Read-only at its top level (a ``FrozenDict``).
     """
 
     label: str
@@ -110,11 +109,8 @@ class Verdict:
         return tuple(e.name for e in self.evidence if e.vote is not None)
 
     def to_dict(self) -> dict:
-        """JSON-serialisable dict with keys label, period, evidence, reasons.
-
-        The evidence used is that with a non-null vote (`used`); the thresholds are in
-        `settings`, which this form leaves out.
-        """
+        """JSON-serialisable dict with keys label, period, evidence, reasons (not `settings`,
+        where the thresholds are)."""
         return dict(
             label=self.label,
             period=None if self.period is None else int(self.period),

@@ -17,21 +17,8 @@ from ._parquet import DamagedFileError, exact_json, read_frame, read_table, writ
 from ._provenance import DRIVERS, code_identity, code_rows
 
 __all__ = [
-    "DRIVERS",
-    "DamagedFileError",
-    "OutputError",
-    "OutputLock",
-    "atomic_path",
-    "atomic_write_bytes",
-    "check_output",
-    "code_identity",
-    "code_rows",
-    "conflict_name",
-    "exact_json",
-    "lock_all",
-    "read_frame",
-    "read_table",
-    "tmp_name",
-    "write_new_parquet",
+    "DRIVERS", "DamagedFileError", "OutputError", "OutputLock", "atomic_path",
+    "atomic_write_bytes", "check_output", "code_identity", "code_rows", "conflict_name",
+    "exact_json", "lock_all", "read_frame", "read_table", "tmp_name", "write_new_parquet",
     "write_table",
-]
+]  # fmt: skip

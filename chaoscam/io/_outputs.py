@@ -1,16 +1,9 @@
 """One rule for every file chaoscam writes: checked first, never overwritten, written whole.
-
-* :func:`check_output` — before any work: the folder exists and is writable, the path is not
-  a directory, and an existing file is refused unless the caller says ``force``.
-* :func:`atomic_path` — write to a temporary name in the same folder, flushed to disk, then
-  :func:`os.replace` into place: a reader (or a resumed run) sees the whole file or none.
-  Without ``--force`` the final move refuses a file that appeared meanwhile (``replace=False``).
-* :class:`OutputLock` — an OS file lock (``fcntl.flock``) beside an output or checkpoint, so
-  a second process on the same output is refused instead of silently losing records.
-
-Every failure is an :class:`OutputError` (a ``ValueError``) whose message names the path and
-says what to do; the command line prints it and exits with code 2.
-"""
+:func:`check_output` runs before any work; :func:`atomic_path` writes a temporary name beside
+the file, flushed, then :func:`os.replace`'d into place (a reader or resumed run sees the whole
+file or none); :class:`OutputLock` (``fcntl.flock`` beside an output or checkpoint) refuses a
+second process on the same output instead of silently losing records. Every failure is an
+:class:`OutputError` (a ``ValueError``) naming the path and what to do (the CLI exits with 2)."""
 
 from __future__ import annotations
 
@@ -21,36 +14,27 @@ from collections.abc import Iterator
 from pathlib import Path
 
 __all__ = [
-    "OutputError",
-    "check_output",
-    "atomic_path",
-    "atomic_write_bytes",
-    "OutputLock",
-    "lock_all",
-]
+    "OutputError", "check_output", "atomic_path", "atomic_write_bytes", "OutputLock", "lock_all",
+]  # fmt: skip
 
 
 class OutputError(ValueError):
-    """An output path cannot be written (missing folder, read-only, a directory, exists,
-    or in use by another process)."""
+    """An output path cannot be written (missing folder, read-only, a directory, exists, or in
+    use by another process)."""
 
 
 def tmp_name(path: Path, tag: str = "") -> Path:
-    """A temporary name beside ``path``, keeping its suffix (matplotlib reads the format
-    from it): ``.tmp-PID[-TAG]-NAME``."""
+    """A temporary name beside ``path``, ``.tmp-PID[-TAG]-NAME``, keeping its suffix
+    (matplotlib reads the format from it)."""
     extra = f"-{tag}" if tag else ""
     return path.with_name(f".tmp-{os.getpid()}{extra}-{path.name}")
 
 
 def check_output(
-    path: str | Path | None,
-    *,
-    flag: str = "--out",
-    force: bool = False,
-    suffixes: tuple[str, ...] | None = None,
-    force_hint: str = "pass --force",
-) -> Path | None:
-    """Check that ``path`` can be written, before any work is done.
+    path: str | Path | None, *, flag: str = "--out", force: bool = False,
+    suffixes: tuple[str, ...] | None = None, force_hint: str = "pass --force",
+) -> Path | None:  # fmt: skip
+    """Check that ``path`` can be written, before any work is done; returns it as a Path.
 
     Parameters
     ----------
@@ -101,13 +85,13 @@ def check_output(
 
 
 NAME_ROOM = 24
-"""Bytes a file name must leave free for the names made from it: ``.tmp-PID-NAME.ckpt``
-(an atomic write or a checkpoint folder on its way, PID up to 7 digits) is 18 longer."""
+"""Bytes a file name must leave free for the names made from it: ``.tmp-PID-NAME.ckpt`` (an
+atomic write or checkpoint folder on its way, PID up to 7 digits) is 18 longer."""
 
 
 def _check_name_length(folder: Path, path: Path, flag: str) -> None:
-    """Refuse a name too long for the names made from it (a 230-character output ran a whole
-    sweep, then failed writing its companion's temporary file, and again on --resume)."""
+    """Refuse a name too long for the temporary and companion names made from it, before any
+    work (not when the result is written)."""
     try:
         most = os.pathconf(folder, "PC_NAME_MAX")
     except (OSError, ValueError, AttributeError):
@@ -121,7 +105,7 @@ def _check_name_length(folder: Path, path: Path, flag: str) -> None:
 
 
 def _probe(folder: Path, what: str) -> None:
-    """Create and remove a file in ``folder``: the only sure test that it takes files
+    """Create and remove a file in ``folder``, the only sure test that it takes files
     (``os.access`` says yes to root on a read-only mount)."""
     probe = folder / f".tmp-{os.getpid()}-{threading.get_ident()}-probe"  # one per thread
     try:
@@ -137,17 +121,12 @@ def _probe(folder: Path, what: str) -> None:
 
 @contextlib.contextmanager
 def atomic_path(path: str | Path, *, replace: bool = True) -> Iterator[Path]:
-    """A temporary path to write ``path`` to; moved into place when the block succeeds.
-
-    The file is flushed to disk before the rename, so it is whole or absent whatever moment
-    the process is killed; on an exception the temporary file is removed.
-
-    ``replace=False`` (an output checked absent, without ``--force``) puts the file in place
-    only if ``path`` still does not exist, atomically (a hard link, which refuses an existing
-    name): a file that another process wrote there while this one worked is kept, and this
-    one's result is kept beside it (:func:`conflict_name`) with an :class:`OutputError` that
-    names both.
-    """
+    """A temporary path to write ``path`` to, moved into place when the block succeeds: flushed
+    to disk before the rename, the file is whole or absent whenever the process is killed; on an
+    exception it is removed. ``replace=False`` (an output checked absent, without ``--force``)
+    places it only if ``path`` still does not exist, atomically (a hard link refuses an existing
+    name): a file another process wrote meanwhile is kept, this one's result beside it
+    (:func:`conflict_name`), and an :class:`OutputError` names both."""
     path = Path(path)
     tmp = tmp_name(path)
     try:
@@ -182,9 +161,8 @@ def _place_new(tmp: Path, path: Path) -> None:
 
 
 def write_new_parquet(table, path: str | Path, *, replace: bool = False) -> None:
-    """A pyarrow ``table`` to ``path`` atomically (:func:`chaoscam._parquet.write_table`),
-    refusing an existing file, a folder or a missing folder unless ``replace`` (the file); a
-    file object (not a path) is written into as it is."""
+    """A pyarrow ``table`` to ``path`` atomically (:func:`write_table`), refusing an existing
+    file (unless ``replace``), a folder or a missing folder; a file object is written into."""
     from ._parquet import write_table
 
     if not isinstance(path, str | os.PathLike):  # a file object: pyarrow writes into it
@@ -201,14 +179,11 @@ def atomic_write_bytes(path: str | Path, data: bytes, *, replace: bool = True) -
 
 
 class OutputLock:
-    """An exclusive OS lock on ``path`` (a hidden ``.NAME.lock`` file beside it).
-
-    Taken without waiting: when another process holds it, :class:`OutputError` says so. The
-    lock is released when the holder exits, however it exits (the OS drops ``flock`` locks
-    with the process), so a killed run never leaves a stale lock. Usable as a context
-    manager; re-entrant within one thread for the same path (a sweep called by the command
-    that locked its output), refused from another thread of the same process.
-    """
+    """An exclusive OS lock on ``path`` (a hidden ``.NAME.lock`` file beside it), taken without
+    waiting (:class:`OutputError` when another process holds it) and released however the
+    holder exits (the OS drops ``flock`` locks with the process), so a killed run leaves no
+    stale lock. A context manager; re-entrant within one thread for the same path (a sweep
+    called by the command that locked its output), refused from another thread."""
 
     _held: dict[str, tuple[int, int]] = {}  # lock file -> (descriptor, thread that took it)
     _table = threading.Lock()
@@ -257,8 +232,7 @@ class OutputLock:
                     f"{self.target} is in use by another chaoscam process (pid {holder}); "
                     f"wait for it to finish, or choose another {self.what}"
                 ) from None
-            # The holder before us may have removed the file after we opened it: then our
-            # lock is on a dead inode; try again on the current file.
+            # the holder before us may have removed the file we opened: retry on the current one
             try:
                 same = os.path.samestat(os.fstat(fd), os.stat(self.path))
             except FileNotFoundError:
@@ -292,9 +266,8 @@ class OutputLock:
 
 @contextlib.contextmanager
 def lock_all(paths, what: str = "output"):
-    """:class:`OutputLock` on each of ``paths`` (a run's output and its companions), so that
-    a second process naming any of them (``--out X.verdicts.parquet`` while a sweep writes
-    ``X.parquet``) is refused at its start, not the first run at its end."""
+    """:class:`OutputLock` on each of ``paths`` (a run's output and companions): a second
+    process naming any of them is refused at its start, not the first run at its end."""
     paths = [Path(p) for p in paths]
     for path in paths:  # first: a lock's name (.NAME.lock) is longer than the name
         _check_name_length(path.parent, path, "--out")

@@ -1,18 +1,11 @@
 """Parquet files with page checksums: damage inside a file is found when it is read.
 
-Every Parquet file chaoscam writes (trajectories, sweep tables, ensemble tables) stores a CRC
-of each data page (``write_page_checksum``), and every read verifies them
-(``page_checksum_verification``): a file whose bytes changed after it was written (a bad
-disk, a copy cut short inside a page) raises :class:`DamagedFileError` naming the file,
-instead of being read with wrong numbers. Without the checksums, 400 flipped bytes in a
-trajectory file changed 50 values of ``omega_f`` and were read without a word (found by a
-new-user review). The file's key-value metadata, where a trajectory keeps its section and
-impacts (most of its bytes) and a sweep its configuration, has no page checksum: a SHA-256
-of it is stored beside it (``chaoscam.digest``) and checked on reading. Files written before
-the checksums have none, and are read unverified, as before. A truncated file, or one that
-is not Parquet, already failed to read.
-
-The pyarrow imports are inside the functions: a run that writes nothing does not pay them.
+Every Parquet file chaoscam writes stores a CRC of each data page (``write_page_checksum``) and
+every read verifies them (``page_checksum_verification``): a file changed after it was written (a
+bad disk, a copy cut short inside a page) raises :class:`DamagedFileError` naming it instead of
+being read with wrong numbers. The key-value metadata (a trajectory's section and impacts, a
+sweep's configuration) has no page checksum: its SHA-256 is stored beside it (``chaoscam.digest``)
+and checked on reading. A file without checksums is read unverified.
 """
 
 from __future__ import annotations
@@ -22,13 +15,8 @@ import json
 from pathlib import Path
 
 __all__ = [
-    "DIGEST_KEY",
-    "DamagedFileError",
-    "exact_json",
-    "read_frame",
-    "read_table",
-    "write_table",
-]
+    "DIGEST_KEY", "DamagedFileError", "exact_json", "read_frame", "read_table", "write_table",
+]  # fmt: skip
 
 DIGEST_KEY = b"chaoscam.digest"
 """Metadata key of the SHA-256 of the file's other metadata (:func:`write_table`)."""
@@ -69,8 +57,7 @@ def _verify(path, meta: dict | None) -> None:
 
 
 def write_table(table, path: str | Path) -> None:
-    """``pyarrow.parquet.write_table`` with a checksum per data page and the digest of the
-    metadata (:data:`DIGEST_KEY`)."""
+    """``pyarrow.parquet.write_table`` with page checksums and the metadata's :data:`DIGEST_KEY`."""
     import pyarrow.parquet as pq
 
     meta = {k: v for k, v in (table.schema.metadata or {}).items() if k != DIGEST_KEY}
@@ -79,8 +66,7 @@ def write_table(table, path: str | Path) -> None:
 
 
 def read_table(path: str | Path):
-    """``pyarrow.parquet.read_table``, verifying the page checksums and the metadata's
-    digest when the file has them."""
+    """``pyarrow.parquet.read_table``, verifying page checksums and digest where present."""
     import pyarrow.parquet as pq
 
     table = _checked(path, lambda: pq.read_table(path, page_checksum_verification=True))
@@ -89,8 +75,7 @@ def read_table(path: str | Path):
 
 
 def read_frame(path: str | Path):
-    """``pandas.read_parquet``, verifying the page checksums and the metadata's digest when
-    the file has them."""
+    """``pandas.read_parquet``, verifying page checksums and digest where present."""
     import pandas as pd
     import pyarrow.parquet as pq
 
@@ -100,15 +85,9 @@ def read_frame(path: str | Path):
 
 
 def exact_json(frame) -> str:
-    """``frame`` as pandas' "split" JSON with every float written exactly (Python's shortest
-    round-trip repr): ``DataFrame.to_json`` keeps at most 15 significant digits, so a section
-    read back differed from the run's in the last bits (up to 5.6e-16 rad, 91 of 92 points of
-    a default 20 s run). NaN is written as null, as ``to_json`` writes it."""
+    """``frame`` as pandas' "split" JSON with every float exact (Python's shortest round-trip
+    repr; ``DataFrame.to_json`` keeps 15 significant digits, which moves 91 of a default 20 s
+    run's 92 section points by up to 5.6e-16 rad). NaN is written as null, as by ``to_json``."""
     cells = frame.astype(object).where(frame.notna(), None)
-    return json.dumps(
-        {
-            "columns": list(frame.columns),
-            "index": list(range(len(frame))),
-            "data": cells.values.tolist(),
-        }
-    )
+    return json.dumps({"columns": list(frame.columns), "index": list(range(len(frame))),
+                       "data": cells.values.tolist()})  # fmt: skip

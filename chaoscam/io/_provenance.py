@@ -1,13 +1,8 @@
-"""What code produced a result: recorded with every sweep and ensemble, and part of the
-configuration a checkpoint must match to be resumed.
-
-The package version alone does not say it (it is not bumped with every change to the
-kernels), so the record also holds a fingerprint of the sources that decide a result's
-numbers (every module but the command line, the reports and the paper's figure scripts,
-which only drive and draw) and the versions of numpy and numba, which compile and run
-the kernels. A checkpoint written by other code is not resumed: its finished records and
-the new ones could differ.
-"""
+"""What code produced a result, recorded with every sweep and ensemble and matched by a resumed
+checkpoint (other code's records could differ from the new ones). The version is not bumped with
+every kernel change, so the record holds a fingerprint of the sources that decide a result's
+numbers (all but the command line, reports and paper scripts, which drive and draw) and the
+versions of numpy and numba, which compile and run the kernels."""
 
 from __future__ import annotations
 
@@ -38,20 +33,14 @@ def code_identity() -> dict[str, str]:
         if rel.parts[0] in DRIVERS:
             continue
         digest.update(rel.as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
-    return {
-        "version": __version__,
-        "sources": digest.hexdigest()[:16],
-        "numpy": numpy.__version__,
-        "numba": numba.__version__,
-    }
+    return {"version": __version__, "sources": digest.hexdigest()[:16],
+            "numpy": numpy.__version__, "numba": numba.__version__}  # fmt: skip
 
 
 def code_rows(code: object) -> dict[str, object]:
-    """A code record (:func:`code_identity`) as rows of a report's provenance table; none
-    for a result written before the record was kept."""
+    """A code record (:func:`code_identity`) as rows of a report's provenance table (none for a
+    result without one)."""
     if not isinstance(code, dict):
         return {}
-    return {
-        "source fingerprint": code.get("sources"),
-        "numpy / numba": f"{code.get('numpy')} / {code.get('numba')}",
-    }
+    return {"source fingerprint": code.get("sources"),
+            "numpy / numba": f"{code.get('numpy')} / {code.get('numba')}"}  # fmt: skip

@@ -1,10 +1,8 @@
-"""The compiled kernels: fixed-step RK4 with located impacts (the reference), the adaptive
-DOP853 path, the tangent dynamics through the impacts, and the loop that drives them on the
-CPU's threads or a GPU.
+"""The compiled kernels: fixed-step RK4 with located impacts (the reference), adaptive DOP853,
+the tangent dynamics through the impacts, and the loop that drives them on CPU threads or a GPU.
 
 Kernels take floats and arrays and return status codes (:class:`Status`); they never raise.
-The memory layout they share with their drivers is :mod:`chaoscam.kernel.layout`. Names
-resolve lazily, so that importing the package does not load numba.
+Their memory layout is :mod:`chaoscam.kernel.layout`. Names resolve lazily (numba loads on use).
 """
 
 from __future__ import annotations
@@ -14,8 +12,7 @@ from pathlib import Path
 from .._util import lazy_face
 from ._numba_cache import guard
 
-# numba's cached kernels call functions of this package's other files: compiled from these
-# sources only (a callee's edit does not reach a cached caller; see ._numba_cache).
+# cached kernels call functions of other files here: a callee's edit must empty the cache
 guard(Path(__file__).parent)
 
 _LAZY = {

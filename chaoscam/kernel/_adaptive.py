@@ -1,65 +1,38 @@
 """Adaptive, event-driven Dormand–Prince 8(5,3) with located impacts: the fast path.
 
-The same model and the same call signature as the fixed-step reference
-(:func:`._rk4.run_chunk`); :func:`._driver.advance`
-picks one by ``Params.integrator``. What differs is how time is cut:
+The model and call signature of :func:`._rk4.run_chunk` (:func:`._driver.advance` picks by
+``Numerics.integrator``); what differs is how time is cut:
 
-- **Steps** are DOP853 steps (Dormand–Prince 8(5,3); Hairer, Nørsett & Wanner, *Solving
-  Ordinary Differential Equations I*, 2nd ed., sec. II.10; :mod:`._dop853`) with the usual
-  error control: a step is accepted when the error estimate, scaled by ``atol + rtol |y|``
-  per component, has norm <= 1, and the next step is ``h 0.9 err^(-1/8)`` (within [1/3, 6] h
-  and ``h_max``). An 8th-order method because the contact oscillation (period ~1e-4 s, barely
-  damped) must be followed to ~1e-11 relative accuracy: at such tolerances DOP853 needs
-  2-3x fewer evaluations than Dormand–Prince 5(4), which this module used first.
-- **In flight** (gap > 0 at the step's start) the step integrates the free pendulum
-  ``J theta'' = -(m g l/2) cos theta``, which *is* the motion until the gap closes, so its
-  interpolant is exact up to the crossing even when the step ends past it. A step longer
-  than the time over which the gap provably stays open (:func:`._physics.safe_horizon`) is cut
-  to ``dt``, the grid step, so that it cannot hold several crossings.
-- **In contact** (gap <= 0) the step integrates (1)–(3) with the compliant force; the error
-  control resolves the contact oscillation (period ~1e-4 s) only as finely as the tolerance
-  asks, instead of ~45 fixed steps a period.
-- **Grazes**: a step whose ends show no sign change but whose gap rate turns (from closing
-  to opening in flight, the reverse in contact) is searched for the turning point on the
-  interpolant; if the gap has changed sign there, the first crossing before it is an event.
-  So a graze, or a micro-flight of a chattering sequence (0.1-1 us), shorter than a step is
-  seen; two turns inside one step are not looked for.
-- **On the surface**: a located event leaves the point on the surface to rounding. As in
-  the fixed-step kernel, a step from there takes its side from the motion
-  (:func:`surface_mode`: flight after a rebound, contact after a plastic closure, else the
-  gap rate's sign), the flags persisting across buffer hand-backs in ``cnt[I_SURFACE]``; a
-  micro-flight from the surface is bracketed from its top (the gap's maximum).
-- **Tangent**: RK4 substeps of ``V' = A V`` along each accepted step, states from the
-  interpolant (:func:`advance_tangent`), split at events, where the saltation matrix applies.
-- **Events**: when the gap changes sign over a step, the crossing is located by Illinois
-  regula falsi on the gap along the step's Hermite interpolant (quintic in theta, from the
-  values, rates and accelerations at both ends) to ``event_tol``; the state there is a
-  DOP853 step of that length from the step's start (an integrator state, so the
-  interpolant's error does not enter the trajectory), the impact law (4)–(5) is applied
-  exactly as in the reference kernel (jump only if the approach speed exceeds ``v_min``),
-  and the next step starts there.
-- **Clock**: every step's and event's length is rounded so that its end time is a double
-  (:func:`._physics.on_clock`), and the cam angle at a step's start is reduced exactly
-  (:func:`._physics.cam_angle`), as in the fixed-step kernel: the end of a chattering
-  sequence is then decided by the dynamics, not by the rounding of ``omega t``.
-- **Scheduled times** (sections ``k T``, line-length resampling ``j dt_l``, the run's end)
-  end a step exactly, so section points are integrator states, not interpolations. Series
-  samples come from the interpolant, so asking for a series never changes the trajectory.
+- **Steps**: DOP853 (Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I*, 2nd
+  ed., sec. II.10; :mod:`._dop853`) with the usual error control (``SAFETY`` below). Eighth
+  order because the barely damped contact oscillation (period ~1e-4 s) must be followed to
+  ~1e-11 relative, where DOP853 needs 2-3x fewer evaluations than Dormand–Prince 5(4).
+- **In flight** (gap > 0) a step integrates the free pendulum ``J theta'' = -(m g l/2) cos
+  theta``, the motion up to the closing, so its interpolant is exact up to the crossing; steps
+  longer than the gap provably stays open (:func:`._physics.safe_horizon`) are cut to ``dt``, so
+  none holds several crossings. **In contact**, (1)–(3) resolved only as finely as the
+  tolerance asks (not ~45 fixed steps a contact period).
+- **Events**: a sign change of the gap over a step is located by Illinois regula falsi on the
+  step's Hermite interpolant (quintic in theta) to ``event_tol``; the state there is a DOP853
+  step of that length (the interpolant's error does not enter) and the impact law (4)–(5)
+  applies as in the reference. Where the gap rate turns without a sign change (a graze or a
+  0.1-1 us chattering micro-flight) the turning point is searched first; two turns in one step
+  are not looked for. A step from the surface takes its side from the motion (:func:`surface_mode`).
+- **Tangent**: RK4 substeps of ``V' = A V`` along each accepted step (:func:`advance_tangent`),
+  split at events, where the saltation matrix applies. **Clock and schedule** as in the
+  reference (:func:`._physics.on_clock`; sections, draws and the end end a step exactly);
+  series samples come from the interpolant, so a series never changes the trajectory.
 
-Chattering guard: at most ``max_events_per_step`` events inside one grid interval
-``[n dt, (n + 1) dt)``; further sign changes there are stepped over (counted in
-``I_CHATTER``). The contact fraction is integrated in time (``Y_RECORDED``, ``Y_CONTACT``).
+Chattering guard: at most ``max_events_per_step`` events in one grid interval ``[n dt, (n + 1)
+dt)``, later sign changes there stepped over (``I_CHATTER``). The contact fraction is integrated
+in time (``Y_RECORDED``, ``Y_CONTACT``). Never raises; returns a status code.
 
-Like the reference kernel this never raises; it returns a status code.
-
-Measured against converged RK4 (``benchmarks/bench_work_precision.py``, 2026-11-29): 20 s
-sections of periodic responses within 1e-6 rad from rtol 1e-8 (omega = 45 rad/s) or 1e-5
-(xi = 0.2), 5.5-10x cheaper than plain fixed-step RK4 and 1.1-1.2x than the default merged
-RK4. The first ten fast impacts of the default run (v_min = 0) cannot be compared to 1e-6 s:
-RK4's own step halving moves them by 0.6-2.8e-6 s down to dt = 6.25e-8 s, as each chattering
-sequence ends on a discontinuous count of bounces and the dynamics amplifies differences of
-order 1e-12 s by 3-6x per impact, so the runs differ by their rounding, not by their
-truncation error. With v_min = 1e-3 m/s they agree within 1e-6 s and rad at rtol 3e-14.
+Accuracy (``benchmarks/bench_work_precision.py``): 20 s sections of periodic responses are within
+1e-6 rad of converged RK4 from rtol 1e-8 (omega = 45 rad/s) or 1e-5 (xi = 0.2), 5.5-10x cheaper
+than plain RK4 and 1.1-1.2x than merged RK4. Limit: with v_min = 0 the fast impacts cannot be
+compared to 1e-6 s (RK4's own step halving moves them by up to 2.8e-6 s: each chattering
+sequence ends on a discontinuous count of bounces, and differences of 1e-12 s grow 3-6x per
+impact); with v_min = 1e-3 m/s they agree within 1e-6 s and rad at rtol 3e-14.
 """
 
 from __future__ import annotations
@@ -114,8 +87,8 @@ from .layout import (
     Y_WINDOW,
 )
 
-# Step-size control (Hairer et al. sec. II.4 and their dop853 code): after a step with
-# error norm err, h_new = h * SAFETY * err^(-1/8), limited to [SHRINK_MIN, GROW_MAX] h.
+# Step-size control (Hairer et al. sec. II.4, their dop853 code): accept when the error norm
+# err <= 1; h_new = h * SAFETY * err^(-1/8) within [SHRINK_MIN, GROW_MAX] h and h_max.
 SAFETY = 0.9
 GROW_MAX = 6.0
 SHRINK_MIN = 1.0 / 3.0
@@ -129,16 +102,12 @@ MAX_EVENT_GROWTH = 60  # doublings of an event step's overshoot (2^60 event tole
 
 @njit(cache=True, inline="always")
 def surface_mode(g, rate, surf):
-    """(flight, on_surface): the mode a step from gap ``g`` with gap rate ``rate`` takes.
+    """(flight, on_surface): the mode of a step from gap ``g`` with gap rate ``rate``.
 
-    As in the fixed-step kernel: a located crossing leaves the point on the surface to
-    rounding (slow closings give delta = 0.0 exactly). There the side is the motion's:
-    contact just after a plastic closure (``SURFACE_SETTLED``; its gap rate is 0 to
-    rounding), else flight when moving out (after a rebound, ``SURFACE_JUMPED``, whose gap
-    may be a rounding below 0, or a located opening). Taking the rounding's sign instead
-    makes an opening event of zero length after each rebound, and those fill the chattering
-    guard.
-    """
+    On the surface (a located crossing, delta = 0 to rounding) the side is the motion's:
+    contact after a plastic closure (``SURFACE_SETTLED``), else flight when moving out (after a
+    rebound, ``SURFACE_JUMPED``, or a located opening). The rounding's sign would make a
+    zero-length opening after each rebound, filling the chattering guard."""
     jumped = (surf & SURFACE_JUMPED) != 0
     settled = (surf & SURFACE_SETTLED) != 0
     on_surface = g == 0.0 or (jumped and g <= 0.0)
@@ -149,15 +118,11 @@ def surface_mode(g, rate, surf):
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def locate_on_interpolant(h, th, tr, co, s_lo, g_lo, s_hi, g_hi, c):
-    """The fraction s in (s_lo, s_hi] of the step at which the gap changes sign, on the
-    interpolant (s_lo = 0 but for a micro-flight from the surface, whose bracket starts at
-    its top; g_lo and g_hi are the gap at the bracket's ends).
-
-    Illinois regula falsi (with bisection when a pass fails to halve the bracket) on
-    ``s -> delta(t + s h, theta(s))`` until the bracket is narrower than ``event_tol / h``;
-    ``tr`` is the step's trigonometric base (``trig_at``), ``co`` its interpolant data.
-    Returns the bracket's end past the crossing.
-    """
+    """The fraction s in (s_lo, s_hi] of the step where the gap changes sign on the interpolant
+    ``co`` (g_lo, g_hi: the gap at the bracket's ends; s_lo > 0 for a micro-flight from the
+    surface, bracketed from its top): Illinois regula falsi on ``s -> delta(t + s h,
+    theta(s))``, bisecting when a pass fails to halve the bracket, to ``event_tol / h``. ``tr``:
+    the step's trigonometric base (``trig_at``). Returns the bracket's end past the crossing."""
     sgn = 1.0 if g_lo > 0.0 else -1.0  # work on sgn * delta, positive at the start
     a, fa, b, fb = s_lo, sgn * g_lo, s_hi, sgn * g_hi
     tol = c[C_EVENT_TOL] / h
@@ -178,11 +143,9 @@ def locate_on_interpolant(h, th, tr, co, s_lo, g_lo, s_hi, g_hi, c):
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def turning_point(h, th, tr, co, rate0, rate1, c):
-    """The fraction s of the step where the gap rate l_1 theta' - dC/dt.n changes sign.
-
-    Illinois regula falsi on the interpolant, to ``TURN_TOL`` of the step (the turning point only
-    needs to be good enough to show on which side of zero the gap's extremum lies).
-    """
+    """The fraction s of the step where the gap rate l_1 theta' - dC/dt.n changes sign:
+    Illinois regula falsi on the interpolant to ``TURN_TOL`` (enough to show on which side of
+    zero the gap's extremum lies)."""
     sgn = -1.0 if rate1 > 0.0 else 1.0  # work on sgn * rate: positive at 0, negative at 1
     a, fa, b, fb = 0.0, sgn * rate0, 1.0, sgn * rate1
     side = 0
@@ -198,17 +161,13 @@ def turning_point(h, th, tr, co, rate0, rate1, c):
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side):
-    """With the tangent on, carry it over the accepted step [t, t + s_end h_step] whose
-    state runs from (th, om) to (th1, om1), the inner points taken from the interpolant
-    ``co``: RK4 substeps of V' = A V (:func:`._tangent.rk4_tangent_along`), as many as keep
-    ``h_sub |A|`` <= ``TANGENT_STEP_RATE``, |A| estimated at the step's start.
-
-    One RK4 step of V over a whole DOP853 step would be far too coarse: in contact the error
-    control allows steps of ~1/10 of the contact period, over which RK4 damps the oscillating
-    part of V by ~1e-4 a step, which biased lambda_1 of the default model to about -22 1/s.
-    The first substep's Jacobian is taken on ``side_first`` (the side a step that starts on
-    the surface starts on), the others on ``side``.
-    """
+    """With the tangent on, carry it over the accepted step [t, t + s_end h_step] from (th, om)
+    to (th1, om1), inner points from the interpolant ``co``: RK4 substeps of V' = A V
+    (:func:`._tangent.rk4_tangent_along`) with ``h_sub |A| <= TANGENT_STEP_RATE``, |A| the
+    largest at the step's start, middle and end. One RK4 step per DOP853 step (~1/10 of the
+    contact period) damps V's oscillating part by ~1e-4 a step and biases lambda_1 of the
+    default model to about -22 1/s. The first substep's Jacobian is taken on ``side_first``
+    (a step from the surface), the others on ``side``."""
     if not steps.tangent_on(t, c):  # off, or in the transient
         return
     _, p0, q0 = ph.acceleration_jacobian(t, th, om, K, c, side_first)
@@ -228,34 +187,18 @@ def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side
             the, ome = theta_at(co, se), omega_at(co, se)
         sm = s_end * (i + 0.5) / m
         r = rk4_tangent_along(
-            t + i * hm,
-            hm,
-            thb,
-            omb,
-            theta_at(co, sm),
-            omega_at(co, sm),
-            the,
-            ome,
-            K,
-            c,
-            y[k.Y_J11],
-            y[k.Y_J21],
-            y[k.Y_J12],
-            y[k.Y_J22],
-            side_first if i == 0 else side,
-        )
+            t + i * hm, hm, thb, omb, theta_at(co, sm), omega_at(co, sm), the, ome, K, c,
+            y[k.Y_J11], y[k.Y_J21], y[k.Y_J12], y[k.Y_J22], side_first if i == 0 else side,
+        )  # fmt: skip
         steps.commit_tangent(y, r[0], r[1], r[2], r[3], r[4])
         thb, omb = the, ome
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def leave(y, cnt, th, om, t, h, events, window, surface, code, c):
-    """Store the state, the time, the next step size, the event count and the surface flags
-    (``surface``: 1 jumped, 2 settled, as ``cnt[I_SURFACE]``); return ``code``.
-
-    Everything the loop carries from one step to the next is either stored here or
-    recomputed from it the same way inside the loop, so a resumed run is bit-identical.
-    """
+    """Store the state, time, next step size, event count and surface flags (``surface``, as
+    ``cnt[I_SURFACE]``) and return ``code``. All the loop carries is stored here or recomputed
+    from it the same way, so a resumed run is bit-identical."""
     y[Y_THETA] = th
     y[Y_OMEGA] = om
     y[Y_TIME] = t
@@ -271,11 +214,9 @@ def leave(y, cnt, th, om, t, h, events, window, surface, code, c):
 def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
     """Advance one trajectory from ``y[Y_TIME]`` to ``n_stop * dt`` with adaptive steps.
 
-    Arguments, buffers and status codes as :func:`._rk4.run_chunk`;
-    ``cnt[I_STEP]`` is kept as the last grid step passed, and ``y[Y_STEP]`` carries the step
-    size across calls, so a run resumed after a buffer hand-back is bit-identical to one that
-    was not interrupted.
-    """
+    Arguments, buffers and status codes as :func:`._rk4.run_chunk`; ``cnt[I_STEP]`` is the last
+    grid step passed and ``y[Y_STEP]`` carries the step size across calls (resumed runs are
+    bit-identical)."""
     dt = c[C_DT]
     t_stop = n_stop * dt
     stride = np.int64(c[C_STRIDE])
@@ -290,8 +231,6 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
     K = ph.stiffness(lam[cnt[I_LAM_POS]], c)
     tr = trig_at(t, th, c)  # trigonometric base of the next step; renewed when (t, th) move
     g, l1, cdn = ph.geometry_trig(tr[1], tr[2], tr[3], tr[4], c)
-    # The surface flags, kept in the counters across a buffer hand-back like the fixed-step
-    # kernel's: JUMPED (a rebound was just applied), SETTLED (a plastic closure).
     surf = cnt[I_SURFACE]
     flight, on_surface = surface_mode(g, l1 * om - cdn, surf)
     a1 = accel_trig(tr, om, K, c, flight)
@@ -316,8 +255,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         t_next, is_section, is_resample = steps.next_scheduled(t_stop, cnt, c)
         hs = min(h, c[C_H_MAX])
         if flight and hs > dt:
-            # Near the cam a long step could hold several crossings, of which the search
-            # might find a later one: steps there are cut to dt (see module doc).
+            # near the cam a long step could hold several crossings: cut to dt
             safe = ph.safe_horizon(max(g, 0.0), l1, cdn, om, c)
             if hs > safe:
                 hs = max(dt, safe)
@@ -351,8 +289,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             events = 0
         rate0 = l1 * om - cdn
         rate1 = l1_1 * om1 - cdn1
-        # The gap at the step's start, signed by the side the step starts on (a point on the
-        # surface has delta = 0 to rounding: the side is the motion's, see surface_mode).
+        # the gap at the start, signed by the side the step starts on (see surface_mode)
         gs = g
         if on_surface:
             gs = ON_SURFACE if flight else -ON_SURFACE
@@ -363,18 +300,13 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             if not closing:
                 crossing = False  # lift-off from the surface: at the step's start
             elif rate0 > 0.0 > rate1:
-                # A micro-flight from the surface: the gap is rounding noise near the start,
-                # so the bracket starts at the flight's top.
+                # a micro-flight from the surface: the bracket starts at its top
                 s_lo = turning_point(hs, th, tr, co, rate0, rate1, c)
                 g_lo, _, _ = geometry_near(s_lo * hs, theta_at(co, s_lo), th, tr, c)
                 crossing = g_lo > 0.0
                 closing = crossing
         elif not crossing and events < max_events:
-            # No sign change between the ends, but the gap rate turns (down to up in flight,
-            # up to down in contact): the gap may cross zero and come back inside the step (a
-            # graze, or a micro-flight of a chattering sequence, 0.1-1 us). Find the turning
-            # point on the interpolant; if the gap has changed sign there, the first
-            # crossing lies before it.
+            # no sign change, but the gap rate turns: a graze or micro-flight may lie inside
             if (rate0 < 0.0 < rate1) if flight else (rate1 < 0.0 < rate0):
                 s_hi = turning_point(hs, th, tr, co, rate0, rate1, c)
                 g_hi, _, _ = geometry_near(s_hi * hs, theta_at(co, s_hi), th, tr, c)
@@ -386,11 +318,8 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             cnt[I_CHATTER] += 1
             crossing = False
         if flight and not crossing and g1 <= 0.0:
-            # A free-flight step that ends inside the cam without a located closing (a
-            # rebound too weak for its flight's top to show above the surface, or the
-            # chattering guard spent): the free pendulum is not the motion there. The step is
-            # taken again in contact mode, the full equations, with no hand-back in between
-            # (a resumed run makes the same choice from the same state).
+            # A flight step ending in the cam without a located closing (a rebound too weak to
+            # show, or the guard spent) is redone in contact mode, with no hand-back between.
             flight = False
             redo = True
             a1 = accel_trig(tr, om, K, c, flight)
@@ -415,25 +344,22 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
                     cnt[I_N_SERIES] += 1
                 j += 1
             cnt[I_SERIES_J] = j
-        # Time bookkeeping for the contact fraction (the step's mode holds until t_end).
+        # the contact fraction's time (the step's mode holds to t_end)
         if t_end > t_rec:
             span = t_end - max(t, t_rec)
             y[Y_RECORDED] += span
             if not flight:
                 y[Y_CONTACT] += span
 
-        # The tangent's sides: a step that starts on the surface takes its first Jacobian
-        # on the side it starts on; flight steps the free pendulum's throughout.
+        # the tangent's sides: a step from the surface takes its first Jacobian on its side
         side = JAC_FLIGHT if flight else JAC_NATURAL
         side_first = side
         if on_surface:
             side_first = JAC_FLIGHT if flight else JAC_CONTACT
 
         if crossing:
-            # An event inside the step: a step of the located length from the step's start
-            # gives the state there (an integrator state, not an interpolation). Should that
-            # state not yet be past the crossing (the interpolant only approximates the step),
-            # the length grows by 2, 4, 8, ... event tolerances until it is.
+            # The state at the event: a step of the located length, grown by 2, 4, 8, ...
+            # event tolerances while not yet past the crossing (the interpolant approximates).
             reach = c[C_EVENT_TOL] / hs
             for _ in range(MAX_EVENT_GROWTH):
                 h_event = ph.on_clock(t, s_end * hs)
@@ -473,8 +399,8 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             h = min(h_next, hs)  # the event cut the step: do not grow past it
             continue
 
-        # The whole step is accepted. theta'' at its end was evaluated from directly computed
-        # trigonometry, as a resumed run does; in a changed mode it is evaluated again.
+        # Accepted whole. theta'' at its end came from direct trigonometry, as a resumed run
+        # computes it; in a changed mode it is evaluated again.
         step_mode = flight
         advance_tangent(y, c, t, t_end - t, th, om, co, 1.0, th1, om1, K, side_first, side)
         th = th1

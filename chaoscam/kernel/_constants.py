@@ -1,9 +1,6 @@
-"""Assemble the kernel's constants vector from a model (:class:`~chaoscam.model.Params`) and
-its integrator settings (:class:`~chaoscam.numerics.Numerics`).
-
-This is the only bridge between the documented settings and the compiled kernels: every
-number a kernel uses is put here, by name.
-"""
+"""The kernel's constants vector from a model (:class:`~chaoscam.model.Params`) and its
+numerics (:class:`~chaoscam.numerics.Numerics`): the only bridge from the documented settings to
+the compiled kernels, every number a kernel uses put here by name."""
 
 from __future__ import annotations
 
@@ -18,11 +15,10 @@ from . import layout as k
 __all__ = ["CALL_STEPS", "initial_counters", "initial_state", "kernel_constants"]
 
 CALL_STEPS = {"rk4": 1 << 21, "adaptive": 1 << 18}
-"""The most loop iterations (steps) a compiled call takes before it hands back to Python, as
-it does for a full buffer: the same bits (a hand-back is bit-identical, tested). Python sees
-Ctrl-C and SIGTERM only between calls, and a call otherwise ran to the next section, buffer
-refill or end: a run whose cam period holds 1e8 steps (omega = 1 rad/s at dt = 2e-8 s) could
-not be stopped for minutes. 2^21 RK4 contact steps take ~0.4 s, 2^18 adaptive ones ~0.3 s."""
+"""Most loop iterations (steps) of one compiled call before it hands back to Python, as for a
+full buffer (bit-identical, tested). Ctrl-C and SIGTERM are seen only between calls, and a cam
+period of 1e8 steps (omega = 1 rad/s, dt = 2e-8 s) would run for minutes without the cap;
+2^21 RK4 contact steps take ~0.4 s, 2^18 adaptive ones ~0.3 s."""
 
 
 def kernel_constants(
@@ -91,11 +87,8 @@ def kernel_constants(
 
 
 def initial_state(p: Params) -> np.ndarray:
-    """The state vector ``y`` (slots ``layout.Y_*``) at t = 0.
-
-    theta_f(0) and theta_f'(0) are ``p.theta_f0`` / ``p.omega_f0``, or in contact with the cam
-    (theta_fc(0) and its rate) when those are None (shared/MODEL.md, decision).
-    """
+    """The state ``y`` (slots ``layout.Y_*``) at t = 0: ``p.theta_f0``, ``p.omega_f0``, or in
+    contact (theta_fc(0) and its rate) where those are None (MODEL.md, decision)."""
     y = np.zeros(k.Y_SIZE)
     y[k.Y_THETA] = float(contact_angle(p, 0.0)) if p.theta_f0 is None else p.theta_f0
     y[k.Y_OMEGA] = float(contact_angle_rate(p, 0.0)) if p.omega_f0 is None else p.omega_f0
@@ -104,11 +97,10 @@ def initial_state(p: Params) -> np.ndarray:
 
 
 def initial_counters() -> np.ndarray:
-    """The integer counters (indices ``layout.I_*``) at t = 0: the first section index 0
-    (sections are scheduled through the transient, where they are not recorded, so that a
-    realization's steps do not depend on the transient and the tangent restarts every
-    period), and the first series sample and resampling index 1 (their index-0 points are
-    the initial state). The recording starts at ``kernel_constants``' ``t_record``."""
+    """The counters (``layout.I_*``) at t = 0: section index 0 (sections are scheduled through
+    the unrecorded transient, so a realization's steps do not depend on it and the tangent
+    restarts every period); series sample and resampling index 1 (index 0 is the initial
+    state). Recording starts at ``kernel_constants``' ``t_record``."""
     cnt = np.zeros(k.N_COUNTERS, dtype=np.int64)
     cnt[k.I_RESAMPLE_J] = 1
     cnt[k.I_SERIES_J] = 1

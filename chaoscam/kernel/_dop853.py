@@ -1,16 +1,12 @@
 """One step of Dormand and Prince's explicit Runge–Kutta 8(5,3) (DOP853), and its interpolant.
 
-The method of Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I* (2nd ed.,
-Springer 1993), sec. II.10: 12 stages, a solution of order 8, and an error estimate that
-combines embedded 5th- and 3rd-order solutions. The coefficients are the ones of the DOP853
-code, as tabulated in ``scipy/integrate/_ivp/dop853_coefficients.py``; the stages below are
-written out (the kernels must also compile for the GPU, where small arrays cannot be
-allocated), with the tableau's zero entries left out.
-
-For the second-order system theta'' = a(t, theta, theta') the state is (theta, w = theta'),
-so the stage derivatives are (w_i, a_i). Between a step's ends the solution is interpolated
-by Hermite polynomials (:func:`theta_at`, :func:`omega_at`), which is all that event location
-and series samples need: a located event is re-stepped exactly (see ``_adaptive.py``).
+Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I* (2nd ed., Springer 1993),
+sec. II.10: 12 stages, order 8, an error estimate combining embedded 5th- and 3rd-order
+solutions. Coefficients of the DOP853 code as in ``scipy/integrate/_ivp/dop853_coefficients.py``;
+the stages are written out without the tableau's zeros (the GPU cannot allocate small arrays).
+For theta'' = a(t, theta, theta') the stage derivatives are (w_i, a_i). Between a step's ends
+the solution is Hermite-interpolated (:func:`theta_at`, :func:`omega_at`) for event location and
+series samples; a located event is re-stepped exactly (:mod:`._adaptive`).
 """
 
 from __future__ import annotations
@@ -114,13 +110,10 @@ ERROR_ORDER = 7  # the step-size controller's exponent is -1 / (ERROR_ORDER + 1)
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def dop853_step(th, om, a1, h, tr, K, c, flight):
-    """One DOP853 step of length h from (th, om) at t, with a1 = theta''(t, th, om).
-
-    ``tr`` = ``_stages.trig_at(t, th)``; ``flight`` selects the free pendulum.
-    Returns (theta, theta') at t + h and the error norm: the RMS over the two components of
-    the error estimate scaled by ``atol + rtol max(|y_start|, |y_end|)`` (<= 1: accept),
-    combined from the 5th- and 3rd-order estimates as in DOP853.
-    """
+    """One DOP853 step of length h from (th, om) at t, a1 = theta''(t, th, om), ``tr`` =
+    ``_stages.trig_at(t, th)``, ``flight`` the free pendulum. Returns (theta, theta') at t + h
+    and the error norm (<= 1: accept): the RMS of the 5th- and 3rd-order estimates combined as
+    in DOP853, scaled by ``atol + rtol max(|y_start|, |y_end|)``."""
     w1 = om
     th2 = th + h * (A2_1 * w1)
     w2 = om + h * (A2_1 * a1)
@@ -146,103 +139,35 @@ def dop853_step(th, om, a1, h, tr, K, c, flight):
     th9 = th + h * (A9_1 * w1 + A9_4 * w4 + A9_5 * w5 + A9_6 * w6 + A9_7 * w7 + A9_8 * w8)
     w9 = om + h * (A9_1 * a1 + A9_4 * a4 + A9_5 * a5 + A9_6 * a6 + A9_7 * a7 + A9_8 * a8)
     a9 = accel_stage(th9, w9, C9 * h, th, tr, K, c, flight)
-    th10 = th + h * (
-        A10_1 * w1 + A10_4 * w4 + A10_5 * w5 + A10_6 * w6 + A10_7 * w7 + A10_8 * w8 + A10_9 * w9
-    )
-    w10 = om + h * (
-        A10_1 * a1 + A10_4 * a4 + A10_5 * a5 + A10_6 * a6 + A10_7 * a7 + A10_8 * a8 + A10_9 * a9
-    )
+    # fmt: off
+    th10 = th + h * (A10_1 * w1 + A10_4 * w4 + A10_5 * w5 + A10_6 * w6 + A10_7 * w7 + A10_8 * w8
+                     + A10_9 * w9)
+    w10 = om + h * (A10_1 * a1 + A10_4 * a4 + A10_5 * a5 + A10_6 * a6 + A10_7 * a7 + A10_8 * a8
+                    + A10_9 * a9)
     a10 = accel_stage(th10, w10, C10 * h, th, tr, K, c, flight)
-    th11 = th + h * (
-        A11_1 * w1
-        + A11_4 * w4
-        + A11_5 * w5
-        + A11_6 * w6
-        + A11_7 * w7
-        + A11_8 * w8
-        + A11_9 * w9
-        + A11_10 * w10
-    )
-    w11 = om + h * (
-        A11_1 * a1
-        + A11_4 * a4
-        + A11_5 * a5
-        + A11_6 * a6
-        + A11_7 * a7
-        + A11_8 * a8
-        + A11_9 * a9
-        + A11_10 * a10
-    )
+    th11 = th + h * (A11_1 * w1 + A11_4 * w4 + A11_5 * w5 + A11_6 * w6 + A11_7 * w7 + A11_8 * w8
+                     + A11_9 * w9 + A11_10 * w10)
+    w11 = om + h * (A11_1 * a1 + A11_4 * a4 + A11_5 * a5 + A11_6 * a6 + A11_7 * a7 + A11_8 * a8
+                    + A11_9 * a9 + A11_10 * a10)
     a11 = accel_stage(th11, w11, C11 * h, th, tr, K, c, flight)
-    th12 = th + h * (
-        A12_1 * w1
-        + A12_4 * w4
-        + A12_5 * w5
-        + A12_6 * w6
-        + A12_7 * w7
-        + A12_8 * w8
-        + A12_9 * w9
-        + A12_10 * w10
-        + A12_11 * w11
-    )
-    w12 = om + h * (
-        A12_1 * a1
-        + A12_4 * a4
-        + A12_5 * a5
-        + A12_6 * a6
-        + A12_7 * a7
-        + A12_8 * a8
-        + A12_9 * a9
-        + A12_10 * a10
-        + A12_11 * a11
-    )
+    th12 = th + h * (A12_1 * w1 + A12_4 * w4 + A12_5 * w5 + A12_6 * w6 + A12_7 * w7 + A12_8 * w8
+                     + A12_9 * w9 + A12_10 * w10 + A12_11 * w11)
+    w12 = om + h * (A12_1 * a1 + A12_4 * a4 + A12_5 * a5 + A12_6 * a6 + A12_7 * a7 + A12_8 * a8
+                    + A12_9 * a9 + A12_10 * a10 + A12_11 * a11)
     a12 = accel_stage(th12, w12, h, th, tr, K, c, flight)
-    th_new = th + h * (
-        B1 * w1 + B6 * w6 + B7 * w7 + B8 * w8 + B9 * w9 + B10 * w10 + B11 * w11 + B12 * w12
-    )
-    om_new = om + h * (
-        B1 * a1 + B6 * a6 + B7 * a7 + B8 * a8 + B9 * a9 + B10 * a10 + B11 * a11 + B12 * a12
-    )
-    e5_th = (
-        E5_1 * w1
-        + E5_6 * w6
-        + E5_7 * w7
-        + E5_8 * w8
-        + E5_9 * w9
-        + E5_10 * w10
-        + E5_11 * w11
-        + E5_12 * w12
-    )
-    e5_om = (
-        E5_1 * a1
-        + E5_6 * a6
-        + E5_7 * a7
-        + E5_8 * a8
-        + E5_9 * a9
-        + E5_10 * a10
-        + E5_11 * a11
-        + E5_12 * a12
-    )
-    e3_th = (
-        E3_1 * w1
-        + E3_6 * w6
-        + E3_7 * w7
-        + E3_8 * w8
-        + E3_9 * w9
-        + E3_10 * w10
-        + E3_11 * w11
-        + E3_12 * w12
-    )
-    e3_om = (
-        E3_1 * a1
-        + E3_6 * a6
-        + E3_7 * a7
-        + E3_8 * a8
-        + E3_9 * a9
-        + E3_10 * a10
-        + E3_11 * a11
-        + E3_12 * a12
-    )
+    th_new = th + h * (B1 * w1 + B6 * w6 + B7 * w7 + B8 * w8 + B9 * w9 + B10 * w10 + B11 * w11
+                       + B12 * w12)
+    om_new = om + h * (B1 * a1 + B6 * a6 + B7 * a7 + B8 * a8 + B9 * a9 + B10 * a10 + B11 * a11
+                       + B12 * a12)
+    e5_th = (E5_1 * w1 + E5_6 * w6 + E5_7 * w7 + E5_8 * w8 + E5_9 * w9 + E5_10 * w10 + E5_11 * w11
+             + E5_12 * w12)
+    e5_om = (E5_1 * a1 + E5_6 * a6 + E5_7 * a7 + E5_8 * a8 + E5_9 * a9 + E5_10 * a10 + E5_11 * a11
+             + E5_12 * a12)
+    e3_th = (E3_1 * w1 + E3_6 * w6 + E3_7 * w7 + E3_8 * w8 + E3_9 * w9 + E3_10 * w10 + E3_11 * w11
+             + E3_12 * w12)
+    e3_om = (E3_1 * a1 + E3_6 * a6 + E3_7 * a7 + E3_8 * a8 + E3_9 * a9 + E3_10 * a10 + E3_11 * a11
+             + E3_12 * a12)
+    # fmt: on
     sc_th = c[C_ATOL] + c[C_RTOL] * max(abs(th), abs(th_new))
     sc_om = c[C_ATOL] + c[C_RTOL] * max(abs(om), abs(om_new))
     e5 = (e5_th / sc_th) ** 2 + (e5_om / sc_om) ** 2
@@ -254,11 +179,8 @@ def dop853_step(th, om, a1, h, tr, K, c, flight):
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def theta_at(co, s):
-    """theta at the fraction s of the step ``co`` = (theta0, w0, a0, theta1, w1, a1, h).
-
-    The quintic Hermite interpolant of the values, first and second derivatives at the
-    ends (error O(h^6)).
-    """
+    """theta at the fraction s of the step ``co`` = (theta0, w0, a0, theta1, w1, a1, h): the
+    quintic Hermite interpolant of values, first and second derivatives (error O(h^6))."""
     th0, w0, a0, th1, w1, a1, h = co
     s2 = s * s
     s3 = s2 * s

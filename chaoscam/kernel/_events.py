@@ -1,11 +1,9 @@
 """Where an event happens inside a fixed step: the gap's sign change, and its turn.
 
-Both are searches over the substep length ``tau`` of a function evaluated through one RK4
-substep from the segment's start (:func:`._physics.rk4`): the gap ``delta`` for a crossing,
-by a bracketed search on the parabola through the last trials and the gap rate
-(:func:`locate_crossing`), and the gap rate for the extremum between two crossings that a
-step would otherwise step over, by the Illinois variant of regula falsi
-(:func:`graze_point`).
+Both search the substep length ``tau`` of a function evaluated through one RK4 substep from the
+segment's start: the gap ``delta`` for a crossing, bracketed with a parabola through the last
+trials and the gap rate (:func:`locate_crossing`), and the gap rate for the extremum between two
+crossings a step would step over, by Illinois regula falsi (:func:`graze_point`).
 """
 
 from __future__ import annotations
@@ -18,18 +16,17 @@ from ._physics import geometry, geometry_trig, on_clock, rk4_flight, rk4_trig
 from .layout import C_EVENT_TOL
 
 MAX_BRACKET_STEPS = 400
-"""Passes of a crossing search at most. Every three passes at least halve the bracket (a
-bisection follows three trials that do not), so 400 take any bracket of doubles below the
-event tolerance; the cap only guards against a gap that returns NaN."""
+"""Passes of a crossing search at most: every three halve the bracket (a bisection follows
+three trials that do not), so 400 reach any tolerance; the cap guards against a NaN gap."""
 
 GRAZE_TOL = 1e-6
-"""Width, as a fraction of the step, to which the turn of the gap rate is found (an error e
-in its time moves the gap's extremum by ~|delta''| e^2 / 2, below 1e-20 m here)."""
+"""Width, as a fraction of the step, to which the gap rate's turn is found (an error e in its
+time moves the gap's extremum by ~|delta''| e^2 / 2, below 1e-20 m)."""
 
 PROBE_STEP = 0.4
-"""How far past Newton's estimate of a crossing, in event tolerances, :func:`locate_crossing`
-puts its next trial (towards the bracket's farther end): below a half, so that two trials on
-either side of one estimate close the bracket, rounding of their times included."""
+"""How far past its estimate of a crossing, in event tolerances, :func:`locate_crossing` puts
+its next trial (towards the bracket's farther end): below a half, so that two trials either
+side of one estimate close the bracket, rounding included."""
 
 MAX_GRAZE_STEPS = 200
 """Passes of the search for the gap rate's turn at most."""
@@ -37,14 +34,9 @@ MAX_GRAZE_STEPS = 200
 
 @njit(cache=True, _nrt=False)
 def gap_after(t, th, om, tau, K, c, trig):
-    """The geometry at the end of one RK4 substep of length tau from (t, th, om):
-    ``(delta, l_1, dC/dt.n, theta_f')`` there.
-
-    ``trig`` is the trigonometry at the substep's start (``(cc, sc, ct, st)``,
-    :func:`._physics.geometry_at`), the same for every trial length of a search; the cam's
-    at ``t + tau`` comes from the substep's last stage. The same bits as
-    :func:`._physics.rk4` followed by :func:`._physics.geometry` at ``t + tau``.
-    """
+    """``(delta, l_1, dC/dt.n, theta_f')`` after one RK4 substep of length tau from (t, th, om),
+    the same bits as :func:`._physics.rk4` then :func:`._physics.geometry`. ``trig``: ``(cc, sc,
+    ct, st)`` at the start (:func:`._physics.geometry_at`), shared by a search's trials."""
     cc, sc, ct, st = trig
     th1, om1, c4, s4 = rk4_trig(t, th, om, tau, K, c, cc, sc, ct, st)
     delta, l1, cdn = geometry_trig(c4, s4, math.cos(th1), math.sin(th1), c)
@@ -63,11 +55,9 @@ def illinois_point(a, fa, b, fb):
 
 @njit(cache=True, inline="always")
 def illinois_update(a, fa, b, fb, m, fm, side):
-    """The bracket after f(m) = fm, for Illinois regula falsi (Dowell & Jarratt 1971).
-
-    The end that stays twice in a row has its value halved, which keeps the method
-    superlinear where plain regula falsi stalls. ``side`` remembers the end replaced last.
-    """
+    """The bracket after f(m) = fm, for Illinois regula falsi (Dowell & Jarratt 1971): the end
+    kept twice in a row has its value halved, which keeps the method superlinear where plain
+    regula falsi stalls. ``side`` remembers the end replaced last."""
     if fm > 0.0:
         a, fa = m, fm
         if side == 1:
@@ -83,42 +73,28 @@ def illinois_update(a, fa, b, fb, m, fm, side):
 
 @njit(cache=True, _nrt=False)
 def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight, trig):
-    """The substep length tau in (a, h] at which the gap delta changes sign.
-
-    With ``flight`` (a closing: the motion is free flight up to the crossing) the substeps
-    are the free pendulum's (:func:`._physics.rk4_flight`): a full RK4 substep that ends
-    past the crossing would put its last stage inside the cam, where the Hertz force
-    (K ~ 1e9 N/m) of an overshoot of ``v event_tol`` (2e-12 m at 2 m/s) changes theta' by
-    ~1e-8 rad/s, and by a different amount for every place the bracket happens to end.
-
-    A bracketed search on ``tau -> delta(RK4 substep of length tau)`` over [a, h] (a = 0
-    but for a micro-flight that starts on the surface, whose bracket starts at its top)
-    until the bracket is narrower than the event tolerance ``tol``:
+    """The substep length tau in (a, h] at which the gap delta changes sign: a bracketed search
+    on ``tau -> delta(RK4 substep of length tau)`` (a > 0 for a micro-flight from the surface,
+    bracketed from its top) to the event tolerance ``tol``:
 
     - the first trial is regula falsi's point (:func:`illinois_point`);
-    - each later one is the root nearest the last trial x of the parabola through the last
-      two trials (at first the bracket's start and x) with the gap rate
-      ``l_1 theta' - dC/dt.n`` at x, the derivative of the substep's gap to O(tau^4)
-      (:func:`model_root`; Newton's step where the parabola has no root), moved
-      ``PROBE_STEP tol`` past that estimate towards the bracket's farther end: an estimate
-      good to better than that puts the crossing between the trial and the near end, and
-      the next trial, on the other side of it, closes the bracket;
-    - an estimate outside the bracket falls back to Illinois regula falsi
-      (:func:`illinois_update` keeps the bracket either way), and three trials that do not
-      halve the bracket are followed by a bisection;
-    - a trial where delta is 0.0 to its last bit is the crossing: the search ends there
-      (slow closings reach the gap's resolution, ~1e-17 m, before the bracket is 1e-12 s
-      wide: at 1e-6 m/s that resolution is 1e-11 s, and the signs inside it are rounding).
+    - each later one is the root nearest the last trial x of the parabola through the last two
+      trials with the gap rate ``l_1 theta' - dC/dt.n`` at x (the substep gap's derivative to
+      O(tau^4); :func:`model_root`, Newton's step where it has no root), moved ``PROBE_STEP
+      tol`` towards the bracket's farther end, so that the next trial closes the bracket;
+    - an estimate outside the bracket falls back to regula falsi (:func:`illinois_update`
+      keeps the bracket), and three trials that do not halve it are followed by a bisection;
+    - a trial where delta is 0.0 to its last bit is the crossing (slow closings reach the gap's
+      ~1e-17 m resolution, 1e-11 s at 1e-6 m/s, before the bracket is 1e-12 s wide).
 
-    On a chattering run (l_lambda = 11 mm, sigma = 1.5 mm, 4 s: 4,456 crossings) it takes
-    3.8 substeps a crossing, where Illinois regula falsi with a bisection after every trial
-    that did not halve the bracket (this function until 2026-11-28) took 17.1; the kernel is
-    11-18 % faster. Every trial length is rounded so that ``t + tau`` is a double
-    (:func:`._physics.on_clock`), ``a`` and ``h`` being such lengths already. ``trig`` is
-    the trigonometry at (t, th) (:func:`gap_after`). Returns the bracket's right end, past
-    the crossing, or the trial where delta is 0.0: delta <= 0 there for a closing, delta
-    >= 0 for an opening.
-    """
+    With ``flight`` (a closing from free flight) the substeps are the free pendulum's
+    (:func:`._physics.rk4_flight`): a full substep past the crossing puts its last stage in the
+    cam, where the Hertz force (K ~ 1e9 N/m) of an overshoot ``v event_tol`` (2e-12 m at 2 m/s)
+    changes theta' by ~1e-8 rad/s, differently wherever the bracket ends. A chattering run
+    (l_lambda = 11 mm, sigma = 1.5 mm, 4 s) takes 3.8 substeps a crossing, against 17.1 for
+    Illinois regula falsi with bisections. Lengths are rounded by :func:`._physics.on_clock`;
+    ``trig`` as in :func:`gap_after`. Returns the bracket's right end past the crossing, or the
+    trial where delta is 0.0 (delta <= 0 there for a closing, >= 0 for an opening)."""
     tol = c[C_EVENT_TOL]
     s = 1.0 if g_start > 0.0 else -1.0  # work on s * delta, positive at the start
     fa, b, fb = s * g_start, h, s * g_end
@@ -157,10 +133,9 @@ def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight, trig):
 
 @njit(cache=True, inline="always")
 def model_root(x, fx, dx, xp, fp):
-    """The root nearest x of the parabola through (x, fx) with slope dx there and through
-    (xp, fp). A micro-flight's gap is a parabola to a few parts in 1e6 over a step, so from
-    two trials the root comes to the gap's resolution. Newton's estimate where the parabola
-    has no root (or xp = x)."""
+    """The root nearest x of the parabola through (x, fx) with slope dx and through (xp, fp);
+    Newton's estimate where it has none (or xp = x). A micro-flight's gap is a parabola to a
+    few parts in 1e6 over a step, so two trials reach the gap's resolution."""
     u = -fx / dx
     if xp != x:
         e = xp - x
@@ -183,23 +158,17 @@ def _gap_at(t, th, om, m, K, c, flight, trig, s):
     return s * delta, s * (l1 * om1 - cdn)
 
 
-# The stand-in for a gap of exactly 0 at a segment's start, signed by the gap rate: only its
-# sign matters (event brackets need a nonzero value at their start).
+# stand-in for a gap of exactly 0 at a segment's start (brackets need a sign there)
 ON_SURFACE = 1e-300
 
 
 @njit(cache=True, _nrt=False)
 def graze_point(t, th, om, h, rate0, rate1, K, c, trig):
-    """The substep length tau in (0, h) at which the gap rate l_1 theta' - dC/dt.n turns.
-
-    Illinois regula falsi on ``tau -> rate(RK4 substep of length tau)`` to ``GRAZE_TOL`` of
-    the step. Only called where the gap rate changes sign between the segment's ends while the gap
-    does not: the extremum of the gap in between shows whether it crossed zero and came
-    back (a micro-flight, or a graze, shorter than the step). The rate is that of the
-    substep's state, on the side of the surface the segment starts on. Trial lengths and the
-    result are rounded so that ``t + tau`` is a double (:func:`._physics.on_clock`).
-    ``trig`` is the trigonometry at (t, th) (:func:`gap_after`).
-    """
+    """The substep length tau in (0, h) at which the gap rate l_1 theta' - dC/dt.n turns:
+    Illinois regula falsi on ``tau -> rate(RK4 substep of length tau)`` to ``GRAZE_TOL`` of the
+    step. Called where the rate changes sign over a segment and the gap does not: the gap's
+    extremum shows whether it crossed zero and came back (a micro-flight or graze shorter than
+    the step). Lengths rounded by :func:`._physics.on_clock`; ``trig`` as in :func:`gap_after`."""
     s = 1.0 if rate0 > 0.0 else -1.0  # work on s * rate, positive at 0, negative at h
     a, fa, b, fb = 0.0, s * rate0, h, s * rate1
     side = 0

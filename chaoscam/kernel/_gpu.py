@@ -1,45 +1,26 @@
 """Ensembles on an NVIDIA GPU with numba-cuda: one CUDA thread per trajectory.
 
-The kernel is the CPU kernel. :func:`._driver.advance` and everything it calls are
-``@numba.njit`` functions, and numba-cuda compiles such a function for the CUDA target when a
-``@cuda.jit`` kernel calls it (``CUDATypingContext.resolve_value_type`` wraps the CPU
-dispatcher in a device dispatcher built from the same Python source). So the physics has one
-source of truth, and whichever integrator ``advance`` dispatches to runs on the GPU too.
+The kernel is the CPU kernel: numba-cuda compiles an ``@numba.njit`` function for the CUDA target
+when a ``@cuda.jit`` kernel calls it (``CUDATypingContext.resolve_value_type`` wraps the CPU
+dispatcher), so :func:`._driver.advance` and either integrator run on the GPU from one source.
 
-Numerics. The GPU result is not bit-identical to the CPU one: NVVM contracts ``a * b + c``
-into fused multiply-adds and libdevice's sin/cos/tanh may differ from the host libm in the
-last bit. The model amplifies such differences strongly: on the CPU a kick of 1e-15 rad to
-the initial angle is 1e-9 rad at the first section (t = 0.22 s, after the initial stiff
-contact), and the default response is chaotic, so over 20 s GPU and CPU trajectories part
-to O(0.1) like any two roundings of them. What stays comparable, and is compared, are
-sections of the first cam period and of periodic configurations after a transient (e.g.
-``Params(xi=0.2)``, 10 s): equal within 1e-6 rad and rad/s (``GPU_TOLERANCE``; a 1e-12 kick
-moves them by 1e-6 and 1e-8). Ensemble statistics are what a GPU run is for. Under the CUDA
-simulator (``NUMBA_ENABLE_CUDASIM=1``) the kernel calls the compiled CPU code and results are
-bit-identical.
+Numerics: not bit-identical to the CPU (NVVM fuses ``a * b + c``; libdevice's sin/cos/tanh may
+differ from libm in the last bit), and the model amplifies that: a 1e-15 rad kick is 1e-9 rad at
+the first section, and chaotic runs part to O(0.1) over 20 s. Sections of the first cam period
+and of periodic runs after a transient (``Params(xi=0.2)``, 10 s) agree within
+``GPU_TOLERANCE`` (a 1e-12 rad kick moves them by 1e-6 and 1e-8); ensemble statistics are what
+a GPU run is for. Under the CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) results are bit-identical.
 
-Buffers. Members run on the device until they end or return ``NEED_BUFFER`` (line-length
-draws used up, or impact rows where impacts are kept; otherwise the kernel only counts
-them: a 20-s member of Table 1 applies ~14,000 impacts, and with 256 rows it stopped 43-49
-times, each stop a relaunch of the batch that waits for its slowest member again, 2.1x the
-time of one launch for 512 members in ``benchmarks/gpu_warp_model.py --tail``'s model).
-Those are refilled on the host exactly as on the CPU path (the impact count moved to the
-member's total, the used draws replaced by the next ones of the same stream, keeping the
-row width) and the kernel is launched again for them only; the
-other threads return at once. A run resumed after a hand-back is bit-identical to one that
-was not interrupted (see :func:`._rk4.run_chunk`), so this relaunch changes nothing.
+Buffers: members run until they end or return ``NEED_BUFFER`` (draws used up, or impact rows
+where impacts are kept, else impacts are only counted: each stop relaunches the batch, which
+waits for its slowest member again, and 256 rows stop a 20-s Table 1 member, ~14,000 impacts,
+43-49 times, 2.1x one launch's time in ``benchmarks/gpu_warp_model.py --tail``). They are
+refilled on the host as on the CPU path and relaunched alone; a resumed run is bit-identical.
 
-Measured on an NVIDIA H200 (2026-11-27, ``benchmarks/bench_gpu_wave.py``): the tolerance
-tests pass; the RK4 kernel takes 202-216 registers and 40 B of local memory a thread. One
-thread is slow (64 members of 0.25 s take 1.09 s, 4.8 us a grid step), so the device needs
-thousands of members in flight: a full wave of 33,792 members of 5 s ran in 57 s, 2,954
-member-seconds a second, 11.3x 2 CPU threads of that machine (the targets ask 3,000 20-s
-trajectories a second and 200x). One launch ran 2.4 of a warp's 32 threads at a time, not
-waiting on memory: members of a warp take different branches. (The earlier sessions'
-"as slow as 2 CPU cores" was the host's quadratic set-up of a batch, since fixed.)
-See docs/speed.md, "The GPU", and benchmarks/PROFILE.md.
-
-numba-cuda is imported lazily, on first use: ``import chaoscam`` never imports it.
+Speed (an H200, ``benchmarks/bench_gpu_wave.py``; docs/speed.md): one thread is slow (4.8 us a
+grid step; a warp's members branch apart, 2.4 of 32 threads running at a time), so the device
+needs thousands of members in flight: 33,792 members of 5 s run 11.3x as fast as 2 CPU threads.
+numba-cuda is imported lazily: ``import chaoscam`` never imports it.
 """
 
 from __future__ import annotations
@@ -60,39 +41,27 @@ from ._driver import advance, drive_members
 from ._rk4 import run_chunk
 
 __all__ = [
-    "GPU_BATCH",
-    "GPU_TOLERANCE",
-    "AUTO_GPU_MIN",
-    "GPUFallbackWarning",
-    "by_size",
-    "gpu_status",
-    "run_on_gpu",
-    "runs_on_gpu",
-]
+    "GPU_BATCH", "GPU_TOLERANCE", "AUTO_GPU_MIN", "GPUFallbackWarning", "by_size", "gpu_status",
+    "run_on_gpu", "runs_on_gpu",
+]  # fmt: skip
 
 GPU_BATCH = 65_536  # members per device batch: ~19 kB each for 20 s runs, 42 kB with impacts kept
 GPU_TOLERANCE = 1e-6  # rad and rad/s: GPU against CPU sections, first period or periodic
 _BLOCK = 64  # threads per block: 202 registers a thread on an H200 (196 from ptxas 12.9)
 _SMALL_GRID = r".*Grid size \d+ will likely result in GPU under-utilization"
-"""numba-cuda's NumbaPerformanceWarning for a launch configured with few blocks (message,
-with its ANSI codes). A small batch is expected; a sweep would otherwise record the warning
-against every run of the batch (seen on an H200, 2026-11-27)."""
+"""numba-cuda's NumbaPerformanceWarning for a launch of few blocks (with its ANSI codes): a
+small batch is expected, and a sweep would record the warning against every run of it."""
 _NUMPY_TRAP = (2, 5)  # numba-cuda <= 0.30.4 compiles no kernel under numpy >= 2.5
 DEVICE_LOCK = threading.Lock()
-"""Held by each :func:`run_on_gpu` call: a GPU sweep launches its next batch in the driver's
-thread while a labelling thread may extend 4,096 members or more on the device
-(:class:`chaoscam.sweep._pipeline.PipelineBackend`); they take turns."""
+"""Held by each :func:`run_on_gpu` call: a GPU sweep launches its next batch from the driver's
+thread while its labelling thread may extend members on the device; they take turns."""
 
 AUTO_GPU_MIN = 4_096
-"""Fewest members (an ensemble's, or a sweep's runs) for which ``"auto"`` runs them on a GPU.
-One GPU thread is slow and the device's rate comes from many in flight (an H200, 2026-11-27,
-0.25-s runs: 64 members took 1.09 s of launch, 8,448 took 1.80 s, 33,792 took 5.1 s, against
-77 member-seconds a second on 2 CPU threads; a 1,024-run regime map ran as fast as 2 CPU
-cores). From 4,096 members the device, by those measurements, outruns a CPU of 16 cores;
-below it ``"auto"`` runs on the CPU (``"gpu"`` still runs any size on the GPU). A sweep
-settles it by its runs before it starts; on Dask workers, which get CPU-sized batches, a
-sweep's ``"auto"`` is settled per batch, so they run on their CPUs. The extensions and fate
-runs of a GPU run's few members settle by it too (``_ensemble_verdicts.EXTEND_BACKEND``)."""
+"""Fewest members (an ensemble's, or a sweep's runs) that ``"auto"`` runs on a GPU: from 4,096
+0.25-s members an H200 outruns a 16-core CPU (64 members take 1.09 s of launch, 33,792 take
+5.1 s); below, ``"auto"`` runs on the CPU (``"gpu"`` runs any size). A sweep settles it by its
+runs before it starts, per batch on Dask workers (CPU-sized batches, so their CPUs); a GPU run's
+few extensions and fate runs settle by it too."""
 
 
 class GPUFallbackWarning(RuntimeWarning):
@@ -100,12 +69,9 @@ class GPUFallbackWarning(RuntimeWarning):
 
 
 def gpu_status() -> tuple[bool, str]:
-    """Whether the GPU backend can run here, and why (one line).
-
-    Checked in order: the numpy version (numba-cuda, 0.30.4 included, fails to compile any
-    kernel under numpy >= 2.5, which has no ``row_stack``), numba-cuda being installed,
-    a CUDA driver and device. When available, the reason names the device.
-    """
+    """Whether the GPU backend can run here, and why in one line (naming the device): checks
+    the numpy version (numba-cuda <= 0.30.4 compiles no kernel under numpy >= 2.5, which has no
+    ``row_stack``), numba-cuda, a CUDA driver and device."""
     trap = _numpy_trap()
     if trap:
         return False, trap
@@ -115,9 +81,8 @@ def gpu_status() -> tuple[bool, str]:
 
 
 def by_size(backend: str, members: int) -> str:
-    """``backend`` with ``"auto"`` settled by the run's size: ``"cpu"`` for fewer than
-    :data:`AUTO_GPU_MIN` members, ``"auto"`` (the GPU where one runs) otherwise; ``"cpu"``
-    and ``"gpu"`` are returned as they are."""
+    """``backend`` with ``"auto"`` settled by size: ``"cpu"`` below :data:`AUTO_GPU_MIN`
+    members, else ``"auto"`` (the GPU where one runs); ``"cpu"``, ``"gpu"`` as they are."""
     return "cpu" if backend == "auto" and members < AUTO_GPU_MIN else backend
 
 
@@ -162,10 +127,8 @@ def _simulated(dev) -> bool:
 
 
 def _advance_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
-    """The kernel's source: ``step`` (``advance``) for each member still to run.
-
-    Its globals ``cuda`` and ``step`` are bound by :func:`_members` in a namespace of its own.
-    """
+    """The kernel's source: ``step`` for each member still to run (globals bound by
+    :func:`_members`)."""
     i = cuda.grid(1)  # noqa: F821
     if i < y.shape[0] and status[i] == k.NEED_BUFFER:
         status[i] = step(  # noqa: F821
@@ -174,24 +137,17 @@ def _advance_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
 
 
 def _members(cuda, step):
-    """:func:`_advance_members` with ``cuda`` and ``step`` bound as its globals.
-
-    Globals, not a closure, so that the CUDA simulator can swap in its fake ``cuda`` module.
-    """
+    """:func:`_advance_members` with ``cuda`` and ``step`` bound as globals, not a closure, so
+    that the CUDA simulator can swap in its fake ``cuda`` module."""
     namespace = {"__name__": __name__, "cuda": cuda, "step": step, "k": k}
     code = _advance_members.__code__
     return types.FunctionType(code, namespace, "advance_members")
 
 
 def _step_function(method: int | None):
-    """The per-member function a kernel calls: the integrator itself when a batch has one.
-
-    A kernel specialised to one integrator takes fewer registers than one that can take
-    either (ptxas 12.9 for sm_90 on :func:`kernel_ptx`'s PTX with contiguous rows, as
-    :func:`run_on_gpu` launches it, 2026-11-27: RK4 196 registers a thread, the adaptive path
-    184, ``advance`` with both 236, no spills; the H200's driver gave RK4 202 registers and
-    40 B of local memory; for arrays of any strides, RK4 255 with 164 / 488 B of spills.)
-    """
+    """The per-member function a kernel calls: the integrator itself when a batch has one, as a
+    specialised kernel takes fewer registers (ptxas 12.9, sm_90, contiguous rows: RK4 196, the
+    adaptive path 184, ``advance`` 236, no spills; any strides spill)."""
     if method == k.METHOD_RK4:
         return run_chunk
     if method == k.METHOD_ADAPTIVE:
@@ -226,13 +182,10 @@ def _batch_method(c: np.ndarray) -> int | None:
 
 
 def kernel_ptx(cc: tuple[int, int] = (9, 0), method: int | None = None) -> str:
-    """PTX of the ensemble kernel for compute capability ``cc``; needs NVVM, not a device.
-
-    ``method``: ``layout.METHOD_RK4``, ``METHOD_ADAPTIVE`` or None (the kernel that takes
-    both), for the C-ordered arrays :func:`run_on_gpu` launches. numba-cuda asks the current
-    device for the compute capability of device functions even when ``compile_ptx`` is given
-    one, so a stand-in device with ``cc`` is put in its place for the compilation.
-    """
+    """PTX of the ensemble kernel for compute capability ``cc`` (needs NVVM, not a device), for
+    ``method`` ``layout.METHOD_RK4``, ``METHOD_ADAPTIVE`` or None (both) and the C-ordered arrays
+    :func:`run_on_gpu` launches. numba-cuda asks the current device for the capability even when
+    ``compile_ptx`` is given one, so a stand-in device with ``cc`` is put in its place."""
     from unittest import mock
 
     import numba.cuda.dispatcher as dispatcher
@@ -261,10 +214,8 @@ def kernel_info(method: int | None = k.METHOD_RK4) -> dict:
 
 
 def _configured(kern, blocks: int):
-    """``kern[blocks, _BLOCK]`` without numba-cuda's low-occupancy warning (a launch of few
-    blocks: a small batch is the caller's choice, and a sweep would record it against every
-    run of the batch); any other warning is raised again. Thread-safe
-    (:func:`chaoscam._util.recorded`, not ``catch_warnings``: a sweep labels on a thread)."""
+    """``kern[blocks, _BLOCK]`` without the low-occupancy warning (:data:`_SMALL_GRID`); any
+    other warning is raised again. Thread-safe (:func:`chaoscam._util.recorded`)."""
     with recorded() as said:
         configured = kern[blocks, _BLOCK]
     for w in said:
@@ -274,17 +225,12 @@ def _configured(kern, blocks: int):
 
 
 def run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts=False):
-    """Run stacked members to ``n_stop`` on the GPU; arrays as in ``_ensemble._run_batch``.
-    One call at a time in this process (:data:`DEVICE_LOCK`).
-
-    The members whose ``status`` is ``NEED_BUFFER`` run (every member of a fresh batch);
-    the others keep their code, and their rows.
-
-    Updates ``y``, ``cnt``, ``lam``, ``section`` and ``status`` in place; ``impacts`` is
-    brought back from the device only with ``keep_impacts`` (otherwise only counted).
-    ``hand_back(j, lam_j, n)`` empties member ``j``'s impact rows and returns its draws with
-    the used ones dropped and ``n`` new ones appended.
-    """
+    """Run stacked members (arrays as in :func:`chaoscam.simulation.run_batch`) to ``n_stop``
+    on the GPU, one call at a time (:data:`DEVICE_LOCK`). Members whose ``status`` is
+    ``NEED_BUFFER`` run; the others keep their code and rows. Updates ``y``, ``cnt``, ``lam``,
+    ``section``, ``status`` in place, ``impacts`` only with ``keep_impacts`` (else counted).
+    ``hand_back(j, lam_j, n)`` empties member ``j``'s impact rows and returns its draws, the
+    used ones dropped and ``n`` new ones appended."""
     with DEVICE_LOCK:
         _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts)
 

@@ -1,22 +1,13 @@
 """numba's on-disk cache, emptied when any source file of a package changes.
 
-numba keys a cached function on its own file's modification time and size only. A compiled
-function that calls a function of another file keeps its compiled copy of that callee after
-the callee's file changes: after a pull that changed only ``integrate/_events.py`` (the
-crossing search, 2026-11-28), runs with a warm cache kept the old search, and so other
-trajectories than the code's, until the cache was emptied (measured: the same run left the
-cam's reach at 16.1 s instead of 28.9 s). A package whose compiled functions call each other
-across files calls :func:`guard` when it is imported, before any of them is compiled or
-loaded: a fingerprint of all its ``.py`` files is kept beside numba's cache files, and when
-it differs the package's cache files are removed, so that every function compiles from the
-current sources (on a fresh install that is what happens anyway).
-
-The cache handled is the one numba uses for the package's folder: ``NUMBA_CACHE_DIR`` when it
-is set (numba then writes there even for a checkout), else ``__pycache__`` beside the sources
-when that folder is writable (an editable install, a checkout), else numba's per-user cache
-folder (a read-only install); numba's own cache locators say which (:func:`cache_folder`).
-Until 2026-11-28's ninth session only ``__pycache__`` was handled, and a checkout run with
-``NUMBA_CACHE_DIR`` set kept a stale callee (tested).
+numba keys a cached function on its own file's modification time and size only, so a cached
+caller keeps its compiled copy of a callee in another file after that file changes (a warm cache
+then runs other trajectories than the code's). A package whose compiled functions call across
+files calls :func:`guard` on import, before any is compiled or loaded: when a fingerprint of its
+``.py`` files, kept beside numba's cache files, differs, they are removed. The cache is numba's
+for the package's folder (:func:`cache_folder`): ``NUMBA_CACHE_DIR`` when set, else a writable
+``__pycache__`` beside the sources, else numba's per-user folder (a read-only install);
+``tests/test_numba_cache.py`` tests the first two.
 """
 
 from __future__ import annotations
@@ -42,10 +33,9 @@ def fingerprint(folder: Path) -> str:
 
 
 def cache_folder(folder: str | os.PathLike) -> Path:
-    """The folder where numba keeps the cache of functions defined in ``folder``'s modules:
-    the path of the first of numba's cache locators that accepts a file of ``folder`` (the
-    order numba itself tries them in), or ``folder/__pycache__`` when numba's locators cannot
-    be asked (they are not public API)."""
+    """Where numba caches functions of ``folder``'s modules: the first of numba's cache
+    locators (in numba's order) to accept a file of ``folder``, or ``folder/__pycache__``
+    where they cannot be asked (not public API)."""
     folder = Path(folder)
     try:
         from numba.core.caching import CacheImpl
@@ -61,12 +51,10 @@ def cache_folder(folder: str | os.PathLike) -> Path:
 
 
 def guard(folder: str | os.PathLike) -> bool:
-    """Remove numba's cache files (``*.nbi``, ``*.nbc``) for ``folder``'s modules from the
-    folder numba keeps them in (:func:`cache_folder`) when ``folder``'s sources differ from
-    those they were compiled from, and record the new fingerprint there. Returns whether any
-    file was removed. Processes that import the package at the same moment may both remove
-    the files; neither has compiled anything yet, so nothing is lost. A cache folder that
-    cannot be written is left as it is."""
+    """Remove numba's cache files (``*.nbi``, ``*.nbc``) of ``folder``'s modules
+    (:func:`cache_folder`) when its sources differ from those they were compiled from, and
+    record the new fingerprint; returns whether any was removed. Concurrent importers may both
+    remove them (neither has compiled yet); a read-only cache folder is left as it is."""
     folder = Path(folder)
     cache = cache_folder(folder)
     stamp = cache / STAMP

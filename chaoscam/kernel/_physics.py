@@ -1,9 +1,8 @@
-"""The cam-follower's physics as compiled functions: geometry, equations (1)–(3), RK4 steps.
+"""The model's physics as compiled functions: geometry, equations (1)–(3), RK4 steps.
 
-Everything a kernel needs to know about the model itself lives here; event handling, the
-schedule of outputs and the stepping loop live in :mod:`._kernel` and :mod:`._adaptive`, the
-tangent dynamics in :mod:`._tangent`. Numbers come from the constants vector (``C_*``,
-:mod:`._layout`).
+Event handling, the output schedule and the stepping loops are in :mod:`._rk4` and
+:mod:`._adaptive`, the tangent dynamics in :mod:`._tangent`; numbers come from the constants
+vector (``C_*``, :mod:`.layout`).
 """
 
 from __future__ import annotations
@@ -47,16 +46,13 @@ def stiffness(lam, c):
 def cam_angle(t, c):
     """The cam angle ``theta_c = omega t + theta_c0`` reduced to [-pi, pi], to ~1e-16 rad.
 
-    Computed naively, ``omega t`` is rounded to the spacing of doubles near it: 2.3e-13 rad
-    at t = 60 s (1.8e-12 at 300 s), which moves the cam by e times that, 1e-14 m (7e-14 m).
-    That is the height of the last bounces of a chattering sequence (``v^2 / 2|delta''|``,
-    3e-14 m at v = 1e-6 m/s), so the gap's sign there would come from rounding, more often
-    the later the time. Here ``omega t`` is formed exactly as a sum of two doubles (Dekker's
-    product), ``theta_c0`` added by Knuth's two-sum, and the multiple of 2 pi taken off by
-    Cody & Waite's three-part reduction (exact for |theta_c| < 4e8 rad; beyond, as accurate
-    as the naive sum). A compiler that fuses multiply-adds (NVVM on the GPU) may round the
-    product's error term differently, to the same order.
-    """
+    A naive ``omega t`` is off by 2.3e-13 rad at t = 60 s (1.8e-12 at 300 s), moving the cam by
+    1e-14 m (7e-14 m): the height of a chattering sequence's last bounces (``v^2 /
+    2|delta''|``, 3e-14 m at v = 1e-6 m/s), where the gap's sign would come from rounding.
+    Here ``omega t`` is exact as two doubles (Dekker's product), ``theta_c0`` is added by
+    Knuth's two-sum and 2 pi taken off by Cody & Waite's three-part reduction (exact for
+    |theta_c| < 4e8 rad; beyond, as the naive sum). Fused multiply-adds (NVVM on the GPU) may
+    round the product's error term differently, to the same order."""
     w = c[C_OMEGA]
     p = w * t
     cw = DEKKER_SPLIT * w
@@ -75,13 +71,10 @@ def cam_angle(t, c):
 
 @njit(cache=True, inline="always")
 def on_clock(t, tau):
-    """``tau`` rounded so that ``t + tau`` is a double: ``(t + tau) - t``.
-
-    A substep of this length from time t ends exactly at the time the kernel stamps its end
-    with, so the state and the cam angle (:func:`cam_angle`) never drift apart by the
-    rounding of ``t + tau`` (up to 3.6e-15 s at t = 60 s, 2.8e-14 s at 300 s: the cam moves
-    1e-15-3e-14 m in that time, the scale of the last bounces of a chattering sequence).
-    """
+    """``tau`` rounded so that ``t + tau`` is a double: ``(t + tau) - t``. A substep of this
+    length ends at the time its end is stamped with, so state and cam angle never part by the
+    rounding of ``t + tau`` (3.6e-15 s at t = 60 s, 2.8e-14 s at 300 s, when the cam moves
+    1e-15-3e-14 m, the scale of a chattering sequence's last bounces)."""
     return (t + tau) - t
 
 
@@ -97,15 +90,12 @@ ROTATE_MAX = 0.01  # [rad] an angle this close to a known one is rotated to (rot
 
 @njit(cache=True, inline="always")
 def rotate(a, ca, sa, b):
-    """(cos(a + b), sin(a + b)) from ca = cos a, sa = sin a.
-
-    For |b| < ROTATE_MAX by the addition theorem with Taylor polynomials of cos b and sin b
-    (truncation below b^8 / 8! < 1e-20), else directly. The stages of a step sit close to
-    its start, so they need no new transcendental calls: cos/sin were 40 % of the RK4
-    kernel's time when every stage called them (``benchmarks/PROFILE.md``). The result is
-    within a few units in the last place of the direct call's; it is never rotated on from
-    (a step's end takes its values directly), so these differences do not accumulate.
-    """
+    """(cos(a + b), sin(a + b)) from ca = cos a, sa = sin a: for |b| < ROTATE_MAX by the
+    addition theorem with Taylor polynomials of cos b, sin b (truncation < b^8 / 8! < 1e-20),
+    else directly. A step's stages sit near its start, so they need no transcendental calls
+    (cos/sin of every stage are 40 % of the RK4 kernel's time, ``benchmarks/PROFILE.md``).
+    Within a few ulp of the direct call; never rotated on from (a step's end takes direct
+    values), so the differences do not accumulate."""
     if abs(b) >= ROTATE_MAX:
         return math.cos(a + b), math.sin(a + b)
     return _turn(ca, sa, b)
@@ -122,9 +112,8 @@ def _turn(ca, sa, b):
 
 @njit(cache=True, inline="always")
 def cam_trig_near(t, s, cc, sc, c):
-    """(cos, sin) of the cam angle at ``t + s`` given them at t (cc, sc): rotated by
-    omega ((t + s) - t) (:func:`rotate`) where that is under ROTATE_MAX, else
-    :func:`cam_trig` at ``t + s``."""
+    """(cos, sin) of the cam angle at ``t + s`` from (cc, sc) at t: rotated by omega ((t + s)
+    - t) below ROTATE_MAX (:func:`rotate`), else :func:`cam_trig` at ``t + s``."""
     b = c[C_OMEGA] * ((t + s) - t)
     if abs(b) >= ROTATE_MAX:
         return cam_trig(t + s, c)
@@ -140,11 +129,8 @@ def geometry(t, th, c):
 
 @njit(cache=True, _nrt=False)
 def geometry_at(t, th, c):
-    """:func:`geometry` and the trigonometry it used: ``(delta, l_1, dC/dt.n, cc, sc, ct,
-    st)``, with (cc, sc) the cam angle's cos/sin at t and (ct, st) theta_f's.
-
-    A step that starts at (t, th) takes its first stage from these (:func:`rk4_trig`).
-    """
+    """:func:`geometry` and its trigonometry, ``(delta, l_1, dC/dt.n, cc, sc, ct, st)``
+    ((cc, sc) of the cam angle, (ct, st) of theta_f), a step's first stage (:func:`rk4_trig`)."""
     cc, sc = cam_trig(t, c)
     ct, st = math.cos(th), math.sin(th)
     delta, l1, cdn = geometry_trig(cc, sc, ct, st, c)
@@ -178,11 +164,10 @@ JAC_CONTACT = 2  # the contact force's continuation, e.g. on a substep ending at
 
 @njit(cache=True, inline="always")
 def _equations(cc, sc, ct, st, om, K, c, jac, side):
-    """The one home of equations (1)–(3), and, when ``jac``, of their Jacobian.
-
-    Returns ``(theta'', d theta''/d theta, d theta''/d theta')`` (the derivatives are 0
-    unless ``jac``). With ``delta = (O - C).n - (R + r)``,
-    ``l_1 = (C - O).u`` and ``dC/dt.n = e w (sin th_c sin th + cos th_c cos th)``:
+    """The one home of equations (1)–(3) and, with ``jac``, of their Jacobian: returns
+    ``(theta'', d theta''/d theta, d theta''/d theta')`` (derivatives 0 without ``jac``). With
+    ``delta = (O - C).n - (R + r)``, ``l_1 = (C - O).u``, ``dC/dt.n = e w (sin th_c sin th + cos
+    th_c cos th)``:
 
     - ``d delta/d theta = l_1``, ``d l_1/d theta = -(delta + R + r)``,
       ``d(dC/dt.n)/d theta = e w (sin th_c cos th - cos th_c sin th)``;
@@ -191,13 +176,11 @@ def _equations(cc, sc, ct, st, om, K, c, jac, side):
     - friction torque ``-mu_f a F_n sgn(v_r)`` with the slip speed at ``B_c = C + R n``,
       ``v_r = r theta' - w (C_x sin th - C_y cos th - R)``.
 
-    The vector field is continuous across delta = 0 (F_n vanishes there), so contact onset
-    and separation need no saltation matrix; its Jacobian jumps there, by ~K l_1^2 / J. A
-    substep that ends at a located crossing has its last stage *on* the surface, so its
-    Jacobian must be taken on the substep's own side (``side``: JAC_FLIGHT before a
-    closing, JAC_CONTACT, the force's continuation past p = 0, before an opening), else
-    the tangent picks up h/6 of that jump.
-    """
+    The field is continuous across delta = 0 (F_n vanishes), so onset and separation need no
+    saltation matrix; its Jacobian jumps by ~K l_1^2 / J. A substep ending at a located crossing
+    has its last stage *on* the surface and takes the Jacobian on its own side (``side``:
+    JAC_FLIGHT before a closing, JAC_CONTACT, the force continued past p = 0, before an
+    opening); else the tangent picks up h/6 of the jump."""
     cx = c[C_E] * cc
     cy = c[C_E] * sc
     dx = c[C_XO] - cx
@@ -252,11 +235,8 @@ def _equations(cc, sc, ct, st, om, K, c, jac, side):
 
 @njit(cache=True, _nrt=False)
 def acceleration_trig(cc, sc, ct, st, om, K, c):
-    """:func:`acceleration` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st).
-
-    Callers that know the trigonometric values (the adaptive kernel rotates them from a
-    step's start) skip four transcendental calls.
-    """
+    """:func:`acceleration` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st),
+    which callers often know (four transcendental calls saved)."""
     return _equations(cc, sc, ct, st, om, K, c, False, JAC_NATURAL)[0]
 
 
@@ -287,15 +267,11 @@ def rk4(t, th, om, h, K, c):
 
 @njit(cache=True, _nrt=False)
 def rk4_trig(t, th, om, h, K, c, cc, sc, ct, st):
-    """:func:`rk4` given the trigonometry at its start (cam angle at t: cc, sc; theta_f:
-    ct, st), e.g. from :func:`geometry_at`; returns ``(th, om, cc4, sc4)``, the last two the
-    cam angle's cos/sin at ``t + h``, where a gap at the step's end can take them from.
-
-    Stages 2 and 3 share their time ``t + h/2``; the cam's cos/sin there and theta_f's at
-    stages 2-4 are rotated from the start's (:func:`rotate`), so a step makes two
-    transcendental calls (the cam and theta_f at its end, which the gap there needs too)
-    instead of six. The end's are direct, so no rounding is carried from step to step.
-    """
+    """:func:`rk4` given the trigonometry at its start (cc, sc of the cam angle at t; ct, st of
+    theta_f), e.g. :func:`geometry_at`'s; returns ``(th, om, cc4, sc4)``, the last two the cam
+    angle's cos/sin at ``t + h`` (for the gap there). The stages' cos/sin are rotated from the
+    start's (:func:`rotate`): two transcendental calls a step, not six; the end's are direct,
+    so no rounding is carried from step to step."""
     a1 = acceleration_trig(cc, sc, ct, st, om, K, c)
     cm, sm = cam_trig_near(t, 0.5 * h, cc, sc, c)
     th2 = th + 0.5 * h * om
@@ -321,12 +297,9 @@ def rk4_trig(t, th, om, h, K, c, cc, sc, ct, st):
 
 @njit(cache=True, _nrt=False)
 def rk4_flight(th, om, h, c):
-    """RK4 step of the free pendulum J theta'' = -(m g l/2) cos theta (no contact force).
-
-    Exactly the step :func:`rk4` takes whenever the gap stays positive over the step, at a
-    quarter of the cost; :func:`closing_bound` decides when that is guaranteed. The stages'
-    cosines are rotated from the start's (:func:`rotate`): one sincos a step, not four cos.
-    """
+    """RK4 step of the free pendulum J theta'' = -(m g l/2) cos theta: :func:`rk4`'s step
+    where the gap stays positive (:func:`closing_bound`), at a quarter of the cost (the
+    stages' cosines rotated: one sincos a step)."""
     k = -c[C_GRAV] * c[C_INV_J]
     ct, st = math.cos(th), math.sin(th)
     a1 = k * ct
@@ -347,12 +320,9 @@ def rk4_flight(th, om, h, c):
 
 @njit(cache=True, _nrt=False)
 def gap_accel_bound(om, c):
-    """A bound on |delta''| in flight while |theta'| stays below |om| + 1 rad/s [m/s^2].
-
-    For ``delta = (O - C).n - (R + r)``:
-    ``|delta''| <= e w^2 + 2 e w |theta'| + rho_max (|theta''| + theta'^2)`` with
-    ``rho_max = |O| + e`` and ``|theta''| <= m g l / (2 J)`` in flight.
-    """
+    """A bound on |delta''| in flight while |theta'| < |om| + 1 rad/s [m/s^2]: ``|delta''| <=
+    e w^2 + 2 e w |theta'| + rho_max (|theta''| + theta'^2)``, ``rho_max = |O| + e``,
+    ``|theta''| <= m g l / (2 J)``."""
     w = abs(om) + 1.0
     ew = c[C_E] * c[C_OMEGA]
     rho = math.hypot(c[C_XO], c[C_YO]) + c[C_E]
@@ -361,22 +331,16 @@ def gap_accel_bound(om, c):
 
 @njit(cache=True, _nrt=False)
 def closing_bound(l1, cdn, om, h, c):
-    """An upper bound on how much the gap can shrink within a time h <= J / (m g l / 2) [m].
-
-    ``|delta(t + s) - delta(t)| <= s |delta'| + s^2/2 max|delta''|``, doubled for safety.
-    Over such an h gravity changes theta' by at most 1 rad/s, as :func:`gap_accel_bound`
-    assumes.
-    """
+    """A bound on how much the gap can shrink within h <= J / (m g l / 2) [m]: ``s |delta'| +
+    s^2/2 max|delta''|``, doubled for safety (gravity changes theta' by <= 1 rad/s in h, as
+    :func:`gap_accel_bound` assumes)."""
     return 2.0 * (h * abs(l1 * om - cdn) + 0.5 * h * h * gap_accel_bound(om, c))
 
 
 @njit(cache=True, _nrt=False)
 def safe_horizon(g, l1, cdn, om, c):
-    """The time over which a positive gap g certainly stays positive [s].
-
-    The largest H with ``closing_bound(H) <= g``, capped at J / (m g l / 2) (the time in
-    which gravity can change theta' by 1 rad/s; no cap without gravity).
-    """
+    """The time [s] over which a positive gap g certainly stays positive: the largest H with
+    ``closing_bound(H) <= g``, capped at J / (m g l / 2) (none without gravity)."""
     acc = gap_accel_bound(om, c)
     v = abs(l1 * om - cdn)
     horizon = 0.5 * g / (v + math.sqrt(v * v + acc * g))

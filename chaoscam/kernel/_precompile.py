@@ -1,26 +1,13 @@
 """The RK4 kernel's first compilation on two cores: a second process compiles some callees.
 
-Started by the first RK4 run of a process (:func:`start_once`, from
-:func:`._driver.alone_kernel`) where numba's cache lacks these callees: the first
-``simulate``, sweep, ensemble or ``chaoscam paper`` of a fresh install.
-
-numba compiles :func:`._kernel.run_chunk` once per install (``cache=True``), in one process,
-on one core: 22-25 s on the 2-core machine, most of it numba's own Python (type inference
-and lowering of each callee, each compiled on its own as the caller's typing reaches it),
-while the other core waits. :func:`start_beside` starts ``python -m
-chaoscam.kernel._precompile``, which compiles the callees that the kernel's typing
-reaches last (:func:`_callees`, in the reverse order) into numba's cache; when the kernel's
-compilation in this process reaches one of them, numba loads it from that cache instead of
-compiling it, as every later process does. The machine code is the same, so the results are
-the same bits (tested). A callee the second process has not finished is compiled here as
-before: nothing waits on it.
-
-Measured (2-core AMD EPYC, empty caches, 2026-11-28): the first ``simulate`` 25.6 s alone,
-14.8 s with the second process beside it.
-
-The signatures must be the ones the kernel asks for; a slow test compiles the kernel after
-this process and checks that each callee was a cache hit. Where they drift, nothing breaks:
-the kernel compiles them itself, as without this module.
+numba compiles :func:`._rk4.run_chunk` once per install (``cache=True``) in one process on one
+core, mostly numba's own Python (typing and lowering each callee as typing reaches it). The
+first RK4 run of a process whose cache lacks them (:func:`start_once`, from
+:func:`._driver.alone_kernel`) starts ``python -m chaoscam.kernel._precompile``, which compiles
+the callees the kernel's typing reaches last (:func:`_callees`, in reverse) into numba's cache,
+where this process's compilation finds them: the same machine code, so the same bits (tested);
+nothing waits on an unfinished one. A fresh install's first ``simulate`` on 2 cores takes 14.8 s
+instead of 25.6 s. Drifted signatures break nothing (a slow test checks each is a cache hit).
 """
 
 from __future__ import annotations
@@ -35,9 +22,8 @@ __all__ = ["start_beside", "start_once"]
 
 
 def _callees():
-    """[(dispatcher, signature)] the second process compiles, in its order: the reverse of
-    the order in which ``run_chunk``'s typing reaches them (numba's compile events), so that
-    the two processes meet in the middle. Built when asked (numba imported)."""
+    """[(dispatcher, signature)] the second process compiles: the reverse of the order in which
+    ``run_chunk``'s typing reaches them, so the two processes meet in the middle."""
     from numba import types
 
     from . import _events, _physics, _tangent
@@ -55,8 +41,8 @@ def _callees():
 
 
 def _cached(dispatcher) -> bool:
-    """Whether numba's cache holds an index for ``dispatcher`` (numba's internals: when they
-    change, False, and the second process runs, at a cost of under a second of its import)."""
+    """Whether numba's cache holds an index for ``dispatcher`` (numba internals; False where
+    they change, and the second process runs, costing under a second)."""
     try:
         return os.path.exists(dispatcher._cache._cache_file._index_path)
     except AttributeError:
@@ -64,9 +50,8 @@ def _cached(dispatcher) -> bool:
 
 
 def start_beside() -> subprocess.Popen | None:
-    """Start the second process when some callee of :func:`_callees` is not in numba's cache
-    yet (a fresh install); None when all are (every later run). Its output is discarded;
-    the caller may ``terminate()`` it when done (its cache writes are atomic)."""
+    """Start the second process where a callee of :func:`_callees` is not cached (a fresh
+    install), else None; output discarded, ``terminate()`` safe (its cache writes are atomic)."""
     if all(_cached(d) for d, _ in _callees()):
         return None
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -86,10 +71,8 @@ _start_lock = threading.Lock()
 
 
 def start_once() -> None:
-    """:func:`start_beside` the first time a process asks (the first RK4 run, through
-    :func:`._driver.alone_kernel`), in a process that is not a sweep's worker (those fork or
-    spawn by the dozen: one second process is enough); the second process ends by itself,
-    and is ended with this one at the latest."""
+    """:func:`start_beside` the first time a process asks, unless it is a multiprocessing child
+    (one second process is enough); the second process ends with this one at the latest."""
     global _started
     with _start_lock:
         if _started:
@@ -110,8 +93,7 @@ def _end(proc: subprocess.Popen) -> None:
 
 
 def _end_with_parent() -> None:
-    """End this process (at once, in a thread beside the compilation) when the process that
-    started it ends: a run killed on a fresh install leaves no compiler behind."""
+    """End this process when the one that started it ends (a killed run leaves no compiler)."""
     import time
 
     parent = os.getppid()

@@ -1,46 +1,30 @@
-"""Compiled fixed-step RK4 with located impacts: the reference integrator (paper sec. 3).
+"""Fixed-step RK4 with located impacts: the reference integrator (paper sec. 3).
 
-One call of :func:`run_chunk` advances one trajectory on the grid ``t_n = n dt`` until the end
-step or until an output buffer needs emptying; the Python driver then empties the buffers and
-calls again. The kernel never raises: it returns a status code
-(:class:`chaoscam.integrate.Status`).
+One call of :func:`run_chunk` advances one trajectory on the grid ``t_n = n dt`` to the end step
+or until an output buffer needs emptying (never raising). A grid step is cut into *segments* at
+the scheduled times inside it (sections ``k T``, line-length draws ``j dt_l``) and at located
+impacts; each is one RK4 substep, so section points are RK4 states and the grid never shifts.
 
-Within one grid step the interval is cut into *segments* at the scheduled times that fall
-inside it (stroboscopic section times ``k T``, line-length resampling times ``j dt_l``) and at
-located impacts. Each segment is one RK4 substep, so the section points are exact RK4 states,
-not interpolations, and the grid itself never shifts.
-
-Impacts (paper (4)–(5), MODEL.md): when the gap ``delta`` is positive at a segment's start and
-non-positive at its end, the crossing time is found by the Illinois variant of regula falsi on
-``tau -> delta(RK4 substep of length tau)`` down to ``event_tol``; the state is taken at the
-bracket end where ``delta <= 0``. There the restitution law applies (:func:`._steps.impact`): a jump
-``theta'+ = -xi theta'- + (1 + xi) (dC/dt . n) / l_1``, or, when the approach is slower than
-``v_chatter``, the plastic closure that ends a complete chattering sequence. Two crossings
-within one segment (a micro-flight or a graze shorter than a step) are found where the gap
-rate turns inside it (:func:`._events.graze_point`).
+Impacts (paper (4)–(5), MODEL.md): where the gap ``delta`` goes from > 0 to <= 0 over a segment,
+the crossing is located on ``tau -> delta(RK4 substep of length tau)`` to ``event_tol``
+(:func:`._events.locate_crossing`), the state taken at the bracket end where ``delta <= 0``, and
+the restitution law applied (:func:`._steps.impact`): ``theta'+ = -xi theta'- + (1 + xi)
+(dC/dt . n) / l_1``, or, slower than ``v_chatter``, the plastic closure that ends a complete
+chattering sequence. Two crossings in one segment (a micro-flight or graze shorter than a step)
+are found where the gap rate turns (:func:`._events.graze_point`).
 
 The gap is resolved to ~1e-16 m at any time (the last bounces of a chattering sequence rise
-~3e-14 m): the cam angle is reduced exactly (:func:`._physics.cam_angle`) and every substep's
-length is rounded so that its end is the double the kernel stamps it with
-(:func:`._physics.on_clock`), so the state and the clock never part by a rounding of ``t``.
+~3e-14 m): the cam angle is reduced exactly (:func:`._physics.cam_angle`) and every substep ends
+on the double it is stamped with (:func:`._physics.on_clock`).
 
-With ``c[C_TANGENT]`` set, the tangent matrix is integrated with the state (:mod:`._tangent`)
-from shortly before the recording starts (:func:`._steps.tangent_on`) and carried through each
-located event by the flow's saltation matrix (:func:`._steps.impact`); at each section time the
-Jacobian of the stroboscopic map over the last period is written beside the section point
-and the tangent restarts from the identity. The state is the same with and without it.
+With ``c[C_TANGENT]`` set the tangent is integrated with the state (:mod:`._tangent`) from shortly
+before the recording (:func:`._steps.tangent_on`), carried through each event by the saltation
+matrix, written beside each section point as the map's Jacobian over the last period and
+restarted from the identity there. The state is the same with and without it.
 
-The model's equations live in :mod:`._physics`, the array layout in :mod:`.layout`, the
-location of events inside a step in :mod:`._events`.
-
-Compiled without numba's reference counting. Every function of the kernels' modules that
-numba compiles on its own (not inlined into its caller) says ``_nrt=False`` (numba's option
-for a function that needs no runtime; none allocates an array). With the runtime on, such a
-function took a reference to its array arguments on entry and let it go on return, and
-:func:`run_chunk` did the same around the code it inlines (``NRT_incref`` / ``NRT_decref``,
-atomic operations): 8 % of a regime map's samples. Without it a run is the same bits and the
-kernels' time shorter (``benchmarks/PROFILE.md``). ``tests/integrate/test_no_refcount.py``
-keeps it so.
+Compiled without numba's reference counting (``_nrt=False`` on each function compiled on its
+own; none allocates): its atomic ``NRT_incref``/``NRT_decref`` on array arguments cost 8 % of a
+regime map's samples (``benchmarks/PROFILE.md``); ``tests/kernel/test_no_refcount.py`` checks.
 """
 
 from __future__ import annotations
@@ -115,17 +99,12 @@ from .layout import (
 
 @njit(cache=True, inline="always")
 def step_rk4(t, th, om, h, K, c, y, commit, first, rest, trig):
-    """One RK4 substep of the state; with the tangent on (:func:`._steps.tangent_on`: not in
-    the transient), of the tangent too, the Jacobian at its first stage taken on side
-    ``first`` of the contact surface, at the others on side ``rest``
-    (:data:`._physics.JAC_NATURAL` and others; :func:`._tangent.rk4_tangent_trig`).
-    ``trig`` is the trigonometry at the substep's start, ``(cc, sc, ct, st)`` from
-    :func:`._physics.geometry_at`.
-
-    Returns ``(th, om, v11, v21, v12, v22, div)``, the last five being the tangent after the
-    step (written into ``y`` when ``commit``; the state is always returned, never stored),
-    and the cam angle's ``(cos, sin)`` at ``t + h``.
-    """
+    """One RK4 substep of the state and, with the tangent on (:func:`._steps.tangent_on`), of
+    the tangent, its first stage's Jacobian taken on side ``first`` of the surface, the others'
+    on ``rest`` (:func:`._tangent.rk4_tangent_trig`). ``trig``: ``(cc, sc, ct, st)`` at the
+    start (:func:`._physics.geometry_at`). Returns ``(th, om, v11, v21, v12, v22, div)`` (the
+    tangent written into ``y`` when ``commit``; the state never stored) and the cam angle's
+    ``(cos, sin)`` at ``t + h``."""
     cc, sc, ct, st = trig
     if tangent_on(t, c):
         v11, v21, v12, v22 = y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22]
@@ -161,29 +140,15 @@ def leave(y, cnt, th, om, t, safe_n, code):
 
 @njit(cache=True, _nrt=False)
 def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
-    """Advance one trajectory from step ``cnt[I_STEP]`` towards ``n_stop``.
+    """Advance one trajectory from step ``cnt[I_STEP]`` towards grid step ``n_stop``; returns a
+    status code, ``NEED_BUFFER`` asking the driver to empty buffers or add draws.
 
-    Parameters
-    ----------
-    y : float64[Y_SIZE]
-        (theta_f [rad], theta_f' [rad/s], t [s], ..., tangent) at ``t = cnt[I_STEP] * dt``;
-        updated in place (slots ``Y_*``).
-    cnt : int64[N_COUNTERS]
-        Counters (indices ``I_*``); updated in place.
-    c : float64[N_CONSTANTS]
-        Constants (indices ``C_*``).
-    n_stop : int
-        Grid step at which the run ends.
-    lam : float64[:]
-        Line-length draws; ``lam[cnt[I_LAM_POS]]`` is the one in use.
-    series, section, impacts : float64[:, SERIES_COLS], [:, SECTION_COLS], [:, IMPACT_COLS]
-        Output buffers, filled from the row counts in ``cnt``. ``impacts`` of no rows: the
-        impacts are counted in ``cnt[I_N_IMPACT]``, not recorded, and never ask for room.
-
-    Returns
-    -------
-    int
-        A status code; ``NEED_BUFFER`` asks the driver to empty buffers or add draws.
+    ``y`` (float64[Y_SIZE]: theta_f [rad], theta_f' [rad/s], t [s], ..., the tangent, at ``t =
+    cnt[I_STEP] dt``) and ``cnt`` (int64[N_COUNTERS]) are updated in place; ``c``: the constants
+    (``C_*``); ``lam``: line-length draws, ``lam[cnt[I_LAM_POS]]`` in use; ``series``,
+    ``section``, ``impacts``: output buffers (``*_COLS`` columns) filled from the row counts in
+    ``cnt``. An ``impacts`` of no rows only counts them (``cnt[I_N_IMPACT]``) and never asks for
+    room.
     """
     h = c[C_DT]
     stride = np.int64(c[C_STRIDE])
@@ -199,16 +164,12 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     if not resample_on_impact:
         draws_per_step += np.int64(h / c[C_RESAMPLE_DT]) + 2
 
-    # gap, lever arm, dC/dt.n here, and the trigonometry they came from (a step from here
-    # takes its first stage from it: :func:`._physics.rk4_trig`)
+    # gap, lever arm, dC/dt.n here and their trigonometry (a step's first stage: rk4_trig)
     g, l1, cdn, cc0, sc0, ct0, st0 = geometry_at(cnt[I_STEP] * h, th, c)
-    # Until grid step safe_n the gap certainly stays open (no geometry needed). Kept in the
-    # counters, so that a run resumed after a buffer hand-back is bit-identical to one that
-    # was not interrupted. Whoever changes the state y from outside must reset it to 0.
+    # Until grid step safe_n the gap certainly stays open. It and the surface flags are kept in
+    # the counters, so a resumed run is bit-identical; whoever changes y must reset it to 0.
     safe_n = cnt[I_SAFE_STEP]
     stale = False  # g, l1, cdn, trig belong to an earlier point (only while the gap is safe)
-    # The surface flags, kept in the counters across a buffer hand-back (an event may end a
-    # grid step exactly) so that a resumed run is bit-identical to one not interrupted.
     jumped = (cnt[I_SURFACE] & 1) != 0  # a rebound was just applied: the opening is flight's
     settled = (cnt[I_SURFACE] & 2) != 0  # a plastic closure: the point stays in contact
     budget = np.int64(c[C_CALL_STEPS])  # steps before a hand-back (Ctrl-C is seen between)
@@ -235,8 +196,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             m = min(m, np.int64((cnt[I_SECTION_K] * c[C_PERIOD] - t) / h))
             if not resample_on_impact:
                 m = min(m, np.int64((cnt[I_RESAMPLE_J] * c[C_RESAMPLE_DT] - t) / h))
-            # A block may straddle the start of the recording: the motion does not depend on
-            # the transient (only what is kept does), so a run is the same bits whatever it.
+            # (a block may straddle the recording's start: the motion ignores the transient)
         if m >= 2:
             th0 = th
             om0 = om
@@ -251,8 +211,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 while first * h < c[C_T_RECORD]:
                     first += 1
                 cnt[I_COUNTED_STEPS] += n + m + 1 - first
-                # Series samples inside the block come from a substep off its start, so that
-                # sampling never changes the trajectory.
+                # samples inside the block: substeps off its start (the trajectory unchanged)
                 j = n + stride - n % stride if stride > 0 else n + m + 1
                 while j <= n + m:
                     if j >= first:
@@ -284,19 +243,14 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     stale = False
                 trig0 = (cc0, sc0, ct0, st0)
                 rate0 = l1 * om - cdn
-                # The side the segment starts on. A located crossing leaves the point on the
-                # surface to rounding (slow closings give delta = 0.0 exactly: 1e-6 m/s over
-                # the 1e-12 s event tolerance is 1e-18 m, below delta's ~1e-16 m resolution).
-                # There the side is the motion's: contact just after a plastic closure (its
-                # gap rate is 0 to rounding, and taking the rounding's sign starts a
-                # ping-pong of zero-length events that only the chattering guard ends), else
-                # flight when moving out (after a rebound, or a located opening).
+                # The start's side. On the surface (a located crossing, delta = 0 to rounding)
+                # it is the motion's: contact after a plastic closure (the rounding's sign would
+                # start a ping-pong of zero-length events), else flight when moving out.
                 on_surface = g == 0.0 or (jumped and g <= 0.0)
                 gs = g
                 if on_surface:
                     gs = ON_SURFACE if not settled and (jumped or rate0 > 0.0) else -ON_SURFACE
-                # On the surface the first stage sits at delta ~ 0 on the wrong side of the
-                # Jacobian's jump (~K l_1^2 / J): take it on the side the segment starts on.
+                # on the surface the first stage's Jacobian (jump ~K l_1^2 / J): the start's side
                 trial_side = JAC_NATURAL
                 if on_surface:
                     trial_side = JAC_FLIGHT if gs > 0.0 else JAC_CONTACT
@@ -324,19 +278,15 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     if not closing:
                         crossing = False  # lift-off from the surface: at the segment's start
                     elif rate0 > 0.0 > rate1:
-                        # A micro-flight from the surface: the gap is rounding noise near the
-                        # start, so the bracket starts at the flight's top.
+                        # a micro-flight from the surface: the bracket starts at its top
                         tau_lo = graze_point(t, th, om, hs, rate0, rate1, K, c, trig0)
                         g_lo, _, _, _ = gap_after(t, th, om, tau_lo, K, c, trig0)
                         crossing = g_lo > 0.0
                         closing = crossing
                 elif not crossing and events < max_events and trial_full:
-                    # No sign change between the ends, but the gap rate turns (closing to
-                    # opening in flight, the reverse in contact): the gap may have crossed
-                    # zero and come back inside the segment. Micro-flights of a chattering
-                    # sequence last ~2 xi v / |delta''| (0.1 us at v = 1e-6 m/s), far below
-                    # dt; unlocated, the step integrates through one without its jump and the
-                    # tangent misses a saltation matrix of size ~|delta''| / v.
+                    # No sign change, but the gap rate turns: the gap may have crossed zero and
+                    # come back. A chattering micro-flight lasts ~2 xi v / |delta''| (0.1 us at
+                    # v = 1e-6 m/s); unlocated, its jump and saltation (~|delta''| / v) are lost.
                     if (rate0 < 0.0 < rate1) if gs > 0.0 else (rate1 < 0.0 < rate0):
                         tau_hi = graze_point(t, th, om, hs, rate0, rate1, K, c, trig0)
                         g_hi, _, _, _ = gap_after(t, th, om, tau_hi, K, c, trig0)
@@ -347,14 +297,10 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 if crossing and events >= max_events:
                     cnt[I_CHATTER] += 1  # chattering: the rest of the step is left as it is
                 elif crossing:
-                    # The gap changes sign inside the segment: go to the crossing, so that no
-                    # RK4 step straddles the kink of the force at delta = 0, then resume.
-                    # A closing ends a free flight: its substep is the free pendulum's (no
-                    # Hertz force from a last stage that overshoots into the cam by up to
-                    # v event_tol), provided the free pendulum crosses in the bracket too (a
-                    # step far too coarse for the contact may close where free flight does
-                    # not). A micro-flight from the surface keeps the full equations: its
-                    # bracket starts at a top found on them, and its overshoot is < 1e-15 m.
+                    # Go to the crossing (no RK4 step straddles the force's kink). A closing's
+                    # substep is the free pendulum's (no Hertz force from a last stage overshooting
+                    # by v event_tol) where free flight crosses in the bracket too; a micro-flight
+                    # from the surface keeps the full equations (overshoot < 1e-15 m).
                     free = False
                     if closing and not on_surface:
                         th_f, _ = rk4_flight(th, om, tau_hi, c)
@@ -366,8 +312,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     if free:
                         th, om, _, _, _, _, _ = step_flight(t, th, om, tau, c, y, True)
                     else:
-                        # The flow's tangent takes every stage on the side the substep comes
-                        # from (flight before a closing and just after a jump, else contact).
+                        # every stage's Jacobian on the side the substep comes from
                         side = JAC_FLIGHT if closing or jumped else JAC_CONTACT
                         r, _ = step_rk4(t, th, om, tau, K, c, y, True, side, side, trig0)
                         th, om = r[0], r[1]
@@ -419,6 +364,6 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 series[i, 2] = om
                 series[i, 3] = lam[cnt[I_LAM_POS]]
                 cnt[I_N_SERIES] += 1
-    # The flags too, for a run continued later from here (``_ensemble.extend_ensemble``).
+    # the flags too, for a run continued from here (chaoscam.extend)
     cnt[I_SURFACE] = (1 if jumped else 0) + (2 if settled else 0)
     return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, OK)

@@ -1,12 +1,6 @@
-"""The per-step pieces both integrators share: the schedule of outputs, the impact law and
-the tangent's bookkeeping.
-
-The fixed-step RK4 kernel (:mod:`._kernel`) and the adaptive one (:mod:`._adaptive`) cut
-time differently, but at a scheduled time (a stroboscopic section ``k T``, a line-length
-draw ``j dt_l``) and at a located closing they do exactly the same, here: record the section
-point with the map's Jacobian, draw the next line length, apply the restitution law (4)–(5)
-with its tangent and record the impact. All are inlined into the kernels.
-"""
+"""What both integrators (:mod:`._rk4`, :mod:`._adaptive`) do the same, inlined into them: the
+output schedule (sections ``k T``, line-length draws ``j dt_l``), the impact law at a located
+closing, the tangent's bookkeeping."""
 
 from __future__ import annotations
 
@@ -44,44 +38,30 @@ from .layout import (
 )
 
 __all__ = [
-    "at_scheduled",
-    "commit_tangent",
-    "impact",
-    "next_scheduled",
-    "reset_tangent",
-    "tangent_on",
-]
+    "at_scheduled", "commit_tangent", "impact", "next_scheduled", "reset_tangent", "tangent_on",
+]  # fmt: skip
 
 TANGENT_LEAD = 2.0
-"""Periods before the recording starts [T] from which the tangent is integrated
-(:func:`tangent_on`). One would do: the first Jacobian read is the one written at the first
-recorded section, over the period from the section before it, where the tangent restarts
-from the identity. The second keeps that section inside the span whatever the rounding of
-``t_record - T``."""
+"""Periods [T] before the recording from which the tangent is integrated (:func:`tangent_on`):
+the first Jacobian read spans the period before the first recorded section, and a second period
+keeps that section's predecessor inside the span whatever the rounding of ``t_record - T``."""
 
 
 @njit(cache=True, inline="always")
 def tangent_on(t, c):
-    """Whether the tangent is carried over a segment (or an impact) that starts at ``t``.
-
-    With ``c[C_TANGENT]`` set, from ``TANGENT_LEAD`` periods before the recording starts:
-    Jacobians are written only at recorded sections, each over the period since the section
-    before it, where the tangent restarted from the identity, so the tangent of the
-    transient is never read, and skipping it there changes no recorded bit (over a whole
-    run the tangent costs 0.15 plain runs' time on the RK4 path, 3 on the adaptive one).
-    No segment crosses a section time, so every segment after that earlier section starts
-    inside the span. The state never depends on the tangent.
-    """
+    """Whether the tangent is carried over a segment (or impact) starting at ``t``: with
+    ``c[C_TANGENT]`` set, from ``TANGENT_LEAD`` periods before the recording. Jacobians are
+    written at recorded sections only, each over the period since the last restart (no segment
+    crosses a section time), so skipping the transient changes no recorded bit (a whole run's
+    tangent costs 0.15 plain runs on the RK4 path, 3 on the adaptive one). The state never
+    depends on the tangent."""
     return c[C_TANGENT] > 0.0 and t >= c[C_T_RECORD] - TANGENT_LEAD * c[C_PERIOD]
 
 
 @njit(cache=True, inline="always")
 def next_scheduled(t_limit, cnt, c):
-    """The first scheduled time up to ``t_limit``: (time, is_section, is_resample).
-
-    Scheduled times are the stroboscopic sections ``k T`` and, with interval resampling,
-    the line-length draws ``j dt_l``; a step or segment must end exactly there.
-    """
+    """The first scheduled time up to ``t_limit``, (time, is_section, is_resample): sections
+    ``k T`` and, with interval resampling, draws ``j dt_l``, where a step must end exactly."""
     t_next = t_limit
     is_section = False
     is_resample = False
@@ -102,12 +82,9 @@ def next_scheduled(t_limit, cnt, c):
 
 @njit(cache=True, inline="always")
 def at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c):
-    """Record the section point and/or draw the next line length at a scheduled time t.
-
-    At a section the tangent matrix (the stroboscopic map's Jacobian over the period that
-    ends here) is written beside the point and restarted from the identity. Returns the
-    stiffness in use afterwards.
-    """
+    """Record the section point and/or draw the next line length at a scheduled time t; at a
+    section the tangent (the map's Jacobian over the period ending here) is written beside the
+    point and restarted from the identity. Returns the stiffness in use afterwards."""
     if is_section:
         if t >= c[C_T_RECORD]:
             i = cnt[I_N_SECTION]
@@ -143,23 +120,17 @@ def reset_tangent(y):
 def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c):
     """The impact law (4)–(5) at a located closing at (t, th) with lever arm l1 and dC/dt.n.
 
-    The approach speed is ``v = -(l1 theta' - dC/dt.n)``. When ``v > v_min`` (0 by default:
-    every closing) the angular velocity jumps,
-    ``theta'+ = -xi theta'- + (1 + xi) (dC/dt.n) / l1``, so that the gap rate becomes
-    ``-xi`` times itself. A closing slower than ``v_chatter`` is the end of a complete
-    chattering sequence (the infinitely many ever shorter bounces whose speeds fall by ``xi``
-    each, Nordmark & Piiroinen 2009, Nonlinear Dyn. 58): it is replaced by its accumulation
-    point, a plastic closure ``theta'+ = (dC/dt.n) / l1`` (gap rate 0), after which the
-    compliant contact carries the motion. With the tangent on, each applied jump multiplies
-    it by its saltation matrix (:func:`._tangent.saltation`). Each applied jump is recorded
-    (after the transient) with its kind: macro, micro (slower than ``v_micro``) or chatter
-    end, as a row of ``impacts``, or only counted when that buffer has no rows (an ensemble
-    that keeps no impacts then never stops to empty them). Under impact resampling a macro
-    impact draws a new line length (``resample="contact"``: a new contact), and so does
-    every applied jump under ``resample="impact"``. Closings slower than ``v_min`` are left
-    to the compliant force and counted.
-
-    Returns (theta' after, stiffness in use).
+    With approach speed ``v = -(l1 theta' - dC/dt.n)`` > ``v_min`` (0 by default) the angular
+    velocity jumps, ``theta'+ = -xi theta'- + (1 + xi) (dC/dt.n) / l1`` (gap rate times -xi).
+    Slower than ``v_chatter`` the closing ends a complete chattering sequence (bounces whose
+    speeds fall by ``xi`` each, Nordmark & Piiroinen 2009, Nonlinear Dyn. 58) and is replaced
+    by its accumulation point, the plastic closure ``theta'+ = (dC/dt.n) / l1``. With the
+    tangent on, a jump multiplies it by its saltation matrix (:func:`._tangent.saltation`).
+    Each jump after the transient is a row of ``impacts`` with its kind (macro, micro below
+    ``v_micro``, chatter end), or only counted for a buffer of no rows. A macro impact draws a
+    new line length under ``resample="contact"``, every jump under ``"impact"``. Closings
+    slower than ``v_min`` are counted and left to the compliant force. Returns (theta' after,
+    stiffness in use).
     """
     rate = l1 * om - cdn
     if not (-rate > c[C_VMIN]):

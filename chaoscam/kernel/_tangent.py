@@ -1,27 +1,20 @@
 """Tangent (variational) dynamics of the cam-follower through its impacts.
 
-The linearised flow ``V' = A(t) V`` with ``A = [[0, 1], [d theta''/d theta,
-d theta''/d theta']]`` is integrated with the state by the *same* RK4 stages
-(:func:`rk4_tangent_trig`), so between events V is the exact derivative of the RK4 steps and
-the state is bit-identical to :func:`._physics.rk4`'s. Through a located event V is
-multiplied by the flow's saltation matrix (:func:`saltation`; Müller 1995, Chaos Solitons
-Fractals 5(9); Leine & Nijmeijer 2004, *Dynamics and Bifurcations of Non-smooth Mechanical
-Systems*, sec. 3.5; Dankowicz & Nordmark 2000, Physica D 136), and every stage of a substep
-that starts or ends on the surface takes that substep's side.
+``V' = A(t) V``, ``A = [[0, 1], [d theta''/d theta, d theta''/d theta']]``, is integrated by the
+*same* RK4 stages as the state (:func:`rk4_tangent_trig`), so between events V is the exact
+derivative of the RK4 steps and the state is bit-identical to :func:`._physics.rk4`'s. Through a
+located event V is multiplied by the flow's saltation matrix (:func:`saltation`; Müller 1995,
+Chaos Solitons Fractals 5(9); Leine & Nijmeijer 2004, *Dynamics and Bifurcations of Non-smooth
+Mechanical Systems*, sec. 3.5; Dankowicz & Nordmark 2000, Physica D 136). Contact onset and
+separation need none (the force vanishes at delta = 0: the field is continuous, its Jacobian
+not, so no RK4 step straddles delta = 0). The same quadrature integrates the divergence ``tr
+A``, for Liouville's ``ln |det V| = int tr A dt + sum ln |det S|``.
 
-Limits: this is the flow's tangent, not the derivative of the RK4 grid map. Where chattering
-ends in sticking, the RK4 substep after a located event starts on the surface and one of its
-stages dips ~1e-12 m into the cam, where the Hertz force is negligible in the state but not in
-its derivative; the grid map then depends on the event time in a way the saltation matrix does
-not carry, and the tangent overstates the growth there by up to tens of percent a chatter
-cycle at dt = 2e-6 s, shrinking as dt^2 (docs/verdicts.md).
-
-Contact onset and separation need no saltation matrix:
-the contact force vanishes at delta = 0, so the vector field is continuous there (its Jacobian
-is not, which is why no RK4 step straddles delta = 0).
-
-The same RK4 quadrature gives the integral of the divergence ``tr A = d theta''/d theta'``,
-so that Liouville's formula ``ln |det V| = int tr A dt + sum ln |det S|`` can be checked.
+Limits: the flow's tangent, not the derivative of the RK4 grid map. Where chattering ends in
+sticking, the substep after a located event starts on the surface and a stage dips ~1e-12 m into
+the cam, negligible in the state but not in its derivative: the tangent then overstates the
+growth by up to tens of percent a chatter cycle at dt = 2e-6 s, shrinking as dt^2
+(docs/verdicts.md).
 """
 
 from __future__ import annotations
@@ -50,33 +43,18 @@ def _column(x, y, h, p1, q1, p2, q2, p3, q3, p4, q4):
     x4, y4 = x + h * y3, y + h * (p3 * x3 + q3 * y3)
     return (
         x + h / 6.0 * (y + 2.0 * y2 + 2.0 * y3 + y4),
-        y
-        + h
-        / 6.0
-        * (
-            p1 * x
-            + q1 * y
-            + 2.0 * (p2 * x2 + q2 * y2)
-            + 2.0 * (p3 * x3 + q3 * y3)
-            + p4 * x4
-            + q4 * y4
-        ),
-    )
+        y + h / 6.0 * (p1 * x + q1 * y + 2.0 * (p2 * x2 + q2 * y2) + 2.0 * (p3 * x3 + q3 * y3)
+                       + p4 * x4 + q4 * y4),
+    )  # fmt: skip
 
 
 @njit(cache=True, _nrt=False)
 def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, first, rest, cc, sc, ct, st):
-    """One RK4 step of the state and of its tangent matrix V (columns (v11, v21), (v12, v22)).
-
-    Returns ``(th, om, v11, v21, v12, v22, div, cc4, sc4)`` with ``div`` the step's RK4
-    quadrature of the divergence. The state is computed exactly as :func:`._physics.rk4`
-    does. The first stage's Jacobian is taken on side ``first`` of the contact surface, the
-    others' on side ``rest`` (:data:`._physics.JAC_NATURAL`: the side each stage lies on). A
-    substep that starts on the surface has its first stage at delta = 0 to rounding and takes
-    the side the motion leaves it on, as do its other stages. As
-    :func:`._physics.rk4_trig`, it takes the trigonometry at its start (cam angle at t: cc,
-    sc; theta_f: ct, st) and hands on the cam angle's cos/sin at ``t + h`` (cc4, sc4).
-    """
+    """One RK4 step of the state (exactly :func:`._physics.rk4`'s) and of its tangent matrix V
+    (columns (v11, v21), (v12, v22)): returns ``(th, om, v11, v21, v12, v22, div, cc4, sc4)``,
+    ``div`` the step's quadrature of the divergence. The first stage's Jacobian is taken on
+    side ``first`` of the surface, the others' on ``rest`` (:data:`._physics.JAC_NATURAL`: where
+    each stage lies). Trigonometry in and out as :func:`._physics.rk4_trig`."""
     a1, p1, q1 = acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, first)
     cm, sm = cam_trig_near(t, 0.5 * h, cc, sc, c)
     th2 = th + 0.5 * h * om
@@ -99,23 +77,14 @@ def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, first, rest, cc, sc
     return (
         th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
         om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
-        n11,
-        n21,
-        n12,
-        n22,
-        div,
-        c4,
-        s4,
-    )
+        n11, n21, n12, n22, div, c4, s4,
+    )  # fmt: skip
 
 
 @njit(cache=True, _nrt=False)
 def rk4_flight_tangent(th, om, h, c, v11, v21, v12, v22):
-    """:func:`._physics.rk4_flight` (the free pendulum) with its tangent matrix.
-
-    In flight ``A = [[0, 1], [(m g l / 2J) sin theta, 0]]``: the divergence is zero. Returns
-    ``(th, om, v11, v21, v12, v22)``.
-    """
+    """:func:`._physics.rk4_flight` with its tangent matrix, ``A = [[0, 1], [(m g l / 2J) sin
+    theta, 0]]`` (no divergence): returns ``(th, om, v11, v21, v12, v22)``."""
     k = -c[C_GRAV] * c[C_INV_J]
     ct, st = math.cos(th), math.sin(th)
     a1 = k * ct
@@ -141,11 +110,8 @@ def rk4_flight_tangent(th, om, h, c, v11, v21, v12, v22):
     return (
         th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
         om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
-        n11,
-        n21,
-        n12,
-        n22,
-    )
+        n11, n21, n12, n22,
+    )  # fmt: skip
 
 
 @njit(cache=True, _nrt=False)
@@ -172,20 +138,15 @@ def jump_derivatives(t, th, l1, cdn, c):
 def saltation(t, th, om_before, om_after, l1, cdn, xi, c):
     """The saltation matrix S of a restitution jump at a located closing (t, th).
 
-    For the event surface ``h(t, x) = delta(t, theta) = 0`` and the jump
-    ``g(t, x) = (theta, -xi theta' + (1 + xi) q)``, ``q = (dC/dt.n) / l_1``:
+    For the surface ``h(t, x) = delta(t, theta) = 0`` and the jump ``g(t, x) = (theta, -xi
+    theta' + (1 + xi) q)``, ``q = (dC/dt.n) / l_1`` (Müller 1995, eq. 16):
 
-    ``S = g_x + (f+ - g_x f- - g_t) h_x^T / (h_t + h_x f-)`` (Müller 1995, eq. 16),
+    ``S = g_x + (f+ - g_x f- - g_t) h_x^T / (h_t + h_x f-)``,
 
-    with ``h_x = (l_1, 0)``, ``h_t + h_x f- = l_1 theta'- - dC/dt.n`` (the gap rate before) and
-    ``f+- = (theta'+-, theta''_flight)``: the contact force vanishes on the surface, so both
-    sides share the free pendulum's acceleration. ``xi`` = 0 gives the plastic closure that
-    ends a complete chattering (a singular S). Whatever the geometry,
-    ``det S = -xi (h_t + h_x f+)/(h_t + h_x f-) = xi^2``. Both kernels apply it at every
-    applied jump.
-
-    Returns ``(s11, s21, s22)``; ``s12`` is 0.
-    """
+    ``h_x = (l_1, 0)``, ``h_t + h_x f- = l_1 theta'- - dC/dt.n`` (the gap rate before),
+    ``f+- = (theta'+-, theta''_flight)`` (the force vanishes on the surface). ``det S = -xi (h_t
+    + h_x f+)/(h_t + h_x f-) = xi^2``; ``xi`` = 0 (the plastic closure ending a chattering)
+    gives a singular S. Returns ``(s11, s21, s22)``; ``s12`` is 0."""
     q_th, q_t = jump_derivatives(t, th, l1, cdn, c)
     a_free = -c[C_GRAV] * c[C_INV_J] * math.cos(th)
     rate = l1 * om_before - cdn
@@ -197,15 +158,10 @@ def saltation(t, th, om_before, om_after, l1, cdn, xi, c):
 
 @njit(cache=True, _nrt=False)
 def rk4_tangent_along(t, h, th0, om0, thm, omm, th1, om1, K, c, v11, v21, v12, v22, side):
-    """One RK4 step of the tangent matrix alone along a known state: its start (th0, om0), its
-    midpoint (thm, omm) and its end (th1, om1), e.g. from an adaptive step and its
-    interpolant. Returns ``(v11, v21, v12, v22, div)``.
-
-    The adaptive path integrates the state with DOP853 (:mod:`._adaptive`); its tangent is
-    this classical RK4 of ``V' = A(t) V`` over a substep, with A at its start, midpoint
-    (twice) and end. Accurate to O((h |A|)^5) per substep: the adaptive path cuts each step
-    into substeps with ``h |A| <= TANGENT_STEP_RATE`` (:func:`._adaptive.advance_tangent`).
-    """
+    """One RK4 step of ``V' = A(t) V`` alone along a known state, A at its start (th0, om0),
+    midpoint (thm, omm, twice) and end (th1, om1): the adaptive path's tangent, O((h |A|)^5) a
+    substep with ``h |A| <= TANGENT_STEP_RATE`` (:func:`._adaptive.advance_tangent`). Returns
+    ``(v11, v21, v12, v22, div)``."""
     _, p1, q1 = acceleration_jacobian(t, th0, om0, K, c, side)
     _, p2, q2 = acceleration_jacobian(t + 0.5 * h, thm, omm, K, c, side)
     _, p4, q4 = acceleration_jacobian(t + h, th1, om1, K, c, side)
@@ -215,10 +171,8 @@ def rk4_tangent_along(t, h, th0, om0, thm, omm, th1, om1, K, c, v11, v21, v12, v
 
 
 def section_jacobians(rows: np.ndarray) -> np.ndarray:
-    """The (n, 2, 2) Jacobians stored beside section points in kernel section rows.
-
-    Columns ``j11, j21, j12, j22`` (``_layout.SECTION_TANGENT_NAMES``) follow the section's
-    own columns: column-major, so ``J = [[j11, j12], [j21, j22]]``.
-    """
+    """The (n, 2, 2) Jacobians stored beside section points in kernel section rows: columns
+    ``j11, j21, j12, j22`` (``layout.SECTION_TANGENT_NAMES``) after the section's own,
+    column-major, so ``J = [[j11, j12], [j21, j22]]``."""
     start = len(SECTION_NAMES)
     return rows[:, start : start + 4].reshape(-1, 2, 2).transpose(0, 2, 1).copy()

@@ -1,10 +1,7 @@
-"""The memory layout shared by the compiled kernels and their Python drivers.
-
-A kernel sees a trajectory as flat arrays: a float64 constants vector ``c`` (indices ``C_*``),
-int64 counters ``cnt`` (``I_*``), a float64 state ``y`` (``Y_*``) and output buffers whose
-columns are named here (``*_NAMES``). Status codes mirror :class:`chaoscam.integrate.Status`.
-Nothing here computes anything: this module is the one place where a slot gets its meaning.
-"""
+"""The memory layout shared by the compiled kernels and their Python drivers, the one place
+where a slot gets its meaning: a float64 constants vector ``c`` (``C_*``), int64 counters
+``cnt`` (``I_*``), a float64 state ``y`` (``Y_*``) and output buffers (columns ``*_NAMES``).
+Status codes mirror :class:`chaoscam.kernel.Status`."""
 
 from __future__ import annotations
 
@@ -36,7 +33,7 @@ C_RESAMPLE_DT = 23  # interval between line-length draws [s]; 0 = draw at impact
 C_MAX_EVENTS = 24  # impacts handled in one step before chattering hand-over
 C_STRIDE = 25  # series sample every C_STRIDE steps; 0 = no series
 C_FLIGHT_MERGE = 26  # most grid steps taken as one RK4 step where the gap provably stays open
-C_METHOD = 27  # METHOD_RK4 (_kernel) or METHOD_ADAPTIVE (_adaptive)
+C_METHOD = 27  # METHOD_RK4 (_rk4) or METHOD_ADAPTIVE (_adaptive)
 C_RTOL = 28  # adaptive: relative tolerance of the step error
 C_ATOL = 29  # adaptive: absolute tolerance [rad and rad/s]
 C_H_MAX = 30  # adaptive: largest step [s]
@@ -87,7 +84,7 @@ Y_J22 = 11  # tangent: d theta'(t) / d theta'(t_k)
 Y_DIV = 12  # tangent: integral of the divergence d theta''/d theta' since t_k [-]
 Y_SIZE = 13
 
-# --- status codes (mirrors chaoscam.integrate.Status) ------------------------------------
+# --- status codes (mirrors chaoscam.kernel.Status) ---------------------------------------
 OK = 0
 NEED_BUFFER = 1
 LEFT_REACH = 2
@@ -129,9 +126,7 @@ INV_TWO_PI = 0.15915494309189535
 DEKKER_SPLIT = 134217729.0  # 2^27 + 1: splits a double into two halves of 26 bits (Dekker)
 
 # --- the adaptive path's tangent -----------------------------------------------------------
-# Largest h |A| of an RK4 substep of the tangent along an accepted DOP853 step, |A| the
-# largest of sqrt|d theta''/d theta| and |d theta''/d theta'| at the step's start, middle and
-# end. The sticking period 1 at e = 0.02 m (whose multiplier is a difference of two close
-# entries of J) gives 0.00381, 0.004153, 0.004154 at 0.1, 0.02, 0.005: 0.02 is converged to
-# ~2e-4 relative. One RK4 step per DOP853 step gave 6.8e-6 there, and lambda_1 = -22 1/s.
+# Largest h |A| of an RK4 substep of the tangent along an accepted DOP853 step, |A| the largest
+# of sqrt|d theta''/d theta| and |d theta''/d theta'| at its start, middle and end: 0.02 gives
+# the sticking period-1 multiplier at e = 0.02 m converged to ~2e-4 relative.
 TANGENT_STEP_RATE = 0.02

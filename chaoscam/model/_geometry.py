@@ -58,7 +58,7 @@ def cam_angle(p: Params, t):
     at e = 0.04 m), the height of the last bounces of a chattering sequence; so the product
     is kept exactly as a sum of two doubles and 2 pi taken off in double-double arithmetic
     (for any |theta_c| below 1e15 rad). The kernels compute the same angle by Cody & Waite's
-    reduction (``chaoscam.integrate._physics.cam_angle``); the tests compare the two.
+    reduction (``chaoscam.kernel._physics.cam_angle``); the tests compare the two.
     """
     t = np.asarray(t, dtype=float)
     prod, err = _two_product(float(p.omega), t)
@@ -121,10 +121,8 @@ def contact_angle_rate(p: Params, t):
 
 
 def slip_speed(p: Params, t, theta_f, omega_f):
-    """Slip speed v_r = r dtheta_f/dt - (omega z x B_c).u at B_c = C + R n [m/s].
-
-    B_c is the cam's surface point facing the rod (MODEL.md; an earlier version used C - R n).
-    """
+    """Slip speed v_r = r dtheta_f/dt - (omega z x B_c).u [m/s] at B_c = C + R n, the cam's
+    surface point facing the rod (MODEL.md)."""
     (cx, cy), _ = cam_centre(p, t)
     nx, ny = -np.sin(theta_f), np.cos(theta_f)
     bx, by = cx + p.R * nx, cy + p.R * ny
@@ -136,8 +134,7 @@ def contact_period(p: Params, l_lambda: float | None = None) -> float:
 
     Evaluated at the initial contact's lever arm; the RK4 step should resolve it with ~20 or
     more steps, and the adaptive path's cost grows as its inverse square
-    (:func:`chaoscam._budget.adaptive_seconds`).
-    """
+    (:func:`chaoscam.simulation._budget.adaptive_seconds`)."""
     if not isinstance(p, Params):
         raise TypeError(f"p must be a chaoscam Params, got {type(p).__name__}")
     if l_lambda is None:

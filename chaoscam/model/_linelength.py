@@ -20,7 +20,7 @@ def realizations_identical(p: Params) -> bool:
     """True when every realization of ``p`` is the same run, so the model is deterministic:
     ``l_lambda_sigma = 0`` (every line is mu long), or ``stiffness = "fractal"``, whose K_n
     (15)/(17) does not depend on the line length, the only place the line length enters the
-    motion (``integrate._physics.stiffness``). A sweep runs such a model once, and its
+    motion (``chaoscam.kernel._physics.stiffness``). A sweep runs such a model once, and its
     periodic orbits can be certified by shooting."""
     return p.l_lambda_sigma == 0.0 or p.stiffness == "fractal"
 

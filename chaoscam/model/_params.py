@@ -14,7 +14,7 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import Any
 
-from .._util import NON_NEGATIVE, POSITIVE, check_fields, parse_field, strict_init
+from .._util import NON_NEGATIVE, check_fields, parse_field, strict_init
 from .._util import meta as _meta
 
 __all__ = ["FIELD_DOCS", "Params", "field_names", "params_arg", "parse_value"]
@@ -24,7 +24,6 @@ STIFFNESS_MODELS = ("hertz", "fractal")
 DAMPING_FORMS = ("hunt_crossley", "paper_literal")
 RESAMPLE_MODES = ("contact", "impact", "interval")
 
-_POS = POSITIVE
 _NONNEG = NON_NEGATIVE
 
 
@@ -64,187 +63,89 @@ class Params:
     g: float = field(default=9.81, metadata=_meta("gravity", "m/s^2", _NONNEG))
     mu_f: float = field(default=0.3, metadata=_meta("friction coefficient", "-", _NONNEG))
     beta: float = field(default=3.25, metadata=_meta("impact damping factor", "s/m", _NONNEG))
-    xi: float = field(
-        default=0.42,
-        metadata=_meta("coefficient of restitution, eq. (4)", "-", (0.0, 1.0, True, True)),
-    )
-    omega: float = field(
-        default=28.7,
-        metadata=_meta(
-            "cam speed (practical bound: 1e4 rad/s, ~95,000 rpm)", "rad/s", (0.0, 1e4, False, True)
-        ),
-    )
-    l_lambda: float = field(
-        default=0.008,
-        metadata=_meta("contact line length l_lambda, the mean mu when random, eq. (18)", "m"),
-    )
-    D: float = field(
-        default=1.45,
-        metadata=_meta("fractal dimension, eq. (15)", "-", (1.0, 2.0, False, False)),
-    )
+    xi: float = field(default=0.42, metadata=_meta(
+        "coefficient of restitution, eq. (4)", "-", (0.0, 1.0, True, True)))  # fmt: skip
+    omega: float = field(default=28.7, metadata=_meta(
+        "cam speed (practical bound: 1e4 rad/s, ~95,000 rpm)", "rad/s",
+        (0.0, 1e4, False, True)))  # fmt: skip
+    l_lambda: float = field(default=0.008, metadata=_meta(
+        "contact line length l_lambda, the mean mu when random, eq. (18)", "m"))  # fmt: skip
+    D: float = field(default=1.45, metadata=_meta(
+        "fractal dimension, eq. (15)", "-", (1.0, 2.0, False, False)))  # fmt: skip
     G: float = field(default=1e-10, metadata=_meta("fractal roughness, eq. (15)", "m"))
     k: float = field(default=2.8, metadata=_meta("hardness/yield-strength ratio", "-"))
     phi: float = field(default=0.01, metadata=_meta("yield-strength/modulus ratio", "-"))
     A_r: float = field(default=1e-5, metadata=_meta("real contact area", "m^2"))
 
     # --- Decisions: geometry and inertia -------------------------------------------------
-    J: float | None = field(
-        default=None,
-        metadata=_meta(
-            "follower moment of inertia about the pivot; None = m (l^2/3 + r^2/4), a solid "
-            "rod about a transverse axis through its end (decision)",
-            "kg m^2",
-        ),
-    )
-    x_O: float = field(
-        default=-0.5,
-        metadata=_meta(
-            "pivot x, cam rotation centre at the origin (decision; practical bound 100 m)",
-            "m",
-            (-100.0, 100.0, True, True),
-        ),
-    )
-    y_O: float | None = field(
-        default=None,
-        metadata=_meta(
-            "pivot y; None = R + r, so the rod is horizontal when touching the cam with the "
-            "cam centre on the x axis (decision; practical bound 100 m)",
-            "m",
-            (-100.0, 100.0, True, True),
-        ),
-    )
-    theta_c0: float = field(
-        default=0.0,
-        metadata=_meta(
-            "cam phase at t = 0 (decision); restarts carry the accumulated phase omega t, so "
-            "the practical bound is wide: 1e9 rad (sin keeps ~1e-7 rad there)",
-            "rad",
-            (-1e9, 1e9, True, True),
-        ),
-    )
-    theta_f0: float | None = field(
-        default=None,
-        metadata=_meta(
-            "initial follower angle; None = theta_fc(0), in contact (decision, paper sec. 2)",
-            "rad",
-            (-2 * math.pi, 2 * math.pi, True, True),
-        ),
-    )
-    omega_f0: float | None = field(
-        default=None,
-        metadata=_meta(
-            "initial follower angular velocity; None = d(theta_fc)/dt at t = 0 (decision)",
-            "rad/s",
-            (-1e4, 1e4, True, True),
-        ),
-    )
+    J: float | None = field(default=None, metadata=_meta(
+        "follower moment of inertia about the pivot; None = m (l^2/3 + r^2/4), a solid rod "
+        "about a transverse axis through its end (decision)", "kg m^2"))  # fmt: skip
+    x_O: float = field(default=-0.5, metadata=_meta(
+        "pivot x, cam rotation centre at the origin (decision; practical bound 100 m)", "m",
+        (-100.0, 100.0, True, True)))  # fmt: skip
+    y_O: float | None = field(default=None, metadata=_meta(
+        "pivot y; None = R + r, so the rod is horizontal when touching the cam with the cam "
+        "centre on the x axis (decision; practical bound 100 m)", "m",
+        (-100.0, 100.0, True, True)))  # fmt: skip
+    theta_c0: float = field(default=0.0, metadata=_meta(
+        "cam phase at t = 0 (decision); restarts carry the accumulated phase omega t, so the "
+        "practical bound is wide: 1e9 rad (sin keeps ~1e-7 rad there)", "rad",
+        (-1e9, 1e9, True, True)))  # fmt: skip
+    theta_f0: float | None = field(default=None, metadata=_meta(
+        "initial follower angle; None = theta_fc(0), in contact (decision, paper sec. 2)", "rad",
+        (-2 * math.pi, 2 * math.pi, True, True)))  # fmt: skip
+    omega_f0: float | None = field(default=None, metadata=_meta(
+        "initial follower angular velocity; None = d(theta_fc)/dt at t = 0 (decision)", "rad/s",
+        (-1e4, 1e4, True, True)))  # fmt: skip
 
     # --- Decisions: contact force, friction, impacts -------------------------------------
-    stiffness: str = field(
-        default="hertz",
-        metadata=_meta(
-            "contact stiffness model: 'hertz' line contact (18) or 'fractal' joint (15)/(17)",
-            "-",
-            None,
-            STIFFNESS_MODELS,
-        ),
-    )
-    damping: str = field(
-        default="hunt_crossley",
-        metadata=_meta(
-            "contact damping: 'hunt_crossley' F = K p (1 + beta dp/dt) (default), or "
-            "'paper_literal' F = -K d - beta K d dd/dt, whose damping feeds energy in on "
-            "restitution; kept for reproduction only (decision). Both are clamped at "
-            "F >= 0: a contact pushes, never pulls",
-            "-",
-            None,
-            DAMPING_FORMS,
-        ),
-    )
-    friction_arm: float | None = field(
-        default=None,
-        metadata=_meta(
-            "arm of the friction force about the pivot; None = r, the rod radius "
-            "(decision: (1) writes a force where a torque belongs)",
-            "m",
-            _NONNEG,
-        ),
-    )
-    v_eps: float = field(
-        default=1e-4,
-        metadata=_meta(
-            "slip-speed scale of the regularised sign, sgn(v) ~ tanh(v / v_eps); 0 = exact "
-            "sign. Decision: keeps the right-hand side smooth for RK4; slips are 1.4-3.8 m/s "
-            "in contact at the defaults, far from 0",
-            "m/s",
-            _NONNEG,
-        ),
-    )
-    v_min: float = field(
-        default=0.0,
-        metadata=_meta(
-            "least approach speed -d(delta)/dt for which the restitution jump (4) is applied; "
-            "slower closings are left to the compliant force. Default 0: the law applies at "
-            "every closing (MODEL.md: a positive v_min lets slow closings rebound almost "
-            "elastically, the sticking phase rattles and the flight amplifies it into bands "
-            "that grow with v_min; the model is the limit v_min -> 0)",
-            "m/s",
-            _NONNEG,
-        ),
-    )
-    v_chatter: float = field(
-        default=1e-6,
-        metadata=_meta(
-            "approach speed below which a closing is taken as the end of a complete "
-            "chattering sequence and replaced by its accumulation point, a plastic closure "
-            "(gap rate 0; Nordmark & Piiroinen 2009). Bounces slower than this last "
-            "< 2 xi v / ((1 - xi) |delta''|) ~ 1e-7 s in all; 0 = simulate every bounce "
-            "(Zeno: the count then depends on dt). Measured convergence: docs/verdicts.md",
-            "m/s",
-            _NONNEG,
-        ),
-    )
-    v_micro: float = field(
-        default=1e-2,
-        metadata=_meta(
-            "approach speed below which an applied impact is micro (in a chattering "
-            "sequence), not macro (the fast impacts after a flight, ~0.05-1 m/s): a label, "
-            "and under resample = 'contact' the start of a new contact's line",
-            "m/s",
-            _NONNEG,
-        ),
-    )
+    stiffness: str = field(default="hertz", metadata=_meta(
+        "contact stiffness model: 'hertz' line contact (18) or 'fractal' joint (15)/(17)", "-",
+        None, STIFFNESS_MODELS))  # fmt: skip
+    damping: str = field(default="hunt_crossley", metadata=_meta(
+        "contact damping: 'hunt_crossley' F = K p (1 + beta dp/dt) (default), or "
+        "'paper_literal' F = -K d - beta K d dd/dt, whose damping feeds energy in on "
+        "restitution; kept for reproduction only (decision). Both are clamped at F >= 0: a "
+        "contact pushes, never pulls", "-", None, DAMPING_FORMS))  # fmt: skip
+    friction_arm: float | None = field(default=None, metadata=_meta(
+        "arm of the friction force about the pivot; None = r, the rod radius (decision: (1) "
+        "writes a force where a torque belongs)", "m", _NONNEG))  # fmt: skip
+    v_eps: float = field(default=1e-4, metadata=_meta(
+        "slip-speed scale of the regularised sign, sgn(v) ~ tanh(v / v_eps); 0 = exact sign. "
+        "Decision: keeps the right-hand side smooth for RK4; slips are 1.4-3.8 m/s in contact "
+        "at the defaults, far from 0", "m/s", _NONNEG))  # fmt: skip
+    v_min: float = field(default=0.0, metadata=_meta(
+        "least approach speed -d(delta)/dt for which the restitution jump (4) is applied; "
+        "slower closings are left to the compliant force. Default 0: the law applies at every "
+        "closing (MODEL.md: a positive v_min lets slow closings rebound almost elastically, the "
+        "sticking phase rattles and the flight amplifies it into bands that grow with v_min; "
+        "the model is the limit v_min -> 0)", "m/s", _NONNEG))  # fmt: skip
+    v_chatter: float = field(default=1e-6, metadata=_meta(
+        "approach speed below which a closing is taken as the end of a complete chattering "
+        "sequence and replaced by its accumulation point, a plastic closure (gap rate 0; "
+        "Nordmark & Piiroinen 2009). Bounces slower than this last < 2 xi v / ((1 - xi) "
+        "|delta''|) ~ 1e-7 s in all; 0 = simulate every bounce (Zeno: the count then depends "
+        "on dt). Measured convergence: docs/verdicts.md", "m/s", _NONNEG))  # fmt: skip
+    v_micro: float = field(default=1e-2, metadata=_meta(
+        "approach speed below which an applied impact is micro (in a chattering sequence), "
+        "not macro (the fast impacts after a flight, ~0.05-1 m/s): a label, and under "
+        "resample = 'contact' the start of a new contact's line", "m/s", _NONNEG))  # fmt: skip
 
     # --- Decisions: random contact-line length (section 2.5) -----------------------------
-    l_lambda_sigma: float = field(
-        default=0.0,
-        metadata=_meta(
-            "standard deviation sigma of the contact-line length; 0 = deterministic", "m", _NONNEG
-        ),
-    )
-    l_min: float = field(
-        default=1e-4,
-        metadata=_meta(
-            "lower truncation of the line-length normal, which must stay positive (decision)",
-            "m",
-        ),
-    )
-    resample: str = field(
-        default="contact",
-        metadata=_meta(
-            "when a new line length is drawn: at each macro impact ('contact', default: each "
-            "contact has its own line), at every applied jump ('impact': micro-impacts too, "
-            "whose count changes with dt, and the draws with it; docs/model.md), or every "
-            "resample_dt ('interval', the paper's Fig. 3)",
-            "-",
-            None,
-            RESAMPLE_MODES,
-        ),
-    )
-    resample_dt: float = field(
-        default=0.01,
-        metadata=_meta("interval between draws when resample = 'interval'", "s"),
-    )
+    l_lambda_sigma: float = field(default=0.0, metadata=_meta(
+        "standard deviation sigma of the contact-line length; 0 = deterministic", "m",
+        _NONNEG))  # fmt: skip
+    l_min: float = field(default=1e-4, metadata=_meta(
+        "lower truncation of the line-length normal, which must stay positive (decision)",
+        "m"))  # fmt: skip
+    resample: str = field(default="contact", metadata=_meta(
+        "when a new line length is drawn: at each macro impact ('contact', default: each "
+        "contact has its own line), at every applied jump ('impact': micro-impacts too, whose "
+        "count changes with dt, and the draws with it; docs/model.md), or every resample_dt "
+        "('interval', the paper's Fig. 3)", "-", None, RESAMPLE_MODES))  # fmt: skip
+    resample_dt: float = field(default=0.01, metadata=_meta(
+        "interval between draws when resample = 'interval'", "s"))  # fmt: skip
 
     # ------------------------------------------------------------------------------------
     def __post_init__(self) -> None:

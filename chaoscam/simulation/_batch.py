@@ -1,22 +1,14 @@
-"""One batch of members through the compiled kernel: set up (at t = 0 or from a kept copy),
-run on the CPU's threads or a GPU, collected as arrays.
+"""One batch of members through the compiled kernel: set up at t = 0 or from a kept copy, run on
+the CPU's threads or a GPU, collected as arrays (for :func:`chaoscam.solve` and the orbit
+shooting). A batch's members share ``dt`` and ``omega`` (grid and section times); each is a pure
+function of its model, numerics and ``(seed, index)``, whatever the batch, pauses or threads.
 
-:func:`chaoscam.solve` cuts its members into batches and runs each here; the periodic-orbit
-shooting runs its map iterates here too. The members of a batch share ``dt`` and ``omega``
-(the grid and the section times). Each member is a pure function of its model, its numerics
-and its realization ``(seed, index)``: how a batch is cut, how often a member stops to have
-its buffers emptied and its draws renewed, and on how many threads it runs change no bit.
-
-**Continuing bit for bit.** The fixed-step kernel resumes bit-identically at any grid step
-where it stopped to hand back a buffer, but not quite at its end step: a block of proven
-flight (up to ``flight_merge`` grid steps in one RK4 step) is cut short there, where a
-longer run takes it whole. No block crosses a stroboscopic section, though: the kernel ends
-each one at most at the grid step before the section time k T. So a resumable run stops
-once more, at the grid step N = floor(k T / dt) of its last section before its end
-(:func:`snapshot_step`), keeps a copy of its state there (:class:`Resume`) and goes on to
-its end; a continuation starts from the copy and records again from that section on. Only
-the fixed-step kernel: the adaptive one shortens its last step to land on the end time, so
-its runs are run again instead.
+**Continuing bit for bit.** RK4 resumes bit-identically at any hand-back, but its end step cuts
+short a block of proven flight (up to ``flight_merge`` grid steps in one RK4 step) that a longer
+run takes whole. No block crosses a section, so a resumable run stops once more at the grid step
+N = floor(k T / dt) of its last section before the end (:func:`snapshot_step`), keeps a copy
+(:class:`Resume`) and goes on; a continuation records again from that section. RK4 only: the
+adaptive kernel shortens its last step onto the end time.
 """
 
 from __future__ import annotations
@@ -50,11 +42,9 @@ OUTPUTS = ("section", "impacts", "series")
 """The kernel's outputs, in the order a :class:`Batch` keeps them."""
 
 ROOM = {"cpu": (2048, 2048), "gpu": (512, 256)}
-"""Room per member and launch, on each backend: (line-length draws, impact rows). Impact
-rows are used only when impacts are kept; otherwise the kernel counts the impacts in a buffer
-of no rows and a member stops only when its draws run out. Every stop is a relaunch, where
-the CPU's threads wait for the slowest member: 2048 of each cost 144 KiB a member. The GPU
-keeps a small room: its batches hold tens of thousands of members."""
+"""Room per member and launch on each backend: (line-length draws, impact rows; used only when
+impacts are kept, else counted). Every stop is a relaunch, where the CPU's threads wait for the
+slowest member; 2048 of each cost 144 KiB a member. A GPU batch holds tens of thousands."""
 
 SERIES_ROWS = 4096
 """Rows of a member's series buffer between two hand-backs (when a series is kept)."""
@@ -63,8 +53,8 @@ _COLS = {"section": k.SECTION_COLS, "impacts": k.IMPACT_COLS, "series": k.SERIES
 
 
 def snapshot_step(num: Numerics, p: Params, n_stop: int) -> int | None:
-    """The grid step N = floor(k T / dt) of the last section time k T before step ``n_stop``
-    (k >= 0), where a resumable run keeps its copy; None for the adaptive integrator."""
+    """The grid step N = floor(k T / dt) of the last section time k T (k >= 0) before step
+    ``n_stop``, where a resumable run keeps its copy; None for the adaptive integrator."""
     if num.integrator != "rk4":
         return None
     t_end = n_stop * num.dt
@@ -76,8 +66,8 @@ def snapshot_step(num: Numerics, p: Params, n_stop: int) -> int | None:
 
 @dataclass(frozen=True)
 class Resume:
-    """Each member's state at grid step ``step`` (t = step dt), from which
-    :func:`chaoscam.extend` continues it; one entry per member, in the solution's order.
+    """Each member's state at grid step ``step`` (t = step dt), from which :func:`chaoscam.extend`
+    continues it; one entry per member, in the solution's order.
 
     Attributes
     ----------
@@ -86,17 +76,14 @@ class Resume:
     y, cnt, c : ndarray
         State (members, Y_SIZE), counters (members, N_COUNTERS; the buffers' row counts and
         the draw position zeroed) and constants (members, N_CONSTANTS) there.
-    draws : tuple of ndarray
-        Each member's line-length draws not yet used, in order.
-    streams : tuple of LineLengthStream
-        Each member's stream after those draws (never drawn from: copied before use).
+    draws, streams : tuple
+        Each member's line-length draws not yet used, in order, and its LineLengthStream after
+        them (never drawn from: copied before use).
     kept : dict
         For each output of :data:`OUTPUTS`, each member's rows recorded before ``step``.
-    n_impacts : ndarray of int
-        Impacts each member applied after the transient and before ``step``.
-    status : ndarray of int
-        Each member's status code there: ``OK`` to go on, else the code it ended with
-        before ``step``: it is not continued.
+    n_impacts, status : ndarray of int
+        Each member's impacts after the transient and before ``step``, and its status code
+        there: ``OK`` to go on, else the code it ended with (not continued).
     """
 
     step: int
@@ -116,16 +103,11 @@ class Resume:
         """The entries of members ``picks`` (positions), in that order."""
         picks = [int(j) for j in picks]
         return Resume(
-            self.step,
-            self.y[picks],
-            self.cnt[picks],
-            self.c[picks],
-            tuple(self.draws[j] for j in picks),
-            tuple(self.streams[j] for j in picks),
+            self.step, self.y[picks], self.cnt[picks], self.c[picks],
+            tuple(self.draws[j] for j in picks), tuple(self.streams[j] for j in picks),
             {name: tuple(rows[j] for j in picks) for name, rows in self.kept.items()},
-            self.n_impacts[picks],
-            self.status[picks],
-        )
+            self.n_impacts[picks], self.status[picks],
+        )  # fmt: skip
 
     @staticmethod
     def join(parts: list[Resume]) -> Resume:
@@ -133,16 +115,12 @@ class Resume:
         if len({r.step for r in parts}) != 1:
             raise ValueError("only copies taken at one step can be joined")
         return Resume(
-            parts[0].step,
-            np.concatenate([r.y for r in parts]),
-            np.concatenate([r.cnt for r in parts]),
-            np.concatenate([r.c for r in parts]),
-            sum((r.draws for r in parts), ()),
-            sum((r.streams for r in parts), ()),
+            parts[0].step, np.concatenate([r.y for r in parts]),
+            np.concatenate([r.cnt for r in parts]), np.concatenate([r.c for r in parts]),
+            sum((r.draws for r in parts), ()), sum((r.streams for r in parts), ()),
             {name: sum((r.kept[name] for r in parts), ()) for name in OUTPUTS},
-            np.concatenate([r.n_impacts for r in parts]),
-            np.concatenate([r.status for r in parts]),
-        )
+            np.concatenate([r.n_impacts for r in parts]), np.concatenate([r.status for r in parts]),
+        )  # fmt: skip
 
 
 @dataclass
@@ -162,9 +140,9 @@ class Start:
 
 @dataclass
 class Batch:
-    """A finished batch: each member's rows (``kept[name][j]``, the kernel's columns; the
-    impacts and series only when kept), its final arrays, status and impact count, and the
-    copy taken on the way (None unless resumable)."""
+    """A finished batch: each member's rows (``kept[name][j]``, the kernel's columns; impacts
+    and series only when kept), final arrays, status, impact count and copy (None unless
+    resumable)."""
 
     first: int
     indices: list[int]
@@ -191,9 +169,8 @@ def _per_member(make, plist) -> np.ndarray:
     return np.stack([done[id(p)] for p in plist])
 
 
-def _margin(plist, num: Numerics) -> int:
+def _margin(num: Numerics) -> int:
     """Rows and draws one grid step may use beyond the room (events, a merged flight)."""
-    del plist
     return 4 * (num.max_events_per_step + num.flight_merge + 2)
 
 
@@ -204,7 +181,7 @@ def _n_draws(plist, num: Numerics, duration: float, room: int) -> int:
     def draws(p: Params) -> int:
         return int(duration / p.resample_dt) + 64 if p.resample == "interval" else room
 
-    return max(draws(p) for p in models_of(plist)) + _margin(plist, num)
+    return max(draws(p) for p in models_of(plist)) + _margin(num)
 
 
 def fresh(plist, num, indices, seed, duration, transient, *, tangent, stride, room) -> Start:
@@ -250,29 +227,19 @@ def resumed(res: Resume, plist, num, duration: float, room, *, series: bool) -> 
 
 
 def run_batch(
-    plist,
-    num: Numerics,
-    indices,
-    start: Start,
-    first: int,
-    duration: float,
-    *,
-    room,
-    gpu: bool = False,
-    keep_impacts: bool = False,
-    resumable: bool = False,
-) -> Batch:
-    """Run one batch of members from ``start`` to ``duration`` and collect its outputs;
-    ``room`` = (draws, impact rows) per member and launch (:data:`ROOM`). With ``resumable``
-    (RK4) the run stops once more on the way, at :func:`snapshot_step`, and keeps its copy
-    there (:class:`Resume`)."""
+    plist, num: Numerics, indices, start: Start, first: int, duration: float, *, room,
+    gpu: bool = False, keep_impacts: bool = False, resumable: bool = False,
+) -> Batch:  # fmt: skip
+    """Run one batch of members from ``start`` to ``duration`` and collect its outputs; ``room``
+    = (draws, impact rows) per member and launch (:data:`ROOM`). With ``resumable`` (RK4) the
+    run stops once more, at :func:`snapshot_step`, and keeps its copy there (:class:`Resume`)."""
     n, p0 = len(plist), plist[0]
     n_stop = int(round(duration / num.dt))
     n_sec = int((duration - start.step * num.dt) / p0.cam_period) + 4 + int(num.dt / p0.cam_period)
     y, cnt, c, lam, streams = start.y, start.cnt, start.c, start.lam, start.streams
     stride = int(c[0, k.C_STRIDE])
     section = np.empty((n, n_sec, k.SECTION_COLS))
-    impacts = np.empty((n, room[1] + _margin(plist, num) if keep_impacts else 0, k.IMPACT_COLS))
+    impacts = np.empty((n, room[1] + _margin(num) if keep_impacts else 0, k.IMPACT_COLS))
     series = np.empty((n, _series_rows(num, stride), k.SERIES_COLS))
     buffers = {"section": section, "impacts": impacts, "series": series}
     counts = {"section": k.I_N_SECTION, "impacts": k.I_N_IMPACT, "series": k.I_N_SERIES}
@@ -291,8 +258,8 @@ def run_batch(
             cnt[j, counts[name]] = 0
 
     def hand_back(j: int, lam_j: np.ndarray, n_new: int) -> np.ndarray:
-        """Empty member j's impact and series rows; its draws with the used ones dropped and
-        ``n_new`` appended. The section buffer holds the whole run (on a GPU, the device's)."""
+        """Empty member j's impact and series rows; its draws, used ones dropped and ``n_new``
+        appended. The section buffer holds the whole run (on a GPU, the device's)."""
         flush(j, ("impacts", "series"))
         pos = cnt[j, k.I_LAM_POS]
         cnt[j, k.I_LAM_POS] = 0
@@ -350,12 +317,10 @@ def _copy(step, y, cnt, c, lam, streams, kept, n_impacts, status) -> Resume:
 
 
 def run_on_cpu(y, cnt, c, n_stop, lam, series, section, impacts, status, hand_back) -> None:
-    """The members in calls of the driver's loop: those whose ``status`` is ``NEED_BUFFER``
-    first (every member of a fresh batch), then those that asked for room, refilled (a
-    resumed member is bit-identical to one that was not interrupted, so the pauses change
-    nothing); the others keep their code. One member, or any inside
-    :func:`chaoscam.kernel.members_on_this_thread`, runs on the calling thread; more run in
-    parallel over numba's threads."""
+    """The members whose ``status`` is ``NEED_BUFFER`` through the driver's loop
+    (:func:`chaoscam.kernel.drive_members`), refilled as they ask; the others keep their code.
+    One member, or any inside :func:`chaoscam.kernel.members_on_this_thread`, runs on the
+    calling thread, more in parallel over numba's threads."""
     if on_this_thread() or y.shape[0] == 1:
         launch = _one_by_one(y, cnt, c, n_stop, lam, series, section, impacts, status)
     else:
@@ -369,8 +334,8 @@ def run_on_cpu(y, cnt, c, n_stop, lam, series, section, impacts, status, hand_ba
 
 
 def _one_by_one(y, cnt, c, n_stop, lam, series, section, impacts, status):
-    """A launch of the members ``need`` on this thread, each through the compiled nogil call
-    on its rows in place (the same kernel as the parallel launch)."""
+    """A launch of the members ``need`` on this thread, each through the nogil call on its rows
+    in place (the same kernel as the parallel launch)."""
     run = alone_kernel(c)
 
     def launch(need: np.ndarray) -> np.ndarray:
@@ -409,7 +374,6 @@ def _in_parallel(y, cnt, c, n_stop, lam, series, section, impacts, status):
 
 
 PARALLEL_LOCK = threading.Lock()
-"""Held by every launch on numba's threads: the fork-safe workqueue threading layer aborts
-the process when two Python threads launch parallel kernels at once ("Concurrent access has
-been detected"); with the lock they take turns. The sweeps' batch threads run members one by
-one and a GPU's launches need no CPU threads, so it guards a user's own threads."""
+"""Held by every launch on numba's threads: the workqueue layer aborts the process when two
+Python threads launch parallel kernels at once ("Concurrent access has been detected"). The
+sweeps' batch threads run members one by one, so it guards a user's own threads."""

@@ -1,24 +1,13 @@
 """Memory and time of a job, estimated before it starts: refuse what cannot fit, warn about hours.
 
-The estimates are coarse upper-side guesses, meant to catch absurd requests (a duration of
-1e9 s, a series sampled every microsecond for minutes, a billion realizations, an inertia
-so small that the adaptive steps shrink to picoseconds), not to predict run times:
-
-* memory: 8 bytes per number kept — the series (``(duration - transient) / output_dt``
-  rows of 4 columns, 8 in the table written), the stroboscopic section (one row of 5 per cam
-  period after the transient) and twice that for the table built from them;
-* time, fixed-step RK4: :data:`NS_PER_STEP` per grid step ``dt`` (measured on the default
-  model, 2-core machine: 8-65 ns a step from periodic to chaotic responses and without
-  flight merging) and :data:`NS_PER_SERIES_ROW` per series row kept, divided among the
-  workers;
-* time, adaptive path: the larger of that and the cost of following the contact,
-  :func:`adaptive_seconds` (its formula and measurements are there).
-
-A job whose memory exceeds what this machine has available is refused with a
-:class:`~chaoscam.model.ParameterError` naming the setting to reduce; one estimated to take
-more than :data:`WARN_SECONDS` gets a warning with the estimate. One run (a realization) is
-judged on its own too (:func:`check_run`): refused beyond :data:`RUN_REFUSE_SECONDS`, warned
-about beyond :data:`RUN_WARN_SECONDS`, naming the fields that set its cost.
+Coarse upper-side guesses that catch absurd requests (a duration of 1e9 s, a series sampled every
+microsecond for minutes, a billion realizations, adaptive steps shrunk to picoseconds by a tiny
+inertia), not predictions: memory at 8 bytes per number kept (series and section rows and their
+tables), time at :data:`NS_PER_STEP` per step and :data:`NS_PER_SERIES_ROW` per series row over
+the workers, adaptive at least :func:`adaptive_seconds`. A job past the memory available is
+refused (:class:`~chaoscam.model.ParameterError` naming the setting to reduce), one past
+:data:`WARN_SECONDS` warned about; one run is refused past :data:`RUN_REFUSE_SECONDS` and warned
+about past :data:`RUN_WARN_SECONDS` (:func:`check_run`).
 """
 
 from __future__ import annotations
@@ -29,24 +18,15 @@ import os
 from .._util import ParameterError, warn
 
 __all__ = [
-    "WARN_SECONDS",
-    "human_bytes",
-    "human_seconds",
-    "estimate",
-    "check_budget",
-    "check_run",
-    "run_seconds",
-    "adaptive_seconds",
-    "available_memory",
-    "JobEstimate",
-]
+    "WARN_SECONDS", "human_bytes", "human_seconds", "estimate", "check_budget", "check_run",
+    "run_seconds", "adaptive_seconds", "available_memory", "JobEstimate",
+]  # fmt: skip
 
 NS_PER_STEP = 40.0
-"""Wall time of one grid step [ns] used for the estimate (measured 8-65 ns)."""
+"""Wall time of one grid step [ns] (8-65 ns on the default model, periodic to chaotic)."""
 
 NS_PER_SERIES_ROW = 2000.0
-"""Wall time of one series row [ns]: the table built from the kernel's samples and its file
-(measured 1.2-1.6 us to build, 0.4 us to write to Parquet)."""
+"""Wall time of one series row [ns]: its table row (1.2-1.6 us) and Parquet write (0.4 us)."""
 
 WARN_SECONDS = 3600.0
 """Jobs estimated to take longer than this get a warning [s]."""
@@ -59,15 +39,14 @@ RUN_REFUSE_SECONDS = 2 * 3600.0
 
 ADAPTIVE_COST = 1e-9
 """Adaptive path in persistent contact: wall seconds per model second times T_c^2 [s^2]
-(measured 0.9e-10 to 2.1e-9 at rtol = 1e-12; see :func:`adaptive_seconds`)."""
+(0.9e-10 to 2.1e-9 at rtol = 1e-12, :func:`adaptive_seconds`)."""
 
 ADAPTIVE_RTOL_EXPONENT = 0.6
-"""How the adaptive path's cost in contact scales with 1 / rtol (measured 0.6 from
-rtol = 1e-13 to 1e-8)."""
+"""Exponent of 1 / rtol in the adaptive path's cost in contact (0.6 from rtol 1e-13 to 1e-8)."""
 
 ADAPTIVE_FLIGHT_SHARE = 0.1
-"""Cost of a response with flights relative to one in persistent contact (measured 0.006 to
-0.35: contact fractions 0.002 to 0.5)."""
+"""Cost of a response with flights relative to persistent contact (0.006-0.35 at contact
+fractions 0.002-0.5)."""
 
 SERIES_BYTES_PER_ROW = 8 * 8  # the kernel's 4 columns and the 8 of the written table
 SECTION_BYTES_PER_ROW = 3 * 5 * 8  # the kernel's buffer, the table and its copy
@@ -101,17 +80,9 @@ def available_memory() -> float:
 
 
 def estimate(
-    params,
-    num,
-    *,
-    duration: float,
-    transient: float = 0.0,
-    series: bool = False,
-    output_dt: float = 1e-3,
-    runs: float = 1,
-    in_memory: float = 1,
-    workers: int = 1,
-) -> JobEstimate:
+    params, num, *, duration: float, transient: float = 0.0, series: bool = False,
+    output_dt: float = 1e-3, runs: float = 1, in_memory: float = 1, workers: int = 1,
+) -> JobEstimate:  # fmt: skip
     """Estimated (bytes, seconds) of ``runs`` realizations, ``in_memory`` of them held at once."""
     kept = max(0.0, float(duration) - float(transient))
     rows = kept / params.cam_period
@@ -122,13 +93,10 @@ def estimate(
 
 
 def persistent_contact(params) -> bool:
-    """Whether gravity holds the follower on the cam: m g l / (2 J) >= e omega^2 / l_1.
-
-    The left side is the angular acceleration gravity gives the rod, the right the largest
-    the cam asks of it (its centre's acceleration e omega^2 over the lever arm l_1 of the
-    initial contact). Above it the follower rides the cam (contact fraction ~1, measured);
-    below it the response is flights and impacts (contact fractions 0.002-0.5, measured).
-    """
+    """Whether gravity holds the follower on the cam: m g l / (2 J) >= e omega^2 / l_1, the
+    rod's angular acceleration from gravity against the largest the cam asks of it (at the
+    initial contact's lever arm). Then the contact fraction is ~1; below, flights and impacts
+    give 0.002-0.5."""
     from ..model import contact_angle, lever_arm
 
     l1 = float(lever_arm(params, 0.0, contact_angle(params, 0.0)))
@@ -143,17 +111,12 @@ def adaptive_seconds(params, num, duration: float) -> float:
 
     with ``T_c = 2 pi sqrt(J / (K_n l_1^2))`` the contact's natural period
     (:func:`chaoscam.model.contact_period`) and ``s = 1`` in persistent contact
-    (:func:`persistent_contact`), else :data:`ADAPTIVE_FLIGHT_SHARE`. The error control
-    must resolve the contact oscillation, so its steps shrink with ``T_c``; measured on this
-    2-core machine, the cost per model second grows as ``1 / T_c^2`` (not ``1 / T_c``: the
-    accepted steps per contact period grow as the period shrinks) — ``t_wall T_c^2 /
-    duration`` stayed within 0.9e-10 to 2.1e-9 s^2 at rtol = 1e-12 over J = 1e-9 to 1e-2
-    kg m^2, the Hertz (l_lambda = 0.002-0.018 m) and fractal stiffness and omega = 15-28.7
-    rad/s in persistent contact, and within 6e-12 to 3.5e-10 s^2 for responses with flights
-    (default model: 1.4e-10). J = 1e-9 kg m^2 gives T_c = 1.4e-8 s and about 530 s per 1e-4 s
-    of model time (measured 85-110 s), where fixed-step RK4 leaves the model at once.
-    Limits: an order of magnitude either way; chattering between contact and micro-flights
-    can cost more.
+    (:func:`persistent_contact`), else :data:`ADAPTIVE_FLIGHT_SHARE`. The error control must
+    resolve the contact oscillation, and the cost per model second grows as ``1 / T_c^2`` (the
+    accepted steps per period grow as it shrinks): on 2 cores ``t_wall T_c^2 / duration`` is
+    0.9e-10 to 2.1e-9 s^2 at rtol = 1e-12 in persistent contact (J = 1e-9 to 1e-2 kg m^2, Hertz
+    and fractal stiffness, omega = 15-28.7 rad/s) and 6e-12 to 3.5e-10 s^2 with flights.
+    Limits: an order of magnitude either way; chattering can cost more.
     """
     from ..model import contact_period
 
@@ -169,29 +132,24 @@ def adaptive_seconds(params, num, duration: float) -> float:
 
 
 def run_seconds(params, num, duration: float, series_rows: float = 0.0) -> float:
-    """Estimated wall time [s] of one run of ``duration`` [s] keeping ``series_rows``: grid
-    steps at :data:`NS_PER_STEP` and rows at :data:`NS_PER_SERIES_ROW`, or for the adaptive
-    path the larger of that and :func:`adaptive_seconds`."""
+    """Estimated wall time [s] of one run of ``duration`` [s] keeping ``series_rows``: steps at
+    :data:`NS_PER_STEP`, rows at :data:`NS_PER_SERIES_ROW`, adaptive at least
+    :func:`adaptive_seconds`."""
     return max(_costs(params, num, duration, series_rows))
 
 
 def _steps(params, num, duration: float) -> tuple[float, str, str]:
-    """(the least number of steps a run takes, why, what shortens it): grid steps of dt, the
-    adaptive path's steps of at most h_max, and a step cut at every interval resampling."""
+    """(the least number of steps a run takes, why, what shortens it): steps of dt, adaptive
+    steps of at most h_max, a step cut at every interval resampling."""
     duration = float(duration)
     found = [(duration / num.dt, f"steps of dt = {num.dt:g} s", "raise dt")]
     if num.integrator == "adaptive":
-        found.append(
-            (duration / num.h_max, f"steps of at most h_max = {num.h_max:g} s", "raise h_max")
-        )
+        found.append((duration / num.h_max, f"steps of at most h_max = {num.h_max:g} s",
+                      "raise h_max"))  # fmt: skip
     if params.resample == "interval":
-        found.append(
-            (
-                duration / params.resample_dt,
-                f"line-length draws every resample_dt = {params.resample_dt:g} s",
-                "raise resample_dt",
-            )
-        )
+        found.append((duration / params.resample_dt,
+                      f"line-length draws every resample_dt = {params.resample_dt:g} s",
+                      "raise resample_dt"))  # fmt: skip
     return max(found)
 
 
@@ -203,22 +161,11 @@ def _costs(params, num, duration: float, series_rows: float = 0.0) -> tuple[floa
     return grid, adaptive_seconds(params, num, duration) if adaptive else 0.0
 
 
-def check_run(
-    params, num, duration: float, *, what: str = "one run", series_rows: float = 0.0
-) -> bool:
-    """Refuse one run estimated beyond :data:`RUN_REFUSE_SECONDS`, warn beyond
-    :data:`RUN_WARN_SECONDS`; the message names the fields that set the cost.
-
-    Returns
-    -------
-    bool
-        Whether it warned.
-
-    Raises
-    ------
-    ParameterError
-        For a run that would take hours.
-    """
+def check_run(params, num, duration: float, *, what: str = "one run",
+              series_rows: float = 0.0) -> bool:  # fmt: skip
+    """Refuse one run estimated beyond :data:`RUN_REFUSE_SECONDS` (a ParameterError), warn
+    beyond :data:`RUN_WARN_SECONDS`, naming the fields that set the cost; returns whether it
+    warned."""
     grid, contact = _costs(params, num, duration, series_rows)
     seconds = max(grid, contact)
     if seconds <= RUN_WARN_SECONDS:
@@ -253,7 +200,6 @@ def human_bytes(n: float) -> str:
         if n < 1024 or unit == "PiB":
             return f"{n:.3g} {unit}"
         n /= 1024.0
-    return f"{n:.3g} PiB"  # pragma: no cover
 
 
 def human_seconds(s: float) -> str:
@@ -269,8 +215,8 @@ def human_seconds(s: float) -> str:
 
 
 def check_budget(job: JobEstimate, *, what: str, reduce: str, run: tuple | None = None) -> None:
-    """Refuse a job that cannot fit in memory; judge one run of it (:func:`check_run`);
-    warn about a job that will take hours (unless its run was warned about already).
+    """Refuse a job that cannot fit in memory, judge one run of it (:func:`check_run`), warn
+    about a job that will take hours (unless its run was warned about already).
 
     Parameters
     ----------

@@ -1,10 +1,7 @@
-"""The one reader of trajectory files for every command (``classify``, ``report``).
-
-A trajectory file is what ``chaoscam simulate --out FILE.parquet`` (``Solution.to_parquet``
-of a one-member solution) writes. :func:`load_trajectory` rebuilds it (checking the metadata
-and columns), and :func:`read_trajectory` also refuses a file that holds too little data to
-classify, so every command accepts and refuses the same files with the same messages.
-"""
+"""The one reader of trajectory files (``Solution.to_parquet`` of a one-member solution, as
+``chaoscam simulate --out FILE.parquet`` writes them) for every command: :func:`load_trajectory`
+rebuilds one, checking its metadata and columns; :func:`read_trajectory` also refuses one too
+short to classify, so every command accepts and refuses the same files with the same messages."""
 
 from __future__ import annotations
 
@@ -29,12 +26,8 @@ from ._solution import (
 )
 
 __all__ = [
-    "MIN_POINTS",
-    "TrajectoryFileError",
-    "check_enough",
-    "load_trajectory",
-    "read_trajectory",
-]
+    "MIN_POINTS", "TrajectoryFileError", "check_enough", "load_trajectory", "read_trajectory",
+]  # fmt: skip
 
 MIN_POINTS = 16
 """Fewest section points or samples a verdict is asked from; fewer is "too little data"."""
@@ -48,8 +41,7 @@ SIMULATE_LONGER = "simulate longer, or keep more of the run after the transient"
 
 
 def check_enough(n: int, what: str, where: str | Path, hint: str = SIMULATE_LONGER) -> None:
-    """Refuse ``n`` < :data:`MIN_POINTS` rows of ``what`` in ``where``: too little data
-    (``hint``: what to do, for a simulated run by default)."""
+    """Refuse ``n`` < :data:`MIN_POINTS` rows of ``what`` in ``where`` (``hint``: what to do)."""
     if n < MIN_POINTS:
         raise TrajectoryFileError(
             f"{where}: too little data: {n} {what}, at least {MIN_POINTS} are needed for a "
@@ -58,12 +50,8 @@ def check_enough(n: int, what: str, where: str | Path, hint: str = SIMULATE_LONG
 
 
 def read_trajectory(path: str | Path, *, need_data: bool = True):
-    """A one-member :class:`chaoscam.Solution` from ``path``; :class:`TrajectoryFileError`
-    if not.
-
-    With ``need_data``, a file with fewer than :data:`MIN_POINTS` section points and series
-    samples is refused ("too little data").
-    """
+    """A one-member :class:`chaoscam.Solution` from ``path``, else :class:`TrajectoryFileError`
+    (with ``need_data``, also for fewer than :data:`MIN_POINTS` section points and samples)."""
     path = Path(path)
     try:
         traj = load_trajectory(path)
@@ -77,8 +65,8 @@ def read_trajectory(path: str | Path, *, need_data: bool = True):
 
 
 def _check_finite(path: Path, status: Status, tables) -> None:
-    """Refuse NaN or infinite times and states in a run that ended normally: chaoscam writes
-    none there, so the file was edited or damaged in a way its checksums did not see."""
+    """Refuse NaN or infinite times and states of a run that ended normally (chaoscam writes
+    none: the file was edited or damaged past its checksums)."""
     if status is not Status.OK:
         return  # a run that diverged may end on a non-finite state
     for name, table in tables:
@@ -92,14 +80,12 @@ def _check_finite(path: Path, status: Status, tables) -> None:
 
 
 def load_trajectory(path) -> Solution:
-    """Rebuild a one-member :class:`Solution` from a trajectory file (``Solution.to_parquet``).
-
-    The table holds the series (or, for a run without one, the section); the metadata keys
+    """Rebuild a one-member :class:`Solution` from a trajectory file (``Solution.to_parquet``):
+    the table holds the series (or the section, for a run without one); the metadata keys
     ``chaoscam.trajectory`` (params, numerics, settings, status, stats), ``chaoscam.section``
-    and ``chaoscam.impacts`` (JSON, pandas "split" orientation, floats exact) hold the rest,
-    read back with their dtypes. Not stored: the Jacobians of a ``tangent=True`` run
-    (:func:`chaoscam.classify` simulates the tangent again) and the copy a resumable run
-    keeps (:func:`chaoscam.extend` runs it again from t = 0).
+    and ``chaoscam.impacts`` (JSON, pandas "split", floats exact) the rest, read back with their
+    dtypes. Not stored: a ``tangent=True`` run's Jacobians (:func:`chaoscam.classify` simulates
+    the tangent again) and a resumable run's copy (:func:`chaoscam.extend` runs it again).
 
     Raises
     ------
@@ -124,11 +110,8 @@ def load_trajectory(path) -> Solution:
     except (pa.ArrowException, OSError) as err:
         raise ValueError(f"{path}: not a Parquet file ({err})") from err
     meta = table.schema.metadata or {}
-    missing = [
-        key
-        for key in (b"chaoscam.trajectory", b"chaoscam.section", b"chaoscam.impacts")
-        if key not in meta
-    ]
+    missing = [key for key in (b"chaoscam.trajectory", b"chaoscam.section", b"chaoscam.impacts")
+               if key not in meta]  # fmt: skip
     if missing:
         raise ValueError(
             f"{path}: not a chaoscam trajectory file (metadata "
@@ -181,14 +164,11 @@ def load_trajectory(path) -> Solution:
 
 
 def _solution(params, numerics, settings, status, stats, frame, series, section, impacts):
-    """The one-member Solution of a file's tables; where it stopped is the table's last row
-    (with ``series=False``, the last section point, not the run's end)."""
+    """The one-member Solution of a file's tables, stopped at the table's last row (without a
+    series, the last section point, not the run's end)."""
     last = frame.iloc[-1] if len(frame) else None
-    end = (
-        (float(last["t"]), float(last["theta_f"]), float(last["omega_f"]))
-        if last is not None
-        else (math.nan, math.nan, math.nan)
-    )
+    end = ((float(last["t"]), float(last["theta_f"]), float(last["omega_f"])) if last is not None
+           else (math.nan, math.nan, math.nan))  # fmt: skip
     row = (
         0, int(settings.pop("index", 0)), status.name, int(stats.get("n_impacts", 0)),
         float(stats.get("contact_fraction", math.nan)), int(stats.get("slow_closings", 0)),
@@ -196,13 +176,10 @@ def _solution(params, numerics, settings, status, stats, frame, series, section,
     )  # fmt: skip
     settings.setdefault("impacts", True)
     return Solution(
-        models=(params,),
-        numerics=numerics,
-        settings=settings,
+        models=(params,), numerics=numerics, settings=settings,
         members=pd.DataFrame([row], columns=list(MEMBER_COLUMNS)),
         sections=section.assign(member=0)[["member", *SECTION_COLUMNS]],
-        impacts=impacts.assign(member=0)[["member", *impacts.columns]]
-        if len(impacts.columns)
+        impacts=impacts.assign(member=0)[["member", *impacts.columns]] if len(impacts.columns)
         else None,
         series=None if series is None else series.assign(member=0)[["member", *SERIES_COLUMNS]],
-    )
+    )  # fmt: skip

@@ -1,19 +1,13 @@
-"""An independent reference path on ``scipy.integrate.solve_ivp`` with events.
+"""An independent reference path on ``scipy.integrate.solve_ivp`` with events: slow (numpy
+right-hand side, DOP853 at tight tolerances), for the tests' cross-checks of the compiled kernel,
+with which it shares no code; :mod:`chaoscam.model`'s functions and the kernel's impact rule
+(MODEL.md: faster than ``v_min`` the restitution jump (4), slower the compliant contact).
 
-Slow (pure numpy right-hand side, adaptive DOP853 at tight tolerances) and meant for short
-runs: the tests use it to cross-check the compiled kernel, which shares none of its code. It
-uses the numpy model functions of :mod:`chaoscam.model` and the same impact rule as the
-kernel (shared/MODEL.md): a closing faster than ``v_min`` gets the restitution jump (4), a
-slower one enters the compliant contact.
-
-Piecewise integration, restarted at every closing and opening so that no solver step
-straddles an impact: in flight a terminal event watches the gap closing (direction -1); in
-contact one watches it opening (direction +1), and the gap's maxima are recorded, so that a
-micro-flight that begins and ends inside one solver step (the micro-flights of chattering
-last 0.1-1 µs) is found from its maximum above 0 and the piece cut back there. A piece that
-starts on the surface (|gap| < 1e-14 m: after a rebound, an opening or a plastic closure)
-takes the side it starts on: flight after a rebound, so that a closing inside the solver's
-first step is seen although the rebound left the gap at -1e-20 m by rounding.
+Piecewise, restarted at every closing and opening so that no solver step straddles an impact:
+in flight a terminal event watches the gap close, in contact one watches it open while the gap's
+maxima are recorded, so a micro-flight inside one solver step (0.1-1 µs in chattering) is found
+from its maximum above 0 and the piece cut back there. A piece from the surface (|gap| < 1e-14
+m) takes its start's side: flight after a rebound, though rounding left the gap at -1e-20 m.
 """
 
 from __future__ import annotations
@@ -51,26 +45,20 @@ class ReferenceResult:
 
 
 FLIGHT, CONTACT = "flight", "contact"
-"""The pieces: FLIGHT from a rebound, an opening or a gap maximum above 0 to the next closing;
-CONTACT (the gap about 0 or negative) to the next opening, or back to the first maximum of the
-gap above 0, where a micro-flight began and an opening and a closing fell inside one solver
-step."""
+"""The pieces: FLIGHT from a rebound, opening or gap maximum above 0 to the next closing; CONTACT
+to the next opening, or back to the first gap maximum above 0 (a micro-flight inside a step)."""
 
 NEAR_STEP = 1.0 / 8.0
 """The solver's longest step near the cam, as a fraction of the contact oscillation's period.
-The error control alone does not keep the solver from stepping over a contact: measured at
-t = 0.018 s of the default run, a flight's first step of 8.5 ms stepped over a 37 µs
-micro-flight, its closing at 2e-6 m/s and the contact after it (no stage fell inside them),
-and a run stopped at another time took other steps and saw them. So in contact no step is
-longer than 1/8 of the period, and a change of sign of the gap rate at a maximum is seen
-between two step ends; in flight, a piece either provably cannot close (:func:`_open_for`)
-or is one step of 1/8 of the period, shorter than any contact, so that a closing in it is
-seen at its end."""
+The error control alone can step over a contact (at t = 0.018 s of the default run a flight's
+8.5 ms first step misses a 37 µs micro-flight and its contact). So in contact no step is longer,
+and a gap maximum shows between two step ends; in flight a piece provably cannot close
+(:func:`_open_for`) or is one such step, shorter than any contact, so a closing shows at its end."""
 
 _ON_SURFACE = {"gap": 1e-14, "rate": 1e-12}
-"""|value| [m, m/s] below which a piece's start is on the event's surface; there the event takes
-the side the piece starts on (the value ±1e-300: only its sign counts; a larger stand-in moves
-the event's root search, and measured on the v_min = 1e-3 model, later impacts by 5e-8 s)."""
+"""|value| [m, m/s] below which a piece starts on the event's surface, where the event takes the
+start's side as ±1e-300 (a larger stand-in moves the root search: later impacts of the v_min =
+1e-3 model by 5e-8 s)."""
 
 
 def _events(p: Params, phase: str, t_start: float) -> list:
@@ -94,25 +82,17 @@ def _events(p: Params, phase: str, t_start: float) -> list:
 
     if phase == FLIGHT:
         return [armed("closing", gap_at, -1.0, 1.0)]
-    # In contact the gap's maxima are only recorded (a restart at each Hertz oscillation's
-    # maximum would start the solver thousands of times from its interpolant, measured: the
-    # v_min = 1e-3 reference then moved 2.6e-8 s with rtol); the piece is cut back to the first
-    # one above 0 afterwards.
-    return [
-        armed("opening", gap_at, 1.0, -1.0),
-        armed("maximum", rate_at, -1.0, -1.0, terminal=False),
-    ]
+    # In contact maxima are only recorded (a restart at each would start the solver thousands
+    # of times from its interpolant); the piece is cut back to the first above 0 afterwards.
+    return [armed("opening", gap_at, 1.0, -1.0),
+            armed("maximum", rate_at, -1.0, -1.0, terminal=False)]  # fmt: skip
 
 
 def _open_for(p: Params, t: float, y: np.ndarray) -> float:
-    """A time [s] in which the gap, open at (t, y), provably stays open.
-
-    With ``|delta''| <= A`` the gap ``g`` closing at rate ``v`` cannot reach 0 before
-    ``(v' + sqrt(v'^2 + 2 A g)) / A`` with ``v' = -v``, halved for safety. A bounds
-    ``e w^2 + 2 e w W + rho (m g l / (2 J) + W^2)`` for ``delta = (O - C).n - (R + r)``,
-    ``rho = |O| + e``, while ``|theta'| <= W = |theta'(t)| + 1 rad/s``, which gravity
-    cannot change by more than 1 rad/s within ``J / (m g l / 2)``.
-    """
+    """A time [s] in which the gap, open at (t, y), provably stays open: with ``|delta''| <= A``
+    a gap ``g`` closing at rate ``v`` cannot reach 0 before ``(-v + sqrt(v^2 + 2 A g)) / A``,
+    halved for safety; ``A = e w^2 + 2 e w W + rho (m g l / (2 J) + W^2)``, ``rho = |O| + e``,
+    while ``|theta'| <= W = |theta'(t)| + 1 rad/s`` (true within ``J / (m g l / 2)``)."""
     g = float(gap(p, t, y[0]))
     if not g > 0.0:
         return 0.0
@@ -127,10 +107,9 @@ def _open_for(p: Params, t: float, y: np.ndarray) -> float:
 
 
 def _closing(p: Params, t: float, y: np.ndarray, lam: float, stream, impacts: list):
-    """The impact law at a located closing, as the kernel's: a closing faster than ``v_min``
-    gets the restitution jump (slower than ``v_chatter``: the plastic closure that ends a
-    complete chattering), and a new line length when it begins a new contact. Updates ``y``
-    and ``impacts``; returns (the next phase, the line length)."""
+    """The kernel's impact law at a located closing (faster than ``v_min``: the restitution
+    jump; slower than ``v_chatter``: the plastic closure), a new line length for a new contact.
+    Updates ``y`` and ``impacts``; returns (the next phase, the line length)."""
     rate = float(gap_rate(p, t, y[0], y[1]))
     if not (-rate > p.v_min):
         return CONTACT, lam
@@ -148,15 +127,9 @@ def _closing(p: Params, t: float, y: np.ndarray, lam: float, stream, impacts: li
 
 
 def simulate_reference(
-    p: Params,
-    duration: float,
-    *,
-    seed: int = 0,
-    index: int = 0,
-    rtol: float = 1e-13,
-    atol: float = 1e-15,
-    max_pieces: int = 200_000,
-) -> ReferenceResult:
+    p: Params, duration: float, *, seed: int = 0, index: int = 0, rtol: float = 1e-13,
+    atol: float = 1e-15, max_pieces: int = 200_000,
+) -> ReferenceResult:  # fmt: skip
     """Integrate the model with ``solve_ivp`` (DOP853) and located impacts.
 
     Parameters
@@ -168,14 +141,15 @@ def simulate_reference(
     seed, index : int
         Realization of the line-length process (as in :func:`chaoscam.simulate`).
     rtol, atol : float
-        solve_ivp tolerances. The default rtol = 1e-13 is the loosest at which the reference is
-        itself converged for the tests' use. Measured on the v_min = 1e-3 model's first three
-        impacts, against RK4 at dt = 2.5e-7 s: rtol 1e-13 within 4.9e-9 s, 3e-14 within
-        8.1e-9 s, 1e-12 within 4e-8 s. (Before flights were cut into provably open pieces,
-        1e-12 sufficed; 1e-11 was 2.3e-7 s off the third impact on an AMD EPYC and passed on
-        other machines: how far depends on the processor's last bits.)
+        solve_ivp tolerances; rtol = 1e-13 is the loosest at which the reference is converged
+        for the tests (the v_min = 1e-3 model's first three impacts within 4.9e-9 s of RK4 at
+        dt = 2.5e-7 s; 1e-12: 4e-8 s, and looser results depend on the processor's last bits).
     max_pieces : int
         Guard on the number of restarts (chattering); a RuntimeError past it.
+
+    Returns
+    -------
+    ReferenceResult
     """
     from .._util import real, whole
     from ..model import contact_angle, contact_angle_rate, params_arg
@@ -217,24 +191,13 @@ def simulate_reference(
             return [yy[1], float(angular_acceleration(p, tt, yy[0], yy[1], lam_now))]
 
         events = _events(p, phase, t)
-        sol = solve_ivp(
-            rhs,
-            (t, t_stop),
-            y,
-            method="DOP853",
-            rtol=rtol,
-            atol=atol,
-            events=events,
-            dense_output=True,
-            max_step=max_step,
-        )
+        sol = solve_ivp(rhs, (t, t_stop), y, method="DOP853", rtol=rtol, atol=atol, events=events,
+                        dense_output=True, max_step=max_step)  # fmt: skip
         t_new, y = float(sol.t[-1]), sol.y[:, -1].copy()
         if phase == CONTACT:  # a maximum above 0: a micro-flight that began inside a step
-            above = [
-                (float(te), ye)
-                for te, ye in zip(sol.t_events[1], sol.y_events[1], strict=True)
-                if te > t and gap(p, float(te), ye[0]) > 0.0
-            ]
+            above = [(float(te), ye)
+                     for te, ye in zip(sol.t_events[1], sol.y_events[1], strict=True)
+                     if te > t and gap(p, float(te), ye[0]) > 0.0]  # fmt: skip
             if above:
                 t_new, y = above[0][0], above[0][1].copy()
         while k_next * T <= t_new:
@@ -247,11 +210,8 @@ def simulate_reference(
         if cut:  # at a maximum above 0 in contact: in flight
             phase = FLIGHT
         elif sol.status == 1:  # a terminal event ended the piece
-            fired = [
-                e.name
-                for e, te in zip(events, sol.t_events, strict=True)
-                if len(te) and e.terminal and te[-1] == t
-            ]
+            fired = [e.name for e, te in zip(events, sol.t_events, strict=True)
+                     if len(te) and e.terminal and te[-1] == t]  # fmt: skip
             if "closing" in fired:
                 phase, lam = _closing(p, t, y, lam, stream, impacts)
             else:  # an opening
@@ -263,6 +223,5 @@ def simulate_reference(
     return ReferenceResult(
         impacts=pd.DataFrame(impacts, columns=cols),
         section=pd.DataFrame(section, columns=["k", "t", "theta_f", "omega_f", "l_lambda"]),
-        final_state=(float(y[0]), float(y[1])),
-        n_pieces=pieces,
-    )
+        final_state=(float(y[0]), float(y[1])), n_pieces=pieces,
+    )  # fmt: skip

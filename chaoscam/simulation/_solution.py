@@ -1,11 +1,8 @@
-"""The result of :func:`chaoscam.solve`: members' sections, impacts, series and statuses, with
-the settings that made them.
-
-One type for one run and for an ensemble: a run is a solution of one member. Tables are tidy
-(one row per sample, a ``member`` column); the per-member conveniences (``section``,
-``status``, ``stats``, ...) read the only member of a one-member solution, and
-``solution[i]`` is member ``i`` as a solution of its own.
-"""
+"""The result of :func:`chaoscam.solve`: the members' sections, impacts, series and statuses
+with the settings that made them. One type for one run and an ensemble (a run is a solution of
+one member): tidy tables (one row per sample, a ``member`` column); the one-member conveniences
+(``section``, ``status``, ``stats``, ...) read a one-member solution, and ``solution[i]`` is
+member ``i`` as a solution of its own."""
 
 from __future__ import annotations
 
@@ -27,31 +24,18 @@ if TYPE_CHECKING:
     import pandas as pd
 
 __all__ = [
-    "IMPACT_COLUMNS",
-    "IMPACT_KINDS",
-    "MEMBER_COLUMNS",
-    "SECTION_COLUMNS",
-    "SERIES_COLUMNS",
-    "Solution",
-    "assemble",
-]
+    "IMPACT_COLUMNS", "IMPACT_KINDS", "MEMBER_COLUMNS", "SECTION_COLUMNS", "SERIES_COLUMNS",
+    "Solution", "assemble",
+]  # fmt: skip
 
 SECTION_COLUMNS = k.SECTION_NAMES
 IMPACT_COLUMNS = k.IMPACT_NAMES
 IMPACT_KINDS = k.IMPACT_KINDS
 SERIES_COLUMNS = ("t", "theta_f", "omega_f", "theta_fc", "gap", "contact", "F_n", "l_lambda")
 MEMBER_COLUMNS = (
-    "member",
-    "index",
-    "status",
-    "n_impacts",
-    "contact_fraction",
-    "slow_closings",
-    "chatter_handovers",
-    "t_end",
-    "theta_f_end",
-    "omega_f_end",
-)
+    "member", "index", "status", "n_impacts", "contact_fraction", "slow_closings",
+    "chatter_handovers", "t_end", "theta_f_end", "omega_f_end",
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -60,22 +44,18 @@ class Solution:
 
     Attributes
     ----------
-    models : tuple of Params
-        Each member's model (one object shared by members of one model).
-    numerics : Numerics
-        The integrator and its settings.
+    models, numerics : tuple of Params, Numerics
+        Each member's model (one object shared by members of one model); the integrator.
     settings : dict
-        duration, transient [s], seed, tangent, output_dt (None without a series), impacts
-        (kept or only counted), backend and device, batch, threads, version, wall_time_s;
-        after :func:`chaoscam.extend` also ``continued_from`` (the grid step its members went
-        on from, None when run again from t = 0) and ``backends`` (where each leg ran).
-        Read-only.
+        Read-only: duration, transient [s], seed, tangent, output_dt (None without a series),
+        impacts (kept or only counted), backend, device, batch, models (digest), version,
+        threads, wall_time_s; after :func:`chaoscam.extend` also ``continued_from`` (the grid
+        step its members went on from, None when run again) and ``backends`` (each leg's).
     members : pandas.DataFrame
-        One row per member (:data:`MEMBER_COLUMNS`): its realization ``index``, ``status``
-        (a :class:`Status` name), impacts applied after the transient, the fraction of the
-        recorded time in contact, closings slower than ``v_min``, chattering-guard
-        hand-overs, and where it stopped (``t_end`` [s], ``theta_f_end`` [rad],
-        ``omega_f_end`` [rad/s]).
+        One row per member (:data:`MEMBER_COLUMNS`): realization ``index``, ``status`` (a
+        :class:`Status` name), impacts applied after the transient, the recorded time's
+        fraction in contact, closings slower than ``v_min``, chattering-guard hand-overs, and
+        where it stopped (``t_end`` [s], ``theta_f_end`` [rad], ``omega_f_end`` [rad/s]).
     sections : pandas.DataFrame
         member, k, t, theta_f, omega_f, l_lambda: the stroboscopic Poincaré section at
         t = k 2 pi / omega after the transient (the cam back at ``theta_c0``).
@@ -87,13 +67,12 @@ class Solution:
         With ``tangent=True``: the integral of the flow's divergence over each such period
         (Liouville: ln|det J_k| = divergence_k + 2 ln(xi) per restitution jump). Read-only.
     impacts : pandas.DataFrame or None
-        With ``impacts=True``: member and the applied restitution jumps after the transient
-        (t, theta_f, omega_before, omega_after, gap_rate_before, lever_arm, l_lambda, kind:
-        "macro", "micro" (slower than ``v_micro``) or "chatter_end", the plastic closure
-        that ends a complete chattering); else None (only counted).
+        With ``impacts=True``: member and the restitution jumps after the transient (t,
+        theta_f, omega_before, omega_after, gap_rate_before, lever_arm, l_lambda, kind:
+        "macro", "micro" (slower than ``v_micro``) or "chatter_end", the plastic closure ending
+        a complete chattering); else None.
     series : pandas.DataFrame or None
-        With ``series=True``: member and the time series sampled every ``output_dt``
-        (:data:`SERIES_COLUMNS`); else None.
+        With ``series=True``: member and the series every ``output_dt`` (:data:`SERIES_COLUMNS`).
     resume : Resume or None
         With ``resumable=True`` (RK4): each member's state near its end, from which
         :func:`chaoscam.extend` continues it bit for bit; None otherwise.
@@ -171,20 +150,17 @@ class Solution:
 
     @property
     def stats(self) -> dict[str, Any]:
-        """The only member's statistics: contact_fraction, n_impacts (and, with impacts kept,
-        n_macro_impacts, n_micro_impacts, n_chatter_ends), slow_closings,
+        """The only member's statistics (read-only): contact_fraction, n_impacts (with impacts
+        kept also n_macro_impacts, n_micro_impacts, n_chatter_ends), slow_closings,
         chatter_handovers, truncated_mass, steps_per_contact_period."""
         self._only("stats")
         row, p = self.members.iloc[0], self.models[0]
-        out: dict[str, Any] = {
-            "contact_fraction": float(row["contact_fraction"]),
-            "n_impacts": int(row["n_impacts"]),
-        }
+        out: dict[str, Any] = {"contact_fraction": float(row["contact_fraction"]),
+                               "n_impacts": int(row["n_impacts"])}  # fmt: skip
         if self.impacts is not None:
             kinds = self.impacts["kind"].astype(str)
-            for key, kind in zip(
-                ("n_macro_impacts", "n_micro_impacts", "n_chatter_ends"), IMPACT_KINDS, strict=True
-            ):
+            for key, kind in zip(("n_macro_impacts", "n_micro_impacts", "n_chatter_ends"),
+                                 IMPACT_KINDS, strict=True):  # fmt: skip
                 out[key] = int((kinds == kind).sum())
         out["slow_closings"] = int(row["slow_closings"])
         out["chatter_handovers"] = int(row["chatter_handovers"])
@@ -223,17 +199,13 @@ class Solution:
         impacts, _ = rows(self.impacts)
         series, _ = rows(self.series)
         return Solution(
-            models=tuple(self.models[m] for m in picks),
-            numerics=self.numerics,
-            settings=dict(self.settings),
-            members=pd.DataFrame(members),
-            sections=sections,
+            models=tuple(self.models[m] for m in picks), numerics=self.numerics,
+            settings=dict(self.settings), members=pd.DataFrame(members), sections=sections,
             jacobians=None if self.jacobians is None else self.jacobians[pos],
             divergence=None if self.divergence is None else self.divergence[pos],
-            impacts=impacts,
-            series=series,
+            impacts=impacts, series=series,
             resume=None if self.resume is None else self.resume.select(picks),
-        )
+        )  # fmt: skip
 
     def provenance(self) -> dict[str, Any]:
         """The only member's model, numerics, settings and statistics, JSON-serialisable."""
@@ -253,8 +225,8 @@ class Solution:
         write_new_parquet(self.parquet_table(), path, replace=replace)
 
     def parquet_table(self):
-        """The only member's series (or section) as a pyarrow table, its section, impacts
-        and provenance in the metadata (read back by :func:`chaoscam.load_trajectory`)."""
+        """The only member's series (or section) as a pyarrow table, with its section, impacts
+        and provenance in the metadata (:func:`chaoscam.load_trajectory` reads it)."""
         import pyarrow as pa
 
         from ..io import exact_json
@@ -299,8 +271,7 @@ def _summary(sol: Solution) -> str:
 
 
 def series_frame(p: Params, a: np.ndarray) -> pd.DataFrame:
-    """The tidy series of one member: kernel samples (t, theta_f, omega_f, l_lambda) and the
-    observables derived from them."""
+    """One member's tidy series: kernel samples (t, theta_f, omega_f, l_lambda) and observables."""
     import pandas as pd
 
     t, th, om, lam = a[:, 0], a[:, 1], a[:, 2], a[:, 3]
@@ -320,23 +291,18 @@ def assemble(batches: list[Batch], plist, num, settings: dict) -> Solution:
     """The Solution of finished batches, in order."""
     import pandas as pd
 
-    sec = np.concatenate(
-        [_tagged(b.kept["section"], b.first, k.SECTION_COLS) for b in batches]
-        or [np.empty((0, 1 + k.SECTION_COLS))]
-    )
+    sec = np.concatenate([_tagged(b.kept["section"], b.first, k.SECTION_COLS) for b in batches]
+                         or [np.empty((0, 1 + k.SECTION_COLS))])  # fmt: skip
     n_sec = len(SECTION_COLUMNS)
     sections = pd.DataFrame(sec[:, : 1 + n_sec], columns=["member", *SECTION_COLUMNS])
     sections[["member", "k"]] = sections[["member", "k"]].astype(np.int64)
     tangent = bool(settings["tangent"])
-    members = pd.DataFrame(
-        [row for b in batches for row in _member_rows(b)], columns=list(MEMBER_COLUMNS)
-    )
+    members = pd.DataFrame([row for b in batches for row in _member_rows(b)],
+                           columns=list(MEMBER_COLUMNS))  # fmt: skip
     impacts = None
     if all(b.kept["impacts"] is not None for b in batches) and settings["impacts"]:
-        a = np.concatenate(
-            [_tagged(b.kept["impacts"], b.first, k.IMPACT_COLS) for b in batches]
-            or [np.empty((0, 1 + k.IMPACT_COLS))]
-        )
+        a = np.concatenate([_tagged(b.kept["impacts"], b.first, k.IMPACT_COLS) for b in batches]
+                           or [np.empty((0, 1 + k.IMPACT_COLS))])  # fmt: skip
         impacts = pd.DataFrame(a, columns=["member", *IMPACT_COLUMNS])
         impacts["member"] = impacts["member"].astype(np.int64)
         impacts["kind"] = pd.Categorical.from_codes(
@@ -344,42 +310,26 @@ def assemble(batches: list[Batch], plist, num, settings: dict) -> Solution:
         )
     series = None
     if settings["output_dt"] is not None:
-        frames = [
-            series_frame(plist[b.first + j], rows).assign(member=b.first + j)
-            for b in batches
-            for j, rows in enumerate(b.kept["series"])
-        ]
+        frames = [series_frame(plist[b.first + j], rows).assign(member=b.first + j)
+                  for b in batches for j, rows in enumerate(b.kept["series"])]  # fmt: skip
         series = pd.concat(frames, ignore_index=True) if frames else None
         if series is not None:
             series = series[["member", *SERIES_COLUMNS]]
     resumes = [b.resume for b in batches]
     resume = Resume.join(resumes) if resumes and all(r is not None for r in resumes) else None
     return Solution(
-        models=tuple(plist),
-        numerics=num,
-        settings=settings,
-        members=members,
-        sections=sections,
+        models=tuple(plist), numerics=num, settings=settings, members=members, sections=sections,
         jacobians=section_jacobians(sec[:, 1:]) if tangent else None,
         divergence=sec[:, 1 + n_sec + 4].copy() if tangent else None,
-        impacts=impacts,
-        series=series,
-        resume=resume,
-    )
+        impacts=impacts, series=series, resume=resume,
+    )  # fmt: skip
 
 
 def _member_rows(b: Batch):
     for j in range(len(b.indices)):
         y, cnt, c = b.y[j], b.cnt[j], b.c[j]
         yield (
-            b.first + j,
-            b.indices[j],
-            Status(int(b.status[j])).name,
-            int(b.n_impacts[j]),
-            contact_fraction(y, cnt, c),
-            int(cnt[k.I_SLOW_CLOSINGS]),
-            int(cnt[k.I_CHATTER]),
-            float(y[k.Y_TIME]),
-            float(y[k.Y_THETA]),
-            float(y[k.Y_OMEGA]),
-        )
+            b.first + j, b.indices[j], Status(int(b.status[j])).name, int(b.n_impacts[j]),
+            contact_fraction(y, cnt, c), int(cnt[k.I_SLOW_CLOSINGS]), int(cnt[k.I_CHATTER]),
+            float(y[k.Y_TIME]), float(y[k.Y_THETA]), float(y[k.Y_OMEGA]),
+        )  # fmt: skip

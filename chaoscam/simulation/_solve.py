@@ -1,9 +1,9 @@
-"""solve(params, numerics, ...) -> Solution: realizations of the model, a run being a batch of one.
+"""solve(params, numerics, ...) -> Solution: realizations of the model, a run a batch of one.
 
 The driver around the compiled kernel: it checks the request, cuts the members into batches
-(:mod:`._batch`), runs each on the CPU's threads or a GPU, and assembles one
-:class:`~._solution.Solution`. :func:`extend` continues a solution bit for bit;
-:func:`simulate` is the one-run convenience.
+(:mod:`._batch`), runs each on the CPU's threads or a GPU and assembles one
+:class:`~._solution.Solution`; :func:`extend` continues it bit for bit, :func:`simulate` is the
+one-run convenience.
 """
 
 from __future__ import annotations
@@ -34,28 +34,19 @@ from ._solution import Solution, assemble
 from ._warnings import run_warnings
 
 __all__ = [
-    "AUTO_GPU_MIN",
-    "BACKENDS",
-    "CPU_BATCH",
-    "check_window",
-    "extend",
-    "models_digest",
-    "numerics_arg",
-    "simulate",
-    "solve",
-    "split_overrides",
-]
+    "AUTO_GPU_MIN", "BACKENDS", "CPU_BATCH", "check_window", "extend", "models_digest",
+    "numerics_arg", "simulate", "solve", "split_overrides",
+]  # fmt: skip
 
 BACKENDS = ("cpu", "gpu", "auto")
 CPU_BATCH = 1024
-"""Members per compiled call on the CPU: bounds memory (about 40 kB a member for 20 s runs,
-of which 40 B per cam period of sections)."""
+"""Members per compiled call on the CPU: bounds memory (~40 kB a member for 20 s runs)."""
 
 
 def check_window(duration, transient, *, dt: float | None = None) -> tuple[float, float]:
-    """The run's time window validated: ``duration`` > 0 (and at least one step ``dt``),
-    ``transient`` in [0, duration); both [s], returned as floats. Every entry point (solve,
-    the exponents, the sweeps) checks its window here."""
+    """The run's time window [s] as floats, checked for every entry point (solve, the
+    exponents, the sweeps): ``duration`` > 0 (at least one step ``dt``), ``transient`` in [0,
+    duration)."""
     if isinstance(duration, bool) or not (
         isinstance(duration, numbers.Real) and math.isfinite(duration) and duration > 0
     ):
@@ -84,9 +75,9 @@ def numerics_arg(numerics: Any) -> Numerics:
 
 
 def split_overrides(p: Params, num: Numerics, overrides: dict, caller) -> tuple[Params, Numerics]:
-    """``overrides`` (keywords of an API function) applied to the model or the numerics, each
-    by its field names; a keyword that is neither one of ``caller``'s settings nor a field is
-    refused naming what it was probably meant to be (``simulate(duraton=1)`` -> duration)."""
+    """``overrides`` (an API function's keywords) applied to the model or the numerics by field
+    name; any other keyword is refused with what it was probably meant to be (``duraton`` ->
+    ``duration``, from ``caller``'s keyword-only settings and the fields)."""
     import inspect
 
     from .._util import close_names
@@ -94,11 +85,8 @@ def split_overrides(p: Params, num: Numerics, overrides: dict, caller) -> tuple[
     fields = (*field_names(), *Numerics.field_names())
     unknown = [name for name in overrides if name not in fields]
     if unknown:
-        own = [
-            n
-            for n, a in inspect.signature(caller).parameters.items()
-            if a.kind is inspect.Parameter.KEYWORD_ONLY
-        ]
+        own = [n for n, a in inspect.signature(caller).parameters.items()
+               if a.kind is inspect.Parameter.KEYWORD_ONLY]  # fmt: skip
         close = close_names(unknown[0], own + list(fields))
         hint = f" Did you mean {', '.join(close)}?" if close else ""
         raise ParameterError(
@@ -112,7 +100,7 @@ def split_overrides(p: Params, num: Numerics, overrides: dict, caller) -> tuple[
 
 
 def models_digest(plist: Sequence[Params], num: Numerics) -> str:
-    """A fingerprint of the members' models in order and their numerics (16 hex digits):
+    """A fingerprint (16 hex digits) of the members' models in order and their numerics,
     numbers as floats (``omega=10`` and ``10.0`` are one model, as ``==`` says)."""
 
     def canonical(v):
@@ -129,8 +117,8 @@ def models_digest(plist: Sequence[Params], num: Numerics) -> str:
 
 
 def _pick_backend(backend: str, members: int) -> tuple[bool, str]:
-    """(use the GPU?, the device in words) for ``backend`` and a run of ``members``
-    (``"auto"``: the GPU from :data:`AUTO_GPU_MIN` members); warns if "gpu" cannot run."""
+    """(use the GPU?, the device in words) for ``backend`` and ``members`` (``"auto"``: the GPU
+    from :data:`AUTO_GPU_MIN` members); warns if "gpu" cannot run."""
     if backend not in BACKENDS:
         raise ValueError(
             f"backend must be one of {', '.join(map(repr, BACKENDS))}, got {backend!r}"
@@ -147,8 +135,8 @@ def _pick_backend(backend: str, members: int) -> tuple[bool, str]:
 
 
 def _check_request(p, num, duration, transient, series, output_dt, members) -> None:
-    """Refuse a request that cannot fit in memory; one run is also judged by its time (refused
-    past hours, warned about past a minute)."""
+    """Refuse a request that cannot fit in memory; judge one run by its time too (refused past
+    hours, warned about past a minute)."""
     one = estimate(p, num, duration=duration, transient=transient, series=series,
                    output_dt=output_dt)  # fmt: skip
     if members > 1:
@@ -157,64 +145,48 @@ def _check_request(p, num, duration, transient, series, output_dt, members) -> N
         check_budget(job, what=what, reduce="the members or duration")
         return
     rows = (duration - transient) / output_dt if series else 0.0
-    check_budget(
-        one,
-        what="this run",
-        reduce="duration (or raise output_dt)",
-        run=dict(params=p, num=num, duration=duration, what="this run", series_rows=rows),
-    )
+    check_budget(one, what="this run", reduce="duration (or raise output_dt)",
+                 run=dict(params=p, num=num, duration=duration, what="this run",
+                          series_rows=rows))  # fmt: skip
 
 
 def solve(
-    params: Params | Sequence[Params] | None = None,
-    numerics: Numerics | None = None,
-    *,
-    indices=(0,),
-    seed: int = 0,
-    duration: float = 20.0,
-    transient: float = 0.0,
-    tangent: bool = False,
-    series: bool = False,
-    output_dt: float = 1e-3,
-    impacts: bool = False,
-    resumable: bool = False,
-    backend: str = "cpu",
-    batch: int | None = None,
-    progress=None,
-) -> Solution:
+    params: Params | Sequence[Params] | None = None, numerics: Numerics | None = None, *,
+    indices=(0,), seed: int = 0, duration: float = 20.0, transient: float = 0.0,
+    tangent: bool = False, series: bool = False, output_dt: float = 1e-3, impacts: bool = False,
+    resumable: bool = False, backend: str = "cpu", batch: int | None = None, progress=None,
+) -> Solution:  # fmt: skip
     """Simulate realizations of the model with located impacts, all in one call.
 
     Parameters
     ----------
     params : Params or sequence of Params, optional
-        One model for every member, or one per member (they must share ``omega``: members
-        share the section times). Table 1 defaults when omitted.
+        One model for every member, or one per member sharing ``omega`` (the section times);
+        Table 1 defaults when omitted.
     numerics : Numerics, optional
-        The integrator and its settings (the paper's fixed-step RK4 by default).
+        The integrator and its settings (default: the paper's fixed-step RK4).
     indices : sequence of int
-        The members' realizations under ``seed``: member i is realization ``indices[i]``, a
-        pure function of ``(seed, indices[i])`` whatever the batch, backend or thread count.
+        Member i is realization ``indices[i]`` under ``seed``, a pure function of ``(seed,
+        indices[i])`` whatever the batch, backend or thread count.
     seed : int
         Master seed of the random line length.
     duration, transient : float
         End time [s]; outputs before ``transient`` are discarded.
     tangent : bool
-        Also integrate the tangent dynamics through the impacts and keep the stroboscopic
-        map's Jacobian over each recorded period (``Solution.jacobians``). The motion is the
-        same with and without it.
+        Also integrate the tangent dynamics and keep the stroboscopic map's Jacobian over each
+        recorded period (``Solution.jacobians``); the motion is the same without it.
     series : bool
         Keep the time series, sampled every ``output_dt`` [s] (rounded to whole steps).
     impacts : bool
         Keep every applied impact (``Solution.impacts``); otherwise only counted.
     resumable : bool
-        Keep each member's state near its end (RK4), so that :func:`extend` continues it
-        instead of running it again (the same bits either way).
+        Keep each member's state near its end (RK4) for :func:`extend` to continue (the same
+        bits as running it again).
     backend : {"cpu", "gpu", "auto"}
-        ``"cpu"``: numba threads over cores. ``"gpu"``: one CUDA thread per member
-        (numba-cuda, ``pip install 'chaoscam[gpu]'``), equal to the CPU within
-        ``GPU_TOLERANCE`` on short or periodic runs; where it cannot run, the CPU after a
+        ``"cpu"``: numba threads. ``"gpu"``: one CUDA thread per member (numba-cuda, ``pip
+        install 'chaoscam[gpu]'``), within ``GPU_TOLERANCE`` of the CPU on short or periodic
+        runs; where it cannot run (or with a series), the CPU after a
         :class:`GPUFallbackWarning`. ``"auto"``: the GPU from ``AUTO_GPU_MIN`` members.
-        A series is kept on the CPU only.
     batch : int, optional
         Members per compiled call (memory); default :data:`CPU_BATCH`, or ``GPU_BATCH``.
     progress : callable, optional
@@ -223,8 +195,8 @@ def solve(
     Returns
     -------
     Solution
-        Its ``members`` table says how each run ended; a run that leaves the cam's reach or
-        diverges is not an error.
+        Its ``members`` table says how each run ended (leaving the cam's reach or diverging is
+        not an error).
     """
     p0, plist, num = _models(params, numerics, indices)
     duration, transient = check_window(duration, transient, dt=num.dt)
@@ -252,40 +224,19 @@ def solve(
     t0 = time.perf_counter()
     stride = max(1, int(round(output_dt / num.dt))) if series else 0
     room = ROOM["gpu" if gpu else "cpu"]
-    parts = []
-    for first in range(0, len(indices), batch):
-        chunk = slice(first, first + batch)
-        start = fresh(plist[chunk], num, indices[chunk], seed, duration, transient,
-                      tangent=tangent, stride=stride, room=room)  # fmt: skip
-        parts.append(
-            run_batch(
-                plist[chunk],
-                num,
-                indices[chunk],
-                start,
-                first,
-                duration,
-                room=room,
-                gpu=gpu,
-                keep_impacts=impacts,
-                resumable=resumable,
-            )  # fmt: skip
-        )
-        if progress is not None:
-            progress(len(parts[-1].indices))
+
+    def start(chunk):
+        return fresh(plist[chunk], num, indices[chunk], seed, duration, transient,
+                     tangent=tangent, stride=stride, room=room)  # fmt: skip
+
+    parts = _batches(plist, num, indices, start, duration, batch, progress, room=room, gpu=gpu,
+                     keep_impacts=impacts, resumable=resumable)  # fmt: skip
     settings = {
-        "duration": duration,
-        "transient": transient,
-        "seed": seed,
-        "tangent": tangent,
-        "output_dt": stride * num.dt if series else None,
-        "impacts": impacts,
-        "backend": "gpu" if gpu else "cpu",
-        "device": device,
-        "batch": batch,
-        "models": models_digest(plist, num),
-        "version": __version__,
-    }
+        "duration": duration, "transient": transient, "seed": seed, "tangent": tangent,
+        "output_dt": stride * num.dt if series else None, "impacts": impacts,
+        "backend": "gpu" if gpu else "cpu", "device": device, "batch": batch,
+        "models": models_digest(plist, num), "version": __version__,
+    }  # fmt: skip
     return _finish(parts, plist, num, settings, t0)
 
 
@@ -307,29 +258,35 @@ def _models(params, numerics, indices) -> tuple[Params, list[Params], Numerics]:
     return plist[0], plist, numerics_arg(numerics)
 
 
+def _batches(plist, num, indices, start, duration, batch, progress, **run) -> list:
+    """The members run in batches of ``batch``, each from ``start(chunk)`` through
+    :func:`run_batch` (keywords ``run``), ``progress`` told after each."""
+    parts = []
+    for first in range(0, len(plist), batch):
+        chunk = slice(first, first + batch)
+        parts.append(run_batch(plist[chunk], num, indices[chunk], start(chunk), first, duration,
+                               **run))  # fmt: skip
+        if progress is not None:
+            progress(len(parts[-1].indices))
+    return parts
+
+
 def _finish(parts, plist, num, settings: dict, t0: float) -> Solution:
     settings = {**settings, "threads": thread_count(), "wall_time_s": time.perf_counter() - t0}
     return assemble(parts, plist, num, settings)
 
 
 def extend(
-    solution: Solution,
-    duration: float,
-    *,
-    members=None,
-    series: bool | None = None,
-    resumable: bool = False,
-    backend: str | None = None,
-    progress=None,
-) -> Solution:
-    """Members of ``solution`` made ``duration`` seconds long, bit-identical to runs made
-    that long from t = 0.
+    solution: Solution, duration: float, *, members=None, series: bool | None = None,
+    resumable: bool = False, backend: str | None = None, progress=None,
+) -> Solution:  # fmt: skip
+    """Members of ``solution`` made ``duration`` seconds long, bit-identical to runs made that
+    long from t = 0.
 
-    Each member goes on from the copy ``solution.resume`` keeps (a run made with
-    ``resumable=True``, RK4), at its last section time before the end, instead of being run
-    again: its sections, Jacobians, impacts, series, counts and status are those of
-    :func:`solve` over the longer window. Without a copy (the adaptive integrator, a run not
-    kept resumable, one read from a file) the members are run again from t = 0.
+    Each member goes on from the copy ``solution.resume`` keeps (``resumable=True``, RK4) at its
+    last section time before the end: its sections, Jacobians, impacts, series, counts and status
+    are those of :func:`solve` over the longer window. Without a copy (the adaptive integrator,
+    a run not kept resumable, one read from a file) the members run again from t = 0.
 
     Parameters
     ----------
@@ -338,16 +295,14 @@ def extend(
     duration : float
         The new end time [s], at least that of ``solution``.
     members : sequence of int, optional
-        Which members (their ``member`` numbers); default all, renumbered 0, 1, ... in this
-        order (``index`` keeps their realization).
+        Which members (``member`` numbers), renumbered 0, 1, ... in this order (``index`` keeps
+        their realization); default all.
     series : bool, optional
-        Keep the time series (default: as the solution did); a solution that kept none
-        cannot gain one.
+        Keep the time series (default: as the solution did; one that kept none cannot gain one).
     resumable : bool
         Keep a copy again, so that the result can be extended further.
     backend : {"cpu", "gpu", "auto"} or None
-        Where the continuation runs; None: where the solution ran. A continuation on the
-        other backend goes on from the same state.
+        Where the continuation runs (None: where the solution ran), from the same state.
     progress : callable, optional
         As for :func:`solve`.
     """
@@ -383,20 +338,11 @@ def _again(sub: Solution, duration, series, resumable, backend, progress) -> Sol
     """The members of ``sub`` run again from t = 0 to ``duration``."""
     s = sub.settings
     out = solve(
-        list(sub.models),
-        sub.numerics,
-        indices=[int(i) for i in sub.members["index"]],
-        seed=s["seed"],
-        duration=duration,
-        transient=s["transient"],
-        tangent=s["tangent"],
-        series=series,
-        output_dt=s["output_dt"] or 1e-3,
-        impacts=s["impacts"],
-        resumable=resumable,
-        backend=backend or s["backend"],
-        progress=progress,
-    )
+        list(sub.models), sub.numerics, indices=[int(i) for i in sub.members["index"]],
+        seed=s["seed"], duration=duration, transient=s["transient"], tangent=s["tangent"],
+        series=series, output_dt=s["output_dt"] or 1e-3, impacts=s["impacts"],
+        resumable=resumable, backend=backend or s["backend"], progress=progress,
+    )  # fmt: skip
     more = {"continued_from": None, "backends": [*s.get("backends", [s["backend"]]),
                                                 out.settings["backend"]]}  # fmt: skip
     return _with_settings(out, more)
@@ -421,38 +367,19 @@ def _continued(sub: Solution, duration, series, resumable, backend, progress) ->
     room = ROOM["gpu" if gpu else "cpu"]
     indices = [int(i) for i in sub.members["index"]]
     t0 = time.perf_counter()
-    parts = []
-    for first in range(0, len(plist), batch):
-        chunk = slice(first, first + batch)
-        start = resumed(res.select(range(len(plist))[chunk]), plist[chunk], num, duration, room,
-                        series=series)  # fmt: skip
-        parts.append(
-            run_batch(
-                plist[chunk],
-                num,
-                indices[chunk],
-                start,
-                first,
-                duration,
-                room=room,
-                gpu=gpu,
-                keep_impacts=s["impacts"],
-                resumable=resumable,
-            )  # fmt: skip
-        )
-        if progress is not None:
-            progress(len(parts[-1].indices))
+
+    def start(chunk):
+        return resumed(res.select(range(len(plist))[chunk]), plist[chunk], num, duration, room,
+                       series=series)  # fmt: skip
+
+    parts = _batches(plist, num, indices, start, duration, batch, progress, room=room, gpu=gpu,
+                     keep_impacts=s["impacts"], resumable=resumable)  # fmt: skip
     used = "gpu" if gpu else "cpu"
     settings = {
-        **s,
-        "duration": duration,
-        "output_dt": s["output_dt"] if series else None,
-        "continued_from": res.step,
-        "backend": used,
-        "device": device,
-        "batch": batch,
+        **s, "duration": duration, "output_dt": s["output_dt"] if series else None,
+        "continued_from": res.step, "backend": used, "device": device, "batch": batch,
         "backends": [*s.get("backends", [s["backend"]]), used],
-    }
+    }  # fmt: skip
     return _finish(parts, plist, num, settings, t0)
 
 
@@ -473,27 +400,17 @@ def _with_settings(sol: Solution, more: dict) -> Solution:
 
 
 def simulate(
-    params: Params | None = None,
-    numerics: Numerics | None = None,
-    *,
-    duration: float = 20.0,
-    transient: float = 0.0,
-    seed: int = 0,
-    index: int = 0,
-    series: bool = True,
-    output_dt: float = 1e-3,
-    tangent: bool = False,
-    resumable: bool = False,
-    **overrides: Any,
-) -> Solution:
+    params: Params | None = None, numerics: Numerics | None = None, *, duration: float = 20.0,
+    transient: float = 0.0, seed: int = 0, index: int = 0, series: bool = True,
+    output_dt: float = 1e-3, tangent: bool = False, resumable: bool = False, **overrides: Any,
+) -> Solution:  # fmt: skip
     """One realization: :func:`solve` of one member, keeping its series and impacts.
 
-    Keyword ``overrides`` are applied on top of ``params`` and ``numerics`` by field name,
-    e.g. ``simulate(omega=30.0, dt=1e-6)``. The follower starts in contact with the cam
-    (``theta_f0``, ``omega_f0`` None). From a section point ``(theta_f, omega_f)`` of an
-    earlier run (at t = k 2 pi / omega the cam is back at ``theta_c0``),
-    ``simulate(theta_f0=theta_f, omega_f0=omega_f)`` is a new run, not the earlier one's
-    continuation to the bit (:func:`extend` is that).
+    Keyword ``overrides`` apply on top of ``params`` and ``numerics`` by field name, e.g.
+    ``simulate(omega=30.0, dt=1e-6)``. The follower starts in contact with the cam (``theta_f0``,
+    ``omega_f0`` None). From a section point of an earlier run (at t = k 2 pi / omega the cam is
+    back at ``theta_c0``), ``simulate(theta_f0=theta_f, omega_f0=omega_f)`` is a new run, not the
+    earlier one's continuation to the bit (:func:`extend` is that).
 
     Returns
     -------
@@ -504,15 +421,6 @@ def simulate(
     if overrides:
         p, num = split_overrides(p, num, overrides, simulate)
     return solve(
-        p,
-        num,
-        indices=[index],
-        seed=seed,
-        duration=duration,
-        transient=transient,
-        tangent=tangent,
-        series=series,
-        output_dt=output_dt,
-        impacts=True,
-        resumable=resumable,
-    )
+        p, num, indices=[index], seed=seed, duration=duration, transient=transient,
+        tangent=tangent, series=series, output_dt=output_dt, impacts=True, resumable=resumable,
+    )  # fmt: skip

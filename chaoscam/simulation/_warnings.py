@@ -1,8 +1,6 @@
-"""The warnings a run gets before it starts: settings that run but do not do what they say.
-
-Used by :func:`chaoscam.solve` (as ``RuntimeWarning``) and by the sweeps (in each
-realization's ``warnings`` column).
-"""
+"""The warnings a run gets before it starts (settings that run but do not do what they say):
+:func:`chaoscam.solve` raises them as ``RuntimeWarning``, the sweeps keep them in each
+realization's ``warnings`` column."""
 
 from __future__ import annotations
 

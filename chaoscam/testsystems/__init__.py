@@ -1,8 +1,5 @@
-"""Known dynamical systems that validate the analysis layer (maps, flows, bouncing ball).
-
-Nothing here depends on the cam-follower model; each generator documents the values
-the literature gives for it.
-"""
+"""Known dynamical systems that validate the analysis layer (maps, flows, bouncing ball), each
+with the values the literature gives for it; nothing here depends on the cam-follower model."""
 
 from ._ball import (
     BallRun,
@@ -12,7 +9,7 @@ from ._ball import (
     period_one_orbit,
     period_one_thresholds,
 )
-from ._flows import FlowSystem, flow_advance, flow_reference, flow_trajectory, lorenz, rossler, ueda
+from ._flows import FlowSystem, flow_reference, flow_trajectory, lorenz, rossler, ueda
 from ._maps import (
     circle_map_orbit,
     circle_map_rotation_number,
@@ -34,7 +31,6 @@ __all__ = [
     "bouncing_ball",
     "circle_map_orbit",
     "circle_map_rotation_number",
-    "flow_advance",
     "flow_reference",
     "flow_trajectory",
     "henon_jacobian",

@@ -1,12 +1,11 @@
 """Bouncing ball on a sinusoidally vibrating table, simulated exactly (event-driven).
 
-Dimensionless form: time ``τ = ω t``, lengths in units of ``g / ω²``. The table moves as
-``s(τ) = Γ sin τ`` with ``Γ = A ω² / g``; between impacts the ball falls freely with unit
-acceleration; at an impact its velocity relative to the table is reversed and scaled by the
-coefficient of restitution e: ``v⁺ - u = -e (v⁻ - u)``, ``u = Γ cos τ`` (Tufillaro, Abbott &
-Reilly 1992, "An Experimental Approach to Nonlinear Dynamics and Chaos", ch. 4; Luck &
-Mehta 1993, Phys. Rev. E 48, 3988). Nothing is approximated: the flight is a parabola
-and the impact time is the first root of the exact gap, no high-bounce simplification.
+Dimensionless: time ``τ = ω t``, lengths in units of ``g / ω²``; the table moves as
+``s(τ) = Γ sin τ``, ``Γ = A ω² / g``; the ball falls with unit acceleration and an impact
+sets ``v⁺ - u = -e (v⁻ - u)``, ``u = Γ cos τ``, e the coefficient of restitution (Tufillaro,
+Abbott & Reilly 1992, "An Experimental Approach to Nonlinear Dynamics and Chaos", ch. 4; Luck
+& Mehta 1993, Phys. Rev. E 48, 3988). The flight is the exact parabola and an impact the
+first root of the exact gap: no high-bounce approximation.
 """
 
 from __future__ import annotations
@@ -37,11 +36,8 @@ _STATUS = {
 
 @numba.njit(cache=True)
 def _gap(tau, t0, w, gamma):
-    """Ball height above the table ``tau`` after leaving it at ``t0`` with relative speed w.
-
-    gap = w τ - τ²/2 + Γ cos t0 (τ - sin τ) + Γ sin t0 (1 - cos τ), written so that the
-    small-τ terms keep full relative precision.
-    """
+    """Ball height above the table ``tau`` after leaving it at ``t0`` with relative speed w:
+    ``w τ - τ²/2 + Γ cos t0 (τ - sin τ) + Γ sin t0 (1 - cos τ)``, small-τ terms in series."""
     if tau < 1e-2:
         t2 = tau * tau
         tms = tau * t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0))
@@ -54,12 +50,10 @@ def _gap(tau, t0, w, gamma):
 
 @numba.njit(cache=True)
 def _next_impact(t0, w, gamma, h_max, h_min):
-    """First τ > 0 where the gap closes; scan with a step that grows from the flight scale.
-
-    A flight that starts with zero relative speed is a release from the table, where the
-    gap grows like Γ cos t0 τ³ / 6; its scan starts at τ = 1e-6, because round-off in
-    Γ sin t0 - 1 (~1e-16 t0) would otherwise fake an impact at τ ~ 1e-12.
-    """
+    """First τ > 0 where the gap closes: a scan with a step growing from the flight scale,
+    then bisection. A release from the table (zero relative speed, gap ~ Γ cos t0 τ³ / 6)
+    is scanned from τ = 1e-6: round-off in Γ sin t0 - 1 (~1e-16 t0) fakes an impact at
+    τ ~ 1e-12."""
     a = 0.0 if w > 0.0 else 1e-6
     while True:
         h = 0.5 * a + w / (1.0 + gamma)
@@ -166,11 +160,9 @@ class BallRun:
         return np.column_stack([phase, self.velocities[discard:]])
 
     def positions(self, t: np.ndarray) -> np.ndarray:
-        """Ball height (units g/ω²) at times `t` between the first and the last impact.
-
-        Free flight ``Γ sin τ_L + v_L (τ - τ_L) - (τ - τ_L)² / 2`` after leaving the table at
-        τ_L with speed v_L; on the table (sticking) the table's height ``Γ sin τ``.
-        """
+        """Ball height [g/ω²] at times `t` between the first and the last impact: the flight
+        ``Γ sin τ_L + v_L (τ - τ_L) - (τ - τ_L)² / 2`` after leaving the table at τ_L with
+        speed v_L, and the table's height ``Γ sin τ`` while sticking."""
         t = np.asarray(t, dtype=float)
         gamma = self.settings["gamma"]
         k = np.searchsorted(self.times, t, side="right") - 1
@@ -210,14 +202,13 @@ def bouncing_ball(
     v0 : float, optional
         Absolute launch velocity; default ``Γ cos t0 + π`` (a flight of about one period).
     h_max : float
-        Largest scan step for the first root of the gap. A graze shallower than
+        Largest scan step for the first root of the gap: a graze shallower than
         ``(1 + Γ) h_max² / 8`` (1.2e-5 g/ω² by default at Γ = 1.5) can be missed.
     h_min : float
-        Smallest scan step (guards the release from the table, where the gap grows like τ³).
+        Smallest scan step (the release from the table, where the gap grows like τ³).
     v_stick : float
-        Relative rebound speed below which a chattering sequence is taken to have converged
-        (its accumulation point is replaced by sticking: the infinitely many impacts of
-        complete chattering are cut at this speed).
+        Relative rebound speed below which complete chattering is cut and replaced by
+        sticking (its accumulation point).
     max_events : int, optional
         Safety limit on flights, default ``50 * n_impacts``.
 
@@ -257,12 +248,9 @@ def bouncing_ball(
 def ball_impact_map(
     state: np.ndarray, gamma: float, e: float, h_max: float = 2.0 * math.pi / 1000.0
 ) -> np.ndarray:
-    """One step of the exact impact map ``(τ_k, v_k) -> (τ_{k+1}, v_{k+1})``.
-
-    The ball leaves the table at τ_k with absolute velocity v_k (which must exceed the
-    table's velocity) and the map returns the next impact time and rebound velocity.
-    Sticking is not handled here (use `bouncing_ball` for whole runs).
-    """
+    """One step of the exact impact map ``(τ_k, v_k) -> (τ_{k+1}, v_{k+1})``: the ball leaves
+    the table at τ_k with absolute velocity v_k (above the table's); the next impact time and
+    rebound velocity. No sticking (`bouncing_ball` runs whole motions)."""
     t, v = float(state[0]), float(state[1])
     w = v - gamma * math.cos(t)
     tau = _next_impact(t, w, gamma, h_max, 1e-12)
@@ -366,18 +354,15 @@ def period_one_thresholds(
 ) -> tuple[float, float]:
     """Saddle-node and period-doubling Γ of the period-one orbit, by continuation.
 
-    From the state that simulations at `gamma_start` settle on (launches at 8 phases with
-    speed nπ), refined by Newton (`period_one_orbit`), the orbit is followed downwards in
-    Γ until Newton finds none, then bisected on existence (the saddle-node where it is
-    born); and upwards until ``1 + tr J + det J`` (the characteristic polynomial of the
-    Jacobian at -1) changes sign, then bisected (the flip, period doubling).
+    From where runs at `gamma_start` settle (8 launch phases, speed nπ), refined by Newton
+    (`period_one_orbit`), the orbit is followed down in Γ until Newton finds none and
+    bisected on existence (the saddle-node), and up until ``1 + tr J + det J`` (the
+    characteristic polynomial at -1) changes sign and bisected (the flip).
 
     Parameters
     ----------
-    e : float
-        Coefficient of restitution.
-    n : int
-        Table periods per flight.
+    e, n : float, int
+        Coefficient of restitution, and table periods per flight.
     gamma_start : float
         A Γ where the period-one orbit attracts (e.g. found by a classifier sweep);
         ValueError if none is found there.
@@ -456,11 +441,10 @@ def period_one_thresholds(
 def ball_period_one_theory(e: float, n: int = 1) -> tuple[float, float]:
     """Closed-form thresholds of the period-one orbit (n table periods per flight).
 
-    Existence: ``Γ >= nπ (1 - e) / (1 + e)``; period doubling at
-    ``Γ = sqrt[(2 (1 + e²) / (1 + e)²)² + (nπ (1 - e) / (1 + e))²]``
-    (Tufillaro et al. 1992, ch. 4; exact for the full model because a period-one flight
-    starts and ends at the same table height). Used as the target the numerics are
-    checked against, never inside them.
+    Existence ``Γ >= nπ (1 - e) / (1 + e)``, period doubling at ``Γ = sqrt[(2 (1 + e²) /
+    (1 + e)²)² + (nπ (1 - e) / (1 + e))²]`` (Tufillaro et al. 1992, ch. 4; exact for the
+    full model: a period-one flight starts and ends at the same table height). The target
+    the numerics are checked against, never used inside them.
     """
     c = n * math.pi * (1.0 - e) / (1.0 + e)
     s = 2.0 * (1.0 + e * e) / (1.0 + e) ** 2

@@ -2,29 +2,18 @@
 
 The vector fields are compiled with numba and integrated by classical fixed-step RK4;
 `flow_reference` integrates them with scipy's DOP853 at tight tolerances (an independent
-path). Forced systems carry time as the last state component (``t' = 1``), so one
-``advance(state, duration)`` covers both kinds.
+path). Forced systems carry time as the last state component (``t' = 1``).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 
-__all__ = [
-    "FlowSystem",
-    "flow_advance",
-    "flow_reference",
-    "flow_trajectory",
-    "lorenz",
-    "rossler",
-    "ueda",
-]
-
+__all__ = ["FlowSystem", "flow_reference", "flow_trajectory", "lorenz", "rossler", "ueda"]
 
 LORENZ, ROSSLER, UEDA = 0, 1, 2
 
@@ -87,7 +76,6 @@ class FlowSystem:
     Attributes
     ----------
     name : str
-        Human-readable name.
     kind : int
         Which compiled vector field (LORENZ, ROSSLER, UEDA) the kernels evaluate.
     params : tuple of float
@@ -104,38 +92,24 @@ class FlowSystem:
     dim: int
     forcing_period: float | None = None
 
-    def f(self, y: np.ndarray) -> np.ndarray:
-        """Evaluate the vector field at `y` (pure Python call, for checks)."""
-        out = np.empty(self.dim)
-        _rhs(self.kind, np.asarray(y, dtype=float), np.asarray(self.params, dtype=float), out)
-        return out
-
 
 def lorenz(sigma: float = 10.0, rho: float = 28.0, beta: float = 8.0 / 3.0) -> FlowSystem:
-    """Lorenz (1963) system ``x' = σ(y - x), y' = x(ρ - z) - y, z' = xy - βz``.
-
-    At (10, 28, 8/3) the largest Lyapunov exponent is ≈ 0.906 (Sprott 2003, "Chaos and
-    Time-Series Analysis", table A.1: 0.9056).
-    """
+    """Lorenz (1963) system ``x' = σ(y - x), y' = x(ρ - z) - y, z' = xy - βz``: at (10, 28,
+    8/3) λ₁ ≈ 0.906 (Sprott 2003, "Chaos and Time-Series Analysis", table A.1: 0.9056)."""
     return FlowSystem("lorenz", LORENZ, (sigma, rho, beta), 3)
 
 
 def rossler(a: float = 0.2, b: float = 0.2, c: float = 5.7) -> FlowSystem:
-    """Rössler (1976) system ``x' = -y - z, y' = x + a y, z' = b + z (x - c)``.
-
-    With a = b = 0.2: a period-1 limit cycle at c = 2.5, period 2 at c = 3.5, chaos at
-    c = 5.7 with largest Lyapunov exponent ≈ 0.0714 (Sprott 2003, table A.1).
-    """
+    """Rössler (1976) system ``x' = -y - z, y' = x + a y, z' = b + z (x - c)``: with a = b =
+    0.2, a period-1 limit cycle at c = 2.5, period 2 at c = 3.5, chaos at c = 5.7 with
+    λ₁ ≈ 0.0714 (Sprott 2003, table A.1)."""
     return FlowSystem("rossler", ROSSLER, (a, b, c), 3)
 
 
 def ueda(k: float = 0.05, b: float = 7.5) -> FlowSystem:
-    """Ueda oscillator ``x'' + k x' + x³ = B cos t``, state ``(x, x', t)``.
-
-    At k = 0.05, B = 7.5 (Ueda 1979, J. Stat. Phys. 20, 181) the motion is chaotic with
-    largest Lyapunov exponent ≈ 0.0999 per unit time in the (x, x') directions; the time
-    direction contributes the trivial zero exponent.
-    """
+    """Ueda oscillator ``x'' + k x' + x³ = B cos t``, state ``(x, x', t)``: at k = 0.05,
+    B = 7.5 (Ueda 1979, J. Stat. Phys. 20, 181) chaotic with λ₁ ≈ 0.0999 per unit time in
+    the (x, x') directions (the time direction adds the trivial zero exponent)."""
     return FlowSystem("ueda", UEDA, (k, b), 3, forcing_period=2.0 * math.pi)
 
 
@@ -153,15 +127,12 @@ def flow_trajectory(
     Parameters
     ----------
     system : FlowSystem
-        The flow.
     y0 : array_like, shape (dim,)
         Initial state (time last for forced systems).
     dt : float
         RK4 step.
-    n_samples : int
-        Number of samples returned.
-    sample_every : int
-        Steps between samples (sampling interval ``dt * sample_every``).
+    n_samples, sample_every : int
+        Samples returned, and steps between them (interval ``dt * sample_every``).
     transient_time : float
         Integrated first and discarded (rounded to whole steps).
 
@@ -189,22 +160,6 @@ def flow_trajectory(
     return t, states
 
 
-def flow_advance(system: FlowSystem, dt: float) -> Callable[[np.ndarray, float], np.ndarray]:
-    """Return ``advance(state, duration) -> state`` integrating `system` with RK4.
-
-    The step is ``duration / ceil(duration / dt)``, so any duration is reached exactly;
-    the callable `lyapunov_benettin` expects.
-    """
-    p = np.asarray(system.params, dtype=float)
-    kind = system.kind
-
-    def advance(state: np.ndarray, duration: float) -> np.ndarray:
-        n = max(1, int(math.ceil(duration / dt - 1e-9)))
-        return _rk4_run(kind, np.asarray(state, dtype=float), p, duration / n, n, n)[-1]
-
-    return advance
-
-
 def flow_reference(
     system: FlowSystem,
     y0: np.ndarray,
@@ -213,12 +168,8 @@ def flow_reference(
     rtol: float = 1e-11,
     atol: float = 1e-12,
 ) -> np.ndarray:
-    """Integrate a test flow with scipy's DOP853 at tight tolerances (independent path).
-
-    Returns
-    -------
-    ndarray, shape (len(t_eval), dim)
-    """
+    """The states at `t_eval`, shape (len(t_eval), dim), by scipy's DOP853 at tight
+    tolerances: the path RK4 is checked against."""
     from scipy.integrate import solve_ivp
 
     p = np.asarray(system.params, dtype=float)

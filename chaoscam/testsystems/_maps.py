@@ -1,8 +1,5 @@
-"""Discrete-time test systems: logistic map, Hénon map, sine circle map.
-
-Each system comes as a one-step function, its Jacobian (where it is smooth) and an orbit
-generator that discards a transient; each documents its values from the literature.
-"""
+"""Discrete-time test systems: logistic map, Hénon map, sine circle map: one-step functions,
+Jacobians and orbit generators (after a transient), with their values from the literature."""
 
 from __future__ import annotations
 
@@ -23,8 +20,7 @@ __all__ = [
 
 
 def logistic_step(x: np.ndarray, r: float) -> np.ndarray:
-    """One step of the logistic map ``x -> r x (1 - x)``: state x, shape (1,), in [0, 1];
-    growth parameter r in (0, 4]."""
+    """One step of the logistic map ``x -> r x (1 - x)``, x in [0, 1], r in (0, 4]."""
     x = np.asarray(x, dtype=float)
     return r * x * (1.0 - x)
 
@@ -42,12 +38,10 @@ def logistic_orbit(r: float, n: int, *, x0: float = 0.1234, transient: int = 100
     ----------
     r : float
         Growth parameter in (0, 4].
-    n : int
-        Number of iterates returned.
+    n, transient : int
+        Iterates returned, and iterates discarded first.
     x0 : float
         Initial condition in (0, 1).
-    transient : int
-        Iterates discarded first.
 
     Returns
     -------
@@ -56,9 +50,9 @@ def logistic_orbit(r: float, n: int, *, x0: float = 0.1234, transient: int = 100
 
     Notes
     -----
-    Known values (May 1976, Nature 261, 459): period 2 for 3 < r < 1 + sqrt(6), period 4 up
-    to r ≈ 3.5441, the period-3 window opens at r = 1 + sqrt(8) ≈ 3.8284, and at r = 4 the
-    map is conjugate to the tent map with Lyapunov exponent ln 2.
+    May 1976 (Nature 261, 459): period 2 for 3 < r < 1 + sqrt(6), period 4 up to r ≈ 3.5441,
+    the period-3 window opens at r = 1 + sqrt(8) ≈ 3.8284; at r = 4 the map is conjugate to
+    the tent map, Lyapunov exponent ln 2.
     """
     x = float(x0)
     for _ in range(int(transient)):
@@ -120,18 +114,16 @@ def circle_map_orbit(
 
     Parameters
     ----------
-    n : int
-        Number of iterates returned.
+    n, transient : int
+        Iterates returned, and iterates discarded first.
     omega : float
         Bare rotation Ω; the default is the golden mean (sqrt(5) - 1) / 2.
     k : float
         Nonlinearity K. For 0 <= K < 1 the map is an analytic circle diffeomorphism; outside
-        the Arnold tongues (a set of positive measure in Ω for K < 1) its rotation number is
-        irrational and the orbit is quasiperiodic, dense on the circle.
+        the Arnold tongues (positive measure in Ω) its rotation number is irrational and the
+        orbit quasiperiodic, dense on the circle.
     x0 : float
         Initial angle (in turns).
-    transient : int
-        Iterates discarded first.
     lift : bool
         Return the lift (not reduced mod 1), from which the rotation number is computed.
 
@@ -161,9 +153,7 @@ def circle_map_orbit(
 def circle_map_rotation_number(
     *, omega: float = (math.sqrt(5.0) - 1.0) / 2.0, k: float = 0.5, n: int = 100_000
 ) -> float:
-    """Rotation number ``ρ = lim (θ_n - θ_0) / n`` of the sine circle map from its lift.
-
-    The error after `n` iterates is below 1/n for a circle homeomorphism (K <= 1).
-    """
+    """Rotation number ``ρ = lim (θ_n - θ_0) / n`` of the sine circle map from its lift; the
+    error after `n` iterates is below 1/n for a circle homeomorphism (K <= 1)."""
     lifted = circle_map_orbit(n + 1, omega=omega, k=k, lift=True)
     return float((lifted[-1] - lifted[0]) / n)

@@ -27,7 +27,6 @@ def torus_signal(
     Parameters
     ----------
     t : array_like
-        Times.
     f1, f2 : float
         Base frequencies; quasiperiodic when f2 / f1 is irrational (default golden mean).
     a, b : float

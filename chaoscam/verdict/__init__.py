@@ -1,8 +1,8 @@
 """The verdict on a run: :func:`classify` labels every member of a solution from its section
-and tangent dynamics (the analysis layer's evidence, then the model-level :data:`RULES`, the
-periodic-orbit certificate, the extension of undetermined runs and the step check); the
-tangent dynamics' own results (:func:`lyapunov_spectrum`, :func:`periodic_orbit`,
-:func:`kick_test`, the stroboscopic map) live here too."""
+and tangent dynamics (the analysis layer's evidence, the model-level :data:`RULES`, the
+periodic-orbit certificate, the extension of undetermined runs, the step check); the tangent
+dynamics' own results (:func:`lyapunov_spectrum`, :func:`periodic_orbit`, :func:`kick_test`,
+:func:`stroboscopic_map`) live here too."""
 
 from ._certificate import MODEL_ATOL, Certificate, certify, on_orbit
 from ._classify import EXTEND_TO, classify, judge_member, judge_points
@@ -17,25 +17,7 @@ from ._orbits import (
 )
 from ._rules import RULES, Rule, apply_rules, extensible, extension_stopped
 
-__all__ = [
-    "EXTEND_TO",
-    "MODEL_ATOL",
-    "RULES",
-    "Certificate",
-    "KickTest",
-    "PeriodicOrbit",
-    "Rule",
-    "apply_rules",
-    "certify",
-    "classify",
-    "extensible",
-    "extension_stopped",
-    "iterate_map",
-    "judge_member",
-    "judge_points",
-    "kick_test",
-    "lyapunov_spectrum",
-    "on_orbit",
-    "periodic_orbit",
-    "stroboscopic_map",
-]
+__all__ = ["EXTEND_TO", "MODEL_ATOL", "RULES", "Certificate", "KickTest", "PeriodicOrbit", "Rule",
+           "apply_rules", "certify", "classify", "extensible", "extension_stopped", "iterate_map",
+           "judge_member", "judge_points", "kick_test", "lyapunov_spectrum", "on_orbit",
+           "periodic_orbit", "stroboscopic_map"]  # fmt: skip

@@ -1,16 +1,5 @@
-"""classify(solution) -> a verdict per member: periodic (with its period), quasiperiodic,
-chaotic or undetermined, with its evidence.
-
-Each member is judged from its stroboscopic section (theta_f, theta_f') at t = k 2 pi / omega
-and its tangent dynamics through the impacts: :func:`chaoscam.analysis.classify_section`
-with the tangent exponent lambda_1 +- its standard error (QR on the section map's
-Jacobians), then the model-level rules (:data:`~._rules.RULES`: n-band chaos, the
-periodic-orbit certificate of the deterministic model). An undetermined member is run longer
-(4x its recorded time a round, up to ``extend_to`` seconds recorded), continued bit for bit
-from where it stopped, until its verdict settles; ``check_step`` judges the same
-realizations at half the step and keeps a verdict only where both agree (MODEL.md: a result
-must not change when the step is halved).
-"""
+"""classify(solution): a verdict per member from its stroboscopic section and tangent
+exponent, the model-level rules, the extension of undetermined runs and the step check."""
 
 from __future__ import annotations
 
@@ -67,6 +56,12 @@ def classify(
 ) -> list[Verdict]:
     """The verdict of every member of ``solution``, in the order of its ``members``.
 
+    A member is judged from its stroboscopic section (theta_f, theta_f') at t = k 2 pi / omega
+    with its tangent exponent lambda_1 +- its standard error by
+    :func:`chaoscam.analysis.classify_section`, then by the model-level :data:`RULES`; an
+    undetermined member is continued bit for bit, 4x its recorded time a round, until its
+    verdict settles.
+
     Parameters
     ----------
     solution : Solution
@@ -81,7 +76,8 @@ def classify(
     check_step : bool
         Judge the same realizations at half the step (:meth:`Numerics.refined`), with the
         same extension; a verdict that changes becomes "undetermined" with the reason
-        (evidence ``step_check``: 1 unchanged, 0 changed; not a vote).
+        (evidence ``step_check``: 1 unchanged, 0 changed; not a vote). shared/MODEL.md: a
+        result must not change when the step is halved.
     discard : float
         Extra time after the transient left out of the classification [s].
     progress : callable, optional
@@ -128,19 +124,15 @@ def classify(
 def _with_run(v: Verdict, sol: Solution, j: int, how: dict) -> Verdict:
     """``v`` with the options and member ``j``'s run recorded in its settings."""
     row = sol.members.iloc[j]
-    record = {
-        "params": sol.models[j].to_dict(),
-        "numerics": sol.numerics.to_dict(),
-        "settings": {**sol.settings, "index": int(row["index"])},
-        "status": str(row["status"]),
-    }
+    record = {"params": sol.models[j].to_dict(), "numerics": sol.numerics.to_dict(),
+              "settings": {**sol.settings, "index": int(row["index"])},
+              "status": str(row["status"])}  # fmt: skip
     return dataclasses.replace(v, settings={**v.settings, "classify": how, "trajectory": record})
 
 
 def _tangent_solution(sol: Solution) -> Solution:
-    """The run whose Jacobians the verdicts read: ``sol`` when solved with the tangent, else
-    the same realizations on the RK4 grid with it, kept resumable (so that an extension goes
-    on from it)."""
+    """``sol`` when solved with the tangent, else the same realizations on the RK4 grid with
+    it, resumable (an extension goes on from it)."""
     if sol.jacobians is not None:
         return sol
     num = sol.numerics
@@ -160,18 +152,16 @@ def _tangent_solution(sol: Solution) -> Solution:
 
 
 def _judge_all(sol: Solution, discard: float, options: dict) -> list[Verdict]:
-    """Each member's verdict; those of a deterministic model on as many threads as the
-    solution ran on (their shootings run compiled without the GIL), the others on the
-    calling thread meanwhile (numpy and Python under the GIL, which threads only contend
-    for). A verdict is a pure function of its member: the threads change nothing but the
-    time."""
+    """Each member's verdict (a pure function of the member): those of a deterministic model
+    on the solution's threads (their shootings run compiled, without the GIL), the others on
+    the calling thread meanwhile (numpy under the GIL, which threads would only contend for)."""
     transient = float(sol.settings["transient"]) + discard
     rows_of = sol.sections.groupby("member").indices
     sec, empty = sol.sections, np.empty(0, dtype=np.int64)
     t, kk, xy = sec["t"].to_numpy(), sec["k"].to_numpy(), sec[_COORDS].to_numpy(dtype=float)
 
     def verdict(m: int) -> Verdict:
-        check_stop()  # a labelling thread asked to stop: before each member (a prompt Ctrl-C)
+        check_stop()  # before each member: a prompt Ctrl-C
         pick = rows_of.get(m, empty)
         status = Status[sol.members["status"].iat[m]]
         return judge_member(status, t[pick], kk[pick], xy[pick], sol.jacobians[pick],
@@ -194,10 +184,8 @@ def judge_member(status, t, kk, xy, jac, p, num, transient: float, options: dict
     period = p.cam_period
     keep = (t >= transient - 1e-9 * period) & (kk > 0)
     if keep.sum() < 2:
-        why = (
-            f"{int(keep.sum())} section point(s) after the transient: too few to judge; "
-            "run longer than the transient by several cam periods"
-        )
+        why = (f"{int(keep.sum())} section point(s) after the transient: too few to judge; "
+               "run longer than the transient by several cam periods")  # fmt: skip
         return Verdict("undetermined", None, (), (why,))
     return judge_points(xy[keep], jac[keep], p, num, options)
 
@@ -223,23 +211,16 @@ def judge_points(points, jacobians, p, num, options: dict) -> Verdict:
 
 def _status_verdict(st: Status, t_end: float) -> Verdict:
     label = st.label or st.name.lower()
-    e = Evidence(
-        "status",
-        int(st),
-        None,
-        f"the run ended with status {st.name} at t = {t_end:.6g} s: {st.message}",
-    )
-    why = (
-        f"the run did not end normally ({label}, t = {t_end:.6g} s): the motion is not "
-        "described by the model after that, so it is not classified"
-    )
+    ended = f"the run ended with status {st.name} at t = {t_end:.6g} s: {st.message}"
+    e = Evidence("status", int(st), None, ended)
+    why = (f"the run did not end normally ({label}, t = {t_end:.6g} s): the motion is not "
+           "described by the model after that, so it is not classified")  # fmt: skip
     return Verdict("undetermined", None, (e,), (why,), {"status": st.name})
 
 
 def _extended(sol, verdicts, extend_to, discard, options, progress) -> list[Verdict]:
-    """The undetermined members run 4x longer (section and tangent only), continued from
-    their last run, until their verdicts settle or the recorded time reaches ``extend_to``:
-    all of them in one call each round."""
+    """The undetermined members continued 4x longer a round (all in one call), until their
+    verdicts settle or the recorded time reaches ``extend_to``."""
     s = sol.settings
     start = s["transient"] + discard
     recorded = s["duration"] - start
@@ -252,7 +233,8 @@ def _extended(sol, verdicts, extend_to, discard, options, progress) -> list[Verd
             progress(0, extending=len(pending), recorded_s=recorded)
         where = {j: i for i, j in enumerate(at)}
         longer = extend(last, start + recorded, members=[where[j] for j in pending],
-                        resumable=True, progress=progress, backend=_extend_backend(last))
+                        resumable=True, progress=progress,
+                        backend=_extend_backend(last))  # fmt: skip
         note = {"recorded_s": recorded, "wall_time_s": time.perf_counter() - t_wall,
                 "why": "the verdict on the run as given was undetermined",
                 "backend": longer.settings["backend"]}  # fmt: skip
@@ -265,15 +247,13 @@ def _extended(sol, verdicts, extend_to, discard, options, progress) -> list[Verd
 
 
 def _extend_backend(sol: Solution) -> str:
-    """Where an extension runs: a CPU run's on the CPU (the same bits as a longer CPU run);
-    a GPU run's few members by size (``"auto"``: one GPU thread is slow, and a few hundred
-    members run sooner on the host's cores)."""
+    """A CPU run's extension on the CPU (the bits of a longer CPU run), a GPU run's by size
+    (``"auto"``: a few hundred members run sooner on the host's cores than on the GPU)."""
     return "cpu" if sol.settings["backend"] == "cpu" else "auto"
 
 
 def _after_extension(before: Verdict, after: Verdict, longer: Solution, i, note, recorded):
-    """The verdict after an extension round: the longer run's, or, when that run ended early,
-    the first verdict kept and saying so."""
+    """The longer run's verdict, or, when that run ended early, the first one, saying so."""
     status = Status[longer.members["status"].iat[i]]
     if status is Status.OK:
         return dataclasses.replace(after, settings={**after.settings, "extended": note})
@@ -282,8 +262,8 @@ def _after_extension(before: Verdict, after: Verdict, longer: Solution, i, note,
 
 
 def _step_checked(sol, verdicts, extend_to, discard, options) -> list[Verdict]:
-    """The verdicts checked at half the step: the same realizations solved at
-    :meth:`Numerics.refined` and judged the same way (extension included)."""
+    """The verdicts checked against the same realizations at :meth:`Numerics.refined`,
+    judged the same way (extension included)."""
     fine = sol.numerics.refined()
     asked = [j for j, v in enumerate(verdicts) if v.label != "undetermined"]
     out = [skipped(v, fine) if v.label == "undetermined" else v for v in verdicts]
@@ -306,13 +286,11 @@ def _step_checked(sol, verdicts, extend_to, discard, options) -> list[Verdict]:
 
 
 def _threaded(fn: Callable, items: list, threads: int, here: list = ()) -> tuple[list, list]:
-    """``([fn(x) for x in items], [fn(x) for x in here])``: ``items`` on up to ``threads``
-    threads, ``here`` on the calling thread meanwhile, each in order. An exception (a Ctrl-C
-    in the waiting thread too) cancels the calls not yet started."""
+    """``([fn(x) for x in items], [fn(x) for x in here])``, ``items`` on up to ``threads``
+    threads and ``here`` on this one meanwhile; an exception (a Ctrl-C too) cancels the rest."""
     if threads <= 1 or len(items) <= 1:
         return [fn(x) for x in items], [fn(x) for x in here]
-    # each call in a copy of this thread's context: a warning it raises is recorded where
-    # this thread's are (chaoscam._util.recorded, the sweeps' batches)
+    # each call in a copy of this thread's context: its warnings are recorded with this one's
     ctx = contextvars.copy_context()
     pool = ThreadPoolExecutor(min(threads, len(items)), thread_name_prefix="chaoscam-verdict")
     try:

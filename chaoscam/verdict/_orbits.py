@@ -1,20 +1,7 @@
-"""The tangent dynamics at work: Lyapunov spectrum, periodic orbits, finite kicks.
-
-All read the stroboscopic map ``P: x(t_k) -> x(t_k + T)``, ``T = 2 pi / omega``, whose
-Jacobians the compiled kernel integrates through the impacts (tangent flow plus saltation
-matrices) and writes beside each section point:
-
-- :func:`lyapunov_spectrum` — both exponents of the non-autonomous 2-D system by repeated QR
-  of the product of those Jacobians (Benettin et al. 1980; Eckmann & Ruelle 1985, Rev. Mod.
-  Phys. 57, sec. IV.B), no separation ``d0`` to choose;
-- :func:`periodic_orbit` — Newton's method (shooting) on ``P^n(x) = x`` with the monodromy
-  matrix ``DP^n`` from the same Jacobians; the orbit, its Floquet multipliers and whether it
-  is a certified attracting orbit;
-- :func:`kick_test` — the direct perturbation test, no tangent at all: kicks of finite size
-  followed on the map itself, which decides stability where the map is not differentiable at
-  the scale of its event jitter (chattering ending in sticking).
-
-The map runs are members of :func:`chaoscam.solve`'s batch runner started from a state.
+"""The tangent dynamics at work: Lyapunov spectrum, periodic orbits, finite kicks, all on the
+stroboscopic map ``P: x(t_k) -> x(t_k + T)``, ``T = 2 pi / omega``, whose Jacobians the kernel
+integrates through the impacts (tangent flow and saltation matrices). The map runs are
+members of :func:`chaoscam.solve`'s batch runner started from a state.
 """
 
 from __future__ import annotations
@@ -36,15 +23,8 @@ from ..model import Params, params_arg, realizations_identical
 from ..numerics import Numerics
 from ..simulation import ROOM, Solution, check_run, fresh, numerics_arg, run_batch, solve
 
-__all__ = [
-    "KickTest",
-    "PeriodicOrbit",
-    "iterate_map",
-    "kick_test",
-    "lyapunov_spectrum",
-    "periodic_orbit",
-    "stroboscopic_map",
-]
+__all__ = ["KickTest", "PeriodicOrbit", "iterate_map", "kick_test", "lyapunov_spectrum",
+           "periodic_orbit", "stroboscopic_map"]  # fmt: skip
 
 
 def lyapunov_spectrum(
@@ -56,14 +36,14 @@ def lyapunov_spectrum(
     seed: int = 0,
     index: int = 0,
 ) -> TangentSpectrum:
-    """Lyapunov spectrum of one realization from its tangent dynamics through the impacts.
+    """Lyapunov spectrum [1/s] of one realization from its tangent dynamics through the impacts.
 
     Solves with ``tangent=True`` (or takes a one-member :class:`Solution` solved so, in place
-    of ``params``) and applies :func:`chaoscam.analysis.spectrum_from_jacobians` to the
-    recorded stroboscopic Jacobians. The tangent costs about 0.1 of a run on RK4 and 2.5 runs
-    on the adaptive path. With a random line length (sigma > 0) the exponents are those of
-    the realization's random map sequence (its top exponent is the random system's:
-    L. Arnold, Random Dynamical Systems, 1998).
+    of ``params``) and applies :func:`chaoscam.analysis.spectrum_from_jacobians` (repeated QR,
+    no separation to choose) to the recorded stroboscopic Jacobians. The tangent costs about
+    0.1 of a run on RK4 and 2.5 runs on the adaptive path. With a random line length the
+    exponents are those of the realization's random map sequence (L. Arnold, Random
+    Dynamical Systems, 1998).
     """
     if isinstance(params, Solution):
         run = params
@@ -99,12 +79,9 @@ def lyapunov_spectrum(
     return dataclasses.replace(spec, settings={**spec.settings, **window})
 
 
-# --- periodic orbits ------------------------------------------------------------------------
-
-
 class _MapRunner:
     """n iterates of the stroboscopic map of a deterministic model from a state at t = 0, and
-    DP^n: one member of :func:`chaoscam.solve`'s batch runner, started from that state."""
+    DP^n: one member of the batch runner started from that state."""
 
     def __init__(self, p: Params, num: Numerics, n: int, *, tangent: bool = True) -> None:
         if not realizations_identical(p):
@@ -126,11 +103,10 @@ class _MapRunner:
         s = self.start
         y = s.y.copy()
         y[0, k.Y_THETA], y[0, k.Y_OMEGA] = x
+        kept = {"section": [[]], "impacts": [[]], "series": [[]]}
         start = dataclasses.replace(
-            s, y=y, cnt=s.cnt.copy(), lam=s.lam.copy(), kept={"section": [[]], "impacts": [[]],
-                                                              "series": [[]]},
-            status=s.status.copy(),
-        )  # fmt: skip
+            s, y=y, cnt=s.cnt.copy(), lam=s.lam.copy(), kept=kept, status=s.status.copy()
+        )
         self.calls += 1
         out = run_batch([self.p], self.num, [0], start, 0, self.duration, room=ROOM["cpu"])
         return out.kept["section"][0], int(out.status[0])
@@ -156,10 +132,9 @@ class _MapRunner:
 
 def iterate_map(params: Params, x, n: int, numerics: Numerics | None = None) -> np.ndarray:
     """The section points ``x, P(x), ..., P^n(x)`` (shape (n + 1, 2)) of the deterministic
-    model, from the state x = (θ_f, θ̇_f) at t = 0: a direct perturbation test at a chosen
-    step (does a point near an orbit settle on it?). Rows after a run that stopped (left
-    the cam's reach) are NaN."""
-    # No tangent: the state is bit-identical without it, and the points are all we need.
+    model from the state x = (θ_f, θ̇_f) at t = 0 (does a point near an orbit settle on it?);
+    NaN rows after a run that stopped (left the cam's reach)."""
+    # no tangent: the state is bit-identical without it
     run = _MapRunner(params, numerics_arg(numerics), int(n), tangent=False)
     return run.points(np.asarray(x, dtype=float))
 
@@ -167,10 +142,8 @@ def iterate_map(params: Params, x, n: int, numerics: Numerics | None = None) -> 
 def stroboscopic_map(
     params: Params, x, n: int = 1, numerics: Numerics | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``(P^n(x), DP^n(x))``: n cam periods from the state x = (θ_f, θ̇_f) at t = 0.
-
-    The deterministic model only (σ = 0); DP^n through the impacts' saltation matrices.
-    """
+    """``(P^n(x), DP^n(x))``: n cam periods from the state x = (θ_f, θ̇_f) at t = 0 of the
+    deterministic model (σ = 0), DP^n through the impacts' saltation matrices."""
     xn, m, code = _MapRunner(params, numerics_arg(numerics), int(n))(np.asarray(x, dtype=float))
     if code != k.OK:
         raise ValueError(f"the map could not be iterated: {Status(code).message}")
@@ -180,10 +153,9 @@ def stroboscopic_map(
 KICKS = (1e-8, 1e-7, 1e-6)
 """Kick sizes of :func:`kick_test` [rad; θ̇_f kicks are ``omega_scale`` times larger]."""
 KICK_DECIDES = 1e-7
-"""Kicks at least this large decide :attr:`KickTest.returns`: sticking orbits of this model
-jitter by ~1e-8 rad from period to period (located events move by whole bisection steps), so a
-1e-8 kick can stay near its own size on an attracting orbit (ξ = 0.525: 0.47 of itself
-after 12 periods of 8)."""
+"""Kicks at least this large decide :attr:`KickTest.returns`: sticking orbits jitter by ~1e-8
+rad from period to period (located events move by whole bisection steps), so a 1e-8 kick can
+stay near its own size on an attracting orbit (ξ = 0.525: 0.47 of itself after 12 periods)."""
 KICK_RETURN = 0.1
 """A kick has returned when the separation it made is at most this fraction of it."""
 
@@ -232,23 +204,16 @@ def kick_test(
 ) -> KickTest:
     """The direct perturbation test at x = (θ_f, θ̇_f) (t = 0, deterministic model): kick θ_f
     by ± each of ``kicks`` and θ̇_f by ± ``omega_scale`` times as much, iterate ``periods`` × n
-    cam periods (:func:`iterate_map`) and compare with the unkicked run.
+    cam periods (:func:`iterate_map`) and compare with the unkicked run; a :class:`KickTest`.
 
-    The tangent is an infinitesimal derivative, and where
-    chattering ends in sticking the grid map is not differentiable at the scale of its event
-    jitter: at ξ = 0.525 the grid tangent's |μ|max is 5.9 while kicks of 1e-9 to 1e-6 return
-    to a 1e-8 floor (docs/findings.md, "Tangent dynamics checked independently"). This test
-    measures at finite sizes. Measured at dt from the last section point of a 130 s run (100 s
-    transient), n the period (8 for chaos): ``returns`` agrees with the label of all 24
-    deterministic settled configurations of the labelled and holdout sets (tests/data: 15
-    periodic, largest final separation over kick 3e-4; 9 chaotic, 0.67 to 5e6), returns on
-    (32.5, 0.5) and ξ = 0.525 (5e-4, 1e-3), and not on (26, 0.3) (0.27) or (45, 0.4) (160).
-    Over 12 periods instead of 40, ξ = 0.2's and ω = 31's slowly contracting orbits (0.15 and
-    0.10 left) did not return. On chaotic bands many kicks do return (sticking merges nearby
-    motions): the four directions at two sizes keep one from deciding alone. With
-    ``until_refused``, the kicks stop at the first deciding one that does not return
-    (``returns`` is then False and the rows of the kicks not run are NaN): the answer for a
-    fraction of the cost, as the kick certificate asks it. Returns a :class:`KickTest`.
+    Where chattering ends in sticking the grid map is not differentiable at the scale of its
+    event jitter (at ξ = 0.525 the tangent's |μ|max is 5.9 while kicks of 1e-9 to 1e-6 return
+    to a 1e-8 floor); kicks measure at finite sizes. ``returns`` agrees with the label of all
+    24 deterministic settled configurations of the labelled and holdout sets (docs/findings.md,
+    "Tangent dynamics checked independently"). On chaotic bands many kicks return (sticking
+    merges nearby motions): four directions at two sizes keep one from deciding alone. With
+    ``until_refused`` the kicks stop at the first deciding one that does not return
+    (``returns`` False, the rows not run NaN).
     """
     params, num = params_arg(params), numerics_arg(numerics)
     n = whole("n", n, low=1)
@@ -292,9 +257,8 @@ class PeriodicOrbit:
     wall_time : float
         Seconds spent.
     settings : dict
-        tol, max_iter, map_calls, cam_period, seed_period, and seed_status: how the map
-        from ``x0`` ended (``LEFT_REACH`` or a divergence: no orbit was found from there,
-        the multipliers are NaN).
+        tol, max_iter, map_calls, cam_period, seed_period, and seed_status: how the map from
+        ``x0`` ended (``LEFT_REACH`` or a divergence: no orbit from there, NaN multipliers).
     """
 
     period: int
@@ -343,23 +307,19 @@ def periodic_orbit(
 ) -> PeriodicOrbit:
     """Newton's method on ``P^n(x) = x`` with the monodromy matrix from the tangent dynamics.
 
-    ``x ← x - (DP^n(x) - I)^{-1} (P^n(x) - x)``, with a step halved while it does not lower
-    the residual (a damped Newton, Deuflhard 2004, *Newton Methods for Nonlinear Problems*,
-    sec. 3). The residual is measured in the scaled norm ``|(Δθ, T Δθ̇)|`` [rad]. Seed it with
-    a section point of a run that looks periodic (the certificate of :func:`chaoscam.classify`
-    does).
+    ``x ← x - (DP^n(x) - I)^{-1} (P^n(x) - x)``, the step halved while it does not lower the
+    residual (damped Newton: Deuflhard 2004, *Newton Methods for Nonlinear Problems*, sec. 3),
+    measured in the scaled norm ``|(Δθ, T Δθ̇)|`` [rad]. Seed it with a section point of a run
+    that looks periodic (as the certificate of :func:`chaoscam.classify` does).
 
     ``tol`` [rad]: P is smooth only to the event tolerance (a located time jitters by
-    ~``event_tol``, which moves the state by ~1e-11 after a jump) and to the chattering
-    threshold ``v_chatter`` (a bounce just above or below it ends differently), so residuals
-    stall at ~1e-9 to 1e-8 rad on orbits with chattering; 1e-7 rad is far below any band
-    the classifier resolves. With |μ|max < 1 and a residual r, a fixed point of the smooth
-    branch lies within ~r / (1 - |μ|max) of the returned one.
-
-    The least period is the smallest divisor d of n with |P^d(x_0) - x_0| within
-    ``max(10 residual, tol / 100)``: just past a flip the period-2d orbit's halves lie close
-    together (measured: 1.2e-7 rad on a period-16 orbit of the fractal stiffness, D = 1.4,
-    G = 1e-9 m, whose residual was 5.7e-9 rad), so the bound follows the residual, not ``tol``.
+    ~``event_tol``) and to the chattering threshold ``v_chatter``, so residuals stall at ~1e-9
+    to 1e-8 rad on orbits with chattering; 1e-7 rad is far below any band the classifier
+    resolves. With |μ|max < 1 and a residual r, a fixed point of the smooth branch lies within
+    ~r / (1 - |μ|max) of the returned one. The least period is the smallest divisor d of n
+    with |P^d(x_0) - x_0| within ``max(10 residual, tol / 100)``: just past a flip the
+    period-2d orbit's halves lie close (1.2e-7 rad on a period-16 orbit of the fractal
+    stiffness whose residual is 5.7e-9 rad), so the bound follows the residual.
 
     Limits: P is piecewise smooth (a grazing impact or the chattering threshold makes it
     jump), so Newton may fail where the orbit grazes; ``converged`` then stays False.
@@ -370,8 +330,7 @@ def periodic_orbit(
     tol = real("tol", tol, low=0.0, strict=True, unit="rad")
     max_iter = whole("max_iter", max_iter, low=0)
     x = _state(x0)
-    # Each Newton iteration runs n cam periods: at most max_iter + 1 of them, judged as one
-    # run (refused past the run limit, as solve is; a warning past a minute).
+    # up to (max_iter + 1) n periods, judged as one run (refused past the run limit, as solve)
     most = (max_iter + 1) * n
     check_run(params, num, most * params.cam_period, what=f"the shooting (up to {most} periods)")
     run = _MapRunner(params, num, n)
@@ -380,23 +339,13 @@ def periodic_orbit(
     least, pts, m = _least_period(params, num, one, x, n, m, res, tol)
     # A map that left the model (the seed off the cam's reach) has no Jacobian: NaN.
     mult = np.linalg.eigvals(m) if np.isfinite(m).all() else np.full(2, np.nan + 0j)
-    return PeriodicOrbit(
-        period=least,
-        points=pts,
-        multipliers=mult,
-        residual=res,
-        converged=res <= tol,
-        iterations=it,
-        wall_time=time.perf_counter() - t0,
-        settings={
-            "tol": tol,
-            "max_iter": max_iter,
-            "map_calls": run.calls + one.calls,
-            "cam_period": params.cam_period,
-            "seed_period": n,
-            "seed_status": first.name,  # e.g. LEFT_REACH: the map from x0 left the model
-        },
-    )
+    # seed_status: how the map from x0 ended (e.g. LEFT_REACH: it left the model)
+    settings = {"tol": tol, "max_iter": max_iter, "map_calls": run.calls + one.calls,
+                "cam_period": params.cam_period, "seed_period": n,
+                "seed_status": first.name}  # fmt: skip
+    return PeriodicOrbit(period=least, points=pts, multipliers=mult, residual=res,
+                         converged=res <= tol, iterations=it, wall_time=time.perf_counter() - t0,
+                         settings=settings)  # fmt: skip
 
 
 def _state(x0) -> np.ndarray:
@@ -413,8 +362,7 @@ def _state(x0) -> np.ndarray:
 
 
 def _newton(run: _MapRunner, x: np.ndarray, period: float, tol: float, max_iter: int):
-    """Damped Newton on ``P^n(x) = x``: (x, DP^n(x), residual, iterations, the status of the
-    map from the seed)."""
+    """Damped Newton on ``P^n(x) = x``: (x, DP^n(x), residual, iterations, the seed's status)."""
     w = np.array([1.0, period])
     fx, m, code = run(x)
     first = Status(code)  # how the map from the seed ended (not OK: no orbit from there)

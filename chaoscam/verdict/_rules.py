@@ -1,13 +1,6 @@
-"""The model-level rules on top of the analysis layer's verdict: an ordered list of named rules.
-
-The analysis layer (:func:`chaoscam.analysis.classify_section`) judges the section's arrays
-with the tangent exponent; these rules add what only the model knows. They run in the order
-of :data:`RULES`; each either leaves the verdict to the next, changes it and passes it on, or
-decides (the last word). Each says what it checks and the measurement behind it;
-``tests/verdict/test_rules.py`` shows each one's verdict and the one it overturns. (That a
-chaotic label needs two independent methods or a positive exponent is the analysis layer's
-own rule, ``classify_section``'s.)
-"""
+"""The model-level rules on top of the analysis layer's verdict, in the order of :data:`RULES`:
+each leaves the verdict to the next, changes it and passes it on, or decides (the last word).
+``tests/verdict/test_rules.py`` shows each one's verdict and the one it overturns."""
 
 from __future__ import annotations
 
@@ -22,26 +15,15 @@ from ..model import Params, realizations_identical
 from ..numerics import Numerics
 from ._certificate import MODEL_ATOL, ORBIT_REFINE, certify
 
-__all__ = [
-    "BAND_RTOL",
-    "EXTENSION_STOPPED",
-    "OVERFLOW",
-    "RULES",
-    "STEP_DEPENDENT",
-    "Context",
-    "Rule",
-    "apply_rules",
-    "extensible",
-    "extension_stopped",
-    "overflow_evidence",
-]
+__all__ = ["BAND_RTOL", "EXTENSION_STOPPED", "OVERFLOW", "RULES", "STEP_DEPENDENT", "Context",
+           "Rule", "apply_rules", "extensible", "extension_stopped",
+           "overflow_evidence"]  # fmt: skip
 
 BAND_RTOL = 0.05
 """Bands narrower than this fraction of the section's extent count as n narrow bands for the
-n-band chaos rule: the 0-1 test sees a chaotic component of relative size w on top of a
-periodic sequence only on N >~ 1/w^2 samples, so narrow chaotic bands read regular to it (at
-(omega, xi) = (42.5, 0.15): 4 bands of 1.4e-2 of the extent, lambda_1 = 0.317 +- 0.014 per
-iterate; 600 s runs at dt and dt/2 show 8-band chaos)."""
+n-band chaos rule: the 0-1 test sees a chaotic component of relative size w on a periodic
+sequence only on N >~ 1/w^2 samples (at (omega, xi) = (42.5, 0.15) 4 bands of 1.4e-2 of the
+extent have lambda_1 = 0.317 +- 0.014 per iterate and are 8-band chaos on 600 s runs)."""
 
 STEP_DEPENDENT = "step_dependent"
 """The evidence of a verdict whose periodic orbit is the grid's alone."""
@@ -55,8 +37,7 @@ EXTENSION_STOPPED = "extension_stopped"
 
 @dataclass(frozen=True)
 class Context:
-    """What the rules know of a member: its model, numerics, section points, tangent spectrum,
-    and the record (``extra``) the certificate writes its shootings to."""
+    """What the rules know of a member, and the record (``extra``) of the certificate."""
 
     p: Params
     num: Numerics
@@ -71,9 +52,8 @@ class Context:
 
 @dataclass(frozen=True)
 class Rule:
-    """One model-level rule: its name, what it checks, and ``apply(verdict, context)``, which
-    returns None (not for this verdict), or ``(verdict, final)``: the verdict passed on, or
-    the last word when ``final``."""
+    """A named model-level rule: ``apply(verdict, context)`` returns None (not for this
+    verdict) or ``(verdict, final)``, the verdict passed on or, when ``final``, the last word."""
 
     name: str
     checks: str
@@ -91,35 +71,24 @@ def _undetermined(v: Verdict, reason: str, *more: Evidence) -> Verdict:
 def _torus_needs_zero_exponent(v: Verdict, ctx: Context):
     if v.label != "quasiperiodic" or _votes(v).get("exponent") == "not_chaotic":
         return None
-    reason = (
-        "quasiperiodic evidence, but the tangent exponent does not confirm lambda_1 = 0 "
-        "within its interval: run longer"
-    )
+    reason = ("quasiperiodic evidence, but the tangent exponent does not confirm lambda_1 = 0 "
+              "within its interval: run longer")  # fmt: skip
     return _undetermined(v, reason), False
 
 
 def _random_period_needs_contraction(v: Verdict, ctx: Context):
-    if (
-        v.label != "periodic"
-        or ctx.deterministic
-        or _votes(v).get("exponent") in ("not_chaotic", "periodic")
-    ):
+    exponent = _votes(v).get("exponent")
+    if v.label != "periodic" or ctx.deterministic or exponent in ("not_chaotic", "periodic"):
         return None
-    reason = (
-        f"the section repeats with period {v.period} to the band tolerance, but the line "
-        "length is random (no periodic orbit to certify) and the tangent exponent does "
-        "not confirm lambda_1 < 0 within its interval: run longer"
-    )
+    reason = (f"the section repeats with period {v.period} to the band tolerance, but the line "
+              "length is random (no periodic orbit to certify) and the tangent exponent does "
+              "not confirm lambda_1 < 0 within its interval: run longer")  # fmt: skip
     return _undetermined(v, reason), False
 
 
 def _banded_chaos(v: Verdict, ctx: Context):
-    if v.label != "undetermined":
-        return None
-    n = _banded_period(v, ctx)
-    if n is None:
-        return None
-    return _banded_verdict(v, ctx, n), True
+    n = _banded_period(v, ctx) if v.label == "undetermined" else None
+    return None if n is None else (_banded_verdict(v, ctx, n), True)
 
 
 def _periodic_orbit(v: Verdict, ctx: Context):
@@ -130,32 +99,21 @@ def _periodic_orbit(v: Verdict, ctx: Context):
 
 
 RULES: tuple[Rule, ...] = (
-    Rule(
-        "torus_needs_zero_exponent",
-        "a quasiperiodic verdict needs lambda_1 = 0 within the tangent exponent's interval "
-        "(a torus has a zero top exponent); else undetermined",
-        _torus_needs_zero_exponent,
-    ),
-    Rule(
-        "random_period_needs_contraction",
-        "with a random line length there is no orbit to certify: n bands are periodic only "
-        "when the tangent exponent confirms lambda_1 < 0 (8 bands of 1e-3 rad at sigma = "
-        "1.5 mm, lambda_1 = 0.53 +- 0.22 after 46 periods, were chaotic on a longer run)",
-        _random_period_needs_contraction,
-    ),
-    Rule(
-        "banded_chaos",
-        "n narrow bands with lambda_1 > 0 beyond its interval: n-band chaos unless an "
-        "attracting period-n orbit the run converges to lies in them (BAND_RTOL)",
-        _banded_chaos,
-    ),
-    Rule(
-        "periodic_orbit",
-        "a periodic (or disputed periodic) section of the deterministic model is certified "
-        "by Newton shooting, refined steps and kicks (the certificate), or not",
-        _periodic_orbit,
-    ),
-)
+    Rule("torus_needs_zero_exponent",
+         "a quasiperiodic verdict needs lambda_1 = 0 within the tangent exponent's interval "
+         "(a torus has a zero top exponent); else undetermined", _torus_needs_zero_exponent),
+    Rule("random_period_needs_contraction",
+         "with a random line length there is no orbit to certify: n bands are periodic only "
+         "when the tangent exponent confirms lambda_1 < 0 (8 bands of 1e-3 rad at sigma = "
+         "1.5 mm, lambda_1 = 0.53 +- 0.22 after 46 periods, were chaotic on a longer run)",
+         _random_period_needs_contraction),
+    Rule("banded_chaos",
+         "n narrow bands with lambda_1 > 0 beyond its interval: n-band chaos unless an "
+         "attracting period-n orbit the run converges to lies in them (BAND_RTOL)", _banded_chaos),
+    Rule("periodic_orbit",
+         "a periodic (or disputed periodic) section of the deterministic model is certified "
+         "by Newton shooting, refined steps and kicks (the certificate), or not", _periodic_orbit),
+)  # fmt: skip
 """The model-level rules, in the order they apply."""
 
 
@@ -173,17 +131,14 @@ def apply_rules(v: Verdict, ctx: Context) -> Verdict:
 
 def tangent_record(spec) -> dict:
     """What a verdict's settings keep of the tangent spectrum."""
-    return {
-        "exponents": [float(x) for x in spec.exponents],
-        "stderr": [float(x) for x in spec.stderr],
-        "n_periods": spec.n_periods,
-        "method": "tangent dynamics through the impacts, QR (chaoscam.lyapunov_spectrum)",
-    }
+    exponents, stderr = [float(x) for x in spec.exponents], [float(x) for x in spec.stderr]
+    method = "tangent dynamics through the impacts, QR (chaoscam.lyapunov_spectrum)"
+    return {"exponents": exponents, "stderr": stderr, "n_periods": spec.n_periods, "method": method}
 
 
 def _disputed_period(v: Verdict) -> int | None:
     """n when an undetermined verdict's section is periodic (n) and the exponent does not say
-    chaotic: the case a periodic-orbit certificate settles."""
+    chaotic (the case a certificate settles)."""
     votes = {e.name: e for e in v.evidence}
     sp, ex = votes.get("section_period"), votes.get("exponent")
     if v.label != "undetermined" or sp is None or sp.vote != "periodic":
@@ -195,8 +150,7 @@ def _disputed_period(v: Verdict) -> int | None:
 
 def _banded_period(v: Verdict, ctx: Context) -> int | None:
     """n when the tangent exponent is positive beyond its interval while the section keeps n
-    narrow bands: periodic to the band tolerance, or n bands each narrower than
-    ``BAND_RTOL`` of the extent; else None."""
+    bands, periodic to the band tolerance or each narrower than ``BAND_RTOL``; else None."""
     votes = {e.name: e for e in v.evidence}
     sp, ex = votes.get("section_period"), votes.get("exponent")
     if sp is None or ex is None or ex.vote != "chaotic":
@@ -204,10 +158,9 @@ def _banded_period(v: Verdict, ctx: Context) -> int | None:
     if sp.vote == "periodic":
         return int(sp.value)
     atol = (MODEL_ATOL, MODEL_ATOL / ctx.p.cam_period)
-    bands = section_period(
+    return section_period(
         ctx.points, rtol=BAND_RTOL, atol=atol, allow_transient=False, distinct=False
-    )
-    return bands.period
+    ).period
 
 
 def _certified_verdict(v: Verdict, ctx: Context, n: int) -> Verdict:
@@ -217,8 +170,7 @@ def _certified_verdict(v: Verdict, ctx: Context, n: int) -> Verdict:
         e = Evidence("periodic_orbit", cert.period, "periodic", "certified: " + cert.detail)
         if v.label == "periodic" and cert.period == v.period:
             return dataclasses.replace(v, evidence=v.evidence + (e,))
-        # The certificate decides what the section and the exponent left open: an attracting
-        # orbit the run converges to outweighs a spectral or 0-1 vote on a short series.
+        # an attracting orbit the run converges to outweighs a spectral or 0-1 vote
         return Verdict("periodic", cert.period, v.evidence + (e,), (), v.settings)
     why = {"off orbit": "the run is not on it", "period differs": "its least period differs"}
     why = why.get(cert.status, cert.status)
@@ -232,28 +184,23 @@ def _certified_verdict(v: Verdict, ctx: Context, n: int) -> Verdict:
         )
         return _undetermined(v, reason, e)
     if v.label == "periodic" and _votes(v).get("exponent") != "not_chaotic":
-        reason = (
-            f"the section repeats with period {v.period} but no attracting orbit is "
-            f"certified ({why}) and the tangent exponent does not confirm lambda_1 < 0: "
-            "run longer"
-        )
+        reason = (f"the section repeats with period {v.period} but no attracting orbit is "
+                  f"certified ({why}) and the tangent exponent does not confirm lambda_1 < 0: "
+                  "run longer")  # fmt: skip
         return _undetermined(v, reason, e)
     return dataclasses.replace(v, evidence=v.evidence + (e,))
 
 
 def _banded_verdict(v: Verdict, ctx: Context, n: int) -> Verdict:
-    """Resolve "n narrow bands but lambda_1 > 0": chaotic when no attracting period-n orbit
-    the run converges to lies in the bands (or the model is random: it has none), periodic
-    when the orbit is attracting only at refined steps or by kicks (the grid's exponent is
-    then its error in the chattering phases), still undetermined when the grid certifies one
-    (a genuine conflict) or refined steps disagree."""
+    """Resolve "n narrow bands but lambda_1 > 0": chaotic when no attracting period-n orbit the run
+    converges to lies in them (none in a random model), periodic when one attracts only at
+    refined steps or by kicks (the grid's exponent is its error in the chattering phases),
+    undetermined when the grid certifies one (a conflict) or refined steps disagree."""
     if not ctx.deterministic:
-        e = Evidence(
-            "periodic_orbit", None, None, "random line length: no periodic orbit to shoot for"
-        )
-        return _band_chaos(v, n, e)
-    # No flip doubling here: only a section that itself repeats with period 2n sends the
-    # shooting to 2n (shooting 2n and 4n in the default's 8 chaotic bands doubled Fig. 4's cost).
+        why = "random line length: no periodic orbit to shoot for"
+        return _band_chaos(v, n, Evidence("periodic_orbit", None, None, why))
+    # no flip doubling: only a section that repeats with period 2n sends the shooting to 2n
+    # (2n and 4n in the default's 8 chaotic bands would double Fig. 4's cost)
     cert = certify(ctx.p, ctx.num, ctx.points, n, ctx.extra, flips_double=False)
     detail = f"from the bands: {cert.detail}"
     if cert.certified and not cert.refined:
@@ -265,16 +212,12 @@ def _banded_verdict(v: Verdict, ctx: Context, n: int) -> Verdict:
         return dataclasses.replace(v, evidence=v.evidence + (e,), reasons=v.reasons + (conflict,))
     if cert.certified:
         e = Evidence("periodic_orbit", cert.period, "periodic", detail)
-        where = (
-            "finite kicks return to it at the run's step and at half of it"
-            if cert.kicked
-            else "it is attracting at every refined step"
-        )
-        note = (
-            f"the tangent exponent on the run's grid is positive, but the run lies on the "
-            f"period-{cert.period} orbit in the bands and {where}: the exponent's sign is "
-            "the grid's error in the chattering phases"
-        )
+        where = "it is attracting at every refined step"
+        if cert.kicked:
+            where = "finite kicks return to it at the run's step and at half of it"
+        note = (f"the tangent exponent on the run's grid is positive, but the run lies on the "
+                f"period-{cert.period} orbit in the bands and {where}: the exponent's sign is "
+                "the grid's error in the chattering phases")  # fmt: skip
         return Verdict("periodic", cert.period, v.evidence + (e,), (note,), v.settings)
     if cert.status == "step-dependent":
         return _step_dependent(v, ctx, cert, Evidence("periodic_orbit", n, None, detail))
@@ -289,14 +232,10 @@ def _banded_verdict(v: Verdict, ctx: Context, n: int) -> Verdict:
 
 
 def _band_chaos(v: Verdict, n: int, e: Evidence) -> Verdict:
-    band = Evidence(
-        "banded_chaos",
-        n,
-        "chaotic",
-        f"the section keeps {n} narrow bands while the tangent exponent is positive beyond "
-        "its confidence interval and no attracting period-n orbit lies in them that the run "
-        f"converges to: chaos confined to {n} bands (n-band chaos){_outweighed(v)}",
-    )
+    why = (f"the section keeps {n} narrow bands while the tangent exponent is positive beyond "
+           "its confidence interval and no attracting period-n orbit lies in them that the run "
+           f"converges to: chaos confined to {n} bands (n-band chaos){_outweighed(v)}")  # fmt: skip
+    band = Evidence("banded_chaos", n, "chaotic", why)
     return Verdict("chaotic", None, v.evidence + (e, band), (), v.settings)
 
 
@@ -313,23 +252,19 @@ def _outweighed(v: Verdict) -> str:
 
 
 def _step_dependent(v: Verdict, ctx: Context, cert, e: Evidence) -> Verdict:
-    """Undetermined, not extended: the run's grid certifies a period-n orbit that is not
-    attracting at half the step, so the answer is the step's."""
+    """Undetermined and not extended: the grid's period-n orbit is not certified at dt/2."""
     dt = ctx.num.dt
-    why = (
-        f"the period-{cert.period} orbit is certified on the run's grid (dt = {dt:g} s) "
-        f"but not at dt/2 ({cert.detail}): the period is the step's; rerun with dt = "
-        f"{dt / ORBIT_REFINE[-1]:.3g} s"
-    )
+    why = (f"the period-{cert.period} orbit is certified on the run's grid (dt = {dt:g} s) "
+           f"but not at dt/2 ({cert.detail}): the period is the step's; rerun with dt = "
+           f"{dt / ORBIT_REFINE[-1]:.3g} s")  # fmt: skip
     step = Evidence(STEP_DEPENDENT, cert.period, None, why)
     return _undetermined(v, why, e, step)
 
 
 def overflow_evidence(jacobians, p: Params, num: Numerics) -> Evidence | None:
-    """The evidence (abstaining, with the reason) that the tangent overflowed: a Jacobian that
-    is not finite, RK4 past its stability limit in the contact; None when every Jacobian is
-    finite. A verdict holding it is undetermined and not extended: a longer run overflows
-    too."""
+    """The abstaining evidence that the tangent overflowed (a Jacobian not finite: RK4 past
+    its stability limit in the contact), else None; its verdict is undetermined and not
+    extended (a longer run overflows too)."""
     from ..simulation import resolution_warning
 
     jac = np.asarray(jacobians, dtype=float)
@@ -339,38 +274,28 @@ def overflow_evidence(jacobians, p: Params, num: Numerics) -> Evidence | None:
     if not bad.any():
         return None
     cause = resolution_warning(p, num) or f"dt = {num.dt:g} s; try a smaller dt"
-    why = (
-        f"the tangent overflowed: {int(bad.sum())} of {len(bad)} cam periods' Jacobians are "
-        f"not finite, so there is no exponent ({cause})"
-    )
+    why = (f"the tangent overflowed: {int(bad.sum())} of {len(bad)} cam periods' Jacobians are "
+           f"not finite, so there is no exponent ({cause})")  # fmt: skip
     return Evidence(OVERFLOW, int(bad.sum()), None, why)
 
 
 def extensible(v: Verdict) -> bool:
-    """Whether an undetermined verdict may settle on a longer run (not after an overflow, nor
-    when its periodic orbit is the step's, nor when a longer run stopped early)."""
-    return (
-        v.label == "undetermined"
-        and EXTENSION_STOPPED not in v.settings
-        and not any(e.name in (OVERFLOW, STEP_DEPENDENT) for e in v.evidence)
-    )
+    """Whether an undetermined verdict may settle on a longer run: not after an overflow, a
+    step-dependent orbit, or a longer run that stopped early."""
+    flagged = any(e.name in (OVERFLOW, STEP_DEPENDENT) for e in v.evidence)
+    return v.label == "undetermined" and EXTENSION_STOPPED not in v.settings and not flagged
 
 
 def extension_stopped(v: Verdict, status, stopped_at: float, wanted_s: float) -> Verdict:
-    """``v``, the verdict of the recorded window, kept when the longer run that was to settle
-    it ended early (it left the cam's reach at ``stopped_at`` [s], its last section time, or
-    diverged): its advice to run longer goes, since no longer window exists, and a reason says
-    so; ``settings["extension_stopped"]`` records the status, the time and the seconds
-    wanted, and the extension is not tried again."""
+    """``v``, the recorded window's verdict, kept when the longer run meant to settle it ended
+    early (left the cam's reach at ``stopped_at`` [s], its last section time, or diverged):
+    its advice to run longer goes and a reason says why; ``settings["extension_stopped"]``
+    records the status, the time and the seconds wanted (the extension is not tried again)."""
     what = status.message.split(":")[0].split(". ")[0]  # "The follower left the cam's reach"
-    why = (
-        f"no longer window exists: extended to {wanted_s:g} s recorded, the run stopped "
-        f"after t = {stopped_at:.4g} s ({status.name}: {what[0].lower() + what[1:]}), so "
-        "the verdict is the recorded window's"
-    )
+    why = (f"no longer window exists: extended to {wanted_s:g} s recorded, the run stopped "
+           f"after t = {stopped_at:.4g} s ({status.name}: {what[0].lower() + what[1:]}), so "
+           "the verdict is the recorded window's")  # fmt: skip
     reasons = tuple(r for r in v.reasons if not r.startswith("to decide:"))
-    settings = {
-        **v.settings,
-        EXTENSION_STOPPED: {"status": status.name, "at_s": stopped_at, "wanted_s": wanted_s},
-    }
+    stopped = {"status": status.name, "at_s": stopped_at, "wanted_s": wanted_s}
+    settings = {**v.settings, EXTENSION_STOPPED: stopped}
     return dataclasses.replace(v, reasons=(*reasons, why), settings=settings)

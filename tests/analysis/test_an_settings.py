@@ -17,10 +17,6 @@ PTS = np.c_[np.tile([0.1, 0.2, 0.3], 100), np.tile([1.0, 2.0, 3.0], 100)]
 JAC = np.tile(np.array([[0.5, 0.1], [0.0, 0.4]]), (200, 1, 1))
 
 
-def _logistic(z):
-    return np.array([4.0 * z[0] * (1.0 - z[0])])
-
-
 CASES = [
     (lambda: an.power_spectrum(X, 0.0), "power_spectrum: dt = 0.0 must be a finite number > 0"),
     (lambda: an.spectrum_analysis(X, math.inf), "spectrum_analysis: dt = inf must be a finite"),
@@ -32,13 +28,6 @@ CASES = [
     (lambda: an.spectrum_from_jacobians(JAC, 0.2, n_batches=0), "n_batches = 0 must be an"),
     (lambda: an.spectrum_from_jacobians(JAC, 0.0), "period = 0.0 must be a finite number > 0"),
     (lambda: an.as_exponent(0.1, 0), "as_exponent: time_per_iterate = 0 must be"),
-    (lambda: an.lyapunov_benettin_map(_logistic, [0.3], math.inf), "n = inf must be an integer"),
-    (lambda: an.lyapunov_benettin_map(_logistic, [0.3], 50, n_align=2.5), "n_align = 2.5"),
-    (lambda: an.lyapunov_benettin_map(_logistic, [0.3], 50, time_per_iterate=0), "time_per_it"),
-    (
-        lambda: an.lyapunov_spectrum_map(_logistic, lambda z: np.eye(1), [0.3], 50, n_exponents=2),
-        "n_exponents = 2 must be <= 1",
-    ),
     (lambda: an.lyapunov_from_series(X, 0.01, max_points=0), "max_points = 0 must be an integer"),
     (lambda: an.lyapunov_from_series(X, -1.0), "lyapunov_from_series: dt = -1.0 must be"),
     (lambda: an.zero_one_test(X, n_c=math.inf), "zero_one_test: n_c = inf must be an integer"),
@@ -85,15 +74,14 @@ def test_the_limits_themselves_are_taken():
     an.spectrum_analysis(X, 0.01, half_width=0, n_peaks=0)
     an.section_period(PTS, min_repeats=1, max_period=1)
     an.spectrum_from_jacobians(JAC, 0.2, n_batches=2)
-    an.lyapunov_benettin_map(_logistic, [0.3], 1, transient=0, n_align=0)
     an.classify_signal(X, 0.01, 0.2, zero_one_per_period=20, seed=0)
     an.neighbour_expansion(PTS, min_distance=0.0)
 
 
 def test_a_coarse_series_and_an_estimate_of_minus_infinity_are_taken():
     """A review's findings: a series sampled 3 times per forcing period is classified with
-    the 0-1 test at its own rate (the default 4 refused it); lyapunov = -inf (two
-    trajectories that merged) and NaN are an estimate's values, not bad settings; a band
+    the 0-1 test at its own rate (the default 4 refused it); lyapunov = -inf (a collapsed
+    tangent vector) and NaN are an estimate's values, not bad settings; a band
     separation of 0 is refused by Thresholds itself (it became a 'failed' evidence)."""
     coarse = np.sin(2 * np.pi * np.arange(300) / 3.0)
     v = an.classify_signal(coarse, 0.1, 0.3)
