@@ -272,7 +272,11 @@ def _batches(plist, num, indices, start, duration, batch, progress, **run) -> li
 
 
 def _finish(parts, plist, num, settings: dict, t0: float) -> Solution:
-    settings = {**settings, "threads": thread_count(), "wall_time_s": time.perf_counter() - t0}
+    """The Solution of ``parts``; ``threads``: numba's thread count for a batch of several
+    members (1 for one member, which ran on the calling thread: asking numba would fix its
+    threading layer and start its threads for every single run)."""
+    threads = thread_count() if len(plist) > 1 else 1
+    settings = {**settings, "threads": threads, "wall_time_s": time.perf_counter() - t0}
     return assemble(parts, plist, num, settings)
 
 

@@ -47,8 +47,14 @@ def lyapunov_spectrum(
     """
     if isinstance(params, Solution):
         run = params
-        if numerics is not None:
-            raise ParameterError("give a solution or its numerics, not both")
+        given = [n for n, v, d in (("numerics", numerics, None), ("duration", duration, 120.0),
+                 ("transient", transient, 60.0), ("seed", seed, 0), ("index", index, 0))
+                 if v is not d and v != d]  # fmt: skip
+        if given:  # they would be silently ignored: the solution's own are used
+            raise ParameterError(
+                f"give a solution or the run's settings, not both: {', '.join(given)} would "
+                "be ignored (the solution's own are used)"
+            )
     else:
         run = solve(params, numerics, indices=[index], seed=seed, duration=duration,
                     transient=transient, tangent=True)  # fmt: skip

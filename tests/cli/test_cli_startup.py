@@ -107,17 +107,6 @@ def _modules_after(code: str) -> set[str]:
     return set(out.split())
 
 
-def test_simulate_without_files_never_imports_pandas():
-    """`chaoscam simulate` that only prints its summary builds no tables: pandas (a quarter of
-    a second of start-up) stays unloaded; writing a table loads it."""
-    code = (
-        "import sys; from chaoscam.cli import main; main(['simulate', '--duration', '0.01']); "
-        "print(*sorted({m.split('.')[0] for m in sys.modules}))"
-    )
-    assert "pandas" not in _modules_after(code)
-    assert "numba" in _modules_after(code)  # it did simulate
-
-
 def test_import_and_run_leave_numba_threading_layer_to_first_parallel_launch():
     """Importing the simulate path changes no process-wide setting, nor does a single run
     (it launches nothing parallel); the first parallel launch (an ensemble) picks the
