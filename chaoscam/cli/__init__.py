@@ -1,48 +1,21 @@
-"""The ``chaoscam`` command: a thin layer over the API.
-
-One module per group of subcommands in this package (``_simulate``, ``_ensemble``,
-``_classify``, ``_sweep``, ``_report``), each importing the layer it drives, never the reverse;
-this module only wires them. A command module exposes ``register(subparsers)``, which adds
-its parsers and sets ``func`` on them; ``func`` takes the parsed arguments and returns an
-exit code. Bad input exits with code 2 and a message naming the field.
-
-Importing this module loads nothing but :mod:`sys`: everything else (argparse, numpy, the
-kernels, the command modules) is imported inside :func:`main`, where a Ctrl-C is caught, so
-a Ctrl-C during start-up ends with one line and exit 130 like one during the work. What runs
-before (the interpreter's own start-up and ``import chaoscam``, about a millisecond) is
-outside the command's reach.
-"""
+"""The ``chaoscam`` command, a thin layer over the API: each command module's ``register``
+adds parsers whose ``func(args)`` returns the exit code. Importing this module loads only
+:mod:`sys`: the rest is imported inside :func:`main`, where a Ctrl-C is caught."""
 
 from __future__ import annotations
 
 import sys
 
-TYPE_CHECKING = False  # typing.TYPE_CHECKING without importing typing (start-up time)
-if TYPE_CHECKING:
-    import argparse
-
-    from ..model import Params
-    from ..numerics import Numerics
-
 __all__ = ["entry", "main", "parse_assignments", "show_warning", "stop_word", "UsageError"]
-
-# Modules that add subcommands, in the order they are listed by --help.
-_COMMAND_MODULES = (
-    "chaoscam.cli._simulate",
-    "chaoscam.cli._ensemble",
-    "chaoscam.cli._classify",
-    "chaoscam.cli._sweep",
-    "chaoscam.cli._report",
-    "chaoscam.cli._params",
-)
 
 
 class UsageError(Exception):
     """Bad command-line input: printed as ``chaoscam: error: ...`` with exit code 2."""
 
 
-def parse_assignments(items: list[str] | None) -> tuple[Params, Numerics]:
-    """The model and numerics of ``--set NAME=VALUE`` items (each name a field of one of them)."""
+def parse_assignments(items: list[str] | None, swept: dict | None = None) -> tuple:
+    """(Params, Numerics) of ``--set NAME=VALUE`` items (each name a field of one of them); a
+    name in ``swept`` (name: the sweep's option giving its values) is refused."""
     from .._util import ParameterError, unknown_message
     from ..model import Params, field_names, parse_value
     from ..numerics import Numerics
@@ -50,14 +23,20 @@ def parse_assignments(items: list[str] | None) -> tuple[Params, Numerics]:
     pairs: dict[str, str] = {}
     for item in items or []:
         name, sep, value = item.partition("=")
-        if not sep or not name.strip():
-            raise UsageError(f"--set expects NAME=VALUE, got {item!r}")
-        if name.strip() in pairs:
+        name = name.strip()
+        if name in (swept or {}):
             raise UsageError(
-                f"--set {name.strip()} is given twice ({pairs[name.strip()]!r} and {value!r}): "
+                f"--set {item}: {name} is swept by {swept[name]}, which gives its values; "
+                "drop the --set"
+            )
+        if not sep or not name:
+            raise UsageError(f"--set expects NAME=VALUE, got {item!r}")
+        if name in pairs:
+            raise UsageError(
+                f"--set {name} is given twice ({pairs[name]!r} and {value!r}): "
                 "give each parameter once"
             )
-        pairs[name.strip()] = value
+        pairs[name] = value
     steps = Numerics.field_names()
     for name in pairs:
         if name not in field_names() and name not in steps:
@@ -67,31 +46,27 @@ def parse_assignments(items: list[str] | None) -> tuple[Params, Numerics]:
     return Params(**model), Numerics(**numerics)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _build_parser() -> tuple:
+    """The command's parser, and its subcommands' (the subparsers action)."""
     import argparse
-    import importlib
+
+    from .._version import __version__
+    from . import _classify, _ensemble, _params, _report, _simulate, _sweep
 
     parser = argparse.ArgumentParser(
         prog="chaoscam",
         description="Stochastic dynamics of a cam-follower oblique impact system.",
     )
-    from .._version import __version__
-
     parser.add_argument("--version", action="version", version=f"chaoscam {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in _COMMAND_MODULES:
-        try:
-            module = importlib.import_module(name)
-        except ModuleNotFoundError as err:
-            if err.name is None or not (name == err.name or name.startswith(err.name + ".")):
-                raise  # a missing dependency inside the module, not a missing module
-            continue  # that layer is not installed in this build
+    for module in (_simulate, _ensemble, _classify, _sweep, _report, _params):  # --help's order
         module.register(sub)
-    return parser
+    return parser, sub
 
 
 _SIGTERM = {"seen": False}
 _SIGINT = {"seen": False}
+_LOCK_CALLBACK = ("cb", "<frozen importlib._bootstrap>")  # importlib's module-lock callback
 
 
 def _on_sigterm(signum, frame) -> None:
@@ -101,27 +76,13 @@ def _on_sigterm(signum, frame) -> None:
 
 
 def _on_sigint(signum, frame) -> None:
-    """Ctrl-C: a KeyboardInterrupt, except inside the weakref callback importlib runs when a
-    module lock is released during an import (``_get_module_lock.<locals>.cb``). An exception
-    raised there cannot propagate: Python prints "Exception ignored ... Traceback" and goes
-    on, the Ctrl-C lost. There the signal is sent again a moment later, when the callback has
-    returned (rare: once in a clean-clone test run, never in 48 tries at 0.15-0.3 s).
-
-    The signal is recorded too, for :func:`main`: a KeyboardInterrupt raised inside an
-    import does not always arrive. Inside a C extension's initialisation it can come back
-    as an ImportError (numpy's ``PyCapsule_Import could not import module "datetime"``, then
-    its "bad install" message and a traceback: 2 of 42 Ctrl-Cs 0.1 s into a start-up on a
-    loaded machine), which a guard around an optional import may swallow (a clean clone's
-    suite once ran a Ctrl-C'd ``simulate`` to its end, exit 0). Putting every signal off
-    until the import under way ends avoids both, but made a Ctrl-C in start-up take 1.1 s
-    (median, 1.4 s at most) instead of 0.04 s."""
+    """Ctrl-C: a KeyboardInterrupt, recorded for :func:`main` (inside an import it may come
+    back as an ImportError, or be swallowed). Inside importlib's module-lock weakref callback,
+    where an exception is printed and lost, the signal is sent again a moment later. (Putting
+    signals off until the import ends made a Ctrl-C in start-up take 1.1 s, not 0.04 s.)"""
     _SIGINT["seen"] = True
     code = getattr(frame, "f_code", None)
-    if (
-        code is not None
-        and code.co_name == "cb"
-        and code.co_filename == "<frozen importlib._bootstrap>"
-    ):
+    if code is not None and (code.co_name, code.co_filename) == _LOCK_CALLBACK:
         import os
         import threading
 
@@ -131,21 +92,12 @@ def _on_sigint(signum, frame) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the ``chaoscam`` command; returns the exit code.
-
-    0 success, 1 a run that could not do what was asked (its cause printed), 2 bad input
-    (a message naming the field or path, never a traceback), 130 Ctrl-C and 143 SIGTERM
-    (both after saving finished work and saying how to resume), 141 when the reader of
-    stdout left (``| head``: no message, as a shell reports SIGPIPE). A Ctrl-C at any point of
-    this function, the imports of start-up included, gives one line and 130, also where
-    the interrupt came back as another exception or was swallowed on its way (the run then
-    ends where it would have, its output whole; :func:`_on_sigint`). Without a Ctrl-C or
-    SIGTERM an exception propagates as it is.
-    """
-    previous = None
-    previous_int = None
-    _SIGTERM["seen"] = False
-    _SIGINT["seen"] = False
+    """Run the ``chaoscam`` command; its exit code: 0 success, 1 a run that could not do what
+    was asked (its cause printed), 2 bad input (a message naming the field or path), 130 Ctrl-C
+    and 143 SIGTERM (one line, after saving finished work; also when the interrupt came back as
+    another exception or was swallowed), 141 when the reader of stdout left (as for SIGPIPE)."""
+    previous = previous_int = None
+    _SIGTERM["seen"] = _SIGINT["seen"] = False
     try:
         import signal
         import threading
@@ -172,17 +124,9 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def entry() -> None:
-    """The ``chaoscam`` process: :func:`main` on ``sys.argv``, then exit with its code.
-
-    The console script, ``python -m chaoscam`` and ``python -m chaoscam.cli`` come here;
-    code that runs commands in-process calls :func:`main`. Before exiting, every live object
-    is moved to the garbage collector's permanent generation (:func:`gc.freeze`): the
-    interpreter's finalization otherwise runs full collections over the objects numba's
-    type registries leave (about 0.09 s of a 0.9 s ``chaoscam simulate --duration 20``,
-    measured by ``benchmarks/bench_startup.py``). Nothing is lost by it: every output is
-    written and closed (atomically renamed into place) before :func:`main` returns, and
-    Python promises no finalizer at exit anyway.
-    """
+    """The ``chaoscam`` process: :func:`main` on ``sys.argv``, then exit with its code, the heap
+    frozen first (finalization otherwise collects numba's type registries: 0.09 s of a 0.9 s
+    run, ``benchmarks/bench_startup.py``); every output is already written and closed."""
     code = main()
     import gc
 
@@ -195,29 +139,16 @@ def stop_word() -> str:
     return "terminated" if _SIGTERM["seen"] else "interrupted"
 
 
-class interrupts_ignored:
-    """A context in which a second Ctrl-C is ignored (in the main thread, where handlers
-    live): a command that stops says once what it kept, and waits for its threads to stop.
-    A class, not ``contextlib``: this module is imported at every start."""
-
-    def __enter__(self) -> None:
-        import signal
-        import threading
-
-        main_thread = threading.current_thread() is threading.main_thread()
-        self._before = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
-
-    def __exit__(self, *exc) -> None:
-        import signal
-
-        if self._before is not None:
-            signal.signal(signal.SIGINT, self._before)
-
-
 def _interrupted() -> int:
     """Say "interrupted" (or "terminated") once; a second Ctrl-C meanwhile is ignored."""
-    with interrupts_ignored():
-        print(f"chaoscam: {stop_word()}", file=sys.stderr)
+    import signal
+    import threading
+
+    main_thread = threading.current_thread() is threading.main_thread()
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN) if main_thread else None
+    print(f"chaoscam: {stop_word()}", file=sys.stderr)
+    if before is not None:
+        signal.signal(signal.SIGINT, before)
     return 130
 
 
@@ -231,9 +162,7 @@ NUMBA_LAYERS = ("default", "safe", "threadsafe", "forksafe", "workqueue", "omp",
 
 
 def check_numba_environment() -> None:
-    """Refuse numba settings in the environment that numba itself would reject with a
-    traceback mid-run (a set but empty or unknown threading layer, a thread count that is
-    not a positive integer): a UsageError naming the variable and what it allows."""
+    """Refuse the numba settings in the environment that numba would reject mid-run."""
     import os
 
     layer = os.environ.get("NUMBA_THREADING_LAYER")
@@ -255,57 +184,27 @@ GRID_FLAGS = ("--values", "--mu", "--sigma")
 
 
 def _negative_values(argv: list[str]) -> list[str]:
-    """``--values -0.5,-0.4`` as ``--values=-0.5,-0.4``: argparse takes a value that starts
-    with "-" and is not a single number for an option, and says "expected one argument"."""
+    """``--values -0.5,-0.4`` as ``--values=-0.5,-0.4`` (argparse reads -0.5,-0.4 as an option)."""
     out: list[str] = []
-    i = 0
-    while i < len(argv):
-        token = argv[i]
-        following = argv[i + 1] if i + 1 < len(argv) else ""
-        if token in GRID_FLAGS and len(following) > 1 and following[0] == "-":
-            if following[1].isdigit() or following[1] == ".":
-                out.append(f"{token}={following}")
-                i += 2
-                continue
-        out.append(token)
-        i += 1
+    for token in argv:
+        negative = len(token) > 1 and token[0] == "-" and (token[1].isdigit() or token[1] == ".")
+        if negative and out and out[-1] in GRID_FLAGS:
+            out[-1] += f"={token}"
+        else:
+            out.append(token)
     return out
-
-
-def _command_parser(parser, args):
-    """The subcommand's parser of ``args`` (the top-level one when there is none)."""
-    import argparse
-
-    for action in parser._actions:
-        if isinstance(action, argparse._SubParsersAction):
-            return action.choices.get(getattr(args, "command", None), parser)
-    return parser
-
-
-def _mute_stdout() -> None:
-    """Point stdout at /dev/null, so that the interpreter's flush of what is left at exit
-    does not fail again on the closed pipe (the Python documentation's recipe for SIGPIPE)."""
-    import os
-
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-    except (OSError, ValueError, AttributeError):  # no real stdout (captured in tests)
-        pass
 
 
 def _dispatch(argv: list[str] | None) -> int:
     import warnings
 
-    from .._util import ParameterError
-    from ..io import OutputError
-
-    parser = build_parser()
-    args, extra = parser.parse_known_args(
-        _negative_values(sys.argv[1:] if argv is None else list(argv))
-    )
+    parser, commands = _build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args, extra = parser.parse_known_args(_negative_values(argv))
     if extra:  # with the command's own usage, not the top level's (argparse's default)
-        _command_parser(parser, args).error(f"unrecognized arguments: {' '.join(extra)}")
+        commands.choices.get(args.command, parser).error(
+            "unrecognized arguments: " + " ".join(extra)
+        )
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
@@ -314,20 +213,27 @@ def _dispatch(argv: list[str] | None) -> int:
         with warnings.catch_warnings():
             warnings.showwarning = show_warning  # as they come, not at the end of the run
             code = int(args.func(args) or 0)
-    except (ParameterError, UsageError, OutputError, FileExistsError) as err:
-        print(f"chaoscam: error: {err}", file=sys.stderr)
-        return 2
     except BrokenPipeError:  # the reader of stdout left (`chaoscam classify ... | head`)
-        _mute_stdout()
+        import contextlib
+        import os
+
+        # stdout to /dev/null: the flush at exit does not fail again (no real stdout in tests)
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141  # as a shell reports a command stopped by SIGPIPE
-    except OSError as err:  # a file the command reads or writes: never a traceback
+    except (UsageError, OSError, ValueError) as err:  # bad input, or a file read or written
+        from .._util import ParameterError
+        from ..io import OutputError
+        from ..report import InputError
+        from ..simulation import TrajectoryFileError
+        from ..sweep import SweepError
+
+        refused = (ParameterError, OutputError, InputError, TrajectoryFileError, SweepError)
+        if isinstance(err, ValueError) and not isinstance(err, refused):
+            raise  # a fault, not bad input: its traceback
         print(f"chaoscam: error: {err}", file=sys.stderr)
         return 2
     except MemoryError:
         print("chaoscam: error: out of memory; ask for a smaller run", file=sys.stderr)
         return 1
     return code
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

@@ -8,18 +8,15 @@ import math
 
 from ._options import path_arg
 
-__all__ = ["register"]
-
 
 def register(sub) -> None:
     p = sub.add_parser(
         "classify",
         help="classify a simulated trajectory (Parquet) as periodic/quasiperiodic/chaotic",
         description="Classify a trajectory written by `chaoscam simulate --out FILE.parquet` "
-        "from its stroboscopic section and the tangent exponent through the impacts (with "
-        "the periodic-orbit certificate for the deterministic model), printed as JSON "
-        "(label, period, evidence, reasons; and, when an undetermined verdict was settled "
-        "by running the realization longer, extended: the recorded time it took).",
+        "from its stroboscopic section and the tangent exponent through the impacts (with the "
+        "periodic-orbit certificate for the deterministic model), printed as JSON (label, "
+        "period, evidence, reasons; extended: the recorded time, when a longer run settled it).",
     )
     p.add_argument("trajectory", type=path_arg, metavar="TRAJ.parquet")
     p.add_argument(
@@ -72,24 +69,14 @@ def register(sub) -> None:
     q.set_defaults(func=run_classify_series)
 
 
-def _print(verdict) -> None:
-    print(json.dumps(verdict.to_dict(), indent=2, ensure_ascii=False))
-
-
 def run_classify(args: argparse.Namespace) -> int:
-    from ..simulation import TrajectoryFileError, read_trajectory
+    from ..simulation import read_trajectory
     from ..verdict import EXTEND_TO, classify
-    from . import UsageError
 
-    try:
-        traj = read_trajectory(args.trajectory)
-    except TrajectoryFileError as err:
-        raise UsageError(str(err)) from None
+    traj = read_trajectory(args.trajectory)
+    extend_to = None if args.no_extend else EXTEND_TO
     (verdict,) = classify(
-        traj,
-        extend_to=None if args.no_extend else EXTEND_TO,
-        check_step=args.check_step,
-        discard=args.discard,
+        traj, extend_to=extend_to, check_step=args.check_step, discard=args.discard
     )
     out = verdict.to_dict()
     extended = verdict.settings.get("extended")
@@ -100,9 +87,6 @@ def run_classify(args: argparse.Namespace) -> int:
 
 
 def run_classify_series(args: argparse.Namespace) -> int:
-    import numpy as np
-    import pandas as pd
-
     from ..analysis import classify_section, classify_signal
     from . import UsageError
 
@@ -128,7 +112,26 @@ def run_classify_series(args: argparse.Namespace) -> int:
         raise UsageError(
             f"--column {', '.join(map(repr, twice))} given more than once: name each once"
         )
-    path = args.file
+    data = _read_columns(args.file, args.column)  # refused unless finite numbers, enough rows
+    try:
+        if args.section:
+            points = data[:, 0] if data.shape[1] == 1 else data
+            verdict = _uncertified(classify_section(points), points)
+        else:
+            verdict = classify_signal(data[:, 0], args.dt, args.forcing_period)
+    except ValueError as err:
+        raise UsageError(f"{args.file}: {err}") from None
+    print(json.dumps(verdict.to_dict(), indent=2, ensure_ascii=False))
+    return 0
+
+
+def _read_columns(path, columns: list[str]):
+    import numpy as np
+    import pandas as pd
+
+    from ..simulation import check_enough
+    from . import UsageError
+
     if not path.is_file():
         what = "is a directory; give a CSV file" if path.is_dir() else "no such file"
         raise UsageError(f"{path}: {what}")
@@ -137,55 +140,39 @@ def run_classify_series(args: argparse.Namespace) -> int:
         header = [str(c) for c in pd.read_csv(path, header=None, nrows=1).iloc[0]]
     except (ValueError, OSError, UnicodeDecodeError, IndexError) as err:
         raise UsageError(f"{path}: not a readable CSV file ({err})") from None
-    twice = sorted({c for c in args.column if header.count(c) > 1})
+    twice = sorted({c for c in columns if header.count(c) > 1})
     if twice:  # pandas would read the first and rename the others "NAME.1"
         raise UsageError(
             f"{path}: the header names column {', '.join(map(repr, twice))} more than once; "
             "rename the copies so that --column picks one"
         )
-    missing = [c for c in args.column if c not in frame.columns]
+    missing = [c for c in columns if c not in frame.columns]
     if missing:
         raise UsageError(
             f"{path}: no column {', '.join(repr(c) for c in missing)}; the columns are "
             f"{', '.join(repr(str(c)) for c in frame.columns)}"
         )
     try:
-        data = frame[args.column].apply(pd.to_numeric, errors="raise").to_numpy(dtype=float)
+        data = frame[columns].apply(pd.to_numeric, errors="raise").to_numpy(dtype=float)
     except (ValueError, TypeError):
         raise UsageError(
-            f"{path}: column(s) {', '.join(args.column)} hold values that are not numbers"
+            f"{path}: column(s) {', '.join(columns)} hold values that are not numbers"
         ) from None
     bad = ~np.isfinite(data).all(axis=1)
     if bad.any():
         rows = np.flatnonzero(bad)
         raise UsageError(
             f"{path}: {rows.size} row(s) with NaN or infinite values in "
-            f"{', '.join(args.column)} (first at data row {int(rows[0]) + 1}); remove them"
+            f"{', '.join(columns)} (first at data row {int(rows[0]) + 1}); remove them"
         )
-    from ..simulation import TrajectoryFileError, check_enough
-
-    try:
-        check_enough(len(data), "rows", path, "record a longer signal")
-    except TrajectoryFileError as err:
-        raise UsageError(str(err)) from None
-    try:
-        if args.section:
-            points = data[:, 0] if data.shape[1] == 1 else data
-            verdict = _uncertified(classify_section(points), points)
-        else:
-            verdict = classify_signal(data[:, 0], args.dt, args.forcing_period)
-    except ValueError as err:
-        raise UsageError(f"{path}: {err}") from None
-    _print(verdict)
-    return 0
+    check_enough(len(data), "rows", path, "record a longer signal")
+    return data
 
 
 def _uncertified(verdict, points):
-    """A periodic section verdict whose bands have a measurable width (over 1e-6 of the
-    orbit's extent) gets a reason saying what it rests on: data alone cannot tell a period
-    from chaos confined to bands narrower than the tolerance, as chaoscam's own runs show
-    (the default model's section: 8 bands up to 8e-4 of the extent wide, chaotic by its
-    tangent exponent). ``chaoscam classify`` has the model, and decides such runs."""
+    """A periodic section verdict whose bands are over 1e-6 of the orbit's extent wide gets a
+    reason saying it is not certified: points alone cannot tell it from chaos confined to
+    narrow bands (the default model's 8 bands, chaotic by its tangent exponent)."""
     import dataclasses
 
     import numpy as np

@@ -1,25 +1,10 @@
-"""``chaoscam ensemble``: many realizations of one model, their sections and verdicts.
-
-A thin layer over :func:`chaoscam.ensemble`, a plan of the one sweep engine: the members run
-in batches (the CPU's threads, a GPU or Dask), each finished record is checkpointed beside
-the output (``FILE.parquet.ckpt/``), an interrupted run resumes with ``--resume`` to the same
-tables, and the output is locked against a second process.
-"""
+"""``chaoscam ensemble``: many realizations of one model (:func:`chaoscam.ensemble`)."""
 
 from __future__ import annotations
 
 import argparse
-import sys
 
-from ._options import (
-    add_engine_options,
-    add_run_options,
-    add_sweep_options,
-    engine_settings,
-    sweep_settings,
-)
-
-__all__ = ["register"]
+from ._options import add_sweep_options, counts, run_sweep, sweep_settings
 
 
 def register(sub) -> None:
@@ -29,65 +14,50 @@ def register(sub) -> None:
         description="Simulate realizations FIRST .. FIRST+MEMBERS-1 of one model in batches "
         "(threads over the cores, one CUDA thread each on a GPU, or Dask) and write one row "
         "per member (status, impact count, verdict with --classify) to FILE.parquet and "
-        "their stroboscopic sections to FILE.sections.parquet. Interrupted runs resume with "
-        "--resume.",
+        "their stroboscopic sections to FILE.sections.parquet.",
     )
     p.add_argument("--members", type=int, required=True, help="number of realizations")
     p.add_argument("--first", type=int, default=0, help="first realization index (default 0)")
-    add_run_options(p, transient=None)
     p.add_argument("--classify", action="store_true", help="judge each member (its verdict)")
-    add_engine_options(p)
     add_sweep_options(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..sweep import SweepError, SweepInterrupted, TaskFailed, companion, ensemble
-    from . import UsageError, parse_assignments, stop_word
+    from ..sweep import companion, ensemble
+    from . import UsageError, parse_assignments
 
     params, numerics = parse_assignments(args.set)
-    engine = engine_settings(args)
-    if not args.classify and (engine["lyapunov"] or engine["check_step"] or engine["classify"]):
+    settings = sweep_settings(args)
+    if not args.classify and (args.lyapunov or args.check_step or settings["classify"]):
         raise UsageError("--lyapunov, --check-step and --classifier judge members: add --classify")
-    classify = engine.pop("classify") or args.classify
-    try:
-        res = ensemble(
-            params, numerics, members=args.members, first=args.first, seed=args.seed,
-            duration=args.duration, transient=args.transient, classify=classify,
-            **engine, **sweep_settings(args),
-        )  # fmt: skip
-    except SweepError as err:
-        raise UsageError(str(err)) from None
-    except TaskFailed as err:
-        print(f"chaoscam: error: {err}", file=sys.stderr)
-        return 1
-    except SweepInterrupted as err:
-        print(f"chaoscam: {err.describe(stop_word())}", file=sys.stderr)
-        return 130 if err.cause is None else 1
+    settings["classify"] = settings["classify"] or args.classify
+    res = run_sweep(
+        ensemble, params, numerics, members=args.members, first=args.first, seed=args.seed,
+        duration=args.duration, transient=args.transient, **settings,
+    )  # fmt: skip
+    if isinstance(res, int):
+        return res
     _say_identical(params, args.members)
     m = res.members
-    counts = m["label" if args.classify else "status"].value_counts().to_dict()
     print(
-        f"{len(m)} members: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items()))
-        + f"\nmembers: {args.out}\nsections: {companion(args.out, 'sections')}"
-    )  # fmt: skip
+        f"{len(m)} members: {counts(m['label' if args.classify else 'status'])}"
+        f"\nmembers: {args.out}\nsections: {companion(args.out, 'sections')}"
+    )
     return 0
 
 
 def _say_identical(params, members: int) -> None:
-    """Say, once, when the members are all the same run: an index draws only line lengths,
-    which change nothing with ``l_lambda_sigma = 0`` or the fractal stiffness (with the
-    runs' own warnings, at the end)."""
+    """Say once, at the end, when the members are all the same run."""
     from ..model import realizations_identical
     from . import show_warning
 
-    if members > 1 and realizations_identical(params):
-        why = (
-            "l_lambda_sigma = 0"
-            if params.l_lambda_sigma == 0.0
-            else "the fractal stiffness does not depend on the line length"
-        )
-        show_warning(
-            f"{why}: every member is the same deterministic run (an index draws only line "
-            "lengths); one member is enough"
-        )
+    if members < 2 or not realizations_identical(params):
+        return
+    why = "the fractal stiffness does not depend on the line length"
+    if params.l_lambda_sigma == 0.0:
+        why = "l_lambda_sigma = 0"
+    show_warning(
+        f"{why}: every member is the same deterministic run (an index draws only line lengths); "
+        "one member is enough"
+    )

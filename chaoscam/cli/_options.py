@@ -1,39 +1,22 @@
-"""Options every run-making subcommand shares: the model overrides and the run's times.
-
-One declaration each, so that ``--set``, ``--duration``, ``--transient`` and ``--seed`` mean
-the same on ``simulate``, ``ensemble``, ``bifurcation`` and ``regime-map``.
-"""
+"""The options the run-making commands share, and how a sweep's outcome becomes an exit code."""
 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
-
-__all__ = [
-    "add_engine_options",
-    "add_run_options",
-    "add_sweep_options",
-    "engine_settings",
-    "path_arg",
-    "sweep_settings",
-]
 
 
 def path_arg(text: str) -> Path:
-    """The argparse type of every file argument: ``Path(text)``, but an empty text is refused
-    (``Path("")`` is the current folder, and ``--out ''`` read as "--out .: the file must
-    end in .parquet")."""
+    """The argparse type of every file argument: an empty text (the current folder) is refused."""
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path: give a file name")
     return Path(text)
 
 
 def add_run_options(p, *, transient: float | None) -> None:
-    """``--set``, ``--duration``, ``--transient`` and ``--seed`` on parser ``p``.
-
-    ``transient`` is the default discarded start [s]; None means half the duration (the
-    sweeps and ensembles), 0.0 the whole run (``simulate``).
-    """
+    """``--set``, ``--duration``, ``--transient`` (default ``transient`` [s]; None: half the
+    duration) and ``--seed`` on parser ``p``."""
     p.add_argument(
         "--set",
         action="append",
@@ -43,18 +26,16 @@ def add_run_options(p, *, transient: float | None) -> None:
         "omega=30 or --set dt=1e-6; `chaoscam params` lists them",
     )
     p.add_argument("--duration", type=float, default=20.0, help="simulated time [s] (default 20)")
+    shown = "half the duration" if transient is None else f"{transient:g}"
     p.add_argument(
-        "--transient",
-        type=float,
-        default=transient,
-        help="discarded start [s] (default: "
-        + ("half the duration)" if transient is None else f"{transient:g})"),
+        "--transient", type=float, default=transient, help=f"discarded start [s] (default: {shown})"
     )
     p.add_argument("--seed", type=int, default=0, help="master seed of the line-length process")
 
 
-def add_engine_options(p) -> None:
-    """How a sweep (or an ensemble) judges its runs and where its batches run."""
+def add_sweep_options(p) -> None:
+    """The run options, how a sweep (or ensemble) judges and runs them, and its outputs."""
+    add_run_options(p, transient=None)
     p.add_argument(
         "--lyapunov",
         action="store_true",
@@ -64,19 +45,17 @@ def add_engine_options(p) -> None:
     p.add_argument(
         "--check-step",
         action="store_true",
-        help="judge each realization at dt/2 too; a changed verdict becomes undetermined",
+        help="judge each run at dt/2 too; a changed verdict becomes undetermined",
     )
     p.add_argument(
         "--classifier",
         metavar="MODULE:NAME",
-        default=None,
         help="a classifier of one's own instead of chaoscam.classify: a function, or a class "
         "instantiated without arguments, taking one run (a chaoscam.Solution)",
     )
     p.add_argument(
         "--workers",
         type=int,
-        default=None,
         help="threads, one batch each (default: every core); with --scheduler local, the "
         "local Dask cluster's workers",
     )
@@ -88,35 +67,9 @@ def add_engine_options(p) -> None:
         "GPU_TOLERANCE; auto: the GPU where one runs and there are 4,096 runs or more); "
         "default cpu",
     )
-
-
-def engine_settings(args) -> dict:
-    """The keyword arguments of :func:`add_engine_options`' options for a sweep."""
-    from . import UsageError
-
-    classify = None
-    if args.classifier is not None:
-        from ..sweep import load_classifier
-
-        try:
-            classify = load_classifier(args.classifier)
-        except (ValueError, ImportError, AttributeError) as err:
-            raise UsageError(f"--classifier {args.classifier}: {err}") from None
-    return dict(
-        classify=classify,
-        lyapunov=args.lyapunov,
-        check_step=args.check_step,
-        workers=args.workers,
-        device=args.device,
-    )
-
-
-def add_sweep_options(p) -> None:
-    """Where a sweep's outputs go, and how it is checkpointed, resumed and shown."""
     p.add_argument(
         "--scheduler",
         metavar="ADDRESS",
-        default=None,
         help="run on Dask: tcp://HOST:PORT of a running scheduler, or 'local' for a local "
         "cluster on 127.0.0.1",
     )
@@ -136,17 +89,25 @@ def add_sweep_options(p) -> None:
     p.add_argument(
         "--force",
         action="store_true",
-        help="start over: replace existing outputs and discard an existing checkpoint",
+        help="start over: replace the outputs, discard a checkpoint",
     )
     p.add_argument("--out", type=path_arg, required=True, help="output FILE.parquet")
 
 
 def sweep_settings(args) -> dict:
-    """The keyword arguments of :func:`add_sweep_options`' options, checked."""
+    """The keyword arguments of :func:`add_sweep_options`' own options, checked."""
     import math
 
     from . import UsageError
 
+    classify = None
+    if args.classifier is not None:
+        from ..sweep import load_classifier
+
+        try:
+            classify = load_classifier(args.classifier)
+        except (ValueError, ImportError, AttributeError) as err:
+            raise UsageError(f"--classifier {args.classifier}: {err}") from None
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers {args.workers}: must be >= 1")
     if args.scheduler not in (None, "local") and args.workers is not None:
@@ -160,10 +121,29 @@ def sweep_settings(args) -> dict:
     if args.force and args.resume:
         raise UsageError("--force starts over and --resume continues: give one of them")
     return dict(
-        scheduler=args.scheduler,
-        out=args.out,
-        resume=args.resume,
-        progress=not args.quiet,
-        flush_interval=args.checkpoint_interval,
+        classify=classify, lyapunov=args.lyapunov, check_step=args.check_step,
+        workers=args.workers, device=args.device, scheduler=args.scheduler, out=args.out,
+        resume=args.resume, progress=not args.quiet, flush_interval=args.checkpoint_interval,
         force=args.force,
-    )
+    )  # fmt: skip
+
+
+def run_sweep(fn, *args, **kwargs):
+    """``fn(*args, **kwargs)``; a stopped sweep says how to go on and returns its exit code (130
+    a Ctrl-C, 1 a lost Dask scheduler or a failed task)."""
+    from ..sweep import SweepInterrupted, TaskFailed
+    from . import stop_word
+
+    try:
+        return fn(*args, **kwargs)
+    except TaskFailed as err:
+        print(f"chaoscam: error: {err}", file=sys.stderr)
+        return 1
+    except SweepInterrupted as err:
+        print(f"chaoscam: {err.describe(stop_word())}", file=sys.stderr)
+        return 130 if err.cause is None else 1
+
+
+def counts(labels) -> str:
+    """``"chaotic 3, periodic 5"``: each value of a column with its count, in order."""
+    return ", ".join(f"{k} {v}" for k, v in labels.value_counts().sort_index().items())

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-__all__ = ["register"]
-
 
 def register(sub) -> None:
     p = sub.add_parser(

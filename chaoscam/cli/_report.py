@@ -9,12 +9,7 @@ from pathlib import Path
 
 from ._options import path_arg
 
-__all__ = ["register"]
-
-
-DEFAULT_PAPER = Path("out/paper.html")
-"""Where ``chaoscam paper`` writes without ``--out``: a folder the repository ignores, so
-that the quick report never touches the committed ``reports/paper.html``."""
+DEFAULT_PAPER = Path("out/paper.html")  # git ignores out/; reports/paper.html only when named
 
 
 def register(sub) -> None:
@@ -35,10 +30,9 @@ def register(sub) -> None:
     p = sub.add_parser(
         "paper",
         help="reproduce the paper's Figs. 3-10 and write the comparison report",
-        description="Run the figure scripts (chaoscam.paper: Figs. 3-10 and the "
-        "sensitivity sweeps), write each "
-        "figure's data and PNG next to the report (DIR/paper-data/), and build the HTML "
-        "report comparing the paper's statements with what this run finds.",
+        description="Run the figure scripts (chaoscam.paper: Figs. 3-10 and the sensitivity "
+        "sweeps), write each figure's data and PNG next to the report (DIR/paper-data/), and "
+        "build the HTML report comparing the paper's statements with what this run finds.",
     )
     p.add_argument(
         "--quick",
@@ -48,26 +42,17 @@ def register(sub) -> None:
     p.add_argument(
         "--out",
         type=path_arg,
-        default=None,
         help=f"the report (default {DEFAULT_PAPER}, created with its folder; git ignores "
         "it: the committed reports/paper.html is written only when named)",
     )
     p.add_argument(
-        "--figures",
-        default=None,
-        metavar="LIST",
-        help="only these figures, e.g. 3,5,7 (default: all)",
+        "--figures", metavar="LIST", help="only these figures, e.g. 3,5,7 (default: all)"
     )
-    p.add_argument(
-        "--workers",
-        type=int,
-        default=None,
-        help="threads for the sweeps (default: every core)",
-    )
+    p.add_argument("--workers", type=int, help="threads for the sweeps (default: every core)")
     p.add_argument(
         "--force",
         action="store_true",
-        help="replace an existing report (and its paper-data folder's files)",
+        help="replace an existing report and its paper-data files",
     )
     p.add_argument(
         "--resume",
@@ -78,22 +63,12 @@ def register(sub) -> None:
     p.set_defaults(func=run_paper)
 
 
-def _check_out(out: Path, force: bool) -> None:
-    from ..io import check_output
-
-    check_output(out, force=force, suffixes=(".html",))
-
-
 def run_report(args: argparse.Namespace) -> int:
-    from ..report import InputError, build_report, load_inputs, write_report
-    from . import UsageError
+    from ..io import check_output
+    from ..report import build_report, load_inputs, write_report
 
-    _check_out(args.out, args.force)
-    try:
-        inputs = load_inputs(args.inputs)
-    except InputError as err:
-        raise UsageError(str(err)) from None
-    parts = build_report(inputs)
+    check_output(args.out, force=args.force, suffixes=(".html",))
+    parts = build_report(load_inputs(args.inputs))
     command = shlex.join(
         ["chaoscam", "report", *map(str, args.inputs), "--out", str(args.out)]
         + (["--title", args.title] if args.title != "chaoscam report" else [])
@@ -138,15 +113,9 @@ def run_paper(args: argparse.Namespace) -> int:
     )
     try:
         run = _run(
-            quick=args.quick,
-            out=args.out,
-            figures=figures,
-            workers=args.workers,
-            command=command,
-            echo=True,
-            force=args.force,
-            resume=args.resume,
-        )
+            quick=args.quick, out=args.out, figures=figures, workers=args.workers,
+            command=command, echo=True, force=args.force, resume=args.resume,
+        )  # fmt: skip
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM: say what is kept and how to go on, once
         from ..paper import RESUME_HINT
         from . import stop_word

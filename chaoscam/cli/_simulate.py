@@ -8,8 +8,6 @@ import warnings
 
 from ._options import add_run_options, path_arg
 
-__all__ = ["register"]
-
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -35,17 +33,14 @@ def run(args: argparse.Namespace) -> int:
     section = check_output(args.section, flag="--section", force=args.force, suffixes=(".csv",))
     impacts = check_output(args.impacts, flag="--impacts", force=args.force, suffixes=(".csv",))
     _distinct(("--out", out), ("--section", section), ("--impacts", impacts))
-    # Locked as a sweep locks its outputs: a run writing one of them refuses this one.
     written: list = []
     asked = [p for p in (out, section, impacts) if p is not None]
-    with lock_all(asked):
+    with lock_all(asked):  # as a sweep's outputs: a second run writing one is refused
         try:
             return _run(args, out, section, impacts, written)
         except KeyboardInterrupt:  # one message, saying what is on disk
             if not asked:
                 raise  # nothing to write: the plain "interrupted"
-            import sys
-
             from . import stop_word
 
             print(
@@ -58,19 +53,13 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace, out, section, impacts, written: list) -> int:
-    from ..io import atomic_path
+    """Simulate, write the files asked for; 0 when the run simulated what was asked, else 1
+    with the cause on stderr (the first warning first: then the likely one)."""
+    from ..io import atomic_path, write_table
     from ..simulation import simulate
     from . import parse_assignments, show_warning
 
     params, numerics = parse_assignments(args.set)
-    settings = dict(
-        duration=args.duration,
-        transient=args.transient,
-        seed=args.seed,
-        index=args.index,
-        series=out is not None,
-        output_dt=args.output_dt,
-    )
     notes: list[str] = []
 
     def note(message, *rest, **kwargs) -> None:  # printed at once: a time estimate comes first
@@ -80,11 +69,21 @@ def _run(args: argparse.Namespace, out, section, impacts, written: list) -> int:
     with warnings.catch_warnings():
         warnings.simplefilter("always")
         warnings.showwarning = note
-        traj = simulate(params, numerics, **settings)
+        traj = simulate(
+            params, numerics, duration=args.duration, transient=args.transient, seed=args.seed,
+            index=args.index, series=out is not None, output_dt=args.output_dt,
+        )  # fmt: skip
     print(traj.summary())
     impact_rows = traj.impacts.drop(columns="member")
+
+    def series(tmp) -> None:
+        if out.suffix.lower() == ".parquet":
+            write_table(traj.parquet_table(), tmp)
+        else:
+            traj.series.drop(columns="member").to_csv(tmp, index=False)
+
     for path, label, write in (
-        (out, "series", _series_writer(traj, out)),
+        (out, "series", series),
         (section, "section", lambda tmp: traj.section.to_csv(tmp, index=False)),
         (impacts, "impacts", lambda tmp: impact_rows.to_csv(tmp, index=False)),
     ):
@@ -101,44 +100,23 @@ def _run(args: argparse.Namespace, out, section, impacts, written: list) -> int:
                 ) from None  # fmt: skip
             written.append(path)
             print(f"{label}: {path}")
-    return _exit_code(traj, notes)
-
-
-def _distinct(*named) -> None:
-    """Refuse two outputs of one run that name the same file (the second would replace the
-    first)."""
-    from ..io import OutputError
-
-    seen: dict = {}
-    for flag, path in named:
-        if path is None:
-            continue
-        key = path.resolve()
-        if key in seen:
-            raise OutputError(f"{seen[key]} and {flag} both name {path}; give each its own file")
-        seen[key] = flag
-
-
-def _series_writer(traj, out):
-    if out is not None and out.suffix.lower() == ".parquet":
-        from ..io import write_table
-
-        return lambda tmp: write_table(traj.parquet_table(), tmp)
-    return lambda tmp: traj.series.drop(columns="member").to_csv(tmp, index=False)
-
-
-def _exit_code(traj, notes: list[str]) -> int:
-    """0 when the run simulated what was asked; else 1, with the cause on stderr (and the
-    step-size warning first when there was one: it is then the likely cause)."""
-    from ..kernel import Status
-
-    if traj.status is Status.OK:
+    if traj.ok:
         return 0
     cause = f"likely cause: {notes[0]}. " if notes else ""
     print(
         f"chaoscam: the run ended {traj.status.name} at t = {traj.final_state[0]:.6g} s "
-        f"of {traj.settings['duration']:g} s, not the end asked for. {cause}"
-        f"{traj.message}",
+        f"of {traj.settings['duration']:g} s, not the end asked for. {cause}{traj.message}",
         file=sys.stderr,
     )
     return 1
+
+
+def _distinct(*named) -> None:
+    """Refuse two outputs of one run that name the same file."""
+    from ..io import OutputError
+
+    seen: dict = {}
+    for flag, path in named:
+        if path is not None and seen.setdefault(path.resolve(), flag) != flag:
+            first = seen[path.resolve()]
+            raise OutputError(f"{first} and {flag} both name {path}; give each its own file")

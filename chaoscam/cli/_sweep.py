@@ -3,43 +3,25 @@
 from __future__ import annotations
 
 import argparse
-import sys
-from pathlib import Path
 
-from ._options import (
-    add_engine_options,
-    add_run_options,
-    add_sweep_options,
-    engine_settings,
-    path_arg,
-    sweep_settings,
-)
+from ._options import add_sweep_options, counts, path_arg, run_sweep, sweep_settings
 
-__all__ = ["register"]
-
-_PLOT_SUFFIXES = (".png", ".pdf", ".svg")
+AXIS = "START:STOP:NUM|V1,V2,..."
 
 
 def _common(p: argparse.ArgumentParser) -> None:
-    add_run_options(p, transient=None)
-    add_engine_options(p)
+    add_sweep_options(p)
     p.add_argument(
         "--fate",
         type=float,
-        default=None,
         metavar="S",
-        help="continue each run labelled chaotic, quasiperiodic or undetermined to S seconds "
-        "(> --duration) and record whether it leaves the cam's reach before (columns fate, "
-        "left_at) and, if it stays, its verdict on the continued run's last half (columns "
-        "fate_label, fate_period): transient chaos",
+        help="continue each run labelled chaotic, quasiperiodic or undetermined to S s "
+        "(> --duration): whether it leaves the cam's reach (columns fate, left_at), else its "
+        "verdict on the continued run's last half (fate_label, fate_period): transient chaos",
     )
     p.add_argument(
-        "--plot",
-        type=path_arg,
-        default=None,
-        help="also draw the figure to FILE (.png, .pdf or .svg)",
+        "--plot", type=path_arg, help="also draw the figure to FILE (.png, .pdf or .svg)"
     )
-    add_sweep_options(p)
 
 
 def register(sub) -> None:
@@ -55,7 +37,7 @@ def register(sub) -> None:
     b.add_argument(
         "--values",
         required=True,
-        metavar="START:STOP:NUM|V1,V2,...",
+        metavar=AXIS,
         help="NUM values from START to STOP, both included, or exact values V1,V2,...",
     )
     b.add_argument(
@@ -80,26 +62,19 @@ def register(sub) -> None:
         "random line length. Writes one row per realization to FILE.parquet and the "
         "per-cell fractions with 95% Wilson intervals to FILE.cells.parquet.",
     )
-    r.add_argument("--mu", metavar="START:STOP:NUM|V1,V2,...", help="mean line length l_lambda [m]")
-    r.add_argument("--sigma", metavar="START:STOP:NUM|V1,V2,...", help="spread l_lambda_sigma [m]")
-    r.add_argument(
-        "--x", metavar="NAME=START:STOP:NUM|V1,V2,...", help="first axis (instead of --mu)"
-    )
-    r.add_argument(
-        "--y", metavar="NAME=START:STOP:NUM|V1,V2,...", help="second axis (instead of --sigma)"
-    )
+    r.add_argument("--mu", metavar=AXIS, help="mean line length l_lambda [m]")
+    r.add_argument("--sigma", metavar=AXIS, help="spread l_lambda_sigma [m]")
+    r.add_argument("--x", metavar=f"NAME={AXIS}", help="first axis (instead of --mu)")
+    r.add_argument("--y", metavar=f"NAME={AXIS}", help="second axis (instead of --sigma)")
     r.add_argument(
         "--realizations",
         type=int,
-        default=None,
         metavar="N",
-        help="realizations per cell (default 20 where a cell has a random line length, "
-        "else 1)",
+        help="realizations per cell (default 20 where a cell has a random line length, else 1)",
     )
     r.add_argument(
         "--target-halfwidth",
         type=float,
-        default=None,
         metavar="W",
         help="adaptive: add N more realizations to a cell while its widest 95%% interval "
         "half-width exceeds W",
@@ -107,183 +82,123 @@ def register(sub) -> None:
     r.add_argument(
         "--max-realizations",
         type=int,
-        default=None,
         metavar="M",
-        help="adaptive: at most M per cell (default 1000)",
+        help="adaptive: at most M a cell (default 1000)",
     )
     _common(r)
     r.set_defaults(func=run_regime_map)
 
 
-def _execution(args) -> dict:
+def _sweep(fn, args, swept: dict[str, str], **kwargs):
+    """``fn`` with ``--set`` (refused for a ``swept`` name) and the shared options: its result,
+    or the exit code of a stopped sweep."""
     from ..io import check_output
+    from . import parse_assignments
 
-    check_output(args.plot, flag="--plot", force=args.force, suffixes=_PLOT_SUFFIXES)
-    return dict(
-        duration=args.duration,
-        transient=args.transient,
-        seed=args.seed,
-        **engine_settings(args),
-        **sweep_settings(args),
-        fate=args.fate,
-    )
+    base, numerics = parse_assignments(args.set, swept)
+    check_output(args.plot, flag="--plot", force=args.force, suffixes=(".png", ".pdf", ".svg"))
+    return run_sweep(
+        fn, base=base, numerics=numerics, duration=args.duration, transient=args.transient,
+        seed=args.seed, **sweep_settings(args), fate=args.fate, **kwargs,
+    )  # fmt: skip
 
 
-def _transient(table) -> str:
-    """The summary line of a sweep with a fate horizon: how many runs left later, and how
-    many settled on a periodic orbit."""
+def _fate(table) -> str:
+    """The summary line of ``--fate``: how many runs left later, how many settled periodic."""
     from ..sweep import continued_labels, fate_settled, fate_split
 
     checked, left = fate_split(table)
     if not len(checked):
         return ""
-    settled = fate_settled(table)
-    late = (
-        f"; {len(settled)} periodic on the continued run's last half (period(s) "
-        f"{_counts(settled['fate_period'].astype(int))})"
-        if len(settled)
-        else ""
-    )
+    settled, late = fate_settled(table), ""
+    if len(settled):
+        periods = counts(settled["fate_period"].astype(int))
+        late = f"; {len(settled)} periodic on the continued run's last half (period(s) {periods})"
     if not len(left):
         return f"\nfate: every run {continued_labels(checked)} stayed in the cam's reach{late}"
     t0, t1 = f"{left['left_at'].min():.4g}", f"{left['left_at'].max():.4g}"
     return (
         f"\nfate: {len(left)} of the {len(checked)} run(s) {continued_labels(checked)} "
-        f"stopped later ({_counts(left['fate'])}; last section at "
+        f"stopped later ({counts(left['fate'])}; last section at "
         f"{t0 if t0 == t1 else f'{t0}–{t1}'} s): transient motion{late}"
     )
 
 
-def _call(fn, **kwargs):
-    """Run a sweep; bad settings become usage errors (exit 2); a stopped run returns its
-    exit code (130 Ctrl-C, 1 a lost Dask scheduler or a failed task) after saying how to
-    resume or reproduce it."""
-    from ..sweep import SweepError, SweepInterrupted, TaskFailed
-    from . import UsageError, stop_word
-
-    try:
-        return fn(**kwargs)
-    except SweepError as err:
-        raise UsageError(str(err)) from None
-    except TaskFailed as err:
-        print(f"chaoscam: error: {err}", file=sys.stderr)
-        return 1
-    except SweepInterrupted as err:
-        print(f"chaoscam: {err.describe(stop_word())}", file=sys.stderr)
-        return 130 if err.cause is None else 1
-
-
-def _counts(labels) -> str:
-    return ", ".join(f"{k} {v}" for k, v in labels.value_counts().sort_index().items())
-
-
-def _not_set(items: list[str] | None, swept: dict[str, str]) -> None:
-    """Refuse ``--set NAME=VALUE`` for a parameter the sweep varies: the axis would silently
-    override it."""
-    from . import UsageError
-
-    for item in items or []:
-        name = item.partition("=")[0].strip()
-        if name in swept:
-            raise UsageError(
-                f"--set {item}: {name} is swept by {swept[name]}, which gives its values; "
-                "drop the --set"
-            )
-
-
-def run_bifurcation(args: argparse.Namespace) -> int:
-    from ..sweep import bifurcation, companion
-    from . import parse_assignments
-
-    _not_set(args.set, {args.param: "--param"})
-    base, numerics = parse_assignments(args.set)
-    if args.initial_conditions < 1:
-        from . import UsageError
-
-        raise UsageError(f"--initial-conditions {args.initial_conditions}: must be >= 1")
-    res = _call(
-        bifurcation,
-        param=args.param,
-        values=args.values,
-        base=base,
-        numerics=numerics,
-        initial_conditions=args.initial_conditions,
-        continuation=args.continuation,
-        **_execution(args),
-    )
-    if isinstance(res, int):
-        return res
-    v = res.verdicts
-    print(
-        f"bifurcation over {res.param}: {v['value_index'].nunique()} values x "
-        f"{v['ic'].nunique()} initial condition(s), {len(res.points)} section points\n"
-        f"verdicts: {_counts(v['label'])}{_transient(v)}\n"
-        f"points: {args.out}\nverdicts: {companion(args.out, 'verdicts')}"
-    )
+def _finish(args, summary: str, draw) -> int:
+    """Print the summary; then, with ``--plot``, draw the figure (``draw()``) and write it."""
+    print(summary)
     if args.plot is not None:
-        from ..report import sweep_diagram
+        from ..io import atomic_path
 
-        _save_figure(sweep_diagram(res), args.plot)
+        fig = draw()
+        with atomic_path(args.plot) as tmp:
+            fig.savefig(tmp, dpi=150)
         print(f"figure: {args.plot}")
     return 0
 
 
-def run_regime_map(args: argparse.Namespace) -> int:
-    from ..sweep import Axis, SweepError, companion, mu_sigma_axes, regime_map
-    from . import UsageError, parse_assignments
+def run_bifurcation(args: argparse.Namespace) -> int:
+    from .. import report
+    from ..sweep import bifurcation, companion
+    from . import UsageError
 
-    try:
-        if (args.mu is None) == (args.x is None):
-            raise UsageError("give the first axis with --mu or --x (one of them)")
-        if (args.sigma is None) == (args.y is None):
-            raise UsageError("give the second axis with --sigma or --y (one of them)")
-        if args.mu is not None and args.sigma is not None:
-            x, y = mu_sigma_axes(args.mu, args.sigma)
-        else:
-            x = Axis.parse(args.mu, name="l_lambda") if args.mu else Axis.parse(args.x)
-            y = Axis.parse(args.sigma, name="l_lambda_sigma") if args.sigma else Axis.parse(args.y)
-    except SweepError as err:
-        raise UsageError(str(err)) from None
-    _not_set(
-        args.set, {x.name: "--mu" if args.mu else "--x", y.name: "--sigma" if args.sigma else "--y"}
+    if args.initial_conditions < 1:
+        raise UsageError(f"--initial-conditions {args.initial_conditions}: must be >= 1")
+    res = _sweep(
+        bifurcation, args, {args.param: "--param"}, param=args.param, values=args.values,
+        initial_conditions=args.initial_conditions, continuation=args.continuation,
+    )  # fmt: skip
+    if isinstance(res, int):
+        return res
+    v = res.verdicts
+    summary = (
+        f"bifurcation over {res.param}: {v['value_index'].nunique()} values x "
+        f"{v['ic'].nunique()} initial condition(s), {len(res.points)} section points\n"
+        f"verdicts: {counts(v['label'])}{_fate(v)}\n"
+        f"points: {args.out}\nverdicts: {companion(args.out, 'verdicts')}"
     )
-    base, numerics = parse_assignments(args.set)
-    res = _call(
-        regime_map,
-        x=x,
-        y=y,
-        base=base,
-        numerics=numerics,
-        realizations=args.realizations,
-        target_halfwidth=args.target_halfwidth,
-        max_realizations=args.max_realizations,
-        **_execution(args),
-    )
+    return _finish(args, summary, lambda: report.sweep_diagram(res))
+
+
+def _axes(args):
+    """The regime map's axes from --mu/--x and --sigma/--y, and the option naming each."""
+    from ..sweep import Axis, mu_sigma_axes
+    from . import UsageError
+
+    if (args.mu is None) == (args.x is None):
+        raise UsageError("give the first axis with --mu or --x (one of them)")
+    if (args.sigma is None) == (args.y is None):
+        raise UsageError("give the second axis with --sigma or --y (one of them)")
+    if args.mu is not None and args.sigma is not None:
+        x, y = mu_sigma_axes(args.mu, args.sigma)
+    else:
+        x = Axis.parse(args.mu, name="l_lambda") if args.mu else Axis.parse(args.x)
+        y = Axis.parse(args.sigma, name="l_lambda_sigma") if args.sigma else Axis.parse(args.y)
+    return x, y, {x.name: "--mu" if args.mu else "--x", y.name: "--sigma" if args.sigma else "--y"}
+
+
+def run_regime_map(args: argparse.Namespace) -> int:
+    from .. import report
+    from ..sweep import companion, regime_map
+
+    x, y, swept = _axes(args)
+    res = _sweep(
+        regime_map, args, swept, x=x, y=y, realizations=args.realizations,
+        target_halfwidth=args.target_halfwidth, max_realizations=args.max_realizations,
+    )  # fmt: skip
     if isinstance(res, int):
         return res
     c = res.cells
     det = int(c["deterministic"].astype(bool).sum()) if "deterministic" in c else 0
     once = f" ({det} deterministic cell(s), sigma = 0: one run each)" if det else ""
-    print(
+    summary = (
         f"regime map {res.x} x {res.y}: {len(c)} cells, {len(res.realizations)} realizations"
         f"{once}\n"
-        f"labels: {_counts(res.realizations['label'])}\n"
-        f"dominant: {_counts(c['dominant'])}{_transient(res.realizations)}\n"
+        f"labels: {counts(res.realizations['label'])}\n"
+        f"dominant: {counts(c['dominant'])}{_fate(res.realizations)}\n"
         f"realizations: {args.out}\ncells: {companion(args.out, 'cells')}"
     )
-    if args.plot is not None:
-        from ..report import regime_map_figure
-
-        _save_figure(
-            regime_map_figure(c, x=res.x, y=res.y, confidence=res.config["confidence"]),
-            args.plot,
-        )
-        print(f"figure: {args.plot}")
-    return 0
-
-
-def _save_figure(fig, path: Path) -> None:
-    from ..io import atomic_path
-
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=150)
+    confidence = res.config["confidence"]
+    return _finish(
+        args, summary, lambda: report.regime_map_figure(c, x=res.x, y=res.y, confidence=confidence)
+    )

@@ -1,10 +1,6 @@
-"""The paper: its figures reproduced, and the sweeps that explain the differences.
-
-The computations behind ``chaoscam paper``: one function per paper figure (:mod:`._paper`,
-``figN(quick, outdir) -> FigureResult``), the sensitivity sweeps (:mod:`._sensitivity`), the
-step audit (:mod:`._step_audit`, :mod:`._ladder`), and the run that executes them and hands
-the results to :mod:`chaoscam.report` to render (:mod:`._run`). This layer sits above
-``report/`` (it uses its figures and HTML), which only renders. In Python::
+"""The paper: its figures reproduced (:mod:`._paper`), the sweeps that explain the
+differences (:mod:`._sensitivity`), the step audit (:mod:`._step_audit`), and
+:func:`run_paper`, which renders them through :mod:`chaoscam.report`::
 
     from chaoscam.paper import run_paper
     run_paper(quick=True, out="out/paper.html")
@@ -20,7 +16,7 @@ _LAZY = {
     "SENSITIVITY": ("._paper", "SENSITIVITY"),
     "FigureResult": ("._stage", "FigureResult"),
     "PaperRun": ("._run", "PaperRun"),
-    "audit_script": ("._audit_script", "audit_script"),
+    "audit_script": ("._step_audit", "audit_script"),
     "check_paper_outputs": ("._run", "check_paper_outputs"),
     "data_files": ("._paper", "data_files"),
     "figure_script": ("._run", "figure_script"),

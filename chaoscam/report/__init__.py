@@ -1,8 +1,5 @@
-"""Reports: figures (seaborn/matplotlib) and HTML for runs, regime maps, diagrams and
-ensembles.
-
-``chaoscam report INPUT... --out FILE.html`` drives this layer, and ``chaoscam paper``
-(:mod:`chaoscam.paper`) renders through it; it only renders. In Python::
+"""Reports: figures (seaborn/matplotlib) and HTML of runs, regime maps, bifurcation diagrams
+and ensembles; ``chaoscam report`` and :mod:`chaoscam.paper` render through it. In Python::
 
     from chaoscam.report import build_report, load_inputs, write_report
     write_report(build_report(load_inputs(["run.parquet"])), "run.html", title="run")

@@ -1,27 +1,24 @@
-"""An ensemble (:func:`chaoscam.ensemble`, ``chaoscam ensemble --out``) in the report: its
-members' section, the share of each label with its 95 % Wilson interval, why members stayed
-undetermined, and the run's configuration.
+"""An ensemble (:func:`chaoscam.ensemble`) in the report: its members' section, the share of
+each label with its 95 % Wilson interval, why members stayed undetermined, its configuration.
 
 A member's label is its verdict or, unclassified, its run status. With ``l_lambda_sigma =
-0``, or the fractal stiffness, every member is the same deterministic run (the members
-differ only in their realization index, whose draws change nothing), so the shares are those
-of one run and get no sampling interval, as a regime map's deterministic cells.
+0`` or the fractal stiffness every member is the same deterministic run, so the shares are
+those of one run and get no sampling interval, as a regime map's deterministic cells.
 """
 
 from __future__ import annotations
 
 import re
 from collections import Counter
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..io import code_rows
 from ..sweep import LABEL_ORDER, wilson_interval
-from ._figures import png_bytes, png_uri
 
-__all__ = ["classified", "deterministic", "ensemble_entry", "ensemble_figure", "label_shares"]
+__all__ = ["classified", "deterministic", "ensemble_figure", "ensemble_settings"]
+__all__ += ["label_shares", "top_reasons"]
 
 TOP_REASONS = 8
 """Most distinct reasons for an undetermined label listed in the report (the rest counted)."""
@@ -33,8 +30,8 @@ def classified(members) -> bool:
 
 
 def _labels(members) -> list[str]:
-    """Each member's label: its verdict, or its status when the run was not classified; a
-    periodic verdict with its period ("periodic (period 2)")."""
+    """Each member's label: its verdict ("periodic (period 2)" with its period), or its
+    status when the run was not classified."""
     if not classified(members):
         return [str(s) for s in members["status"]]
     import pandas as pd
@@ -53,8 +50,8 @@ def _order(label: str) -> tuple[int, int, str]:
 
 
 def deterministic(config: dict) -> bool:
-    """True when the configuration says every member is the same run: ``l_lambda_sigma =
-    0``, or the fractal stiffness (:func:`chaoscam.model.realizations_identical`)."""
+    """Whether the configuration makes every member the same run
+    (:func:`chaoscam.model.realizations_identical`)."""
     from ..model import Params, realizations_identical
 
     try:
@@ -83,6 +80,9 @@ def ensemble_figure(ens, *, title: str = ""):
 
     from ._sweep_figures import _OTHER, LABEL_COLORS, axis_label
 
+    def color(label: str) -> str:
+        return LABEL_COLORS.get(label.partition(" ")[0], _OTHER)
+
     fig = Figure(figsize=(12, 5), layout="constrained")
     a, b = fig.subplots(1, 2, width_ratios=(3, 2))
     members, sec = ens.members, ens.sections
@@ -92,9 +92,10 @@ def ensemble_figure(ens, *, title: str = ""):
         lab = sec["member"].map(labels).fillna("?")
         for key in sorted(set(lab), key=_order):
             g = sec[lab == key]
-            color = LABEL_COLORS.get(key.partition(" ")[0], _OTHER)
-            a.scatter(g["theta_f"], g["omega_f"], s=size, c=color, linewidths=0, rasterized=True)
-            a.scatter([], [], s=30, c=color, label=key)
+            a.scatter(
+                g["theta_f"], g["omega_f"], s=size, c=color(key), linewidths=0, rasterized=True
+            )
+            a.scatter([], [], s=30, c=color(key), label=key)
         a.legend(frameon=False, fontsize="small")
         a.set_xlabel(axis_label("theta_f"))
         a.set_ylabel(axis_label("omega_f"))
@@ -105,7 +106,7 @@ def ensemble_figure(ens, *, title: str = ""):
     rows = label_shares(members)
     x = np.arange(len(rows))
     share = np.array([r["share"] for r in rows])
-    colors = [LABEL_COLORS.get(r["label"].partition(" ")[0], _OTHER) for r in rows]
+    colors = [color(r["label"]) for r in rows]
     if deterministic(ens.config):
         b.bar(x, share, color=colors)
         b.set_title("share of members (one deterministic run)")
@@ -134,7 +135,14 @@ def _reasons(members) -> list[tuple[str, int]]:
     return counts.most_common()
 
 
-def _settings(cfg: dict, ens) -> dict[str, Any]:
+def top_reasons(members) -> list[tuple[str, int]]:
+    """:func:`_reasons`, the :data:`TOP_REASONS` most common and the rest counted together."""
+    reasons = _reasons(members)
+    shown, rest = reasons[:TOP_REASONS], sum(c for _, c in reasons[TOP_REASONS:])
+    return shown + [(f"{len(reasons) - TOP_REASONS} other reasons", rest)] if rest else shown
+
+
+def ensemble_settings(cfg: dict, ens) -> dict[str, Any]:
     """The provenance rows of an ensemble's configuration."""
     p, num = cfg.get("params") or {}, cfg.get("numerics") or {}
     first = cfg.get("first", 0)
@@ -149,65 +157,10 @@ def _settings(cfg: dict, ens) -> dict[str, Any]:
         "classifier": cfg.get("classifier"),
     }
     rows.update(code_rows(cfg.get("code")))
-    for source, k, unit in (
-        (num, "integrator", ""),
-        (num, "dt", " [s]"),
-        (p, "stiffness", ""),
-        (p, "l_lambda", " [m]"),
-        (p, "l_lambda_sigma", " [m]"),
-        (p, "resample", ""),
-        (p, "omega", " [rad/s]"),
-        (p, "xi", ""),
+    units = {"dt": " [s]", "l_lambda": " [m]", "l_lambda_sigma": " [m]", "omega": " [rad/s]"}
+    for source, keys in (
+        (num, ("integrator", "dt")),
+        (p, ("stiffness", "l_lambda", "l_lambda_sigma", "resample", "omega", "xi")),
     ):
-        if k in source:
-            rows[f"{k}{unit}"] = source[k]
+        rows.update({k + units.get(k, ""): source[k] for k in keys if k in source})
     return rows
-
-
-def ensemble_entry(path: str, ens, *, png: bytes | None = None) -> dict[str, Any]:
-    """What the report shows of one ensemble: ``figure`` (title, uri, alt, caption), the
-    label table ``rows``, the undetermined members' ``reasons`` with their counts, the
-    ``settings`` for the provenance section and a ``summary`` line (``png``: the figure
-    already rendered, else drawn here)."""
-    name = Path(path).name
-    rows = label_shares(ens.members)
-    fixed = deterministic(ens.config)
-    if png is None:
-        png = png_bytes(ensemble_figure(ens, title=name))
-    n = len(ens.members)
-    reasons = _reasons(ens.members)
-    shown = reasons[:TOP_REASONS]
-    rest = sum(c for _, c in reasons[TOP_REASONS:])
-    if rest:
-        shown.append((f"{len(reasons) - TOP_REASONS} other reasons", rest))
-    what = "verdicts" if classified(ens.members) else "run statuses (not classified)"
-    counts = "; ".join(f"{r['label']}: {r['count']}" for r in rows)
-    return {
-        "figure": {
-            "title": f"Ensemble of {n} members ({name})",
-            "uri": png_uri(png),
-            "alt": f"Left: the stroboscopic section theta_f, omega_f of every member, coloured "
-            f"by its label. Right: the share of each label among {n} members"
-            + ("." if fixed else " with its 95% Wilson interval."),
-            "caption": f"{n} members, {what}"
-            + (
-                "; every member is the same deterministic run (l_lambda_sigma = 0 or the fractal "
-                "stiffness)."
-                if fixed
-                else "."
-            ),
-        },
-        "rows": [
-            (
-                r["label"],
-                r["count"],
-                f"{r['share']:.3f}",
-                "none: one deterministic run" if fixed else f"[{r['lo']:.3f}, {r['hi']:.3f}]",
-            )
-            for r in rows
-        ],
-        "reasons": shown,
-        "settings": _settings(ens.config, ens),
-        "summary": f"{name}: ensemble of {n} members, {what}: {counts}"
-        + (" (σ = 0: one deterministic run)." if fixed else "."),
-    }

@@ -1,7 +1,7 @@
 """Figures of single runs (paper Figs. 7-10) and the PNG data URIs the HTML embeds.
 
-Built with matplotlib's object API (no pyplot: nothing opens a window, the Agg canvas
-renders), scatter layers rasterised so that thousands of points stay light.
+matplotlib's object API (no pyplot: nothing opens a window, the Agg canvas renders); scatter
+layers are rasterised so that thousands of points stay light.
 """
 
 from __future__ import annotations
@@ -25,44 +25,32 @@ def png_bytes(fig, dpi: int = 96) -> bytes:
 
 
 def png_uri(png: bytes) -> str:
-    """``data:image/png;base64,...`` of PNG bytes already rendered (:func:`png_bytes`), for an
-    ``<img src>`` that needs no network."""
+    """``data:image/png;base64,...`` of PNG bytes (:func:`png_bytes`), for an ``<img src>``
+    that needs no network."""
     return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
 
 
 def response_figure(run, title: str = ""):
     """Four panels of one run (a one-member :class:`chaoscam.Solution`): θ_f and θ_fc over
-    time, phase portrait, section, spectrum.
-
-    The time panel shows the last 2 s of the kept series; the phase portrait the whole kept
-    series; the Poincaré panel the stroboscopic section at t = k 2π/ω; the spectrum the
-    periodogram of θ_f (:func:`chaoscam.analysis.power_spectrum`) with the cam frequency
-    ω/2π marked.
-    """
+    the last 2 s of the kept series, the phase portrait of the whole series, the stroboscopic
+    section at t = k 2π/ω, and the periodogram of θ_f
+    (:func:`chaoscam.analysis.power_spectrum`) with the cam frequency ω/2π marked."""
     from matplotlib.figure import Figure
 
     from ..analysis import power_spectrum
 
     fig = Figure(figsize=(11, 7.5), layout="constrained")
     (a, b), (c, d) = fig.subplots(2, 2)
-    s = run.series
-    sec = run.section
+    s, sec = run.series, run.section
     f_cam = run.params.omega / (2 * np.pi)
     if s is not None and len(s) > 2:
         last = s[s["t"] >= s["t"].iloc[-1] - 2.0]
         a.plot(last["t"], last["theta_f"], lw=0.8, color="#0072B2", label="θ_f (follower)")
-        a.plot(
-            last["t"],
-            last["theta_fc"],
-            lw=0.8,
-            ls="--",
-            color="#D55E00",
-            label="θ_fc (persistent contact)",
-        )
+        a.plot(last["t"], last["theta_fc"], lw=0.8, ls="--", color="#D55E00",
+               label="θ_fc (persistent contact)")  # fmt: skip
         a.legend(frameon=False, fontsize="small", loc="upper right")
         b.plot(s["theta_f"], s["omega_f"], lw=0.3, color="#555555", rasterized=True)
-        dt = float(s["t"].diff().median())
-        f, pw = power_spectrum(s["theta_f"].to_numpy(), dt)
+        f, pw = power_spectrum(s["theta_f"].to_numpy(), float(s["t"].diff().median()))
         keep = (f > 0) & (f <= 10 * f_cam)
         d.semilogy(f[keep], pw[keep] + 1e-300, lw=0.7, color="#0072B2")
         d.axvline(f_cam, color="#D55E00", lw=0.8, ls=":", label=f"cam ω/2π = {f_cam:.3g} Hz")
@@ -75,16 +63,10 @@ def response_figure(run, title: str = ""):
     c.scatter(sec["theta_f"], sec["omega_f"], s=6, color="#000000", linewidths=0, rasterized=True)
     a.set(xlabel="time t [s]", ylabel="angle [rad]", title="θ_f and θ_fc, last 2 s")
     b.set(xlabel="θ_f [rad]", ylabel="θ̇_f [rad/s]", title="phase portrait")
-    c.set(
-        xlabel="θ_f [rad]",
-        ylabel="θ̇_f [rad/s]",
-        title=f"Poincaré section at t = k·2π/ω ({len(sec)} points)",
-    )
-    d.set(
-        xlabel="frequency [Hz]",
-        ylabel="power of θ_f [rad²·s, arbitrary scale]",
-        title="spectrum of θ_f",
-    )
+    c.set(xlabel="θ_f [rad]", ylabel="θ̇_f [rad/s]",
+          title=f"Poincaré section at t = k·2π/ω ({len(sec)} points)")  # fmt: skip
+    d.set(xlabel="frequency [Hz]", ylabel="power of θ_f [rad²·s, arbitrary scale]",
+          title="spectrum of θ_f")  # fmt: skip
     if title:
         fig.suptitle(title)
     return fig

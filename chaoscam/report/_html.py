@@ -1,14 +1,16 @@
 """The self-contained HTML report: inputs read, figures drawn, a Jinja2 template rendered.
 
-Figures are inline PNG data URIs; the template holds its own CSS; nothing in the file refers
-to the network, so it opens from disk anywhere. A report built from a partial set of inputs
-says what is missing instead of failing.
+Figures are inline PNG data URIs and the template holds its own CSS: nothing in the file
+refers to the network, so it opens from disk anywhere. A report built from a partial set of
+inputs says what is missing instead of failing.
 """
 
 from __future__ import annotations
 
 import datetime as _dt
+import hashlib
 import math
+import subprocess
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -17,7 +19,7 @@ from typing import Any
 from ..io import code_rows
 from ..sweep import fate_clause
 from ._figures import png_bytes, png_uri, response_figure
-from ._inputs import require_inputs
+from ._inputs import Inputs
 
 __all__ = ["Comparison", "FigureItem", "ReportParts", "add_bifurcation", "add_ensemble"]
 __all__ += ["add_regime_map", "add_trajectory", "build_report", "git_commit", "render"]
@@ -41,6 +43,17 @@ SECTIONS = (
 
 ENSEMBLES = ("ensembles", "Ensembles")
 """A section shown after the bifurcation diagrams only when the report has an ensemble."""
+
+SOURCES = ("chaoscam", "analyses", "pyproject.toml")
+"""What a report's numbers come from: uncommitted changes there are named in its provenance."""
+
+_SWEEP_ROWS = {
+    "kind": "kind", "version": "package version", "seed": "seed", "duration": "duration [s]",
+    "transient": "transient [s]", "realizations": "realizations per cell",
+    "classifier": "classifier", "device": "device", "confidence": "confidence of the intervals",
+    "adaptive": "adaptive sampling", "continuation": "continuation",
+}  # fmt: skip
+"""The sweep record's keys shown in its provenance, and their names there."""
 
 
 @dataclass
@@ -88,66 +101,50 @@ class ReportParts:
     missing: list[str] = field(default_factory=list)
 
 
+def _checkout(start: Path | None) -> Path | None:
+    """The folder holding the ``.git`` around ``start`` (default: this file), or None."""
+    here = Path(start or Path(__file__)).resolve()
+    return next((d for d in [here, *here.parents] if (d / ".git").exists()), None)
+
+
 def git_commit(start: Path | None = None) -> str | None:
     """The commit checked out around ``start`` (read from ``.git``, no git process), or None."""
-    here = Path(start or Path(__file__)).resolve()
-    for d in [here, *here.parents]:
-        g = d / ".git"
-        if g.is_file():  # a worktree: "gitdir: PATH"
-            text = g.read_text().strip()
-            if text.startswith("gitdir:"):
-                g = (d / text.split(":", 1)[1].strip()).resolve()
-        if not g.is_dir():
-            continue
-        try:
-            head = (g / "HEAD").read_text().strip()
-            if not head.startswith("ref:"):
-                return head
-            ref = head.split(":", 1)[1].strip()
-            common = g
-            if (g / "commondir").exists():
-                common = (g / (g / "commondir").read_text().strip()).resolve()
-            for base in (g, common):
-                if (base / ref).exists():
-                    return (base / ref).read_text().strip()
-            packed = common / "packed-refs"
-            if packed.exists():
-                for line in packed.read_text().splitlines():
-                    if line.endswith(" " + ref):
-                        return line.split()[0]
-        except OSError:
-            return None
+    root = _checkout(start)
+    if root is None:
         return None
-    return None
-
-
-SOURCES = ("chaoscam", "analyses", "pyproject.toml")
-"""What a report's numbers come from: changes there that are not committed are named in its
-provenance (a report and its data are not)."""
+    g = root / ".git"
+    try:
+        if g.is_file() and (text := g.read_text().strip()).startswith("gitdir:"):  # a worktree
+            g = (root / text.split(":", 1)[1].strip()).resolve()
+        head = (g / "HEAD").read_text().strip()
+        if not head.startswith("ref:"):
+            return head
+        ref = head.split(":", 1)[1].strip()
+        common = g
+        if (g / "commondir").exists():
+            common = (g / (g / "commondir").read_text().strip()).resolve()
+        for base in (g, common):
+            if (base / ref).exists():
+                return (base / ref).read_text().strip()
+        packed = common / "packed-refs"
+        lines = packed.read_text().splitlines() if packed.exists() else []
+        return next((line.split()[0] for line in lines if line.endswith(" " + ref)), None)
+    except OSError:
+        return None
 
 
 def uncommitted_sources(start: Path | None = None) -> list[str] | None:
     """Tracked files under :data:`SOURCES` that differ from the commit checked out (``git
-    status``), so that a report built from an uncommitted tree does not pass for the commit
-    it names; None when git or the checkout is not there."""
-    import subprocess
-
-    here = Path(start or Path(__file__)).resolve()
-    root = next((d for d in [here, *here.parents] if (d / ".git").exists()), None)
+    status``), so that a report does not pass for that commit; None without git or checkout."""
+    root = _checkout(start)
     if root is None:
         return None
+    cmd = ["git", "status", "--porcelain", "--untracked-files=no", "--", *SOURCES]
     try:
-        out = subprocess.run(
-            ["git", "status", "--porcelain", "--untracked-files=no", "--", *SOURCES],
-            cwd=root,
-            capture_output=True,
-            text=True,
-            timeout=20,
-            check=True,
-        ).stdout
+        out = subprocess.run(cmd, cwd=root, capture_output=True, text=True, timeout=20, check=True)
     except (OSError, subprocess.SubprocessError):
         return None
-    return sorted(line[3:] for line in out.splitlines() if len(line) > 3)
+    return sorted(line[3:] for line in out.stdout.splitlines() if len(line) > 3)
 
 
 def _counts(counts: dict) -> str:
@@ -160,15 +157,20 @@ def _fmt(v: Any) -> str:
     return "" if v is None else str(v)
 
 
-def _provenance_rows(source: str, kind: str, rows: dict[str, Any]) -> dict[str, Any]:
-    return {"source": source, "kind": kind, "rows": [(k, _fmt(v)) for k, v in rows.items()]}
+def _uri(png: bytes | None, draw) -> str:
+    """The data URI of ``png``, or of ``draw()``'s figure rendered when there is none."""
+    return png_uri(png_bytes(draw()) if png is None else png)
+
+
+def _record(parts: ReportParts, path: str, kind: str, settings: dict, summary: str) -> None:
+    """An input's settings in the provenance section and its line in the summary."""
+    rows = [(k, _fmt(v)) for k, v in settings.items()]
+    parts.provenance.append({"source": path, "kind": kind, "rows": rows})
+    parts.summary.append(summary)
 
 
 def classifier_fingerprint() -> str:
-    """:data:`CLASSIFIER` and the sha256 (12 hex digits) of the verdict package's source, for
-    provenance."""
-    import hashlib
-
+    """:data:`CLASSIFIER` and the sha256 (12 hex digits) of the verdict package's source."""
     from .. import verdict
 
     digest = hashlib.sha256()
@@ -188,64 +190,50 @@ def add_trajectory(
     """A run's response figure, its verdict and its provenance (``run``: a one-member
     :class:`chaoscam.Solution`).
 
-    ``png``: the response figure already rendered (:func:`._figures.png_bytes`); without it
-    the figure is drawn here, titled with the file name and the label. ``verdict``: the run's
-    verdict by :func:`chaoscam.classify`, already computed; without it the run is classified
-    here.
+    ``png``: the response figure already rendered (:func:`png_bytes`), else drawn here and
+    titled with the file name and the label. ``verdict``: the run's verdict by
+    :func:`chaoscam.classify`, else classified here.
     """
     from ..verdict import classify
 
-    name = Path(path).name
-    p, s = run.params, run.settings
+    name, p, s = Path(path).name, run.params, run.settings
     if verdict is None:
         (verdict,) = classify(run)
-    parts.provenance.append(
-        _provenance_rows(path, "trajectory", {
-            "status": run.status.name,
-            "seed": s.get("seed"),
-            "realization index": run.index,
-            "integrator": run.numerics.integrator,
-            "integration": run.numerics.describe_step(),
-            "duration [s]": s.get("duration"),
-            "transient [s]": s.get("transient"),
-            "package version": s.get("version"),
-            "stiffness": p.stiffness,
-            "l_lambda (mean) [m]": p.l_lambda,
-            "l_lambda_sigma [m]": p.l_lambda_sigma,
-            "resample": p.resample,
-            "impacts applied": run.stats.get("n_impacts"),
-            "contact fraction": run.stats.get("contact_fraction"),
-        })
-    )  # fmt: skip
     label = verdict.label + (f" (period {verdict.period})" if verdict.period else "")
-    if png is None:
-        png = png_bytes(response_figure(run, title=f"{name}: {label}"))
-    parts.responses.append(
-        FigureItem(
-            f"resp-{len(parts.responses) + 1}",
-            f"Response of {name}",
-            png_uri(png),
-            f"Four panels for {name}: follower angle and persistent-contact angle over the "
-            f"last 2 s, phase portrait, stroboscopic Poincaré section and spectrum of theta_f; "
-            f"classified {label}.",
-            caption
-            or f"μ = l_lambda = {p.l_lambda:g} m, σ = {p.l_lambda_sigma:g} m, "
-            f"stiffness {p.stiffness}; classified {label}.",
-        )
+    figure = FigureItem(
+        f"resp-{len(parts.responses) + 1}",
+        f"Response of {name}",
+        _uri(png, lambda: response_figure(run, title=f"{name}: {label}")),
+        f"Four panels for {name}: follower angle and persistent-contact angle over the last "
+        f"2 s, phase portrait, stroboscopic Poincaré section and spectrum of theta_f; "
+        f"classified {label}.",
+        caption
+        or f"μ = l_lambda = {p.l_lambda:g} m, σ = {p.l_lambda_sigma:g} m, "
+        f"stiffness {p.stiffness}; classified {label}.",
     )
-    parts.evidence.append(
-        {
-            "run": name,
-            "label": verdict.label,
-            "period": verdict.period,
-            "reasons": list(verdict.reasons),
-            "classifier": CLASSIFIER,
-            "rows": [
-                (e.name, _fmt(e.value), e.vote or "abstains", e.detail) for e in verdict.evidence
-            ],
-        }
-    )
-    parts.summary.append(f"{name}: {label} ({run.status.name}).")
+    parts.responses.append(figure)
+    rows = [(e.name, _fmt(e.value), e.vote or "abstains", e.detail) for e in verdict.evidence]
+    parts.evidence.append({
+        "run": name, "label": verdict.label, "period": verdict.period,
+        "reasons": list(verdict.reasons), "classifier": CLASSIFIER, "rows": rows,
+    })  # fmt: skip
+    settings = {
+        "status": run.status.name,
+        "seed": s.get("seed"),
+        "realization index": run.index,
+        "integrator": run.numerics.integrator,
+        "integration": run.numerics.describe_step(),
+        "duration [s]": s.get("duration"),
+        "transient [s]": s.get("transient"),
+        "package version": s.get("version"),
+        "stiffness": p.stiffness,
+        "l_lambda (mean) [m]": p.l_lambda,
+        "l_lambda_sigma [m]": p.l_lambda_sigma,
+        "resample": p.resample,
+        "impacts applied": run.stats.get("n_impacts"),
+        "contact fraction": run.stats.get("contact_fraction"),
+    }
+    _record(parts, path, "trajectory", settings, f"{name}: {label} ({run.status.name}).")
 
 
 def add_bifurcation(
@@ -257,50 +245,32 @@ def add_bifurcation(
 
     from ._sweep_figures import sweep_diagram
 
-    name = Path(path).name
-    cfg = bif.config or {}
+    name, cfg, v = Path(path).name, bif.config or {}, bif.verdicts
     param = cfg.get("axis", {}).get("name", "value")
-    v = bif.verdicts
-    counts = v["label"].value_counts().to_dict() if len(v) else {}
-    if png is None:
-        png = png_bytes(sweep_diagram(bif))
+    counts = _counts(v["label"].value_counts().to_dict() if len(v) else {})
     ev_cols = [c for c in v.columns if c.startswith("ev_")]
     named = dict(fate="at the fate horizon", fate_label="label there", fate_period="period there")
     later = [c for c in named if c in v] if cfg.get("fate") else []  # the sweep had a horizon
-    parts.bifurcations.append(
-        {
-            "figure": FigureItem(
-                f"bif-{len(parts.bifurcations) + 1}",
-                f"Bifurcation diagram over {param} ({name})",
-                png_uri(png),
-                f"Stroboscopic section theta_f in rad against {param}, coloured by the "
-                f"classifier's label; label counts {_counts(counts)}.",
-                caption
-                or f"{len(v)} runs, {len(bif.points)} section points; labels {_counts(counts)}.",
-            ),
-            "header": [param, "initial condition", "label", "period", "status"]
-            + [c[3:] for c in ev_cols]
-            + [named[c] for c in later],
-            "rows": [
-                (
-                    _fmt(r["value"]),
-                    int(r["ic"]),
-                    r["label"],
-                    _fmt(r["period"]),
-                    r["status"],
-                    *(_fmt(float(r[c])) for c in ev_cols),
-                    *(_fmt(r[c]) if pd.notna(r[c]) else "" for c in later),
-                )
-                for r in v.sort_values(["value", "ic"]).to_dict("records")
-            ][:300],
-        }
+    rows = [
+        (_fmt(r["value"]), int(r["ic"]), r["label"], _fmt(r["period"]), r["status"],
+         *(_fmt(float(r[c])) for c in ev_cols),
+         *(_fmt(r[c]) if pd.notna(r[c]) else "" for c in later))
+        for r in v.sort_values(["value", "ic"]).to_dict("records")
+    ]  # fmt: skip
+    figure = FigureItem(
+        f"bif-{len(parts.bifurcations) + 1}",
+        f"Bifurcation diagram over {param} ({name})",
+        _uri(png, lambda: sweep_diagram(bif)),
+        f"Stroboscopic section theta_f in rad against {param}, coloured by the classifier's "
+        f"label; label counts {counts}.",
+        caption or f"{len(v)} runs, {len(bif.points)} section points; labels {counts}.",
     )
-    parts.provenance.append(_provenance_rows(path, "bifurcation", _sweep_settings(cfg)))
-    parts.summary.append(
-        f"{name}: bifurcation over {param}, labels {_counts(counts)}"
-        + fate_clause(v, cfg.get("fate"), "runs")
-        + "."
-    )
+    header = [param, "initial condition", "label", "period", "status"]
+    header += [c[3:] for c in ev_cols] + [named[c] for c in later]
+    parts.bifurcations.append({"figure": figure, "header": header, "rows": rows[:300]})
+    fate = fate_clause(v, cfg.get("fate"), "runs")
+    summary = f"{name}: bifurcation over {param}, labels {counts}{fate}."
+    _record(parts, path, "bifurcation", _sweep_settings(cfg), summary)
 
 
 def add_regime_map(
@@ -310,63 +280,62 @@ def add_regime_map(
     rendered, else drawn here)."""
     from ._sweep_figures import all_deterministic, percent, regime_map_figure
 
-    name = Path(path).name
-    cfg = rm.config or {}
+    name, cfg, c = Path(path).name, rm.config or {}, rm.cells
     x, y = cfg.get("x", {}).get("name", "x"), cfg.get("y", {}).get("name", "y")
     confidence = float(cfg.get("confidence", 0.95))
-    c = rm.cells
-    if png is None:
-        png = png_bytes(regime_map_figure(c, x=x, y=y, confidence=confidence))
-    rows = []
-    for r in c.sort_values([x, y]).to_dict("records"):
-        rows.append(
-            (
-                _fmt(r[x]),
-                _fmt(r[y]),
-                int(r.get("n", 0)),
-                r.get("dominant", ""),
-                _p_chaotic_text(r),
-                f"{r.get('p_quasiperiodic', float('nan')):.2f}",
-                f"{r.get('p_periodic', float('nan')):.2f}",
-            )
-        )
-    parts.regime_maps.append(
-        {
-            "figure": FigureItem(
-                f"map-{len(parts.regime_maps) + 1}",
-                f"Regime map {x} × {y} ({name})",
-                png_uri(png),
-                f"Heatmap over {x} and {y}: the label and period of each deterministic cell."
-                if all_deterministic(c)
-                else f"Heatmaps over {x} and {y}: dominant label per cell, probability of chaos "
-                f"with its {percent(confidence)} Wilson interval, and the interval width.",
-                caption or f"{len(rm.realizations)} realizations in {len(c)} cells.",
-            ),
-            "x": x,
-            "y": y,
-            "level": percent(confidence),
-            "rows": rows,
-        }
+    nan = float("nan")
+    rows = [
+        (_fmt(r[x]), _fmt(r[y]), int(r.get("n", 0)), r.get("dominant", ""), _p_chaotic_text(r),
+         f"{r.get('p_quasiperiodic', nan):.2f}", f"{r.get('p_periodic', nan):.2f}")
+        for r in c.sort_values([x, y]).to_dict("records")
+    ]  # fmt: skip
+    figure = FigureItem(
+        f"map-{len(parts.regime_maps) + 1}",
+        f"Regime map {x} × {y} ({name})",
+        _uri(png, lambda: regime_map_figure(c, x=x, y=y, confidence=confidence)),
+        f"Heatmap over {x} and {y}: the label and period of each deterministic cell."
+        if all_deterministic(c)
+        else f"Heatmaps over {x} and {y}: dominant label per cell, probability of chaos "
+        f"with its {percent(confidence)} Wilson interval, and the interval width.",
+        caption or f"{len(rm.realizations)} realizations in {len(c)} cells.",
     )
-    parts.provenance.append(_provenance_rows(path, "regime map", _sweep_settings(cfg)))
-    dom = c["dominant"].value_counts().to_dict() if len(c) else {}
-    parts.summary.append(
-        f"{name}: regime map {x} × {y}, dominant labels {_counts(dom)}"
-        + fate_clause(rm.realizations, cfg.get("fate"), "realizations")
-        + "."
-    )
+    level = percent(confidence)
+    parts.regime_maps.append({"figure": figure, "x": x, "y": y, "level": level, "rows": rows})
+    dom = _counts(c["dominant"].value_counts().to_dict() if len(c) else {})
+    fate = fate_clause(rm.realizations, cfg.get("fate"), "realizations")
+    summary = f"{name}: regime map {x} × {y}, dominant labels {dom}{fate}."
+    _record(parts, path, "regime map", _sweep_settings(cfg), summary)
 
 
 def add_ensemble(parts: ReportParts, path: str, ens, *, png: bytes | None = None) -> None:
-    """An ensemble's figure, label table, undetermined reasons, record and summary line
-    (:func:`._ensemble.ensemble_entry`; ``png``: its figure already rendered)."""
-    from ._ensemble import ensemble_entry
+    """An ensemble's figure, label table, undetermined reasons, provenance and summary line
+    (``png``: its figure already rendered, else drawn here)."""
+    from . import _ensemble as e
 
-    entry = ensemble_entry(path, ens, png=png)
-    entry["figure"] = FigureItem(f"ens-{len(parts.ensembles) + 1}", **entry["figure"])
-    parts.ensembles.append(entry)
-    parts.provenance.append(_provenance_rows(path, "ensemble", entry.pop("settings")))
-    parts.summary.append(entry.pop("summary"))
+    name, n, members = Path(path).name, len(ens.members), ens.members
+    shares, fixed = e.label_shares(members), e.deterministic(ens.config)
+    what = "verdicts" if e.classified(members) else "run statuses (not classified)"
+    alone = "; every member is the same deterministic run (l_lambda_sigma = 0 or the fractal "
+    alone += "stiffness)."
+    figure = FigureItem(
+        f"ens-{len(parts.ensembles) + 1}",
+        f"Ensemble of {n} members ({name})",
+        _uri(png, lambda: e.ensemble_figure(ens, title=name)),
+        f"Left: the stroboscopic section theta_f, omega_f of every member, coloured by its "
+        f"label. Right: the share of each label among {n} members"
+        + ("." if fixed else " with its 95% Wilson interval."),
+        f"{n} members, {what}" + (alone if fixed else "."),
+    )
+    rows = [
+        (r["label"], r["count"], f"{r['share']:.3f}",
+         "none: one deterministic run" if fixed else f"[{r['lo']:.3f}, {r['hi']:.3f}]")
+        for r in shares
+    ]  # fmt: skip
+    parts.ensembles.append({"figure": figure, "rows": rows, "reasons": e.top_reasons(members)})
+    counts = "; ".join(f"{r['label']}: {r['count']}" for r in shares)
+    summary = f"{name}: ensemble of {n} members, {what}: {counts}"
+    summary += " (σ = 0: one deterministic run)." if fixed else "."
+    _record(parts, path, "ensemble", e.ensemble_settings(ens.config, ens), summary)
 
 
 def _p_chaotic_text(r: dict[str, Any]) -> str:
@@ -380,30 +349,15 @@ def _p_chaotic_text(r: dict[str, Any]) -> str:
 
 
 def _sweep_settings(cfg: dict[str, Any]) -> dict[str, Any]:
-    names = {
-        "kind": "kind",
-        "version": "package version",
-        "seed": "seed",
-        "duration": "duration [s]",
-        "transient": "transient [s]",
-        "realizations": "realizations per cell",
-        "classifier": "classifier",
-        "device": "device",
-        "confidence": "confidence of the intervals",
-        "adaptive": "adaptive sampling",
-        "continuation": "continuation",
-    }
-    rows = {label: cfg.get(k) for k, label in names.items() if k in cfg}
+    """The provenance rows of a bifurcation's or regime map's record."""
+    rows = {label: cfg.get(k) for k, label in _SWEEP_ROWS.items() if k in cfg}
     rows.update(code_rows(cfg.get("code")))
     for axis, label in (("axis", "swept parameter"), ("x", "x axis"), ("y", "y axis")):
         if axis in cfg:
-            a = cfg[axis]
-            vals = a.get("values", [])
-            rows[label] = (
-                f"{a.get('name')}: {len(vals)} values in [{min(vals):g}, {max(vals):g}]"
-                if vals
-                else a.get("name")
-            )
+            name, vals = cfg[axis].get("name"), cfg[axis].get("values", [])
+            rows[label] = name
+            if vals:
+                rows[label] = f"{name}: {len(vals)} values in [{min(vals):g}, {max(vals):g}]"
     return rows | _base_rows(cfg.get("base", {}), cfg.get("numerics", {}))
 
 
@@ -427,11 +381,11 @@ def _base_rows(base: dict[str, Any], numerics: dict[str, Any]) -> dict[str, Any]
 
 def model_rows() -> list[tuple[str, Any, str, str]]:
     """(name, value, unit, meaning) of each field of ``Params()`` and ``Numerics()``, where
-    every run starts."""
+    every run starts; a meaning over 160 characters is cut near 150."""
     from ..model import FIELD_DOCS, Params
     from ..numerics import Numerics
 
-    def short(doc: str) -> str:  # the first ~150 characters of a long field doc
+    def short(doc: str) -> str:
         return doc if len(doc) < 160 else doc[:150].rsplit(" ", 1)[0] + " …"
 
     docs = {**FIELD_DOCS, **Numerics.field_docs()}
@@ -461,12 +415,10 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
         undefined=jinja2.StrictUndefined,
     )
     commit = git_commit()
-    if commit:
-        changed = uncommitted_sources()
-        if changed:
-            more = f" and {len(changed) - 5} more" if len(changed) > 5 else ""
-            shown = ", ".join(changed[:5]) + more
-            commit += f" plus uncommitted changes to {shown}"
+    changed = uncommitted_sources() if commit else None
+    if changed:
+        more = f" and {len(changed) - 5} more" if len(changed) > 5 else ""
+        commit += " plus uncommitted changes to " + ", ".join(changed[:5]) + more
     return env.get_template("report.html").render(
         title=title,
         sections=_sections(parts),
@@ -481,23 +433,24 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
     )
 
 
-def build_report(inputs, parts: ReportParts | None = None) -> ReportParts:
-    """Add every input (:func:`load_inputs`' :class:`~._inputs.Inputs`) to the report parts."""
-    inputs, parts = require_inputs(inputs), parts or ReportParts()
-    for path, rm in inputs.regime_maps:
-        add_regime_map(parts, path, rm)
-    for path, bif in inputs.bifurcations:
-        add_bifurcation(parts, path, bif)
-    for path, ens in inputs.ensembles:
-        add_ensemble(parts, path, ens)
-    for path, traj in inputs.trajectories:
-        add_trajectory(parts, path, traj)
-    for kind, items, what in (
-        ("regime map", inputs.regime_maps, "regime-map"),
-        ("bifurcation diagram", inputs.bifurcations, "bifurcation"),
-        ("trajectory", inputs.trajectories, "simulate --out"),
+def build_report(inputs: Inputs, parts: ReportParts | None = None) -> ReportParts:
+    """Add every input (what :func:`load_inputs` returns) to the report parts; a kind of
+    input that is not there is named in the "What is missing" section."""
+    if not isinstance(inputs, Inputs):
+        raise TypeError(
+            f"build_report takes what load_inputs returns, not a {type(inputs).__name__}: "
+            "build_report(load_inputs(paths))"
+        )
+    parts = parts or ReportParts()
+    for add, items, kind, what in (
+        (add_regime_map, inputs.regime_maps, "regime map", "regime-map"),
+        (add_bifurcation, inputs.bifurcations, "bifurcation diagram", "bifurcation"),
+        (add_ensemble, inputs.ensembles, None, None),
+        (add_trajectory, inputs.trajectories, "trajectory", "simulate --out"),
     ):
-        if not items:
+        for path, result in items:
+            add(parts, path, result)
+        if kind and not items:
             parts.missing.append(
                 f"No {kind} among the inputs: its section is empty (make one with "
                 f"`chaoscam {what}`)."

@@ -1,10 +1,9 @@
 """Read the files a report is built from, and say clearly which file is wrong and why.
 
-Four kinds of input, told apart by the metadata chaoscam writes into its Parquet files: a
-run (``chaoscam simulate --out``, ``Solution.to_parquet``; key ``chaoscam.trajectory``), and
-the sweeps, whose record says its ``kind``: a bifurcation diagram, a regime map and an
-ensemble (``chaoscam bifurcation`` / ``regime-map`` / ``ensemble``). A sweep may be named by
-its main file or by its companion (``.verdicts``, ``.cells`` or ``.sections.parquet``).
+Four kinds, told apart by the metadata chaoscam writes into its Parquet files: a run
+(``Solution.to_parquet``; key ``chaoscam.trajectory``), and the sweeps whose record names
+their ``kind``: a bifurcation diagram, a regime map, an ensemble. A sweep may be named by its
+main file or by its companion (``.verdicts``, ``.cells`` or ``.sections.parquet``).
 """
 
 from __future__ import annotations
@@ -14,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["InputError", "Inputs", "load_inputs", "require_inputs"]
+__all__ = ["InputError", "Inputs", "load_inputs"]
 
 _TRAJ_KEY = b"chaoscam.trajectory"
 _SWEEP_KEY = b"chaoscam.sweep"
@@ -73,17 +72,6 @@ def _read_sweep(path: Path, kind: str):
         return getattr(sweep, f"read_{kind}")(path)
     except (OSError, ValueError, KeyError, TypeError) as err:
         raise InputError(f"{path}: could not read the {kind} ({err})") from None
-
-
-def require_inputs(inputs) -> Inputs:
-    """``inputs`` itself when it is an :class:`Inputs`; otherwise a TypeError saying how to
-    make one."""
-    if not isinstance(inputs, Inputs):
-        raise TypeError(
-            f"build_report takes what load_inputs returns, not a {type(inputs).__name__}: "
-            "build_report(load_inputs(paths))"
-        )
-    return inputs
 
 
 def load_inputs(paths: list[str | Path] | str | Path) -> Inputs:

@@ -1,8 +1,8 @@
 """Figures of sweeps: regime-map heatmaps (seaborn) and bifurcation diagrams.
 
 Every function takes the tidy tables of :mod:`chaoscam.sweep` and returns a matplotlib
-``Figure`` (built without pyplot, so nothing opens a window); ``fig.savefig(path)`` writes
-it. seaborn and matplotlib are imported inside the functions.
+``Figure`` built without pyplot (nothing opens a window); seaborn and matplotlib are imported
+inside the functions.
 """
 
 from __future__ import annotations
@@ -10,16 +10,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-__all__ = [
-    "LABEL_COLORS",
-    "axis_label",
-    "plot_dominant",
-    "percent",
-    "plot_probability",
-    "plot_bifurcation",
-    "regime_map_figure",
-    "bifurcation_figure",
-]
+__all__ = ["LABEL_COLORS", "SETTLED_MARK", "TRANSIENT_MARK", "all_deterministic", "axis_label"]
+__all__ += ["bifurcation_figure", "mark_without_points", "percent", "plot_bifurcation"]
+__all__ += ["plot_dominant", "plot_interval_width", "plot_probability", "regime_map_figure"]
+__all__ += ["sweep_diagram"]
 
 # Okabe-Ito colours: distinguishable with the common colour-vision deficiencies.
 LABEL_COLORS = {
@@ -42,34 +36,22 @@ ANNOTATE_CELLS = 64
 """Heatmaps with at most this many cells are annotated (larger ones would not fit the text)."""
 
 ANNOTATE_PERIODS = 400
-"""Dominant-label maps with at most this many cells get their periods written in (short
-text, at a smaller size beyond ``ANNOTATE_CELLS``)."""
+"""Dominant-label maps with at most this many cells get their periods written in."""
 
 TRANSIENT_MARK = "↗"
 """Written in a dominant-label cell where a ``fate`` horizon found runs that leave the cam's
 reach later (transient chaos; see :func:`chaoscam.sweep.regime_map`)."""
 SETTLED_MARK = "→"
 """Before Pn in a cell where a fate horizon found runs periodic (n) on the continued run's
-last half, after the recorded window its label describes (chaos that settles, or a verdict
-that needed the longer window)."""
+last half, after the recorded window its label describes."""
 
-_SYMBOLS = {
-    "l_lambda": "l_λ",
-    "l_lambda_sigma": "σ of l_λ",
-    "omega": "ω",
-    "xi": "ξ",
-    "beta": "β",
-    "mu_f": "μ_f",
-    "theta_f": "θ_f",
-    "omega_f": "θ̇_f",
-}
+_SYMBOLS = {"l_lambda": "l_λ", "omega": "ω", "xi": "ξ", "beta": "β", "mu_f": "μ_f",
+            "theta_f": "θ_f", "omega_f": "θ̇_f"}  # fmt: skip
 
 
 def axis_label(name: str, *, role: str | None = None) -> str:
-    """``"symbol (name) [unit]"`` for a parameter or a section coordinate.
-
-    ``role="mean"`` names l_lambda as the mean mu of the random line length.
-    """
+    """``"symbol (name) [unit]"`` for a parameter or a section coordinate; ``role="mean"``
+    names l_lambda as the mean mu of the random line length."""
     from ..model import FIELD_DOCS
 
     units = {"theta_f": "rad", "omega_f": "rad/s", "t": "s", "l_lambda_used": "m"}
@@ -79,24 +61,46 @@ def axis_label(name: str, *, role: str | None = None) -> str:
     elif name == "l_lambda_sigma":
         text = "line-length spread σ (l_lambda_sigma)"
     else:
-        sym = _SYMBOLS.get(name)
-        text = f"{sym} ({name})" if sym and sym != name else name
+        text = f"{_SYMBOLS[name]} ({name})" if name in _SYMBOLS else name
     return f"{text} [{unit}]" if unit and unit != "-" else text
 
 
-def _grid(cells: pd.DataFrame, x: str, y: str, column: str) -> pd.DataFrame:
-    """Cells as a matrix: rows = y values, top row the largest, columns = x values."""
-    m = cells.pivot(index=y, columns=x, values=column)
+def percent(confidence: float) -> str:
+    """A confidence level as the report writes it: 0.95 -> "95%"."""
+    return f"{100 * confidence:.4g}%"
+
+
+def _grid(cells: pd.DataFrame, x: str, y: str, values) -> pd.DataFrame:
+    """``values`` (a column name, or a Series beside the cells) as a matrix: rows = y values,
+    top row the largest, columns = x values."""
+    if not isinstance(values, str):
+        cells, values = cells.assign(_v=values), "_v"
+    m = cells.pivot(index=y, columns=x, values=values)
     return m.sort_index(ascending=False).sort_index(axis=1)
 
 
-def _ticks(ax, m: pd.DataFrame, x: str, y: str, role: str | None) -> None:
-    nx, ny = m.shape[1], m.shape[0]
-    sx, sy = max(1, nx // 10), max(1, ny // 10)
-    ax.set_xticks(np.arange(0, nx, sx) + 0.5)
-    ax.set_xticklabels([f"{v:.4g}" for v in m.columns[::sx]], rotation=45, ha="right")
-    ax.set_yticks(np.arange(0, ny, sy) + 0.5)
-    ax.set_yticklabels([f"{v:.4g}" for v in m.index[::sy]], rotation=0)
+def _deterministic(cells: pd.DataFrame) -> pd.Series:
+    """Whether each cell is deterministic (sigma = 0: one run); False without the column."""
+    if "deterministic" not in cells:
+        return pd.Series(False, index=cells.index)
+    return cells["deterministic"].fillna(False).astype(bool)
+
+
+def all_deterministic(cells: pd.DataFrame) -> bool:
+    """Whether every cell of a map is deterministic (sigma = 0: one run, no probabilities)."""
+    return "deterministic" in cells and bool(cells["deterministic"].astype(bool).all())
+
+
+def _heatmap(ax, m: pd.DataFrame, x: str, y: str, **kw) -> None:
+    """``sns.heatmap`` of ``m`` (its NaN cells blank), with at most ~10 ticks an axis."""
+    import seaborn as sns
+
+    sns.heatmap(m, ax=ax, mask=m.isna(), **kw)
+    sx, sy = max(1, m.shape[1] // 10), max(1, m.shape[0] // 10)
+    xs, ys = [f"{v:.4g}" for v in m.columns[::sx]], [f"{v:.4g}" for v in m.index[::sy]]
+    ax.set_xticks(np.arange(len(xs)) * sx + 0.5, xs, rotation=45, ha="right")
+    ax.set_yticks(np.arange(len(ys)) * sy + 0.5, ys, rotation=0)
+    role = "mean" if x == "l_lambda" and y == "l_lambda_sigma" else None
     ax.set_xlabel(axis_label(x, role=role))
     ax.set_ylabel(axis_label(y))
 
@@ -105,59 +109,38 @@ def plot_dominant(cells: pd.DataFrame, x: str, y: str, ax) -> None:
     """Heatmap of each cell's dominant label, with a legend of the labels present; periodic
     cells carry ``Pn`` (period n), and cells where a fate horizon saw runs leave the cam's
     reach later carry :data:`TRANSIENT_MARK`."""
-    import seaborn as sns
     from matplotlib.colors import ListedColormap
 
     present = [lab for lab in cells["dominant"].unique() if lab]
-    order = [lab for lab in LABEL_COLORS if lab in present] + sorted(
-        set(present) - set(LABEL_COLORS)
-    )
+    order = [lab for lab in LABEL_COLORS if lab in present]
+    order += sorted(set(present) - set(LABEL_COLORS))
     code = {lab: i for i, lab in enumerate(order)}
-    coded = cells.assign(_code=cells["dominant"].map(code).astype(float))
-    m = _grid(coded, x, y, "_code")
+    m = _grid(cells, x, y, cells["dominant"].map(code).astype(float))
     colors = [LABEL_COLORS.get(lab, _OTHER) for lab in order] or ["#FFFFFF"]
     annot = _dominant_text(cells, x, y, m.shape) if m.size <= ANNOTATE_PERIODS else False
-    sns.heatmap(
-        m,
-        ax=ax,
-        cmap=ListedColormap(colors),
-        vmin=-0.5,
-        vmax=len(colors) - 0.5,
-        cbar=False,
-        linewidths=0.2 if m.size <= 400 else 0,
-        linecolor="white",
-        mask=m.isna(),
-        annot=annot,
-        fmt="",
-        annot_kws={
-            "fontsize": ANNOTATION_PT if m.size <= ANNOTATE_CELLS else ANNOTATION_PT - 2,
-            "color": "white",
-            "fontweight": "bold",
-        },
-    )
+    size = ANNOTATION_PT if m.size <= ANNOTATE_CELLS else ANNOTATION_PT - 2
+    _heatmap(
+        ax, m, x, y, cmap=ListedColormap(colors), vmin=-0.5, vmax=len(colors) - 0.5, cbar=False,
+        linewidths=0.2 if m.size <= 400 else 0, linecolor="white", annot=annot, fmt="",
+        annot_kws={"fontsize": size, "color": "white", "fontweight": "bold"},
+    )  # fmt: skip
     for t in ax.texts:  # the arrow glyph is small at the numbers' size
         if t.get_text() == TRANSIENT_MARK:
             t.set_fontsize(1.6 * t.get_fontsize())
-    _ticks(ax, m, x, y, _role(x, y))
     shown = annot is not False and bool(np.any(np.char.startswith(annot, "P")))
     ax.set_title("dominant label (Pn: periodic, period n)" if shown else "dominant label")
-    ax.legend(
-        handles=_dominant_handles(order, annot),
-        loc="upper left",
-        bbox_to_anchor=(1.01, 1.0),
-        frameon=False,
-        fontsize="small",
-    )
+    kw = dict(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False, fontsize="small")
+    ax.legend(handles=_dominant_handles(order, annot), **kw)
 
 
 def _dominant_text(cells: pd.DataFrame, x: str, y: str, shape) -> np.ndarray:
-    """The text of each cell of a dominant-label map: ``Pn`` for a periodic cell,
+    """Each cell's text on a dominant-label map: ``Pn`` for a periodic cell,
     :data:`TRANSIENT_MARK` after it where runs stop later, ``→Pn`` where they settle."""
     text = np.full(shape, "", dtype=object)
     dom = _grid(cells, x, y, "dominant").to_numpy()
 
-    def grid_of(name: str) -> np.ndarray:  # a cell column on the map's grid, as floats
-        return _grid(cells.assign(_v=cells[name].astype(float)), x, y, "_v").to_numpy()
+    def grid_of(name: str) -> np.ndarray:
+        return _grid(cells, x, y, cells[name].astype(float)).to_numpy()
 
     if "period" in cells:
         per = grid_of("period")
@@ -195,70 +178,31 @@ def _dominant_handles(order: list[str], annot) -> list:
     return handles
 
 
-def _role(x: str, y: str) -> str | None:
-    return "mean" if x == "l_lambda" and y == "l_lambda_sigma" else None
-
-
 def plot_probability(
-    cells: pd.DataFrame,
-    x: str,
-    y: str,
-    ax,
-    *,
-    label: str = "chaotic",
-    annotate=None,
+    cells: pd.DataFrame, x: str, y: str, ax, *, label: str = "chaotic", annotate=None,
     confidence: float = 0.95,
-) -> None:
-    """Heatmap of P(label) per cell; small grids are annotated with the Wilson interval (at
-    the map's ``confidence``, which the title names).
-
-    ``annotate`` None annotates grids of at most :data:`ANNOTATE_CELLS` cells with ``p``
-    and ``[lo, hi]``.
-    """
-    import seaborn as sns
-
+) -> None:  # fmt: skip
+    """Heatmap of P(label) per cell; ``annotate`` (None: grids of at most
+    :data:`ANNOTATE_CELLS` cells) writes ``p`` and its Wilson interval ``[lo, hi]`` at the
+    map's ``confidence``, which the title names."""
     m = _grid(cells, x, y, f"p_{label}")
     if annotate is None:
         annotate = m.size <= ANNOTATE_CELLS
     annot = False
     if annotate:
-        lo = _grid(cells, x, y, f"p_{label}_lo").to_numpy()
-        hi = _grid(cells, x, y, f"p_{label}_hi").to_numpy()
-        p = m.to_numpy()
-        det = (
-            _grid(cells, x, y, "deterministic").fillna(False).to_numpy(dtype=bool)
-            if "deterministic" in cells
-            else np.zeros(p.shape, dtype=bool)
-        )
-        annot = np.array(
-            [
-                [
-                    f"{a:.2f}\none run" if d else f"{a:.2f}\n[{b:.2f}, {c:.2f}]"
-                    for a, b, c, d in zip(ra, rb, rc, rd, strict=True)
-                ]
-                for ra, rb, rc, rd in zip(p, lo, hi, det, strict=True)
-            ]
-        )
-    sns.heatmap(
-        m,
-        ax=ax,
-        cmap="rocket_r",
-        vmin=0.0,
-        vmax=1.0,
-        annot=annot,
-        fmt="",
-        annot_kws={"fontsize": ANNOTATION_PT - 1},
-        cbar_kws={"label": f"P({label})"},
-        mask=m.isna(),
-    )
-    _ticks(ax, m, x, y, _role(x, y))
+        p, lo, hi = (_grid(cells, x, y, f"p_{label}{s}").to_numpy() for s in ("", "_lo", "_hi"))
+        det = _grid(cells, x, y, _deterministic(cells)).fillna(False).to_numpy(dtype=bool)
+        text = [
+            f"{a:.2f}\none run" if d else f"{a:.2f}\n[{b:.2f}, {c:.2f}]"
+            for a, b, c, d in zip(p.flat, lo.flat, hi.flat, det.flat, strict=True)
+        ]
+        annot = np.array(text).reshape(p.shape)
+    _heatmap(
+        ax, m, x, y, cmap="rocket_r", vmin=0.0, vmax=1.0, annot=annot, fmt="",
+        annot_kws={"fontsize": ANNOTATION_PT - 1}, cbar_kws={"label": f"P({label})"},
+    )  # fmt: skip
     level = percent(confidence)
     ax.set_title(f"P({label})" + (f" with {level} Wilson interval" if annotate else ""))
-
-
-def percent(confidence: float) -> str:
-    """A confidence level as the report writes it: 0.95 -> "95%"."""
-    return f"{100 * confidence:.4g}%"
 
 
 def plot_interval_width(
@@ -268,32 +212,14 @@ def plot_interval_width(
 
     A deterministic cell (sigma = 0: one run) has no interval: it is left blank and marked
     "one run", not coloured as a width (a width of ~0 would read as the narrowest)."""
-    import seaborn as sns
-
-    det = cells["deterministic"].fillna(False).astype(bool) if "deterministic" in cells else None
-    width = cells[f"p_{label}_hi"] - cells[f"p_{label}_lo"]
-    width = width if det is None else width.mask(det)
-    m = _grid(cells.assign(_w=width), x, y, "_w")
-    sns.heatmap(
-        m,
-        ax=ax,
-        cmap="mako_r",
-        vmin=0.0,
-        vmax=1.0,
-        cbar_kws={"label": "interval width"},
-        mask=m.isna(),
-    )
-    if det is not None and det.any():
-        one = _grid(cells.assign(_d=det), x, y, "_d").fillna(False).to_numpy(dtype=bool)
-        for i, j in zip(*np.nonzero(one), strict=True):
-            ax.text(j + 0.5, i + 0.5, "one run", ha="center", va="center", fontsize=ANNOTATION_PT)
-    _ticks(ax, m, x, y, _role(x, y))
+    det = _deterministic(cells)
+    width = (cells[f"p_{label}_hi"] - cells[f"p_{label}_lo"]).mask(det)
+    m = _grid(cells, x, y, width)
+    _heatmap(ax, m, x, y, cmap="mako_r", vmin=0.0, vmax=1.0, cbar_kws={"label": "interval width"})
+    one = _grid(cells, x, y, det).fillna(False).to_numpy(dtype=bool)
+    for i, j in zip(*np.nonzero(one), strict=True):
+        ax.text(j + 0.5, i + 0.5, "one run", ha="center", va="center", fontsize=ANNOTATION_PT)
     ax.set_title(f"{percent(confidence)} interval width of P({label})")
-
-
-def all_deterministic(cells: pd.DataFrame) -> bool:
-    """Whether every cell of a map is deterministic (sigma = 0: one run, no probabilities)."""
-    return "deterministic" in cells and bool(cells["deterministic"].astype(bool).all())
 
 
 def regime_map_figure(
@@ -301,11 +227,9 @@ def regime_map_figure(
 ):
     """A regime map at the size a report shows it (~1,200 px wide, text >= 10 px there).
 
-    Four panels: the dominant label (periodic cells annotated with their period), P(label)
-    and P(periodic) (annotated with the Wilson interval at the map's ``confidence`` when the
-    grid is small), and the interval width. A map whose cells are all deterministic (sigma =
-    0: one run each) has no probabilities to show: one panel, the label and period of each
-    cell.
+    Four panels: the dominant label (with periods), P(label) and P(periodic) (with Wilson
+    intervals at ``confidence`` on small grids), and the interval width. A map of only
+    deterministic cells (sigma = 0) has one panel: the label and period of each cell.
     """
     from matplotlib.figure import Figure
 
@@ -326,13 +250,9 @@ def regime_map_figure(
 
 
 def plot_bifurcation(
-    points: pd.DataFrame,
-    ax,
-    *,
-    coordinate: str = "theta_f",
-    color_by: str = "label",
+    points: pd.DataFrame, ax, *, coordinate: str = "theta_f", color_by: str = "label",
     size: float | None = None,
-) -> None:
+) -> None:  # fmt: skip
     """Section points over the swept value, rasterised (tens of thousands stay light).
 
     ``color_by`` = "label" (the verdict), "ic" (the initial condition) or None. Several
@@ -345,22 +265,12 @@ def plot_bifurcation(
     if size is None:  # dots that stay visible for a few points and do not merge for 1e5
         size = float(np.clip(6e4 / max(len(points), 1), 0.5, 10.0))
     for key, g in groups:
-        if color_by == "label":
-            color = LABEL_COLORS.get(key, _OTHER)
-        elif color_by is None:
-            color = "#000000"
-        else:
-            color = None
+        color = LABEL_COLORS.get(key, _OTHER) if color_by == "label" else None
+        color = "#000000" if color_by is None else color
         ax.scatter(
-            x[g.index],
-            g[coordinate],
-            s=size,
-            c=color,
-            marker="o",
-            linewidths=0,
-            rasterized=True,
-            label=None if key is None else str(key),
-        )
+            x[g.index], g[coordinate], s=size, c=color,
+            marker="o", linewidths=0, rasterized=True, label=None if key is None else str(key),
+        )  # fmt: skip
     ax.set_xlabel(axis_label(param) if len(points) else "value")
     ax.set_ylabel(axis_label(coordinate))
     if _log_axis(points):
@@ -377,8 +287,8 @@ def _log_axis(points: pd.DataFrame) -> bool:
 
 
 def _dodged(points: pd.DataFrame) -> pd.Series:
-    """The x of each point: its value, shifted by initial condition when there are several
-    and the values are evenly enough spaced for a linear axis."""
+    """Each point's x: its value, shifted by initial condition when there are several and
+    the values are spaced for a linear axis."""
     values = np.unique(points["value"].to_numpy(dtype=float))
     ics = np.unique(points["ic"]) if "ic" in points else []
     if len(ics) < 2 or len(values) < 2 or _log_axis(points):
@@ -402,17 +312,15 @@ def mark_without_points(ax, points: pd.DataFrame, verdicts: pd.DataFrame, x="val
 
 
 def bifurcation_figure(
-    points: pd.DataFrame,
-    *,
-    coordinate: str = "theta_f",
-    color_by: str = "label",
-    note: str = "",
-    verdicts: pd.DataFrame | None = None,
-):
-    """One panel: the bifurcation diagram of ``coordinate`` over the swept parameter;
+    points: pd.DataFrame, *, coordinate: str = "theta_f", color_by: str = "label",
+    note: str = "", verdicts: pd.DataFrame | None = None,
+):  # fmt: skip
+    """One panel: the bifurcation diagram of ``coordinate`` over the swept parameter.
+
     ``note`` (e.g. "G = 1e-10 m") goes into the title, to tell panels of one figure apart.
     With the sweep's ``verdicts``, a run that left no section point after the transient (out
-    of the cam's reach, diverged) is an x on the top edge, named in the legend."""
+    of the cam's reach, diverged) is an x on the top edge, named in the legend.
+    """
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(9, 5), layout="constrained")
@@ -421,15 +329,13 @@ def bifurcation_figure(
     if verdicts is not None and mark_without_points(ax, points, verdicts):
         scale = ax.get_legend().markerscale if ax.get_legend() else 1.0  # the diagram's dots
         ax.legend(markerscale=scale, frameon=False, fontsize="small", title=color_by)
-    param = str(points["param"].iloc[0]) if len(points) else ""
-    note = f" ({note})" if note else ""
-    ax.set_title(
-        f"bifurcation diagram over {param}{note}: stroboscopic section after the transient"
-    )
+    what = str(points["param"].iloc[0]) if len(points) else ""
+    what += f" ({note})" if note else ""
+    ax.set_title(f"bifurcation diagram over {what}: stroboscopic section after the transient")
     return fig
 
 
 def sweep_diagram(bif, *, note: str = ""):
-    """:func:`bifurcation_figure` of a finished bifurcation sweep: its points, and its
-    verdicts to mark the runs without a section point."""
+    """:func:`bifurcation_figure` of a finished bifurcation sweep, its verdicts marking the
+    runs without a section point."""
     return bifurcation_figure(bif.points, note=note, verdicts=bif.verdicts)

@@ -1,11 +1,11 @@
-"""The paper report's figures drawn on one thread beside the stages (paper._drawing)."""
+"""The paper report's figures drawn on one thread beside the stages (paper._stage)."""
 
 import threading
 
 import pytest
 
 from chaoscam.paper import FigureResult
-from chaoscam.paper._drawing import Drawing, draw, drawing, png_of, settle, uri_of
+from chaoscam.paper._stage import Drawing, draw, drawing, png_of, settle, uri_of
 from chaoscam.report import FigureItem
 
 

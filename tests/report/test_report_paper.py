@@ -283,7 +283,7 @@ def test_ctrl_c_in_the_sensitivity_stage_stops_the_map_beside_it_and_resume_fini
     import chaoscam.sweep
     from chaoscam.kernel import stops_here
     from chaoscam.paper import _paper
-    from chaoscam.paper._store import store_mode
+    from chaoscam.paper._stage import store_mode
     from chaoscam.sweep import SweepInterrupted
 
     _shrink_the_runs(monkeypatch)

@@ -142,7 +142,7 @@ def test_the_open_choices_sentence_is_computed_from_the_sweeps():
     """J, pivot and friction-arm sweeps and the literal damping: regimes counted together
     against the Hertz range (undetermined on neither side), the paper's period 2 looked for,
     and the choices not swept named with the values the runs used (from Params())."""
-    from chaoscam.paper._choices import choices_finding
+    from chaoscam.paper._findings import choices_finding
 
     p = Params()
     inertia = _verdicts(

@@ -172,21 +172,20 @@ def test_audit_reads_the_sensitivity_sweeps_and_a_ladder_follows_one_label(
     """--figures s: every sensitivity-*.parquet of the folder (not its companions), each
     named by its file, read as the kind its record says; --label: the ladder draws only rows
     with that label (the jobs it would run, captured instead of run)."""
-    from chaoscam.paper import _ladder
-    from chaoscam.paper._audit_script import read_sweeps
+    from chaoscam.paper._step_audit import read_sweeps
 
     small_diagram.to_parquet(tmp_path / "sensitivity-e.parquet")
     small_diagram.to_parquet(tmp_path / "fig4.parquet")
     got = read_sweeps(tmp_path, ["s", 4])
     assert [name for name, _ in got] == ["sensitivity-e", "Fig. 4"]
     assert got[0][1].verdicts.equals(small_diagram.verdicts)
-    monkeypatch.setattr(_ladder, "side_by_side", lambda fn, jobs, workers, prefix: jobs)
+    monkeypatch.setattr(sa, "side_by_side", lambda fn, jobs, workers, prefix: jobs)
     table = small_diagram.verdicts
     mixed = table.assign(label=["undetermined", "periodic", "undetermined"][: len(table)])
     sweep = type("Sweep", (), {"config": small_diagram.config, "verdicts": mixed})()
-    jobs = _ladder.step_ladder([("S", sweep)], (1,), 5, None, label="undetermined")
+    jobs = sa.step_ladder([("S", sweep)], (1,), 5, None, label="undetermined")
     assert [job[2]["label"] for job in jobs] == ["undetermined"] * 2
-    assert len(_ladder.step_ladder([("S", sweep)], (1,), 5, None)) == len(table)
+    assert len(sa.step_ladder([("S", sweep)], (1,), 5, None)) == len(table)
     # a rung whose run leaves the cam's reach is labelled so, as a sweep labels it, with no
     # exponent (not "undetermined" with the verdict's reason)
     import chaoscam.sweep
@@ -195,7 +194,7 @@ def test_audit_reads_the_sensitivity_sweeps_and_a_ladder_follows_one_label(
     left = type("Run", (), {"status": Status.LEFT_REACH, "ok": False})()
     monkeypatch.setattr(chaoscam.sweep, "replay", lambda settings, row, refine: left)
     job = jobs[0][:3] + ((1,), None)
-    row = _ladder._ladder_one(job)
+    row = sa._ladder_one(job)
     assert [tag for _, tag, _ in row.rungs] == ["left_reach", "left_reach"]
     assert all(lam != lam for _, _, lam in row.rungs)  # NaN
 
@@ -203,7 +202,7 @@ def test_audit_reads_the_sensitivity_sweeps_and_a_ladder_follows_one_label(
 def test_a_ladder_counts_the_runs_the_step_no_longer_moves():
     """settled: one decided label at every halved step (dt/2 down), not the sweep's own
     step; "undetermined" everywhere, or labels that differ, are not settled."""
-    from chaoscam.paper._ladder import LadderRow, ladder_sentence, settled
+    from chaoscam.paper._step_audit import LadderRow, ladder_sentence, settled
 
     def row(*tags):
         return LadderRow("F", "x", tags[0], tuple((h, t, 0.1) for h, t in enumerate(tags)), 1.0)
@@ -230,7 +229,7 @@ def test_ladder_follows_every_drawn_run_down_the_step(tmp_path, capsys, small_di
     rung is the recorded verdict (the replay is the sweep's run); the sentence compares dt
     and dt/2 with dt/4."""
     from chaoscam.paper import audit_script
-    from chaoscam.paper._ladder import ladder_sample, ladder_sentence, step_ladder
+    from chaoscam.paper._step_audit import ladder_sample, ladder_sentence, step_ladder
 
     table = pd.DataFrame({"label": ["chaotic", "undetermined"] * 5})
     assert "undetermined" in set(ladder_sample(table, 6)["label"])  # any label: 6 > 5 chaotic
