@@ -1,40 +1,17 @@
-"""Where a sweep's batches run: in this process, on its threads, a GPU's pipeline, or Dask.
-
-Each backend offers the same verbs to the engine (``submit``, ``wait_any``, ``result``,
-``cancel``, ``close``); a record never depends on which backend or how many workers ran it.
-
-* :class:`SerialBackend` — one batch at a time, in this process.
-* :class:`ThreadBackend` — ``workers`` threads of this process, each running its batches'
-  members one at a time through the compiled call without the GIL: a batch's slowest member
-  leaves no other core waiting, as a ``prange`` launch over one batch would.
-* :class:`PipelineBackend` — a local GPU: a batch is launched at submission in the driver's
-  thread and labelled on one labelling thread, so the device runs the next batch while the
-  host labels the last.
-* :class:`DaskBackend` — a ``distributed.Client`` on a scheduler address, on an existing
-  client, or on a ``LocalCluster`` of worker processes bound to 127.0.0.1. Dask itself
-  reschedules the tasks of a lost worker. A lost scheduler, or no worker connected for
-  :data:`DASK_NO_WORKER_S`, is a :class:`BackendLost`: the engine saves what finished and
-  stops with a resume hint instead of a ``FuturesCancelledError`` or a silent wait.
-"""
+"""Where a sweep's batches run: in this process, on its threads, a GPU's pipeline, or Dask;
+each offers ``submit``, ``wait_any``, ``result``, ``cancel`` and ``close``."""
 
 from __future__ import annotations
 
 import concurrent.futures as cf
+import logging
+import numbers
 import os
+import sys
 import threading
+import time
 from collections.abc import Callable, Iterable
 from typing import Any
-
-__all__ = [
-    "BackendLost",
-    "DaskBackend",
-    "PipelineBackend",
-    "SerialBackend",
-    "ThreadBackend",
-    "WorkerLost",
-    "local_workers",
-    "make_backend",
-]
 
 _DASK_POLL_S = 2.0
 _DASK_NOTICE_S = 10.0
@@ -43,26 +20,17 @@ DASK_NO_WORKER_S = 300.0
 _DASK_LOST_ERRORS = ("FuturesCancelledError", "CancelledError", "CommClosedError")
 
 
-class WorkerLost(RuntimeError):
-    """The worker running a task died; the task can be submitted again."""
-
-
 class BackendLost(RuntimeError):
-    """The backend itself is gone (the Dask scheduler died or the connection to it broke):
-    no task can run until it is restarted; the finished records are kept."""
+    """The Dask scheduler died or the connection to it broke; the finished records are kept."""
 
 
 WORKERS_PER_CORE = 4
-"""Most local workers (processes, or the ensemble engine's batch threads) per core a sweep
-accepts: more only compete for the cores, and each holds a run in memory (a typo such as
-``--workers 99999`` would otherwise start thousands of processes)."""
+"""Most local workers per core a sweep accepts: more only compete for the cores, and each
+holds a run in memory."""
 
 
 def local_workers(workers: int | None) -> int:
-    """The local worker count: ``workers``, or every core when None; a ValueError naming
-    ``workers`` and its range [1, WORKERS_PER_CORE x cores] otherwise."""
-    import numbers
-
+    """``workers``, or every core when None; a ValueError outside [1, 4 x cores]."""
     most = WORKERS_PER_CORE * default_workers()
     if workers is not None and (
         isinstance(workers, bool) or not isinstance(workers, numbers.Integral)
@@ -88,7 +56,6 @@ def default_workers() -> int:
 class SerialBackend:
     """Runs each task at submission, in this process."""
 
-    name = "serial"
     workers = 1
 
     def submit(self, fn: Callable, arg: Any) -> cf.Future:
@@ -113,18 +80,10 @@ class SerialBackend:
 
 
 class ThreadBackend:
-    """Tasks on ``workers`` threads of this process (the ensemble engine's local backend).
-
-    Each task runs inside :func:`chaoscam.kernel.members_on_this_thread`: its
-    ensembles' members one after another through the compiled call, which releases the GIL,
-    so ``workers`` tasks simulate at once and a task's slow member delays only its own
-    thread (numba's workqueue layer takes one parallel launch at a time, and a launch over a
-    batch waits for its slowest member). The members are the same compiled kernel, so the
-    records are the same bits as on one thread. ``cancel`` asks the running tasks to stop
-    between two compiled calls (a prompt Ctrl-C); ``close`` joins the threads.
-    """
-
-    name = "threads"
+    """Tasks on ``workers`` threads, each running its members one after another through the
+    compiled call without the GIL (:func:`chaoscam.kernel.members_on_this_thread`): a slow
+    member delays only its own thread, as a ``prange`` launch over a batch would not.
+    ``cancel`` stops the running tasks between two compiled calls."""
 
     def __init__(self, workers: int, prefix: str = "chaoscam-batch") -> None:
         self.workers = int(workers)
@@ -157,19 +116,11 @@ class ThreadBackend:
 
 
 class DaskBackend:
-    """Tasks on a Dask distributed cluster.
+    """Tasks on Dask: ``scheduler`` ``"tcp://HOST:PORT"``, a connected ``Client`` (left open),
+    or None / ``"local"`` for a ``LocalCluster`` of ``workers`` single-thread processes on
+    127.0.0.1. Dask reschedules a lost worker's tasks; a lost scheduler, or no worker for
+    :data:`DASK_NO_WORKER_S`, is a :class:`BackendLost`."""
 
-    Parameters
-    ----------
-    scheduler : str, distributed.Client or None
-        ``"tcp://HOST:PORT"`` of a running scheduler; a connected ``Client`` (left open on
-        close); or ``None`` / ``"local"`` for a ``LocalCluster`` of ``workers`` single-thread
-        worker processes on 127.0.0.1, closed on close.
-    workers : int
-        Worker processes of a local cluster (ignored for an address or a client).
-    """
-
-    name = "dask"
     _noticed = False
 
     def __init__(self, scheduler: Any = None, workers: int | None = None) -> None:
@@ -180,22 +131,15 @@ class DaskBackend:
                 "the Dask backend needs dask.distributed: pip install 'chaoscam[dask]'"
             ) from None
         self._distributed = distributed
-        # Installed before the first connection: the background sender may log a closed
-        # comm before the driver notices the scheduler is gone.
-        _quiet_lost_connection_log()
-        self._cluster = None
-        self._own_client = True
-        if isinstance(scheduler, distributed.Client):
+        _quiet_lost_connection_log()  # before connecting: the sender may log first
+        self._cluster, self._own_client = None, not isinstance(scheduler, distributed.Client)
+        if not self._own_client:
             self.client = scheduler
-            self._own_client = False
         elif scheduler is None or scheduler == "local":
             self._cluster = distributed.LocalCluster(
-                n_workers=workers or default_workers(),
-                threads_per_worker=1,
-                processes=True,
-                host="127.0.0.1",
-                dashboard_address="127.0.0.1:0",  # loopback, any free port
-            )
+                n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
+                host="127.0.0.1", dashboard_address="127.0.0.1:0",
+            )  # fmt: skip
             self.client = distributed.Client(self._cluster)
         else:
             try:
@@ -217,14 +161,9 @@ class DaskBackend:
             raise
 
     def wait_any(self, futures: Iterable[Any], timeout: float | None = None) -> set:
-        """The finished futures (none after ``timeout`` seconds, if given).
-
-        With no worker connected it says so once on stderr after ``_DASK_NOTICE_S`` and
-        raises :class:`BackendLost` after :data:`DASK_NO_WORKER_S` without one; a lost
-        scheduler raises it at once.
-        """
-        import time
-
+        """The finished futures (none after ``timeout`` s); with no worker connected, a
+        notice after ``_DASK_NOTICE_S`` and :class:`BackendLost` after
+        :data:`DASK_NO_WORKER_S`; a lost scheduler at once."""
         futures = list(futures)
         poll = _DASK_POLL_S if timeout is None else min(_DASK_POLL_S, timeout)
         started = time.monotonic()
@@ -248,27 +187,20 @@ class DaskBackend:
             if self._workers_now():
                 seen_worker = now
                 continue
-            self._notice_waiting()
+            if not self._noticed:
+                self._noticed = True
+                print(
+                    f"chaoscam: waiting: no Dask worker is connected to the scheduler "
+                    f"({self.client.scheduler.address}); start one with `dask worker ADDRESS`; "
+                    f"stopping if none connects within {DASK_NO_WORKER_S:g} s (finished runs "
+                    "are saved; --resume continues)",
+                    file=sys.stderr, flush=True,
+                )  # fmt: skip
             if now - seen_worker >= DASK_NO_WORKER_S:
                 raise BackendLost(
                     f"no Dask worker was connected to the scheduler "
                     f"({self.client.scheduler.address}) for {DASK_NO_WORKER_S:g} s"
                 )
-
-    def _notice_waiting(self) -> None:
-        import sys
-
-        if self._noticed:
-            return
-        print(
-            f"chaoscam: waiting: no Dask worker is connected to the scheduler "
-            f"({self.client.scheduler.address}); start one with `dask worker ADDRESS`; "
-            f"stopping if none connects within {DASK_NO_WORKER_S:g} s (finished runs are "
-            "saved; --resume continues)",
-            file=sys.stderr,
-            flush=True,
-        )
-        self._noticed = True
 
     def _workers_now(self) -> int:
         try:
@@ -277,7 +209,7 @@ class DaskBackend:
             return 0
 
     def _lost(self, err: Exception | None) -> str:
-        """One line for a lost scheduler (the error's own text spans several lines)."""
+        """One line for a lost scheduler."""
         address = getattr(getattr(self.client, "scheduler", None), "address", None) or "?"
         detail = f" ({type(err).__name__})" if err is not None else ""
         return f"the Dask scheduler at {address} was lost{detail}"
@@ -296,8 +228,7 @@ class DaskBackend:
             self.client.cancel(futures)
 
     def close(self) -> None:
-        # A lost scheduler must not turn the closing into a hang or a traceback.
-        try:
+        try:  # a lost scheduler: no hang, no traceback
             if self._own_client:
                 self.client.close(timeout=10)
             if self._cluster is not None:
@@ -306,67 +237,35 @@ class DaskBackend:
             pass
 
 
-class _DropLostConnectionLog:
-    """Drops what distributed logs in this process when its connection to the scheduler
-    closes: "Failed to reconnect to scheduler", and the tracebacks of a closed comm
-    (``CommClosedError``, e.g. "Batched Comm Closed" from the background sender) or of a
-    cancelled reconnection. The lost scheduler is reported in one line
-    (:meth:`DaskBackend._lost`); these records would put tracebacks around it, in an order
-    that depends on which thread notices first."""
+def _drop_lost_connection(record) -> bool:
+    """A logging filter dropping what distributed logs when the connection to the scheduler
+    closes ("Failed to reconnect", a closed comm's or a cancelled reconnection's traceback):
+    :meth:`DaskBackend._lost` says it in one line."""
+    import asyncio
 
-    def filter(self, record) -> bool:
-        import asyncio
+    from distributed.comm.core import CommClosedError
 
-        from distributed.comm.core import CommClosedError
-
-        if "Failed to reconnect to scheduler" in record.getMessage():
-            return False
-        exc = record.exc_info[1] if record.exc_info else None
-        return not isinstance(exc, (asyncio.CancelledError, CommClosedError))
+    if "Failed to reconnect to scheduler" in record.getMessage():
+        return False
+    exc = record.exc_info[1] if record.exc_info else None
+    return not isinstance(exc, (asyncio.CancelledError, CommClosedError))
 
 
-_LOST_CONNECTION_FILTER = _DropLostConnectionLog()
-
-# The loggers that report a client's connection closing (a logger's filters apply to the
-# records logged on it, not to those of its children, so each is named).
-_CLIENT_CONNECTION_LOGGERS = (
-    "distributed.client",
-    "distributed.batched",
-    "distributed.core",
-    "distributed.comm.tcp",
-    "distributed.utils",
-)
+_CLIENT_CONNECTION_LOGGERS = ("distributed.client", "distributed.batched", "distributed.core",
+                              "distributed.comm.tcp", "distributed.utils")  # fmt: skip
+"""The loggers that report a client's connection closing (a filter covers its own logger's
+records only, not its children's)."""
 
 
 def _quiet_lost_connection_log() -> None:
-    import logging
-
     for name in _CLIENT_CONNECTION_LOGGERS:
-        logging.getLogger(name).addFilter(_LOST_CONNECTION_FILTER)  # idempotent
-
-
-def make_backend(workers: int | None = None, scheduler: Any = None):
-    """The Dask backend of ``scheduler`` ("local", "tcp://HOST:PORT" or a client), with
-    ``workers`` local Dask workers for "local"."""
-    if not isinstance(scheduler, str) and not hasattr(scheduler, "submit"):
-        from ._grid import SweepError
-
-        raise SweepError(
-            f"scheduler = {scheduler!r} is not a Dask scheduler: give 'local', the "
-            "address of a running one ('tcp://HOST:PORT') or a distributed.Client"
-        )
-    return DaskBackend(scheduler, workers)
+        logging.getLogger(name).addFilter(_drop_lost_connection)  # idempotent
 
 
 class PipelineBackend(ThreadBackend):
-    """A local GPU's batches: launched at submission in the driver's thread (numba-cuda is
-    used from that thread only, and Ctrl-C stops a launch when it returns), labelled on one
-    labelling thread; the engine keeps two batches in flight, so the next launch runs while
-    the last is labelled. ``threads``: numba's thread count for the labelling thread's CPU
-    work. The records are those of the serial backend, bit for bit (a record depends on its
-    member only)."""
-
-    name = "pipeline"
+    """A local GPU's batches: launched at submission in the driver's thread (numba-cuda's
+    only thread), labelled on one thread with ``threads`` numba threads, so the next launch
+    runs while the last is labelled; the records are the serial backend's, bit for bit."""
 
     def __init__(self, threads: int | None = None) -> None:
         # the engine keeps 2 x workers tasks in flight: one labelled, one launched

@@ -1,74 +1,50 @@
 """The one engine of every sweep: submit batches, collect records, checkpoint, follow up.
 
-A *plan* decides which tasks exist (a regime map's realizations, a bifurcation diagram's
-values and initial conditions, an ensemble's members); the engine packs them into batches
-(:class:`._runs.Batch`), feeds those to a backend with a bounded number in flight (so memory
-does not grow with the grid), stores each record as it completes, and asks the plan for
-follow-up tasks (continuation to the next value, more realizations for an adaptive cell).
-Plans decide from finished records only, never from their completion order, so the set of
-records is the same for any backend, batch size and worker count. Locally the batches run
-one per core on threads (each member through the compiled call without the GIL), or, on a
-GPU, the next batch launched while the last is labelled; on Dask each worker runs whole
-batches.
+A :class:`Plan` decides from finished records only which tasks follow, so the records are
+the same for any backend, batch size and worker count.
 """
 
 from __future__ import annotations
 
 import contextlib
 import errno
+import json
+import signal
 import sys
+import threading
 from collections import Counter, deque
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
-from ..kernel import StopRequested, check_stop, fork_safe_threads, runs_on_gpu, stops_here
-from ._backends import (
-    BackendLost,
-    PipelineBackend,
-    SerialBackend,
-    ThreadBackend,
-    WorkerLost,
-    make_backend,
-)
+from .._util import warn
+from .._version import __version__
+from ..io import lock_all
+from ..kernel import StopRequested, by_size, check_stop, fork_safe_threads, runs_on_gpu, stops_here
+from ._backends import BackendLost, DaskBackend, PipelineBackend, SerialBackend, ThreadBackend
+from ._common import companion
 from ._grid import SweepError
 from ._runs import Batch, Judge
-
-__all__ = ["Engine", "SweepInterrupted", "TaskFailed", "execute", "resolve_engine", "run_sweep"]
-
-MAX_RETRIES = 3
-"""Times a task may lose its worker before the run stops with an error."""
+from ._store import open_store
 
 STOP_POLL_S = 0.1
-"""How often [s] a sweep whose thread can be asked to stop (inside
-:func:`chaoscam.kernel.stop_on`: a sweep run beside another) looks whether it was, while it
-waits for its tasks. Only the main thread gets Ctrl-C; another thread learns of it this way."""
+"""How often [s] a sweep on a thread that can be asked to stop (:func:`chaoscam.kernel.stop_on`;
+only the main thread gets Ctrl-C) looks whether it was, while it waits."""
 
 
 class TaskFailed(RuntimeError):
-    """A task raised (a classifier's error, a bug); the finished records are saved. The
-    message says how to reproduce it; the command line prints it and exits 1."""
+    """A task raised (a classifier's error, a bug); the message says how to reproduce it."""
 
 
 class SweepInterrupted(KeyboardInterrupt):
-    """Ctrl-C stopped a sweep; the finished records are saved (when it has an output).
-
-    Attributes
-    ----------
-    done, total : int
-        Records finished (including those of earlier runs) and records planned.
-    checkpoint : Path or None
-        Where they are saved; None when the sweep had no output file.
-    """
+    """Ctrl-C stopped a sweep: ``done`` of ``total`` records finished (earlier runs' too),
+    saved in ``checkpoint`` (None without an output file); ``cause``: what else stopped it."""
 
     def __init__(self, done: int, total: int, checkpoint, cause: str | None = None) -> None:
         self.done, self.total, self.checkpoint, self.cause = done, total, checkpoint, cause
+        self.message = self.describe()
         super().__init__(self.message)
-
-    @property
-    def message(self) -> str:
-        return self.describe()
 
     def describe(self, word: str = "interrupted") -> str:
         """The message, opening with ``word`` (the command line says "terminated" after a
@@ -85,71 +61,70 @@ class SweepInterrupted(KeyboardInterrupt):
         )
 
 
-class Plan(Protocol):
-    """What the engine needs from a sweep."""
+class Plan:
+    """A sweep's tasks: :meth:`start` yields the first (subclasses define it, ``total``,
+    ``make_task`` and ``keys``), :meth:`on_record` the follow-ups of a finished record. Each
+    key (the record's ``keys`` fields) counts once."""
 
-    total: int
-    done: int
+    keys: tuple[str, ...]
 
-    def restore(self, record: dict[str, Any]) -> bool: ...
+    def __init__(self) -> None:
+        self.finished: set[tuple] = set()
+        self.done = 0
 
-    def start(self) -> Iterator[Any]: ...
+    def restore(self, record: dict[str, Any]) -> bool:
+        """Count a finished record; False when its key was counted already."""
+        key = tuple(record[k] for k in self.keys)
+        if key in self.finished:
+            return False
+        self.finished.add(key)
+        self.done += 1
+        self.counted(record)
+        return True
 
-    def on_record(self, record: dict[str, Any]) -> list[Any]: ...
+    def counted(self, record: dict[str, Any]) -> None:
+        """What a plan learns from a record it counts."""
+
+    def on_record(self, record: dict[str, Any]) -> list[Any]:
+        return self.follow(record) if self.restore(record) else []
+
+    def follow(self, record: dict[str, Any]) -> list[Any]:
+        """The tasks a newly counted record asks for."""
+        return []
 
 
 def _bar(progress: bool, plan: Plan, desc: str):
     from tqdm.auto import tqdm
 
     class Bar(tqdm):
-        # No monitor thread: a later local pool forks its workers only from a driver
-        # running a single thread (see ProcessBackend).
-        monitor_interval = 0
+        monitor_interval = 0  # no monitor thread beside the batches
 
-    return Bar(
-        total=plan.total,
-        initial=plan.done,
-        desc=desc,
-        unit="run",
-        disable=not progress,
-        file=sys.stderr,
-        smoothing=0.05,
-        dynamic_ncols=True,
-    )
+    return Bar(total=plan.total, initial=plan.done, desc=desc, unit="run", disable=not progress,
+               file=sys.stderr, smoothing=0.05, dynamic_ncols=True)  # fmt: skip
 
 
 def _next_task(queue: deque, source: Iterator[Any], pack, size: int):
-    """The next task to submit: one of the plan's, or up to ``size`` of them packed into
-    one (``pack(tasks)``, the ensemble engine's batches); None when there is none."""
+    """Up to ``size`` of the plan's tasks packed into one batch; None when there is none."""
     tasks = []
     while len(tasks) < size:
         task = queue.popleft() if queue else next(source, None)
         if task is None:
             break
         tasks.append(task)
-    if not tasks:
-        return None
-    return pack(tuple(tasks)) if pack is not None else tasks[0]
+    return pack(tuple(tasks)) if tasks else None
 
 
 def _share(plan: Plan, saved: int, inflight: dict, size: int, spread: int) -> int:
-    """How many tasks the next pack takes when ``spread`` packs run at once: at most
-    ``size``, and at most the tasks not yet submitted over twice ``spread`` (guided
-    scheduling), so that a sweep of few tasks, or a sweep's last ones, keep every thread
-    busy instead of one thread running one large pack while the others wait. Measured on
-    2 cores: the quick report's small sweeps (3-11 values of 20 s, one pack each) ran on
-    one core."""
+    """Tasks in the next pack: at most ``size`` and, when ``spread`` packs run at once, the
+    tasks left over twice ``spread`` (guided scheduling: a small sweep keeps every thread busy)."""
     if spread <= 1:
         return size
-    flying = sum(len(getattr(task, "tasks", (task,))) for task in inflight.values())
-    left = plan.total - saved - flying
+    left = plan.total - saved - sum(len(batch.tasks) for batch in inflight.values())
     return max(1, min(size, -(-left // (2 * spread))))
 
 
 def _finished(backend, futures: list) -> set:
-    """``backend.wait_any(futures)``; on a thread that can be asked to stop (:func:`stops_here`
-    is not empty), :data:`STOP_POLL_S` at a time, raising
-    :class:`~chaoscam.integrate._driver.StopRequested` once it is asked."""
+    """``backend.wait_any(futures)``, polled on a thread that can be asked to stop."""
     if not stops_here():
         return backend.wait_any(futures)
     while True:
@@ -159,28 +134,10 @@ def _finished(backend, futures: list) -> set:
             return done
 
 
-def execute(
-    plan: Plan,
-    backend,
-    store,
-    *,
-    progress: bool = False,
-    desc: str = "",
-    pack=None,
-    pack_size: int = 1,
-    spread: int = 1,
-) -> None:
-    """Run ``plan`` on ``backend``, storing every record in ``store``.
-
-    Records already in ``store`` (a resumed checkpoint) are given to the plan first and not
-    run again. With ``pack``, up to ``pack_size`` tasks travel as one (``pack(tasks)``, whose
-    ``run`` returns their records in a list: the ensemble engine); the plan sees each record
-    as if its task ran alone. With ``spread`` > 1 (packs run that many at once, one a
-    thread), a pack takes fewer tasks as they run out (:func:`_share`); a member's record
-    does not depend on its pack. Raises :class:`SweepInterrupted` on Ctrl-C after saving
-    what finished.
-    """
-    size = pack_size if pack is not None else 1
+def execute(plan: Plan, backend, store, eng: Engine, *, progress=False, desc="", spread=1) -> None:
+    """Run ``plan`` on ``backend`` in batches of up to ``eng.size`` tasks (fewer as they run
+    out with ``spread`` > 1 threads), storing every record in ``store``; the records already
+    there are given to the plan first. :class:`SweepInterrupted` on Ctrl-C, after saving."""
     store.open()
     for record in store.restored():
         try:
@@ -194,13 +151,13 @@ def execute(
     saved = plan.done  # records restored; each one stored below adds one
     queue: deque = deque()
     inflight: dict[Any, Any] = {}
-    retries: Counter = Counter()
     window = 1 if isinstance(backend, SerialBackend) else 2 * backend.workers
     bar = _bar(progress, plan, desc)
     try:
         while True:
             while len(inflight) < window:
-                task = _next_task(queue, source, pack, _share(plan, saved, inflight, size, spread))
+                size = _share(plan, saved, inflight, eng.size, spread)
+                task = _next_task(queue, source, eng.pack, size)
                 if task is None:
                     break
                 inflight[backend.submit(run_batch, task)] = task
@@ -209,25 +166,15 @@ def execute(
             for fut in _finished(backend, list(inflight)):
                 task = inflight.pop(fut)
                 try:
-                    record = backend.result(fut)
+                    records = backend.result(fut)
                 except StopRequested:  # this thread was asked to stop (serial: in the task)
                     raise
-                except WorkerLost as err:
-                    retries[task.key()] += 1
-                    if retries[task.key()] > MAX_RETRIES:
-                        raise TaskFailed(
-                            f"task {task.key()} lost its worker {MAX_RETRIES + 1} times; "
-                            f"the finished records are saved, resume after fixing it ({err})"
-                        ) from err
-                    getattr(backend, "recover", lambda: None)()
-                    queue.extendleft(reversed(getattr(task, "tasks", (task,))))
-                    continue
                 except Exception as err:
                     raise TaskFailed(
                         f"task {task.key()} failed ({type(err).__name__}: {err}); reproduce "
                         f"it with {task.hint()}, then the classifier on that run"
                     ) from err
-                for rec in record if isinstance(record, list) else [record]:
+                for rec in records:
                     store.add(rec)
                     saved += 1
                     queue.extend(plan.on_record(rec))
@@ -257,12 +204,7 @@ def execute(
 
 @contextlib.contextmanager
 def _second_interrupt_ignored():
-    """A context in which a second Ctrl-C is ignored (in the main thread, where handlers
-    live): a sweep stopped by the first waits for its batches under way to stop, then says
-    once what it kept, instead of leaving with a bare KeyboardInterrupt."""
-    import signal
-    import threading
-
+    """A second Ctrl-C ignored (in the main thread) while a stopped sweep cancels."""
     before = signal.getsignal(signal.SIGINT)
     if threading.current_thread() is not threading.main_thread() or before is None:
         yield  # no handler to put back (one not set from Python): left alone
@@ -280,25 +222,21 @@ def run_batch(batch: Batch) -> list[dict[str, Any]]:
 
 
 BATCH_SECONDS = 2.0
-"""Target wall time of one CPU batch [s]: short enough for a prompt Ctrl-C and frequent
-checkpoints, long enough that every thread has several members to balance."""
+"""Target wall time of one CPU batch [s]: a prompt Ctrl-C and frequent checkpoints, yet
+several members per thread to balance."""
 
 MAX_BATCH = 256
 """Members per CPU batch at most (bounds the memory of one compiled call)."""
 
 GPU_BATCH = 8_192
-"""Members per batch when a sweep's batches run on a GPU: one thread is slow and the device's
-rate comes from many in flight (on an H200, 0.25-s runs: 64 members took 1.09 s of launch,
-8,448 took 1.80 s, a full wave of 33,792 took 5.1 s), so batches must be large; a quarter
-of an H200's wave keeps a checkpoint every few minutes."""
+"""Members per GPU batch: the device's rate comes from many members in flight (on an H200,
+0.25-s runs: 64 members took 1.09 s, 8,448 took 1.80 s)."""
 
 
 @dataclass(frozen=True)
 class Engine:
-    """Where and how a sweep's batches run: ``pack`` makes a batch of up to ``size`` tasks;
-    ``threads`` numba threads in this process (local; None: leave it), ``batch_threads``
-    batches at once on threads, ``pipeline`` a local GPU's batches launched while the last
-    is labelled; ``device`` "gpu" or "cpu"."""
+    """Where a sweep's batches of up to ``size`` tasks run: ``device``, ``threads`` numba
+    threads here (None: leave it), ``batch_threads`` batches at once, or a GPU ``pipeline``."""
 
     judge: Judge
     device: str
@@ -310,10 +248,15 @@ class Engine:
     def pack(self, tasks: tuple) -> Batch:
         return Batch(tasks, self.judge, self.device)
 
+    def config(self, kind: str, code: dict, **fields) -> dict[str, Any]:
+        """A sweep's configuration: kind, version, ``fields``, classifier, device, code."""
+        judge = self.judge.identity()
+        return {"kind": kind, "version": __version__, **fields, "classifier": judge,
+                "device": self.device, "code": code}  # fmt: skip
+
 
 def batch_size(base, num, duration: float, transient: float, threads: int) -> int:
-    """Members per CPU batch: about :data:`BATCH_SECONDS` of work on ``threads`` threads,
-    from the run-time estimate (at least one per thread)."""
+    """Members per CPU batch: about :data:`BATCH_SECONDS` of work on ``threads`` threads."""
     from ..simulation import estimate
 
     per_run = max(estimate(base, num, duration=duration, transient=transient).seconds, 1e-3)
@@ -322,8 +265,7 @@ def batch_size(base, num, duration: float, transient: float, threads: int) -> in
 
 
 def resolve_engine(judge: Judge, device: str, base, num, run, workers, scheduler) -> Engine:
-    """The engine of a sweep of ``base`` and ``num`` with ``run`` = (duration, transient):
-    one batch per core on threads, a GPU's pipeline, or batches on Dask workers."""
+    """The engine for ``run`` = (duration, transient): a batch per core, a GPU, or Dask."""
     from ..kernel import GPUFallbackWarning, gpu_status
     from ._backends import local_workers
 
@@ -337,11 +279,8 @@ def resolve_engine(judge: Judge, device: str, base, num, run, workers, scheduler
             raise SweepError(str(err)) from None
     gpu = scheduler is None and runs_on_gpu(device) and not judge.series
     if device == "gpu" and scheduler is None and not gpu:
-        import warnings
-
         why = "a classifier that reads the series" if judge.series else gpu_status()[1]
-        warnings.warn(f"GPU backend unavailable: {why}; the sweep runs on the CPU",
-                      GPUFallbackWarning, stacklevel=4)  # fmt: skip
+        warn(f"GPU backend unavailable: {why}; the sweep runs on the CPU", GPUFallbackWarning)
     if gpu:
         return Engine(judge, "gpu", GPU_BATCH, threads, pipeline=True)
     if scheduler is not None:  # Dask workers: whole batches, on their GPUs when asked
@@ -352,31 +291,74 @@ def resolve_engine(judge: Judge, device: str, base, num, run, workers, scheduler
     return Engine(judge, "cpu", size, None if by_batch > 1 else threads, by_batch)
 
 
+RECORD_BYTES = 4096
+"""Memory of one finished record held by the driver [bytes]."""
+
+
+def plan_engine(judge, device, runs, base, num, duration, transient, workers, scheduler, *,
+                what, reduce, sections, fate=None) -> Engine:  # fmt: skip
+    """The engine of a sweep of ``runs`` runs like ``base`` (``device`` "auto" settled by
+    their number) after the budget check: refused when it cannot fit in memory (a batch per
+    worker, the records, with ``sections`` their points), warned about when it takes hours
+    (the step check doubles, a ``fate`` horizon at most ``fate / duration``) or when the
+    extensions of undetermined runs, which the estimate leaves out, could take far longer."""
+    from ..simulation import WARN_SECONDS, JobEstimate, check_budget, estimate, human_seconds
+    from ._backends import default_workers
+
+    eng = resolve_engine(judge, by_size(device, runs), base, num, (duration, transient),
+                         workers, scheduler)  # fmt: skip
+    n = default_workers() if workers is None else max(1, int(workers))
+    one = estimate(base, num, duration=duration, transient=transient, series=judge.series)
+    if fate is not None:
+        longer = estimate(base, num, duration=fate, transient=duration)
+        one = JobEstimate((max(one.bytes, longer.bytes), one.seconds))
+        reduce = f"{reduce}, or the fate horizon"
+    kept = estimate(base, num, duration=duration, transient=transient) if sections else None
+    memory = one.bytes * n + runs * (RECORD_BYTES + (kept.bytes / 3 if kept else 0.0))
+    seconds = one.seconds * runs * (1 + judge.check_step + (fate / duration if fate else 0)) / n
+    check_budget(JobEstimate((memory, seconds)), what=what, reduce=reduce,
+                 run=dict(params=base, num=num, duration=duration,
+                          what="each run of the base model"))  # fmt: skip
+    recorded, extend_to = duration - transient, judge.extend_to
+    if judge.custom is None and extend_to is not None and recorded < extend_to:
+        more = one.seconds * runs / n * (extend_to - recorded) / duration
+        if more > max(WARN_SECONDS, 10 * seconds):
+            warn(
+                f"{what} records {recorded:g} s per run; an undetermined run is extended up "
+                f"to {extend_to:g} s recorded, which the time estimate does not count: if "
+                f"most are, about {human_seconds(more)} more. Record more per run (duration "
+                "- transient) for fewer extensions"
+            )
+    return eng
+
+
+@contextlib.contextmanager
 def _numba_threads(n: int | None):
     """A context in which numba runs ``n`` threads (None: leave it), restored after."""
     if n is None:
-        return contextlib.nullcontext()
+        yield
+        return
+    import numba
 
-    @contextlib.contextmanager
-    def scope():
-        import numba
-
-        fork_safe_threads()  # numba's threads start here, fixing the layer: fork-safe first
-        before = numba.get_num_threads()
-        numba.set_num_threads(max(1, min(int(n), numba.config.NUMBA_NUM_THREADS)))
-        try:
-            yield
-        finally:
-            numba.set_num_threads(before)
-
-    return scope()
+    fork_safe_threads()  # numba's threads start here, fixing the layer: fork-safe first
+    before = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(int(n), numba.config.NUMBA_NUM_THREADS)))
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
 
 
 def run_plan(plan, eng: Engine, store, *, workers, scheduler, progress: bool, desc: str) -> None:
     """Execute a sweep's plan on its engine's backend."""
     if scheduler is not None:
+        if not isinstance(scheduler, str) and not hasattr(scheduler, "submit"):
+            raise SweepError(
+                f"scheduler = {scheduler!r} is not a Dask scheduler: give 'local', the "
+                "address of a running one ('tcp://HOST:PORT') or a distributed.Client"
+            )
         try:
-            backend = make_backend(workers, scheduler)
+            backend = DaskBackend(scheduler, workers)
         except (ValueError, ConnectionError) as err:
             where = "" if "scheduler" in str(err) else f"scheduler {scheduler!r}: "
             raise SweepError(f"{where}{err}") from None
@@ -389,45 +371,26 @@ def run_plan(plan, eng: Engine, store, *, workers, scheduler, progress: bool, de
     try:
         with _numba_threads(eng.threads):
             spread = eng.batch_threads if isinstance(backend, ThreadBackend) else 1
-            execute(plan, backend, store, progress=progress, desc=desc, pack=eng.pack,
-                    pack_size=eng.size, spread=spread)  # fmt: skip
+            execute(plan, backend, store, eng, progress=progress, desc=desc, spread=spread)
     finally:
         backend.close()
 
 
-def run_sweep(
-    plan,
-    eng: Engine,
-    *,
-    out: Path | None,
-    second: str,
-    config: dict[str, Any],
-    keys: tuple[str, str],
-    read: Callable[[Path], Any],
-    build: Callable[[list[dict[str, Any]]], Any],
-    resume: bool,
-    force: bool,
-    flush_interval: float,
-    workers,
-    scheduler,
-    progress: bool,
-    desc: str,
-):
-    """The steps every sweep takes around its plan, in one place.
-
-    Lock the output ``out`` (FILE.parquet, with FILE.<second>.parquet beside it; None: kept
-    in memory), open its checkpoint (a finished output of the same ``config`` is reused
-    through ``read`` under ``resume``), run the plan (:func:`run_plan`), sort the records by
-    ``keys`` (one per key), warn once per message the runs raised, ``build`` the result
-    from the records, write it to ``out`` and remove the checkpoint.
-    """
-    from ._common import companion, lock_outputs, open_store
-
-    with lock_outputs(out, second):
-        store, reuse = open_store(out, second, config, resume, flush_interval, force)
+def run_sweep(plan: Plan, eng: Engine, cls, config: dict[str, Any], build: Callable, *, out,
+              resume, force, flush_interval, workers, scheduler, progress, desc: str):  # fmt: skip
+    """Around a plan: lock the output ``out`` and its companion (None: in memory), open its
+    checkpoint (or read back a finished ``cls`` of the same ``config`` under ``resume``),
+    run the plan, ``build`` the result from the sorted records and write it to ``out``, the
+    checkpoint removed. ``progress`` None: a bar when stderr is a terminal."""
+    out = None if out is None else Path(out)
+    outputs = None if out is None else [out, companion(out, cls._tables[1])]
+    if progress is None:
+        progress = bool(getattr(sys.stderr, "isatty", lambda: False)())
+    with contextlib.nullcontext() if out is None else lock_all(outputs):
+        store, reuse = open_store(outputs, config, resume, flush_interval, force)
         if reuse:
             try:
-                result = read(out)
+                result = cls.read(out)
             except (OSError, ValueError) as err:  # pyarrow's errors are among them
                 raise SweepError(
                     f"{out} is this configuration's finished run, but it or its companion "
@@ -435,22 +398,16 @@ def run_sweep(
                     "in Python) to compute it again"
                 ) from None
             if progress:
-                print(
-                    f"already finished: {out} (same configuration); read, nothing run",
-                    file=sys.stderr,
-                )
+                print(f"already finished: {out} (same configuration); read, nothing run",
+                      file=sys.stderr)  # fmt: skip
             return result
         # Outputs there now are this configuration's (a resumed run's) or --force's; any
         # other that appears while the plan runs is not replaced at the end.
-        replace = force or (
-            out is not None and any(p.exists() for p in (out, companion(out, second)))
-        )
+        replace = force or (out is not None and any(p.exists() for p in outputs))
         try:
-            run_plan(
-                plan, eng, store, workers=workers, scheduler=scheduler, progress=progress,
-                desc=desc,
-            )  # fmt: skip
-            return _finish(plan, store, out, keys, build, replace)
+            run_plan(plan, eng, store, workers=workers, scheduler=scheduler,
+                     progress=bool(progress), desc=desc)  # fmt: skip
+            return _finish(plan, store, out, build, replace)
         except OSError as err:  # a full disk: say what is kept, and where
             if out is None or err.errno not in SAVE_ERRNOS:
                 raise  # not a failure to save (a lost connection, a file that appeared)
@@ -462,33 +419,44 @@ def run_sweep(
                 "cause (free space) and run the same command with --resume",
             ) from None
         except Exception:
-            # A run that failed before finishing any (a bad initial condition, a classifier
-            # that cannot be pickled) keeps no checkpoint: it would only block the corrected
-            # command ("holds the checkpoint of an interrupted run").
+            # A run that finished nothing keeps no checkpoint: it would only block the
+            # corrected command ("holds the checkpoint of an interrupted run").
             if next(iter(store.records()), None) is None:
                 store.remove()
             raise
 
 
 SAVE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EROFS})
-"""The errors of a disk that takes no more (full, over quota, failing, read-only): a sweep
-stopped by one says where its finished runs are kept and to --resume once it is fixed."""
+"""The errors of a disk that takes no more (full, over quota, failing, read-only)."""
 
 
-def _finish(plan, store, out: Path | None, keys, build, replace: bool):
+def _finish(plan: Plan, store, out: Path | None, build: Callable, replace: bool):
     """The result from the finished records, written to ``out`` (its checkpoint removed)."""
-    from ._common import reemit_warnings, unique_sorted
-
     try:
-        records = unique_sorted(store.records(), keys)
-        reemit_warnings(records)
+        records = _unique_sorted(store.records(), plan.keys)
+        counts = Counter(m for r in records for m in filter(None, r["warnings"].split(" | ")))
+        for msg, n in counts.items():  # once per message (each row has its own)
+            warn(f"{n} of {len(records)} runs: {msg}")
         result = build(records)
         if out is not None:
             result._write(out, replace=replace)
             store.remove()
     except KeyboardInterrupt:
-        # Every record is in the checkpoint; a resume writes the tables from it.
-        if out is None:
+        if out is None:  # else every record is in the checkpoint: a resume writes the tables
             raise
         raise SweepInterrupted(plan.total, plan.total, store.path) from None
     return result
+
+
+def _unique_sorted(records, keys: tuple[str, ...]) -> list[dict]:
+    """Records sorted by their key, one per key (a duplicate must equal the first, NaN
+    included: compared as JSON)."""
+    seen: dict[tuple, dict] = {}
+    for r in records:
+        k = tuple(r[f] for f in keys)
+        if k in seen:
+            if json.dumps(seen[k], sort_keys=True) != json.dumps(r, sort_keys=True):
+                raise SweepError(f"two different records for {dict(zip(keys, k, strict=True))}")
+            continue
+        seen[k] = r
+    return [seen[k] for k in sorted(seen)]

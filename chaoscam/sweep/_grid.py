@@ -1,10 +1,5 @@
-"""Sweep axes (``START:STOP:NUM``), grid validation and the realization-index scheme.
-
-A sweep never changes a kernel: it only builds a validated model (:class:`~chaoscam.Params`)
-and integrator settings (:class:`~chaoscam.Numerics`) for each point of a grid and asks
-:func:`chaoscam.solve` for realizations ``(seed, index)``. An axis is any numeric field of
-either.
-"""
+"""Sweep axes (``START:STOP:NUM``; any numeric Params or Numerics field), grid validation
+and the realization-index scheme."""
 
 from __future__ import annotations
 
@@ -19,17 +14,12 @@ from .._util import ParameterError, whole
 from ..model import FIELD_DOCS, LineLengthStream, Params, field_names
 from ..numerics import Numerics
 
-__all__ = ["Axis", "SweepError", "cell_params", "parse_range", "realization_index"]
-
 _DOCS = {**FIELD_DOCS, **{f: dict(m) for f, m in Numerics.field_docs().items()}}
 """The sweepable fields' metadata: the model's and the numerics'."""
 
 
 class SweepError(ValueError):
-    """A sweep cannot start or continue as asked: bad axis, checkpoint of another run, ...
-
-    The message says what to change. The command line reports it with exit code 2.
-    """
+    """A sweep cannot start or continue as asked; the message says what to change."""
 
 
 MAX_AXIS_POINTS = 100_000
@@ -40,14 +30,8 @@ MAX_GRID_POINTS = 1_000_000
 
 
 def parse_range(text: str, what: str = "range") -> tuple[float, float, int]:
-    """Parse ``START:STOP:NUM`` (NUM points, both ends included) into (start, stop, num).
-
-    Raises
-    ------
-    SweepError
-        Not three fields, non-numbers, NUM < 1, stop < start, or NUM = 1 with stop != start
-        (one point cannot include two different ends).
-    """
+    """``START:STOP:NUM`` (NUM points, both ends included) as (start, stop, num); a
+    :class:`SweepError` for anything else (NUM < 1, STOP < START, one point with two ends)."""
     parts = text.split(":")
     if len(parts) != 3:
         raise SweepError(f"{what} {text!r}: expected START:STOP:NUM (NUM points, ends included)")
@@ -81,16 +65,9 @@ def parse_range(text: str, what: str = "range") -> tuple[float, float, int]:
 
 @dataclass(frozen=True)
 class Axis:
-    """One swept field and its values.
-
-    Attributes
-    ----------
-    name : str
-        A numeric field of :class:`~chaoscam.Params` or :class:`~chaoscam.Numerics` (the
-        ``--set`` name), e.g. ``l_lambda`` or ``dt``.
-    values : tuple of float
-        The values in sweep order, in the field's SI unit.
-    """
+    """One swept field: ``name``, a numeric field of :class:`~chaoscam.Params` or
+    :class:`~chaoscam.Numerics` (e.g. ``l_lambda``, ``dt``), and its ``values`` in sweep
+    order, in the field's SI unit; each value once."""
 
     name: str
     values: tuple[float, ...]
@@ -121,10 +98,8 @@ class Axis:
             raise SweepError(f"axis {self.name}: no values")
         if not all(math.isfinite(v) for v in vals):
             raise SweepError(f"axis {self.name}: values must be finite")
-        if len(set(vals)) < len(vals):
+        if len(set(vals)) < len(vals):  # the same runs again, under other indices
             twice = sorted(v for v, n in Counter(vals).items() if n > 1)
-            # A repeated value would be a second grid column of the same parameters: run
-            # again under other realization indices and drawn on top of the first.
             raise SweepError(
                 f"axis {self.name}: the value {twice[0]!r} appears more than once; give each "
                 "value once"
@@ -167,11 +142,6 @@ class Axis:
         start, stop, num = parse_range(text, what=f"{name} range")
         return cls.linspace(name, start, stop, num)
 
-    @property
-    def unit(self) -> str:
-        """SI unit of the swept field."""
-        return _DOCS[self.name]["unit"]
-
     def __len__(self) -> int:
         return len(self.values)
 
@@ -180,14 +150,10 @@ class Axis:
 
 
 def realization_index(cell: int, index: int) -> int:
-    """The :func:`chaoscam.simulate` index of realization ``index`` of grid cell ``cell``.
-
-    The Cantor pairing ``(c + i)(c + i + 1)/2 + i``: a bijection of pairs of non-negative
-    integers onto the non-negative integers. Each (cell, realization) therefore gets its own
-    stream ``SeedSequence(seed, spawn_key=(pair,))``, which depends neither on the worker
-    count nor on how many realizations a cell ends with (adaptive sampling only appends
-    indices), nor on the size of the grid beyond the cell number itself.
-    """
+    """The :func:`chaoscam.simulate` index of realization ``index`` of grid cell ``cell``:
+    the Cantor pairing ``(c + i)(c + i + 1)/2 + i``, a bijection onto the non-negative
+    integers, so each (cell, realization) has its own stream whatever the workers, the grid
+    size or how many realizations a cell ends with."""
     try:
         c, i = whole("cell", cell, low=0), whole("index", index, low=0)
     except ParameterError as err:
@@ -196,12 +162,8 @@ def realization_index(cell: int, index: int) -> int:
     return s * (s + 1) // 2 + i
 
 
-def cell_params(
-    base: Params, num: Numerics, changes: dict[str, float]
-) -> tuple[Params, Numerics]:
-    """``base`` and ``num`` with ``changes`` applied (each field to its owner), validated as
-    a run would need them: beyond the field ranges (a :class:`~chaoscam.ParameterError`
-    naming the field), the random line length must keep some mass above ``l_min``."""
+def cell_params(base: Params, num: Numerics, changes: dict[str, float]) -> tuple[Params, Numerics]:
+    """``base`` and ``num`` with ``changes`` applied to their owners, validated as a run is."""
     model = {k: v for k, v in changes.items() if k in field_names()}
     steps = {k: v for k, v in changes.items() if k not in model}
     p = base.replace(**model) if model else base

@@ -1,17 +1,11 @@
-"""One realization of a finished sweep, run again alone.
-
-A regime map's or a bifurcation diagram's table row, with the sweep's ``config``, records all
-that fixes its realization: the base model and numerics, the swept values, the window
-(duration, transient), the seed and the solve index, and for a diagram the initial state
-(which a continued branch took from the previous value's run). :func:`replay` solves that
-realization alone, the run the sweep classified bit for bit, so one cell or value can be
-looked at, plotted, or classified again with other options, for instance at half the step
-(``classify(replay(rm, 3), check_step=True)``).
-"""
+"""One realization of a finished sweep, run again alone: a row and the sweep's ``config``
+fix it, so :func:`replay` solves the run the sweep classified, bit for bit, to look at or
+classify again (``classify(replay(rm, 3), check_step=True)``)."""
 
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Mapping
 from typing import Any
 
@@ -24,12 +18,9 @@ from ._grid import cell_params
 OUTPUT_DT = 1e-3
 """Series sampling of a replayed run [s], or dt where dt is coarser."""
 
-__all__ = ["replay", "replay_params"]
-
 
 def _field(row: Any, name: str) -> Any:
-    """``row[name]`` for a mapping or a pandas row (Series), ``row.name`` for a namedtuple
-    (``DataFrame.itertuples``)."""
+    """``row[name]`` of a mapping or a pandas row, ``row.name`` of a namedtuple."""
     if isinstance(row, Mapping) or hasattr(row, "index") and hasattr(row, "loc"):
         try:
             return row[name]
@@ -43,10 +34,9 @@ def _field(row: Any, name: str) -> Any:
     )
 
 
-def _sweep_config(sweep: Any) -> dict[str, Any]:
-    """The sweep's ``config`` with its ``kind``: recorded, or for files written before
-    sweeps recorded it (which ``read_*`` still accept), told by its axes ("x" and "y": a
-    regime map; "axis": a diagram)."""
+def _sweep_row(sweep: Any, row: Any) -> tuple[dict[str, Any], Any]:
+    """The sweep's ``config`` with its ``kind`` (told by its axes in older files), and
+    ``row`` (a whole number: the table's row at that position)."""
     cfg = getattr(sweep, "config", None)
     kind = None
     if isinstance(cfg, dict):
@@ -58,14 +48,18 @@ def _sweep_config(sweep: Any) -> dict[str, Any]:
             f"sweep must be a RegimeMap or a Bifurcation (from regime_map, bifurcation or "
             f"their read_* functions), got {type(sweep).__name__}"
         )
-    return {**cfg, "kind": kind}
+    if isinstance(row, numbers.Integral) and not isinstance(row, bool):
+        table = sweep.realizations if kind == "regime_map" else sweep.verdicts
+        if not 0 <= int(row) < len(table):
+            raise IndexError(f"row {row}: the table has {len(table)} rows")
+        row = table.iloc[int(row)]
+    return {**cfg, "kind": kind}, row
 
 
 def replay_params(sweep: Any, row: Any) -> tuple[Params, Numerics]:
     """The model and numerics of ``row``'s realization: the sweep's base with the row's axis
-    values (and, for a diagram, its initial state; NaN = in contact with the cam)."""
-    cfg = _sweep_config(sweep)
-    row = _row(sweep, cfg, row)
+    values (a diagram's: and its initial state, NaN = in contact)."""
+    cfg, row = _sweep_row(sweep, row)
     base, num = Params(**cfg["base"]), Numerics(**cfg.get("numerics", {}))
     if cfg["kind"] == "regime_map":
         names = (cfg["x"]["name"], cfg["y"]["name"])
@@ -76,45 +70,27 @@ def replay_params(sweep: Any, row: Any) -> tuple[Params, Numerics]:
     return p, num
 
 
-def _row(sweep: Any, cfg: dict, row: Any) -> Any:
-    """``row`` itself, or for a whole number the table's row at that position."""
-    import numbers
-
-    if isinstance(row, numbers.Integral) and not isinstance(row, bool):
-        table = sweep.realizations if cfg["kind"] == "regime_map" else sweep.verdicts
-        if not 0 <= int(row) < len(table):
-            raise IndexError(f"row {row}: the table has {len(table)} rows")
-        return table.iloc[int(row)]
-    return row
-
-
 def replay(sweep: Any, row: Any, *, tangent: bool = True, refine: int = 0) -> Solution:
     """Solve ``row``'s realization alone, as the sweep ran it.
 
     Parameters
     ----------
     sweep : RegimeMap or Bifurcation
-        The finished sweep (``regime_map``, ``bifurcation``, ``read_regime_map``,
-        ``read_bifurcation``).
+        The finished sweep.
     row : int, pandas row, namedtuple or mapping
-        A row number or one row of ``sweep.realizations`` (regime map) or ``sweep.verdicts``
-        (diagram).
+        A row (number) of ``sweep.realizations`` (a map) or ``sweep.verdicts`` (a diagram).
     tangent : bool
-        Also integrate the tangent dynamics, and keep the run resumable, as the sweeps do
-        (RK4 only): :func:`chaoscam.classify` then reads its Jacobians and extends it without
-        solving it again.
+        Integrate the tangent too and keep the run resumable, as the sweeps do (RK4 only),
+        so :func:`chaoscam.classify` needs no second solve.
     refine : int
-        Halve the step this many times (:meth:`Numerics.refined`), the same realization
-        otherwise: the rungs of a step ladder. 0: the sweep's run.
+        Halve the step this many times (:meth:`Numerics.refined`); 0: the sweep's run.
 
     Returns
     -------
     Solution
-        Of one member: duration, transient, seed and index of the sweep, the series sampled
-        every 1 ms (or every dt where dt is coarser). The motion does not depend on it.
+        Of one member, with the series every 1 ms (or dt where coarser).
     """
-    cfg = _sweep_config(sweep)
-    row = _row(sweep, cfg, row)
+    cfg, row = _sweep_row(sweep, row)
     p, num = replay_params(sweep, row)
     if isinstance(refine, bool) or not isinstance(refine, int) or refine < 0:
         raise ValueError(f"refine = {refine!r}: must be an integer >= 0 (step halvings)")
@@ -122,13 +98,7 @@ def replay(sweep: Any, row: Any, *, tangent: bool = True, refine: int = 0) -> So
         num = num.refined()
     tangent = flag("tangent", tangent) and num.integrator == "rk4"
     return simulate(
-        p,
-        num,
-        duration=float(cfg["duration"]),
-        transient=float(cfg["transient"]),
-        seed=int(_field(row, "seed")),
-        index=int(_field(row, "sim_index")),
-        output_dt=max(OUTPUT_DT, num.dt),
-        tangent=tangent,
-        resumable=tangent,
-    )
+        p, num, duration=float(cfg["duration"]), transient=float(cfg["transient"]),
+        seed=int(_field(row, "seed")), index=int(_field(row, "sim_index")),
+        output_dt=max(OUTPUT_DT, num.dt), tangent=tangent, resumable=tangent,
+    )  # fmt: skip

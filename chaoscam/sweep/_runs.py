@@ -1,17 +1,9 @@
-"""The work of a sweep: realizations solved in batches, judged, kept as records.
+"""The work of a sweep: realizations (:class:`Realization`) solved in batches, judged, kept.
 
-A sweep's plan makes *tasks* (:class:`Realization`: one realization of a regime-map cell, a
-bifurcation diagram's value and initial condition, or an ensemble's member). The engine packs
-them into a :class:`Batch`, which runs in two phases: :meth:`Batch.launch` solves its tasks,
-one :func:`chaoscam.solve` call per group of tasks that share the grid, on the CPU's threads
-or a GPU; :meth:`Batch.label` judges them (:class:`Judge`: the package's verdict, or a
-classifier of one's own, with the Lyapunov and step-check adapters), continues the runs a
-``fate`` horizon asks for, and builds each task's record. Apart, the phases let a GPU sweep
-launch its next batch while the host labels the last.
-
-A record is a JSON-safe dict (the verdict, counts, evidence values, never a time series): a
-pure function of its task, the same whatever batch it ran in, the thread count, the backend
-or an interruption.
+A :class:`Batch` solves its tasks (:meth:`~Batch.launch`), then judges them, continues those
+a ``fate`` horizon asks for and builds the records (:meth:`~Batch.label`); apart, a GPU sweep
+launches its next batch while the host labels the last. A record is a JSON-safe dict, a pure
+function of its task whatever the batch, threads, backend or interruption.
 """
 
 from __future__ import annotations
@@ -26,8 +18,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, is_dataclass
 from typing import Any
 
-import numpy as np
-
 from .._util import quiet, recorded
 from ..analysis import LABELS, spectrum_from_jacobians
 from ..kernel import Status
@@ -36,22 +26,9 @@ from ..numerics import Numerics
 from ..simulation import Solution, extend, run_warnings, solve
 from ..verdict import EXTEND_TO, classify, judge_points
 
-__all__ = [
-    "FATE_FIELDS",
-    "FATE_LABELS",
-    "Batch",
-    "Judge",
-    "Realization",
-    "classifier_identity",
-    "fate_columns",
-    "load_classifier",
-    "verdict_fields",
-]
-
 FATE_LABELS = frozenset({"chaotic", "quasiperiodic", "undetermined"})
-"""Labels whose runs a sweep's ``fate`` horizon continues: their motion is not a certified
-attracting orbit, so it may still leave the cam's reach or settle later (at (omega, xi) =
-(42.5 rad/s, 0.40) the motion is chaotic for 229 s and then leaves)."""
+"""Labels whose runs a ``fate`` horizon continues: not a certified attracting orbit, so the
+motion may still leave the cam's reach or settle later."""
 
 FATE_LATE = 0.5
 """The part of a fate run (its last half) on which its verdict at the horizon is taken."""
@@ -59,30 +36,17 @@ FATE_LATE = 0.5
 FATE_FIELDS = ("fate", "left_at", "fate_label", "fate_period")
 """A record's fate fields; None in a run not continued."""
 
+SECTION_KEYS = ("k", "t", "theta_f", "omega_f", "l_lambda")
+"""The section columns a record keeps for the plans that ask for them."""
+
 
 @dataclass(frozen=True)
 class Judge:
-    """How a sweep labels its runs: the package's verdict (:func:`chaoscam.classify`) or
-    ``custom(solution) -> verdict`` on each one-member solution, and the adapters applied to
-    either.
-
-    Attributes
-    ----------
-    custom : callable or None
-        A classifier of one's own (``label``, ``period``, ``evidence``, ``reasons``); it gets
-        each run with its series unless it declares ``needs_series = False``. None: the
-        package's verdict.
-    lyapunov : bool
-        Record the tangent spectrum of each run (evidence ``lyapunov_1``, its standard error
-        ``lyapunov_1_stderr`` and ``lyapunov_2``, in 1/s), what a regime map's
-        ``lyapunov_mean`` / ``lyapunov_std`` summarise.
-    check_step : bool
-        The package's verdict at half the step too (``classify(check_step=True)``).
-    extend_to : float or None
-        Longest recorded time [s] an undetermined verdict is extended to (None: never).
-    labels : bool
-        False: no verdict (every label None; an ensemble kept for its sections).
-    """
+    """How a sweep labels its runs: the package's verdict (``custom`` None) or
+    ``custom(solution) -> verdict`` on each one-member solution (with its series unless it
+    declares ``needs_series = False``); ``lyapunov`` records the tangent spectrum (evidence
+    ``lyapunov_1``, ``lyapunov_1_stderr``, ``lyapunov_2`` [1/s]); ``check_step`` and
+    ``extend_to`` as for :func:`chaoscam.classify`; ``labels`` False: no verdict at all."""
 
     custom: Callable | None = None
     lyapunov: bool = False
@@ -96,7 +60,7 @@ class Judge:
         return self.custom is not None and bool(getattr(self.custom, "needs_series", True))
 
     def identity(self) -> str:
-        """A stable text naming the classifier and its settings (part of the configuration)."""
+        """A stable text naming the classifier and its settings (in the configuration)."""
         if not self.labels:
             return "none"
         name = "chaoscam.classify" if self.custom is None else classifier_identity(self.custom)
@@ -106,11 +70,9 @@ class Judge:
         )
 
     def fields(self, sol: Solution) -> list[dict[str, Any]]:
-        """The verdict fields of every member of ``sol`` (status labels for the runs that did
-        not end normally)."""
+        """The verdict fields of every member of ``sol`` (a failed run's: its status's)."""
         if not self.labels:
-            return [{"label": None, "period": None, "reasons": "", "evidence": {},
-                     "recorded_s": None} for _ in range(len(sol))]  # fmt: skip
+            return [status_fields(None) for _ in range(len(sol))]
         if self.custom is None:
             verdicts = classify(sol, extend_to=self.extend_to, check_step=self.check_step)
         else:
@@ -130,8 +92,7 @@ def _ok(sol: Solution, i: int) -> bool:
 
 
 def _spectrum_evidence(v, sol: Solution, i: int) -> dict[str, float]:
-    """The tangent spectrum of member ``i`` [1/s]: from its verdict's record, or (for a
-    classifier of one's own) from the run's Jacobians."""
+    """Member ``i``'s tangent spectrum [1/s]: its verdict's, or from the run's Jacobians."""
     rec = (getattr(v, "settings", None) or {}).get("tangent") if v is not None else None
     if rec is None and sol.jacobians is not None and _ok(sol, i):
         rows = sol.sections["member"].to_numpy() == i
@@ -148,11 +109,10 @@ def _spectrum_evidence(v, sol: Solution, i: int) -> dict[str, float]:
 
 
 def classifier_identity(classify: Callable) -> str:
-    """A stable text naming a classifier and its settings, part of a run's configuration:
-    ``module.qualname`` for a function (plus a digest of its code, defaults and closure for
-    a lambda or a local function, whose names are not unique; line numbers and file names
-    left out); for a bound method, its instance too; for ``functools.partial``, its
-    function's with the bound arguments; for an instance, its class's name and ``repr``."""
+    """A stable text naming a classifier and its settings: ``module.qualname`` (plus a digest
+    of code, defaults and closure for a lambda or local function, positions left out); a
+    bound method's instance; a ``functools.partial``'s function and arguments; an instance's
+    class and ``repr``."""
     if isinstance(classify, type) or not callable(classify):
         raise TypeError(f"classify must be a function or an instance, got {classify!r}")
     if isinstance(classify, functools.partial):  # its own name is functools.partial's
@@ -189,14 +149,13 @@ def _code_key(code) -> tuple:
 
 
 def _code_digest(func: Callable, code) -> str:
-    """A digest of a lambda's or a local function's code, defaults and closure."""
     cells = tuple(_stable_repr(c.cell_contents) for c in (func.__closure__ or ()))
     extra = (func.__defaults__, func.__kwdefaults__, cells)
     return hashlib.sha256(repr((_code_key(code), extra)).encode()).hexdigest()[:16]
 
 
 def load_classifier(spec: str) -> Callable:
-    """``MODULE:NAME`` to a classifier: a function, or a class instantiated without arguments."""
+    """``MODULE:NAME`` to a classifier: a function, or a class made without arguments."""
     module, sep, name = spec.partition(":")
     if not sep or not module or not name:
         raise ValueError(f"classifier {spec!r}: expected MODULE:NAME")
@@ -218,8 +177,6 @@ def load_classifier(spec: str) -> Callable:
 
 
 def _number(v: Any) -> float:
-    if isinstance(v, bool):
-        return float(v)
     try:
         return float(v)
     except (TypeError, ValueError):
@@ -227,11 +184,10 @@ def _number(v: Any) -> float:
 
 
 def verdict_fields(verdict: Any) -> dict[str, Any]:
-    """The parts of a verdict a table keeps: label, period, reasons, evidence values, and
-    ``recorded_s``, the recorded time of the extended run the verdict was made on (None when
-    made on the run as given). Works with any object with ``label`` (one of ``LABELS``),
-    ``period`` (a whole number >= 1, or None), ``evidence`` (items with ``name``, ``value``)
-    and ``reasons``; another label or period is a ValueError naming it."""
+    """What a table keeps of a verdict: label, period, reasons, evidence values and
+    ``recorded_s`` (of the extended run it was made on; None if not extended). Any object
+    with ``label`` (one of ``LABELS``), ``period`` (whole >= 1 or None), ``evidence`` (items
+    with ``name``, ``value``) and ``reasons``; another label or period is a ValueError."""
     evidence: dict[str, float] = {}
     for e in getattr(verdict, "evidence", ()) or ():
         evidence.setdefault(str(e.name), _number(e.value))
@@ -252,17 +208,16 @@ def verdict_fields(verdict: Any) -> dict[str, Any]:
     }
 
 
-def status_fields(status: Status) -> dict[str, Any]:
-    """The verdict fields of a run that did not end normally: labelled by its status."""
-    return {"label": status.label, "period": None, "reasons": status.message, "evidence": {},
-            "recorded_s": None}  # fmt: skip
+def status_fields(status: Status | None) -> dict[str, Any]:
+    """The verdict fields of a run not judged: labelled by its status (None: no label)."""
+    label, reasons = (None, "") if status is None else (status.label, status.message)
+    return {"label": label, "period": None, "reasons": reasons, "evidence": {}, "recorded_s": None}
 
 
 @dataclass(frozen=True)
 class Realization:
-    """One realization a sweep runs: ``key`` (its place in the plan), the model and numerics,
-    the window, ``seed`` and ``sim_index`` (its :func:`chaoscam.solve` index), a ``fate``
-    horizon or None, and ``extra``: the plan's own fields of its record."""
+    """One realization a sweep runs: its place in the plan, what fixes the run, a ``fate``
+    horizon, ``extra`` fields of its record and whether the record keeps the section."""
 
     key: tuple[int, int]
     params: Params
@@ -292,43 +247,24 @@ class Realization:
         )
 
     def record(self, sol: Solution, i: int, fields: dict[str, Any]) -> dict[str, Any]:
-        """The record of this realization from member ``i`` of ``sol`` and its verdict
-        fields: the plan's fields, then the run's."""
+        """The record from member ``i`` of ``sol`` and its verdict fields."""
         m, p = sol.members.iloc[i], self.params
         rows = sol.sections["member"].to_numpy() == i
         recorded = fields.get("recorded_s")
         rec = {
-            **self.extra,
-            "seed": self.seed,
-            "sim_index": self.sim_index,
-            "status": str(m["status"]),
-            "label": fields["label"],
-            "period": fields["period"],
+            **self.extra, "seed": self.seed, "sim_index": self.sim_index,
+            "status": str(m["status"]), "label": fields["label"], "period": fields["period"],
             "n_section": int(rows.sum()),
             "recorded_s": float(self.duration - self.transient if recorded is None else recorded),
-            "n_impacts": int(m["n_impacts"]),
-            "contact_fraction": _number(m["contact_fraction"]),
+            "n_impacts": int(m["n_impacts"]), "contact_fraction": _number(m["contact_fraction"]),
             "truncated_mass": truncated_mass(p.l_lambda, p.l_lambda_sigma, p.l_min),
-            "reasons": fields["reasons"],
-            "warnings": fields["warnings"],
-            "evidence": fields["evidence"],
-            **{name: fields.get(name) for name in FATE_FIELDS},
-        }
+            "reasons": fields["reasons"], "warnings": fields["warnings"],
+            "evidence": fields["evidence"], **{name: fields.get(name) for name in FATE_FIELDS},
+        }  # fmt: skip
         if self.sections:
             sec = sol.sections[rows]
-            rec["section"] = {c: sec[c].tolist() for c in ("k", "t", "theta_f", "omega_f",
-                                                             "l_lambda")}  # fmt: skip
+            rec["section"] = {c: sec[c].tolist() for c in SECTION_KEYS}
         return rec
-
-
-@dataclass(frozen=True)
-class Launched:
-    """One group of a batch after its solve: the positions of its tasks in the batch, the
-    solution, and what the call warned."""
-
-    picks: list[int]
-    solution: Solution
-    warned: list[str]
 
 
 @dataclass(frozen=True)
@@ -350,10 +286,9 @@ class Batch:
     def run(self) -> list[dict[str, Any]]:
         return self.label(self.launch())
 
-    def launch(self) -> list[Launched]:
-        """The first phase: one solve per group of tasks that share (seed, window, numerics,
-        omega, fate), each task's order kept within its group; resumable (RK4) where an
-        undetermined member may be extended or a fate run continued."""
+    def launch(self) -> list[tuple[list[int], Solution, list[str]]]:
+        """The first phase: per group, (positions in the batch, solution, warnings); resumable
+        (RK4) where a member may be extended or continued to its fate."""
         groups: dict[tuple, list[int]] = {}
         for i, t in enumerate(self.tasks):
             groups.setdefault(t.group(), []).append(i)
@@ -368,27 +303,26 @@ class Batch:
                     series=self.judge.series, backend=self.backend,
                     resumable=rk4 and (self.judge.extend_to is not None or fate is not None),
                 )  # fmt: skip
-            out.append(Launched(picks, sol, [str(w.message) for w in caught]))
+            out.append((picks, sol, [str(w.message) for w in caught]))
         return out
 
-    def label(self, launched: list[Launched]) -> list[dict[str, Any]]:
-        """The second phase: each member's verdict fields, its fate where asked, its
-        warnings, and the task's record."""
+    def label(self, launched: list) -> list[dict[str, Any]]:
+        """The second phase: verdicts, fates where asked, warnings, and the records."""
         records: list[dict[str, Any] | None] = [None] * len(self.tasks)
-        for group in launched:
-            sol, plist = group.solution, list(group.solution.models)
+        for picks, sol, warned in launched:
+            plist = list(sol.models)
             with recorded() as caught:
                 fields = self.judge.fields(sol)
-            fate = self.tasks[group.picks[0]].fate
+            fate = self.tasks[picks[0]].fate
             later = [j for j, f in enumerate(fields) if _ok(sol, j) and f["label"] in FATE_LABELS]
             if fate is not None and later:
                 for j, more in zip(later, _fates(sol, later, fate), strict=True):
                     fields[j].update(more)
             # what the batch warned, less the models' own (each record adds its own model's)
             models = {w for q in set(plist) for w in run_warnings(q, sol.numerics)}
-            said = [*group.warned, *(str(w.message) for w in caught)]
+            said = [*warned, *(str(w.message) for w in caught)]
             shared = [w for w in said if w not in models]
-            for j, i in enumerate(group.picks):
+            for j, i in enumerate(picks):
                 seen = [w for w in (*run_warnings(plist[j], sol.numerics), *shared) if w]
                 fields[j]["warnings"] = " | ".join(dict.fromkeys(seen))
                 records[i] = self.tasks[i].record(sol, j, fields[j])
@@ -396,10 +330,8 @@ class Batch:
 
 
 def _fates(sol: Solution, later: Sequence[int], fate: float) -> list[dict[str, Any]]:
-    """The fate fields of members ``later`` run on to ``fate`` seconds with the tangent:
-    continued from the copy a resumable run keeps (the same bits as a run made that long)
-    where the judged last half starts after the first run's transient, from which a
-    continued run records; else run again from t = 0."""
+    """The fate fields of members ``later`` run on to ``fate`` [s] with the tangent (extended
+    where the judged last half starts after the transient, else solved from t = 0)."""
     s = sol.settings
     period = max(p.cam_period for p in sol.models)
     continues = sol.resume is not None and (1.0 - FATE_LATE) * (fate - period) > (
@@ -420,10 +352,8 @@ def _fates(sol: Solution, later: Sequence[int], fate: float) -> list[dict[str, A
 
 
 def _fate_fields(long: Solution, i: int) -> dict[str, Any]:
-    """Member ``i``'s fate at the horizon: ``fate`` (its status name), ``left_at`` (the last
-    section time before a run that stopped; NaN for one that stayed) and, for one that
-    stayed, ``fate_label`` and ``fate_period``: the model's verdict on the run's last half
-    (:data:`FATE_LATE`), which says whether chaos over the recorded window settles later."""
+    """Member ``i``'s fate: its status, ``left_at`` (NaN if it stayed) and the verdict on the
+    run's last :data:`FATE_LATE` when it stayed."""
     status = str(long.members["status"].iat[i])
     rows = long.sections["member"].to_numpy() == i
     t = long.sections["t"].to_numpy()[rows]
@@ -440,22 +370,3 @@ def _fate_fields(long: Solution, i: int) -> dict[str, Any]:
     with quiet():  # a short late window warns like the first run did (on batch threads too)
         v = judge_points(xy, long.jacobians[rows][late], long.models[i], long.numerics, {})
     return {**out, "fate_label": v.label, "fate_period": v.period}
-
-
-def fate_columns(records: list[dict]) -> dict[str, Any]:
-    """The fate columns of a sweep's table (None / NaN where a run was not continued)."""
-    import pandas as pd
-
-    return {
-        "fate": [r.get("fate") for r in records],
-        "left_at": [math.nan if r.get("left_at") is None else r["left_at"] for r in records],
-        "fate_label": [r.get("fate_label") for r in records],
-        "fate_period": pd.array([r.get("fate_period") for r in records], dtype="Int64"),
-    }
-
-
-def section_arrays(record: dict) -> dict[str, np.ndarray]:
-    """A record's section (kept by plans that ask for it) as arrays."""
-    sec = record.get("section", {})
-    return {c: np.asarray(sec.get(c, []), dtype=float) for c in ("k", "t", "theta_f",
-                                                                 "omega_f", "l_lambda")}

@@ -7,54 +7,31 @@ inference", J. Am. Stat. Assoc. 22 (1927) 209-212; L. D. Brown, T. T. Cai, A. Da
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
 from scipy.special import ndtri
 
-__all__ = [
-    "LABEL_ORDER",
-    "fate_clause",
-    "fate_split",
-    "wilson_interval",
-    "max_halfwidth",
-    "summarize_cells",
-]
-
-LABEL_ORDER = (
-    "periodic",
-    "quasiperiodic",
-    "chaotic",
-    "undetermined",
-    "left_reach",
-    "diverged",
-)
-"""Labels of a map in display order: the verdicts, then the non-regular run statuses.
-
-A run that leaves the cam's reach or diverges is labelled by its status and counted like
-any other label; it is never dropped. Ties for the dominant label go to the earlier one.
-"""
-
-LYAPUNOV_EVIDENCE = "lyapunov_1"
-"""Name of the evidence item holding a run's largest Lyapunov exponent [1/s] (the tangent
-spectrum's, recorded with ``lyapunov=True``)."""
+LABEL_ORDER = ("periodic", "quasiperiodic", "chaotic", "undetermined", "left_reach", "diverged")
+"""Labels of a map in display order: the verdicts, then the statuses of runs that left the
+cam's reach or diverged (counted like any label, never dropped). Ties for the dominant label
+go to the earlier one."""
 
 
 def wilson_interval(k, n, confidence: float = 0.95) -> tuple[np.ndarray, np.ndarray]:
     """Wilson score interval for a binomial proportion ``k / n``.
 
-    ``(p + z^2/2n -+ z sqrt(p(1-p)/n + z^2/4n^2)) / (1 + z^2/n)`` with ``z`` the two-sided
-    normal quantile of ``confidence`` (1.96 for 95 %). Unlike the Wald interval it stays in
-    [0, 1] and keeps close to its nominal coverage for small ``n`` and ``p`` near 0 or 1
-    (Brown, Cai & DasGupta 2001).
+    ``(p + z^2/2n -+ z sqrt(p(1-p)/n + z^2/4n^2)) / (1 + z^2/n)``, ``z`` the two-sided normal
+    quantile of ``confidence``; unlike Wald's it stays in [0, 1] and near its nominal
+    coverage for small ``n`` and ``p`` near 0 or 1 (Brown, Cai & DasGupta 2001).
 
     Parameters
     ----------
     k, n : int or array_like
         Successes and trials, 0 <= k <= n; n = 0 gives (0, 1).
     confidence : float
-        Two-sided confidence level in (0, 1).
+        Two-sided level in (0, 1).
 
     Returns
     -------
@@ -63,8 +40,7 @@ def wilson_interval(k, n, confidence: float = 0.95) -> tuple[np.ndarray, np.ndar
     """
     if not 0.0 < confidence < 1.0:
         raise ValueError(f"confidence = {confidence!r} must be in (0, 1)")
-    k = np.asarray(k, dtype=float)
-    n = np.asarray(n, dtype=float)
+    k, n = np.asarray(k, dtype=float), np.asarray(n, dtype=float)
     if not (np.isfinite(k).all() and np.isfinite(n).all()) or (k % 1).any() or (n % 1).any():
         raise ValueError(f"k = {k} and n = {n} must be whole numbers (counts)")
     if np.any(k < 0) or np.any(k > n):
@@ -85,12 +61,8 @@ def wilson_interval(k, n, confidence: float = 0.95) -> tuple[np.ndarray, np.ndar
 
 
 def max_halfwidth(counts: Mapping[str, int], n: int, confidence: float = 0.95) -> float:
-    """Largest Wilson half-width over the labels of one cell (1 when ``n`` = 0).
-
-    A label never seen has the same half-width as one seen every time and a smaller one
-    than any label seen sometimes, so the maximum over the observed labels is the maximum
-    over all labels.
-    """
+    """Largest Wilson half-width over the labels of one cell (1 when ``n`` = 0); a label
+    never seen is no wider than the observed ones, so they suffice."""
     if n <= 0:
         return 1.0
     ks = list(counts.values()) or [0]
@@ -98,48 +70,32 @@ def max_halfwidth(counts: Mapping[str, int], n: int, confidence: float = 0.95) -
     return float(np.max((hi - lo) / 2.0))
 
 
-def _labels(observed: Iterable[str]) -> list[str]:
-    extra = sorted(set(observed) - set(LABEL_ORDER))
-    return list(LABEL_ORDER) + extra
-
-
-def summarize_cells(
-    rows: pd.DataFrame,
-    cells: pd.DataFrame,
-    *,
-    confidence: float = 0.95,
-) -> pd.DataFrame:
+def summarize_cells(rows: pd.DataFrame, cells: pd.DataFrame, *, confidence=0.95) -> pd.DataFrame:
     """One row per grid cell: label fractions, intervals, dominant label, Lyapunov spread.
 
     Parameters
     ----------
     rows : DataFrame
-        One row per realization with columns ``cell``, ``label``, ``truncated_mass`` and,
-        with ``lyapunov=True``, ``ev_lyapunov_1``.
+        One row per realization: ``cell``, ``label``, ``truncated_mass`` (and
+        ``ev_lyapunov_1``, ``period``, the fate columns where recorded).
     cells : DataFrame
-        One row per cell: ``cell``, ``ix``, ``iy`` and the two axis values; with a boolean
-        column ``deterministic``, such cells (one run standing for identical realizations)
-        get the point value as their interval.
+        One row per cell: ``cell``, ``ix``, ``iy``, the axis values; cells flagged in a
+        boolean ``deterministic`` column (one run standing for all) get a point interval.
     confidence : float
         Level of the Wilson intervals.
 
     Returns
     -------
     DataFrame
-        The columns of ``cells``, then ``n``; ``dominant``; for each label L of
-        `LABEL_ORDER` (and any other label observed): ``n_L``, ``p_L``, ``p_L_lo``,
-        ``p_L_hi``; ``halfwidth`` (the widest interval's half-width); ``lyapunov_mean``,
-        ``lyapunov_std`` (sample standard deviation, NaN below two values) and
-        ``lyapunov_n`` over the finite exponents; ``period``, the most frequent period of
-        the cell's periodic realizations (the smallest on a tie; NA when none);
-        ``truncated_mass``, the probability mass of Normal(mu, sigma^2) below ``l_min``
-        that the truncation removed; ``n_transient``, how many of the cell's realizations
-        a ``fate`` horizon found to stop later (leave the cam's reach or diverge; 0 where
-        none was checked, see :func:`chaoscam.sweep.regime_map`); ``n_settled`` and
-        ``settled_period``, how many it found periodic on the continued run's last half
-        (:func:`fate_settled`) and their most frequent period.
+        The columns of ``cells``, then ``n``, ``dominant``, for each label L of
+        `LABEL_ORDER` (and any other observed) ``n_L``, ``p_L``, ``p_L_lo``, ``p_L_hi``;
+        ``halfwidth`` (the widest); ``lyapunov_mean``, ``lyapunov_std`` (sample, NaN below
+        two) and ``lyapunov_n`` over the finite exponents; ``period`` (the modal period of
+        the periodic runs, smallest on a tie); ``truncated_mass`` (of Normal(mu, sigma^2)
+        below ``l_min``); ``n_transient`` (runs a ``fate`` horizon found to stop later),
+        ``n_settled`` and ``settled_period`` (found periodic there, :func:`fate_settled`).
     """
-    labels = _labels(rows["label"].unique() if len(rows) else [])
+    labels = [*LABEL_ORDER, *sorted(set(rows["label"]) - set(LABEL_ORDER))]
     out = cells.sort_values("cell").reset_index(drop=True).copy()
     counts = (
         pd.crosstab(rows["cell"], rows["label"]).reindex(
@@ -158,18 +114,16 @@ def summarize_cells(
     for j, lab in enumerate(labels):
         k = k_mat[:, j]
         lo, hi = wilson_interval(k, n, confidence)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            out[f"n_{lab}"] = k.astype(np.int64)
-            out[f"p_{lab}"] = np.where(n > 0, k / np.maximum(n, 1), np.nan)
+        p = np.where(n > 0, k / np.maximum(n, 1), np.nan)
+        out[f"n_{lab}"], out[f"p_{lab}"] = k.astype(np.int64), p
         if "deterministic" in out:  # one run stands for the cell: no sampling interval
             det = out["deterministic"].to_numpy(dtype=bool)
-            p_hat = np.where(n > 0, k / np.maximum(n, 1), np.nan)
-            lo, hi = np.where(det, p_hat, lo), np.where(det, p_hat, hi)
+            lo, hi = np.where(det, p, lo), np.where(det, p, hi)
         out[f"p_{lab}_lo"] = lo
         out[f"p_{lab}_hi"] = hi
         half = np.maximum(half, (hi - lo) / 2.0)
     out["halfwidth"] = half
-    col = f"ev_{LYAPUNOV_EVIDENCE}"
+    col = "ev_lyapunov_1"  # the largest exponent [1/s], with lyapunov=True
     lam = rows[["cell", col]] if col in rows else pd.DataFrame({"cell": rows["cell"], col: np.nan})
     lam = lam[np.isfinite(lam[col].to_numpy(dtype=float))]
     g = lam.groupby("cell")[col]
@@ -190,25 +144,22 @@ def summarize_cells(
 
 
 def _modal_period(cells: pd.Series, rows: pd.DataFrame, column: str):
-    """Per cell, the most frequent ``column`` of ``rows`` (the smallest on a tie; NA where
-    the cell has none), as a nullable integer column."""
+    """Per cell, the most frequent ``column`` of ``rows`` (smallest on a tie; else NA)."""
     mode = rows.groupby("cell")[column].agg(lambda s: s.mode().min()) if len(rows) else {}
     return pd.array(cells.map(mode), dtype="Int64")
 
 
 def fate_settled(rows: pd.DataFrame) -> pd.DataFrame:
-    """The rows a ``fate`` horizon continued that stayed in the cam's reach and were periodic
-    on the continued run's last half (``fate_label``): chaos that settles later, or a verdict
-    that needed the longer window. Empty without those columns."""
+    """The rows a ``fate`` horizon continued that stayed in reach and were periodic on the
+    continued run's last half (empty without those columns)."""
     if "fate_label" not in rows:
         return rows.iloc[:0]
     return rows[(rows["fate"] == "OK") & (rows["fate_label"] == "periodic")]
 
 
 def fate_split(rows: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """(the rows a sweep's ``fate`` horizon continued, those of them that stopped before it:
-    left the cam's reach or diverged) from a table with a ``fate`` column (the status at the
-    horizon, None where not continued); both empty without that column."""
+    """(the rows a ``fate`` horizon continued, those of them that stopped before it); both
+    empty without a ``fate`` column."""
     if "fate" not in rows:
         return rows.iloc[:0], rows.iloc[:0]
     checked = rows[rows["fate"].notna()]
@@ -216,9 +167,8 @@ def fate_split(rows: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
 
 
 def continued_labels(checked: pd.DataFrame) -> str:
-    """How the continued rows were labelled, for a sentence: "labelled chaotic or
-    undetermined" (runs that already left the cam's reach are not continued, so "not
-    labelled periodic" would overcount)."""
+    """How the continued rows were labelled, for a sentence ("labelled chaotic or
+    undetermined")."""
     labels = [x for x in ("chaotic", "quasiperiodic", "undetermined") if x in set(checked["label"])]
     if not labels:
         return "continued"
@@ -227,9 +177,8 @@ def continued_labels(checked: pd.DataFrame) -> str:
 
 
 def fate_clause(rows, fate, what: str) -> str:
-    """A report summary's clause on a sweep's fate horizon: how many of the continued runs
-    stopped before it, and how many are periodic on the continued run's last half (transient
-    motion); empty without a horizon."""
+    """A report's clause on a fate horizon: how many continued runs stopped before it and
+    how many are periodic later; empty without a horizon."""
     checked, stopped = fate_split(rows) if fate else (rows.iloc[:0], None)
     if not len(checked):  # no horizon, or no run to continue (all periodic or out of reach)
         return ""

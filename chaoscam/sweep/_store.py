@@ -1,18 +1,9 @@
 """Checkpoints: finished records written as they complete, so a killed run can resume.
 
-Layout, beside the output ``FILE.parquet``: a folder ``FILE.parquet.ckpt/`` holding
-``manifest.json`` (the run's configuration and its SHA-256) and append-only part files
-``part-NNNNNN.jsonl``, one JSON record per line and a last line
-``#chaoscam-part n=COUNT sha256=HEX`` (the records' count and the checksum of the bytes
-before it). Every file is written to a temporary name, flushed to disk and moved into place
-with :func:`os.replace`, so a part is either whole or absent whatever moment the process is
-killed (SIGKILL included); a resumed run reads the parts, skips the records they hold and
-appends new parts. A part damaged all the same (a full disk, a copy cut short) is found by
-its trailer: the last part is dropped with a one-line notice and its records recomputed; a
-damaged part before it is refused with a message saying what to do. Floats are written with
-Python's shortest round-trip ``repr``, so a record read back is bit-identical to the one
-written. The run holds an OS lock on its output (:class:`chaoscam._outputs.OutputLock`), so
-two processes never share a checkpoint.
+``FILE.parquet.ckpt/`` holds ``manifest.json`` (the configuration and its SHA-256) and parts
+``part-NNNNNN.jsonl`` (JSON records, then ``#chaoscam-part n=COUNT sha256=HEX``), each moved
+into place whole (:func:`os.replace`); a damaged last part is recomputed, an earlier one
+refused. Floats round-trip exactly; the output's OS lock keeps a checkpoint to one process.
 """
 
 from __future__ import annotations
@@ -30,17 +21,9 @@ from typing import Any
 
 import pandas as pd
 
+from .._util import real
+from ..io import atomic_path, atomic_write_bytes, check_output, tmp_name, write_table
 from ._grid import SweepError
-
-__all__ = [
-    "MemoryStore",
-    "CheckpointStore",
-    "config_hash",
-    "checkpoint_dir",
-    "discard_checkpoint",
-    "remove_leftovers",
-    "write_parquet",
-]
 
 _META_KEY = b"chaoscam.sweep"
 
@@ -52,9 +35,7 @@ def config_hash(config: dict[str, Any]) -> str:
 
 
 def differences(saved: Any, config: dict[str, Any]) -> str:
-    """What sets a saved configuration apart from this run's, for the refusal message:
-    " (made by other chaoscam code: ...)" when only the code differs, else the differing
-    settings' names; "" when the saved one cannot be read."""
+    """What sets a saved configuration apart from this run's (the code, or the settings)."""
     if not isinstance(saved, dict):
         return ""
     keys = sorted(k for k in set(saved) | set(config) if saved.get(k) != config.get(k))
@@ -75,12 +56,6 @@ def checkpoint_dir(out: Path) -> Path:
     return out.with_name(out.name + ".ckpt")
 
 
-def _atomic_write(path: Path, data: bytes) -> None:
-    from ..io import atomic_write_bytes
-
-    atomic_write_bytes(path, data)
-
-
 _TRAILER = b"#chaoscam-part "
 _PART = re.compile(r"part-(\d{6,})\.jsonl")
 
@@ -97,11 +72,7 @@ def encode_part(records: list[dict[str, Any]]) -> bytes:
 
 
 def decode_part(data: bytes) -> list[dict[str, Any]]:
-    """The records of a part; :class:`DamagedPart` when it is torn or altered.
-
-    A part without a trailer (written before trailers existed) is accepted when every line
-    is a JSON object.
-    """
+    """The records of a part; :class:`DamagedPart` when torn or altered (no trailer: older)."""
     body, sep, trailer = data.rpartition(_TRAILER)
     if sep:
         fields = dict(
@@ -123,13 +94,8 @@ def decode_part(data: bytes) -> list[dict[str, Any]]:
 
 
 def remove_leftovers(path: Path) -> None:
-    """Finish what killed runs left beside ``path``: the ``.tmp-PID-NAME`` and
-    ``.tmp-PID-removed-NAME`` folders (a checkpoint being created, or being deleted by
-    :func:`discard_checkpoint`) and files (an output being written,
-    :func:`chaoscam._outputs.atomic_path`) of processes PID that no longer run.
-
-    Call it holding the output's lock; a leftover whose process still runs is left alone.
-    """
+    """Remove the ``.tmp-PID-...`` files and folders beside ``path`` of processes that no
+    longer run (a checkpoint or output being made or removed when killed)."""
     for left in path.parent.glob(f".tmp-*-{path.name}"):
         pid = left.name.split("-", 2)[1]
         if pid.isdigit() and not _running(int(pid)):
@@ -147,109 +113,55 @@ def _running(pid: int) -> bool:
     except ProcessLookupError:
         return False
     except PermissionError:  # another user's process
-        return True
+        pass
     return True
 
 
-def not_a_folder(path: Path) -> bool:
-    """Whether something other than a folder (a file, a dangling link) holds ``path``."""
-    return (path.is_symlink() and not path.exists()) or (path.exists() and not path.is_dir())
-
-
 def discard_checkpoint(path: Path) -> None:
-    """Delete a checkpoint folder: renamed away first, in one step, so a kill during the
-    deletion never leaves a half-deleted checkpoint that a later --resume would trip over
-    (the renamed folder it leaves is removed by the next run, :func:`remove_leftovers`).
-    A file or link where the folder belongs is removed as such."""
+    """Delete a checkpoint folder, renamed away first (a kill never leaves half of one)."""
     if not (path.exists() or path.is_symlink()):
         return
     if path.is_symlink() or not path.is_dir():
         path.unlink()
         return
-    gone = path.with_name(f".tmp-{os.getpid()}-removed-{path.name}")
+    gone = tmp_name(path, "removed")
     os.replace(path, gone)
     shutil.rmtree(gone, ignore_errors=True)
 
 
-class MemoryStore:
-    """Records kept in memory only (a run without an output file)."""
-
-    path: Path | None = None
-
-    def __init__(self) -> None:
-        self._records: list[dict[str, Any]] = []
-
-    def open(self) -> None:
-        pass
-
-    def restored(self) -> Iterator[dict[str, Any]]:
-        return iter(())
-
-    def add(self, record: dict[str, Any]) -> None:
-        self._records.append(record)
-
-    def maybe_flush(self) -> None:
-        pass
-
-    def flush(self) -> None:
-        pass
-
-    def records(self) -> Iterator[dict[str, Any]]:
-        return iter(self._records)
-
-    def remove(self) -> None:
-        self._records = []
-
-
 class CheckpointStore:
-    """Append-only part files under ``directory`` with a manifest of the configuration.
+    """A run's records: part files every ``flush_interval`` seconds (0: one per record) under
+    ``directory`` with a manifest of ``config``, or (``directory`` None) in memory only.
 
-    Parameters
-    ----------
-    directory : Path
-        The checkpoint folder (created if absent).
-    config : dict
-        The run's configuration; a folder made by another configuration is refused.
-    resume : bool
-        Continue the records already there. Without it an existing folder is refused, so
-        nothing is overwritten by accident.
-    flush_interval : float
-        Seconds between part files while records arrive [s]; 0 writes one part per record.
-        At most this much finished work is lost (and simply recomputed) when killed.
-    replaces : list of Path
-        The outputs this run was asked to replace (``--force``): the manifest records what
-        they are when it starts (:func:`file_identity`), so that a resume replaces those
-        files and no other made since (:func:`guard_outputs`).
+    An existing folder is refused without ``resume``, and of another configuration always.
+    ``replaces``: the outputs this run was asked to replace (``--force``), recorded as they
+    are now (:func:`file_identity`) so that a resume replaces them and no file made since.
     """
 
-    def __init__(
-        self,
-        directory: Path,
-        config: dict[str, Any],
-        *,
-        resume: bool,
-        flush_interval: float = 1.0,
-        replaces: tuple[Path, ...] = (),
-    ) -> None:
+    def __init__(self, directory: Path | None, config: dict[str, Any], *, resume: bool,
+                 flush_interval: float = 1.0, replaces: tuple[Path, ...] = ()) -> None:  # fmt: skip
         self._replaces = {p.name: file_identity(p) for p in replaces if p.exists()}
-        self.path = Path(directory)
+        self.path = None if directory is None else Path(directory)
         self.hash = config_hash(config)
         self.flush_interval = float(flush_interval)
         self._pending: list[dict[str, Any]] = []
         self._last = time.monotonic()
-        if not_a_folder(self.path):
+        self._config, self._seq = config, 0
+        if self.path is None:
+            return
+        if (self.path.is_symlink() and not self.path.exists()) or (
+            self.path.exists() and not self.path.is_dir()
+        ):
             raise FileExistsError(
                 f"{self.path} is a file where this run keeps its checkpoint folder: move it "
                 "away, or pass --force (force=True in Python) to replace it"
             )
-        if self.path.exists():
-            if not resume:
-                raise FileExistsError(
-                    f"{self.path} holds the checkpoint of an interrupted run: run the same "
-                    "command with --resume to finish it, or pass --force (force=True in Python) to "
-                    "start over"
-                )
-        self._config = config
+        if self.path.exists() and not resume:
+            raise FileExistsError(
+                f"{self.path} holds the checkpoint of an interrupted run: run the same "
+                "command with --resume to finish it, or pass --force (force=True in Python) to "
+                "start over"
+            )
         if self.path.exists():
             self._check_manifest()
             for tmp in self.path.glob(".tmp-*"):
@@ -258,15 +170,13 @@ class CheckpointStore:
 
     def open(self) -> None:
         """Create the folder and its manifest if absent (when the run starts)."""
-        if not self.path.exists():
-            self._create(self._config)
-
-    def _create(self, config: dict[str, Any]) -> None:
-        tmp = self.path.with_name(f".tmp-{os.getpid()}-{self.path.name}")
+        if self.path is None or self.path.exists():
+            return
+        tmp = tmp_name(self.path)
         shutil.rmtree(tmp, ignore_errors=True)
         tmp.mkdir(parents=True)
-        manifest = {"hash": self.hash, "config": config, "replaces": self._replaces}
-        _atomic_write(tmp / "manifest.json", json.dumps(manifest, indent=1).encode())
+        manifest = {"hash": self.hash, "config": self._config, "replaces": self._replaces}
+        atomic_write_bytes(tmp / "manifest.json", json.dumps(manifest, indent=1).encode())
         os.replace(tmp, self.path)
 
     def _check_manifest(self) -> None:
@@ -287,17 +197,12 @@ class CheckpointStore:
             )
 
     def _parts(self) -> list[Path]:
-        if not self.path.is_dir():
+        if self.path is None or not self.path.is_dir():
             return []
         return sorted(p for p in self.path.glob("part-*.jsonl") if _PART.fullmatch(p.name))
 
     def restored(self) -> Iterator[dict[str, Any]]:
-        """The records already checkpointed, part by part (streamed, not all in memory).
-
-        A damaged last part (torn by a kill at the wrong moment, a full disk) is removed
-        with a one-line notice on stderr; its records are simply computed again. A damaged
-        part before the last is refused: a :class:`SweepError` says what to do.
-        """
+        """The records checkpointed; a damaged last part is dropped, an earlier one refused."""
         parts = self._parts()
         for i, part in enumerate(parts):
             try:
@@ -309,13 +214,9 @@ class CheckpointStore:
                         f"file to compute its records again, or delete {self.path} to start "
                         "over"
                     ) from None
-                os.replace(part, part.with_name(f".tmp-{os.getpid()}-damaged-{part.name}"))
-                print(
-                    f"chaoscam: notice: {part.name} in {self.path} was torn ({err}); "
-                    "dropped, its runs are computed again",
-                    file=sys.stderr,
-                    flush=True,
-                )
+                os.replace(part, tmp_name(part, "damaged"))
+                print(f"chaoscam: notice: {part.name} in {self.path} was torn ({err}); dropped, "
+                      "its runs are computed again", file=sys.stderr, flush=True)  # fmt: skip
                 return
             yield from records
 
@@ -329,10 +230,10 @@ class CheckpointStore:
     def flush(self) -> None:
         """Write the pending records as one new part file, atomically."""
         self._last = time.monotonic()
-        if not self._pending:
+        if not self._pending or self.path is None:
             return
         self.open()
-        _atomic_write(self.path / f"part-{self._seq:06d}.jsonl", encode_part(self._pending))
+        atomic_write_bytes(self.path / f"part-{self._seq:06d}.jsonl", encode_part(self._pending))
         self._seq += 1
         self._pending = []
 
@@ -342,35 +243,26 @@ class CheckpointStore:
         yield from self._pending
 
     def remove(self) -> None:
-        """Delete the folder (after the final table is safely written).
-
-        It is first renamed away in one step, so a kill during the deletion never leaves a
-        half-deleted checkpoint that a later --resume would trip over.
-        """
-        discard_checkpoint(self.path)
+        """Delete the folder (after the final table is safely written)."""
+        if self.path is not None:
+            discard_checkpoint(self.path)
 
 
 def write_parquet(
     frame: pd.DataFrame, path: Path, config: dict[str, Any], *, replace: bool = True
 ) -> None:
-    """Write ``frame`` atomically, with the configuration and its hash as file metadata
-    (``replace=False``: never over a file that exists; :func:`chaoscam._outputs.atomic_path`)."""
+    """Write ``frame`` atomically with the configuration and its hash as file metadata."""
     import pyarrow as pa
-
-    from ..io import write_table
 
     table = pa.Table.from_pandas(frame, preserve_index=False)
     meta = dict(table.schema.metadata or {})
     meta[_META_KEY] = json.dumps({"hash": config_hash(config), "config": config}).encode()
-    from ..io import atomic_path
-
     with atomic_path(path, replace=replace) as tmp:
         write_table(table.replace_schema_metadata(meta), tmp)
 
 
 def read_sweep_metadata(path: Path) -> dict[str, Any] | None:
-    """The configuration record of a sweep output, or None if it has none (or is not a
-    readable parquet file, or its record is damaged)."""
+    """The configuration record of a sweep output; None without a readable one."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -383,21 +275,20 @@ def read_sweep_metadata(path: Path) -> dict[str, Any] | None:
 
 
 def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> bool:
-    """Check the output files before any work; True when a finished run can be reused.
-
-    Without ``resume`` an existing output is refused (nothing is overwritten). With it, a
-    finished output of the same configuration is reused as is; one of another configuration
-    is refused, unless the checkpoint beside it is this configuration's: a ``--force`` run
-    over that output was interrupted, and its resume finishes it (replacing the output, as
-    the ``--force`` asked). Only the file that run found there is replaced: one made since
-    (another command writing the free name after the interruption) is refused.
-    """
+    """Check the outputs before any work; True when a finished run can be reused. Without
+    ``resume`` an existing output is refused; with it, one of the same configuration is
+    reused, one of another refused unless the checkpoint beside it is this configuration's
+    (an interrupted ``--force`` run, whose resume replaces the file it found, no other)."""
     existing = [p for p in outputs if p.exists()]
     if not existing:
         return False
-    ours = _checkpoint_hash(checkpoint_dir(outputs[0])) == config_hash(config)
+    try:
+        manifest = _read_manifest(checkpoint_dir(outputs[0]))
+    except (OSError, ValueError):
+        manifest = {}
+    ours = manifest.get("hash") == config_hash(config)
     if ours:
-        _check_replaced(checkpoint_dir(outputs[0]), existing, config)
+        _check_replaced(manifest, existing, config)
     if not outputs[0].exists() and not ours:
         # A companion without its main table: nothing to finish or reuse.
         raise FileExistsError(
@@ -437,20 +328,17 @@ def file_identity(path: Path) -> list[int]:
 
 
 def _read_manifest(directory: Path) -> dict[str, Any]:
-    """A checkpoint's ``manifest.json``; OSError or ValueError when it cannot be read or is
-    not a JSON object."""
+    """A checkpoint's ``manifest.json``; OSError or ValueError when it is not a JSON object."""
     manifest = json.loads((directory / "manifest.json").read_text())
     if not isinstance(manifest, dict):
         raise ValueError(f"a JSON {type(manifest).__name__}, not an object")
     return manifest
 
 
-def _check_replaced(directory: Path, existing: list[Path], config: dict[str, Any]) -> None:
-    """Refuse an output beside this configuration's checkpoint that is neither this
-    configuration's (a finished table) nor a file the interrupted run was asked to replace
-    (``--force``: recorded in its manifest as it was then): one made since would be
-    overwritten silently by the resume."""
-    replaces = _read_manifest(directory).get("replaces") or {}
+def _check_replaced(manifest: dict, existing: list[Path], config: dict[str, Any]) -> None:
+    """Refuse an output the resume would overwrite: neither this configuration's table nor
+    the file the interrupted ``--force`` run recorded."""
+    replaces = manifest.get("replaces") or {}
     for path in existing:
         meta = read_sweep_metadata(path)
         if meta is not None and meta.get("hash") == config_hash(config):
@@ -463,9 +351,23 @@ def _check_replaced(directory: Path, existing: list[Path], config: dict[str, Any
             )
 
 
-def _checkpoint_hash(directory: Path) -> str | None:
-    """The configuration hash in a checkpoint's manifest; None without a readable one."""
-    try:
-        return _read_manifest(directory).get("hash")
-    except (OSError, ValueError):
-        return None
+def open_store(outputs: list[Path] | None, config, resume: bool, flush_interval, force: bool):
+    """(the run's record store, whether a finished output is reused), under the outputs'
+    lock; ``force`` discards a checkpoint and replaces the outputs."""
+    flush_interval = real("flush_interval", flush_interval, low=0.0, unit="s")
+    if outputs is None:
+        return CheckpointStore(None, config, resume=False), False
+    if outputs[0].suffix != ".parquet":
+        raise SweepError(f"--out {outputs[0]}: the output must be a .parquet file")
+    for path in outputs:
+        check_output(path, force=True)  # the folder and the path; existence is below
+    ckpt = checkpoint_dir(outputs[0])
+    for path in (ckpt, *outputs):  # of a run killed while it made or removed them
+        remove_leftovers(path)
+    if force and not resume:
+        discard_checkpoint(ckpt)
+    elif guard_outputs(outputs, config, resume):
+        return None, True
+    store = CheckpointStore(ckpt, config, resume=resume, flush_interval=flush_interval,
+                            replaces=tuple(outputs) if force else ())  # fmt: skip
+    return store, False
