@@ -5,11 +5,9 @@ Everything here takes numpy arrays; nothing imports the model, the kernels or th
 
 from ._birkhoff import BirkhoffResult, birkhoff_weights, weighted_birkhoff
 from ._classify import classify_signal
-from ._classify_section import classify_section
-from ._evidence import zero_one_evidence
-from ._exponent import as_exponent, exponent_evidence
+from ._classify_section import SECTION_OPTIONS, check_options, classify_section, section_options
+from ._evidence import as_exponent, exponent_evidence, zero_one_evidence
 from ._lyapunov_series import DoubtfulEstimateWarning, SeriesLyapunovResult, lyapunov_from_series
-from ._options import SECTION_OPTIONS, check_options, section_options
 from ._periodicity import PeriodResult, RotationResult, embed_angles, rotation_order, section_period
 from ._saltation import saltation_matrix
 from ._sections import crossing_section, local_maxima

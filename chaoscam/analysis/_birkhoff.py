@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._periodicity import _curve_angles
 from ._validate import as_points, check_settings
 
 __all__ = ["BirkhoffResult", "birkhoff_weights", "weighted_birkhoff"]
@@ -33,45 +34,30 @@ def birkhoff_weights(n: int) -> np.ndarray:
 class BirkhoffResult:
     """Result of `weighted_birkhoff`.
 
-    Attributes
-    ----------
-    digits : float
-        Converged digits, the smallest over the observables (see `digits_by_observable`);
-        NaN when too few points.
-    digits_by_observable : dict
-        ``-log10(|WB_h(f)(x_0) - WB_h(f)(x_h)| / range(f))`` for each observable f, named
-        "x0", "x1", ... (the coordinates), "cos", "sin" (of the angle about the centroid)
-        and "turn" (the angle increment, in turns). At most 16 (double precision).
-    rotation_number : float
-        Weighted Birkhoff average of the angle increment about the centroid, in turns,
-        in [0, 1): the rotation number of the orbit along its curve (or 1 minus it when
-        the plane of the curve is seen from the other side, d > 2). NaN for d = 1.
-    n : int
-        Points used, ``2 h + 1`` (two averages of h points, h increments each).
-    message : str
-        Why nothing was computed (too few points), else empty.
-    settings : dict
-        The weight function and the half length h used.
+    ``digits_by_observable`` holds ``-log10(|WB_h(f)(x_0) - WB_h(f)(x_h)| / range(f))``
+    (at most 16) for each observable f: "x0", "x1", ... (the coordinates), "cos", "sin"
+    (of the angle about the centroid) and "turn" (the angle increment, in turns);
+    ``digits`` is the smallest of them (NaN on too few points). ``rotation_number`` is the
+    weighted average of the turn, in [0, 1) (1 minus it when the plane of the curve is
+    seen from the other side, d > 2; NaN for d = 1).
     """
 
     digits: float
     digits_by_observable: dict
     rotation_number: float
-    n: int
-    message: str = ""
-    settings: dict = field(default_factory=dict)
+    n: int  # points used, 2 h + 1 (two averages of h points, h increments each)
+    message: str = ""  # why nothing was computed (too few points), else empty
+    settings: dict = field(default_factory=dict)  # the weight function and h
 
 
 def _plane_angles(x: np.ndarray) -> np.ndarray:
     """Angle of each point about the centroid (d = 2: axes scaled by their spread, which
     keeps the orientation of (x0, x1); d > 2: the plane of the two principal axes)."""
+    if x.shape[1] > 2:
+        return _curve_angles(x)
     c = x - x.mean(axis=0)
-    if x.shape[1] == 2:
-        s = c.std(axis=0)
-        u = c / np.where(s > 0, s, 1.0)
-    else:
-        _, s, vt = np.linalg.svd(c, full_matrices=False)
-        u = (c @ vt[:2].T) / np.where(s[:2] > 0, s[:2], 1.0)
+    s = c.std(axis=0)
+    u = c / np.where(s > 0, s, 1.0)
     return np.arctan2(u[:, 1], u[:, 0])
 
 

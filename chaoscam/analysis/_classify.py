@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 import numpy as np
 
-from ._classify_section import classify_section
-from ._evidence import lyapunov_evidence, safe, section_evidence, zero_one_evidence
-from ._exponent import as_exponent, exponent_evidence
+from ._evidence import exponent_votes, safe, section_evidence, zero_one_evidence
 from ._lyapunov_series import lyapunov_from_series
 from ._sections import local_maxima
 from ._spectrum import check_spectrum_options, spectrum_analysis
@@ -16,7 +15,10 @@ from ._thresholds import Thresholds, resolve
 from ._validate import MIN_SERIES, as_points, as_series, check_atol, check_settings
 from ._verdict import Evidence, Verdict, combine
 
-__all__ = ["classify_section", "classify_signal"]
+__all__ = ["classify_signal"]
+
+_SPECTRUM_VOTES = {"periodic": "periodic", "quasiperiodic": "quasiperiodic",
+                   "broadband": "chaotic", "aperiodic": "not_periodic"}  # fmt: skip
 
 
 def _zero_one_signal(x, dt, forcing_period, seed, per_period, line_freq, thr):
@@ -63,23 +65,10 @@ def _check_signal_settings(given: dict) -> int:
     """classify_signal's settings in their ranges, before any evidence is gathered (an
     evidence function that raises is reported as failed evidence, not as an error); returns
     the 0-1 test's samples per forcing period (default 4, at most the signal's own)."""
-    check_settings(
-        "classify_signal",
-        **{
-            name: (given[name], rule)
-            for name, rule in (
-                ("dt", "real>0"),
-                ("forcing_period", "real>0?"),
-                ("lyapunov", "number?"),
-                ("lyapunov_tol", "real>=0?"),
-                ("max_period", "int>=1?"),
-                ("min_points_aperiodic", "int>=1?"),
-                ("zero_one_per_period", "int>=1?"),
-                ("seed", "int>=0"),
-                ("exponent_time", "real>0"),
-            )
-        },
-    )
+    rules = dict(dt="real>0", forcing_period="real>0?", lyapunov="number?",
+                 lyapunov_tol="real>=0?", max_period="int>=1?", min_points_aperiodic="int>=1?",
+                 zero_one_per_period="int>=1?", seed="int>=0", exponent_time="real>0")  # fmt: skip
+    check_settings("classify_signal", **{k: (given[k], rule) for k, rule in rules.items()})
     per_period, forcing_period = given["zero_one_per_period"], given["forcing_period"]
     most = 4 if forcing_period is None else max(1, round(forcing_period / given["dt"]))
     if per_period is not None and forcing_period is not None and per_period > most:
@@ -94,6 +83,37 @@ def _check_signal_settings(given: dict) -> int:
         raise TypeError("classify_signal: the spectrum's forcing_frequency is 1 / forcing_period")
     check_spectrum_options("classify_signal: spectrum_options", options or {})
     return min(4, most) if per_period is None else per_period
+
+
+def _spectrum_evidence(spec) -> Evidence:
+    """The spectrum's vote: its line model's, the residual fraction as the value."""
+    if spec.model not in _SPECTRUM_VOTES:
+        return Evidence("spectrum", None, None, spec.message)
+    bases = ", ".join(f"{f:.5g}" for f in spec.base_frequencies)
+    txt = (
+        f"{spec.model}: line model holds {spec.line_fraction:.6f} of the power "
+        f"(bases {bases} Hz; spectral entropy {spec.spectral_entropy:.3f})"
+    )
+    return Evidence("spectrum", spec.residual_fraction, _SPECTRUM_VOTES[spec.model], txt)
+
+
+def _series_evidence(x, dt, t_char, thr: Thresholds) -> Evidence:
+    """Rosenstein's λ₁ from the signal, voting only when not doubtful (λ₁ T against
+    ``series_chaotic`` and ``series_regular``, T the characteristic period)."""
+    res, failed = safe("lyapunov_series", lyapunov_from_series, x, dt, warn=False)
+    if failed:
+        return failed
+    if res.doubtful or t_char is None:
+        why = "; ".join(res.reasons) or "no time scale"
+        txt = f"Rosenstein λ₁ = {res.exponent:.4g}, doubtful: {why}"
+        return Evidence("lyapunov_series", res.exponent, None, txt)
+    lt = res.exponent * t_char
+    txt = f"Rosenstein λ₁ = {res.exponent:.4g} (λ₁ T = {lt:.3f})"
+    if lt > thr.series_chaotic:
+        return Evidence("lyapunov_series", res.exponent, "chaotic", txt)
+    if abs(lt) < thr.series_regular:
+        return Evidence("lyapunov_series", res.exponent, "not_chaotic", txt)
+    return Evidence("lyapunov_series", res.exponent, None, txt + ": inconclusive")
 
 
 def classify_signal(
@@ -126,20 +146,18 @@ def classify_signal(
       comb votes periodic (the period in forcing periods when forced), two incommensurate
       bases quasiperiodic, a broadband fraction >= 1 % chaotic, a smaller unexplained
       remainder "not_periodic".
-    * ``zero_one`` (`zero_one_test`, voting where `zero_one_evidence` finds it valid) on a
-      map-like sequence, never the oversampled signal: forced, the signal interpolated
-      `zero_one_per_period` times per forcing period less its forcing-synchronous mean;
-      unforced, the successive `local_maxima`. A sequence with nothing left is K = 0. A
-      chaotic K is not used when a line spectrum's slowest base spans more than
-      N / (10 · zero_one_line_periods) samples: a long period mimics diffusion (a period-8
-      cam response sampled 4 times per forcing period over 20 s gives K ≈ 0.9).
-    * the section evidence of `classify_section` for `section` (names prefixed ``section_``).
-    * ``exponent``: a largest exponent with its standard error (`exponent_evidence`).
-    * ``lyapunov``: a largest exponent per unit time computed elsewhere: > `lyapunov_tol`
-      chaotic, else not chaotic.
-    * ``lyapunov_series`` (`series_lyapunov`): Rosenstein's estimate from the signal
-      (`lyapunov_from_series`), voting only when not doubtful: chaotic when λ T >
-      series_chaotic, not chaotic when |λ T| < series_regular, T the characteristic period.
+    * ``zero_one`` (`zero_one_evidence`) on a map-like sequence, never the oversampled
+      signal: forced, the signal interpolated `zero_one_per_period` times per forcing
+      period less its forcing-synchronous mean; unforced, the successive `local_maxima`. A
+      sequence with nothing left is K = 0. A chaotic K is not used when a line spectrum's
+      slowest base spans more than N / (10 · zero_one_line_periods) samples: a long period
+      mimics diffusion (a period-8 cam response sampled 4 times per forcing period over
+      20 s gives K ≈ 0.9).
+    * the evidence of `classify_section` for `section` (names prefixed ``section_``), and
+      ``exponent`` and ``lyapunov`` as there (`lyapunov` per unit time).
+    * ``lyapunov_series`` (`series_lyapunov`): Rosenstein's estimate (`lyapunov_from_series`),
+      voting only when not doubtful: chaotic when λ T > series_chaotic, not chaotic when
+      |λ T| < series_regular, T the characteristic period.
 
     The votes are combined by `combine`. The period comes from the section when given, else
     from the spectrum of a forced signal; an unforced periodic signal without section gets
@@ -160,8 +178,8 @@ def classify_signal(
     lyapunov_tol : float, optional
         |λ₁| [1/s] below this counts as zero; default ``signal_lyapunov_tol / T``, T the
         forcing period, else the fundamental period of the spectrum.
-    angle_periods, rtol, atol, max_period, min_points_aperiodic
-        Passed to the section analysis (see `classify_section`).
+    angle_periods, rtol, atol, max_period, min_points_aperiodic, thresholds, seed
+        As for `classify_section`.
     series_lyapunov : bool
         Also estimate λ₁ from the signal with nolds (~0.2–0.5 s more).
     zero_one_per_period : int, optional
@@ -169,16 +187,8 @@ def classify_signal(
         signal's own; default 4, or the signal's own when it has fewer.
     spectrum_options : dict, optional
         Extra keyword arguments of `spectrum_analysis`.
-    seed : int
-        Seed of the 0–1 test's c values.
-    thresholds : Thresholds, optional
-        The decision thresholds (default `Thresholds()`), recorded in
-        ``settings["thresholds"]``; `rtol` and `min_points_aperiodic` override their entries.
-    exponent : float, (float, float), (float, float, int) or object, optional
-        A largest exponent with its standard error; see `as_exponent`.
-    exponent_time : float
-        Multiplies λ and its error to make them per forcing period (the forcing period [s]
-        for an exponent in 1/s).
+    exponent, exponent_time
+        As for `classify_section`; `exponent_time` makes λ per forcing period.
 
     Returns
     -------
@@ -192,11 +202,10 @@ def classify_signal(
     Notes
     -----
     A constant signal is an equilibrium, not an oscillation: "undetermined" (even where
-    constant section points would say period 1).
-
-    Limits: with ~20 s of a cam signal (~90 forcing periods) the 0–1 test runs on ~360
-    samples and the spectrum resolves subharmonics up to order 9: a periodic call is solid,
-    a quasiperiodic versus chaotic call rests on the spectrum and the 0–1 test agreeing.
+    constant section points would say period 1). Limits: with ~20 s of a cam signal (~90
+    forcing periods) the 0–1 test runs on ~360 samples and the spectrum resolves
+    subharmonics up to order 9: a periodic call is solid, a quasiperiodic versus chaotic
+    call rests on the spectrum and the 0–1 test agreeing.
     """
     x = as_series(x, min_size=MIN_SERIES)
     zero_one_per_period = _check_signal_settings(locals())
@@ -225,48 +234,27 @@ def classify_signal(
     ev: list[Evidence] = []
     periods: dict[str, int] = {}
     reasons: list[str] = []
-
-    # --- spectrum
     f_force = None if forcing_period is None else 1.0 / forcing_period
     spec, failed = safe(
         "spectrum", spectrum_analysis, x, dt, forcing_frequency=f_force, **(spectrum_options or {})
     )
-    t_char = forcing_period
+    t_char, line_freq = forcing_period, None
     if failed:
         ev.append(failed)
     else:
         settings["broadband_tol"] = spec.settings["broadband_tol"]
-        bases = ", ".join(f"{f:.5g}" for f in spec.base_frequencies)
-        txt = (
-            f"{spec.model}: line model holds {spec.line_fraction:.6f} of the power "
-            f"(bases {bases} Hz; spectral entropy {spec.spectral_entropy:.3f})"
-        )
-        resid = spec.residual_fraction
-        if spec.model == "periodic":
-            ev.append(Evidence("spectrum", resid, "periodic", txt))
-            if spec.period is not None:
-                periods["spectrum"] = spec.period
-        elif spec.model == "quasiperiodic":
-            ev.append(Evidence("spectrum", resid, "quasiperiodic", txt))
-        elif spec.model == "broadband":
-            ev.append(Evidence("spectrum", resid, "chaotic", txt))
-        elif spec.model == "aperiodic":
-            ev.append(Evidence("spectrum", resid, "not_periodic", txt))
-        else:
-            ev.append(Evidence("spectrum", None, None, spec.message))
+        ev.append(_spectrum_evidence(spec))
+        if spec.model == "periodic" and spec.period is not None:
+            periods["spectrum"] = spec.period
+        if spec.model not in _SPECTRUM_VOTES:
             reasons.append(f"spectrum: {spec.message}")
         if t_char is None and spec.base_frequencies and spec.base_frequencies[0] > 0:
             t_char = 1.0 / spec.base_frequencies[0]
-    line_freq = None
-    if not failed and spec.model in ("periodic", "quasiperiodic"):
-        line_freq = min(spec.base_frequencies)
-
-    # --- 0-1 test
+        if spec.model in ("periodic", "quasiperiodic"):
+            line_freq = min(spec.base_frequencies)
     e01, failed = safe("zero_one", _zero_one_signal, x, dt, forcing_period, seed,
                        int(zero_one_per_period), line_freq, thr)  # fmt: skip
     ev.append(failed or e01)
-
-    # --- section
     if section is not None:
         sev, speriods, sreasons = section_evidence(section, thr, angle_periods=angle_periods,
                                                    atol=atol, max_period=max_period,
@@ -274,37 +262,12 @@ def classify_signal(
         ev.extend(sev)
         periods.update(speriods)
         reasons.extend(sreasons)
-
-    # --- Lyapunov exponents
-    if exponent is not None:  # with its confidence interval, per forcing period
-        lam, se, n_int = as_exponent(exponent, exponent_time)
-        ev.append(exponent_evidence(lam, se, n_int, thresholds=thr))
     tol = lyapunov_tol
     if tol is None and t_char is not None:
         tol = thr.signal_lyapunov_tol / t_char
-    if lyapunov is not None:
-        if tol is None:
-            why = "no time scale to judge λ₁ against: pass lyapunov_tol"
-            ev.append(Evidence("lyapunov", float(lyapunov), None, why))
-        else:
-            ev.append(lyapunov_evidence(lyapunov, tol, "per unit time"))
+    ev += exponent_votes(thr, exponent, exponent_time, lyapunov, tol, "per unit time")[0]
     if series_lyapunov:
-        res, failed = safe("lyapunov_series", lyapunov_from_series, x, dt, warn=False)
-        if failed:
-            ev.append(failed)
-        elif res.doubtful or t_char is None:
-            why = "; ".join(res.reasons) or "no time scale"
-            txt = f"Rosenstein λ₁ = {res.exponent:.4g}, doubtful: {why}"
-            ev.append(Evidence("lyapunov_series", res.exponent, None, txt))
-        else:
-            lt = res.exponent * t_char
-            txt = f"Rosenstein λ₁ = {res.exponent:.4g} (λ₁ T = {lt:.3f})"
-            if lt > thr.series_chaotic:
-                ev.append(Evidence("lyapunov_series", res.exponent, "chaotic", txt))
-            elif abs(lt) < thr.series_regular:
-                ev.append(Evidence("lyapunov_series", res.exponent, "not_chaotic", txt))
-            else:
-                ev.append(Evidence("lyapunov_series", res.exponent, None, txt + ": inconclusive"))
+        ev.append(_series_evidence(x, dt, t_char, thr))
     settings["lyapunov_tol_used"] = tol
     verdict = combine(ev, periods, reasons, settings)
     if verdict.label == "periodic" and forcing_period is None and section is None:
@@ -312,6 +275,5 @@ def classify_signal(
             "no forcing period and no section: the period is counted in periods of the "
             "signal's own fundamental (1)"
         )
-        v = verdict
-        verdict = Verdict(v.label, 1, v.evidence, (*v.reasons, note), v.settings)
+        verdict = dataclasses.replace(verdict, period=1, reasons=(*verdict.reasons, note))
     return verdict

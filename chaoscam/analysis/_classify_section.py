@@ -1,23 +1,25 @@
-"""Classify map iterates or Poincaré-section points into a `Verdict`."""
+"""Classify map iterates or Poincaré-section points into a `Verdict`; the options a model
+verdict may pass through to it."""
 
 from __future__ import annotations
 
+import dataclasses
+import inspect
 import math
 from collections.abc import Sequence
 
-from ._evidence import lyapunov_evidence, section_evidence
-from ._exponent import as_exponent, exponent_evidence
+from ._evidence import exponent_votes, section_evidence
 from ._thresholds import Thresholds, resolve
 from ._validate import as_points, check_atol, check_settings
 from ._verdict import Verdict, combine
 
-__all__ = ["classify_section"]
+__all__ = ["SECTION_OPTIONS", "check_options", "classify_section", "section_options"]
 
 _DECISIVE = ("exponent", "lyapunov")
 
 
 def _undetermined(v: Verdict, reason: str) -> Verdict:
-    return Verdict("undetermined", None, v.evidence, (*v.reasons, reason), v.settings)
+    return dataclasses.replace(v, label="undetermined", period=None, reasons=(*v.reasons, reason))
 
 
 def unsupported_chaos(evidence, need: int) -> list[str] | None:
@@ -67,9 +69,7 @@ def _decide(
     elif expo is not None and expo.vote is None:
         todo.append("run the exponent longer (see its evidence)")
     if todo:
-        v = Verdict(
-            v.label, None, v.evidence, (*v.reasons, "to decide: " + "; ".join(todo)), v.settings
-        )
+        v = _undetermined(v, "to decide: " + "; ".join(todo))
     return v
 
 
@@ -91,29 +91,24 @@ def classify_section(
 ) -> Verdict:
     """Classify map iterates or Poincaré-section points as periodic, quasiperiodic or chaotic.
 
-    Evidence gathered (each an `Evidence` in the verdict; `Thresholds` holds every number):
+    Evidence gathered (`Thresholds` holds every number):
 
-    * ``section_period`` — bands at a fixed lag (`section_period`): periodic with the
-      smallest lag n whose n bands are each narrower than ``max(atol, period_rtol ·
-      extent)``; otherwise "not_periodic", unless the points have not settled (spread of
-      the second half over the first outside [stationary_low, stationary_high]: abstains).
-      On a periodic section the expansion, Birkhoff and 0–1 tests abstain (only jitter is
-      left).
-    * ``section_rotation`` — rank-shift consistency R (`rotation_order`): R >=
-      rotation_quasi votes quasiperiodic.
-    * ``section_birkhoff`` — converged digits of weighted Birkhoff averages
-      (`weighted_birkhoff`, N >= birkhoff_min_points): >= birkhoff_quasi_digits votes
-      quasiperiodic, unless the rotation number is within birkhoff_rational_tol of p/q.
-    * ``section_expansion`` — mean one-step log growth of nearest-neighbour distances
-      beyond the noise floor (`neighbour_expansion`): > expansion_chaotic votes chaotic.
-    * ``section_dimension`` — correlation dimension (d >= 2, N >= dimension_min_points):
+    * ``section_period`` (`section_period`): periodic with the smallest lag n whose n bands
+      are each narrower than ``max(atol, period_rtol · extent)``, else "not_periodic"; it
+      abstains while the points have not settled (spread of the second half over the first
+      outside [stationary_low, stationary_high]). On a periodic section the expansion,
+      Birkhoff and 0–1 tests abstain (only jitter is left).
+    * ``section_rotation`` (`rotation_order`): R >= rotation_quasi votes quasiperiodic.
+    * ``section_birkhoff`` (`weighted_birkhoff`, N >= birkhoff_min_points): converged digits
+      >= birkhoff_quasi_digits vote quasiperiodic, unless the rotation number is within
+      birkhoff_rational_tol of a p/q.
+    * ``section_expansion`` (`neighbour_expansion` beyond the noise floor): > expansion_chaotic
+      votes chaotic.
+    * ``section_dimension`` (`correlation_dimension`, d >= 2, N >= dimension_min_points):
       >= dimension_chaotic votes chaotic (not a curve).
-    * ``section_zero_one`` — 0–1 test on the first coordinate, where valid
-      (`zero_one_evidence`).
-    * ``exponent`` — a largest exponent with its standard error (`exponent_evidence`):
-      chaotic when its confidence interval lies above exponent_zero, not chaotic when
-      below (always for -inf), else abstains with the run length that would decide.
-    * ``lyapunov`` — a bare exponent per iterate: > `lyapunov_tol` chaotic, else not.
+    * ``section_zero_one``: the 0–1 test on the first coordinate (`zero_one_evidence`).
+    * ``exponent`` (`exponent_evidence`): a largest exponent judged by its confidence interval.
+    * ``lyapunov``: a bare exponent per iterate, > `lyapunov_tol` chaotic, else not.
 
     The votes are combined by `combine`; then a chaotic label needs a chaotic exponent or
     at least min_chaotic_votes chaotic votes, and a quasiperiodic label with a negative
@@ -129,20 +124,17 @@ def classify_section(
     lyapunov_tol : float
         |λ₁| below this counts as zero (for `lyapunov` only).
     exponent : float, (float, float), (float, float, int) or object, optional
-        Largest exponent with its standard error (e.g. the model's tangent exponent; the
-        forms are those of `as_exponent`). λ = -inf (a zero Floquet multiplier) is
-        decisively not chaotic.
+        Largest exponent with its standard error (the forms of `as_exponent`), e.g. the
+        model's tangent exponent; λ = -inf (a zero Floquet multiplier) is not chaotic.
     exponent_time : float
         Multiplies λ and stderr to give them per iterate (the forcing period T for an
-        exponent in 1/s and a stroboscopic section); 1 when they already are.
+        exponent in 1/s and a stroboscopic section).
     angle_periods : sequence of float or None, optional
         Period of each angular coordinate (None for ordinary ones), see `embed_angles`.
-    rtol : float, optional
-        Overrides `Thresholds.period_rtol`.
+    rtol, min_points_aperiodic : optional
+        Override `Thresholds.period_rtol` and `Thresholds.min_points_aperiodic`.
     atol, max_period
         Passed to `section_period` (atol in the units of the embedded points).
-    min_points_aperiodic : int, optional
-        Overrides `Thresholds.min_points_aperiodic`.
     zero_one : bool
         Run the 0–1 test.
     seed : int
@@ -162,12 +154,10 @@ def classify_section(
 
     Notes
     -----
-    A set of identical points is a fixed point of the section map: periodic with period 1
-    (for a stroboscopic section, a response with the forcing's period). Fewer than 8
-    points: "undetermined".
-
-    Limits: with the ~90 points of a 20 s cam run a period is called reliably, but only
-    the exponent separates quasiperiodic from chaotic.
+    Identical points are a fixed point of the section map: periodic with period 1 (for a
+    stroboscopic section, a response with the forcing's period). Fewer than 8 points:
+    "undetermined". Limits: with the ~90 points of a 20 s cam run a period is called
+    reliably, but only the exponent separates quasiperiodic from chaotic.
     """
     x = as_points(points)
     check_atol("classify_section", atol, x.shape[1])
@@ -196,14 +186,35 @@ def classify_section(
     ev, periods, reasons = section_evidence(x, thr, angle_periods=angle_periods, atol=atol,
                                             max_period=max_period, zero_one=zero_one,
                                             seed=seed)  # fmt: skip
-    upper = math.nan
-    if exponent is not None:
-        lam, se, n_int = as_exponent(exponent, exponent_time)
-        upper = lam + thr.exponent_z * se
-        settings["exponent"] = dict(exponent=lam, stderr=se, n_intervals=n_int)
-        ev.append(exponent_evidence(lam, se, n_int, thresholds=thr))
-    if lyapunov is not None:
-        ev.append(lyapunov_evidence(lyapunov, lyapunov_tol, "per iterate"))
-    verdict = combine(ev, periods, reasons, settings)
+    votes, expo = exponent_votes(thr, exponent, exponent_time, lyapunov, lyapunov_tol,
+                                 "per iterate")  # fmt: skip
+    if expo is not None:
+        settings["exponent"] = expo
+    upper = math.nan if expo is None else expo["exponent"] + thr.exponent_z * expo["stderr"]
+    verdict = combine(ev + votes, periods, reasons, settings)
     given = exponent is not None or lyapunov is not None
     return _decide(verdict, x.shape[0], thr, zero_one, given, upper)
+
+
+_BUILT_BY_THE_CALLER = {"points", "lyapunov", "lyapunov_tol", "exponent", "exponent_time"}
+
+SECTION_OPTIONS = frozenset(inspect.signature(classify_section).parameters) - _BUILT_BY_THE_CALLER
+"""What a model verdict (:func:`chaoscam.classify`) may pass through to `classify_section`:
+its settings less the inputs the verdict builds itself (the points, the tangent exponent)."""
+
+
+def check_options(options: dict, caller: str) -> None:
+    """Refuse (TypeError) an option :func:`classify_section` does not take here, naming the
+    ones it does, and (ValueError) a bad ``atol`` (two coordinates)."""
+    check_atol(caller, options.get("atol"), 2)
+    unknown = sorted(set(options) - SECTION_OPTIONS)
+    if unknown:
+        raise TypeError(
+            f"{caller} got an unknown option {unknown[0]!r}; the options are "
+            f"classify_section's: {', '.join(sorted(SECTION_OPTIONS))}"
+        )
+
+
+def section_options(options: dict) -> dict:
+    """``options`` less those :func:`classify_section` does not take."""
+    return {k: v for k, v in options.items() if k in SECTION_OPTIONS}

@@ -11,9 +11,11 @@ from ._birkhoff import weighted_birkhoff
 from ._periodicity import _floor, embed_angles, rotation_order, section_period
 from ._set_measures import correlation_dimension, neighbour_expansion, stationarity_ratio
 from ._thresholds import Thresholds
-from ._validate import as_points
+from ._validate import as_points, check_settings
 from ._verdict import Evidence
 from ._zero_one import zero_one_test
+
+__all__ = ["as_exponent", "exponent_evidence", "zero_one_evidence"]
 
 
 def safe(name: str, fn, *args, **kwargs):
@@ -35,21 +37,18 @@ def _k_side(k: float, thr: Thresholds) -> str | None:
 def zero_one_evidence(
     name: str, series, what: str, seed: int, thresholds: Thresholds | None = None
 ) -> Evidence:
-    """The 0–1 test's vote, cast only where the test is valid and has converged in N.
+    """The 0–1 test's vote on `series`, cast only where the test is valid and has converged.
 
-    `zero_one_test` on `series` votes only when (1) the sequence has at least
-    `Thresholds.zero_one_min_points` samples, (2) it is not flagged as oversampled, and
-    (3) K of the first half and K of the whole lie on the same side of the thresholds
-    (both >= `zero_one_chaotic` or both <= `zero_one_regular`) and differ by at most
-    `zero_one_max_change`. Otherwise it abstains and the detail says which condition
-    failed; `what` names the sequence in the detail.
+    `zero_one_test` votes only when the sequence has at least
+    `Thresholds.zero_one_min_points` samples, is not flagged as oversampled, and K of its
+    first half and K of the whole lie on the same side of the thresholds (>=
+    `zero_one_chaotic` or <= `zero_one_regular`) within `zero_one_max_change` of each other.
+    Otherwise it abstains and the detail, which names the sequence by `what`, says why.
 
     References: K separates 0 from 1 cleanly only for N ~ 1000 samples of a map-like
-    sequence (Gottwald & Melbourne, "On the validity of the 0-1 test for chaos",
-    Nonlinearity 22 (2009) 1367; "On the implementation of the 0-1 test for chaos", SIAM
-    J. Appl. Dyn. Syst. 8 (2009) 129); an oversampled regular signal can give K near 1
-    (Melosik & Marszalek, "On the 0/1 test for chaos in continuous systems", Bull. Pol.
-    Acad. Sci. Tech. Sci. 64 (2016)).
+    sequence (Gottwald & Melbourne, Nonlinearity 22 (2009) 1367; SIAM J. Appl. Dyn. Syst.
+    8 (2009) 129); an oversampled regular signal can give K near 1 (Melosik & Marszalek,
+    Bull. Pol. Acad. Sci. Tech. Sci. 64 (2016)).
     """
     thr = thresholds or Thresholds()
     x = np.asarray(series, dtype=float)
@@ -84,9 +83,118 @@ def zero_one_evidence(
     return Evidence(name, k, side, txt + f", both {bound}")
 
 
-def lyapunov_evidence(lyap: float, tol: float, unit: str) -> Evidence:
+def as_exponent(exponent, time_per_iterate: float = 1.0) -> tuple[float, float, int | None]:
+    """``(λ, stderr, n_intervals)`` per iterate from a number, a tuple or a result object.
+
+    Accepted: a float (stderr unknown: NaN), a pair ``(λ, stderr)``, a triple ``(λ, stderr,
+    n_intervals)``, or an object with attributes ``exponent`` and ``stderr`` (and optionally
+    ``n_intervals``). λ and stderr are multiplied by `time_per_iterate` (the forcing period
+    T for an exponent in 1/s and a stroboscopic section).
+    """
+    check_settings("as_exponent", time_per_iterate=(time_per_iterate, "real>0"))
+    n = None
+    if hasattr(exponent, "exponent"):
+        lam = exponent.exponent
+        se = getattr(exponent, "stderr", math.nan)
+        n = getattr(exponent, "n_intervals", None)
+    elif isinstance(exponent, tuple | list):
+        if len(exponent) not in (2, 3):
+            raise ValueError(
+                f"exponent must be (λ, stderr) or (λ, stderr, n_intervals), got {exponent!r}"
+            )
+        lam, se = exponent[0], exponent[1]
+        n = exponent[2] if len(exponent) == 3 else None
+    else:
+        lam, se = exponent, math.nan
+    lam = float(lam) * time_per_iterate
+    se = math.nan if se is None else abs(float(se)) * time_per_iterate
+    return lam, se, None if n is None else int(n)
+
+
+def exponent_evidence(
+    exponent: float,
+    stderr: float | None = None,
+    n_intervals: int | None = None,
+    *,
+    thresholds: Thresholds | None = None,
+    name: str = "exponent",
+    unit: str = "per iterate",
+) -> Evidence:
+    """Vote of a largest Lyapunov exponent judged by its confidence interval.
+
+    With z = `Thresholds.exponent_z`, ε = `Thresholds.exponent_zero` and σ the standard
+    error (e.g. from batch means of the per-iterate log growths), ``[λ - z σ, λ + z σ]``
+    votes "chaotic" when ``λ - z σ > ε``, "not_chaotic" when ``λ + z σ < ε`` (zero within ε:
+    a torus; negative: a stable periodic orbit) and always for λ = -inf (the tangent vector
+    collapsed: a zero Floquet multiplier, as after sticking); otherwise it abstains and says
+    how much longer to run, σ taken to shrink as 1/sqrt(run length).
+
+    Parameters
+    ----------
+    exponent : float
+        λ₁, in the units named by `unit` (the thresholds are per iterate of the section map).
+    stderr : float, optional
+        Standard error of λ₁ in the same units; None or NaN abstains (unless λ₁ = -inf).
+    n_intervals : int, optional
+        Intervals (iterates) averaged; only used to say how many more to run.
+    thresholds : Thresholds, optional
+        Default `Thresholds()`.
+    name, unit : str
+        Name of the evidence; unit written after the numbers in the detail.
+
+    Returns
+    -------
+    Evidence
+        Value λ₁; detail with the interval and why it votes (or what to run).
+
+    Notes
+    -----
+    Limits: σ is statistical only; the bias of a too-short transient is not in it. A
+    weakly chaotic orbit with λ₁ below ε per iterate is read as not chaotic.
+    """
+    thr = thresholds or Thresholds()
+    lam = float(exponent)
+    se = math.nan if stderr is None else float(stderr)
+    if lam == -math.inf:
+        why = ("λ₁ = -inf: the tangent vector collapsed (a zero Floquet multiplier, e.g. "
+               "sticking): not chaotic")  # fmt: skip
+        return Evidence(name, lam, "not_chaotic", why)
+    if not math.isfinite(lam):
+        return Evidence(name, None, None, f"λ₁ = {lam}: not computed, not used")
+    eps, z = thr.exponent_zero, thr.exponent_z
+    runs = "" if n_intervals is None else f" over {n_intervals} intervals"
+    if not math.isfinite(se):
+        why = (f"λ₁ = {lam:.4g} {unit}{runs} without a standard error: run the exponent "
+               "longer (at least 20 intervals) so that its confidence interval can be "
+               "judged")  # fmt: skip
+        return Evidence(name, lam, None, why)
+    lo, hi = lam - z * se, lam + z * se
+    txt = f"λ₁ = {lam:.4g} ± {se:.2g} {unit}{runs}, {z:g}σ interval [{lo:.3g}, {hi:.3g}]"
+    if lo > eps:
+        return Evidence(name, lam, "chaotic", txt + f" > {eps:g}: positive")
+    if hi < eps:
+        what = "negative: a stable periodic orbit" if hi < -eps else "zero within the threshold"
+        return Evidence(name, lam, "not_chaotic", txt + f" < {eps:g}: {what}")
+    gap = abs(lam - eps)
+    factor = math.inf if gap == 0 else (z * se / gap) ** 2
+    if math.isfinite(factor) and factor <= 1e4:
+        times = f"{factor:.3g}" if factor < 10 else f"{math.ceil(factor)}"  # not ~2x for 1.13x
+        more = f"run the exponent ~{times}x longer"
+        if n_intervals is not None:
+            more += f" ({n_intervals} -> {math.ceil(factor * n_intervals)} intervals)"
+        more += " to decide"
+    else:
+        more = f"λ₁ sits at the threshold {eps:g}: no run of practical length decides"
+    return Evidence(name, lam, None, txt + f" contains {eps:g}: {more}")
+
+
+def lyapunov_evidence(lyap: float, tol: float | None, unit: str) -> Evidence:
     """Vote of an exponent without error bar: > tol chaotic, else not chaotic."""
     lyap = float(lyap)
+    if tol is None:
+        return Evidence(
+            "lyapunov", lyap, None, "no time scale to judge λ₁ against: pass lyapunov_tol"
+        )
     if not math.isfinite(lyap):
         if lyap == -math.inf:
             return Evidence("lyapunov", lyap, "not_chaotic", "λ₁ = -inf (superstable)")
@@ -95,6 +203,19 @@ def lyapunov_evidence(lyap: float, tol: float, unit: str) -> Evidence:
     if lyap > tol:
         return Evidence("lyapunov", lyap, "chaotic", txt + ": positive")
     return Evidence("lyapunov", lyap, "not_chaotic", txt + ": not positive")
+
+
+def exponent_votes(thr, exponent, exponent_time, lyapunov, tol, unit):
+    """A classifier's ``exponent`` and ``lyapunov`` evidence, and the exponent per iterate
+    as ``dict(exponent, stderr, n_intervals)`` (None without one)."""
+    ev, record = [], None
+    if exponent is not None:
+        lam, se, n_int = as_exponent(exponent, exponent_time)
+        record = dict(exponent=lam, stderr=se, n_intervals=n_int)
+        ev.append(exponent_evidence(lam, se, n_int, thresholds=thr))
+    if lyapunov is not None:
+        ev.append(lyapunov_evidence(lyapunov, tol, unit))
+    return ev, record
 
 
 def _fmt(a) -> str:
@@ -106,9 +227,8 @@ def birkhoff_evidence(name: str, z: np.ndarray, thr: Thresholds) -> Evidence:
     n = z.shape[0]
     if n < thr.birkhoff_min_points:
         why = f"{n} points < {thr.birkhoff_min_points}: too few for the Birkhoff averages"
-        return Evidence(
-            name, None, None, f"{why} (run ~{math.ceil(thr.birkhoff_min_points / n)}x longer)"
-        )
+        more = math.ceil(thr.birkhoff_min_points / n)
+        return Evidence(name, None, None, f"{why} (run ~{more}x longer)")
     res, failed = safe(name, weighted_birkhoff, z)
     if failed:
         return failed
@@ -138,7 +258,7 @@ def _rational_near(rho: float, q_max: int, tol: float) -> str:
     return f"{f.numerator}/{f.denominator}" if abs(rho - f) <= tol else ""
 
 
-def _periodic_evidence(prefix, pr, rtol, thr, zero_one):
+def _periodic_evidence(prefix, pr, rtol, zero_one):
     """Evidence list of a section found periodic, with the methods that then abstain."""
     what = (
         "all points coincide (a fixed point)"
@@ -147,128 +267,97 @@ def _periodic_evidence(prefix, pr, rtol, thr, zero_one):
     )
     trans = f"; first {pr.transient} points left out as transient" if pr.transient else ""
     rel = np.max(pr.jitter / np.where(pr.extent > 0, pr.extent, np.inf))
-    ev = [
-        Evidence(
-            f"{prefix}period",
-            pr.period,
-            "periodic",
-            f"{what}: bands {_fmt(pr.jitter)} on an orbit of extent {_fmt(pr.extent)} "
-            f"(per coordinate; widest band {rel:.2g} of the extent), within the tolerance "
-            f"{_fmt(pr.tolerance)} = max(atol, rtol {rtol:g} x extent){trans}",
-        )
-    ]
+    why = (f"{what}: bands {_fmt(pr.jitter)} on an orbit of extent {_fmt(pr.extent)} "
+           f"(per coordinate; widest band {rel:.2g} of the extent), within the tolerance "
+           f"{_fmt(pr.tolerance)} = max(atol, rtol {rtol:g} x extent){trans}")  # fmt: skip
     skip = "the section is periodic to the tolerance: only its jitter is left, not used"
-    ev.append(Evidence(f"{prefix}expansion", None, None, skip))
-    ev.append(Evidence(f"{prefix}birkhoff", None, None, skip))
-    if zero_one:
-        ev.append(Evidence(f"{prefix}zero_one", None, None, skip))
-    return ev
+    skipped = ["expansion", "birkhoff"] + (["zero_one"] if zero_one else [])
+    return [Evidence(f"{prefix}period", pr.period, "periodic", why)] + [
+        Evidence(f"{prefix}{name}", None, None, skip) for name in skipped
+    ]
 
 
 def section_evidence(
-    points,
-    thr: Thresholds,
-    *,
-    angle_periods=None,
-    atol=None,
-    max_period=None,
-    zero_one=True,
-    seed=0,
-    prefix="section_",
-):
+    points, thr: Thresholds, *, angle_periods=None, atol=None, max_period=None, zero_one=True,
+    seed=0, prefix="section_",
+):  # fmt: skip
     """Evidence from section points; returns (evidence list, periods dict, reasons)."""
     rtol, min_points_aperiodic = thr.period_rtol, thr.min_points_aperiodic
-    reasons: list[str] = []
     x = as_points(points)
     n = x.shape[0]
     z = embed_angles(x, angle_periods)
-    pr, failed = safe(
-        f"{prefix}period",
-        section_period,
-        z,
-        rtol=rtol,
-        atol=atol,
-        max_period=max_period,
-        noise_floor=thr.noise_floor,
-        band_separation=thr.band_separation,
-    )
+    name = f"{prefix}period"
+    pr, failed = safe(name, section_period, z, rtol=rtol, atol=atol, max_period=max_period,
+                      noise_floor=thr.noise_floor, band_separation=thr.band_separation)  # fmt: skip
     if failed:
-        return [failed], {}, reasons
+        return [failed], {}, []
     if pr.message:
-        reasons.append(f"section: {pr.message}")
-        return [Evidence(f"{prefix}period", None, None, pr.message)], {}, reasons
+        return [Evidence(name, None, None, pr.message)], {}, [f"section: {pr.message}"]
     if pr.period is not None:
-        ev = _periodic_evidence(prefix, pr, rtol, thr, zero_one)
-        return ev, {f"{prefix}period": pr.period}, reasons
-
+        return _periodic_evidence(prefix, pr, rtol, zero_one), {name: pr.period}, []
     ratio = stationarity_ratio(z)
-    settled = thr.stationary_low <= ratio <= thr.stationary_high if math.isfinite(ratio) else True
-    if not settled:
-        reasons.append(
-            f"section: the points have not settled (second-half/first-half spread "
-            f"{ratio:.2f}); discard more transient"
-        )
-        why = (
-            f"no period <= {pr.max_period}, but the points are still "
-            f"converging or escaping (spread ratio {ratio:.2f})"
-        )
-        return [Evidence(f"{prefix}period", None, None, why)], {}, reasons
-    why = (
-        f"no lag 1..{pr.max_period} has all its bands within rtol = {rtol:g} of the "
-        f"extent (narrowest: {pr.mismatch:.3g} tol)"
-    )
-    ev = [Evidence(f"{prefix}period", None, "not_periodic", why)]
+    if math.isfinite(ratio) and not thr.stationary_low <= ratio <= thr.stationary_high:
+        reason = (f"section: the points have not settled (second-half/first-half spread "
+                  f"{ratio:.2f}); discard more transient")  # fmt: skip
+        why = (f"no period <= {pr.max_period}, but the points are still "
+               f"converging or escaping (spread ratio {ratio:.2f})")  # fmt: skip
+        return [Evidence(name, None, None, why)], {}, [reason]
+    why = (f"no lag 1..{pr.max_period} has all its bands within rtol = {rtol:g} of the "
+           f"extent (narrowest: {pr.mismatch:.3g} tol)")  # fmt: skip
     few = ""
     if n < min_points_aperiodic:
         few = (
             f"; {n} points < {min_points_aperiodic}: too few to separate quasiperiodic from chaotic"
         )
-    ev.append(_rotation_evidence(f"{prefix}rotation", z, thr, few))
-    ev.append(birkhoff_evidence(f"{prefix}birkhoff", z, thr))
-    ev.append(_expansion_evidence(f"{prefix}expansion", z, atol, thr, few))
+    ev = [
+        Evidence(name, None, "not_periodic", why),
+        _rotation_evidence(f"{prefix}rotation", z, thr, few),
+        birkhoff_evidence(f"{prefix}birkhoff", z, thr),
+        _expansion_evidence(f"{prefix}expansion", z, atol, thr, few),
+    ]
     if z.shape[1] >= 2 and n >= thr.dimension_min_points:
         ev.append(_dimension_evidence(f"{prefix}dimension", z, thr))
     if zero_one:
         what = "0-1 test on the first section coordinate"
         ev.append(zero_one_evidence(f"{prefix}zero_one", z[:, 0], what, seed, thr))
-    return ev, {}, reasons
+    return ev, {}, []
+
+
+def _vote(name, value, txt, few, passed, vote, yes, no) -> Evidence:
+    """``vote`` (detail ``txt + yes``) when the measure `passed` its threshold, else an
+    abstention (``txt + no``); an abstention (``txt + few``) on too few points."""
+    if few:
+        return Evidence(name, value, None, txt + few)
+    if passed:
+        return Evidence(name, value, vote, txt + yes)
+    return Evidence(name, value, None, txt + no)
 
 
 def _rotation_evidence(name: str, z: np.ndarray, thr: Thresholds, few: str) -> Evidence:
-    """Rank-shift consistency (`rotation_order`): quasiperiodic from ``rotation_quasi``; no
-    vote on fewer points than ``min_points_aperiodic`` (``few`` says so)."""
+    """Rank-shift consistency (`rotation_order`): quasiperiodic from ``rotation_quasi``."""
     rot = rotation_order(z)
-    r = rot.consistency
+    r, q = rot.consistency, thr.rotation_quasi
     txt = f"rank-shift consistency R = {r:.3f}, rotation number {rot.rotation_number:.4f}"
-    if few:
-        return Evidence(name, r, None, txt + few)
-    if r >= thr.rotation_quasi:
-        why = f" >= {thr.rotation_quasi}: points turn along a closed curve"
-        return Evidence(name, r, "quasiperiodic", txt + why)
-    return Evidence(name, r, None, txt + f" < {thr.rotation_quasi}: no rotation order")
+    yes, no = f" >= {q}: points turn along a closed curve", f" < {q}: no rotation order"
+    return _vote(name, r, txt, few, r >= q, "quasiperiodic", yes, no)
 
 
 def _expansion_evidence(name: str, z: np.ndarray, atol, thr: Thresholds, few: str) -> Evidence:
     """Nearest-neighbour expansion beyond the noise floor (`neighbour_expansion`): chaotic
-    above ``expansion_chaotic``; no vote on fewer points than ``min_points_aperiodic``."""
+    above ``expansion_chaotic``."""
     g = neighbour_expansion(z, atol=_floor(z, atol, thr.noise_floor))
-    txt = f"mean one-step log growth of nearest-neighbour distances {g:.3f}"
     if not math.isfinite(g):
         return Evidence(name, None, None, "too few distinct neighbours above the noise floor")
-    if few:
-        return Evidence(name, g, None, txt + few)
-    if g > thr.expansion_chaotic:
-        return Evidence(
-            name, g, "chaotic", txt + f" > {thr.expansion_chaotic}: neighbours separate"
-        )
-    return Evidence(name, g, None, txt + f" <= {thr.expansion_chaotic}: no clear stretching")
+    c = thr.expansion_chaotic
+    txt = f"mean one-step log growth of nearest-neighbour distances {g:.3f}"
+    yes, no = f" > {c}: neighbours separate", f" <= {c}: no clear stretching"
+    return _vote(name, g, txt, few, g > c, "chaotic", yes, no)
 
 
 def _dimension_evidence(name: str, z: np.ndarray, thr: Thresholds) -> Evidence:
     """Correlation dimension (`correlation_dimension`): chaotic (not a curve) from
     ``dimension_chaotic``."""
-    d2 = correlation_dimension(z)
+    d2, c = correlation_dimension(z), thr.dimension_chaotic
     txt = f"correlation dimension D2 = {d2:.2f}"
-    if math.isfinite(d2) and d2 >= thr.dimension_chaotic:
-        return Evidence(name, d2, "chaotic", txt + f" >= {thr.dimension_chaotic}: not a curve")
-    return Evidence(name, d2, None, txt + f" < {thr.dimension_chaotic}: a curve or unresolved")
+    yes, no = f" >= {c}: not a curve", f" < {c}: a curve or unresolved"
+    return _vote(name, d2, txt, "", math.isfinite(d2) and d2 >= c, "chaotic", yes, no)

@@ -20,39 +20,17 @@ class DoubtfulEstimateWarning(UserWarning):
 
 @dataclass(frozen=True)
 class SeriesLyapunovResult:
-    """Largest Lyapunov exponent estimated from a series by `lyapunov_from_series`.
+    """Largest Lyapunov exponent estimated from a series by `lyapunov_from_series`."""
 
-    Attributes
-    ----------
-    exponent : float
-        Largest exponent per unit time (NaN if the estimate could not be made).
-    method : str
-        "rosenstein" (nolds.lyap_r) or "eckmann" (nolds.lyap_e).
-    doubtful : bool
-        True when a diagnostic failed; `reasons` says which.
-    reasons : tuple of str
-        Why the estimate is doubtful (empty otherwise).
-    stride : int
-        Subsampling stride applied to the series.
-    n_used : int
-        Samples passed to nolds.
-    exponents : ndarray
-        All exponents returned (Eckmann gives `matrix_dim` of them; Rosenstein one).
-    fit_r2 : float
-        Rosenstein: R² of the straight-line fit to the mean log divergence (NaN for Eckmann).
-    settings : dict
-        Every setting passed to nolds, plus the sampling interval used.
-    """
-
-    exponent: float
-    method: str
-    doubtful: bool
+    exponent: float  # per unit time (NaN if the estimate could not be made)
+    method: str  # "rosenstein" (nolds.lyap_r) or "eckmann" (nolds.lyap_e)
+    doubtful: bool  # a diagnostic failed; `reasons` says which
     reasons: tuple[str, ...]
-    stride: int
-    n_used: int
-    exponents: np.ndarray
-    fit_r2: float
-    settings: dict = field(default_factory=dict)
+    stride: int  # subsampling stride applied to the series
+    n_used: int  # samples passed to nolds
+    exponents: np.ndarray  # all exponents returned (Eckmann: `matrix_dim` of them)
+    fit_r2: float  # Rosenstein: R² of the line fitted to the mean log divergence, else NaN
+    settings: dict = field(default_factory=dict)  # every setting passed to nolds, and dt
 
 
 def lyapunov_from_series(
@@ -124,8 +102,6 @@ def lyapunov_from_series(
     signals at these settings. Where the map's Jacobians are known, prefer
     `spectrum_from_jacobians`.
     """
-    import nolds
-
     x = as_series(x)
     if method not in ("rosenstein", "eckmann"):
         raise ValueError(f"method must be 'rosenstein' or 'eckmann', got {method!r}")
@@ -143,96 +119,71 @@ def lyapunov_from_series(
     stride = max(1, math.ceil(x.size / max_points))
     y = x[::stride]
     tau = dt * stride
-    settings = dict(
-        method=method,
-        max_points=max_points,
-        emb_dim=emb_dim,
-        lag=lag,
-        min_tsep=min_tsep,
-        trajectory_len=trajectory_len,
-        matrix_dim=matrix_dim,
-        tau=tau,
-        dt=dt,
-        stride=stride,
-    )
+    settings = dict(method=method, max_points=max_points, emb_dim=emb_dim, lag=lag,
+                    min_tsep=min_tsep, trajectory_len=trajectory_len, matrix_dim=matrix_dim,
+                    tau=tau, dt=dt, stride=stride)  # fmt: skip
     reasons: list[str] = []
-
-    def result(exponent, exponents, r2):
-        doubtful = bool(reasons)
-        if doubtful and warn:
-            warn_user(
-                f"Lyapunov estimate from the series is doubtful: {'; '.join(reasons)}",
-                DoubtfulEstimateWarning,
-            )
-        return SeriesLyapunovResult(
-            float(exponent),
-            method,
-            doubtful,
-            tuple(reasons),
-            stride,
-            int(y.size),
-            np.asarray(exponents, dtype=float),
-            float(r2),
-            settings,
-        )
-
+    le, exps, r2 = math.nan, [], math.nan
+    needed = (emb_dim - 1) * (lag or 1) + trajectory_len + 2 * (min_tsep or 0) + 20
     if np.ptp(y) <= 1e-12 * max(1.0, float(np.max(np.abs(y)))):
         reasons.append("constant series: no exponent can be estimated")
-        return result(math.nan, [], math.nan)
-    needed = (emb_dim - 1) * (lag or 1) + trajectory_len + 2 * (min_tsep or 0) + 20
-    if y.size < max(needed, 50):
+    elif y.size < max(needed, 50):
         reasons.append(f"only {y.size} samples after subsampling: too few for the embedding")
-        return result(math.nan, [], math.nan)
-    if y.size < min_points:
-        reasons.append(f"only {y.size} samples (< {min_points})")
+    else:
+        if y.size < min_points:
+            reasons.append(f"only {y.size} samples (< {min_points})")
+        le, exps, r2 = _nolds(y, method, settings, reasons)
+    if reasons and warn:
+        warn_user(
+            f"Lyapunov estimate from the series is doubtful: {'; '.join(reasons)}",
+            DoubtfulEstimateWarning,
+        )
+    return SeriesLyapunovResult(float(le), method, bool(reasons), tuple(reasons), stride,
+                                int(y.size), np.asarray(exps, dtype=float), float(r2),
+                                settings)  # fmt: skip
+
+
+def _nolds(y, method, s, reasons) -> tuple[float, list, float]:
+    """(λ₁, the exponents, R²) by nolds with the settings ``s``; appends to ``reasons`` what
+    makes the estimate doubtful."""
+    import nolds
 
     with recorded() as caught:  # nolds's warnings, kept as reasons (thread-safe)
         try:
             if method == "rosenstein":
                 le, (ks, div, poly) = nolds.lyap_r(
-                    y,
-                    emb_dim=emb_dim,
-                    lag=lag,
-                    min_tsep=min_tsep,
-                    tau=tau,
-                    trajectory_len=trajectory_len,
-                    fit="poly",
-                    debug_data=True,
-                )
+                    y, emb_dim=s["emb_dim"], lag=s["lag"], min_tsep=s["min_tsep"], tau=s["tau"],
+                    trajectory_len=s["trajectory_len"], fit="poly", debug_data=True,
+                )  # fmt: skip
                 exps = [le]
             else:
-                exps = nolds.lyap_e(
-                    y, emb_dim=emb_dim, matrix_dim=matrix_dim, min_tsep=min_tsep or 0, tau=tau
-                )
+                exps = nolds.lyap_e(y, emb_dim=s["emb_dim"], matrix_dim=s["matrix_dim"],
+                                    min_tsep=s["min_tsep"] or 0, tau=s["tau"])  # fmt: skip
                 le = float(np.max(exps))
         except Exception as err:  # nolds raises on degenerate embeddings
             reasons.append(f"nolds failed: {err}")
-            return result(math.nan, [], math.nan)
-    for w in caught:
-        reasons.append(f"nolds warned: {w.message}")
-
-    r2 = math.nan
-    if method == "rosenstein":
-        div = np.asarray(div, dtype=float)
-        ok = np.isfinite(div)
-        if ok.sum() < 3:
-            reasons.append("divergence curve undefined (no neighbours)")
-        else:
-            k, d = np.asarray(ks, dtype=float)[ok], div[ok]
-            fit = np.polyval(poly, k)
-            ss = float(np.sum((d - d.mean()) ** 2))
-            r2 = 1.0 - float(np.sum((d - fit) ** 2)) / ss if ss > 0 else math.nan
-            if not (r2 >= 0.95):
-                reasons.append(f"the log divergence is not linear in time (R² = {r2:.3f})")
-            third = max(2, k.size // 3)
-            s_first = np.polyfit(k[:third], d[:third], 1)[0]
-            s_last = np.polyfit(k[-third:], d[-third:], 1)[0]
-            if s_first > 0 and s_last < 0.3 * s_first:
-                reasons.append("the divergence saturates within the fit range")
-    else:
+            return math.nan, [], math.nan
+    reasons.extend(f"nolds warned: {w.message}" for w in caught)
+    if method != "rosenstein":
         exps_arr = np.asarray(exps, dtype=float)
         if exps_arr.sum() > 0:
             reasons.append("the exponents sum to a positive number")
         if np.min(np.abs(exps_arr)) > 0.1 * np.max(np.abs(exps_arr)):
             reasons.append("no exponent near zero, as a flow must have (ignore for maps)")
-    return result(le, exps, r2)
+        return le, exps, math.nan
+    div = np.asarray(div, dtype=float)
+    ok = np.isfinite(div)
+    if ok.sum() < 3:
+        reasons.append("divergence curve undefined (no neighbours)")
+        return le, exps, math.nan
+    k, d = np.asarray(ks, dtype=float)[ok], div[ok]
+    ss = float(np.sum((d - d.mean()) ** 2))
+    r2 = 1.0 - float(np.sum((d - np.polyval(poly, k)) ** 2)) / ss if ss > 0 else math.nan
+    if not (r2 >= 0.95):
+        reasons.append(f"the log divergence is not linear in time (R² = {r2:.3f})")
+    third = max(2, k.size // 3)
+    s_first = np.polyfit(k[:third], d[:third], 1)[0]
+    s_last = np.polyfit(k[-third:], d[-third:], 1)[0]
+    if s_first > 0 and s_last < 0.3 * s_first:
+        reasons.append("the divergence saturates within the fit range")
+    return le, exps, r2

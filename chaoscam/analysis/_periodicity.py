@@ -81,49 +81,20 @@ def _band_widths(y: np.ndarray, p: int) -> np.ndarray:
 
 @dataclass(frozen=True)
 class PeriodResult:
-    """Result of `section_period`.
+    """Result of `section_period`; arrays are per coordinate, in the units of the points."""
 
-    Attributes
-    ----------
-    period : int or None
-        Smallest n for which every band ``x[r::n]`` (after `transient` points) is narrower
-        than the tolerance in every coordinate, or None.
-    transient : int
-        Leading points left out to find the period (0 when the whole set is periodic).
-    max_period : int
-        Largest lag tested.
-    mismatch : float
-        Widest band over the tolerance, ``max_{r,j} width_{r,j} / tol_j``, at the period
-        found (<= 1), or the smallest over the lags tested when none was found.
-    tolerance : ndarray
-        Per-coordinate tolerance used, ``max(atol_j, rtol · extent_j)``.
-    coincident : bool
-        All points coincide within tolerance (a fixed point: period 1).
-    message : str
-        Why no period could be tested (too few points), else empty.
-    settings : dict
-        The settings used.
-    jitter : ndarray
-        Per coordinate, the widest band at the period found (the measured jitter, in the
-        units of the points); NaN when no period was found.
-    extent : ndarray
-        Per coordinate, the range of the points kept (the orbit's size).
-    separation : float
-        Smallest Chebyshev distance between two band centres at the period found, in
-        units of ``max(band_separation · jitter_j, round-off_j)`` (> 1: distinct bands);
-        inf for period 1 or none.
-    """
-
-    period: int | None
-    transient: int
-    max_period: int
-    mismatch: float
-    tolerance: np.ndarray
-    coincident: bool
-    message: str = ""
+    period: int | None  # smallest n whose bands x[r::n] (after `transient`) are all narrow
+    transient: int  # leading points left out to find the period
+    max_period: int  # largest lag tested
+    mismatch: float  # max_{r,j} width_rj / tol_j at the period (<= 1), else the least tested
+    tolerance: np.ndarray  # max(atol_j, rtol · extent_j)
+    coincident: bool  # all points coincide within tolerance (a fixed point: period 1)
+    message: str = ""  # why no period could be tested (too few points)
     settings: dict = field(default_factory=dict)
-    jitter: np.ndarray = field(default_factory=lambda: np.array([]))
-    extent: np.ndarray = field(default_factory=lambda: np.array([]))
+    jitter: np.ndarray = field(default_factory=lambda: np.array([]))  # widest band; NaN: none
+    extent: np.ndarray = field(default_factory=lambda: np.array([]))  # range of the points kept
+    # least Chebyshev distance of two band centres in units of max(band_separation · jitter_j,
+    # round-off_j) (> 1: distinct bands); inf for period 1 or none
     separation: float = math.inf
 
     def __post_init__(self) -> None:
@@ -162,17 +133,17 @@ def section_period(
         max_k x_{r+kn, j} - min_k x_{r+kn, j} <= tol_j = max(atol_j, rtol · extent_j),
 
     extent_j the range of coordinate j (the orbit's size). A band's width is the jitter the
-    orbit carries (integration error, a slow transient, noise), reported as
-    `PeriodResult.jitter`. Bands of a lag, unlike clusters, also check the order of the
-    visits, and a slow drift along a curve (a torus near a resonance p/n) widens them.
+    orbit carries (integration error, a slow transient, noise). Bands of a lag, unlike
+    clusters, also check the order of the visits, and a slow drift along a curve (a torus
+    near a resonance p/n) widens them.
 
     Parameters
     ----------
     points : array_like, shape (N,) or (N, d)
-        Section points in time order (map iterates, or stroboscopic (θ, ω) points), after
-        the transient; angular coordinates through `embed_angles` first.
+        Section points in time order, after the transient; angular coordinates through
+        `embed_angles` first.
     rtol : float, optional
-        Band width allowed relative to the extent; default `Thresholds.period_rtol` (3e-3).
+        Band width allowed relative to the extent; default `Thresholds.period_rtol`.
     atol : float or array_like, optional
         Absolute floor per coordinate, in the units of the points; default
         ``noise_floor · max_j max_k |x_kj|``, which makes period 1 detectable (a fixed
@@ -181,8 +152,7 @@ def section_period(
     max_period : int, optional
         Largest lag tested; default ``N // min_repeats``.
     min_repeats : int
-        The pattern must be seen at least this many times (N - transient >= min_repeats n);
-        2: every point of one period is seen to come back.
+        The pattern must be seen at least this many times (N - transient >= min_repeats n).
     allow_transient : bool
         Also try leaving out the first 10 %, 20 %, ..., 50 % of the points (a slowly
         converging transient); the tolerance is then computed on the points kept.
@@ -190,7 +160,7 @@ def section_period(
         Fewer points than this: no test (period None, `message` says why).
     noise_floor : float, optional
         Fraction of the largest coordinate magnitude used as `atol` when none is given;
-        default `Thresholds.noise_floor` (1e-6).
+        default `Thresholds.noise_floor`.
     distinct : bool
         Refuse a lag two of whose bands overlap: centres within `band_separation` widths of
         the widest band (or within 64 ulps of the coordinate's magnitude) in every
@@ -198,7 +168,7 @@ def section_period(
         distinct points. False returns the smallest lag whose bands are all narrow: whether
         the points keep to bands visited in order (banded chaos), not whether they repeat.
     band_separation : float, optional
-        See `distinct`; default `Thresholds.band_separation` (4).
+        See `distinct`; default `Thresholds.band_separation`.
 
     Returns
     -------
@@ -224,25 +194,17 @@ def section_period(
         min_points=(min_points, "int>=1"),
         noise_floor=(noise_floor, "real>=0?"),
     )
-    defaults = Thresholds()
-    rtol = defaults.period_rtol if rtol is None else float(rtol)
-    noise_floor = defaults.noise_floor if noise_floor is None else float(noise_floor)
-    if band_separation is None:
-        band_separation = defaults.band_separation
+    default = Thresholds()
+    rtol = default.period_rtol if rtol is None else float(rtol)
+    noise_floor = default.noise_floor if noise_floor is None else float(noise_floor)
+    band_separation = default.band_separation if band_separation is None else band_separation
     x = as_points(points)
     n = x.shape[0]
     check_atol("section_period", atol, x.shape[1])
-    settings = dict(
-        rtol=rtol,
-        atol=atol,
-        noise_floor=noise_floor,
-        max_period=max_period,
-        min_repeats=min_repeats,
-        allow_transient=allow_transient,
-        min_points=min_points,
-        distinct=distinct,
-        band_separation=band_separation,
-    )
+    settings = dict(rtol=rtol, atol=atol, noise_floor=noise_floor, max_period=max_period,
+                    min_repeats=min_repeats, allow_transient=allow_transient,
+                    min_points=min_points, distinct=distinct,
+                    band_separation=band_separation)  # fmt: skip
     d = x.shape[1]
     nan = np.full(d, math.nan)
     if n < min_points:
@@ -286,20 +248,10 @@ def section_period(
 
 @dataclass(frozen=True)
 class RotationResult:
-    """Result of `rotation_order`.
+    """Result of `rotation_order`."""
 
-    Attributes
-    ----------
-    consistency : float
-        Mean resultant length R in [0, 1] of the rank shifts (1: every point advances by
-        the same number of ranks along the curve, as under a rotation).
-    rotation_number : float
-        Mean rank shift / N, in [0, 1): the rotation number of the orbit in the angular
-        coordinate used (1 - ρ if it turns the other way).
-    """
-
-    consistency: float
-    rotation_number: float
+    consistency: float  # mean resultant length R in [0, 1] of the rank shifts (1: a rotation)
+    rotation_number: float  # mean rank shift / N in [0, 1) (1 - ρ when it turns the other way)
 
 
 def _curve_angles(z: np.ndarray) -> np.ndarray:

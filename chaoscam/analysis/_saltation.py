@@ -41,14 +41,10 @@ def saltation_matrix(g_x, g_t, f_minus, f_plus, h_x, h_t: float) -> np.ndarray:
     ValueError
         For a grazing event (``h_t + h_x · f- = 0``): no saltation matrix exists there.
     """
-    g_x = np.asarray(g_x, dtype=float)
-    h_x = np.asarray(h_x, dtype=float)
+    g_x, h_x = np.asarray(g_x, dtype=float), np.asarray(h_x, dtype=float)
     rate = float(h_t) + float(h_x @ np.asarray(f_minus, dtype=float))
     if rate == 0.0:
         raise ValueError("grazing event (h_t + h_x . f- = 0): the saltation matrix is undefined")
-    w = (
-        np.asarray(f_plus, dtype=float)
-        - g_x @ np.asarray(f_minus, dtype=float)
-        - np.asarray(g_t, dtype=float)
-    )
+    f_minus = np.asarray(f_minus, dtype=float)
+    w = np.asarray(f_plus, dtype=float) - g_x @ f_minus - np.asarray(g_t, dtype=float)
     return g_x + np.outer(w, h_x) / rate

@@ -34,13 +34,23 @@ def local_maxima(x, dt: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     check_settings("local_maxima", dt=(dt, "real>0"))
     if x.size < 3:
         return np.array([]), np.array([])
-    i = np.nonzero((x[1:-1] > x[:-2]) & (x[1:-1] >= x[2:]))[0] + 1
+    i = peak_indices(x)
     a, b, c = x[i - 1], x[i], x[i + 1]
+    delta = vertex_offset(a, b, c)
+    return (i + delta) * dt, b - 0.25 * (a - c) * delta
+
+
+def peak_indices(x: np.ndarray) -> np.ndarray:
+    """Indices i of the strict interior maxima, x[i-1] < x[i] >= x[i+1]."""
+    return np.nonzero((x[1:-1] > x[:-2]) & (x[1:-1] >= x[2:]))[0] + 1
+
+
+def vertex_offset(a, b, c) -> np.ndarray:
+    """Vertex of the parabola through (-1, a), (0, b), (1, c), clipped to ±0.5 (0 if none)."""
     den = a - 2.0 * b + c
     with np.errstate(invalid="ignore", divide="ignore"):
         delta = np.where(den < 0, 0.5 * (a - c) / den, 0.0)
-    delta = np.clip(delta, -0.5, 0.5)
-    return (i + delta) * dt, b - 0.25 * (a - c) * delta
+    return np.clip(delta, -0.5, 0.5)
 
 
 def crossing_section(

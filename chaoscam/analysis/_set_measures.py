@@ -17,6 +17,11 @@ def _scaled(x: np.ndarray) -> np.ndarray:
     return (x - x.mean(axis=0)) / np.where(ext > 0, ext, 1.0)
 
 
+def _spread(a: np.ndarray) -> float:
+    """RMS distance of the points to their centroid."""
+    return float(np.sqrt(np.mean(np.sum((a - a.mean(axis=0)) ** 2, axis=1))))
+
+
 def neighbour_expansion(
     z, *, max_points: int = 2000, min_distance: float = 1e-9, atol=None
 ) -> float:
@@ -154,9 +159,7 @@ def stationarity_ratio(z) -> float:
     h = x.shape[0] // 2
     if h < 4:
         return math.nan
-    a, b = x[:h], x[h:]
-    sa = float(np.sqrt(np.mean(np.sum((a - a.mean(axis=0)) ** 2, axis=1))))
-    sb = float(np.sqrt(np.mean(np.sum((b - b.mean(axis=0)) ** 2, axis=1))))
+    sa, sb = _spread(x[:h]), _spread(x[h:])
     if sa == 0.0:
         return math.inf if sb > 0 else 1.0
     return sb / sa

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._sections import peak_indices, vertex_offset
 from ._validate import as_series, check_settings
 
 __all__ = ["SpectrumResult", "power_spectrum", "spectrum_analysis"]
@@ -45,50 +46,28 @@ def power_spectrum(x, dt: float) -> tuple[np.ndarray, np.ndarray]:
 
 @dataclass(frozen=True)
 class SpectrumResult:
-    """Result of `spectrum_analysis`.
+    """Result of `spectrum_analysis`; frequencies in Hz.
 
-    Attributes
-    ----------
-    model : str
-        "periodic" (a harmonic comb explains the power), "quasiperiodic" (combinations of
-        two incommensurate bases explain it), "broadband" (a large part of the power lies
-        outside both), "aperiodic" (neither explains it, but the broadband part is small),
-        or "undetermined" (input too short or constant; see `message`).
-    period : int or None
-        For a forced signal with a periodic model: the smallest n such that the harmonics of
-        f_forcing / n hold the power (weak subharmonics below `line_tol` are missed, so n
-        can under-count a period seen on a section; it divides it).
-    base_frequencies : tuple of float
-        The comb's fundamental (periodic) or the two bases (quasiperiodic), Hz.
-    line_fraction : float
-        Fraction of the power within ± `half_width` bins of the best line model's lines.
-    periodic_fraction, quasiperiodic_fraction : float
-        The same fraction for each model (NaN when not tried).
-    spectral_entropy : float
-        Normalised Shannon entropy of the power distribution, in [0, 1].
-    spectral_flatness : float
-        Geometric over arithmetic mean of the power (Wiener entropy), in [0, 1].
-    peaks : tuple of (float, float)
-        Strongest peaks: (frequency in Hz, fraction of the total power in ± half_width bins).
-    resolution : float
-        Frequency resolution 1 / (N dt), Hz.
-    message : str
-        Why the analysis is undetermined or weak.
-    settings : dict
-        The settings used.
+    ``model`` is "periodic" (a harmonic comb explains the power), "quasiperiodic"
+    (combinations of two incommensurate bases explain it), "broadband" (a large part of the
+    power lies outside both), "aperiodic" (neither explains it, but the broadband part is
+    small) or "undetermined" (input too short or constant; see ``message``). ``period``,
+    for a forced signal with a periodic model, is the smallest n such that the harmonics of
+    f_forcing / n hold the power: weak subharmonics below `line_tol` are missed, so it can
+    under-count a period seen on a section (it divides it).
     """
 
     model: str
     period: int | None
-    base_frequencies: tuple[float, ...]
-    line_fraction: float
-    periodic_fraction: float
+    base_frequencies: tuple[float, ...]  # the comb's fundamental, or the two bases
+    line_fraction: float  # power within ± half_width bins of the best line model's lines
+    periodic_fraction: float  # the same for each model (NaN when not tried)
     quasiperiodic_fraction: float
-    spectral_entropy: float
-    spectral_flatness: float
-    peaks: tuple[tuple[float, float], ...]
-    resolution: float
-    message: str = ""
+    spectral_entropy: float  # normalised Shannon entropy of the power, in [0, 1]
+    spectral_flatness: float  # geometric over arithmetic mean of the power, in [0, 1]
+    peaks: tuple[tuple[float, float], ...]  # (frequency, power fraction in ± half_width bins)
+    resolution: float  # 1 / (N dt)
+    message: str = ""  # why the analysis is undetermined or weak
     settings: dict = field(default_factory=dict)
 
     @property
@@ -108,21 +87,13 @@ def _windows(centres: np.ndarray, n_bins: int, h: int) -> np.ndarray:
 
 
 def _local_maxima(power: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Bins of the local maxima and their frequencies in bins, refined on log power.
-
-    Parabolic interpolation of the log periodogram; for a Hann-windowed line its bias is
-    below 0.02 bin.
-    """
+    """Bins of the local maxima and their positions in bins, refined by the parabola through
+    the log power (for a Hann-windowed line its bias is below 0.02 bin)."""
     p = power
-    k = np.nonzero((p[1:-1] > p[:-2]) & (p[1:-1] >= p[2:]))[0] + 1
+    k = peak_indices(p)
     k = k[p[k] > 1e-14 * p.max()]
-    a = np.log(p[k - 1] + 1e-300)
-    b = np.log(p[k])
-    c = np.log(p[k + 1] + 1e-300)
-    den = a - 2.0 * b + c
-    with np.errstate(invalid="ignore", divide="ignore"):
-        delta = np.where(den < 0, 0.5 * (a - c) / den, 0.0)
-    return k, k + np.clip(delta, -0.5, 0.5)
+    a, b, c = np.log(p[k - 1] + 1e-300), np.log(p[k]), np.log(p[k + 1] + 1e-300)
+    return k, k + vertex_offset(a, b, c)
 
 
 def _refine_fundamental(f0: float, fk: np.ndarray, pk: np.ndarray, tol: float) -> float:
@@ -133,6 +104,41 @@ def _refine_fundamental(f0: float, fk: np.ndarray, pk: np.ndarray, tol: float) -
         return f0
     w = pk[on]
     return float(np.sum(w * m[on] * fk[on]) / np.sum(w * m[on] ** 2))
+
+
+def _entropy_flatness(power: np.ndarray, total: float) -> tuple[float, float]:
+    """Normalised Shannon entropy and flatness (Wiener entropy) of a periodogram, DC left out."""
+    pk = power[1:] / power[1:].sum()
+    pk = pk[pk > 0]
+    entropy = float(-np.sum(pk * np.log(pk)) / math.log(power.size - 1))
+    flatness = float(np.exp(np.mean(np.log(power[1:] + 1e-300 * total))) / np.mean(power[1:]))
+    return entropy, flatness
+
+
+def _on_torus_lines(fk, f1, f2, max_order, ftol) -> np.ndarray:
+    """Which peaks lie within `ftol` of a line ``|a f1 + b f2|``, |a|, |b| <= `max_order`."""
+    a = np.arange(-max_order, max_order + 1)
+    lines = np.unique(np.abs(a[:, None] * f1 + a[None, :] * f2).ravel())
+    pos = np.clip(np.searchsorted(lines, fk), 1, lines.size - 1)
+    return np.minimum(np.abs(fk - lines[pos - 1]), np.abs(fk - lines[pos])) <= ftol
+
+
+def _comb_candidates(fk, pk, forcing_frequency, df, max_period, min_cycles, ftol):
+    """(max_period, [(n, f0 in bins)]): the periodic model's fundamentals that the record
+    holds `min_cycles` cycles of, ``f_F / n`` when forced, else the strongest peak over n
+    refined on its harmonics."""
+    if max_period is None:
+        if forcing_frequency is not None:
+            max_period = int(min(64, max(1, forcing_frequency / df // min_cycles)))
+        else:
+            max_period = 8
+    min_f0 = float(min_cycles)  # in bins: f0 / df = cycles in the record
+    if forcing_frequency is not None:
+        found = [(k, forcing_frequency / k / df) for k in range(1, max_period + 1)]
+    else:
+        found = [(k, _refine_fundamental(fk[0] / k, fk, pk, max(ftol, 0.5)))
+                 for k in range(1, max_period + 1) if fk[0] / k >= min_f0]  # fmt: skip
+    return max_period, [(k, f0) for k, f0 in found if f0 >= min_f0]
 
 
 SPECTRUM_RULES = {
@@ -244,17 +250,9 @@ def spectrum_analysis(
     """
     x = as_series(x)
     n = x.size
-    settings = dict(
-        dt=dt,
-        forcing_frequency=forcing_frequency,
-        max_period=max_period,
-        half_width=half_width,
-        line_tol=line_tol,
-        broadband_tol=broadband_tol,
-        max_order=max_order,
-        min_cycles=min_cycles,
-        peak_tol=peak_tol,
-    )
+    settings = dict(dt=dt, forcing_frequency=forcing_frequency, max_period=max_period,
+                    half_width=half_width, line_tol=line_tol, broadband_tol=broadband_tol,
+                    max_order=max_order, min_cycles=min_cycles, peak_tol=peak_tol)  # fmt: skip
     check_settings("spectrum_analysis", dt=(dt, "real>0"))
     options = {k: v for k, v in settings.items() if k != "dt"}
     check_spectrum_options("spectrum_analysis", {**options, "n_peaks": n_peaks})
@@ -271,34 +269,25 @@ def spectrum_analysis(
 
     if n < 64:
         return undetermined(f"only {n} samples; the spectrum needs >= 64")
-    freqs, power = power_spectrum(x, dt)
+    _, power = power_spectrum(x, dt)
     total = float(power.sum())
-    scale = max(1.0, float(np.max(np.abs(x))))
-    if np.ptp(x) <= 1e-12 * scale or total <= 0.0:
+    if np.ptp(x) <= 1e-12 * max(1.0, float(np.max(np.abs(x)))) or total <= 0.0:
         return undetermined("constant signal: no spectrum to analyse")
-    h = int(half_width)
-    nb = power.size
-    pk = power[1:] / power[1:].sum()
-    pk = pk[pk > 0]
-    entropy = float(-np.sum(pk * np.log(pk)) / math.log(nb - 1))
-    flatness = float(np.exp(np.mean(np.log(power[1:] + 1e-300 * total))) / np.mean(power[1:]))
+    h, nb = int(half_width), power.size
+    entropy, flatness = _entropy_flatness(power, total)
     kb, fk = _local_maxima(power)  # peak bins and refined positions, in bins
     if kb.size == 0:
         return undetermined("no spectral peak", entropy, flatness)
     pk = power[kb]
     order = np.argsort(pk)[::-1]
     kb, fk, pk = kb[order], fk[order], pk[order]
-    peak_out = tuple(
-        (float(f * df), float(power[max(k - h, 0) : k + h + 1].sum()) / total)
-        for k, f in zip(kb[:n_peaks], fk[:n_peaks], strict=True)
-    )
+    peak_out = tuple((float(f * df), float(power[max(k - h, 0) : k + h + 1].sum()) / total)
+                     for k, f in zip(kb[:n_peaks], fk[:n_peaks], strict=True))  # fmt: skip
     ftol = float(peak_tol)
 
     def result(model, period, bases, line_fraction, periodic, quasiperiodic):
         return SpectrumResult(model, period, bases, line_fraction, periodic, quasiperiodic,
                               entropy, flatness, peak_out, df, "", settings)  # fmt: skip
-
-    min_f0 = float(min_cycles)  # in bins: f0 / df = cycles in the record
 
     def explained(on_model: np.ndarray) -> float:
         return float(power[_windows(kb[on_model], nb, h)].sum()) / total
@@ -308,22 +297,9 @@ def spectrum_analysis(
         return np.abs(fk - m * f0) <= ftol
 
     # --- periodic model (frequencies in bins)
-    candidates = []
-    if max_period is None:
-        if forcing_frequency is not None:
-            max_period = int(min(64, max(1, forcing_frequency / df // min_cycles)))
-        else:
-            max_period = 8
+    max_period, candidates = _comb_candidates(fk, pk, forcing_frequency, df, max_period,
+                                              min_cycles, ftol)  # fmt: skip
     settings["max_period"] = max_period
-    if forcing_frequency is not None:
-        for k in range(1, max_period + 1):
-            candidates.append((k, forcing_frequency / k / df))
-    else:
-        for k in range(1, max_period + 1):
-            f0 = fk[0] / k
-            if f0 >= min_f0:
-                candidates.append((k, _refine_fundamental(f0, fk, pk, max(ftol, 0.5))))
-    candidates = [(k, f0) for k, f0 in candidates if f0 >= min_f0]
     if not candidates:
         why = f"the record holds fewer than {min_cycles:g} cycles of the fundamental"
         return undetermined(why + "; use a longer signal", entropy, flatness, peak_out)
@@ -341,15 +317,11 @@ def spectrum_analysis(
         f1 = forcing_frequency / df
     else:
         f1 = _refine_fundamental(fk[0], fk, pk, max(ftol, 0.5))
-    off = ~on_comb(f1) & (fk >= min_f0)
+    off = ~on_comb(f1) & (fk >= float(min_cycles))  # in bins: cycles in the record
     qp, f2 = nan, nan
     if np.any(off):
         f2 = float(fk[np.argmax(off)])
-        a = np.arange(-max_order, max_order + 1)
-        lines = np.unique(np.abs(a[:, None] * f1 + a[None, :] * f2).ravel())
-        pos = np.clip(np.searchsorted(lines, fk), 1, lines.size - 1)
-        dist = np.minimum(np.abs(fk - lines[pos - 1]), np.abs(fk - lines[pos]))
-        qp = explained(dist <= ftol)
+        qp = explained(_on_torus_lines(fk, f1, f2, max_order, ftol))
         if qp >= 1.0 - line_tol:
             return result("quasiperiodic", None, (f1 * df, f2 * df), qp, per_best, qp)
     best = max(per_best, -1.0 if math.isnan(qp) else qp)

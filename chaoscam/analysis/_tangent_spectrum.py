@@ -19,30 +19,18 @@ __all__ = ["TangentSpectrum", "spectrum_from_jacobians"]
 class TangentSpectrum:
     """Lyapunov exponents of a sequence of map Jacobians (`spectrum_from_jacobians`).
 
-    Attributes
-    ----------
-    exponents : ndarray, shape (2,)
-        λ₁ ≥ λ₂ per unit time of `period` [1/s for the model]. λ₂ = -inf when a Jacobian is
-        singular (for the model, a plastic closure ending a complete chattering: a Floquet
-        multiplier 0).
-    stderr : ndarray, shape (2,)
-        Standard errors from batch means of the per-iterate log growths (NaN with fewer
-        than `n_batches` iterates, or for an infinite exponent).
-    n_periods : int
-        Iterates (for the model: cam periods) averaged.
-    local : ndarray, shape (n_periods, 2)
-        ln R_kk of each QR step (the local growth per iterate).
-    det_log : float
-        Mean of ln|det J_k| per unit time (equals λ₁ + λ₂).
-    settings : dict
-        What the estimate used.
+    ``exponents`` are λ₁ ≥ λ₂ per unit time of `period` [1/s for the model]; λ₂ = -inf when
+    a Jacobian is singular (for the model, a plastic closure ending a complete chattering:
+    a Floquet multiplier 0). ``stderr`` are their standard errors from batch means of the
+    per-iterate log growths (NaN with fewer than `n_batches` iterates, or for an infinite
+    exponent).
     """
 
-    exponents: np.ndarray
-    stderr: np.ndarray
-    n_periods: int
-    local: np.ndarray = field(repr=False)
-    det_log: float
+    exponents: np.ndarray  # shape (2,)
+    stderr: np.ndarray  # shape (2,)
+    n_periods: int  # iterates (for the model: cam periods) averaged
+    local: np.ndarray = field(repr=False)  # ln R_kk of each QR step, shape (n_periods, 2)
+    det_log: float  # mean of ln|det J_k| per unit time (equals λ₁ + λ₂)
     settings: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:

@@ -40,16 +40,15 @@ class Thresholds:
         Fewest section points for the rotation-order and expansion votes (a period up to
         N / 2 shows on fewer; a quasiperiodic/chaotic call from fewer than 100 is weak).
     rotation_quasi : float
-        Rank-shift consistency R (`rotation_order`) at or above which the points advance
-        along a closed curve like a rotation (R ~ 1 / sqrt(N) for chaos).
+        Rank-shift consistency R (`rotation_order`) from which the points advance along a
+        closed curve like a rotation (R ~ 1 / sqrt(N) for chaos).
     expansion_chaotic : float
         Mean one-step log growth of nearest-neighbour distances (`neighbour_expansion`)
         above which neighbours separate: 0.1 per iterate, a tenth of an e-fold.
-    dimension_chaotic : float
-        Correlation dimension at or above which the set is not a curve (closed curves give
-        1.02-1.09, the Hénon attractor 1.17-1.19, Ueda's section 1.53-1.60).
-    dimension_min_points : int
-        Fewest points for the correlation dimension to vote (10^{D₂} per scaling decade).
+    dimension_chaotic, dimension_min_points : float, int
+        Correlation dimension from which the set is not a curve (closed curves give
+        1.02-1.09, the Hénon attractor 1.17-1.19, Ueda's section 1.53-1.60), and the fewest
+        points for it to vote (10^{D₂} per scaling decade).
     zero_one_chaotic, zero_one_regular : float
         0-1 test: K >= 0.8 votes chaotic, K <= 0.2 not chaotic (Gottwald & Melbourne 2009).
     zero_one_min_points : int
@@ -58,12 +57,15 @@ class Thresholds:
     zero_one_max_change : float
         Largest |K(first half) - K(whole)| for which K is taken as converged in N, else the
         test abstains (on a cam attractor K can fall from 0.94 at 229 points to 0.16 at 914).
-    birkhoff_quasi_digits : float
-        Converged digits of the weighted Birkhoff averages (`weighted_birkhoff`) at or
-        above which an orbit with no period is quasiperiodic: on 200-4000 points tori give
-        6-15 digits, chaotic orbits (logistic r = 4, Hénon) below 2.5, noise of 1e-4 about 5.
-    birkhoff_min_points : int
-        Fewest points for the Birkhoff evidence to vote (two halves of 100).
+    birkhoff_quasi_digits, birkhoff_min_points : float, int
+        Converged digits of the weighted Birkhoff averages (`weighted_birkhoff`) from which
+        an orbit with no period is quasiperiodic (on 200-4000 points tori give 6-15 digits,
+        chaotic orbits (logistic r = 4, Hénon) below 2.5, noise of 1e-4 about 5), and the
+        fewest points for it to vote (two halves of 100).
+    birkhoff_rational_tol : float
+        A converged rotation number within this of a rational p/q, q <= N/2, is not a torus
+        vote: an unresolved period-q orbit has one too (the cam at ξ = 0.30, period 30:
+        3/5 + 4e-10); 1e-8 mistakes a torus for one with probability ~1e-8 (N/2)².
     exponent_zero : float
         A largest exponent whose confidence interval lies above this is positive (chaotic),
         below it not positive: 0.01, an e-fold in 100 iterates, below what a run resolves.
@@ -88,10 +90,6 @@ class Thresholds:
     constant_signal : float
         `classify_signal`: a signal whose range is below this fraction of its magnitude is
         constant (an equilibrium).
-    birkhoff_rational_tol : float
-        A converged rotation number within this of a rational p/q, q <= N/2, is not a torus
-        vote: an unresolved period-q orbit has one too (the cam at ξ = 0.30, period 30:
-        3/5 + 4e-10); 1e-8 mistakes a torus for one with probability ~1e-8 (N/2)².
     """
 
     period_rtol: float = 3e-3

@@ -41,20 +41,9 @@ def _json_value(v):
 
 @dataclass(frozen=True)
 class Evidence:
-    """One method's finding.
-
-    Attributes
-    ----------
-    name : str
-        The method ("section_period", "spectrum", "zero_one", "lyapunov", ...).
-    value : float, int or None
-        Its headline number (the period, K, λ₁, the broadband fraction, ...).
-    vote : str or None
-        "periodic", "quasiperiodic", "chaotic", "not_chaotic", "not_periodic", or None
-        when the method abstains (see `VOTES`).
-    detail : str
-        What was measured and why it votes as it does (or why it abstains).
-    """
+    """One method's finding: its ``name`` ("section_period", "spectrum", "zero_one", ...), its
+    headline ``value`` (the period, K, λ₁, ...), its ``vote`` (a key of `VOTES`; None
+    abstains) and a ``detail`` saying what was measured and why it votes as it does."""
 
     name: str
     value: float | int | None
@@ -79,7 +68,7 @@ class Verdict:
     Attributes
     ----------
     label : str
-        "periodic", "quasiperiodic", "chaotic" or "undetermined".
+        One of `LABELS`.
     period : int or None
         For "periodic": the period in iterates of the section map (in forcing periods for a
         stroboscopic section); None otherwise.
@@ -88,8 +77,8 @@ class Verdict:
     reasons : tuple of str
         Why the label is "undetermined" (disagreement, too little data), or what limits it.
     settings : dict
-        The settings used by each method; ``settings["thresholds"]`` is the `Thresholds`
-        table the classifier used (as a dict). Read-only at its top level (a ``FrozenDict``).
+        The settings used by each method, ``settings["thresholds"]`` the `Thresholds` table
+        (as a dict); read-only at its top level (a ``FrozenDict``).
     """
 
     label: str
@@ -109,8 +98,7 @@ class Verdict:
         return tuple(e.name for e in self.evidence if e.vote is not None)
 
     def to_dict(self) -> dict:
-        """JSON-serialisable dict with keys label, period, evidence, reasons (not `settings`,
-        where the thresholds are)."""
+        """JSON-serialisable dict with keys label, period, evidence, reasons (not `settings`)."""
         return dict(
             label=self.label,
             period=None if self.period is None else int(self.period),
@@ -137,51 +125,44 @@ def combine(
     spectrum); any other disagreement makes the verdict undetermined.
     """
     evidence = tuple(evidence)
-    reasons = list(reasons)
-    settings = dict(settings or {})
+    label, period, why = _label(evidence, periods or {})
+    reasons = (*reasons, why) if why else tuple(reasons)
+    return Verdict(label, period, evidence, reasons, dict(settings or {}))
+
+
+def _label(evidence: tuple[Evidence, ...], periods: dict) -> tuple[str, int | None, str]:
+    """(label, period, why it is undetermined or "") by the rules of `combine`."""
     cast = [e for e in evidence if e.vote is not None]
     if not cast:
-        reasons.append("no method could decide (see the evidence for why each abstained)")
-        return Verdict("undetermined", None, evidence, tuple(reasons), settings)
+        why = "no method could decide (see the evidence for why each abstained)"
+        return "undetermined", None, why
     admitted = frozenset({"periodic", "quasiperiodic", "chaotic"})
     for e in cast:
         admitted = admitted & VOTES[e.vote]
     votes_txt = ", ".join(f"{e.name}: {e.vote}" for e in cast)
     if not admitted:
-        reasons.append(f"the evidence disagrees ({votes_txt})")
-        return Verdict("undetermined", None, evidence, tuple(reasons), settings)
+        return "undetermined", None, f"the evidence disagrees ({votes_txt})"
     if len(admitted) > 1:
-        reasons.append(
-            f"the evidence does not separate {' / '.join(sorted(admitted))} ({votes_txt})"
-        )
-        return Verdict("undetermined", None, evidence, tuple(reasons), settings)
+        why = f"the evidence does not separate {' / '.join(sorted(admitted))} ({votes_txt})"
+        return "undetermined", None, why
     (label,) = admitted
     if not any(e.vote == label for e in cast):
-        reasons.append(
-            f"only exclusions point to {label} ({votes_txt}); no method supports it directly"
-        )
-        return Verdict("undetermined", None, evidence, tuple(reasons), settings)
-    period = None
-    if label == "periodic":
-        periods = {k: int(v) for k, v in (periods or {}).items() if v is not None}
-        exact = {k: v for k, v in periods.items() if k.startswith("section")}
-        spectral = {k: v for k, v in periods.items() if not k.startswith("section")}
-        if len(set(exact.values())) > 1:
-            reasons.append(f"the section periods disagree: {exact}")
-            return Verdict("undetermined", None, evidence, tuple(reasons), settings)
-        if exact:
-            period = next(iter(exact.values()))
-            bad = {k: v for k, v in spectral.items() if period % v != 0}
-            if bad:
-                reasons.append(
-                    f"the spectral period {bad} does not divide the section period {period}"
-                )
-                return Verdict("undetermined", None, evidence, tuple(reasons), settings)
-        elif spectral:
-            if len(set(spectral.values())) > 1:
-                reasons.append(f"the periods disagree: {spectral}")
-                return Verdict("undetermined", None, evidence, tuple(reasons), settings)
-            period = next(iter(spectral.values()))
-        else:
-            period = 1
-    return Verdict(label, period, evidence, tuple(reasons), settings)
+        why = f"only exclusions point to {label} ({votes_txt}); no method supports it directly"
+        return "undetermined", None, why
+    if label != "periodic":
+        return label, None, ""
+    periods = {k: int(v) for k, v in periods.items() if v is not None}
+    exact = {k: v for k, v in periods.items() if k.startswith("section")}
+    spectral = {k: v for k, v in periods.items() if not k.startswith("section")}
+    if len(set(exact.values())) > 1:
+        return "undetermined", None, f"the section periods disagree: {exact}"
+    if exact:
+        period = next(iter(exact.values()))
+        bad = {k: v for k, v in spectral.items() if period % v != 0}
+        if bad:
+            why = f"the spectral period {bad} does not divide the section period {period}"
+            return "undetermined", None, why
+        return label, period, ""
+    if len(set(spectral.values())) > 1:
+        return "undetermined", None, f"the periods disagree: {spectral}"
+    return label, next(iter(spectral.values()), 1), ""

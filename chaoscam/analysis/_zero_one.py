@@ -15,38 +15,18 @@ __all__ = ["ZeroOneResult", "zero_one_test"]
 
 @dataclass(frozen=True)
 class ZeroOneResult:
-    """Result of `zero_one_test`.
+    """Result of `zero_one_test`. ``oversampled`` is Matthews' z1test heuristic: the series
+    moves little per sample, or K_c differs strongly between small and large c (subsample
+    and run again)."""
 
-    Attributes
-    ----------
-    k : float
-        Median of K_c over the c values: near 1 for chaotic, near 0 for regular dynamics;
-        NaN when the test could not run (see `message`).
-    k_c : ndarray
-        K_c for each c.
-    c : ndarray
-        The c values used.
-    n : int
-        Series length used.
-    n_cut : int
-        Largest lag n of the displacement D_c(n).
-    oversampled : bool
-        Heuristic flag (Matthews' z1test): the series moves little per sample, or K_c
-        differs strongly between small and large c. Subsample and run again.
-    message : str
-        Empty when the test ran, otherwise why it did not.
-    settings : dict
-        The settings used (n_c, c_range, seed, n_cut).
-    """
-
-    k: float
-    k_c: np.ndarray
-    c: np.ndarray
-    n: int
-    n_cut: int
+    k: float  # median of K_c: near 1 chaotic, near 0 regular; NaN when not run (`message`)
+    k_c: np.ndarray  # K_c for each c
+    c: np.ndarray  # the c values used
+    n: int  # series length used
+    n_cut: int  # largest lag of the displacement D_c(n)
     oversampled: bool
-    message: str = ""
-    settings: dict = field(default_factory=dict)
+    message: str = ""  # why the test did not run, else empty
+    settings: dict = field(default_factory=dict)  # n_c, c_range, seed, n_cut, min_length
 
     def __post_init__(self) -> None:
         freeze_fields(self, "k_c", "c", "settings")
@@ -126,29 +106,14 @@ def zero_one_test(
         )
     n_total = phi.size
     settings = dict(n_c=n_c, c_range=tuple(c_range), seed=seed, n_cut=n_cut, min_length=min_length)
-    empty = np.array([])
+    why = ""
     if n_total < min_length:
-        return ZeroOneResult(
-            math.nan,
-            empty,
-            empty,
-            n_total,
-            0,
-            False,
-            f"only {n_total} samples; the 0-1 test needs >= {min_length}",
-            settings,
-        )
-    if np.ptp(phi) <= 1e-12 * max(1.0, float(np.max(np.abs(phi)))):
-        return ZeroOneResult(
-            math.nan,
-            empty,
-            empty,
-            n_total,
-            0,
-            False,
-            "constant series: the 0-1 test is undefined",
-            settings,
-        )
+        why = f"only {n_total} samples; the 0-1 test needs >= {min_length}"
+    elif np.ptp(phi) <= 1e-12 * max(1.0, float(np.max(np.abs(phi)))):
+        why = "constant series: the 0-1 test is undefined"
+    if why:
+        empty = np.array([])
+        return ZeroOneResult(math.nan, empty, empty, n_total, 0, False, why, settings)
     nc = int(n_cut) if n_cut is not None else n_total // 10
     nc = max(2, min(nc, n_total - 2))
     rng = np.random.default_rng(np.random.SeedSequence(seed))

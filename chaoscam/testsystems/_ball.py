@@ -127,32 +127,17 @@ def _run(t0, v0, gamma, e, n_impacts, h_max, h_min, v_stick, max_events):
 
 @dataclass(frozen=True)
 class BallRun:
-    """Impacts of one bouncing-ball run (dimensionless units).
+    """Impacts of one bouncing-ball run (dimensionless units). The ball leaves the table
+    after impact k at ``leave_times[k]`` with ``leave_velocities[k]``: at the impact itself,
+    or at the end of a sticking episode."""
 
-    Attributes
-    ----------
-    times : ndarray
-        Impact times τ_k (unwrapped).
-    velocities : ndarray
-        Absolute ball velocities just after each impact.
-    leave_times, leave_velocities : ndarray
-        When (and how fast) the ball leaves the table after each impact: the impact itself,
-        or the end of a sticking episode.
-    n_stick : int
-        Number of sticking episodes (complete chattering followed by riding the table).
-    status : str
-        "ok", or why the run stopped early.
-    settings : dict
-        Everything the run used.
-    """
-
-    times: np.ndarray
-    velocities: np.ndarray
+    times: np.ndarray  # impact times τ_k (unwrapped)
+    velocities: np.ndarray  # absolute ball velocities just after each impact
     leave_times: np.ndarray
     leave_velocities: np.ndarray
-    n_stick: int
-    status: str
-    settings: dict = field(default_factory=dict)
+    n_stick: int  # sticking episodes (complete chattering, then riding the table)
+    status: str  # "ok", or why the run stopped early
+    settings: dict = field(default_factory=dict)  # everything the run used
 
     def impact_section(self, discard: int = 0) -> np.ndarray:
         """Impact map points ``(τ_k mod 2π, v_k)``, shape (N - discard, 2)."""
@@ -220,28 +205,12 @@ def bouncing_ball(
         v0 = gamma * math.cos(t0) + math.pi
     if max_events is None:
         max_events = 50 * int(n_impacts)
+    settings = dict(gamma=gamma, e=e, n_impacts=n_impacts, t0=t0, v0=v0, h_max=h_max,
+                    h_min=h_min, v_stick=v_stick, max_events=max_events)  # fmt: skip
     times, vels, leave_t, leave_v, n_stick, status = _run(
-        float(t0),
-        float(v0),
-        float(gamma),
-        float(e),
-        int(n_impacts),
-        float(h_max),
-        float(h_min),
-        float(v_stick),
-        int(max_events),
-    )
-    settings = dict(
-        gamma=gamma,
-        e=e,
-        n_impacts=n_impacts,
-        t0=t0,
-        v0=v0,
-        h_max=h_max,
-        h_min=h_min,
-        v_stick=v_stick,
-        max_events=max_events,
-    )
+        float(t0), float(v0), float(gamma), float(e), int(n_impacts), float(h_max),
+        float(h_min), float(v_stick), int(max_events),
+    )  # fmt: skip
     return BallRun(times, vels, leave_t, leave_v, int(n_stick), _STATUS[status], settings)
 
 
@@ -388,54 +357,50 @@ def period_one_thresholds(
     if x0 is None:
         raise ValueError(f"no attracting period-one orbit at gamma_start = {gamma_start}")
 
-    # --- existence: step down, then bisect
-    hi, x_hi = gamma_start, x0
-    lo = None
-    g = gamma_start
-    while lo is None:
-        g *= 0.99
-        x, _, ok = period_one_orbit(g, e, n, guess=tuple(x_hi))
-        if ok:
-            hi, x_hi = g, x
-        else:
-            lo = g
-        if g < 1e-3:
-            raise ValueError("continuation downwards did not end")
-    while (hi - lo) > rel_tol * hi:
-        mid = 0.5 * (lo + hi)
-        x, _, ok = period_one_orbit(mid, e, n, guess=tuple(x_hi))
-        if ok:
-            hi, x_hi = mid, x
-        else:
-            lo = mid
-    gamma_exist = hi
+    def exists(g, guess):
+        x, _, ok = period_one_orbit(g, e, n, guess=tuple(guess))
+        return ok, x
 
-    # --- period doubling of the branch followed from gamma_start: step up, then bisect
-    def flip(g, guess):
-        x, j, ok = period_one_orbit(g, e, n, guess=guess)
+    def flip_sign(g, guess):  # the sign of 1 + tr J + det J, the characteristic polynomial at -1
+        x, j, ok = period_one_orbit(g, e, n, guess=tuple(guess))
         if not ok:
             raise ValueError(f"lost the period-one orbit at gamma = {g}")
-        return 1.0 + np.trace(j) + np.linalg.det(j), x
+        return np.sign(1.0 + np.trace(j) + np.linalg.det(j)), x
 
-    f0, x_lo = flip(gamma_start, tuple(x0))
-    lo, g = gamma_start, gamma_start
-    while True:
-        g *= 1.01
-        f1, x1 = flip(g, tuple(x_lo))
-        if np.sign(f1) != np.sign(f0):
-            hi = g
-            break
-        lo, x_lo = g, x1
-        if g > 1e3:
-            raise ValueError("no period doubling found")
-    while (hi - lo) > rel_tol * hi:
-        mid = 0.5 * (lo + hi)
-        fm, xm = flip(mid, tuple(x_lo))
-        if np.sign(fm) == np.sign(f0):
-            lo, x_lo = mid, xm
-        else:
-            hi = mid
+    def unflipped(g, guess):
+        sign, x = flip_sign(g, guess)
+        return sign == sign0, x
+
+    gamma_exist, _ = _edge(exists, gamma_start, x0, 0.99, rel_tol,
+                           "continuation downwards did not end")  # fmt: skip
+    sign0, x_start = flip_sign(gamma_start, x0)  # the branch followed from gamma_start
+    lo, hi = _edge(unflipped, gamma_start, x_start, 1.01, rel_tol, "no period doubling found")
     return gamma_exist, 0.5 * (lo + hi)
+
+
+def _edge(holds, g, state, factor, rel_tol, stuck):
+    """Where ``holds(g, state) -> (bool, state)`` stops holding: g stepped by `factor` from
+    where it holds, then bisected to relative precision `rel_tol`, each probe started from
+    the state of the last g where it held. Returns (last g where it holds, first where it
+    does not); ValueError(`stuck`) when g leaves [1e-3, 1e3] first."""
+    inside = g
+    while True:
+        g *= factor
+        ok, new = holds(g, state)
+        if not ok:
+            break
+        inside, state = g, new
+        if not 1e-3 <= g <= 1e3:
+            raise ValueError(stuck)
+    outside = g
+    while abs(outside - inside) > rel_tol * max(inside, outside):
+        mid = 0.5 * (inside + outside)
+        ok, new = holds(mid, state)
+        if ok:
+            inside, state = mid, new
+        else:
+            outside = mid
+    return inside, outside
 
 
 def ball_period_one_theory(e: float, n: int = 1) -> tuple[float, float]:

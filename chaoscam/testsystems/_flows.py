@@ -43,11 +43,7 @@ def _rk4_run(kind, y0, p, h, n_steps, every):
     n_out = n_steps // every + 1
     out = np.empty((n_out, d))
     y = y0.copy()
-    k1 = np.empty(d)
-    k2 = np.empty(d)
-    k3 = np.empty(d)
-    k4 = np.empty(d)
-    tmp = np.empty(d)
+    k1, k2, k3, k4, tmp = np.empty(d), np.empty(d), np.empty(d), np.empty(d), np.empty(d)
     out[0] = y
     j = 1
     for s in range(1, n_steps + 1):
@@ -71,26 +67,13 @@ def _rk4_run(kind, y0, p, h, n_steps, every):
 
 @dataclass(frozen=True)
 class FlowSystem:
-    """A test flow ``y' = f(y; p)``: name, compiled right-hand side and parameters.
-
-    Attributes
-    ----------
-    name : str
-    kind : int
-        Which compiled vector field (LORENZ, ROSSLER, UEDA) the kernels evaluate.
-    params : tuple of float
-        Parameter values, in the order the vector field reads them.
-    dim : int
-        State dimension (time included for forced systems).
-    forcing_period : float or None
-        Period of the forcing for non-autonomous systems (time is then ``y[-1]``).
-    """
+    """A test flow ``y' = f(y; p)``: its compiled right-hand side and parameters."""
 
     name: str
-    kind: int
-    params: tuple[float, ...]
-    dim: int
-    forcing_period: float | None = None
+    kind: int  # which compiled vector field (LORENZ, ROSSLER, UEDA) the kernels evaluate
+    params: tuple[float, ...]  # in the order the vector field reads them
+    dim: int  # state dimension (time included for forced systems)
+    forcing_period: float | None = None  # of a non-autonomous system (time is then y[-1])
 
 
 def lorenz(sigma: float = 10.0, rho: float = 28.0, beta: float = 8.0 / 3.0) -> FlowSystem:
@@ -130,7 +113,8 @@ def flow_trajectory(
     y0 : array_like, shape (dim,)
         Initial state (time last for forced systems).
     dt : float
-        RK4 step.
+        RK4 step: global error O(dt⁴); 0.005 for Lorenz, 0.01 for Rössler and Ueda keep it
+        far below what the tests resolve.
     n_samples, sample_every : int
         Samples returned, and steps between them (interval ``dt * sample_every``).
     transient_time : float
@@ -139,14 +123,9 @@ def flow_trajectory(
     Returns
     -------
     t : ndarray, shape (n_samples,)
-        Sample times, starting at 0 after the transient (for forced systems use
-        ``states[:, -1]`` for the absolute time).
+        Sample times from 0 after the transient (``states[:, -1]`` is a forced system's
+        absolute time).
     states : ndarray, shape (n_samples, dim)
-
-    Notes
-    -----
-    RK4 has global error O(dt⁴); choose dt well below the fastest time scale (0.005 for
-    Lorenz, 0.01 for Rössler and Ueda keep the error far below what the tests resolve).
     """
     p = np.asarray(system.params, dtype=float)
     y = np.asarray(y0, dtype=float).copy()
@@ -180,15 +159,9 @@ def flow_reference(
         return out.copy()
 
     t_eval = np.asarray(t_eval, dtype=float)
-    sol = solve_ivp(
-        f,
-        (t_eval[0], t_eval[-1]),
-        np.asarray(y0, dtype=float),
-        method="DOP853",
-        t_eval=t_eval,
-        rtol=rtol,
-        atol=atol,
-    )
+    y0 = np.asarray(y0, dtype=float)
+    span = (t_eval[0], t_eval[-1])
+    sol = solve_ivp(f, span, y0, method="DOP853", t_eval=t_eval, rtol=rtol, atol=atol)
     if not sol.success:
         raise RuntimeError(f"solve_ivp failed: {sol.message}")
     return sol.y.T

@@ -13,30 +13,15 @@ GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 
 def torus_signal(
-    t: np.ndarray,
-    *,
-    f1: float = 1.0,
-    f2: float = GOLDEN,
-    a: float = 0.5,
-    b: float = 0.3,
+    t: np.ndarray, *, f1: float = 1.0, f2: float = GOLDEN, a: float = 0.5, b: float = 0.3
 ) -> np.ndarray:
-    """Quasiperiodic signal on a two-torus: an amplitude- and phase-modulated carrier.
+    """Quasiperiodic signal on a two-torus: an amplitude- and phase-modulated carrier,
 
-    ``x(t) = (1 + a cos 2π f2 t) cos 2π f1 t + b sin 2π f2 t``
+        x(t) = (1 + a cos 2π f2 t) cos 2π f1 t + b sin 2π f2 t,
 
-    Parameters
-    ----------
-    t : array_like
-    f1, f2 : float
-        Base frequencies; quasiperiodic when f2 / f1 is irrational (default golden mean).
-    a, b : float
-        Modulation depth and the weight of the second frequency.
-
-    Returns
-    -------
-    ndarray
-        x(t). Its spectrum holds lines at f1, f2 and f1 ± f2 only (a trigonometric
-        polynomial on the torus), so it is exactly a two-frequency signal.
+    quasiperiodic when f2 / f1 is irrational (default the golden mean). Its spectrum holds
+    lines at f1, f2 and f1 ± f2 only (a trigonometric polynomial on the torus), so it is
+    exactly a two-frequency signal.
     """
     t = np.asarray(t, dtype=float)
     p1 = 2.0 * math.pi * f1 * t
@@ -45,24 +30,12 @@ def torus_signal(
 
 
 def torus_section(
-    n: int,
-    *,
-    f1: float = 1.0,
-    f2: float = GOLDEN,
-    a: float = 0.5,
-    b: float = 0.3,
+    n: int, *, f1: float = 1.0, f2: float = GOLDEN, a: float = 0.5, b: float = 0.3,
     phase: float = 0.0,
-) -> np.ndarray:
-    """Stroboscopic section of `torus_signal` at the period 1/f1: points (x, x').
-
-    At ``t_k = (k + phase) / f1`` the points lie on a closed curve (an ellipse for phase 0)
-    and advance along it by the rotation number f2 / f1 each step.
-
-    Returns
-    -------
-    ndarray, shape (n, 2)
-        ``(x(t_k), x'(t_k))``, the derivative taken analytically.
-    """
+) -> np.ndarray:  # fmt: skip
+    """Stroboscopic section of `torus_signal` at the period 1/f1: the points ``(x(t_k),
+    x'(t_k))``, shape (n, 2), at ``t_k = (k + phase) / f1`` (x' analytic). They lie on a
+    closed curve (an ellipse for phase 0) and advance along it by f2 / f1 each step."""
     t = (np.arange(int(n)) + phase) / f1
     w1 = 2.0 * math.pi * f1
     w2 = 2.0 * math.pi * f2
