@@ -10,7 +10,7 @@ from typing import Any
 
 from ._fields import ParameterError
 
-__all__ = ["COUNT_MAX", "flag", "of_type", "real", "whole"]
+__all__ = ["COUNT_MAX", "flag", "real", "whole"]
 
 COUNT_MAX = 2**63 - 1
 """Largest seed or realization index: the tables store them as 64-bit integers, so a larger one
@@ -58,14 +58,4 @@ def real(
         raise ParameterError(f"{name} = {value!r}{unit} must be {'>' if strict else '>='} {low}")
     if high is not None and value > high:
         raise ParameterError(f"{name} = {value!r}{unit} must be <= {high}")
-    return value
-
-
-def of_type(name: str, value: Any, cls: type, made_by: str) -> Any:
-    """``value`` when it is a ``cls``; else a TypeError naming ``name``, what it got and what
-    makes one (not an AttributeError from deep inside)."""
-    if not isinstance(value, cls):
-        raise TypeError(
-            f"{name} must be a chaoscam {cls.__name__} ({made_by}), got {type(value).__name__}"
-        )
     return value

@@ -1,7 +1,6 @@
 """Documented, validated fields of a frozen settings dataclass (``Params``, ``Numerics``): each
-declares its meaning, unit, allowed range or choices (:func:`meta`); :func:`check_fields`
-enforces them, naming the field and range; :func:`field_table` is the table ``chaoscam params``
-prints; :func:`strict_init` refuses an unknown keyword with the names it was probably meant as."""
+declares its meaning, unit, allowed range or choices (:func:`meta`), which :func:`check_fields`
+enforces and :func:`field_table` lists; :func:`strict_init` refuses an unknown keyword."""
 
 from __future__ import annotations
 
@@ -78,16 +77,13 @@ def check_fields(obj: Any) -> None:
         value = getattr(obj, f.name)
         if type(value).__module__ == "numpy" and getattr(value, "size", 0) == 1:
             value = value.item()
+        kind = {"int": int, "float": float, "float | None": float}.get(f.type)
         try:
             _validate(f, value)
-        except OverflowError:  # int(10**400) compared with a float
-            raise ParameterError(f"{f.name} = {value!r} is too large") from None
-        kind = {"int": int, "float": float, "float | None": float}.get(f.type)
-        if kind and value is not None and type(value) is not kind:
-            try:
+            if kind and value is not None and type(value) is not kind:
                 value = kind(value)
-            except OverflowError:
-                raise ParameterError(f"{f.name} = {value!r} is too large") from None
+        except OverflowError:  # int(10**400) compared with, or made, a float
+            raise ParameterError(f"{f.name} = {value!r} is too large") from None
         object.__setattr__(obj, f.name, value)
 
 
@@ -150,11 +146,9 @@ def field_table(cls: type) -> list[dict[str, Any]]:
     rows = []
     for f in dataclasses.fields(cls):
         m = f.metadata
-        allowed = (
-            ", ".join(map(repr, m["choices"]))
-            if m["choices"] is not None
-            else (describe_range(m["range"]) if m["range"] is not None else "any")
-        )
+        allowed = describe_range(m["range"]) if m["range"] is not None else "any"
+        if m["choices"] is not None:
+            allowed = ", ".join(map(repr, m["choices"]))
         rows.append({"name": f.name, "unit": m["unit"], "default": f.default, "range": allowed,
                      "doc": m["doc"]})  # fmt: skip
     return rows

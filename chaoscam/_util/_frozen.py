@@ -1,8 +1,7 @@
-"""A dict that cannot be changed, the record of how a result was made: :class:`FrozenDict` reads
-like a dict (``json.dumps``, ``{**d}``, ``d.get``, pickling) and refuses every change with a
-TypeError saying how to make a changed copy, so a result's ``settings`` cannot be edited into
-the record of a run not made; :func:`freeze_fields` does the same for a frozen result's fields
-(arrays as read-only views). Standard library only, so any module may use it."""
+"""Records of how a result was made that cannot be changed: :class:`FrozenDict` reads like a dict
+(``json.dumps``, ``{**d}``, pickling) and refuses every change with a TypeError saying how to
+make a changed copy; :func:`freeze_fields` does the same for a frozen result's fields (arrays as
+read-only views). Standard library only."""
 
 from __future__ import annotations
 

@@ -1,14 +1,11 @@
 """Warnings that point at the user's line, and warning capture that is safe on threads.
 
-A fixed ``stacklevel`` is right for one call path only (``simulate`` warning at level 3 names a
-line of chaoscam when :func:`chaoscam.classify` re-simulates): :func:`warn` walks the stack past
-every frame of this package to the first line outside it (the user's script, the test, the
-console script); a stack that is chaoscam all the way (``python -m chaoscam``) names the
-interpreter's frame above it, as ``warnings.warn`` does past the top. :func:`recorded` is
-``warnings.catch_warnings(record=True)`` for code on several threads at once (the sweeps' batch
-threads): ``catch_warnings`` swaps module-wide state, and two threads leaving it out of order
-leave a dead record list as the process's printer and an "always" filter, so every later warning
-vanishes. Standard library only, so any module may use it.
+:func:`warn` walks the stack past every frame of this package to the first line outside it (a
+fixed ``stacklevel`` is right for one call path only); a stack that is chaoscam all the way
+(``python -m chaoscam``) names the interpreter's frame above it. :func:`recorded` is
+``warnings.catch_warnings(record=True)`` for code on several threads at once:
+``catch_warnings`` swaps module-wide state, and two threads leaving it out of order leave a dead
+record list as the process's printer, so every later warning vanishes. Standard library only.
 """
 
 from __future__ import annotations
@@ -24,16 +21,12 @@ from collections.abc import Iterator
 _PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
 
 
-def _inside(filename: str) -> bool:
-    return os.path.abspath(filename).startswith(_PACKAGE)
-
-
 def user_stacklevel() -> int:
     """The ``stacklevel`` that, given to ``warnings.warn`` by the function that called this
     one, names the first frame outside the chaoscam package."""
     level = 2  # warnings.warn's level 2: the caller of the function calling user_stacklevel
     frame = sys._getframe(2)  # that caller
-    while frame is not None and _inside(frame.f_code.co_filename):
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE):
         frame = frame.f_back
         level += 1
     return level
@@ -90,11 +83,10 @@ def _leave_hub() -> None:
 @contextlib.contextmanager
 def recorded() -> Iterator[list[warnings.WarningMessage]]:
     """Every warning raised in this context (this thread, and threads running a copy of its
-    context: :func:`contextvars.copy_context`) as ``warnings.WarningMessage`` objects, none
-    printed; other threads' warnings go where they went before. Thread-safe: the module-wide
-    state is swapped by the first of any number of concurrent ``recorded`` contexts and
-    restored by the last; while any is active every thread's warnings pass an "always" filter
-    (repeats are not folded) under the filters of when the first began."""
+    context) as ``warnings.WarningMessage`` objects, none printed; other threads' warnings go
+    where they went before. The module-wide state is swapped by the first of any number of
+    concurrent ``recorded`` contexts and restored by the last; meanwhile every thread's warnings
+    pass an "always" filter (repeats not folded) under the filters of when the first began."""
     sink: list[warnings.WarningMessage] = []
     token = _SINK.set(sink)
     _enter_hub()
@@ -105,7 +97,6 @@ def recorded() -> Iterator[list[warnings.WarningMessage]]:
         _SINK.reset(token)
 
 
-def quiet() -> contextlib.AbstractContextManager:
-    """``catch_warnings()`` + ``simplefilter("ignore")`` for this context only, safe on
-    several threads at once: :func:`recorded`, its list dropped."""
-    return recorded()
+quiet = recorded
+"""``catch_warnings()`` + ``simplefilter("ignore")`` for this context only, safe on several
+threads at once: :func:`recorded`, its list dropped."""

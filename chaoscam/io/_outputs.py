@@ -1,9 +1,7 @@
-"""One rule for every file chaoscam writes: checked first, never overwritten, written whole.
-:func:`check_output` runs before any work; :func:`atomic_path` writes a temporary name beside
-the file, flushed, then :func:`os.replace`'d into place (a reader or resumed run sees the whole
-file or none); :class:`OutputLock` (``fcntl.flock`` beside an output or checkpoint) refuses a
-second process on the same output instead of silently losing records. Every failure is an
-:class:`OutputError` (a ``ValueError``) naming the path and what to do (the CLI exits with 2)."""
+"""One rule for every file chaoscam writes: checked first (:func:`check_output`, before any
+work), never overwritten silently, written whole (:func:`atomic_path`: a temporary name beside
+it, flushed, then renamed into place), locked against a second process (:class:`OutputLock`).
+Every failure is an :class:`OutputError` (a ``ValueError``) naming the path and what to do."""
 
 from __future__ import annotations
 
@@ -34,16 +32,15 @@ def check_output(
     path: str | Path | None, *, flag: str = "--out", force: bool = False,
     suffixes: tuple[str, ...] | None = None, force_hint: str = "pass --force",
 ) -> Path | None:  # fmt: skip
-    """Check that ``path`` can be written, before any work is done; returns it as a Path.
+    """Check that ``path`` can be written, before any work is done; returns it as a Path
+    (None, no output asked for, passes).
 
     Parameters
     ----------
-    path : path or None
-        The output; None (no output asked for) passes.
     flag : str
         How the path was given (``--out``, ``--section``, ...), for the message.
     force : bool
-        Replace an existing file (``--force``); without it an existing file is refused.
+        Replace an existing file (``--force``); else an existing file is refused.
     suffixes : tuple of str, optional
         Allowed suffixes (case-insensitive), e.g. ``(".parquet", ".csv")``.
     force_hint : str
@@ -90,8 +87,7 @@ atomic write or checkpoint folder on its way, PID up to 7 digits) is 18 longer."
 
 
 def _check_name_length(folder: Path, path: Path, flag: str) -> None:
-    """Refuse a name too long for the temporary and companion names made from it, before any
-    work (not when the result is written)."""
+    """Refuse, before any work, a name too long for the temporary and companion names."""
     try:
         most = os.pathconf(folder, "PC_NAME_MAX")
     except (OSError, ValueError, AttributeError):
@@ -121,12 +117,11 @@ def _probe(folder: Path, what: str) -> None:
 
 @contextlib.contextmanager
 def atomic_path(path: str | Path, *, replace: bool = True) -> Iterator[Path]:
-    """A temporary path to write ``path`` to, moved into place when the block succeeds: flushed
-    to disk before the rename, the file is whole or absent whenever the process is killed; on an
-    exception it is removed. ``replace=False`` (an output checked absent, without ``--force``)
-    places it only if ``path`` still does not exist, atomically (a hard link refuses an existing
-    name): a file another process wrote meanwhile is kept, this one's result beside it
-    (:func:`conflict_name`), and an :class:`OutputError` names both."""
+    """A temporary path to write ``path`` to, flushed and moved into place when the block
+    succeeds (the file is whole or absent whenever the process is killed), removed on an
+    exception. ``replace=False`` places it only if ``path`` still does not exist, atomically (a
+    hard link refuses an existing name): a file another process wrote meanwhile is kept, this
+    one's result beside it (:func:`conflict_name`), and an :class:`OutputError` names both."""
     path = Path(path)
     tmp = tmp_name(path)
     try:
@@ -136,7 +131,16 @@ def atomic_path(path: str | Path, *, replace: bool = True) -> Iterator[Path]:
         if replace:
             os.replace(tmp, path)
         else:
-            _place_new(tmp, path)
+            try:
+                os.link(tmp, path)
+            except FileExistsError:
+                kept = conflict_name(path)
+                os.replace(tmp, kept)
+                raise OutputError(
+                    f"{path} exists: another process wrote it while this run worked, or (a call "
+                    "with replace=False) it was there before; it was not overwritten, and this "
+                    f"run's result is in {kept}"
+                ) from None
     finally:
         with contextlib.suppress(OSError):
             tmp.unlink()
@@ -145,19 +149,6 @@ def atomic_path(path: str | Path, *, replace: bool = True) -> Iterator[Path]:
 def conflict_name(path: Path) -> Path:
     """Where a result goes when ``path`` appeared meanwhile: ``NAME.PID.SUFFIX`` beside it."""
     return path.with_name(f"{path.stem}.{os.getpid()}{path.suffix}")
-
-
-def _place_new(tmp: Path, path: Path) -> None:
-    try:
-        os.link(tmp, path)
-    except FileExistsError:
-        kept = conflict_name(path)
-        os.replace(tmp, kept)
-        raise OutputError(
-            f"{path} exists: another process wrote it while this run worked, or (a call with "
-            "replace=False) it was there before; it was not overwritten, and this run's "
-            f"result is in {kept}"
-        ) from None
 
 
 def write_new_parquet(table, path: str | Path, *, replace: bool = False) -> None:
@@ -179,11 +170,10 @@ def atomic_write_bytes(path: str | Path, data: bytes, *, replace: bool = True) -
 
 
 class OutputLock:
-    """An exclusive OS lock on ``path`` (a hidden ``.NAME.lock`` file beside it), taken without
-    waiting (:class:`OutputError` when another process holds it) and released however the
-    holder exits (the OS drops ``flock`` locks with the process), so a killed run leaves no
-    stale lock. A context manager; re-entrant within one thread for the same path (a sweep
-    called by the command that locked its output), refused from another thread."""
+    """An exclusive OS lock on ``path`` (``flock`` on a hidden ``.NAME.lock`` file beside it),
+    taken without waiting (:class:`OutputError` when another process holds it) and released
+    however the holder exits, so a killed run leaves no stale lock. A context manager;
+    re-entrant within one thread for the same path, refused from another thread."""
 
     _held: dict[str, tuple[int, int]] = {}  # lock file -> (descriptor, thread that took it)
     _table = threading.Lock()
@@ -233,12 +223,9 @@ class OutputLock:
                     f"wait for it to finish, or choose another {self.what}"
                 ) from None
             # the holder before us may have removed the file we opened: retry on the current one
-            try:
-                same = os.path.samestat(os.fstat(fd), os.stat(self.path))
-            except FileNotFoundError:
-                same = False
-            if same:
-                break
+            with contextlib.suppress(FileNotFoundError):
+                if os.path.samestat(os.fstat(fd), os.stat(self.path)):
+                    break
             os.close(fd)
         os.ftruncate(fd, 0)
         os.pwrite(fd, str(os.getpid()).encode(), 0)
@@ -250,15 +237,13 @@ class OutputLock:
         if self._nested or self._fd is None:
             return
         with OutputLock._table:  # all of it: another thread must not open the dying file
-            key = str(self.path.resolve())
-            OutputLock._held.pop(key, None)
+            OutputLock._held.pop(str(self.path.resolve()), None)
             with contextlib.suppress(OSError):
                 self.path.unlink()  # while still locked: a waiter re-checks the inode
             os.close(self._fd)
             self._fd = None
 
-    def __enter__(self) -> OutputLock:
-        return self.acquire()
+    __enter__ = acquire
 
     def __exit__(self, *exc) -> None:
         self.release()

@@ -1,11 +1,10 @@
 """Parquet files with page checksums: damage inside a file is found when it is read.
 
-Every Parquet file chaoscam writes stores a CRC of each data page (``write_page_checksum``) and
-every read verifies them (``page_checksum_verification``): a file changed after it was written (a
-bad disk, a copy cut short inside a page) raises :class:`DamagedFileError` naming it instead of
-being read with wrong numbers. The key-value metadata (a trajectory's section and impacts, a
-sweep's configuration) has no page checksum: its SHA-256 is stored beside it (``chaoscam.digest``)
-and checked on reading. A file without checksums is read unverified.
+Every file chaoscam writes stores a CRC of each data page and every read verifies them: a file
+changed after it was written (a bad disk, a copy cut short) raises :class:`DamagedFileError`
+naming it instead of being read with wrong numbers. The key-value metadata (a trajectory's
+section, a sweep's configuration) has no page checksum: its SHA-256 is stored beside it
+(``chaoscam.digest``) and checked on reading. A file without checksums is read unverified.
 """
 
 from __future__ import annotations
@@ -27,9 +26,10 @@ class DamagedFileError(OSError):
     """A Parquet file whose page checksums do not match its data."""
 
 
-def _checked(path, read):
+def _checked(path, read, metadata):
+    """``read()``, refused when a page checksum or the metadata's digest does not match."""
     try:
-        return read()
+        out = read()
     except OSError as err:
         if "checksum" in str(err).lower():
             raise DamagedFileError(
@@ -37,6 +37,13 @@ def _checked(path, read):
                 f"{err}); write it again"
             ) from None
         raise
+    meta = metadata(out) or {}
+    if DIGEST_KEY in meta and meta[DIGEST_KEY] != _digest(meta):
+        raise DamagedFileError(
+            f"{path}: damaged (its metadata does not match the digest written with it); "
+            "write it again"
+        )
+    return out
 
 
 def _digest(meta: dict) -> bytes:
@@ -45,15 +52,6 @@ def _digest(meta: dict) -> bytes:
         for part in (key, meta[key]):
             h.update(len(part).to_bytes(8, "little") + part)
     return h.hexdigest().encode()
-
-
-def _verify(path, meta: dict | None) -> None:
-    meta = meta or {}
-    if DIGEST_KEY in meta and meta[DIGEST_KEY] != _digest(meta):
-        raise DamagedFileError(
-            f"{path}: damaged (its metadata does not match the digest written with it); "
-            "write it again"
-        )
 
 
 def write_table(table, path: str | Path) -> None:
@@ -69,9 +67,8 @@ def read_table(path: str | Path):
     """``pyarrow.parquet.read_table``, verifying page checksums and digest where present."""
     import pyarrow.parquet as pq
 
-    table = _checked(path, lambda: pq.read_table(path, page_checksum_verification=True))
-    _verify(path, table.schema.metadata)
-    return table
+    return _checked(path, lambda: pq.read_table(path, page_checksum_verification=True),
+                    lambda table: table.schema.metadata)  # fmt: skip
 
 
 def read_frame(path: str | Path):
@@ -79,9 +76,8 @@ def read_frame(path: str | Path):
     import pandas as pd
     import pyarrow.parquet as pq
 
-    frame = _checked(path, lambda: pd.read_parquet(path, page_checksum_verification=True))
-    _verify(path, pq.read_schema(path).metadata)
-    return frame
+    return _checked(path, lambda: pd.read_parquet(path, page_checksum_verification=True),
+                    lambda _: pq.read_schema(path).metadata)  # fmt: skip
 
 
 def exact_json(frame) -> str:

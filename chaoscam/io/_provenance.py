@@ -1,8 +1,6 @@
 """What code produced a result, recorded with every sweep and ensemble and matched by a resumed
-checkpoint (other code's records could differ from the new ones). The version is not bumped with
-every kernel change, so the record holds a fingerprint of the sources that decide a result's
-numbers (all but the command line, reports and paper scripts, which drive and draw) and the
-versions of numpy and numba, which compile and run the kernels."""
+checkpoint: a fingerprint of the sources that decide a result's numbers (the version is not
+bumped with every kernel change) and the versions of numpy and numba, which run the kernels."""
 
 from __future__ import annotations
 

@@ -1,7 +1,5 @@
-"""Contact force, friction torque and the equation of motion (paper eqs. (1)–(3)).
-
-Plain numpy; the compiled kernel has its own scalar copy, checked against this one in the tests.
-"""
+"""Contact force, friction torque and the equation of motion (paper eqs. (1)–(3)), in plain
+numpy; the compiled kernel has its own scalar copy, checked against this one in the tests."""
 
 from __future__ import annotations
 
@@ -36,9 +34,8 @@ def normal_force(p: Params, t, theta_f, omega_f, l_lambda):
 
 def stiffness_array(p: Params, l_lambda):
     """K_n for each line length (constant for the fractal model) [N/m]."""
-    if p.stiffness == "hertz":
-        return 0.25 * np.pi * p.E * np.asarray(l_lambda, dtype=float)
-    return np.full(np.shape(l_lambda), p.stiffness_at(0.0))
+    lam = np.asarray(l_lambda, dtype=float)
+    return np.broadcast_to(p.stiffness_at(lam), lam.shape)
 
 
 def friction_torque(p: Params, t, theta_f, omega_f, F_n):

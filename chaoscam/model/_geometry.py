@@ -1,8 +1,7 @@
 """Geometry of the cam and the follower rod (shared/MODEL.md, "Geometry"; paper eqs. (5), (6)).
 
-Plain numpy functions of time and the follower state; they accept scalars or arrays. The
-compiled kernels carry their own scalar copy of these formulas, and the tests check the two
-against each other.
+Plain numpy functions of time and the follower state (scalars or arrays); the compiled kernels
+carry their own scalar copy, checked against these in the tests.
 
 Frame: cam rotation centre O' at the origin, pivot O = (x_O, y_O), cam phase
 ``theta_c = omega t + theta_c0``, cam centre ``C = e (cos theta_c, sin theta_c)``. Rod axis
@@ -19,19 +18,8 @@ import numpy as np
 from .._util import ParameterError
 from ._params import Params
 
-__all__ = [
-    "cam_angle",
-    "cam_centre",
-    "gap",
-    "lever_arm",
-    "gap_rate",
-    "normal_cam_speed",
-    "contact_angle",
-    "contact_angle_rate",
-    "slip_speed",
-    "contact_period",
-]
-
+__all__ = ["cam_angle", "cam_centre", "gap", "lever_arm", "gap_rate", "normal_cam_speed",
+           "contact_angle", "contact_angle_rate", "slip_speed", "contact_period"]  # fmt: skip
 
 # 2 pi as a sum of two doubles (the tail is 2 pi - float(2 pi), to 1e-32)
 _TWO_PI = 2.0 * math.pi
@@ -57,8 +45,8 @@ def cam_angle(p: Params, t):
     ``omega t`` rounded to a double is off by up to 1e-12 rad at t = 300 s (4e-14 m of cam
     at e = 0.04 m), the height of the last bounces of a chattering sequence; so the product
     is kept exactly as a sum of two doubles and 2 pi taken off in double-double arithmetic
-    (for any |theta_c| below 1e15 rad). The kernels compute the same angle by Cody & Waite's
-    reduction (``chaoscam.kernel._physics.cam_angle``); the tests compare the two.
+    (for any |theta_c| below 1e15 rad). The kernels use Cody & Waite's reduction instead; the
+    tests compare the two.
     """
     t = np.asarray(t, dtype=float)
     prod, err = _two_product(float(p.omega), t)
@@ -130,11 +118,9 @@ def slip_speed(p: Params, t, theta_f, omega_f):
 
 
 def contact_period(p: Params, l_lambda: float | None = None) -> float:
-    """Period of the linearised contact oscillation, 2 pi sqrt(J / (K_n l_1^2)) [s].
-
-    Evaluated at the initial contact's lever arm; the RK4 step should resolve it with ~20 or
-    more steps, and the adaptive path's cost grows as its inverse square
-    (:func:`chaoscam.simulation._budget.adaptive_seconds`)."""
+    """Period of the linearised contact oscillation, 2 pi sqrt(J / (K_n l_1^2)) [s], at the
+    initial contact's lever arm: the RK4 step should resolve it with ~20 or more steps, and the
+    adaptive path's cost grows as its inverse square."""
     if not isinstance(p, Params):
         raise TypeError(f"p must be a chaoscam Params, got {type(p).__name__}")
     if l_lambda is None:

@@ -1,9 +1,8 @@
 """The random contact-line length l_lambda ~ Normal(mu, sigma^2), truncated to (l_min, inf).
 
-Paper section 2.5. Decisions (shared/MODEL.md): the normal is truncated below at ``l_min``
-so the line stays positive, and the mass the truncation removes is reported; each
-realization is a pure function of ``(seed, index)`` through ``SeedSequence(seed,
-spawn_key=(index,))``, whatever the number of workers.
+Paper section 2.5. Decisions (shared/MODEL.md): the normal is truncated below at ``l_min`` so the
+line stays positive, and the mass removed is reported; each realization is a pure function of
+``(seed, index)`` through ``SeedSequence(seed, spawn_key=(index,))``, whatever the workers.
 """
 
 from __future__ import annotations
@@ -17,11 +16,10 @@ __all__ = ["realization_rng", "realizations_identical", "truncated_mass", "LineL
 
 
 def realizations_identical(p: Params) -> bool:
-    """True when every realization of ``p`` is the same run, so the model is deterministic:
-    ``l_lambda_sigma = 0`` (every line is mu long), or ``stiffness = "fractal"``, whose K_n
-    (15)/(17) does not depend on the line length, the only place the line length enters the
-    motion (``chaoscam.kernel._physics.stiffness``). A sweep runs such a model once, and its
-    periodic orbits can be certified by shooting."""
+    """True when every realization of ``p`` is the same run (a deterministic model):
+    ``l_lambda_sigma = 0``, or ``stiffness = "fractal"``, whose K_n (15)/(17), the only place the
+    line length enters the motion, does not depend on it. A sweep runs such a model once, and
+    its periodic orbits can be certified by shooting."""
     return p.l_lambda_sigma == 0.0 or p.stiffness == "fractal"
 
 

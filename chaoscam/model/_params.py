@@ -1,7 +1,5 @@
-"""The parameter set: Table 1 of the paper plus every decision of shared/MODEL.md.
-
-This module is the single home of physics choices. A kernel never holds a constant of its
-own; it receives the numbers assembled from here (``chaoscam.kernel.kernel_constants``).
+"""The parameter set: Table 1 of the paper plus every decision of shared/MODEL.md, the single
+home of physics choices (a kernel receives its numbers from here: ``kernel_constants``).
 
 Reference: "Effect of Surface Morphology on Dynamic Characteristics of Cam-Follower Oblique
 Impact System", Table 1 (SI units throughout).
@@ -14,17 +12,16 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import Any
 
-from .._util import NON_NEGATIVE, check_fields, parse_field, strict_init
+from .._util import NON_NEGATIVE as _NONNEG
+from .._util import check_fields, parse_field, strict_init
 from .._util import meta as _meta
+from ._stiffness import composite_modulus, fractal_stiffness, hertz_line_stiffness
 
 __all__ = ["FIELD_DOCS", "Params", "field_names", "params_arg", "parse_value"]
-
 
 STIFFNESS_MODELS = ("hertz", "fractal")
 DAMPING_FORMS = ("hunt_crossley", "paper_literal")
 RESAMPLE_MODES = ("contact", "impact", "interval")
-
-_NONNEG = NON_NEGATIVE
 
 
 @strict_init
@@ -151,9 +148,7 @@ class Params:
     def __post_init__(self) -> None:
         check_fields(self)
         if self.stiffness == "fractal":  # a ParameterError naming D or G where (15)/(17) fail
-            from ._stiffness import fractal_stiffness
-
-            fractal_stiffness(self.E, self.D, self.G, self.k, self.phi, self.A_r)
+            self.stiffness_at(0.0)
 
     # --- derived quantities --------------------------------------------------------------
     @property
@@ -174,14 +169,10 @@ class Params:
     @property
     def E(self) -> float:
         """Composite modulus, eq. (7) [Pa]."""
-        from ._stiffness import composite_modulus
-
         return composite_modulus(self.nu_f, self.Y_f, self.nu_c, self.Y_c)
 
     def stiffness_at(self, l_lambda: float) -> float:
         """Contact stiffness K_n [N/m] for a contact-line length ``l_lambda`` [m]."""
-        from ._stiffness import fractal_stiffness, hertz_line_stiffness
-
         if self.stiffness == "hertz":
             return hertz_line_stiffness(self.E, l_lambda)
         return fractal_stiffness(self.E, self.D, self.G, self.k, self.phi, self.A_r)

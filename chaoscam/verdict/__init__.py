@@ -1,8 +1,7 @@
 """The verdict on a run: :func:`classify` labels every member of a solution from its section
 and tangent dynamics (the analysis layer's evidence, the model-level :data:`RULES`, the
-periodic-orbit certificate, the extension of undetermined runs, the step check); the tangent
-dynamics' own results (:func:`lyapunov_spectrum`, :func:`periodic_orbit`, :func:`kick_test`,
-:func:`stroboscopic_map`) live here too."""
+periodic-orbit certificate, extension, the step check), with the tangent dynamics' own results
+(:func:`lyapunov_spectrum`, :func:`periodic_orbit`, :func:`kick_test`, :func:`stroboscopic_map`)."""
 
 from ._certificate import MODEL_ATOL, Certificate, certify, on_orbit
 from ._classify import EXTEND_TO, classify, judge_member, judge_points

@@ -4,10 +4,9 @@ A section that repeats with period n is certified periodic when Newton shooting
 (:func:`~._orbits.periodic_orbit`) finds a period-n orbit of the stroboscopic map that is
 attracting (every Floquet multiplier |mu| < 1), the run converges to it (:func:`on_orbit`),
 and both hold at half the step (else "step-dependent"). Where chattering makes the grid's
-multipliers err, the orbit is shot for again at refined steps (:func:`_refined`); after a
-flip, the period 2n is tried (:func:`_doubled`); where chattering ends in sticking, finite
-kicks decide (:func:`_kicked`). docs/verdicts.md gives the configurations each threshold was
-set on.
+multipliers err the orbit is shot for at refined steps, after a flip the period 2n is tried,
+and where chattering ends in sticking finite kicks decide. docs/verdicts.md gives the
+configurations each threshold was set on.
 """
 
 from __future__ import annotations
@@ -20,24 +19,22 @@ from ..model import Params
 from ..numerics import Numerics
 from ._orbits import PeriodicOrbit, iterate_map, kick_test, periodic_orbit
 
-__all__ = ["APPROACH", "CONFIRM_REFINE", "KICK_MIN_PERIODS", "KICK_SIZES", "KICK_STEPS",
-           "MAX_DOUBLINGS", "MODEL_ATOL", "ORBIT_REFINE", "REFINE_ITER", "Certificate", "certify",
-           "on_orbit"]  # fmt: skip
+__all__ = ["MODEL_ATOL", "Certificate", "certify", "on_orbit"]
 
 MODEL_ATOL = 1e-5
-"""Absolute band tolerance [rad] of the model's section, for theta_f and theta_f' T, below
-which bands are jitter (a sticking period-1 orbit at e = 0.02 m keeps 6.9e-6 rad/s in
-theta_f' from its contact oscillation); also the distance within which a run lies on an orbit
-and the Newton residual below which a stalled shooting is refined."""
+"""Absolute band tolerance [rad] of the model's section (theta_f and theta_f' T), below which
+bands are jitter (a sticking period-1 orbit at e = 0.02 m keeps 6.9e-6 rad/s in theta_f');
+also the distance within which a run lies on an orbit, and the Newton residual below which a
+stalled shooting is refined."""
 
 REFINE_ITER = 8
 """Newton iterations on a refined step (from the grid's orbit or a band point)."""
 
 ORBIT_REFINE = (2, 4)
-"""Step divisors at which an orbit the run's grid does not certify is shot for again, when it
-converges unstable or stalls within ``MODEL_ATOL`` and the run lies on it: where chattering
-dominates the grid's tangent overstates the multipliers (xi = 0.45, period 6: |mu|max 2.97 at
-dt, 0.0047 at dt/2). A refined step counts a stalled Newton within ``MODEL_ATOL`` as converged."""
+"""Step divisors at which an orbit the grid does not certify (unstable, or stalled within
+``MODEL_ATOL``, the run lying on it) is shot for again; there a stalled Newton within
+``MODEL_ATOL`` counts as converged. Where chattering dominates the grid's tangent overstates
+the multipliers (xi = 0.45, period 6: |mu|max 2.97 at dt, 0.0047 at dt/2)."""
 
 APPROACH = 0.5
 """A run approaches an orbit when its largest distance over its last 4n section points is at
@@ -46,9 +43,9 @@ distance within 14 orbit periods, while at (omega, xi) = (45, 0.2) a run stays 2
 a certified period-11 orbit for 600 s (ratio 1.0)."""
 
 MAX_DOUBLINGS = 1
-"""How many times a flip-unstable or uncertified period-n orbit sends the shooting to 2n:
-every doubled orbit found in the model is 2n (at (37.5, 0.15) and (47.5, 0.1) the
-flip-unstable periods 8 and 9 settle on 16 and 18); shooting for 4n is a report's dearest part."""
+"""How many times a flip-unstable or uncertified period-n orbit sends the shooting to 2n
+(every doubled orbit found in the model is 2n: at (37.5, 0.15) and (47.5, 0.1) periods 8 and
+9 settle on 16 and 18; shooting for 4n would be a report's dearest part)."""
 
 CONFIRM_REFINE = ORBIT_REFINE[:1]
 """The step division at which an orbit the grid certifies must be certified too, else it is
@@ -61,20 +58,18 @@ point, must settle on the refined orbit (at (45, 0.4) a period-18 orbit attracts
 dt/4, but 600 s runs keep 9 chaotic bands)."""
 
 KICK_STEPS = (1, 2)
-"""Step divisors at which the kick certificate asks finite perturbations to return (an
-attraction of the grid alone is the step's)."""
+"""Step divisors at which kicks must return (an attraction of the grid alone is the step's)."""
 
 KICK_MIN_PERIODS = 8
-"""Orbit periods the section must hold before kicks are asked (they follow 40 orbit periods
-at two steps, tens of times a short run's cost; an extended run asks them on its window)."""
+"""Orbit periods the section must hold before kicks are asked (40 orbit periods at two steps
+cost tens of times a short run; an extended run asks them on its window)."""
 
 KICK_SIZES = (1e-7, 1e-6)
-"""Kick sizes [rad] of the kick certificate: those that decide ``KickTest.returns`` (1e-8
-kicks sit at the event jitter of sticking orbits)."""
+"""Kick sizes [rad] of the certificate: those that decide ``KickTest.returns`` (1e-8 kicks sit
+at the event jitter of sticking orbits)."""
 
 KICKED = ("unstable", "not converged", "mixed")
-"""The outcomes kicks may overturn (with "step-dependent"): unstable, stalled, or certified
-at some refined steps only."""
+"""The outcomes kicks may overturn (with "step-dependent")."""
 
 
 @dataclass(frozen=True)
@@ -84,23 +79,20 @@ class Certificate:
     Attributes
     ----------
     status : str
-        "certified" (an attracting orbit the run converges to, on the grid and at dt/2, or at
-        every refined step when the grid's multipliers err, or by kicks), "step-dependent"
-        (certified on the run's grid but not at dt / 2), "mixed" (attracting at some refined
-        steps only), "unstable" (converged, not attracting), "off orbit" (attracting, but the
-        run neither lies on it nor approaches it), "period differs" (its least period is not
-        the one shot for) or "not converged".
+        "certified" (an attracting orbit the run converges to, on the grid and at dt/2, at
+        every refined step, or by kicks), "step-dependent" (on the grid, not at dt / 2),
+        "mixed" (attracting at some refined steps only), "unstable" (converged, not
+        attracting), "off orbit" (the run neither lies on it nor approaches it), "period
+        differs" (its least period is not the one shot for) or "not converged".
     period : int
         The period shot for last: n, or 2n after a flip.
     orbit : PeriodicOrbit
-        The orbit on the run's grid for that period (the finest refined one when certified
-        on refined steps).
+        The orbit on the run's grid (the finest refined one when certified on refined steps).
     detail : str
         Residual, multipliers and the run's distance, in words, for the evidence.
-    refined : bool
-        Certified only on refined steps or by kicks (the grid's multipliers were at fault).
-    kicked : bool
-        Certified by kicks, not by Newton's multipliers.
+    refined, kicked : bool
+        Certified only on refined steps or by kicks (the grid's multipliers were at fault);
+        by kicks, not by Newton's multipliers.
     """
 
     status: str
@@ -131,10 +123,9 @@ class _Run:
 
 def on_orbit(orbit: PeriodicOrbit, points: np.ndarray) -> tuple[bool, float, str]:
     """(on it, the distance [rad] of its last 4n section points, in words): the run lies on
-    ``orbit`` when those points are within ``MODEL_ATOL`` of it, or approach it (at most
-    ``APPROACH`` times as far as its first 4n, on 8n points or more). Distances are in the
-    scaled norm |(d theta, T d theta')|; a run that keeps its distance is not on the orbit,
-    whatever its multipliers."""
+    ``orbit`` when those points are within ``MODEL_ATOL`` of it (scaled norm |(d theta, T d
+    theta')|), or approach it (at most ``APPROACH`` times as far as its first 4n, on 8n points
+    or more); a run that keeps its distance is not on the orbit, whatever its multipliers."""
     d = orbit.distances(points)
     w = 4 * orbit.period
     tail = float(d[-w:].max())
@@ -191,17 +182,10 @@ def certify(p: Params, num: Numerics, points: np.ndarray, n: int, extra: dict, *
         if twice is not None:
             return Certificate("certified", twice.period, twice.orbit, detail, True)
     stalled = orbit.converged or orbit.residual <= MODEL_ATOL
-    if confirm and status in KICKED and sits and stalled and _long_enough(points, n):
+    if confirm and status in KICKED and sits and stalled:
         # the multipliers left it open and the run lies on the orbit: finite kicks decide
-        kicked, summary = _kicked(run, n)
-        detail += "; " + summary
-        if kicked:
-            return Certificate("certified", n, orbit, detail, refined=True, kicked=True)
+        return _by_kicks(run, n, orbit, detail, status)
     return Certificate(status, n, orbit, detail)
-
-
-def _long_enough(points: np.ndarray, n: int) -> bool:
-    return len(points) >= KICK_MIN_PERIODS * n
 
 
 def _confirmed(run: _Run, n: int, orbit: PeriodicOrbit, detail: str) -> Certificate:
@@ -210,21 +194,26 @@ def _confirmed(run: _Run, n: int, orbit: PeriodicOrbit, detail: str) -> Certific
     detail += "; " + summary
     if again == "certified":
         return Certificate("certified", n, orbit, detail)
-    if not _long_enough(run.points, n):
-        return Certificate("step-dependent", n, orbit, detail)
+    return _by_kicks(run, n, orbit, detail, "step-dependent")
+
+
+def _by_kicks(run: _Run, n: int, orbit: PeriodicOrbit, detail: str, status: str) -> Certificate:
+    """Certified when the run holds ``KICK_MIN_PERIODS`` orbit periods and kicks return
+    (:func:`_kicked`), else ``status``."""
+    if len(run.points) < KICK_MIN_PERIODS * n:
+        return Certificate(status, n, orbit, detail)
     kicked, summary = _kicked(run, n)
     detail += "; " + summary
     if kicked:
         return Certificate("certified", n, orbit, detail, refined=True, kicked=True)
-    return Certificate("step-dependent", n, orbit, detail)
+    return Certificate(status, n, orbit, detail)
 
 
 def _doubled(run: _Run, n, status, flips, doublings, flips_double):
     """A flip-unstable period-n orbit (a real multiplier < -1) leaves a period-2n orbit whose
     2n bands read as n: 2n is shot for when the section shows the doubling, or when an
-    uncertified n's section repeats with period 2n within ``MODEL_ATOL``. Returns (the
-    certificate of 2n when it holds at the refined steps too, else None; in words), or None
-    when 2n is not tried."""
+    uncertified n's section repeats with period 2n within ``MODEL_ATOL``. Returns None (2n not
+    tried) or (the certificate of 2n when it holds at the refined steps too, else None; words)."""
     flipped = (doublings > 0 and status == "unstable" and flips_double
                and any(_flip(o) for o in flips) and _doubling_seen(run.points, n))  # fmt: skip
     sharp = (doublings > 0 and not flipped and status in ("unstable", "not converged", "off orbit")
@@ -305,16 +294,13 @@ def _flip(orbit: PeriodicOrbit) -> bool:
 
 
 def _refined(run: _Run, n: int, seed, steps=ORBIT_REFINE):
-    """The period-n orbit shot for again at ``dt / f`` for f in ``steps`` (the grid's tangent
-    overstates the multipliers where chattering dominates), each from the last, until a step
-    does not certify it: residual within ``MODEL_ATOL`` after ``REFINE_ITER`` iterations,
-    attracting with least period n, the motion from the run's last section point settling
-    on it within ``SETTLE_PERIODS`` orbit periods.
-
-    Returns (status, the finest orbit when certified, the orbits shot, in words); status
-    "certified" (every step), "mixed" (the first ones only), "off orbit" (attracting, not
-    settled on), "period differs", "unstable" or "not converged".
-    """
+    """The period-n orbit shot for again at ``dt / f`` for f in ``steps``, each from the last,
+    until a step does not certify it (residual within ``MODEL_ATOL`` after ``REFINE_ITER``
+    iterations, attracting with least period n, the motion from the run's last section point
+    settling on it within ``SETTLE_PERIODS`` orbit periods). Returns (status, the finest orbit
+    when certified, the orbits shot, in words); status "certified" (every step), "mixed" (the
+    first ones only), "off orbit" (attracting, not settled on), "period differs", "unstable"
+    or "not converged"."""
     x = seed
     orbits, records, attracting, settles = [], [], [], []
     for f in steps:

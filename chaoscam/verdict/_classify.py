@@ -1,5 +1,6 @@
 """classify(solution): a verdict per member from its stroboscopic section and tangent
-exponent, the model-level rules, the extension of undetermined runs and the step check."""
+exponent, the model-level rules, the extension of undetermined runs and the step check
+(shared/MODEL.md: a result must not change when the step is halved)."""
 
 from __future__ import annotations
 
@@ -23,17 +24,10 @@ from ..analysis import (
 )
 from ..kernel import Status, check_stop
 from ..model import realizations_identical
+from ..numerics import Numerics
 from ..simulation import Solution, extend, solve
 from ._certificate import MODEL_ATOL
-from ._rules import (
-    Context,
-    apply_rules,
-    extensible,
-    extension_stopped,
-    overflow_evidence,
-    tangent_record,
-)
-from ._step_check import compared, skipped
+from ._rules import Context, apply_rules, extensible, extension_stopped, overflow_evidence
 
 __all__ = ["EXTEND_TO", "classify", "judge_member", "judge_points"]
 
@@ -45,15 +39,9 @@ square root of the run (~0.15 1/s after 60 s on the default model)."""
 _COORDS = ["theta_f", "omega_f"]
 
 
-def classify(
-    solution: Solution,
-    *,
-    extend_to: float | None = EXTEND_TO,
-    check_step: bool = False,
-    discard: float = 0.0,
-    progress: Callable | None = None,
-    **options: Any,
-) -> list[Verdict]:
+def classify(solution: Solution, *, extend_to: float | None = EXTEND_TO, check_step: bool = False,
+             discard: float = 0.0, progress: Callable | None = None,
+             **options: Any) -> list[Verdict]:  # fmt: skip
     """The verdict of every member of ``solution``, in the order of its ``members``.
 
     A member is judged from its stroboscopic section (theta_f, theta_f') at t = k 2 pi / omega
@@ -76,8 +64,7 @@ def classify(
     check_step : bool
         Judge the same realizations at half the step (:meth:`Numerics.refined`), with the
         same extension; a verdict that changes becomes "undetermined" with the reason
-        (evidence ``step_check``: 1 unchanged, 0 changed; not a vote). shared/MODEL.md: a
-        result must not change when the step is halved.
+        (evidence ``step_check``: 1 unchanged, 0 changed; not a vote).
     discard : float
         Extra time after the transient left out of the classification [s].
     progress : callable, optional
@@ -114,8 +101,7 @@ def classify(
         )
     how = {"check_step": check_step, "discard": discard, "extend_to": extend_to, **options}
     run = _tangent_solution(solution)
-    verdicts = _extended(run, _judge_all(run, discard, options), extend_to, discard, options,
-                         progress)  # fmt: skip
+    verdicts = _settled(run, extend_to, discard, options, progress)
     if check_step:
         verdicts = _step_checked(run, verdicts, extend_to, discard, options)
     return [_with_run(v, solution, j, how) for j, v in enumerate(verdicts)]
@@ -131,8 +117,7 @@ def _with_run(v: Verdict, sol: Solution, j: int, how: dict) -> Verdict:
 
 
 def _tangent_solution(sol: Solution) -> Solution:
-    """``sol`` when solved with the tangent, else the same realizations on the RK4 grid with
-    it, resumable (an extension goes on from it)."""
+    """``sol`` when solved with the tangent, else the same realizations on the RK4 grid."""
     if sol.jacobians is not None:
         return sol
     num = sol.numerics
@@ -143,18 +128,24 @@ def _tangent_solution(sol: Solution) -> Solution:
             "certificate and any extension), which the adaptive tolerances do not refine: to "
             "converge the verdict, refine dt"
         )
+    return _solved_again(sol, range(len(sol)), num.replace(integrator="rk4"))
+
+
+def _solved_again(sol: Solution, members, num: Numerics) -> Solution:
+    """The realizations of ``members`` of ``sol`` solved again at ``num`` with the tangent,
+    resumable (an extension goes on from it)."""
     s = sol.settings
     return solve(
-        list(sol.models), num.replace(integrator="rk4"),
-        indices=[int(i) for i in sol.members["index"]], seed=s["seed"],
+        [sol.models[j] for j in members], num,
+        indices=[int(sol.members["index"].iat[j]) for j in members], seed=s["seed"],
         duration=s["duration"], transient=s["transient"], tangent=True, resumable=True,
     )  # fmt: skip
 
 
 def _judge_all(sol: Solution, discard: float, options: dict) -> list[Verdict]:
-    """Each member's verdict (a pure function of the member): those of a deterministic model
-    on the solution's threads (their shootings run compiled, without the GIL), the others on
-    the calling thread meanwhile (numpy under the GIL, which threads would only contend for)."""
+    """Each member's verdict: those of a deterministic model on the solution's threads (their
+    shootings run compiled, without the GIL), the others on this thread meanwhile (numpy
+    under the GIL, which threads would only contend for)."""
     transient = float(sol.settings["transient"]) + discard
     rows_of = sol.sections.groupby("member").indices
     sec, empty = sol.sections, np.empty(0, dtype=np.int64)
@@ -204,8 +195,12 @@ def judge_points(points, jacobians, p, num, options: dict) -> Verdict:
     spec = spectrum_from_jacobians(jacobians, period)
     exponent = (spec.exponent, float(spec.stderr[0]), spec.n_periods)
     v = classify_section(points, exponent=exponent, exponent_time=period, **opts)
-    extra = {"tangent": tangent_record(spec)}
-    v = apply_rules(v, Context(p, num.replace(integrator="rk4"), points, spec, extra))
+    method = "tangent dynamics through the impacts, QR (chaoscam.lyapunov_spectrum)"
+    tangent = {"exponents": [float(x) for x in spec.exponents],
+               "stderr": [float(x) for x in spec.stderr], "n_periods": spec.n_periods,
+               "method": method}  # fmt: skip
+    extra = {"tangent": tangent}
+    v = apply_rules(v, Context(p, num.replace(integrator="rk4"), points, extra))
     return dataclasses.replace(v, settings={**v.settings, **extra})
 
 
@@ -218,9 +213,10 @@ def _status_verdict(st: Status, t_end: float) -> Verdict:
     return Verdict("undetermined", None, (e,), (why,), {"status": st.name})
 
 
-def _extended(sol, verdicts, extend_to, discard, options, progress) -> list[Verdict]:
-    """The undetermined members continued 4x longer a round (all in one call), until their
-    verdicts settle or the recorded time reaches ``extend_to``."""
+def _settled(sol, extend_to, discard, options, progress) -> list[Verdict]:
+    """The members' verdicts, the undetermined ones continued 4x longer a round (all in one
+    call) until their verdicts settle or the recorded time reaches ``extend_to``."""
+    verdicts = _judge_all(sol, discard, options)
     s = sol.settings
     start = s["transient"] + discard
     recorded = s["duration"] - start
@@ -232,9 +228,11 @@ def _extended(sol, verdicts, extend_to, discard, options, progress) -> list[Verd
         if progress is not None:
             progress(0, extending=len(pending), recorded_s=recorded)
         where = {j: i for i, j in enumerate(at)}
+        # a CPU run's extension on the CPU (its bits), a GPU run's by size ("auto": a few
+        # hundred members run sooner on the host's cores than on the GPU)
+        backend = "cpu" if last.settings["backend"] == "cpu" else "auto"
         longer = extend(last, start + recorded, members=[where[j] for j in pending],
-                        resumable=True, progress=progress,
-                        backend=_extend_backend(last))  # fmt: skip
+                        resumable=True, progress=progress, backend=backend)  # fmt: skip
         note = {"recorded_s": recorded, "wall_time_s": time.perf_counter() - t_wall,
                 "why": "the verdict on the run as given was undetermined",
                 "backend": longer.settings["backend"]}  # fmt: skip
@@ -244,12 +242,6 @@ def _extended(sol, verdicts, extend_to, discard, options, progress) -> list[Verd
         last, at = longer, list(pending)
         pending = [j for j in pending if extensible(verdicts[j])]
     return verdicts
-
-
-def _extend_backend(sol: Solution) -> str:
-    """A CPU run's extension on the CPU (the bits of a longer CPU run), a GPU run's by size
-    (``"auto"``: a few hundred members run sooner on the host's cores than on the GPU)."""
-    return "cpu" if sol.settings["backend"] == "cpu" else "auto"
 
 
 def _after_extension(before: Verdict, after: Verdict, longer: Solution, i, note, recorded):
@@ -262,27 +254,59 @@ def _after_extension(before: Verdict, after: Verdict, longer: Solution, i, note,
 
 
 def _step_checked(sol, verdicts, extend_to, discard, options) -> list[Verdict]:
-    """The verdicts checked against the same realizations at :meth:`Numerics.refined`,
-    judged the same way (extension included)."""
+    """The verdicts checked against the same realizations at :meth:`Numerics.refined` (dt / 2;
+    the adaptive tolerances / 32), judged the same way (extension included). An undetermined
+    verdict is not re-run: no half-step verdict can change it."""
     fine = sol.numerics.refined()
     asked = [j for j, v in enumerate(verdicts) if v.label != "undetermined"]
-    out = [skipped(v, fine) if v.label == "undetermined" else v for v in verdicts]
+    out = [_skipped(v, fine) if v.label == "undetermined" else v for v in verdicts]
     if not asked:
         return out
+    fine_verdicts = _settled(_solved_again(sol, asked, fine), extend_to, discard, options, None)
     s = sol.settings
-    half = solve(
-        [sol.models[j] for j in asked], fine,
-        indices=[int(sol.members["index"].iat[j]) for j in asked], seed=s["seed"],
-        duration=s["duration"], transient=s["transient"], tangent=True, resumable=True,
-    )  # fmt: skip
-    fine_verdicts = _extended(half, _judge_all(half, discard, options), extend_to, discard,
-                              options, None)  # fmt: skip
     recorded = s["duration"] - s["transient"] - discard
     for i, j in enumerate(asked):
         hv = fine_verdicts[i]
         seconds = hv.settings.get("extended", {}).get("recorded_s", recorded)
-        out[j] = compared(verdicts[j], hv, sol.numerics, fine, half_recorded_s=seconds)
+        out[j] = _compared(verdicts[j], hv, sol.numerics, fine, seconds)
     return out
+
+
+def _step_record(v: Verdict, item: Evidence, record: dict) -> Verdict:
+    """``v`` with the step check's evidence ``item`` and ``settings["step_check"]``."""
+    record = {**record, "grid_label": v.label, "grid_period": v.period}
+    settings = {**v.settings, "step_check": record}
+    return dataclasses.replace(v, evidence=(*v.evidence, item), settings=settings)
+
+
+def _skipped(v: Verdict, fine: Numerics) -> Verdict:
+    """An undetermined verdict with evidence ``step_check`` (no value) saying why the
+    realization was not re-run at ``fine``'s step."""
+    why = (f"not re-run at {fine.describe_step()}: the verdict is undetermined already, "
+           "which a half step cannot change")  # fmt: skip
+    record = {"dt_half": fine.dt, "skipped": True}
+    return _step_record(v, Evidence("step_check", None, None, why), record)
+
+
+def _compared(v: Verdict, half: Verdict, coarse: Numerics, fine: Numerics, seconds) -> Verdict:
+    """The grid verdict ``v`` checked against ``half``, the same realization's at ``fine``'s
+    step (on ``seconds`` recorded): kept with evidence ``step_check`` = 1 when label and period
+    agree, else "undetermined" with the reason and ``step_check`` = 0."""
+    same = half.label == v.label and half.period == v.period
+    what = f"{coarse.describe_step()}: {_described(v)}; {fine.describe_step()}: {_described(half)}"
+    changed = f"{'unchanged' if same else 'changed'} when the step is halved ({what})"
+    record = {"dt_half": fine.dt, "refined": fine.describe_step(), "label": half.label,
+              "period": half.period, "reasons": list(half.reasons),
+              "recorded_s": seconds}  # fmt: skip
+    checked = _step_record(v, Evidence("step_check", int(same), None, changed), record)
+    if same:
+        return checked
+    why = f"halving the step changes the verdict ({what})"
+    return Verdict("undetermined", None, checked.evidence, (*v.reasons, why), checked.settings)
+
+
+def _described(v: Verdict) -> str:
+    return v.label + (f" (period {v.period})" if v.period is not None else "")
 
 
 def _threaded(fn: Callable, items: list, threads: int, here: list = ()) -> tuple[list, list]:

@@ -27,15 +27,9 @@ __all__ = ["KickTest", "PeriodicOrbit", "iterate_map", "kick_test", "lyapunov_sp
            "periodic_orbit", "stroboscopic_map"]  # fmt: skip
 
 
-def lyapunov_spectrum(
-    params: Params | Solution | None = None,
-    numerics: Numerics | None = None,
-    *,
-    duration: float = 120.0,
-    transient: float = 60.0,
-    seed: int = 0,
-    index: int = 0,
-) -> TangentSpectrum:
+def lyapunov_spectrum(params: Params | Solution | None = None, numerics: Numerics | None = None,
+                      *, duration: float = 120.0, transient: float = 60.0, seed: int = 0,
+                      index: int = 0) -> TangentSpectrum:  # fmt: skip
     """Lyapunov spectrum [1/s] of one realization from its tangent dynamics through the impacts.
 
     Solves with ``tangent=True`` (or takes a one-member :class:`Solution` solved so, in place
@@ -110,9 +104,8 @@ class _MapRunner:
         y = s.y.copy()
         y[0, k.Y_THETA], y[0, k.Y_OMEGA] = x
         kept = {"section": [[]], "impacts": [[]], "series": [[]]}
-        start = dataclasses.replace(
-            s, y=y, cnt=s.cnt.copy(), lam=s.lam.copy(), kept=kept, status=s.status.copy()
-        )
+        start = dataclasses.replace(s, y=y, cnt=s.cnt.copy(), lam=s.lam.copy(), kept=kept,
+                                    status=s.status.copy())  # fmt: skip
         self.calls += 1
         out = run_batch([self.p], self.num, [0], start, 0, self.duration, room=ROOM["cpu"])
         return out.kept["section"][0], int(out.status[0])
@@ -176,8 +169,7 @@ class KickTest:
         Kick sizes in θ_f [rad]; θ̇_f kicks are ``omega_scale`` times these [rad/s].
     growth : ndarray, shape (len(kicks), 4, periods + 1)
         Separation from the unkicked run over kick size, max over (θ_f, θ̇_f / omega_scale),
-        after 0, n, 2n, ... periods·n cam periods; axis 1: the kick's direction, +θ_f, -θ_f,
-        +θ̇_f, -θ̇_f.
+        after 0, n, ..., periods·n cam periods; axis 1: the direction, +θ_f, -θ_f, +θ̇_f, -θ̇_f.
     returns : bool
         Every kick of at least :data:`KICK_DECIDES` ends at most :data:`KICK_RETURN` of its
         size: the motion attracts what is near it, at the scale the model resolves.
@@ -197,36 +189,25 @@ class KickTest:
         freeze_fields(self, "growth", "points")
 
 
-def kick_test(
-    params: Params,
-    x,
-    n: int = 1,
-    *,
-    numerics: Numerics | None = None,
-    kicks: tuple = KICKS,
-    periods: int = 40,
-    omega_scale: float = 30.0,
-    until_refused: bool = False,
-) -> KickTest:
+def kick_test(params: Params, x, n: int = 1, *, numerics: Numerics | None = None,
+              kicks: tuple = KICKS, periods: int = 40, omega_scale: float = 30.0,
+              until_refused: bool = False) -> KickTest:  # fmt: skip
     """The direct perturbation test at x = (θ_f, θ̇_f) (t = 0, deterministic model): kick θ_f
     by ± each of ``kicks`` and θ̇_f by ± ``omega_scale`` times as much, iterate ``periods`` × n
     cam periods (:func:`iterate_map`) and compare with the unkicked run; a :class:`KickTest`.
 
     Where chattering ends in sticking the grid map is not differentiable at the scale of its
     event jitter (at ξ = 0.525 the tangent's |μ|max is 5.9 while kicks of 1e-9 to 1e-6 return
-    to a 1e-8 floor); kicks measure at finite sizes. ``returns`` agrees with the label of all
-    24 deterministic settled configurations of the labelled and holdout sets (docs/findings.md,
-    "Tangent dynamics checked independently"). On chaotic bands many kicks return (sticking
-    merges nearby motions): four directions at two sizes keep one from deciding alone. With
-    ``until_refused`` the kicks stop at the first deciding one that does not return
-    (``returns`` False, the rows not run NaN).
+    to a 1e-8 floor): kicks measure at finite sizes (docs/findings.md checks ``returns`` on the
+    labelled sets). On chaotic bands many kicks return (sticking merges nearby motions), so
+    four directions at two sizes decide together. With ``until_refused`` the kicks stop at the
+    first deciding one that does not return (the rows not run NaN).
     """
-    params, num = params_arg(params), numerics_arg(numerics)
+    params, num, x = _start(params, numerics, x, "x")
     n = whole("n", n, low=1)
     periods = whole("periods", periods, low=1)
     omega_scale = real("omega_scale", omega_scale, low=0.0, strict=True)
     sizes = tuple(real("kicks", v, low=0.0, strict=True) for v in kicks)
-    x = np.asarray(x, dtype=float)
     scale = np.array([1.0, omega_scale])
     points = iterate_map(params, x, periods * n, num)
     base = points[::n] / scale
@@ -258,10 +239,8 @@ class PeriodicOrbit:
         |P^n(x_0) - x_0| in the scaled norm (θ in rad, θ̇ times T) at the last iterate.
     converged : bool
         Newton's residual fell below `tol`.
-    iterations : int
-        Newton iterations used.
-    wall_time : float
-        Seconds spent.
+    iterations, wall_time : int, float
+        Newton iterations used, and seconds spent.
     settings : dict
         tol, max_iter, map_calls, cam_period, seed_period, and seed_status: how the map from
         ``x0`` ended (``LEFT_REACH`` or a divergence: no orbit from there, NaN multipliers).
@@ -289,28 +268,20 @@ class PeriodicOrbit:
         """Converged and attracting: decisive evidence of a periodic response."""
         return self.converged and self.stable
 
-    def distances(self, points: np.ndarray, theta_scale: float = 1.0) -> np.ndarray:
-        """Distance [rad, scaled: |(Δθ, T Δθ̇)|] from each given section point to the
-        nearest point of the orbit."""
+    def distances(self, points: np.ndarray) -> np.ndarray:
+        """Distance [rad, scaled: |(Δθ, T Δθ̇)|] from each section point to the orbit."""
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
-        w = np.array([1.0, self.settings["cam_period"]]) * theta_scale
+        w = np.array([1.0, self.settings["cam_period"]])
         d = np.linalg.norm((pts[:, None, :] - self.points[None, :, :]) * w, axis=2)
         return d.min(axis=1)
 
-    def distance(self, points: np.ndarray, theta_scale: float = 1.0) -> float:
-        """Largest distance [rad, scaled] from each given section point to the orbit."""
-        return float(self.distances(points, theta_scale).max())
+    def distance(self, points: np.ndarray) -> float:
+        """Largest distance [rad, scaled] from the section points to the orbit."""
+        return float(self.distances(points).max())
 
 
-def periodic_orbit(
-    params: Params,
-    x0,
-    period: int,
-    *,
-    numerics: Numerics | None = None,
-    tol: float = 1e-7,
-    max_iter: int = 20,
-) -> PeriodicOrbit:
+def periodic_orbit(params: Params, x0, period: int, *, numerics: Numerics | None = None,
+                   tol: float = 1e-7, max_iter: int = 20) -> PeriodicOrbit:  # fmt: skip
     """Newton's method on ``P^n(x) = x`` with the monodromy matrix from the tangent dynamics.
 
     ``x ← x - (DP^n(x) - I)^{-1} (P^n(x) - x)``, the step halved while it does not lower the
@@ -331,11 +302,10 @@ def periodic_orbit(
     jump), so Newton may fail where the orbit grazes; ``converged`` then stays False.
     """
     t0 = time.perf_counter()
-    params, num = params_arg(params), numerics_arg(numerics)
+    params, num, x = _start(params, numerics, x0, "x0")
     n = whole("period", period, low=1)
     tol = real("tol", tol, low=0.0, strict=True, unit="rad")
     max_iter = whole("max_iter", max_iter, low=0)
-    x = _state(x0)
     # up to (max_iter + 1) n periods, judged as one run (refused past the run limit, as solve)
     most = (max_iter + 1) * n
     check_run(params, num, most * params.cam_period, what=f"the shooting (up to {most} periods)")
@@ -345,7 +315,6 @@ def periodic_orbit(
     least, pts, m = _least_period(params, num, one, x, n, m, res, tol)
     # A map that left the model (the seed off the cam's reach) has no Jacobian: NaN.
     mult = np.linalg.eigvals(m) if np.isfinite(m).all() else np.full(2, np.nan + 0j)
-    # seed_status: how the map from x0 ended (e.g. LEFT_REACH: it left the model)
     settings = {"tol": tol, "max_iter": max_iter, "map_calls": run.calls + one.calls,
                 "cam_period": params.cam_period, "seed_period": n,
                 "seed_status": first.name}  # fmt: skip
@@ -354,17 +323,19 @@ def periodic_orbit(
                          settings=settings)  # fmt: skip
 
 
-def _state(x0) -> np.ndarray:
-    """``x0`` as a finite state (theta_f [rad], omega_f [rad/s]), else a ParameterError."""
+def _start(params, numerics, x0, name: str) -> tuple[Params, Numerics, np.ndarray]:
+    """The model, the numerics and the finite state ``name`` = (theta_f [rad], omega_f
+    [rad/s]) a map function starts from, checked (a ParameterError naming the state)."""
+    params, num = params_arg(params), numerics_arg(numerics)
     try:
         x = np.array(x0, dtype=float)
     except (TypeError, ValueError):
         x = np.full(1, np.nan)
     if x.shape != (2,) or not np.isfinite(x).all():
         raise ParameterError(
-            f"x0 = {x0!r}: must be two finite numbers (theta_f [rad], omega_f [rad/s])"
+            f"{name} = {x0!r}: must be two finite numbers (theta_f [rad], omega_f [rad/s])"
         )
-    return x
+    return params, num, x
 
 
 def _newton(run: _MapRunner, x: np.ndarray, period: float, tol: float, max_iter: int):

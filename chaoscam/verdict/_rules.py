@@ -15,8 +15,7 @@ from ..model import Params, realizations_identical
 from ..numerics import Numerics
 from ._certificate import MODEL_ATOL, ORBIT_REFINE, certify
 
-__all__ = ["BAND_RTOL", "EXTENSION_STOPPED", "OVERFLOW", "RULES", "STEP_DEPENDENT", "Context",
-           "Rule", "apply_rules", "extensible", "extension_stopped",
+__all__ = ["RULES", "Context", "Rule", "apply_rules", "extensible", "extension_stopped",
            "overflow_evidence"]  # fmt: skip
 
 BAND_RTOL = 0.05
@@ -25,14 +24,9 @@ n-band chaos rule: the 0-1 test sees a chaotic component of relative size w on a
 sequence only on N >~ 1/w^2 samples (at (omega, xi) = (42.5, 0.15) 4 bands of 1.4e-2 of the
 extent have lambda_1 = 0.317 +- 0.014 per iterate and are 8-band chaos on 600 s runs)."""
 
-STEP_DEPENDENT = "step_dependent"
-"""The evidence of a verdict whose periodic orbit is the grid's alone."""
-
-OVERFLOW = "tangent_overflow"
-"""The evidence of a verdict whose Jacobians are not finite (:func:`overflow_evidence`)."""
-
-EXTENSION_STOPPED = "extension_stopped"
-"""``Verdict.settings`` key of :func:`extension_stopped`."""
+STEP_DEPENDENT, OVERFLOW = "step_dependent", "tangent_overflow"
+"""The evidence names of a verdict whose periodic orbit is the grid's alone, and of one whose
+Jacobians are not finite (:func:`overflow_evidence`): neither is extended."""
 
 
 @dataclass(frozen=True)
@@ -42,7 +36,6 @@ class Context:
     p: Params
     num: Numerics
     points: np.ndarray
-    spec: object
     extra: dict
 
     @property
@@ -121,19 +114,11 @@ def apply_rules(v: Verdict, ctx: Context) -> Verdict:
     """The verdict after :data:`RULES`, in order, until one decides."""
     for rule in RULES:
         out = rule.apply(v, ctx)
-        if out is None:
-            continue
-        v, final = out
-        if final:
-            break
+        if out is not None:
+            v, final = out
+            if final:
+                break
     return v
-
-
-def tangent_record(spec) -> dict:
-    """What a verdict's settings keep of the tangent spectrum."""
-    exponents, stderr = [float(x) for x in spec.exponents], [float(x) for x in spec.stderr]
-    method = "tangent dynamics through the impacts, QR (chaoscam.lyapunov_spectrum)"
-    return {"exponents": exponents, "stderr": stderr, "n_periods": spec.n_periods, "method": method}
 
 
 def _disputed_period(v: Verdict) -> int | None:
@@ -143,9 +128,7 @@ def _disputed_period(v: Verdict) -> int | None:
     sp, ex = votes.get("section_period"), votes.get("exponent")
     if v.label != "undetermined" or sp is None or sp.vote != "periodic":
         return None
-    if ex is not None and ex.vote == "chaotic":
-        return None
-    return int(sp.value)
+    return None if ex is not None and ex.vote == "chaotic" else int(sp.value)
 
 
 def _banded_period(v: Verdict, ctx: Context) -> int | None:
@@ -178,10 +161,9 @@ def _certified_verdict(v: Verdict, ctx: Context, n: int) -> Verdict:
     if cert.status == "step-dependent":
         return _step_dependent(v, ctx, cert, e)
     if cert.status in ("unstable", "not converged") and cert.orbit.converged:
-        reason = (
-            f"the section looks periodic but the orbit found is unstable ({cert.detail}): run "
-            "longer, to see whether the exponent is positive (chaos near an unstable orbit)"
-        )
+        reason = (f"the section looks periodic but the orbit found is unstable ({cert.detail}): "
+                  "run longer, to see whether the exponent is positive (chaos near an unstable "
+                  "orbit)")  # fmt: skip
         return _undetermined(v, reason, e)
     if v.label == "periodic" and _votes(v).get("exponent") != "not_chaotic":
         reason = (f"the section repeats with period {v.period} but no attracting orbit is "
@@ -205,10 +187,8 @@ def _banded_verdict(v: Verdict, ctx: Context, n: int) -> Verdict:
     detail = f"from the bands: {cert.detail}"
     if cert.certified and not cert.refined:
         e = Evidence("periodic_orbit", cert.period, "periodic", "certified " + detail)
-        conflict = (
-            "an attracting orbit is certified inside the bands, yet the tangent exponent is "
-            "positive"
-        )
+        conflict = ("an attracting orbit is certified inside the bands, yet the tangent "
+                    "exponent is positive")  # fmt: skip
         return dataclasses.replace(v, evidence=v.evidence + (e,), reasons=v.reasons + (conflict,))
     if cert.certified:
         e = Evidence("periodic_orbit", cert.period, "periodic", detail)
@@ -222,33 +202,24 @@ def _banded_verdict(v: Verdict, ctx: Context, n: int) -> Verdict:
     if cert.status == "step-dependent":
         return _step_dependent(v, ctx, cert, Evidence("periodic_orbit", n, None, detail))
     if cert.status == "mixed":
-        reason = (
-            f"the period-{n} orbit in the bands changes stability with the step "
-            f"({cert.detail}): run with dt = {ctx.num.dt / ORBIT_REFINE[-1]:.3g} s"
-        )
+        dt = ctx.num.dt / ORBIT_REFINE[-1]
+        reason = (f"the period-{n} orbit in the bands changes stability with the step "
+                  f"({cert.detail}): run with dt = {dt:.3g} s")  # fmt: skip
         return _undetermined(v, reason, Evidence("periodic_orbit", n, None, detail))
     e = Evidence("periodic_orbit", cert.orbit.period, "not_periodic", f"{cert.status}: {detail}")
     return _band_chaos(v, n, e)
 
 
 def _band_chaos(v: Verdict, n: int, e: Evidence) -> Verdict:
+    names = [e.name for e in v.evidence if e.vote in ("periodic", "quasiperiodic")]
+    outweighed = (f"; it outweighs the {', '.join(names)} vote(s), which see the narrow bands (a "
+                  "recurrence to the band tolerance, or the lines of a spectrum) but not the "
+                  "stretching inside them") if names else ""  # fmt: skip
     why = (f"the section keeps {n} narrow bands while the tangent exponent is positive beyond "
            "its confidence interval and no attracting period-n orbit lies in them that the run "
-           f"converges to: chaos confined to {n} bands (n-band chaos){_outweighed(v)}")  # fmt: skip
+           f"converges to: chaos confined to {n} bands (n-band chaos){outweighed}")  # fmt: skip
     band = Evidence("banded_chaos", n, "chaotic", why)
     return Verdict("chaotic", None, v.evidence + (e, band), (), v.settings)
-
-
-def _outweighed(v: Verdict) -> str:
-    """The clause naming the votes n-band chaos outweighs, or ""."""
-    names = [e.name for e in v.evidence if e.vote in ("periodic", "quasiperiodic")]
-    if not names:
-        return ""
-    return (
-        f"; it outweighs the {', '.join(names)} vote(s), which see the narrow bands (a "
-        "recurrence to the band tolerance, or the lines of a spectrum) but not the "
-        "stretching inside them"
-    )
 
 
 def _step_dependent(v: Verdict, ctx: Context, cert, e: Evidence) -> Verdict:
@@ -283,7 +254,7 @@ def extensible(v: Verdict) -> bool:
     """Whether an undetermined verdict may settle on a longer run: not after an overflow, a
     step-dependent orbit, or a longer run that stopped early."""
     flagged = any(e.name in (OVERFLOW, STEP_DEPENDENT) for e in v.evidence)
-    return v.label == "undetermined" and EXTENSION_STOPPED not in v.settings and not flagged
+    return v.label == "undetermined" and "extension_stopped" not in v.settings and not flagged
 
 
 def extension_stopped(v: Verdict, status, stopped_at: float, wanted_s: float) -> Verdict:
@@ -297,5 +268,5 @@ def extension_stopped(v: Verdict, status, stopped_at: float, wanted_s: float) ->
            "the verdict is the recorded window's")  # fmt: skip
     reasons = tuple(r for r in v.reasons if not r.startswith("to decide:"))
     stopped = {"status": status.name, "at_s": stopped_at, "wanted_s": wanted_s}
-    settings = {**v.settings, EXTENSION_STOPPED: stopped}
+    settings = {**v.settings, "extension_stopped": stopped}
     return dataclasses.replace(v, reasons=(*reasons, why), settings=settings)
