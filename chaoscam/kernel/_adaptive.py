@@ -1,38 +1,32 @@
 """Adaptive, event-driven Dormand–Prince 8(5,3) with located impacts: the fast path.
 
-The model and call signature of :func:`._rk4.run_chunk` (:func:`._driver.advance` picks by
-``Numerics.integrator``); what differs is how time is cut:
+The model and call signature of :func:`._rk4.run_chunk`; what differs is how time is cut:
 
 - **Steps**: DOP853 (Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I*, 2nd
-  ed., sec. II.10; :mod:`._dop853`) with the usual error control (``SAFETY`` below). Eighth
-  order because the barely damped contact oscillation (period ~1e-4 s) must be followed to
-  ~1e-11 relative, where DOP853 needs 2-3x fewer evaluations than Dormand–Prince 5(4).
+  ed., sec. II.10; :mod:`._dop853`) with the usual error control. Eighth order because the
+  barely damped contact oscillation (period ~1e-4 s) must be followed to ~1e-11 relative.
 - **In flight** (gap > 0) a step integrates the free pendulum ``J theta'' = -(m g l/2) cos
-  theta``, the motion up to the closing, so its interpolant is exact up to the crossing; steps
-  longer than the gap provably stays open (:func:`._physics.safe_horizon`) are cut to ``dt``, so
-  none holds several crossings. **In contact**, (1)–(3) resolved only as finely as the
-  tolerance asks (not ~45 fixed steps a contact period).
+  theta``, so its interpolant is exact up to the crossing; steps longer than the gap provably
+  stays open (:func:`._physics.safe_horizon`) are cut to ``dt``. **In contact**, (1)–(3)
+  resolved only as finely as the tolerance asks.
 - **Events**: a sign change of the gap over a step is located by Illinois regula falsi on the
-  step's Hermite interpolant (quintic in theta) to ``event_tol``; the state there is a DOP853
-  step of that length (the interpolant's error does not enter) and the impact law (4)–(5)
-  applies as in the reference. Where the gap rate turns without a sign change (a graze or a
-  0.1-1 us chattering micro-flight) the turning point is searched first; two turns in one step
-  are not looked for. A step from the surface takes its side from the motion (:func:`surface_mode`).
+  step's Hermite interpolant to ``event_tol``; the state there is a DOP853 step of that length
+  and the impact law (4)–(5) applies as in the reference. Where the gap rate turns without a
+  sign change (a graze or chattering micro-flight) the turning point is searched first; two
+  turns in one step are not looked for.
 - **Tangent**: RK4 substeps of ``V' = A V`` along each accepted step (:func:`advance_tangent`),
-  split at events, where the saltation matrix applies. **Clock and schedule** as in the
-  reference (:func:`._physics.on_clock`; sections, draws and the end end a step exactly);
+  split at events, where the saltation matrix applies. Clock and schedule as in the reference;
   series samples come from the interpolant, so a series never changes the trajectory.
 
 Chattering guard: at most ``max_events_per_step`` events in one grid interval ``[n dt, (n + 1)
 dt)``, later sign changes there stepped over (``I_CHATTER``). The contact fraction is integrated
-in time (``Y_RECORDED``, ``Y_CONTACT``). Never raises; returns a status code.
+in time (``Y_RECORDED``, ``Y_CONTACT``).
 
 Accuracy (``benchmarks/bench_work_precision.py``): 20 s sections of periodic responses are within
-1e-6 rad of converged RK4 from rtol 1e-8 (omega = 45 rad/s) or 1e-5 (xi = 0.2), 5.5-10x cheaper
-than plain RK4 and 1.1-1.2x than merged RK4. Limit: with v_min = 0 the fast impacts cannot be
-compared to 1e-6 s (RK4's own step halving moves them by up to 2.8e-6 s: each chattering
-sequence ends on a discontinuous count of bounces, and differences of 1e-12 s grow 3-6x per
-impact); with v_min = 1e-3 m/s they agree within 1e-6 s and rad at rtol 3e-14.
+1e-6 rad of converged RK4 from rtol 1e-8 (omega = 45 rad/s) or 1e-5 (xi = 0.2). Limit: with v_min
+= 0 the impact times cannot be compared to 1e-6 s (each chattering sequence ends on a
+discontinuous count of bounces, and differences of 1e-12 s grow 3-6x per impact); with v_min =
+1e-3 m/s they agree within 1e-6 s and rad at rtol 3e-14.
 """
 
 from __future__ import annotations
@@ -50,42 +44,6 @@ from ._events import MAX_BRACKET_STEPS, ON_SURFACE, illinois_point, illinois_upd
 from ._physics import JAC_CONTACT, JAC_FLIGHT, JAC_NATURAL
 from ._stages import accel_trig, geometry_near, trig_at
 from ._tangent import rk4_tangent_along
-from .layout import (
-    C_CALL_STEPS,
-    C_DT,
-    C_EVENT_TOL,
-    C_H_MAX,
-    C_MAX_EVENTS,
-    C_RCAM,
-    C_ROD_L,
-    C_STRIDE,
-    C_T_RECORD,
-    C_V_CHATTER,
-    I_CHATTER,
-    I_GRAZES,
-    I_LAM_POS,
-    I_N_IMPACT,
-    I_N_SECTION,
-    I_N_SERIES,
-    I_SERIES_J,
-    I_STEP,
-    I_SURFACE,
-    LEFT_REACH,
-    NEED_BUFFER,
-    NON_FINITE,
-    OK,
-    PENETRATION,
-    SURFACE_JUMPED,
-    SURFACE_SETTLED,
-    Y_CONTACT,
-    Y_EVENTS,
-    Y_OMEGA,
-    Y_RECORDED,
-    Y_STEP,
-    Y_THETA,
-    Y_TIME,
-    Y_WINDOW,
-)
 
 # Step-size control (Hairer et al. sec. II.4, their dop853 code): accept when the error norm
 # err <= 1; h_new = h * SAFETY * err^(-1/8) within [SHRINK_MIN, GROW_MAX] h and h_max.
@@ -100,22 +58,6 @@ MAX_TURN_STEPS = 100  # passes of that search at most
 MAX_EVENT_GROWTH = 60  # doublings of an event step's overshoot (2^60 event tolerances) at most
 
 
-@njit(cache=True, inline="always")
-def surface_mode(g, rate, surf):
-    """(flight, on_surface): the mode of a step from gap ``g`` with gap rate ``rate``.
-
-    On the surface (a located crossing, delta = 0 to rounding) the side is the motion's:
-    contact after a plastic closure (``SURFACE_SETTLED``), else flight when moving out (after a
-    rebound, ``SURFACE_JUMPED``, or a located opening). The rounding's sign would make a
-    zero-length opening after each rebound, filling the chattering guard."""
-    jumped = (surf & SURFACE_JUMPED) != 0
-    settled = (surf & SURFACE_SETTLED) != 0
-    on_surface = g == 0.0 or (jumped and g <= 0.0)
-    if on_surface:
-        return (not settled) and (jumped or rate > 0.0), True
-    return g > 0.0, False
-
-
 @njit(cache=True, _nrt=False, error_model="numpy")
 def locate_on_interpolant(h, th, tr, co, s_lo, g_lo, s_hi, g_hi, c):
     """The fraction s in (s_lo, s_hi] of the step where the gap changes sign on the interpolant
@@ -125,7 +67,7 @@ def locate_on_interpolant(h, th, tr, co, s_lo, g_lo, s_hi, g_hi, c):
     the step's trigonometric base (``trig_at``). Returns the bracket's end past the crossing."""
     sgn = 1.0 if g_lo > 0.0 else -1.0  # work on sgn * delta, positive at the start
     a, fa, b, fb = s_lo, sgn * g_lo, s_hi, sgn * g_hi
-    tol = c[C_EVENT_TOL] / h
+    tol = c[k.C_EVENT_TOL] / h
     side = 0
     for _ in range(MAX_BRACKET_STEPS):
         width = b - a
@@ -164,10 +106,9 @@ def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side
     """With the tangent on, carry it over the accepted step [t, t + s_end h_step] from (th, om)
     to (th1, om1), inner points from the interpolant ``co``: RK4 substeps of V' = A V
     (:func:`._tangent.rk4_tangent_along`) with ``h_sub |A| <= TANGENT_STEP_RATE``, |A| the
-    largest at the step's start, middle and end. One RK4 step per DOP853 step (~1/10 of the
-    contact period) damps V's oscillating part by ~1e-4 a step and biases lambda_1 of the
-    default model to about -22 1/s. The first substep's Jacobian is taken on ``side_first``
-    (a step from the surface), the others on ``side``."""
+    largest at the step's start, middle and end (one substep per DOP853 step would bias lambda_1
+    of the default model to about -22 1/s). The first substep's Jacobian is taken on
+    ``side_first`` (a step from the surface), the others on ``side``."""
     if not steps.tangent_on(t, c):  # off, or in the transient
         return
     _, p0, q0 = ph.acceleration_jacobian(t, th, om, K, c, side_first)
@@ -196,64 +137,63 @@ def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def leave(y, cnt, th, om, t, h, events, window, surface, code, c):
-    """Store the state, time, next step size, event count and surface flags (``surface``, as
-    ``cnt[I_SURFACE]``) and return ``code``. All the loop carries is stored here or recomputed
-    from it the same way, so a resumed run is bit-identical."""
-    y[Y_THETA] = th
-    y[Y_OMEGA] = om
-    y[Y_TIME] = t
-    y[Y_STEP] = h
-    cnt[I_STEP] = np.int64(math.floor(t / c[C_DT] + 1e-9))
-    y[Y_EVENTS] = events
-    y[Y_WINDOW] = window
-    cnt[I_SURFACE] = surface
+    """Store all the loop carries (state, time, next step size, event count, surface flags) and
+    return ``code``: a resumed run recomputes the rest the same way, bit-identical."""
+    y[k.Y_THETA] = th
+    y[k.Y_OMEGA] = om
+    y[k.Y_TIME] = t
+    y[k.Y_STEP] = h
+    cnt[k.I_STEP] = np.int64(math.floor(t / c[k.C_DT] + 1e-9))
+    y[k.Y_EVENTS] = events
+    y[k.Y_WINDOW] = window
+    cnt[k.I_SURFACE] = surface
     return code
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
-    """Advance one trajectory from ``y[Y_TIME]`` to ``n_stop * dt`` with adaptive steps.
+    """Advance one trajectory from ``y[k.Y_TIME]`` to ``n_stop * dt`` with adaptive steps.
 
-    Arguments, buffers and status codes as :func:`._rk4.run_chunk`; ``cnt[I_STEP]`` is the last
-    grid step passed and ``y[Y_STEP]`` carries the step size across calls (resumed runs are
+    Arguments, buffers and status codes as :func:`._rk4.run_chunk`; ``cnt[k.I_STEP]`` is the last
+    grid step passed and ``y[k.Y_STEP]`` carries the step size across calls (resumed runs are
     bit-identical)."""
-    dt = c[C_DT]
+    dt = c[k.C_DT]
     t_stop = n_stop * dt
-    stride = np.int64(c[C_STRIDE])
-    samples_per_step = np.int64(c[C_H_MAX] / (stride * dt)) + 2 if stride > 0 else 0
-    max_events = np.int64(c[C_MAX_EVENTS])
-    t_rec = c[C_T_RECORD]
+    stride = np.int64(c[k.C_STRIDE])
+    samples_per_step = np.int64(c[k.C_H_MAX] / (stride * dt)) + 2 if stride > 0 else 0
+    max_events = np.int64(c[k.C_MAX_EVENTS])
+    t_rec = c[k.C_T_RECORD]
 
-    t = y[Y_TIME]
-    th = y[Y_THETA]
-    om = y[Y_OMEGA]
-    h = y[Y_STEP] if y[Y_STEP] > 0.0 else min(dt, c[C_H_MAX])
-    K = ph.stiffness(lam[cnt[I_LAM_POS]], c)
+    t = y[k.Y_TIME]
+    th = y[k.Y_THETA]
+    om = y[k.Y_OMEGA]
+    h = y[k.Y_STEP] if y[k.Y_STEP] > 0.0 else min(dt, c[k.C_H_MAX])
+    K = ph.stiffness(lam[cnt[k.I_LAM_POS]], c)
     tr = trig_at(t, th, c)  # trigonometric base of the next step; renewed when (t, th) move
     g, l1, cdn = ph.geometry_trig(tr[1], tr[2], tr[3], tr[4], c)
-    surf = cnt[I_SURFACE]
-    flight, on_surface = surface_mode(g, l1 * om - cdn, surf)
+    surf = cnt[k.I_SURFACE]
+    flight, on_surface = steps.surface_mode(g, l1 * om - cdn, surf)
     a1 = accel_trig(tr, om, K, c, flight)
-    window = np.int64(y[Y_WINDOW])  # grid interval of the chattering guard ...
-    events = np.int64(y[Y_EVENTS])  # ... and the events in it so far
+    window = np.int64(y[k.Y_WINDOW])  # grid interval of the chattering guard ...
+    events = np.int64(y[k.Y_EVENTS])  # ... and the events in it so far
 
     redo = False  # the step is being taken again in contact mode (see below)
-    budget = np.int64(c[C_CALL_STEPS])  # steps before a hand-back (Ctrl-C is seen between)
+    budget = np.int64(c[k.C_CALL_STEPS])  # steps before a hand-back (Ctrl-C is seen between)
     taken = np.int64(0)
     while t < t_stop:
         taken += 1
         if not redo and (
             (budget > 0 and taken > budget)
-            or cnt[I_N_SERIES] + samples_per_step > series.shape[0]
-            or cnt[I_N_SECTION] + 2 > section.shape[0]
-            or 0 < impacts.shape[0] < cnt[I_N_IMPACT] + 2  # (no rows: counted only)
-            or cnt[I_LAM_POS] + 3 >= lam.shape[0]
+            or cnt[k.I_N_SERIES] + samples_per_step > series.shape[0]
+            or cnt[k.I_N_SECTION] + 2 > section.shape[0]
+            or 0 < impacts.shape[0] < cnt[k.I_N_IMPACT] + 2  # (no rows: counted only)
+            or cnt[k.I_LAM_POS] + 3 >= lam.shape[0]
         ):
-            return leave(y, cnt, th, om, t, h, events, window, surf, NEED_BUFFER, c)
+            return leave(y, cnt, th, om, t, h, events, window, surf, k.NEED_BUFFER, c)
 
         # The step ends at the next scheduled time at the latest.
         t_next, is_section, is_resample = steps.next_scheduled(t_stop, cnt, c)
-        hs = min(h, c[C_H_MAX])
+        hs = min(h, c[k.C_H_MAX])
         if flight and hs > dt:
             # near the cam a long step could hold several crossings: cut to dt
             safe = ph.safe_horizon(max(g, 0.0), l1, cdn, om, c)
@@ -269,7 +209,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         fac = SAFETY * max(err, ERR_FLOOR) ** EXPONENT
         if not (err <= 1.0):
             if not math.isfinite(err) or hs < H_FLOOR:
-                return leave(y, cnt, th, om, t, h, events, window, surf, NON_FINITE, c)
+                return leave(y, cnt, th, om, t, h, events, window, surf, k.NON_FINITE, c)
             h = hs * max(SHRINK_MIN, fac)
             continue
         h_next = hs * min(GROW_MAX, max(SHRINK_MIN, fac))
@@ -289,10 +229,8 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             events = 0
         rate0 = l1 * om - cdn
         rate1 = l1_1 * om1 - cdn1
-        # the gap at the start, signed by the side the step starts on (see surface_mode)
-        gs = g
-        if on_surface:
-            gs = ON_SURFACE if flight else -ON_SURFACE
+        # the gap at the start, signed by the side the step starts on (_steps.surface_mode)
+        gs = (ON_SURFACE if flight else -ON_SURFACE) if on_surface else g
         closing = flight and g1 <= 0.0
         crossing = closing or (not flight and g1 > 0.0)
         s_lo, g_lo, s_hi, g_hi = 0.0, gs, 1.0, g1  # the crossing lies in (s_lo, s_hi]
@@ -313,9 +251,9 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
                 closing = flight and g_hi <= 0.0
                 crossing = closing or (not flight and g_hi > 0.0)
                 if crossing:
-                    cnt[I_GRAZES] += 1
+                    cnt[k.I_GRAZES] += 1
         if crossing and events >= max_events:
-            cnt[I_CHATTER] += 1
+            cnt[k.I_CHATTER] += 1
             crossing = False
         if flight and not crossing and g1 <= 0.0:
             # A flight step ending in the cam without a located closing (a rebound too weak to
@@ -331,25 +269,20 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         # Series samples in (t, t + s_end hs], from the interpolant.
         t_end = t + s_end * hs if crossing else t1
         if stride > 0:
-            j = cnt[I_SERIES_J]
+            j = cnt[k.I_SERIES_J]
             while (j * stride) * dt <= t_end:
                 tj = (j * stride) * dt
                 if tj >= t_rec:
                     s = (tj - t) / hs
-                    i = cnt[I_N_SERIES]
-                    series[i, 0] = tj
-                    series[i, 1] = theta_at(co, s)
-                    series[i, 2] = omega_at(co, s)
-                    series[i, 3] = lam[cnt[I_LAM_POS]]
-                    cnt[I_N_SERIES] += 1
+                    steps.sample(series, cnt, tj, theta_at(co, s), omega_at(co, s), lam)
                 j += 1
-            cnt[I_SERIES_J] = j
+            cnt[k.I_SERIES_J] = j
         # the contact fraction's time (the step's mode holds to t_end)
         if t_end > t_rec:
             span = t_end - max(t, t_rec)
-            y[Y_RECORDED] += span
+            y[k.Y_RECORDED] += span
             if not flight:
-                y[Y_CONTACT] += span
+                y[k.Y_CONTACT] += span
 
         # the tangent's sides: a step from the surface takes its first Jacobian on its side
         side = JAC_FLIGHT if flight else JAC_NATURAL
@@ -360,7 +293,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         if crossing:
             # The state at the event: a step of the located length, grown by 2, 4, 8, ...
             # event tolerances while not yet past the crossing (the interpolant approximates).
-            reach = c[C_EVENT_TOL] / hs
+            reach = c[k.C_EVENT_TOL] / hs
             for _ in range(MAX_EVENT_GROWTH):
                 h_event = ph.on_clock(t, s_end * hs)
                 r2 = dop853_step(th, om, a1, h_event, tr, K, c, flight)
@@ -383,18 +316,10 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             g, l1, cdn = ph.geometry_trig(tr[1], tr[2], tr[3], tr[4], c)
             surf = 0
             if closing:
-                if not (0.0 < l1 < c[C_ROD_L]):
-                    return leave(y, cnt, th, om, t, h_next, events, window, surf, LEFT_REACH, c)
-                om_before = om
-                plastic = cdn - l1 * om < c[C_V_CHATTER]  # a chattering end, if applied
-                om, K = steps.impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
-                if om != om_before:
-                    # after a rebound the point still lies on the surface, moving out
-                    if plastic:
-                        surf = SURFACE_SETTLED
-                    elif l1 * om - cdn > 0.0:
-                        surf = SURFACE_JUMPED
-            flight, on_surface = surface_mode(g, l1 * om - cdn, surf)
+                if not (0.0 < l1 < c[k.C_ROD_L]):
+                    return leave(y, cnt, th, om, t, h_next, events, window, surf, k.LEFT_REACH, c)
+                om, K, surf = steps.impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
+            flight, on_surface = steps.surface_mode(g, l1 * om - cdn, surf)
             a1 = accel_trig(tr, om, K, c, flight)
             h = min(h_next, hs)  # the event cut the step: do not grow past it
             continue
@@ -409,18 +334,18 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         tr = tr1
         g, l1, cdn = g1, l1_1, cdn1
         surf = 0
-        flight, on_surface = surface_mode(g, l1 * om - cdn, surf)
+        flight, on_surface = steps.surface_mode(g, l1 * om - cdn, surf)
         h = h_next
         a1 = a_end if flight == step_mode else accel_trig(tr, om, K, c, flight)
         if not (math.isfinite(th) and math.isfinite(om)):
-            return leave(y, cnt, th, om, t, h, events, window, surf, NON_FINITE, c)
+            return leave(y, cnt, th, om, t, h, events, window, surf, k.NON_FINITE, c)
         if g <= 0.0:
-            if not (0.0 < l1 < c[C_ROD_L]):
-                return leave(y, cnt, th, om, t, h, events, window, surf, LEFT_REACH, c)
-            if -g > c[C_RCAM]:
-                return leave(y, cnt, th, om, t, h, events, window, surf, PENETRATION, c)
+            if not (0.0 < l1 < c[k.C_ROD_L]):
+                return leave(y, cnt, th, om, t, h, events, window, surf, k.LEFT_REACH, c)
+            if -g > c[k.C_RCAM]:
+                return leave(y, cnt, th, om, t, h, events, window, surf, k.PENETRATION, c)
         if clipped:
             K = steps.at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)
             if is_resample:
                 a1 = accel_trig(tr, om, K, c, flight)
-    return leave(y, cnt, th, om, t, h, events, window, surf, OK, c)
+    return leave(y, cnt, th, om, t, h, events, window, surf, k.OK, c)

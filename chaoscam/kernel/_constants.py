@@ -1,6 +1,6 @@
 """The kernel's constants vector from a model (:class:`~chaoscam.model.Params`) and its
 numerics (:class:`~chaoscam.numerics.Numerics`): the only bridge from the documented settings to
-the compiled kernels, every number a kernel uses put here by name."""
+the compiled kernels."""
 
 from __future__ import annotations
 
@@ -12,13 +12,10 @@ from ..model import Params, contact_angle, contact_angle_rate
 from ..numerics import Numerics
 from . import layout as k
 
-__all__ = ["CALL_STEPS", "initial_counters", "initial_state", "kernel_constants"]
-
 CALL_STEPS = {"rk4": 1 << 21, "adaptive": 1 << 18}
 """Most loop iterations (steps) of one compiled call before it hands back to Python, as for a
-full buffer (bit-identical, tested). Ctrl-C and SIGTERM are seen only between calls, and a cam
-period of 1e8 steps (omega = 1 rad/s, dt = 2e-8 s) would run for minutes without the cap;
-2^21 RK4 contact steps take ~0.4 s, 2^18 adaptive ones ~0.3 s."""
+full buffer (bit-identical): Ctrl-C and SIGTERM are seen only between calls; 2^21 RK4 contact
+steps take ~0.4 s, 2^18 adaptive ones ~0.3 s."""
 
 
 def kernel_constants(
@@ -98,9 +95,8 @@ def initial_state(p: Params) -> np.ndarray:
 
 def initial_counters() -> np.ndarray:
     """The counters (``layout.I_*``) at t = 0: section index 0 (sections are scheduled through
-    the unrecorded transient, so a realization's steps do not depend on it and the tangent
-    restarts every period); series sample and resampling index 1 (index 0 is the initial
-    state). Recording starts at ``kernel_constants``' ``t_record``."""
+    the transient, so a realization's steps do not depend on it); series sample and resampling
+    index 1 (index 0 is the initial state)."""
     cnt = np.zeros(k.N_COUNTERS, dtype=np.int64)
     cnt[k.I_RESAMPLE_J] = 1
     cnt[k.I_SERIES_J] = 1

@@ -2,11 +2,10 @@
 
 Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I* (2nd ed., Springer 1993),
 sec. II.10: 12 stages, order 8, an error estimate combining embedded 5th- and 3rd-order
-solutions. Coefficients of the DOP853 code as in ``scipy/integrate/_ivp/dop853_coefficients.py``;
-the stages are written out without the tableau's zeros (the GPU cannot allocate small arrays).
-For theta'' = a(t, theta, theta') the stage derivatives are (w_i, a_i). Between a step's ends
-the solution is Hermite-interpolated (:func:`theta_at`, :func:`omega_at`) for event location and
-series samples; a located event is re-stepped exactly (:mod:`._adaptive`).
+solutions. Coefficients as in ``scipy/integrate/_ivp/dop853_coefficients.py``, the stages written
+out without the tableau's zeros (the GPU cannot allocate small arrays); for theta'' = a(t, theta,
+theta') the stage derivatives are (w_i, a_i). Between a step's ends the solution is
+Hermite-interpolated (:func:`theta_at`, :func:`omega_at`) for event location and series samples.
 """
 
 from __future__ import annotations

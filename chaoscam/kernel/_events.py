@@ -1,10 +1,6 @@
-"""Where an event happens inside a fixed step: the gap's sign change, and its turn.
-
-Both search the substep length ``tau`` of a function evaluated through one RK4 substep from the
-segment's start: the gap ``delta`` for a crossing, bracketed with a parabola through the last
-trials and the gap rate (:func:`locate_crossing`), and the gap rate for the extremum between two
-crossings a step would step over, by Illinois regula falsi (:func:`graze_point`).
-"""
+"""Where an event happens inside a fixed step: the substep length ``tau`` at which, through one
+RK4 substep from the segment's start, the gap ``delta`` changes sign (:func:`locate_crossing`)
+or the gap rate turns (:func:`graze_point`), and the Illinois regula falsi both searches use."""
 
 from __future__ import annotations
 
@@ -15,9 +11,7 @@ from numba import njit
 from ._physics import geometry, geometry_trig, on_clock, rk4_flight, rk4_trig
 from .layout import C_EVENT_TOL
 
-MAX_BRACKET_STEPS = 400
-"""Passes of a crossing search at most: every three halve the bracket (a bisection follows
-three trials that do not), so 400 reach any tolerance; the cap guards against a NaN gap."""
+MAX_BRACKET_STEPS = 400  # passes of a crossing search at most (a guard against a NaN gap)
 
 GRAZE_TOL = 1e-6
 """Width, as a fraction of the step, to which the gap rate's turn is found (an error e in its
@@ -25,18 +19,16 @@ time moves the gap's extremum by ~|delta''| e^2 / 2, below 1e-20 m)."""
 
 PROBE_STEP = 0.4
 """How far past its estimate of a crossing, in event tolerances, :func:`locate_crossing` puts
-its next trial (towards the bracket's farther end): below a half, so that two trials either
-side of one estimate close the bracket, rounding included."""
+its next trial: below a half, so that two trials either side of one estimate close the bracket."""
 
-MAX_GRAZE_STEPS = 200
-"""Passes of the search for the gap rate's turn at most."""
+MAX_GRAZE_STEPS = 200  # passes of the search for the gap rate's turn at most
 
 
 @njit(cache=True, _nrt=False)
 def gap_after(t, th, om, tau, K, c, trig):
-    """``(delta, l_1, dC/dt.n, theta_f')`` after one RK4 substep of length tau from (t, th, om),
-    the same bits as :func:`._physics.rk4` then :func:`._physics.geometry`. ``trig``: ``(cc, sc,
-    ct, st)`` at the start (:func:`._physics.geometry_at`), shared by a search's trials."""
+    """``(delta, l_1, dC/dt.n, theta_f')`` after one RK4 substep of length tau from (t, th, om)
+    (:func:`._physics.rk4` then :func:`._physics.geometry`, the same bits); ``trig``: ``(cc, sc,
+    ct, st)`` at the start (:func:`._physics.geometry_at`)."""
     cc, sc, ct, st = trig
     th1, om1, c4, s4 = rk4_trig(t, th, om, tau, K, c, cc, sc, ct, st)
     delta, l1, cdn = geometry_trig(c4, s4, math.cos(th1), math.sin(th1), c)
@@ -56,8 +48,8 @@ def illinois_point(a, fa, b, fb):
 @njit(cache=True, inline="always")
 def illinois_update(a, fa, b, fb, m, fm, side):
     """The bracket after f(m) = fm, for Illinois regula falsi (Dowell & Jarratt 1971): the end
-    kept twice in a row has its value halved, which keeps the method superlinear where plain
-    regula falsi stalls. ``side`` remembers the end replaced last."""
+    kept twice in a row has its value halved (superlinear where plain regula falsi stalls).
+    ``side`` remembers the end replaced last."""
     if fm > 0.0:
         a, fa = m, fm
         if side == 1:
@@ -79,22 +71,18 @@ def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight, trig):
 
     - the first trial is regula falsi's point (:func:`illinois_point`);
     - each later one is the root nearest the last trial x of the parabola through the last two
-      trials with the gap rate ``l_1 theta' - dC/dt.n`` at x (the substep gap's derivative to
-      O(tau^4); :func:`model_root`, Newton's step where it has no root), moved ``PROBE_STEP
-      tol`` towards the bracket's farther end, so that the next trial closes the bracket;
-    - an estimate outside the bracket falls back to regula falsi (:func:`illinois_update`
-      keeps the bracket), and three trials that do not halve it are followed by a bisection;
-    - a trial where delta is 0.0 to its last bit is the crossing (slow closings reach the gap's
-      ~1e-17 m resolution, 1e-11 s at 1e-6 m/s, before the bracket is 1e-12 s wide).
+      trials with the gap rate at x (:func:`model_root`), moved ``PROBE_STEP tol`` towards the
+      bracket's farther end, so that the next trial closes the bracket (3.8 substeps a crossing
+      in chattering, against 17.1 for Illinois regula falsi);
+    - an estimate outside the bracket falls back to regula falsi, and three trials that do not
+      halve the bracket are followed by a bisection;
+    - a trial where delta is 0.0 to its last bit is the crossing.
 
-    With ``flight`` (a closing from free flight) the substeps are the free pendulum's
-    (:func:`._physics.rk4_flight`): a full substep past the crossing puts its last stage in the
-    cam, where the Hertz force (K ~ 1e9 N/m) of an overshoot ``v event_tol`` (2e-12 m at 2 m/s)
-    changes theta' by ~1e-8 rad/s, differently wherever the bracket ends. A chattering run
-    (l_lambda = 11 mm, sigma = 1.5 mm, 4 s) takes 3.8 substeps a crossing, against 17.1 for
-    Illinois regula falsi with bisections. Lengths are rounded by :func:`._physics.on_clock`;
-    ``trig`` as in :func:`gap_after`. Returns the bracket's right end past the crossing, or the
-    trial where delta is 0.0 (delta <= 0 there for a closing, >= 0 for an opening)."""
+    With ``flight`` (a closing from free flight) the substeps are the free pendulum's: a full
+    substep's last stage in the cam would feel the Hertz force of an overshoot ``v event_tol``,
+    differently wherever the bracket ends. Lengths rounded by :func:`._physics.on_clock`;
+    ``trig`` as in :func:`gap_after`. Returns the bracket's right end past the crossing (delta
+    <= 0 there for a closing, >= 0 for an opening), or the trial where delta is 0.0."""
     tol = c[C_EVENT_TOL]
     s = 1.0 if g_start > 0.0 else -1.0  # work on s * delta, positive at the start
     fa, b, fb = s * g_start, h, s * g_end
@@ -134,8 +122,7 @@ def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight, trig):
 @njit(cache=True, inline="always")
 def model_root(x, fx, dx, xp, fp):
     """The root nearest x of the parabola through (x, fx) with slope dx and through (xp, fp);
-    Newton's estimate where it has none (or xp = x). A micro-flight's gap is a parabola to a
-    few parts in 1e6 over a step, so two trials reach the gap's resolution."""
+    Newton's estimate where it has none (or xp = x)."""
     u = -fx / dx
     if xp != x:
         e = xp - x
@@ -166,9 +153,8 @@ ON_SURFACE = 1e-300
 def graze_point(t, th, om, h, rate0, rate1, K, c, trig):
     """The substep length tau in (0, h) at which the gap rate l_1 theta' - dC/dt.n turns:
     Illinois regula falsi on ``tau -> rate(RK4 substep of length tau)`` to ``GRAZE_TOL`` of the
-    step. Called where the rate changes sign over a segment and the gap does not: the gap's
-    extremum shows whether it crossed zero and came back (a micro-flight or graze shorter than
-    the step). Lengths rounded by :func:`._physics.on_clock`; ``trig`` as in :func:`gap_after`."""
+    step, where the gap's extremum shows whether it crossed zero and came back (a micro-flight
+    or graze shorter than the step). Lengths rounded by :func:`._physics.on_clock`."""
     s = 1.0 if rate0 > 0.0 else -1.0  # work on s * rate, positive at 0, negative at h
     a, fa, b, fb = 0.0, s * rate0, h, s * rate1
     side = 0

@@ -1,26 +1,17 @@
 """Ensembles on an NVIDIA GPU with numba-cuda: one CUDA thread per trajectory.
 
 The kernel is the CPU kernel: numba-cuda compiles an ``@numba.njit`` function for the CUDA target
-when a ``@cuda.jit`` kernel calls it (``CUDATypingContext.resolve_value_type`` wraps the CPU
-dispatcher), so :func:`._driver.advance` and either integrator run on the GPU from one source.
+when a ``@cuda.jit`` kernel calls it, so :func:`._driver.advance` and either integrator run on
+the GPU from one source. Members run until they end or return ``NEED_BUFFER``, are refilled on
+the host as on the CPU path and relaunched alone; a resumed run is bit-identical.
 
-Numerics: not bit-identical to the CPU (NVVM fuses ``a * b + c``; libdevice's sin/cos/tanh may
-differ from libm in the last bit), and the model amplifies that: a 1e-15 rad kick is 1e-9 rad at
-the first section, and chaotic runs part to O(0.1) over 20 s. Sections of the first cam period
-and of periodic runs after a transient (``Params(xi=0.2)``, 10 s) agree within
-``GPU_TOLERANCE`` (a 1e-12 rad kick moves them by 1e-6 and 1e-8); ensemble statistics are what
-a GPU run is for. Under the CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``) results are bit-identical.
-
-Buffers: members run until they end or return ``NEED_BUFFER`` (draws used up, or impact rows
-where impacts are kept, else impacts are only counted: each stop relaunches the batch, which
-waits for its slowest member again, and 256 rows stop a 20-s Table 1 member, ~14,000 impacts,
-43-49 times, 2.1x one launch's time in ``benchmarks/gpu_warp_model.py --tail``). They are
-refilled on the host as on the CPU path and relaunched alone; a resumed run is bit-identical.
-
-Speed (an H200, ``benchmarks/bench_gpu_wave.py``; docs/speed.md): one thread is slow (4.8 us a
-grid step; a warp's members branch apart, 2.4 of 32 threads running at a time), so the device
-needs thousands of members in flight: 33,792 members of 5 s run 11.3x as fast as 2 CPU threads.
-numba-cuda is imported lazily: ``import chaoscam`` never imports it.
+Limits: not bit-identical to the CPU (NVVM fuses ``a * b + c``; libdevice's sin/cos/tanh may
+differ in the last bit), and chaotic runs part to O(0.1) over 20 s; sections of the first cam
+period and of periodic runs after a transient agree within ``GPU_TOLERANCE``, and ensemble
+statistics are what a GPU run is for (under ``NUMBA_ENABLE_CUDASIM=1`` bit-identical). One
+thread is slow (a warp's members branch apart), so the device needs thousands of members in
+flight: 33,792 members of 5 s run 11.3x as fast as 2 CPU threads on an H200. numba-cuda is
+imported lazily.
 """
 
 from __future__ import annotations
@@ -40,11 +31,6 @@ from ._adaptive import run_chunk_adaptive
 from ._driver import advance, drive_members
 from ._rk4 import run_chunk
 
-__all__ = [
-    "GPU_BATCH", "GPU_TOLERANCE", "AUTO_GPU_MIN", "GPUFallbackWarning", "by_size", "gpu_status",
-    "run_on_gpu", "runs_on_gpu",
-]  # fmt: skip
-
 GPU_BATCH = 65_536  # members per device batch: ~19 kB each for 20 s runs, 42 kB with impacts kept
 GPU_TOLERANCE = 1e-6  # rad and rad/s: GPU against CPU sections, first period or periodic
 _BLOCK = 64  # threads per block: 202 registers a thread on an H200 (196 from ptxas 12.9)
@@ -58,10 +44,8 @@ thread while its labelling thread may extend members on the device; they take tu
 
 AUTO_GPU_MIN = 4_096
 """Fewest members (an ensemble's, or a sweep's runs) that ``"auto"`` runs on a GPU: from 4,096
-0.25-s members an H200 outruns a 16-core CPU (64 members take 1.09 s of launch, 33,792 take
-5.1 s); below, ``"auto"`` runs on the CPU (``"gpu"`` runs any size). A sweep settles it by its
-runs before it starts, per batch on Dask workers (CPU-sized batches, so their CPUs); a GPU run's
-few extensions and fate runs settle by it too."""
+0.25-s members an H200 outruns a 16-core CPU; below, ``"auto"`` runs on the CPU (``"gpu"`` runs
+any size)."""
 
 
 class GPUFallbackWarning(RuntimeWarning):
@@ -70,8 +54,7 @@ class GPUFallbackWarning(RuntimeWarning):
 
 def gpu_status() -> tuple[bool, str]:
     """Whether the GPU backend can run here, and why in one line (naming the device): checks
-    the numpy version (numba-cuda <= 0.30.4 compiles no kernel under numpy >= 2.5, which has no
-    ``row_stack``), numba-cuda, a CUDA driver and device."""
+    the numpy version, numba-cuda, a CUDA driver and device."""
     trap = _numpy_trap()
     if trap:
         return False, trap
@@ -93,7 +76,7 @@ def runs_on_gpu(backend: str) -> bool:
 
 
 def _numpy_trap() -> str:
-    """The reason the numpy version rules the backend out, or "" if it does not."""
+    """Why the numpy version rules the backend out (no ``row_stack``), or ""."""
     match = re.match(r"(\d+)\.(\d+)", np.__version__)
     if match and tuple(int(x) for x in match.groups()) >= _NUMPY_TRAP:
         return (
@@ -127,8 +110,7 @@ def _simulated(dev) -> bool:
 
 
 def _advance_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
-    """The kernel's source: ``step`` for each member still to run (globals bound by
-    :func:`_members`)."""
+    """The kernel's source: ``step`` for each member still to run."""
     i = cuda.grid(1)  # noqa: F821
     if i < y.shape[0] and status[i] == k.NEED_BUFFER:
         status[i] = step(  # noqa: F821
@@ -137,17 +119,16 @@ def _advance_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
 
 
 def _members(cuda, step):
-    """:func:`_advance_members` with ``cuda`` and ``step`` bound as globals, not a closure, so
-    that the CUDA simulator can swap in its fake ``cuda`` module."""
+    """:func:`_advance_members` with ``cuda`` and ``step`` bound as globals (not a closure: the
+    CUDA simulator swaps in its fake ``cuda`` module)."""
     namespace = {"__name__": __name__, "cuda": cuda, "step": step, "k": k}
     code = _advance_members.__code__
     return types.FunctionType(code, namespace, "advance_members")
 
 
 def _step_function(method: int | None):
-    """The per-member function a kernel calls: the integrator itself when a batch has one, as a
-    specialised kernel takes fewer registers (ptxas 12.9, sm_90, contiguous rows: RK4 196, the
-    adaptive path 184, ``advance`` 236, no spills; any strides spill)."""
+    """The per-member function a kernel calls: the integrator itself when a batch has one (fewer
+    registers: RK4 196, adaptive 184, ``advance`` 236 on sm_90)."""
     if method == k.METHOD_RK4:
         return run_chunk
     if method == k.METHOD_ADAPTIVE:
@@ -182,10 +163,9 @@ def _batch_method(c: np.ndarray) -> int | None:
 
 
 def kernel_ptx(cc: tuple[int, int] = (9, 0), method: int | None = None) -> str:
-    """PTX of the ensemble kernel for compute capability ``cc`` (needs NVVM, not a device), for
-    ``method`` ``layout.METHOD_RK4``, ``METHOD_ADAPTIVE`` or None (both) and the C-ordered arrays
-    :func:`run_on_gpu` launches. numba-cuda asks the current device for the capability even when
-    ``compile_ptx`` is given one, so a stand-in device with ``cc`` is put in its place."""
+    """PTX of the ensemble kernel for compute capability ``cc`` (needs NVVM, not a device) and
+    ``method`` (``layout.METHOD_*``, None for both). numba-cuda asks the current device for the
+    capability even when given one, so a stand-in device is put in its place."""
     from unittest import mock
 
     import numba.cuda.dispatcher as dispatcher
@@ -215,7 +195,7 @@ def kernel_info(method: int | None = k.METHOD_RK4) -> dict:
 
 def _configured(kern, blocks: int):
     """``kern[blocks, _BLOCK]`` without the low-occupancy warning (:data:`_SMALL_GRID`); any
-    other warning is raised again. Thread-safe (:func:`chaoscam._util.recorded`)."""
+    other warning is raised again."""
     with recorded() as said:
         configured = kern[blocks, _BLOCK]
     for w in said:
@@ -244,9 +224,6 @@ def _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, kee
     def put(a):
         return cuda.to_device(np.ascontiguousarray(a))
 
-    def get(d, host) -> None:
-        d.copy_to_host(host)
-
     d_y, d_cnt, d_c, d_lam, d_status = (put(a) for a in (y, cnt, c, lam, status))
     d_series = cuda.device_array((n, 1, k.SERIES_COLS))
     if cnt[:, k.I_N_SECTION].any():  # rows of an earlier launch (a resumable run's first)
@@ -263,16 +240,11 @@ def _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, kee
         d_status.copy_to_host(status)
         return status[need]
 
-    def impact_rows(need: np.ndarray) -> None:
-        """The filled impact rows of the members in ``need``, brought to ``impacts``."""
-        for j in need:
-            d_impacts[j].copy_to_host(impacts[j])
-
     def refill(need: np.ndarray) -> None:
-        get(d_cnt, cnt)
-        if keep_impacts:
-            impact_rows(need)
-        for j in need:  # the same width again: as many new draws as were used
+        d_cnt.copy_to_host(cnt)
+        for j in need:  # the impact rows, and as many new draws as were used
+            if keep_impacts:
+                d_impacts[j].copy_to_host(impacts[j])
             lam[j] = hand_back(j, lam[j], int(cnt[j, k.I_LAM_POS]))
         d_cnt.copy_to_device(np.ascontiguousarray(cnt))
         if 8 * need.size < n:
@@ -282,8 +254,7 @@ def _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, kee
             d_lam.copy_to_device(np.ascontiguousarray(lam))
 
     drive_members(n, launch, refill, np.flatnonzero(status == k.NEED_BUFFER))
-    get(d_y, y)
-    get(d_cnt, cnt)
-    get(d_section, section)
+    for d, host in ((d_y, y), (d_cnt, cnt), (d_section, section)):
+        d.copy_to_host(host)
     if keep_impacts:
-        get(d_impacts, impacts)
+        d_impacts.copy_to_host(impacts)

@@ -1,13 +1,10 @@
 """numba's on-disk cache, emptied when any source file of a package changes.
 
 numba keys a cached function on its own file's modification time and size only, so a cached
-caller keeps its compiled copy of a callee in another file after that file changes (a warm cache
-then runs other trajectories than the code's). A package whose compiled functions call across
-files calls :func:`guard` on import, before any is compiled or loaded: when a fingerprint of its
-``.py`` files, kept beside numba's cache files, differs, they are removed. The cache is numba's
-for the package's folder (:func:`cache_folder`): ``NUMBA_CACHE_DIR`` when set, else a writable
-``__pycache__`` beside the sources, else numba's per-user folder (a read-only install);
-``tests/test_numba_cache.py`` tests the first two.
+caller keeps its compiled copy of a callee in another file after that file changes. A package
+whose compiled functions call across files calls :func:`guard` on import, before any is
+compiled or loaded: when a fingerprint of its ``.py`` files, kept beside numba's cache files
+(:func:`cache_folder`), differs, they are removed.
 """
 
 from __future__ import annotations
@@ -15,8 +12,6 @@ from __future__ import annotations
 import hashlib
 import os
 from pathlib import Path
-
-__all__ = ["STAMP", "cache_folder", "fingerprint", "guard"]
 
 STAMP = "chaoscam-sources.sha256"
 """The fingerprint's file, in the folder numba caches the package in (:func:`cache_folder`)."""
@@ -33,9 +28,9 @@ def fingerprint(folder: Path) -> str:
 
 
 def cache_folder(folder: str | os.PathLike) -> Path:
-    """Where numba caches functions of ``folder``'s modules: the first of numba's cache
-    locators (in numba's order) to accept a file of ``folder``, or ``folder/__pycache__``
-    where they cannot be asked (not public API)."""
+    """Where numba caches functions of ``folder``'s modules (``NUMBA_CACHE_DIR``, a writable
+    ``__pycache__``, or numba's per-user folder): the first of numba's cache locators to accept
+    a file of ``folder``, or ``folder/__pycache__`` where they cannot be asked."""
     folder = Path(folder)
     try:
         from numba.core.caching import CacheImpl

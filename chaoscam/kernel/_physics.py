@@ -1,9 +1,5 @@
-"""The model's physics as compiled functions: geometry, equations (1)–(3), RK4 steps.
-
-Event handling, the output schedule and the stepping loops are in :mod:`._rk4` and
-:mod:`._adaptive`, the tangent dynamics in :mod:`._tangent`; numbers come from the constants
-vector (``C_*``, :mod:`.layout`).
-"""
+"""The model's physics as compiled functions: geometry, equations (1)–(3), RK4 steps; numbers
+come from the constants vector (``C_*``, :mod:`.layout`)."""
 
 from __future__ import annotations
 
@@ -46,13 +42,11 @@ def stiffness(lam, c):
 def cam_angle(t, c):
     """The cam angle ``theta_c = omega t + theta_c0`` reduced to [-pi, pi], to ~1e-16 rad.
 
-    A naive ``omega t`` is off by 2.3e-13 rad at t = 60 s (1.8e-12 at 300 s), moving the cam by
-    1e-14 m (7e-14 m): the height of a chattering sequence's last bounces (``v^2 /
-    2|delta''|``, 3e-14 m at v = 1e-6 m/s), where the gap's sign would come from rounding.
-    Here ``omega t`` is exact as two doubles (Dekker's product), ``theta_c0`` is added by
-    Knuth's two-sum and 2 pi taken off by Cody & Waite's three-part reduction (exact for
-    |theta_c| < 4e8 rad; beyond, as the naive sum). Fused multiply-adds (NVVM on the GPU) may
-    round the product's error term differently, to the same order."""
+    A naive ``omega t`` is off by 2.3e-13 rad at t = 60 s, moving the cam by 1e-14 m: the
+    height of a chattering sequence's last bounces (``v^2 / 2|delta''|``). Here ``omega t`` is
+    exact as two doubles (Dekker's product), ``theta_c0`` added by Knuth's two-sum and 2 pi
+    taken off by Cody & Waite's three-part reduction. Limits: exact for |theta_c| < 4e8 rad
+    (beyond, as the naive sum); fused multiply-adds (the GPU) round the error term differently."""
     w = c[C_OMEGA]
     p = w * t
     cw = DEKKER_SPLIT * w
@@ -71,10 +65,9 @@ def cam_angle(t, c):
 
 @njit(cache=True, inline="always")
 def on_clock(t, tau):
-    """``tau`` rounded so that ``t + tau`` is a double: ``(t + tau) - t``. A substep of this
-    length ends at the time its end is stamped with, so state and cam angle never part by the
-    rounding of ``t + tau`` (3.6e-15 s at t = 60 s, 2.8e-14 s at 300 s, when the cam moves
-    1e-15-3e-14 m, the scale of a chattering sequence's last bounces)."""
+    """``tau`` rounded so that ``t + tau`` is a double, ``(t + tau) - t``: a substep of this
+    length ends at the time it is stamped with, so state and cam angle never part by the
+    rounding of ``t + tau`` (3.6e-15 s at t = 60 s: the cam moves 1e-15 m)."""
     return (t + tau) - t
 
 
@@ -92,10 +85,8 @@ ROTATE_MAX = 0.01  # [rad] an angle this close to a known one is rotated to (rot
 def rotate(a, ca, sa, b):
     """(cos(a + b), sin(a + b)) from ca = cos a, sa = sin a: for |b| < ROTATE_MAX by the
     addition theorem with Taylor polynomials of cos b, sin b (truncation < b^8 / 8! < 1e-20),
-    else directly. A step's stages sit near its start, so they need no transcendental calls
-    (cos/sin of every stage are 40 % of the RK4 kernel's time, ``benchmarks/PROFILE.md``).
-    Within a few ulp of the direct call; never rotated on from (a step's end takes direct
-    values), so the differences do not accumulate."""
+    else directly. Saves the stages' transcendental calls (40 % of the RK4 kernel's time).
+    Within a few ulp of the direct call; a step's end takes direct values, so no drift."""
     if abs(b) >= ROTATE_MAX:
         return math.cos(a + b), math.sin(a + b)
     return _turn(ca, sa, b)
@@ -130,7 +121,7 @@ def geometry(t, th, c):
 @njit(cache=True, _nrt=False)
 def geometry_at(t, th, c):
     """:func:`geometry` and its trigonometry, ``(delta, l_1, dC/dt.n, cc, sc, ct, st)``
-    ((cc, sc) of the cam angle, (ct, st) of theta_f), a step's first stage (:func:`rk4_trig`)."""
+    ((cc, sc) of the cam angle, (ct, st) of theta_f)."""
     cc, sc = cam_trig(t, c)
     ct, st = math.cos(th), math.sin(th)
     delta, l1, cdn = geometry_trig(cc, sc, ct, st, c)
@@ -176,11 +167,10 @@ def _equations(cc, sc, ct, st, om, K, c, jac, side):
     - friction torque ``-mu_f a F_n sgn(v_r)`` with the slip speed at ``B_c = C + R n``,
       ``v_r = r theta' - w (C_x sin th - C_y cos th - R)``.
 
-    The field is continuous across delta = 0 (F_n vanishes), so onset and separation need no
-    saltation matrix; its Jacobian jumps by ~K l_1^2 / J. A substep ending at a located crossing
-    has its last stage *on* the surface and takes the Jacobian on its own side (``side``:
-    JAC_FLIGHT before a closing, JAC_CONTACT, the force continued past p = 0, before an
-    opening); else the tangent picks up h/6 of the jump."""
+    The field is continuous across delta = 0 (no saltation at onset and separation); its
+    Jacobian jumps by ~K l_1^2 / J, so a substep ending on the surface takes it on its own side
+    (``side``: JAC_FLIGHT before a closing, JAC_CONTACT, the force continued past p = 0, before
+    an opening)."""
     cx = c[C_E] * cc
     cy = c[C_E] * sc
     dx = c[C_XO] - cx
@@ -235,15 +225,13 @@ def _equations(cc, sc, ct, st, om, K, c, jac, side):
 
 @njit(cache=True, _nrt=False)
 def acceleration_trig(cc, sc, ct, st, om, K, c):
-    """:func:`acceleration` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st),
-    which callers often know (four transcendental calls saved)."""
+    """:func:`acceleration` given cos/sin of the cam angle (cc, sc) and of theta_f (ct, st)."""
     return _equations(cc, sc, ct, st, om, K, c, False, JAC_NATURAL)[0]
 
 
 @njit(cache=True, _nrt=False)
 def acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, side):
-    """:func:`acceleration_jacobian` given cos/sin of the cam angle (cc, sc) and of theta_f
-    (ct, st)."""
+    """:func:`acceleration_jacobian` given cos/sin of the cam angle and of theta_f."""
     return _equations(cc, sc, ct, st, om, K, c, True, side)
 
 
@@ -265,57 +253,79 @@ def rk4(t, th, om, h, K, c):
     return r[0], r[1]
 
 
-@njit(cache=True, _nrt=False)
-def rk4_trig(t, th, om, h, K, c, cc, sc, ct, st):
-    """:func:`rk4` given the trigonometry at its start (cc, sc of the cam angle at t; ct, st of
-    theta_f), e.g. :func:`geometry_at`'s; returns ``(th, om, cc4, sc4)``, the last two the cam
-    angle's cos/sin at ``t + h`` (for the gap there). The stages' cos/sin are rotated from the
-    start's (:func:`rotate`): two transcendental calls a step, not six; the end's are direct,
-    so no rounding is carried from step to step."""
-    a1 = acceleration_trig(cc, sc, ct, st, om, K, c)
+@njit(cache=True, inline="always")
+def _accel(cc, sc, ct, st, om, K, c, jac, side):
+    """(theta'', d/d theta, d/d theta') of a stage; the derivatives 0 without ``jac``."""
+    if jac:
+        return acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, side)
+    return acceleration_trig(cc, sc, ct, st, om, K, c), 0.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def rk4_stages(t, th, om, h, K, c, cc, sc, ct, st, jac, first, rest):
+    """The one home of the RK4 step: ``(th, om, cc4, sc4, (p1, q1, ..., p4, q4))``, with
+    ``jac`` each stage's (d theta''/d theta, d theta''/d theta'), the first's taken on side
+    ``first`` of the surface, the others' on ``rest`` (:func:`_equations`). The stages' cos/sin
+    are rotated from the start's (:func:`rotate`); the end's cam angle is direct."""
+    a1, p1, q1 = _accel(cc, sc, ct, st, om, K, c, jac, first)
     cm, sm = cam_trig_near(t, 0.5 * h, cc, sc, c)
     th2 = th + 0.5 * h * om
     om2 = om + 0.5 * h * a1
     ct2, st2 = rotate(th, ct, st, th2 - th)
-    a2 = acceleration_trig(cm, sm, ct2, st2, om2, K, c)
+    a2, p2, q2 = _accel(cm, sm, ct2, st2, om2, K, c, jac, rest)
     th3 = th + 0.5 * h * om2
     om3 = om + 0.5 * h * a2
     ct3, st3 = rotate(th, ct, st, th3 - th)
-    a3 = acceleration_trig(cm, sm, ct3, st3, om3, K, c)
+    a3, p3, q3 = _accel(cm, sm, ct3, st3, om3, K, c, jac, rest)
     c4, s4 = cam_trig(t + h, c)
     th4 = th + h * om3
     om4 = om + h * a3
     ct4, st4 = rotate(th, ct, st, th4 - th)
-    a4 = acceleration_trig(c4, s4, ct4, st4, om4, K, c)
-    return (
-        th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
-        om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
-        c4,
-        s4,
-    )
+    a4, p4, q4 = _accel(c4, s4, ct4, st4, om4, K, c, jac, rest)
+    th_new = th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4)
+    om_new = om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+    return th_new, om_new, c4, s4, (p1, q1, p2, q2, p3, q3, p4, q4)
 
 
 @njit(cache=True, _nrt=False)
-def rk4_flight(th, om, h, c):
-    """RK4 step of the free pendulum J theta'' = -(m g l/2) cos theta: :func:`rk4`'s step
-    where the gap stays positive (:func:`closing_bound`), at a quarter of the cost (the
-    stages' cosines rotated: one sincos a step)."""
+def rk4_trig(t, th, om, h, K, c, cc, sc, ct, st):
+    """:func:`rk4` given the trigonometry at its start (cc, sc of the cam angle at t; ct, st of
+    theta_f), e.g. :func:`geometry_at`'s; returns ``(th, om, cc4, sc4)``, the last two the cam
+    angle's cos/sin at ``t + h``. Two transcendental calls a step, not six."""
+    r = rk4_stages(t, th, om, h, K, c, cc, sc, ct, st, False, JAC_NATURAL, JAC_NATURAL)
+    return r[0], r[1], r[2], r[3]
+
+
+@njit(cache=True, inline="always")
+def flight_stages(th, om, h, c):
+    """The RK4 step of the free pendulum: ``(th, om, (p1, p2, p3, p4))``, p_i = d theta''/d
+    theta at the stages (the cosines rotated: one sincos a step)."""
     k = -c[C_GRAV] * c[C_INV_J]
     ct, st = math.cos(th), math.sin(th)
     a1 = k * ct
     om2 = om + 0.5 * h * a1
     th2 = th + 0.5 * h * om
-    a2 = k * rotate(th, ct, st, th2 - th)[0]
+    ct2, st2 = rotate(th, ct, st, th2 - th)
+    a2 = k * ct2
     om3 = om + 0.5 * h * a2
     th3 = th + 0.5 * h * om2
-    a3 = k * rotate(th, ct, st, th3 - th)[0]
+    ct3, st3 = rotate(th, ct, st, th3 - th)
+    a3 = k * ct3
     om4 = om + h * a3
     th4 = th + h * om3
-    a4 = k * rotate(th, ct, st, th4 - th)[0]
-    return (
-        th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
-        om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
-    )
+    ct4, st4 = rotate(th, ct, st, th4 - th)
+    a4 = k * ct4
+    th_new = th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4)
+    om_new = om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+    return th_new, om_new, (-k * st, -k * st2, -k * st3, -k * st4)
+
+
+@njit(cache=True, _nrt=False)
+def rk4_flight(th, om, h, c):
+    """RK4 step of the free pendulum J theta'' = -(m g l/2) cos theta: :func:`rk4`'s step
+    where the gap stays positive (:func:`closing_bound`), at a quarter of the cost."""
+    r = flight_stages(th, om, h, c)
+    return r[0], r[1]
 
 
 @njit(cache=True, _nrt=False)

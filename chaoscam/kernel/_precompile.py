@@ -1,13 +1,11 @@
 """The RK4 kernel's first compilation on two cores: a second process compiles some callees.
 
 numba compiles :func:`._rk4.run_chunk` once per install (``cache=True``) in one process on one
-core, mostly numba's own Python (typing and lowering each callee as typing reaches it). The
-first RK4 run of a process whose cache lacks them (:func:`start_once`, from
-:func:`._driver.alone_kernel`) starts ``python -m chaoscam.kernel._precompile``, which compiles
-the callees the kernel's typing reaches last (:func:`_callees`, in reverse) into numba's cache,
-where this process's compilation finds them: the same machine code, so the same bits (tested);
-nothing waits on an unfinished one. A fresh install's first ``simulate`` on 2 cores takes 14.8 s
-instead of 25.6 s. Drifted signatures break nothing (a slow test checks each is a cache hit).
+core. The first RK4 run of a process whose cache lacks them (:func:`start_once`) starts ``python
+-m chaoscam.kernel._precompile``, which compiles the callees the kernel's typing reaches last
+(:func:`_callees`) into numba's cache, where this process's compilation finds them: the same
+machine code, so the same bits. A fresh install's first ``simulate`` on 2 cores takes 14.8 s
+instead of 25.6 s; drifted signatures break nothing (a slow test checks each is a cache hit).
 """
 
 from __future__ import annotations
@@ -18,12 +16,10 @@ import subprocess
 import sys
 import threading
 
-__all__ = ["start_beside", "start_once"]
-
 
 def _callees():
-    """[(dispatcher, signature)] the second process compiles: the reverse of the order in which
-    ``run_chunk``'s typing reaches them, so the two processes meet in the middle."""
+    """[(dispatcher, signature)] the second process compiles, in the reverse of the order in
+    which ``run_chunk``'s typing reaches them (the two processes meet in the middle)."""
     from numba import types
 
     from . import _events, _physics, _tangent
@@ -42,7 +38,7 @@ def _callees():
 
 def _cached(dispatcher) -> bool:
     """Whether numba's cache holds an index for ``dispatcher`` (numba internals; False where
-    they change, and the second process runs, costing under a second)."""
+    they change)."""
     try:
         return os.path.exists(dispatcher._cache._cache_file._index_path)
     except AttributeError:
@@ -71,8 +67,8 @@ _start_lock = threading.Lock()
 
 
 def start_once() -> None:
-    """:func:`start_beside` the first time a process asks, unless it is a multiprocessing child
-    (one second process is enough); the second process ends with this one at the latest."""
+    """:func:`start_beside` the first time a process asks, unless it is a multiprocessing
+    child; the second process ends with this one at the latest."""
     global _started
     with _start_lock:
         if _started:

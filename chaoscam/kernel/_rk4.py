@@ -1,30 +1,24 @@
 """Fixed-step RK4 with located impacts: the reference integrator (paper sec. 3).
 
 One call of :func:`run_chunk` advances one trajectory on the grid ``t_n = n dt`` to the end step
-or until an output buffer needs emptying (never raising). A grid step is cut into *segments* at
-the scheduled times inside it (sections ``k T``, line-length draws ``j dt_l``) and at located
-impacts; each is one RK4 substep, so section points are RK4 states and the grid never shifts.
+or until an output buffer needs emptying. A grid step is cut into *segments* at the scheduled
+times inside it (sections ``k T``, line-length draws ``j dt_l``) and at located impacts, each
+one RK4 substep, so section points are RK4 states and the grid never shifts.
 
 Impacts (paper (4)–(5), MODEL.md): where the gap ``delta`` goes from > 0 to <= 0 over a segment,
 the crossing is located on ``tau -> delta(RK4 substep of length tau)`` to ``event_tol``
 (:func:`._events.locate_crossing`), the state taken at the bracket end where ``delta <= 0``, and
-the restitution law applied (:func:`._steps.impact`): ``theta'+ = -xi theta'- + (1 + xi)
-(dC/dt . n) / l_1``, or, slower than ``v_chatter``, the plastic closure that ends a complete
-chattering sequence. Two crossings in one segment (a micro-flight or graze shorter than a step)
-are found where the gap rate turns (:func:`._events.graze_point`).
+the impact law applied (:func:`._steps.impact`). Two crossings in one segment (a micro-flight
+or graze shorter than a step) are found where the gap rate turns (:func:`._events.graze_point`).
+The gap is resolved to ~1e-16 m at any time: the cam angle is reduced exactly
+(:func:`._physics.cam_angle`) and every substep ends on the double it is stamped with
+(:func:`._physics.on_clock`).
 
-The gap is resolved to ~1e-16 m at any time (the last bounces of a chattering sequence rise
-~3e-14 m): the cam angle is reduced exactly (:func:`._physics.cam_angle`) and every substep ends
-on the double it is stamped with (:func:`._physics.on_clock`).
-
-With ``c[C_TANGENT]`` set the tangent is integrated with the state (:mod:`._tangent`) from shortly
-before the recording (:func:`._steps.tangent_on`), carried through each event by the saltation
-matrix, written beside each section point as the map's Jacobian over the last period and
-restarted from the identity there. The state is the same with and without it.
-
-Compiled without numba's reference counting (``_nrt=False`` on each function compiled on its
-own; none allocates): its atomic ``NRT_incref``/``NRT_decref`` on array arguments cost 8 % of a
-regime map's samples (``benchmarks/PROFILE.md``); ``tests/kernel/test_no_refcount.py`` checks.
+With ``c[C_TANGENT]`` set the tangent is integrated with the state (:mod:`._tangent`), carried
+through each impact by the saltation matrix, written beside each section point as the map's
+Jacobian over the last period and restarted from the identity; the state is the same without.
+Compiled without numba's reference counting (``_nrt=False``; nothing allocates): its atomic
+increments cost 8 % of a regime map's samples (``tests/kernel/test_no_refcount.py`` checks).
 """
 
 from __future__ import annotations
@@ -34,6 +28,7 @@ import math
 import numpy as np
 from numba import njit
 
+from . import layout as k
 from ._events import ON_SURFACE, gap_after, graze_point, locate_crossing
 from ._physics import (
     JAC_CONTACT,
@@ -54,60 +49,22 @@ from ._steps import (
     commit_tangent,
     impact,
     next_scheduled,
+    sample,
+    surface_mode,
     tangent_on,
 )
 from ._tangent import rk4_flight_tangent, rk4_tangent_trig
-from .layout import (
-    C_CALL_STEPS,
-    C_DT,
-    C_FLIGHT_MERGE,
-    C_MAX_EVENTS,
-    C_PERIOD,
-    C_RCAM,
-    C_RESAMPLE_DT,
-    C_ROD_L,
-    C_STRIDE,
-    C_T_RECORD,
-    C_V_CHATTER,
-    I_CHATTER,
-    I_CONTACT_STEPS,
-    I_COUNTED_STEPS,
-    I_GRAZES,
-    I_LAM_POS,
-    I_N_IMPACT,
-    I_N_SECTION,
-    I_N_SERIES,
-    I_RESAMPLE_J,
-    I_SAFE_STEP,
-    I_SECTION_K,
-    I_STEP,
-    I_SURFACE,
-    LEFT_REACH,
-    NEED_BUFFER,
-    NON_FINITE,
-    OK,
-    PENETRATION,
-    Y_J11,
-    Y_J12,
-    Y_J21,
-    Y_J22,
-    Y_OMEGA,
-    Y_THETA,
-    Y_TIME,
-)
 
 
 @njit(cache=True, inline="always")
 def step_rk4(t, th, om, h, K, c, y, commit, first, rest, trig):
-    """One RK4 substep of the state and, with the tangent on (:func:`._steps.tangent_on`), of
-    the tangent, its first stage's Jacobian taken on side ``first`` of the surface, the others'
-    on ``rest`` (:func:`._tangent.rk4_tangent_trig`). ``trig``: ``(cc, sc, ct, st)`` at the
-    start (:func:`._physics.geometry_at`). Returns ``(th, om, v11, v21, v12, v22, div)`` (the
-    tangent written into ``y`` when ``commit``; the state never stored) and the cam angle's
-    ``(cos, sin)`` at ``t + h``."""
+    """One RK4 substep of the state and, with the tangent on, of the tangent (Jacobian sides
+    ``first``, ``rest``: :func:`._tangent.rk4_tangent_trig`) from ``trig`` = (cc, sc, ct, st):
+    ``(th, om, v11, v21, v12, v22, div)`` (the tangent stored with ``commit``) and the cam
+    angle's (cos, sin) at ``t + h``."""
     cc, sc, ct, st = trig
     if tangent_on(t, c):
-        v11, v21, v12, v22 = y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22]
+        v11, v21, v12, v22 = y[k.Y_J11], y[k.Y_J21], y[k.Y_J12], y[k.Y_J22]
         r = rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, first, rest, cc, sc, ct, st)
         if commit:
             commit_tangent(y, r[2], r[3], r[4], r[5], r[6])
@@ -120,7 +77,7 @@ def step_rk4(t, th, om, h, K, c, y, commit, first, rest, trig):
 def step_flight(t, th, om, h, c, y, commit):
     """:func:`step_rk4` for the free pendulum (:func:`rk4_flight`); divergence 0."""
     if tangent_on(t, c):
-        r = rk4_flight_tangent(th, om, h, c, y[Y_J11], y[Y_J21], y[Y_J12], y[Y_J22])
+        r = rk4_flight_tangent(th, om, h, c, y[k.Y_J11], y[k.Y_J21], y[k.Y_J12], y[k.Y_J22])
         if commit:
             commit_tangent(y, r[2], r[3], r[4], r[5], 0.0)
         return r[0], r[1], r[2], r[3], r[4], r[5], 0.0
@@ -131,10 +88,10 @@ def step_flight(t, th, om, h, c, y, commit):
 @njit(cache=True, _nrt=False)
 def leave(y, cnt, th, om, t, safe_n, code):
     """Store the state and the flight horizon before returning ``code`` to the driver."""
-    y[Y_THETA] = th
-    y[Y_OMEGA] = om
-    y[Y_TIME] = t
-    cnt[I_SAFE_STEP] = safe_n
+    y[k.Y_THETA] = th
+    y[k.Y_OMEGA] = om
+    y[k.Y_TIME] = t
+    cnt[k.I_SAFE_STEP] = safe_n
     return code
 
 
@@ -143,59 +100,55 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     """Advance one trajectory from step ``cnt[I_STEP]`` towards grid step ``n_stop``; returns a
     status code, ``NEED_BUFFER`` asking the driver to empty buffers or add draws.
 
-    ``y`` (float64[Y_SIZE]: theta_f [rad], theta_f' [rad/s], t [s], ..., the tangent, at ``t =
-    cnt[I_STEP] dt``) and ``cnt`` (int64[N_COUNTERS]) are updated in place; ``c``: the constants
-    (``C_*``); ``lam``: line-length draws, ``lam[cnt[I_LAM_POS]]`` in use; ``series``,
-    ``section``, ``impacts``: output buffers (``*_COLS`` columns) filled from the row counts in
-    ``cnt``. An ``impacts`` of no rows only counts them (``cnt[I_N_IMPACT]``) and never asks for
-    room.
-    """
-    h = c[C_DT]
-    stride = np.int64(c[C_STRIDE])
-    merge = np.int64(c[C_FLIGHT_MERGE])
+    ``y`` (``Y_*``, at ``t = cnt[I_STEP] dt``) and ``cnt`` (``I_*``) are updated in place; ``c``:
+    the constants (``C_*``); ``lam``: line-length draws, ``lam[cnt[I_LAM_POS]]`` in use;
+    ``series``, ``section``, ``impacts``: output buffers filled from the row counts in ``cnt``
+    (an ``impacts`` of no rows only counts them)."""
+    h = c[k.C_DT]
+    stride = np.int64(c[k.C_STRIDE])
+    merge = np.int64(c[k.C_FLIGHT_MERGE])
     samples_per_block = merge // stride + 1 if stride > 0 else 0
-    max_events = np.int64(c[C_MAX_EVENTS])
-    resample_on_impact = c[C_RESAMPLE_DT] <= 0.0
-    th = y[Y_THETA]
-    om = y[Y_OMEGA]
-    K = stiffness(lam[cnt[I_LAM_POS]], c)
-    sections_per_step = np.int64(h / c[C_PERIOD]) + 2
+    max_events = np.int64(c[k.C_MAX_EVENTS])
+    resample_on_impact = c[k.C_RESAMPLE_DT] <= 0.0
+    th = y[k.Y_THETA]
+    om = y[k.Y_OMEGA]
+    K = stiffness(lam[cnt[k.I_LAM_POS]], c)
+    sections_per_step = np.int64(h / c[k.C_PERIOD]) + 2
     draws_per_step = max_events + 1
     if not resample_on_impact:
-        draws_per_step += np.int64(h / c[C_RESAMPLE_DT]) + 2
+        draws_per_step += np.int64(h / c[k.C_RESAMPLE_DT]) + 2
 
     # gap, lever arm, dC/dt.n here and their trigonometry (a step's first stage: rk4_trig)
-    g, l1, cdn, cc0, sc0, ct0, st0 = geometry_at(cnt[I_STEP] * h, th, c)
+    g, l1, cdn, cc0, sc0, ct0, st0 = geometry_at(cnt[k.I_STEP] * h, th, c)
     # Until grid step safe_n the gap certainly stays open. It and the surface flags are kept in
     # the counters, so a resumed run is bit-identical; whoever changes y must reset it to 0.
-    safe_n = cnt[I_SAFE_STEP]
+    safe_n = cnt[k.I_SAFE_STEP]
     stale = False  # g, l1, cdn, trig belong to an earlier point (only while the gap is safe)
-    jumped = (cnt[I_SURFACE] & 1) != 0  # a rebound was just applied: the opening is flight's
-    settled = (cnt[I_SURFACE] & 2) != 0  # a plastic closure: the point stays in contact
-    budget = np.int64(c[C_CALL_STEPS])  # steps before a hand-back (Ctrl-C is seen between)
+    surf = cnt[k.I_SURFACE]  # the surface flags (_steps.surface_mode)
+    budget = np.int64(c[k.C_CALL_STEPS])  # steps before a hand-back (Ctrl-C is seen between)
     taken = np.int64(0)
-    while cnt[I_STEP] < n_stop:
+    while cnt[k.I_STEP] < n_stop:
         # Room for one more step's worth of outputs and draws, else hand back to Python.
         taken += 1
         if (
             (budget > 0 and taken > budget)
-            or cnt[I_N_SERIES] + samples_per_block > series.shape[0]
-            or cnt[I_N_SECTION] + sections_per_step > section.shape[0]
-            or 0 < impacts.shape[0] < cnt[I_N_IMPACT] + max_events  # (no rows: counted only)
-            or cnt[I_LAM_POS] + draws_per_step >= lam.shape[0]
+            or cnt[k.I_N_SERIES] + samples_per_block > series.shape[0]
+            or cnt[k.I_N_SECTION] + sections_per_step > section.shape[0]
+            or 0 < impacts.shape[0] < cnt[k.I_N_IMPACT] + max_events  # (no rows: counted only)
+            or cnt[k.I_LAM_POS] + draws_per_step >= lam.shape[0]
         ):
-            cnt[I_SURFACE] = (1 if jumped else 0) + (2 if settled else 0)
-            return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, NEED_BUFFER)
+            cnt[k.I_SURFACE] = surf
+            return leave(y, cnt, th, om, cnt[k.I_STEP] * h, safe_n, k.NEED_BUFFER)
 
-        n = cnt[I_STEP]
+        n = cnt[k.I_STEP]
         t = n * h
         # Proven flight over several grid steps: one RK4 step of the free pendulum across
         # them, ending on the grid and before any scheduled time or series sample.
         m = min(safe_n - n, merge, n_stop - n)
         if m >= 2:
-            m = min(m, np.int64((cnt[I_SECTION_K] * c[C_PERIOD] - t) / h))
+            m = min(m, np.int64((cnt[k.I_SECTION_K] * c[k.C_PERIOD] - t) / h))
             if not resample_on_impact:
-                m = min(m, np.int64((cnt[I_RESAMPLE_J] * c[C_RESAMPLE_DT] - t) / h))
+                m = min(m, np.int64((cnt[k.I_RESAMPLE_J] * c[k.C_RESAMPLE_DT] - t) / h))
             # (a block may straddle the recording's start: the motion ignores the transient)
         if m >= 2:
             th0 = th
@@ -203,14 +156,14 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             # the block's length as the difference of its stamped ends (see on_clock)
             th, om, _, _, _, _, _ = step_flight(t, th0, om0, (n + m) * h - t, c, y, True)
             stale = True
-            cnt[I_STEP] = n + m
+            cnt[k.I_STEP] = n + m
             if not (math.isfinite(th) and math.isfinite(om)):
-                return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, NON_FINITE)
-            if (n + m) * h >= c[C_T_RECORD]:
+                return leave(y, cnt, th, om, cnt[k.I_STEP] * h, safe_n, k.NON_FINITE)
+            if (n + m) * h >= c[k.C_T_RECORD]:
                 first = n + 1  # the block's first grid step ending in the recording
-                while first * h < c[C_T_RECORD]:
+                while first * h < c[k.C_T_RECORD]:
                     first += 1
-                cnt[I_COUNTED_STEPS] += n + m + 1 - first
+                cnt[k.I_COUNTED_STEPS] += n + m + 1 - first
                 # samples inside the block: substeps off its start (the trajectory unchanged)
                 j = n + stride - n % stride if stride > 0 else n + m + 1
                 while j <= n + m:
@@ -219,12 +172,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                             th_j, om_j = th, om
                         else:
                             th_j, om_j = rk4_flight(th0, om0, (j - n) * h, c)
-                        i = cnt[I_N_SERIES]
-                        series[i, 0] = j * h
-                        series[i, 1] = th_j
-                        series[i, 2] = om_j
-                        series[i, 3] = lam[cnt[I_LAM_POS]]
-                        cnt[I_N_SERIES] += 1
+                        sample(series, cnt, j * h, th_j, om_j, lam)
                     j += stride
             continue
         t_end = (n + 1) * h
@@ -243,17 +191,12 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     stale = False
                 trig0 = (cc0, sc0, ct0, st0)
                 rate0 = l1 * om - cdn
-                # The start's side. On the surface (a located crossing, delta = 0 to rounding)
-                # it is the motion's: contact after a plastic closure (the rounding's sign would
-                # start a ping-pong of zero-length events), else flight when moving out.
-                on_surface = g == 0.0 or (jumped and g <= 0.0)
-                gs = g
-                if on_surface:
-                    gs = ON_SURFACE if not settled and (jumped or rate0 > 0.0) else -ON_SURFACE
-                # on the surface the first stage's Jacobian (jump ~K l_1^2 / J): the start's side
+                # the start's side, on the surface the motion's; the first stage's Jacobian too
+                up, on_surface = surface_mode(g, rate0, surf)
+                gs = (ON_SURFACE if up else -ON_SURFACE) if on_surface else g
                 trial_side = JAC_NATURAL
                 if on_surface:
-                    trial_side = JAC_FLIGHT if gs > 0.0 else JAC_CONTACT
+                    trial_side = JAC_FLIGHT if up else JAC_CONTACT
                 trial_full = not (g > 0.0 and g > closing_bound(l1, cdn, om, hs, c))
                 if trial_full:
                     trial, cam1 = step_rk4(
@@ -293,9 +236,9 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                         closing = gs > 0.0 and g_hi <= 0.0
                         crossing = closing or (gs < 0.0 and g_hi > 0.0)
                         if crossing:
-                            cnt[I_GRAZES] += 1
+                            cnt[k.I_GRAZES] += 1
                 if crossing and events >= max_events:
-                    cnt[I_CHATTER] += 1  # chattering: the rest of the step is left as it is
+                    cnt[k.I_CHATTER] += 1  # chattering: the rest of the step is left as it is
                 elif crossing:
                     # Go to the crossing (no RK4 step straddles the force's kink). A closing's
                     # substep is the free pendulum's (no Hertz force from a last stage overshooting
@@ -313,28 +256,21 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                         th, om, _, _, _, _, _ = step_flight(t, th, om, tau, c, y, True)
                     else:
                         # every stage's Jacobian on the side the substep comes from
-                        side = JAC_FLIGHT if closing or jumped else JAC_CONTACT
+                        side = JAC_FLIGHT if closing else JAC_CONTACT
                         r, _ = step_rk4(t, th, om, tau, K, c, y, True, side, side, trig0)
                         th, om = r[0], r[1]
-                    jumped = False
-                    settled = False
+                    surf = 0
                     t = t + tau
                     events += 1
                     g, l1, cdn, cc0, sc0, ct0, st0 = geometry_at(t, th, c)
-                    om_before = om
-                    plastic = cdn - l1 * om < c[C_V_CHATTER]  # a chattering end, if applied
                     if closing:
-                        if not (0.0 < l1 < c[C_ROD_L]):
-                            return leave(y, cnt, th, om, t, safe_n, LEFT_REACH)
-                        om, K = impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
-                        # after a rebound the point still lies on the surface, moving out
-                        jumped = om != om_before and not plastic and l1 * om - cdn > 0.0
-                        settled = om != om_before and plastic
+                        if not (0.0 < l1 < c[k.C_ROD_L]):
+                            return leave(y, cnt, th, om, t, safe_n, k.LEFT_REACH)
+                        om, K, surf = impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c)
                     continue
                 if tangent_on(t, c):
                     commit_tangent(y, trial[2], trial[3], trial[4], trial[5], trial[6])
-                jumped = False
-                settled = False
+                surf = 0
                 th = th_new
                 om = om_new
                 t = seg_end
@@ -345,25 +281,19 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
             K = at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)
 
         # End of the grid step: checks and outputs. Here g and l1 belong to (t_end, th).
-        cnt[I_STEP] = n + 1
+        cnt[k.I_STEP] = n + 1
         if not (math.isfinite(th) and math.isfinite(om)):
-            return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, NON_FINITE)
+            return leave(y, cnt, th, om, cnt[k.I_STEP] * h, safe_n, k.NON_FINITE)
         if g <= 0.0:
-            if not (0.0 < l1 < c[C_ROD_L]):
-                return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, LEFT_REACH)
-            if -g > c[C_RCAM]:
-                return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, PENETRATION)
-        if t_end >= c[C_T_RECORD]:
-            cnt[I_COUNTED_STEPS] += 1
+            if not (0.0 < l1 < c[k.C_ROD_L]):
+                return leave(y, cnt, th, om, cnt[k.I_STEP] * h, safe_n, k.LEFT_REACH)
+            if -g > c[k.C_RCAM]:
+                return leave(y, cnt, th, om, cnt[k.I_STEP] * h, safe_n, k.PENETRATION)
+        if t_end >= c[k.C_T_RECORD]:
+            cnt[k.I_COUNTED_STEPS] += 1
             if g <= 0.0:
-                cnt[I_CONTACT_STEPS] += 1
+                cnt[k.I_CONTACT_STEPS] += 1
             if stride > 0 and (n + 1) % stride == 0:
-                i = cnt[I_N_SERIES]
-                series[i, 0] = t_end
-                series[i, 1] = th
-                series[i, 2] = om
-                series[i, 3] = lam[cnt[I_LAM_POS]]
-                cnt[I_N_SERIES] += 1
-    # the flags too, for a run continued from here (chaoscam.extend)
-    cnt[I_SURFACE] = (1 if jumped else 0) + (2 if settled else 0)
-    return leave(y, cnt, th, om, cnt[I_STEP] * h, safe_n, OK)
+                sample(series, cnt, t_end, th, om, lam)
+    cnt[k.I_SURFACE] = surf  # the flags too, for a run continued from here (chaoscam.extend)
+    return leave(y, cnt, th, om, cnt[k.I_STEP] * h, safe_n, k.OK)

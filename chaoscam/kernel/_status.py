@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import enum
 
-__all__ = ["Status"]
-
 
 class Status(enum.IntEnum):
     """How a run ended. Kernels return the integer; Python maps it here."""

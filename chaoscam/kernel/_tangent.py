@@ -1,20 +1,16 @@
 """Tangent (variational) dynamics of the cam-follower through its impacts.
 
 ``V' = A(t) V``, ``A = [[0, 1], [d theta''/d theta, d theta''/d theta']]``, is integrated by the
-*same* RK4 stages as the state (:func:`rk4_tangent_trig`), so between events V is the exact
-derivative of the RK4 steps and the state is bit-identical to :func:`._physics.rk4`'s. Through a
-located event V is multiplied by the flow's saltation matrix (:func:`saltation`; Müller 1995,
-Chaos Solitons Fractals 5(9); Leine & Nijmeijer 2004, *Dynamics and Bifurcations of Non-smooth
-Mechanical Systems*, sec. 3.5; Dankowicz & Nordmark 2000, Physica D 136). Contact onset and
-separation need none (the force vanishes at delta = 0: the field is continuous, its Jacobian
-not, so no RK4 step straddles delta = 0). The same quadrature integrates the divergence ``tr
-A``, for Liouville's ``ln |det V| = int tr A dt + sum ln |det S|``.
+*same* RK4 stages as the state (:func:`rk4_tangent_trig`), the state bit-identical to
+:func:`._physics.rk4`'s. Through a located impact V is multiplied by the saltation matrix
+(:func:`saltation`; Müller 1995, Chaos Solitons Fractals 5(9); Leine & Nijmeijer 2004,
+*Dynamics and Bifurcations of Non-smooth Mechanical Systems*, sec. 3.5); contact onset and
+separation need none (the field is continuous there). The same quadrature integrates ``tr A``,
+for Liouville's ``ln |det V| = int tr A dt + sum ln |det S|``.
 
 Limits: the flow's tangent, not the derivative of the RK4 grid map. Where chattering ends in
-sticking, the substep after a located event starts on the surface and a stage dips ~1e-12 m into
-the cam, negligible in the state but not in its derivative: the tangent then overstates the
-growth by up to tens of percent a chatter cycle at dt = 2e-6 s, shrinking as dt^2
-(docs/verdicts.md).
+sticking a stage after a located event dips ~1e-12 m into the cam: the tangent then overstates
+the growth by up to tens of percent a chatter cycle at dt = 2e-6 s, shrinking as dt^2.
 """
 
 from __future__ import annotations
@@ -24,14 +20,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ._physics import (
-    acceleration_jacobian,
-    acceleration_jacobian_trig,
-    cam_angle,
-    cam_trig,
-    cam_trig_near,
-    rotate,
-)
+from ._physics import acceleration_jacobian, cam_angle, flight_stages, rk4_stages
 from .layout import C_E, C_GRAV, C_INV_J, C_OMEGA, C_XO, C_YO, SECTION_NAMES
 
 
@@ -53,85 +42,23 @@ def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, first, rest, cc, sc
     """One RK4 step of the state (exactly :func:`._physics.rk4`'s) and of its tangent matrix V
     (columns (v11, v21), (v12, v22)): returns ``(th, om, v11, v21, v12, v22, div, cc4, sc4)``,
     ``div`` the step's quadrature of the divergence. The first stage's Jacobian is taken on
-    side ``first`` of the surface, the others' on ``rest`` (:data:`._physics.JAC_NATURAL`: where
-    each stage lies). Trigonometry in and out as :func:`._physics.rk4_trig`."""
-    a1, p1, q1 = acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, first)
-    cm, sm = cam_trig_near(t, 0.5 * h, cc, sc, c)
-    th2 = th + 0.5 * h * om
-    om2 = om + 0.5 * h * a1
-    ct2, st2 = rotate(th, ct, st, th2 - th)
-    a2, p2, q2 = acceleration_jacobian_trig(cm, sm, ct2, st2, om2, K, c, rest)
-    th3 = th + 0.5 * h * om2
-    om3 = om + 0.5 * h * a2
-    ct3, st3 = rotate(th, ct, st, th3 - th)
-    a3, p3, q3 = acceleration_jacobian_trig(cm, sm, ct3, st3, om3, K, c, rest)
-    c4, s4 = cam_trig(t + h, c)
-    th4 = th + h * om3
-    om4 = om + h * a3
-    ct4, st4 = rotate(th, ct, st, th4 - th)
-    a4, p4, q4 = acceleration_jacobian_trig(c4, s4, ct4, st4, om4, K, c, rest)
-    # The same stages for each column (x, y) of V: x' = y, y' = p x + q y.
+    side ``first`` of the surface, the others' on ``rest`` (:func:`._physics.rk4_stages`)."""
+    th1, om1, c4, s4, pq = rk4_stages(t, th, om, h, K, c, cc, sc, ct, st, True, first, rest)
+    p1, q1, p2, q2, p3, q3, p4, q4 = pq
     n11, n21 = _column(v11, v21, h, p1, q1, p2, q2, p3, q3, p4, q4)
     n12, n22 = _column(v12, v22, h, p1, q1, p2, q2, p3, q3, p4, q4)
     div = h / 6.0 * (q1 + 2.0 * q2 + 2.0 * q3 + q4)
-    return (
-        th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
-        om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
-        n11, n21, n12, n22, div, c4, s4,
-    )  # fmt: skip
+    return th1, om1, n11, n21, n12, n22, div, c4, s4
 
 
 @njit(cache=True, _nrt=False)
 def rk4_flight_tangent(th, om, h, c, v11, v21, v12, v22):
     """:func:`._physics.rk4_flight` with its tangent matrix, ``A = [[0, 1], [(m g l / 2J) sin
     theta, 0]]`` (no divergence): returns ``(th, om, v11, v21, v12, v22)``."""
-    k = -c[C_GRAV] * c[C_INV_J]
-    ct, st = math.cos(th), math.sin(th)
-    a1 = k * ct
-    om2 = om + 0.5 * h * a1
-    th2 = th + 0.5 * h * om
-    ct2, st2 = rotate(th, ct, st, th2 - th)
-    a2 = k * ct2
-    om3 = om + 0.5 * h * a2
-    th3 = th + 0.5 * h * om2
-    ct3, st3 = rotate(th, ct, st, th3 - th)
-    a3 = k * ct3
-    om4 = om + h * a3
-    th4 = th + h * om3
-    ct4, st4 = rotate(th, ct, st, th4 - th)
-    a4 = k * ct4
-    p1 = -k * st
-    p2 = -k * st2
-    p3 = -k * st3
-    p4 = -k * st4
-    # the columns of V through the same stages; no damping in flight (q = 0)
+    th1, om1, (p1, p2, p3, p4) = flight_stages(th, om, h, c)
     n11, n21 = _column(v11, v21, h, p1, 0.0, p2, 0.0, p3, 0.0, p4, 0.0)
     n12, n22 = _column(v12, v22, h, p1, 0.0, p2, 0.0, p3, 0.0, p4, 0.0)
-    return (
-        th + h / 6.0 * (om + 2.0 * om2 + 2.0 * om3 + om4),
-        om + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
-        n11, n21, n12, n22,
-    )  # fmt: skip
-
-
-@njit(cache=True, _nrt=False)
-def jump_derivatives(t, th, l1, cdn, c):
-    """``(q_theta, q_t)``: the derivatives of ``q = (dC/dt.n) / l_1`` in the restitution law
-    ``theta'+ = -xi theta'- + (1 + xi) q(t, theta)`` (4)–(5) at (t, th)."""
-    w = c[C_OMEGA]
-    thc = cam_angle(t, c)
-    cc, sc = math.cos(thc), math.sin(thc)
-    ct, st = math.cos(th), math.sin(th)
-    ew = c[C_E] * w
-    dx = c[C_XO] - c[C_E] * cc
-    dy = c[C_YO] - c[C_E] * sc
-    l1_th = dx * st - dy * ct
-    cdn_th = ew * (sc * ct - cc * st)
-    l1_t = ew * (cc * st - sc * ct)
-    cdn_t = w * l1_t
-    q_th = (cdn_th * l1 - cdn * l1_th) / (l1 * l1)
-    q_t = (cdn_t * l1 - cdn * l1_t) / (l1 * l1)
-    return q_th, q_t
+    return th1, om1, n11, n21, n12, n22
 
 
 @njit(cache=True, _nrt=False)
@@ -147,7 +74,19 @@ def saltation(t, th, om_before, om_after, l1, cdn, xi, c):
     ``f+- = (theta'+-, theta''_flight)`` (the force vanishes on the surface). ``det S = -xi (h_t
     + h_x f+)/(h_t + h_x f-) = xi^2``; ``xi`` = 0 (the plastic closure ending a chattering)
     gives a singular S. Returns ``(s11, s21, s22)``; ``s12`` is 0."""
-    q_th, q_t = jump_derivatives(t, th, l1, cdn, c)
+    w = c[C_OMEGA]
+    thc = cam_angle(t, c)
+    cc, sc = math.cos(thc), math.sin(thc)
+    ct, st = math.cos(th), math.sin(th)
+    ew = c[C_E] * w
+    dx = c[C_XO] - c[C_E] * cc
+    dy = c[C_YO] - c[C_E] * sc
+    l1_th = dx * st - dy * ct
+    cdn_th = ew * (sc * ct - cc * st)
+    l1_t = ew * (cc * st - sc * ct)
+    cdn_t = w * l1_t
+    q_th = (cdn_th * l1 - cdn * l1_th) / (l1 * l1)  # q's derivatives in theta and t
+    q_t = (cdn_t * l1 - cdn * l1_t) / (l1 * l1)
     a_free = -c[C_GRAV] * c[C_INV_J] * math.cos(th)
     rate = l1 * om_before - cdn
     g_th = (1.0 + xi) * q_th

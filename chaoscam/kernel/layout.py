@@ -102,16 +102,8 @@ SECTION_NAMES = ("k", "t", "theta_f", "omega_f", "l_lambda")
 # that ends at this section, d(theta, theta')(t_k) / d(theta, theta')(t_k - T), and the
 # integral of the divergence over that period (NaN when the tangent is not integrated).
 SECTION_TANGENT_NAMES = ("j11", "j21", "j12", "j22", "div")
-IMPACT_NAMES = (
-    "t",
-    "theta_f",
-    "omega_before",
-    "omega_after",
-    "gap_rate_before",
-    "lever_arm",
-    "l_lambda",
-    "kind",
-)
+IMPACT_NAMES = ("t", "theta_f", "omega_before", "omega_after", "gap_rate_before", "lever_arm",
+                "l_lambda", "kind")  # fmt: skip
 SERIES_COLS = 4  # t, theta_f, omega_f, l_lambda
 SECTION_COLS = len(SECTION_NAMES) + len(SECTION_TANGENT_NAMES)
 IMPACT_COLS = len(IMPACT_NAMES)

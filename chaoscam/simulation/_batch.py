@@ -1,14 +1,12 @@
 """One batch of members through the compiled kernel: set up at t = 0 or from a kept copy, run on
-the CPU's threads or a GPU, collected as arrays (for :func:`chaoscam.solve` and the orbit
-shooting). A batch's members share ``dt`` and ``omega`` (grid and section times); each is a pure
-function of its model, numerics and ``(seed, index)``, whatever the batch, pauses or threads.
+the CPU's threads or a GPU, collected as arrays. A batch's members share ``dt`` and ``omega``;
+each is a pure function of its model, numerics and ``(seed, index)``, whatever the batch.
 
 **Continuing bit for bit.** RK4 resumes bit-identically at any hand-back, but its end step cuts
-short a block of proven flight (up to ``flight_merge`` grid steps in one RK4 step) that a longer
-run takes whole. No block crosses a section, so a resumable run stops once more at the grid step
-N = floor(k T / dt) of its last section before the end (:func:`snapshot_step`), keeps a copy
-(:class:`Resume`) and goes on; a continuation records again from that section. RK4 only: the
-adaptive kernel shortens its last step onto the end time.
+short a block of proven flight that a longer run takes whole. No block crosses a section, so a
+resumable run stops once more at its last section before the end (:func:`snapshot_step`), keeps
+a copy (:class:`Resume`) and goes on. RK4 only: the adaptive kernel shortens its last step onto
+the end time.
 """
 
 from __future__ import annotations
@@ -36,15 +34,13 @@ from ..kernel import layout as k
 from ..model import LineLengthStream, Params
 from ..numerics import Numerics
 
-__all__ = ["OUTPUTS", "ROOM", "Batch", "Resume", "fresh", "resumed", "run_batch", "snapshot_step"]
-
 OUTPUTS = ("section", "impacts", "series")
 """The kernel's outputs, in the order a :class:`Batch` keeps them."""
 
 ROOM = {"cpu": (2048, 2048), "gpu": (512, 256)}
-"""Room per member and launch on each backend: (line-length draws, impact rows; used only when
-impacts are kept, else counted). Every stop is a relaunch, where the CPU's threads wait for the
-slowest member; 2048 of each cost 144 KiB a member. A GPU batch holds tens of thousands."""
+"""Room per member and launch on each backend: (line-length draws, impact rows, used only when
+impacts are kept). Every stop is a relaunch, waiting for the slowest member again; 2048 of
+each cost 144 KiB a member, and a GPU batch holds tens of thousands."""
 
 SERIES_ROWS = 4096
 """Rows of a member's series buffer between two hand-backs (when a series is kept)."""
@@ -66,24 +62,23 @@ def snapshot_step(num: Numerics, p: Params, n_stop: int) -> int | None:
 
 @dataclass(frozen=True)
 class Resume:
-    """Each member's state at grid step ``step`` (t = step dt), from which :func:`chaoscam.extend`
-    continues it; one entry per member, in the solution's order.
+    """Each member's state at grid step ``step`` (one for all members), from which
+    :func:`chaoscam.extend` continues it; one entry per member, in the solution's order.
 
     Attributes
     ----------
     step : int
-        The grid step of the copy (one for all members: they share dt and omega).
+        The grid step of the copy.
     y, cnt, c : ndarray
-        State (members, Y_SIZE), counters (members, N_COUNTERS; the buffers' row counts and
-        the draw position zeroed) and constants (members, N_CONSTANTS) there.
+        State, counters (the buffers' row counts and the draw position zeroed) and constants.
     draws, streams : tuple
-        Each member's line-length draws not yet used, in order, and its LineLengthStream after
-        them (never drawn from: copied before use).
+        Each member's line-length draws not yet used and its LineLengthStream after them
+        (copied before use).
     kept : dict
         For each output of :data:`OUTPUTS`, each member's rows recorded before ``step``.
     n_impacts, status : ndarray of int
-        Each member's impacts after the transient and before ``step``, and its status code
-        there: ``OK`` to go on, else the code it ended with (not continued).
+        Each member's impacts after the transient before ``step``, and its status code there
+        (``OK`` to go on, else the code it ended with).
     """
 
     step: int
@@ -318,9 +313,8 @@ def _copy(step, y, cnt, c, lam, streams, kept, n_impacts, status) -> Resume:
 
 def run_on_cpu(y, cnt, c, n_stop, lam, series, section, impacts, status, hand_back) -> None:
     """The members whose ``status`` is ``NEED_BUFFER`` through the driver's loop
-    (:func:`chaoscam.kernel.drive_members`), refilled as they ask; the others keep their code.
-    One member, or any inside :func:`chaoscam.kernel.members_on_this_thread`, runs on the
-    calling thread, more in parallel over numba's threads."""
+    (:func:`chaoscam.kernel.drive_members`), refilled as they ask: on the calling thread for one
+    member or inside :func:`chaoscam.kernel.members_on_this_thread`, else on numba's threads."""
     if on_this_thread() or y.shape[0] == 1:
         launch = _one_by_one(y, cnt, c, n_stop, lam, series, section, impacts, status)
     else:
@@ -334,8 +328,7 @@ def run_on_cpu(y, cnt, c, n_stop, lam, series, section, impacts, status, hand_ba
 
 
 def _one_by_one(y, cnt, c, n_stop, lam, series, section, impacts, status):
-    """A launch of the members ``need`` on this thread, each through the nogil call on its rows
-    in place (the same kernel as the parallel launch)."""
+    """A launch of the members ``need`` on this thread, each through the nogil call."""
     run = alone_kernel(c)
 
     def launch(need: np.ndarray) -> np.ndarray:
@@ -348,8 +341,7 @@ def _one_by_one(y, cnt, c, n_stop, lam, series, section, impacts, status):
 
 
 def _in_parallel(y, cnt, c, n_stop, lam, series, section, impacts, status):
-    """A launch of the members ``need`` on numba's threads (``prange``), one launch at a
-    time in this process (:data:`PARALLEL_LOCK`)."""
+    """A launch of the members ``need`` on numba's threads (one at a time: PARALLEL_LOCK)."""
     fork_safe_threads()
     n = y.shape[0]
     kernel = members_kernel(c)
@@ -375,5 +367,4 @@ def _in_parallel(y, cnt, c, n_stop, lam, series, section, impacts, status):
 
 PARALLEL_LOCK = threading.Lock()
 """Held by every launch on numba's threads: the workqueue layer aborts the process when two
-Python threads launch parallel kernels at once ("Concurrent access has been detected"). The
-sweeps' batch threads run members one by one, so it guards a user's own threads."""
+Python threads launch parallel kernels at once."""

@@ -1,13 +1,11 @@
 """Memory and time of a job, estimated before it starts: refuse what cannot fit, warn about hours.
 
 Coarse upper-side guesses that catch absurd requests (a duration of 1e9 s, a series sampled every
-microsecond for minutes, a billion realizations, adaptive steps shrunk to picoseconds by a tiny
-inertia), not predictions: memory at 8 bytes per number kept (series and section rows and their
-tables), time at :data:`NS_PER_STEP` per step and :data:`NS_PER_SERIES_ROW` per series row over
-the workers, adaptive at least :func:`adaptive_seconds`. A job past the memory available is
-refused (:class:`~chaoscam.model.ParameterError` naming the setting to reduce), one past
-:data:`WARN_SECONDS` warned about; one run is refused past :data:`RUN_REFUSE_SECONDS` and warned
-about past :data:`RUN_WARN_SECONDS` (:func:`check_run`).
+microsecond for minutes, adaptive steps shrunk to picoseconds by a tiny inertia), not
+predictions: memory at 8 bytes per number kept, time per step and series row over the workers,
+adaptive at least :func:`adaptive_seconds`. A job past the memory available is refused (a
+:class:`~chaoscam.model.ParameterError` naming the setting to reduce), one past
+:data:`WARN_SECONDS` warned about; one run is judged by :func:`check_run`.
 """
 
 from __future__ import annotations
@@ -17,36 +15,17 @@ import os
 
 from .._util import ParameterError, warn
 
-__all__ = [
-    "WARN_SECONDS", "human_bytes", "human_seconds", "estimate", "check_budget", "check_run",
-    "run_seconds", "adaptive_seconds", "available_memory", "JobEstimate",
-]  # fmt: skip
-
-NS_PER_STEP = 40.0
-"""Wall time of one grid step [ns] (8-65 ns on the default model, periodic to chaotic)."""
-
-NS_PER_SERIES_ROW = 2000.0
-"""Wall time of one series row [ns]: its table row (1.2-1.6 us) and Parquet write (0.4 us)."""
-
-WARN_SECONDS = 3600.0
-"""Jobs estimated to take longer than this get a warning [s]."""
-
-RUN_WARN_SECONDS = 60.0
-"""One run estimated to take longer than this gets a warning [s]."""
-
-RUN_REFUSE_SECONDS = 2 * 3600.0
-"""One run estimated to take longer than this is refused [s]."""
-
+NS_PER_STEP = 40.0  # wall time of one grid step [ns] (8-65 ns, periodic to chaotic)
+NS_PER_SERIES_ROW = 2000.0  # wall time of one series row [ns], its table row and Parquet write
+WARN_SECONDS = 3600.0  # jobs estimated to take longer get a warning [s]
+RUN_WARN_SECONDS = 60.0  # one run estimated to take longer gets a warning [s]
+RUN_REFUSE_SECONDS = 2 * 3600.0  # one run estimated to take longer is refused [s]
+# The adaptive path's cost (:func:`adaptive_seconds`): wall seconds per model second times T_c^2
+# in persistent contact [s^2] (0.9e-10 to 2.1e-9 at rtol = 1e-12), the exponent of 1 / rtol
+# (rtol 1e-13 to 1e-8), and a response with flights relative to persistent contact (0.006-0.35).
 ADAPTIVE_COST = 1e-9
-"""Adaptive path in persistent contact: wall seconds per model second times T_c^2 [s^2]
-(0.9e-10 to 2.1e-9 at rtol = 1e-12, :func:`adaptive_seconds`)."""
-
 ADAPTIVE_RTOL_EXPONENT = 0.6
-"""Exponent of 1 / rtol in the adaptive path's cost in contact (0.6 from rtol 1e-13 to 1e-8)."""
-
 ADAPTIVE_FLIGHT_SHARE = 0.1
-"""Cost of a response with flights relative to persistent contact (0.006-0.35 at contact
-fractions 0.002-0.5)."""
 
 SERIES_BYTES_PER_ROW = 8 * 8  # the kernel's 4 columns and the 8 of the written table
 SECTION_BYTES_PER_ROW = 3 * 5 * 8  # the kernel's buffer, the table and its copy
@@ -95,8 +74,7 @@ def estimate(
 def persistent_contact(params) -> bool:
     """Whether gravity holds the follower on the cam: m g l / (2 J) >= e omega^2 / l_1, the
     rod's angular acceleration from gravity against the largest the cam asks of it (at the
-    initial contact's lever arm). Then the contact fraction is ~1; below, flights and impacts
-    give 0.002-0.5."""
+    initial contact's lever arm)."""
     from ..model import contact_angle, lever_arm
 
     l1 = float(lever_arm(params, 0.0, contact_angle(params, 0.0)))
@@ -111,12 +89,9 @@ def adaptive_seconds(params, num, duration: float) -> float:
 
     with ``T_c = 2 pi sqrt(J / (K_n l_1^2))`` the contact's natural period
     (:func:`chaoscam.model.contact_period`) and ``s = 1`` in persistent contact
-    (:func:`persistent_contact`), else :data:`ADAPTIVE_FLIGHT_SHARE`. The error control must
-    resolve the contact oscillation, and the cost per model second grows as ``1 / T_c^2`` (the
-    accepted steps per period grow as it shrinks): on 2 cores ``t_wall T_c^2 / duration`` is
-    0.9e-10 to 2.1e-9 s^2 at rtol = 1e-12 in persistent contact (J = 1e-9 to 1e-2 kg m^2, Hertz
-    and fractal stiffness, omega = 15-28.7 rad/s) and 6e-12 to 3.5e-10 s^2 with flights.
-    Limits: an order of magnitude either way; chattering can cost more.
+    (:func:`persistent_contact`), else :data:`ADAPTIVE_FLIGHT_SHARE`: the error control must
+    resolve the contact oscillation (measured on 2 cores, J = 1e-9 to 1e-2 kg m^2, Hertz and
+    fractal stiffness). Limits: an order of magnitude either way; chattering can cost more.
     """
     from ..model import contact_period
 
@@ -132,41 +107,34 @@ def adaptive_seconds(params, num, duration: float) -> float:
 
 
 def run_seconds(params, num, duration: float, series_rows: float = 0.0) -> float:
-    """Estimated wall time [s] of one run of ``duration`` [s] keeping ``series_rows``: steps at
-    :data:`NS_PER_STEP`, rows at :data:`NS_PER_SERIES_ROW`, adaptive at least
-    :func:`adaptive_seconds`."""
-    return max(_costs(params, num, duration, series_rows))
+    """Estimated wall time [s] of one run of ``duration`` [s] keeping ``series_rows``."""
+    return max(_costs(params, num, duration, series_rows)[:2])
 
 
-def _steps(params, num, duration: float) -> tuple[float, str, str]:
-    """(the least number of steps a run takes, why, what shortens it): steps of dt, adaptive
-    steps of at most h_max, a step cut at every interval resampling."""
+def _costs(params, num, duration: float, series_rows: float = 0.0):
+    """One run's times [s], (steps and series rows, adaptive steps following the contact), and
+    (the least number of steps it takes, why, what shortens it): steps of dt, adaptive steps of
+    at most h_max, a step cut at every interval resampling."""
     duration = float(duration)
     found = [(duration / num.dt, f"steps of dt = {num.dt:g} s", "raise dt")]
-    if num.integrator == "adaptive":
+    adaptive = num.integrator == "adaptive"
+    if adaptive:
         found.append((duration / num.h_max, f"steps of at most h_max = {num.h_max:g} s",
                       "raise h_max"))  # fmt: skip
     if params.resample == "interval":
         found.append((duration / params.resample_dt,
                       f"line-length draws every resample_dt = {params.resample_dt:g} s",
                       "raise resample_dt"))  # fmt: skip
-    return max(found)
-
-
-def _costs(params, num, duration: float, series_rows: float = 0.0) -> tuple[float, float]:
-    """(grid steps and series rows, following the contact) estimates of one run [s]."""
-    steps = _steps(params, num, duration)[0]
-    grid = (steps * NS_PER_STEP + series_rows * NS_PER_SERIES_ROW) * 1e-9
-    adaptive = num.integrator == "adaptive"
-    return grid, adaptive_seconds(params, num, duration) if adaptive else 0.0
+    steps = max(found)
+    grid = (steps[0] * NS_PER_STEP + series_rows * NS_PER_SERIES_ROW) * 1e-9
+    return grid, adaptive_seconds(params, num, duration) if adaptive else 0.0, steps
 
 
 def check_run(params, num, duration: float, *, what: str = "one run",
               series_rows: float = 0.0) -> bool:  # fmt: skip
     """Refuse one run estimated beyond :data:`RUN_REFUSE_SECONDS` (a ParameterError), warn
-    beyond :data:`RUN_WARN_SECONDS`, naming the fields that set the cost; returns whether it
-    warned."""
-    grid, contact = _costs(params, num, duration, series_rows)
+    beyond :data:`RUN_WARN_SECONDS`, naming the fields that set the cost; whether it warned."""
+    grid, contact, (steps, why, raise_) = _costs(params, num, duration, series_rows)
     seconds = max(grid, contact)
     if seconds <= RUN_WARN_SECONDS:
         return False
@@ -183,7 +151,6 @@ def check_run(params, num, duration: float, *, what: str = "one run",
         remedy = "raise J, lower the stiffness (l_lambda, stiffness), loosen rtol or shorten "
         remedy += "duration"
     else:
-        steps, why, raise_ = _steps(params, num, duration)
         text += f": {steps:.3g} {why}"
         remedy = f"shorten duration or {raise_}"
         if series_rows:
@@ -222,10 +189,8 @@ def check_budget(job: JobEstimate, *, what: str, reduce: str, run: tuple | None 
     ----------
     job : JobEstimate
         From :func:`estimate`.
-    what : str
-        The job in words ("this run", "this regime map").
-    reduce : str
-        The settings to reduce, for the message ("--duration or --output-dt").
+    what, reduce : str
+        The job in words ("this run"); the settings to reduce ("--duration or --output-dt").
     run : dict, optional
         One run of the job: the keyword arguments of :func:`check_run`.
     """

@@ -1,7 +1,6 @@
-"""The one reader of trajectory files (``Solution.to_parquet`` of a one-member solution, as
-``chaoscam simulate --out FILE.parquet`` writes them) for every command: :func:`load_trajectory`
-rebuilds one, checking its metadata and columns; :func:`read_trajectory` also refuses one too
-short to classify, so every command accepts and refuses the same files with the same messages."""
+"""The one reader of trajectory files (``Solution.to_parquet``, ``chaoscam simulate --out``) for
+every command: :func:`load_trajectory` rebuilds one, checking its metadata and columns;
+:func:`read_trajectory` also refuses one too short to classify."""
 
 from __future__ import annotations
 
@@ -24,10 +23,6 @@ from ._solution import (
     SERIES_COLUMNS,
     Solution,
 )
-
-__all__ = [
-    "MIN_POINTS", "TrajectoryFileError", "check_enough", "load_trajectory", "read_trajectory",
-]  # fmt: skip
 
 MIN_POINTS = 16
 """Fewest section points or samples a verdict is asked from; fewer is "too little data"."""
@@ -59,14 +54,13 @@ def read_trajectory(path: str | Path, *, need_data: bool = True):
         raise TrajectoryFileError(str(err).strip("'\"") or repr(err)) from None
     if need_data:
         n_series = 0 if traj.series is None else len(traj.series)
-        n = max(len(traj.section), n_series)
-        check_enough(n, "section points and samples", path)
+        check_enough(max(len(traj.section), n_series), "section points and samples", path)
     return traj
 
 
 def _check_finite(path: Path, status: Status, tables) -> None:
     """Refuse NaN or infinite times and states of a run that ended normally (chaoscam writes
-    none: the file was edited or damaged past its checksums)."""
+    none)."""
     if status is not Status.OK:
         return  # a run that diverged may end on a non-finite state
     for name, table in tables:
@@ -83,9 +77,8 @@ def load_trajectory(path) -> Solution:
     """Rebuild a one-member :class:`Solution` from a trajectory file (``Solution.to_parquet``):
     the table holds the series (or the section, for a run without one); the metadata keys
     ``chaoscam.trajectory`` (params, numerics, settings, status, stats), ``chaoscam.section``
-    and ``chaoscam.impacts`` (JSON, pandas "split", floats exact) the rest, read back with their
-    dtypes. Not stored: a ``tangent=True`` run's Jacobians (:func:`chaoscam.classify` simulates
-    the tangent again) and a resumable run's copy (:func:`chaoscam.extend` runs it again).
+    and ``chaoscam.impacts`` (JSON, pandas "split", floats exact) the rest. Not stored: a
+    ``tangent=True`` run's Jacobians and a resumable run's copy.
 
     Raises
     ------
@@ -164,8 +157,7 @@ def load_trajectory(path) -> Solution:
 
 
 def _solution(params, numerics, settings, status, stats, frame, series, section, impacts):
-    """The one-member Solution of a file's tables, stopped at the table's last row (without a
-    series, the last section point, not the run's end)."""
+    """The one-member Solution of a file's tables, stopped at the table's last row."""
     last = frame.iloc[-1] if len(frame) else None
     end = ((float(last["t"]), float(last["theta_f"]), float(last["omega_f"])) if last is not None
            else (math.nan, math.nan, math.nan))  # fmt: skip

@@ -1,13 +1,11 @@
-"""An independent reference path on ``scipy.integrate.solve_ivp`` with events: slow (numpy
-right-hand side, DOP853 at tight tolerances), for the tests' cross-checks of the compiled kernel,
-with which it shares no code; :mod:`chaoscam.model`'s functions and the kernel's impact rule
-(MODEL.md: faster than ``v_min`` the restitution jump (4), slower the compliant contact).
+"""An independent reference path on ``scipy.integrate.solve_ivp`` with events, for the tests'
+cross-checks of the compiled kernel: slow (numpy right-hand side, DOP853 at tight tolerances)
+and sharing no code with it; :mod:`chaoscam.model`'s functions and the kernel's impact rule.
 
 Piecewise, restarted at every closing and opening so that no solver step straddles an impact:
 in flight a terminal event watches the gap close, in contact one watches it open while the gap's
-maxima are recorded, so a micro-flight inside one solver step (0.1-1 µs in chattering) is found
-from its maximum above 0 and the piece cut back there. A piece from the surface (|gap| < 1e-14
-m) takes its start's side: flight after a rebound, though rounding left the gap at -1e-20 m.
+maxima are recorded, so a micro-flight inside one solver step is found from its maximum above 0
+and the piece cut back there. A piece from the surface (|gap| < 1e-14 m) takes its start's side.
 """
 
 from __future__ import annotations
@@ -31,8 +29,6 @@ from ..model import (
     normal_cam_speed,
 )
 
-__all__ = ["simulate_reference", "ReferenceResult"]
-
 
 @dataclass(frozen=True)
 class ReferenceResult:
@@ -49,16 +45,14 @@ FLIGHT, CONTACT = "flight", "contact"
 to the next opening, or back to the first gap maximum above 0 (a micro-flight inside a step)."""
 
 NEAR_STEP = 1.0 / 8.0
-"""The solver's longest step near the cam, as a fraction of the contact oscillation's period.
-The error control alone can step over a contact (at t = 0.018 s of the default run a flight's
-8.5 ms first step misses a 37 µs micro-flight and its contact). So in contact no step is longer,
-and a gap maximum shows between two step ends; in flight a piece provably cannot close
-(:func:`_open_for`) or is one such step, shorter than any contact, so a closing shows at its end."""
+"""The solver's longest step near the cam, as a fraction of the contact oscillation's period:
+the error control alone can step over a contact (a flight's 8.5 ms first step misses a 37 µs
+micro-flight). In contact no step is longer, so a gap maximum shows between two step ends; in
+flight a piece provably cannot close (:func:`_open_for`) or is one such step."""
 
 _ON_SURFACE = {"gap": 1e-14, "rate": 1e-12}
 """|value| [m, m/s] below which a piece starts on the event's surface, where the event takes the
-start's side as ±1e-300 (a larger stand-in moves the root search: later impacts of the v_min =
-1e-3 model by 5e-8 s)."""
+start's side as ±1e-300 (a larger stand-in moves the root search)."""
 
 
 def _events(p: Params, phase: str, t_start: float) -> list:
@@ -92,7 +86,7 @@ def _open_for(p: Params, t: float, y: np.ndarray) -> float:
     """A time [s] in which the gap, open at (t, y), provably stays open: with ``|delta''| <= A``
     a gap ``g`` closing at rate ``v`` cannot reach 0 before ``(-v + sqrt(v^2 + 2 A g)) / A``,
     halved for safety; ``A = e w^2 + 2 e w W + rho (m g l / (2 J) + W^2)``, ``rho = |O| + e``,
-    while ``|theta'| <= W = |theta'(t)| + 1 rad/s`` (true within ``J / (m g l / 2)``)."""
+    ``W = |theta'(t)| + 1 rad/s`` (within ``J / (m g l / 2)``)."""
     g = float(gap(p, t, y[0]))
     if not g > 0.0:
         return 0.0
@@ -107,9 +101,8 @@ def _open_for(p: Params, t: float, y: np.ndarray) -> float:
 
 
 def _closing(p: Params, t: float, y: np.ndarray, lam: float, stream, impacts: list):
-    """The kernel's impact law at a located closing (faster than ``v_min``: the restitution
-    jump; slower than ``v_chatter``: the plastic closure), a new line length for a new contact.
-    Updates ``y`` and ``impacts``; returns (the next phase, the line length)."""
+    """The kernel's impact law at a located closing (the jump above ``v_min``, the plastic
+    closure below ``v_chatter``); updates ``y``, ``impacts``; (the next phase, line length)."""
     rate = float(gap_rate(p, t, y[0], y[1]))
     if not (-rate > p.v_min):
         return CONTACT, lam
@@ -142,8 +135,7 @@ def simulate_reference(
         Realization of the line-length process (as in :func:`chaoscam.simulate`).
     rtol, atol : float
         solve_ivp tolerances; rtol = 1e-13 is the loosest at which the reference is converged
-        for the tests (the v_min = 1e-3 model's first three impacts within 4.9e-9 s of RK4 at
-        dt = 2.5e-7 s; 1e-12: 4e-8 s, and looser results depend on the processor's last bits).
+        for the tests (looser results depend on the processor's last bits).
     max_pieces : int
         Guard on the number of restarts (chattering); a RuntimeError past it.
 

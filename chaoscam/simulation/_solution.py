@@ -1,8 +1,6 @@
 """The result of :func:`chaoscam.solve`: the members' sections, impacts, series and statuses
-with the settings that made them. One type for one run and an ensemble (a run is a solution of
-one member): tidy tables (one row per sample, a ``member`` column); the one-member conveniences
-(``section``, ``status``, ``stats``, ...) read a one-member solution, and ``solution[i]`` is
-member ``i`` as a solution of its own."""
+with the settings that made them, one type for one run and an ensemble (tidy tables with a
+``member`` column; the one-member conveniences read a solution of one member)."""
 
 from __future__ import annotations
 
@@ -22,11 +20,6 @@ from ._batch import Batch, Resume
 
 if TYPE_CHECKING:
     import pandas as pd
-
-__all__ = [
-    "IMPACT_COLUMNS", "IMPACT_KINDS", "MEMBER_COLUMNS", "SECTION_COLUMNS", "SERIES_COLUMNS",
-    "Solution", "assemble",
-]  # fmt: skip
 
 SECTION_COLUMNS = k.SECTION_NAMES
 IMPACT_COLUMNS = k.IMPACT_NAMES
@@ -58,24 +51,20 @@ class Solution:
         where it stopped (``t_end`` [s], ``theta_f_end`` [rad], ``omega_f_end`` [rad/s]).
     sections : pandas.DataFrame
         member, k, t, theta_f, omega_f, l_lambda: the stroboscopic Poincaré section at
-        t = k 2 pi / omega after the transient (the cam back at ``theta_c0``).
-    jacobians : ndarray or None
-        With ``tangent=True``: shape (len(sections), 2, 2), the Jacobian of the stroboscopic
-        map d(theta_f, theta_f')(t_k) / d(theta_f, theta_f')(t_k - T) over the period that
-        ends at each section row, through the impacts' saltation matrices. Read-only.
-    divergence : ndarray or None
-        With ``tangent=True``: the integral of the flow's divergence over each such period
-        (Liouville: ln|det J_k| = divergence_k + 2 ln(xi) per restitution jump). Read-only.
+        t = k 2 pi / omega after the transient.
+    jacobians, divergence : ndarray or None
+        With ``tangent=True`` (read-only): the stroboscopic map's Jacobian d(theta_f,
+        theta_f')(t_k) / d(theta_f, theta_f')(t_k - T), shape (len(sections), 2, 2), and the
+        flow's divergence integrated over the period that ends at each section row (Liouville:
+        ln|det J_k| = divergence_k + 2 ln(xi) per restitution jump).
     impacts : pandas.DataFrame or None
-        With ``impacts=True``: member and the restitution jumps after the transient (t,
-        theta_f, omega_before, omega_after, gap_rate_before, lever_arm, l_lambda, kind:
-        "macro", "micro" (slower than ``v_micro``) or "chatter_end", the plastic closure ending
-        a complete chattering); else None.
+        With ``impacts=True``: member and the restitution jumps after the transient
+        (:data:`IMPACT_COLUMNS`; kind "macro", "micro" (slower than ``v_micro``) or
+        "chatter_end", the plastic closure ending a complete chattering).
     series : pandas.DataFrame or None
         With ``series=True``: member and the series every ``output_dt`` (:data:`SERIES_COLUMNS`).
     resume : Resume or None
-        With ``resumable=True`` (RK4): each member's state near its end, from which
-        :func:`chaoscam.extend` continues it bit for bit; None otherwise.
+        With ``resumable=True`` (RK4): each member's state near its end, for :func:`extend`.
     """
 
     models: tuple[Params, ...]
@@ -173,7 +162,28 @@ class Solution:
         if len(self) != 1:
             counts = self.members["status"].value_counts().to_dict()
             return f"{len(self)} members: " + ", ".join(f"{v} {k_}" for k_, v in counts.items())
-        return _summary(self)
+        s = self.stats
+        fraction = s["contact_fraction"]
+        contact = "n/a (no step recorded)" if math.isnan(fraction) else f"{fraction:.4f}"
+        end = self.final_state[0]  # NaN for a run read from a file that kept no section row
+        reached = "an end time not recorded in the file" if math.isnan(end) else f"{end:.4g} s"
+        kinds = (
+            f" ({s['n_macro_impacts']} macro, {s['n_micro_impacts']} micro, "
+            f"{s['n_chatter_ends']} chattering ends)"
+            if "n_macro_impacts" in s
+            else ""
+        )
+        return (
+            f"status: {self.status.name} - {self.message}\n"
+            f"simulated: {reached} of {self.settings['duration']:.4g} s "
+            f"(transient {self.settings['transient']:.4g} s discarded), "
+            f"{self.numerics.describe_step()}\n"
+            f"impacts: {s['n_impacts']} applied{kinds}, "
+            f"{s['slow_closings']} slow closings left to the compliant contact, "
+            f"{s['chatter_handovers']} chattering-guard hand-overs\n"
+            f"contact fraction: {contact}\n"
+            f"section points: {len(self.sections)}"
+        )
 
     # --- selection and files --------------------------------------------------------------
     def select(self, picks) -> Solution:
@@ -236,38 +246,14 @@ class Solution:
         meta = dict(table.schema.metadata or {})
         meta[b"chaoscam.trajectory"] = json.dumps(self.provenance()).encode()
         meta[b"chaoscam.section"] = exact_json(self.section).encode()
-        impacts = self.impacts.drop(columns="member") if self.impacts is not None else None
-        if impacts is None:
+        if self.impacts is None:
             import pandas as pd
 
             impacts = pd.DataFrame(columns=list(IMPACT_COLUMNS))
+        else:
+            impacts = self.impacts.drop(columns="member")
         meta[b"chaoscam.impacts"] = exact_json(impacts).encode()
         return table.replace_schema_metadata(meta)
-
-
-def _summary(sol: Solution) -> str:
-    s = sol.stats
-    fraction = s["contact_fraction"]
-    contact = "n/a (no step recorded)" if math.isnan(fraction) else f"{fraction:.4f}"
-    end = sol.final_state[0]  # NaN for a run read from a file that kept no section row
-    reached = "an end time not recorded in the file" if math.isnan(end) else f"{end:.4g} s"
-    kinds = (
-        f" ({s['n_macro_impacts']} macro, {s['n_micro_impacts']} micro, "
-        f"{s['n_chatter_ends']} chattering ends)"
-        if "n_macro_impacts" in s
-        else ""
-    )
-    return (
-        f"status: {sol.status.name} - {sol.message}\n"
-        f"simulated: {reached} of {sol.settings['duration']:.4g} s "
-        f"(transient {sol.settings['transient']:.4g} s discarded), "
-        f"{sol.numerics.describe_step()}\n"
-        f"impacts: {s['n_impacts']} applied{kinds}, "
-        f"{s['slow_closings']} slow closings left to the compliant contact, "
-        f"{s['chatter_handovers']} chattering-guard hand-overs\n"
-        f"contact fraction: {contact}\n"
-        f"section points: {len(sol.sections)}"
-    )
 
 
 def series_frame(p: Params, a: np.ndarray) -> pd.DataFrame:
@@ -281,9 +267,10 @@ def series_frame(p: Params, a: np.ndarray) -> pd.DataFrame:
     return pd.DataFrame(dict(zip(SERIES_COLUMNS, columns, strict=True)))
 
 
-def _tagged(blocks: list[np.ndarray], first: int, ncol: int) -> np.ndarray:
-    """Rows of consecutive members with their member number in front."""
-    out = [np.column_stack([np.full(len(b), first + j), b]) for j, b in enumerate(blocks)]
+def _tagged(batches: list[Batch], name: str, ncol: int) -> np.ndarray:
+    """The kept rows ``name`` of every member, in order, with its member number in front."""
+    out = [np.column_stack([np.full(len(rows), b.first + j), rows])
+           for b in batches for j, rows in enumerate(b.kept[name])]  # fmt: skip
     return np.concatenate(out) if out else np.empty((0, 1 + ncol))
 
 
@@ -291,8 +278,7 @@ def assemble(batches: list[Batch], plist, num, settings: dict) -> Solution:
     """The Solution of finished batches, in order."""
     import pandas as pd
 
-    sec = np.concatenate([_tagged(b.kept["section"], b.first, k.SECTION_COLS) for b in batches]
-                         or [np.empty((0, 1 + k.SECTION_COLS))])  # fmt: skip
+    sec = _tagged(batches, "section", k.SECTION_COLS)
     n_sec = len(SECTION_COLUMNS)
     sections = pd.DataFrame(sec[:, : 1 + n_sec], columns=["member", *SECTION_COLUMNS])
     sections[["member", "k"]] = sections[["member", "k"]].astype(np.int64)
@@ -301,8 +287,7 @@ def assemble(batches: list[Batch], plist, num, settings: dict) -> Solution:
                            columns=list(MEMBER_COLUMNS))  # fmt: skip
     impacts = None
     if all(b.kept["impacts"] is not None for b in batches) and settings["impacts"]:
-        a = np.concatenate([_tagged(b.kept["impacts"], b.first, k.IMPACT_COLS) for b in batches]
-                           or [np.empty((0, 1 + k.IMPACT_COLS))])  # fmt: skip
+        a = _tagged(batches, "impacts", k.IMPACT_COLS)
         impacts = pd.DataFrame(a, columns=["member", *IMPACT_COLUMNS])
         impacts["member"] = impacts["member"].astype(np.int64)
         impacts["kind"] = pd.Categorical.from_codes(

@@ -1,13 +1,9 @@
-"""solve(params, numerics, ...) -> Solution: realizations of the model, a run a batch of one.
-
-The driver around the compiled kernel: it checks the request, cuts the members into batches
-(:mod:`._batch`), runs each on the CPU's threads or a GPU and assembles one
-:class:`~._solution.Solution`; :func:`extend` continues it bit for bit, :func:`simulate` is the
-one-run convenience.
-"""
+"""solve(params, numerics, ...) -> Solution: realizations of the model, a run a batch of one;
+:func:`extend` continues a solution bit for bit, :func:`simulate` is the one-run convenience."""
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import math
 import numbers
@@ -18,7 +14,6 @@ from typing import Any
 from .._util import ParameterError, flag, real, warn, whole
 from .._version import __version__
 from ..kernel import (
-    AUTO_GPU_MIN,
     GPU_BATCH,
     GPUFallbackWarning,
     by_size,
@@ -26,17 +21,13 @@ from ..kernel import (
     kernel_constants,
     thread_count,
 )
+from ..kernel import layout as k
 from ..model import Params, field_names, params_arg
 from ..numerics import Numerics
 from ._batch import ROOM, fresh, models_of, resumed, run_batch
 from ._budget import JobEstimate, check_budget, estimate
 from ._solution import Solution, assemble
 from ._warnings import run_warnings
-
-__all__ = [
-    "AUTO_GPU_MIN", "BACKENDS", "CPU_BATCH", "check_window", "extend", "models_digest",
-    "numerics_arg", "simulate", "solve", "split_overrides",
-]  # fmt: skip
 
 BACKENDS = ("cpu", "gpu", "auto")
 CPU_BATCH = 1024
@@ -173,20 +164,19 @@ def solve(
     duration, transient : float
         End time [s]; outputs before ``transient`` are discarded.
     tangent : bool
-        Also integrate the tangent dynamics and keep the stroboscopic map's Jacobian over each
-        recorded period (``Solution.jacobians``); the motion is the same without it.
-    series : bool
+        Also keep the stroboscopic map's Jacobian over each recorded period (the tangent
+        dynamics; ``Solution.jacobians``); the motion is the same without it.
+    series, output_dt : bool, float
         Keep the time series, sampled every ``output_dt`` [s] (rounded to whole steps).
     impacts : bool
         Keep every applied impact (``Solution.impacts``); otherwise only counted.
     resumable : bool
-        Keep each member's state near its end (RK4) for :func:`extend` to continue (the same
-        bits as running it again).
+        Keep each member's state near its end (RK4) for :func:`extend` to continue bit for bit.
     backend : {"cpu", "gpu", "auto"}
-        ``"cpu"``: numba threads. ``"gpu"``: one CUDA thread per member (numba-cuda, ``pip
-        install 'chaoscam[gpu]'``), within ``GPU_TOLERANCE`` of the CPU on short or periodic
-        runs; where it cannot run (or with a series), the CPU after a
-        :class:`GPUFallbackWarning`. ``"auto"``: the GPU from ``AUTO_GPU_MIN`` members.
+        ``"cpu"``: numba threads. ``"gpu"``: one CUDA thread per member (``pip install
+        'chaoscam[gpu]'``), within ``GPU_TOLERANCE`` of the CPU on short or periodic runs;
+        where it cannot run (or with a series), the CPU after a :class:`GPUFallbackWarning`.
+        ``"auto"``: the GPU from ``AUTO_GPU_MIN`` members.
     batch : int, optional
         Members per compiled call (memory); default :data:`CPU_BATCH`, or ``GPU_BATCH``.
     progress : callable, optional
@@ -221,23 +211,19 @@ def solve(
     batch = whole("batch", (GPU_BATCH if gpu else CPU_BATCH) if batch is None else batch, low=1)
     for text in dict.fromkeys(w for q in models_of(plist) for w in run_warnings(q, num)):
         warn(text)
-    t0 = time.perf_counter()
     stride = max(1, int(round(output_dt / num.dt))) if series else 0
-    room = ROOM["gpu" if gpu else "cpu"]
 
-    def start(chunk):
+    def start(chunk, room):
         return fresh(plist[chunk], num, indices[chunk], seed, duration, transient,
                      tangent=tangent, stride=stride, room=room)  # fmt: skip
 
-    parts = _batches(plist, num, indices, start, duration, batch, progress, room=room, gpu=gpu,
-                     keep_impacts=impacts, resumable=resumable)  # fmt: skip
     settings = {
         "duration": duration, "transient": transient, "seed": seed, "tangent": tangent,
         "output_dt": stride * num.dt if series else None, "impacts": impacts,
         "backend": "gpu" if gpu else "cpu", "device": device, "batch": batch,
         "models": models_digest(plist, num), "version": __version__,
     }  # fmt: skip
-    return _finish(parts, plist, num, settings, t0)
+    return _run(plist, num, indices, start, settings, progress, resumable)
 
 
 def _models(params, numerics, indices) -> tuple[Params, list[Params], Numerics]:
@@ -258,23 +244,21 @@ def _models(params, numerics, indices) -> tuple[Params, list[Params], Numerics]:
     return plist[0], plist, numerics_arg(numerics)
 
 
-def _batches(plist, num, indices, start, duration, batch, progress, **run) -> list:
-    """The members run in batches of ``batch``, each from ``start(chunk)`` through
-    :func:`run_batch` (keywords ``run``), ``progress`` told after each."""
-    parts = []
+def _run(plist, num, indices, start, settings: dict, progress, resumable) -> Solution:
+    """The members run in batches of ``settings["batch"]`` on its backend, each from
+    ``start(chunk, room)`` through :func:`run_batch` (``progress`` told after each), as one
+    Solution. ``threads``: numba's thread count, 1 for one member (which ran on the calling
+    thread: asking numba would fix its threading layer for every single run)."""
+    t0, parts = time.perf_counter(), []
+    gpu, batch, duration = settings["backend"] == "gpu", settings["batch"], settings["duration"]
+    room = ROOM["gpu" if gpu else "cpu"]
     for first in range(0, len(plist), batch):
         chunk = slice(first, first + batch)
-        parts.append(run_batch(plist[chunk], num, indices[chunk], start(chunk), first, duration,
-                               **run))  # fmt: skip
+        parts.append(run_batch(plist[chunk], num, indices[chunk], start(chunk, room), first,
+                               duration, room=room, gpu=gpu, keep_impacts=settings["impacts"],
+                               resumable=resumable))  # fmt: skip
         if progress is not None:
             progress(len(parts[-1].indices))
-    return parts
-
-
-def _finish(parts, plist, num, settings: dict, t0: float) -> Solution:
-    """The Solution of ``parts``; ``threads``: numba's thread count for a batch of several
-    members (1 for one member, which ran on the calling thread: asking numba would fix its
-    threading layer and start its threads for every single run)."""
     threads = thread_count() if len(plist) > 1 else 1
     settings = {**settings, "threads": threads, "wall_time_s": time.perf_counter() - t0}
     return assemble(parts, plist, num, settings)
@@ -285,12 +269,9 @@ def extend(
     resumable: bool = False, backend: str | None = None, progress=None,
 ) -> Solution:  # fmt: skip
     """Members of ``solution`` made ``duration`` seconds long, bit-identical to runs made that
-    long from t = 0.
-
-    Each member goes on from the copy ``solution.resume`` keeps (``resumable=True``, RK4) at its
-    last section time before the end: its sections, Jacobians, impacts, series, counts and status
-    are those of :func:`solve` over the longer window. Without a copy (the adaptive integrator,
-    a run not kept resumable, one read from a file) the members run again from t = 0.
+    long from t = 0: each goes on from the copy ``solution.resume`` keeps (``resumable=True``,
+    RK4) at its last section time before the end; without a copy (the adaptive integrator, a
+    run not kept resumable, one read from a file) the members run again from t = 0.
 
     Parameters
     ----------
@@ -349,7 +330,7 @@ def _again(sub: Solution, duration, series, resumable, backend, progress) -> Sol
     )  # fmt: skip
     more = {"continued_from": None, "backends": [*s.get("backends", [s["backend"]]),
                                                 out.settings["backend"]]}  # fmt: skip
-    return _with_settings(out, more)
+    return dataclasses.replace(out, settings={**out.settings, **more})
 
 
 def _continued(sub: Solution, duration, series, resumable, backend, progress) -> Solution:
@@ -358,7 +339,8 @@ def _continued(sub: Solution, duration, series, resumable, backend, progress) ->
     plist = list(sub.models)
     for j, p in enumerate(plist):
         made = kernel_constants(p, num, t_record=s["transient"], tangent=s["tangent"])
-        if not _same_model(made, res.c[j]):
+        made[k.C_STRIDE] = res.c[j, k.C_STRIDE]  # (a continuation may drop the series)
+        if not (made == res.c[j]).all():
             raise ValueError(f"member {j}'s model is not the one its copy was made with")
     if backend is None:
         gpu, device, batch = s["backend"] == "gpu", s.get("device", s["backend"]), s["batch"]
@@ -368,39 +350,19 @@ def _continued(sub: Solution, duration, series, resumable, backend, progress) ->
         batch = s["batch"] if same else (GPU_BATCH if gpu else CPU_BATCH)
     if gpu and series:
         gpu, device = False, "cpu"
-    room = ROOM["gpu" if gpu else "cpu"]
-    indices = [int(i) for i in sub.members["index"]]
-    t0 = time.perf_counter()
 
-    def start(chunk):
+    def start(chunk, room):
         return resumed(res.select(range(len(plist))[chunk]), plist[chunk], num, duration, room,
                        series=series)  # fmt: skip
 
-    parts = _batches(plist, num, indices, start, duration, batch, progress, room=room, gpu=gpu,
-                     keep_impacts=s["impacts"], resumable=resumable)  # fmt: skip
     used = "gpu" if gpu else "cpu"
     settings = {
         **s, "duration": duration, "output_dt": s["output_dt"] if series else None,
         "continued_from": res.step, "backend": used, "device": device, "batch": batch,
         "backends": [*s.get("backends", [s["backend"]]), used],
     }  # fmt: skip
-    return _finish(parts, plist, num, settings, t0)
-
-
-def _same_model(made, kept) -> bool:
-    """Whether two constants vectors agree but for the series stride (which a continuation
-    may drop)."""
-    from ..kernel import layout as k
-
-    a, b = made.copy(), kept.copy()
-    a[k.C_STRIDE] = b[k.C_STRIDE] = 0.0
-    return bool((a == b).all())
-
-
-def _with_settings(sol: Solution, more: dict) -> Solution:
-    import dataclasses
-
-    return dataclasses.replace(sol, settings={**sol.settings, **more})
+    indices = [int(i) for i in sub.members["index"]]
+    return _run(plist, num, indices, start, settings, progress, resumable)
 
 
 def simulate(
@@ -412,9 +374,8 @@ def simulate(
 
     Keyword ``overrides`` apply on top of ``params`` and ``numerics`` by field name, e.g.
     ``simulate(omega=30.0, dt=1e-6)``. The follower starts in contact with the cam (``theta_f0``,
-    ``omega_f0`` None). From a section point of an earlier run (at t = k 2 pi / omega the cam is
-    back at ``theta_c0``), ``simulate(theta_f0=theta_f, omega_f0=omega_f)`` is a new run, not the
-    earlier one's continuation to the bit (:func:`extend` is that).
+    ``omega_f0`` None); ``simulate(theta_f0=theta_f, omega_f0=omega_f)`` from an earlier run's
+    section point is a new run, not that run's continuation to the bit (:func:`extend` is).
 
     Returns
     -------

@@ -7,8 +7,6 @@ from __future__ import annotations
 from ..model import Params, contact_period
 from ..numerics import Numerics
 
-__all__ = ["ignored_sigma_warning", "resolution_warning", "run_warnings"]
-
 
 def resolution_warning(p: Params, num: Numerics) -> str | None:
     """The warning for a fixed step too coarse for the contact oscillation (fewer than 20
