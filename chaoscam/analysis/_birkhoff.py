@@ -16,13 +16,10 @@ _MIN_HALF = 8
 
 
 def birkhoff_weights(n: int) -> np.ndarray:
-    """Normalised bump weights ``w(t) = exp(-1 / (t (1 - t)))`` at ``t = k / (n + 1)``.
+    """Normalised bump weights ``ŵ_k ∝ exp(-1 / (t (1 - t)))`` at ``t = k / (n + 1)``, k = 1 .. n.
 
-    ``ŵ_k = w(k / (n + 1)) / Σ_j w(j / (n + 1))``, k = 1 .. n, the weights of the weighted
-    Birkhoff average ``WB_n(f) = Σ_k ŵ_k f(x_k)`` (Das, Saiki, Sander & Yorke 2017; Das &
-    Yorke 2018). All derivatives of w vanish at both ends, so the average of a smooth
-    function on a quasiperiodic orbit converges faster than any power of 1/n (the plain
-    average as 1/n).
+    The weights of the weighted Birkhoff average ``WB_n(f) = Σ_k ŵ_k f(x_k)`` (Das, Saiki,
+    Sander & Yorke 2017): w and all its derivatives vanish at both ends.
     """
     check_settings("birkhoff_weights", n=(n, "int>=1"))
     t = np.arange(1, n + 1) / (n + 1.0)
@@ -34,11 +31,9 @@ def birkhoff_weights(n: int) -> np.ndarray:
 class BirkhoffResult:
     """Result of `weighted_birkhoff`.
 
-    ``digits_by_observable`` holds ``-log10(|WB_h(f)(x_0) - WB_h(f)(x_h)| / range(f))``
-    (at most 16) for each observable f: "x0", "x1", ... (the coordinates), "cos", "sin"
-    (of the angle about the centroid) and "turn" (the angle increment, in turns);
-    ``digits`` is the smallest of them (NaN on too few points). ``rotation_number`` is the
-    weighted average of the turn, in [0, 1) (1 minus it when the plane of the curve is
+    ``digits_by_observable``: the converged digits (at most 16) of each observable, "x0",
+    "x1", ... (coordinates), "cos", "sin" (angle about the centroid), "turn" (its increment);
+    ``digits`` their minimum (NaN on too few points). ``rotation_number`` in [0, 1) (1 - ρ
     seen from the other side, d > 2; NaN for d = 1).
     """
 
@@ -51,8 +46,7 @@ class BirkhoffResult:
 
 
 def _plane_angles(x: np.ndarray) -> np.ndarray:
-    """Angle of each point about the centroid (d = 2: axes scaled by their spread, which
-    keeps the orientation of (x0, x1); d > 2: the plane of the two principal axes)."""
+    """Angle about the centroid: d = 2 axes scaled by their spread, d > 2 principal plane."""
     if x.shape[1] > 2:
         return _curve_angles(x)
     c = x - x.mean(axis=0)
@@ -71,43 +65,29 @@ def _lifted_turns(phi: np.ndarray) -> np.ndarray:
 def weighted_birkhoff(points) -> BirkhoffResult:
     """Converged digits of weighted Birkhoff averages, and the rotation number of a curve.
 
-    With the bump weights ``ŵ_k`` of `birkhoff_weights`, the weighted Birkhoff average of
-    an observable f over h iterates starting at x_m is ``WB_h(f)(x_m) = Σ_{k=1}^{h} ŵ_k
-    f(x_{m+k-1})``. On a quasiperiodic orbit (a smooth torus with a Diophantine rotation)
-    and a smooth f it converges faster than any power of 1/h; on a chaotic orbit only as
-    h^{-1/2}. The converged digits compare the first h iterates with the next h (Das,
-    Saiki, Sander & Yorke 2017),
+    With the weights of `birkhoff_weights`, ``WB_h(f)(x_m) = Σ_{k=1}^{h} ŵ_k f(x_{m+k-1})``
+    converges faster than any power of 1/h on a smooth Diophantine torus, as h^{-1/2} on a
+    chaotic orbit (Das, Saiki, Sander & Yorke, Nonlinearity 30 (2017) 4111; Das & Yorke,
+    Nonlinearity 31 (2018) 491). The digits compare the first h iterates with the next h,
 
         dig = -log10 |WB_h(f)(x_0) - WB_h(f)(x_h)|,
 
-    with f scaled by its range so that dig does not depend on units. Observables: each
-    coordinate, cos and sin of the angle φ about the centroid, and the increment
-    Δφ_k = φ_{k+1} - φ_k (lifted: cut opposite its circular mean), whose average in turns
-    is the rotation number ρ of a closed curve; ``digits`` is the smallest over these.
+    f scaled by its range, the minimum over the coordinates, cos and sin of the angle φ
+    about the centroid, and the lifted increment Δφ_k, whose average in turns is ρ.
+
+    Limits: a periodic orbit converges as fast (test the period first); noise of relative
+    size ε caps the digits near -log10 ε (a noisy torus reads like weak chaos); ρ is the
+    rotation number only for a curve star-shaped about its centroid.
 
     Parameters
     ----------
     points : array_like, shape (N,) or (N, d)
         Section points (or map iterates) in time order, after the transient; angles
-        embedded as (cos, sin) with `embed_angles`.
+        embedded with `embed_angles`.
 
     Returns
     -------
     BirkhoffResult
-
-    Notes
-    -----
-    With 200-4000 points, quasiperiodic test orbits give 6-15 digits, chaotic ones
-    (logistic r = 4, Hénon) 1.2-2.3.
-
-    Limits: a periodic orbit converges as fast as a quasiperiodic one (test the period
-    first); jitter or noise of relative size ε caps the digits near -log10 ε, so a noisy
-    torus reads like weak chaos. ρ is the rotation number only when the curve winds once
-    around its centroid (star-shaped); the digits stay meaningful otherwise.
-
-    References: Das, Saiki, Sander & Yorke, "Quantitative quasiperiodicity", Nonlinearity 30
-    (2017) 4111; Das, Sander & Yorke, "Quasiquasiperiodicity" (2016); Das & Yorke, "Super
-    convergence of ergodic averages for quasiperiodic orbits", Nonlinearity 31 (2018) 491.
     """
     x = as_points(points)
     n = x.shape[0]

@@ -62,9 +62,7 @@ def _zero_one_signal(x, dt, forcing_period, seed, per_period, line_freq, thr):
 
 
 def _check_signal_settings(given: dict) -> int:
-    """classify_signal's settings in their ranges, before any evidence is gathered (an
-    evidence function that raises is reported as failed evidence, not as an error); returns
-    the 0-1 test's samples per forcing period (default 4, at most the signal's own)."""
+    """Check classify_signal's settings; returns the 0-1 test's samples per forcing period."""
     rules = dict(dt="real>0", forcing_period="real>0?", lyapunov="number?",
                  lyapunov_tol="real>=0?", max_period="int>=1?", min_points_aperiodic="int>=1?",
                  zero_one_per_period="int>=1?", seed="int>=0", exponent_time="real>0")  # fmt: skip
@@ -98,8 +96,7 @@ def _spectrum_evidence(spec) -> Evidence:
 
 
 def _series_evidence(x, dt, t_char, thr: Thresholds) -> Evidence:
-    """Rosenstein's λ₁ from the signal, voting only when not doubtful (λ₁ T against
-    ``series_chaotic`` and ``series_regular``, T the characteristic period)."""
+    """Rosenstein's λ₁ T against ``series_chaotic`` and ``series_regular``, unless doubtful."""
     res, failed = safe("lyapunov_series", lyapunov_from_series, x, dt, warn=False)
     if failed:
         return failed
@@ -137,54 +134,49 @@ def classify_signal(
     exponent=None,
     exponent_time: float = 1.0,
 ) -> Verdict:
-    """Classify a uniformly sampled signal of a flow (with optional section points).
+    """Classify a uniformly sampled flow signal (and optional section points) by votes.
 
-    Evidence gathered (every number an entry of `Thresholds`, except the spectrum's own,
-    `spectrum_options`; its broadband tolerance is recorded in ``settings["broadband_tol"]``):
+    Evidence (numbers from `Thresholds`; the spectrum's from `spectrum_options`, its
+    broadband tolerance recorded in ``settings["broadband_tol"]``):
 
     * ``spectrum`` (`spectrum_analysis`, forcing frequency 1 / `forcing_period`): a harmonic
-      comb votes periodic (the period in forcing periods when forced), two incommensurate
-      bases quasiperiodic, a broadband fraction >= 1 % chaotic, a smaller unexplained
-      remainder "not_periodic".
-    * ``zero_one`` (`zero_one_evidence`) on a map-like sequence, never the oversampled
-      signal: forced, the signal interpolated `zero_one_per_period` times per forcing
-      period less its forcing-synchronous mean; unforced, the successive `local_maxima`. A
-      sequence with nothing left is K = 0. A chaotic K is not used when a line spectrum's
-      slowest base spans more than N / (10 · zero_one_line_periods) samples: a long period
-      mimics diffusion (a period-8 cam response sampled 4 times per forcing period over
-      20 s gives K ≈ 0.9).
-    * the evidence of `classify_section` for `section` (names prefixed ``section_``), and
-      ``exponent`` and ``lyapunov`` as there (`lyapunov` per unit time).
-    * ``lyapunov_series`` (`series_lyapunov`): Rosenstein's estimate (`lyapunov_from_series`),
-      voting only when not doubtful: chaotic when λ T > series_chaotic, not chaotic when
-      |λ T| < series_regular, T the characteristic period.
+      comb votes periodic, two incommensurate bases quasiperiodic, broadband >= 1 % chaotic,
+      a smaller unexplained remainder "not_periodic".
+    * ``zero_one`` (`zero_one_evidence`) on a map-like sequence: forced, the signal sampled
+      `zero_one_per_period` times per forcing period less its forcing-synchronous mean;
+      unforced, the successive `local_maxima`; K = 0 when nothing is left. A chaotic K is
+      dropped per `Thresholds.zero_one_line_periods`.
+    * `classify_section`'s evidence for `section` (prefixed ``section_``), ``exponent`` and
+      ``lyapunov`` (here per unit time).
+    * ``lyapunov_series`` (`series_lyapunov`): `lyapunov_from_series`, when not doubtful.
 
-    The votes are combined by `combine`. The period comes from the section when given, else
-    from the spectrum of a forced signal; an unforced periodic signal without section gets
-    period 1 (one period of its own fundamental), with a note in `reasons`.
+    The votes are combined by `combine`. The period comes from the section, else from the
+    spectrum of a forced signal, else 1 (the signal's own fundamental, noted in `reasons`).
+
+    Raises ValueError on NaN or infinite samples, a non-positive `dt` or `forcing_period`.
+    Limits: ~20 s of a cam signal (~90 forcing periods) gives the 0–1 test ~360 samples and
+    the spectrum subharmonics up to order 9: a periodic call is solid, quasiperiodic versus
+    chaotic rests on the spectrum and the 0–1 test agreeing.
 
     Parameters
     ----------
     x : array_like, shape (N,)
         Uniformly sampled signal after the transient (e.g. θ_f(t)).
-    dt : float
-        Sampling interval [s].
-    forcing_period : float, optional
-        Period of the forcing [s], e.g. 2π / ω of the cam.
+    dt, forcing_period : float
+        Sampling interval and (optional) forcing period [s], e.g. 2π / ω of the cam.
     section : array_like, shape (M,) or (M, d), optional
         Section points (e.g. stroboscopic (θ, θ̇) once per forcing period).
     lyapunov : float, optional
         Largest Lyapunov exponent [1/s] computed elsewhere.
     lyapunov_tol : float, optional
-        |λ₁| [1/s] below this counts as zero; default ``signal_lyapunov_tol / T``, T the
-        forcing period, else the fundamental period of the spectrum.
+        |λ₁| [1/s] counted as zero; default `Thresholds.signal_lyapunov_tol` / T (T the
+        forcing period, else the spectrum's fundamental period).
     angle_periods, rtol, atol, max_period, min_points_aperiodic, thresholds, seed
         As for `classify_section`.
     series_lyapunov : bool
         Also estimate λ₁ from the signal with nolds (~0.2–0.5 s more).
     zero_one_per_period : int, optional
-        Samples per forcing period fed to the 0–1 test of a forced signal, at most the
-        signal's own; default 4, or the signal's own when it has fewer.
+        Samples per forcing period for the 0–1 test, at most the signal's own (default 4).
     spectrum_options : dict, optional
         Extra keyword arguments of `spectrum_analysis`.
     exponent, exponent_time
@@ -193,19 +185,7 @@ def classify_signal(
     Returns
     -------
     Verdict
-
-    Raises
-    ------
-    ValueError
-        NaN or infinite samples, a non-positive `dt` or `forcing_period`.
-
-    Notes
-    -----
-    A constant signal is an equilibrium, not an oscillation: "undetermined" (even where
-    constant section points would say period 1). Limits: with ~20 s of a cam signal (~90
-    forcing periods) the 0–1 test runs on ~360 samples and the spectrum resolves
-    subharmonics up to order 9: a periodic call is solid, a quasiperiodic versus chaotic
-    call rests on the spectrum and the 0–1 test agreeing.
+        "undetermined" for a constant signal (an equilibrium, whatever its section says).
     """
     x = as_series(x, min_size=MIN_SERIES)
     zero_one_per_period = _check_signal_settings(locals())

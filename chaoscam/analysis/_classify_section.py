@@ -1,5 +1,4 @@
-"""Classify map iterates or Poincaré-section points into a `Verdict`; the options a model
-verdict may pass through to it."""
+"""Classify map iterates or Poincaré-section points into a `Verdict`; its pass-through options."""
 
 from __future__ import annotations
 
@@ -23,8 +22,7 @@ def _undetermined(v: Verdict, reason: str) -> Verdict:
 
 
 def unsupported_chaos(evidence, need: int) -> list[str] | None:
-    """The names voting chaotic when they are fewer than ``need`` and none is decisive (the
-    exponent's): a chaotic label they alone cannot carry; None when it is supported."""
+    """The names voting chaotic when fewer than ``need`` and none is decisive, else None."""
     chaotic = [e.name for e in evidence if e.vote == "chaotic"]
     if any(name in _DECISIVE for name in chaotic) or len(chaotic) >= need:
         return None
@@ -34,10 +32,7 @@ def unsupported_chaos(evidence, need: int) -> list[str] | None:
 def _decide(
     v: Verdict, n: int, thr: Thresholds, zero_one: bool, given: bool, upper: float
 ) -> Verdict:
-    """The rules `combine` does not know: two chaotic votes, a negative exponent, what to run.
-
-    `upper` is the upper end of the exponent's confidence interval (NaN without one).
-    """
+    """The rules `combine` does not know; `upper` is the exponent interval's top (NaN: none)."""
     by_name = {e.name: e for e in v.evidence}
     expo = by_name.get("exponent")
     if v.label == "chaotic":
@@ -91,73 +86,53 @@ def classify_section(
 ) -> Verdict:
     """Classify map iterates or Poincaré-section points as periodic, quasiperiodic or chaotic.
 
-    Evidence gathered (`Thresholds` holds every number):
+    Evidence (numbers from `Thresholds`):
 
-    * ``section_period`` (`section_period`): periodic with the smallest lag n whose n bands
-      are each narrower than ``max(atol, period_rtol · extent)``, else "not_periodic"; it
-      abstains while the points have not settled (spread of the second half over the first
-      outside [stationary_low, stationary_high]). On a periodic section the expansion,
+    * ``section_period`` (`section_period`): periodic with the smallest lag whose bands are
+      all narrow, else "not_periodic"; abstains while the points have not settled
+      (`Thresholds.stationary_low`, `stationary_high`). On a periodic section the expansion,
       Birkhoff and 0–1 tests abstain (only jitter is left).
-    * ``section_rotation`` (`rotation_order`): R >= rotation_quasi votes quasiperiodic.
-    * ``section_birkhoff`` (`weighted_birkhoff`, N >= birkhoff_min_points): converged digits
-      >= birkhoff_quasi_digits vote quasiperiodic, unless the rotation number is within
-      birkhoff_rational_tol of a p/q.
-    * ``section_expansion`` (`neighbour_expansion` beyond the noise floor): > expansion_chaotic
-      votes chaotic.
-    * ``section_dimension`` (`correlation_dimension`, d >= 2, N >= dimension_min_points):
-      >= dimension_chaotic votes chaotic (not a curve).
-    * ``section_zero_one``: the 0–1 test on the first coordinate (`zero_one_evidence`).
-    * ``exponent`` (`exponent_evidence`): a largest exponent judged by its confidence interval.
-    * ``lyapunov``: a bare exponent per iterate, > `lyapunov_tol` chaotic, else not.
+    * ``section_rotation`` (`rotation_order`) and ``section_birkhoff`` (`weighted_birkhoff`,
+      not near a rational): quasiperiodic votes.
+    * ``section_expansion`` (`neighbour_expansion`) and ``section_dimension``
+      (`correlation_dimension`, d >= 2): chaotic votes.
+    * ``section_zero_one``: `zero_one_evidence` on the first coordinate.
+    * ``exponent`` (`exponent_evidence`), and ``lyapunov``: > `lyapunov_tol` chaotic, else not.
 
     The votes are combined by `combine`; then a chaotic label needs a chaotic exponent or
-    at least min_chaotic_votes chaotic votes, and a quasiperiodic label with a negative
-    exponent is a conflict (a stable periodic orbit whose period was not found). An
-    "undetermined" verdict says in `reasons` what to run (longer, the tangent exponent).
+    `Thresholds.min_chaotic_votes`, and a quasiperiodic one with a negative exponent (a
+    period not found) is undetermined. An "undetermined" verdict says in `reasons` what to run.
+
+    Raises ValueError on NaN or infinite points, or points of the wrong shape. Limits: on
+    the ~90 points of a 20 s cam run a period is called reliably, but only the exponent
+    separates quasiperiodic from chaotic.
 
     Parameters
     ----------
     points : array_like, shape (N,) or (N, d)
-        Section points in time order, after the transient. N >= 8.
-    lyapunov : float, optional
-        Largest Lyapunov exponent per iterate of the section map, without error bar.
-    lyapunov_tol : float
-        |λ₁| below this counts as zero (for `lyapunov` only).
+        Section points in time order, after the transient. N >= 8, else "undetermined".
+    lyapunov, lyapunov_tol : float
+        A largest exponent per iterate without error bar (optional), and |λ₁| counted as zero.
     exponent : float, (float, float), (float, float, int) or object, optional
-        Largest exponent with its standard error (the forms of `as_exponent`), e.g. the
-        model's tangent exponent; λ = -inf (a zero Floquet multiplier) is not chaotic.
+        Largest exponent with its standard error (forms of `as_exponent`), e.g. the tangent's.
     exponent_time : float
-        Multiplies λ and stderr to give them per iterate (the forcing period T for an
-        exponent in 1/s and a stroboscopic section).
+        Factor making λ and stderr per iterate (the forcing period T [s] for λ in 1/s).
     angle_periods : sequence of float or None, optional
         Period of each angular coordinate (None for ordinary ones), see `embed_angles`.
     rtol, min_points_aperiodic : optional
         Override `Thresholds.period_rtol` and `Thresholds.min_points_aperiodic`.
     atol, max_period
         Passed to `section_period` (atol in the units of the embedded points).
-    zero_one : bool
-        Run the 0–1 test.
-    seed : int
-        Seed of the 0–1 test's c values.
+    zero_one, seed : bool, int
+        Run the 0–1 test, with this seed for its c values.
     thresholds : Thresholds, optional
         The decision thresholds; default `Thresholds()`.
 
     Returns
     -------
     Verdict
-        Period in iterates of the section map (forcing periods for a stroboscopic section).
-
-    Raises
-    ------
-    ValueError
-        NaN or infinite points, or points of the wrong shape.
-
-    Notes
-    -----
-    Identical points are a fixed point of the section map: periodic with period 1 (for a
-    stroboscopic section, a response with the forcing's period). Fewer than 8 points:
-    "undetermined". Limits: with the ~90 points of a 20 s cam run a period is called
-    reliably, but only the exponent separates quasiperiodic from chaotic.
+        Period in iterates of the section map (forcing periods for a stroboscopic section);
+        identical points are period 1 (a fixed point of the map).
     """
     x = as_points(points)
     check_atol("classify_section", atol, x.shape[1])
@@ -199,13 +174,11 @@ def classify_section(
 _BUILT_BY_THE_CALLER = {"points", "lyapunov", "lyapunov_tol", "exponent", "exponent_time"}
 
 SECTION_OPTIONS = frozenset(inspect.signature(classify_section).parameters) - _BUILT_BY_THE_CALLER
-"""What a model verdict (:func:`chaoscam.classify`) may pass through to `classify_section`:
-its settings less the inputs the verdict builds itself (the points, the tangent exponent)."""
+"""The settings a model verdict (:func:`chaoscam.classify`) may pass to `classify_section`."""
 
 
 def check_options(options: dict, caller: str) -> None:
-    """Refuse (TypeError) an option :func:`classify_section` does not take here, naming the
-    ones it does, and (ValueError) a bad ``atol`` (two coordinates)."""
+    """TypeError for an option `classify_section` does not take here; ValueError for a bad atol."""
     check_atol(caller, options.get("atol"), 2)
     unknown = sorted(set(options) - SECTION_OPTIONS)
     if unknown:

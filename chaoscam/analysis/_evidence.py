@@ -37,18 +37,13 @@ def _k_side(k: float, thr: Thresholds) -> str | None:
 def zero_one_evidence(
     name: str, series, what: str, seed: int, thresholds: Thresholds | None = None
 ) -> Evidence:
-    """The 0–1 test's vote on `series`, cast only where the test is valid and has converged.
+    """The 0–1 test's vote on `series` (named `what` in the detail), where valid and converged.
 
-    `zero_one_test` votes only when the sequence has at least
-    `Thresholds.zero_one_min_points` samples, is not flagged as oversampled, and K of its
-    first half and K of the whole lie on the same side of the thresholds (>=
-    `zero_one_chaotic` or <= `zero_one_regular`) within `zero_one_max_change` of each other.
-    Otherwise it abstains and the detail, which names the sequence by `what`, says why.
-
-    References: K separates 0 from 1 cleanly only for N ~ 1000 samples of a map-like
-    sequence (Gottwald & Melbourne, Nonlinearity 22 (2009) 1367; SIAM J. Appl. Dyn. Syst.
-    8 (2009) 129); an oversampled regular signal can give K near 1 (Melosik & Marszalek,
-    Bull. Pol. Acad. Sci. Tech. Sci. 64 (2016)).
+    Votes only with at least `Thresholds.zero_one_min_points` samples, not oversampled, and
+    K of the first half and of the whole on the same side of `Thresholds.zero_one_chaotic`
+    / `zero_one_regular` within `Thresholds.zero_one_max_change`; else abstains, saying why.
+    References: Gottwald & Melbourne, Nonlinearity 22 (2009) 1367 (N ~ 1000 separates 0 from
+    1); Melosik & Marszalek, Bull. Pol. Acad. Sci. Tech. Sci. 64 (2016) (oversampling).
     """
     thr = thresholds or Thresholds()
     x = np.asarray(series, dtype=float)
@@ -86,10 +81,8 @@ def zero_one_evidence(
 def as_exponent(exponent, time_per_iterate: float = 1.0) -> tuple[float, float, int | None]:
     """``(λ, stderr, n_intervals)`` per iterate from a number, a tuple or a result object.
 
-    Accepted: a float (stderr unknown: NaN), a pair ``(λ, stderr)``, a triple ``(λ, stderr,
-    n_intervals)``, or an object with attributes ``exponent`` and ``stderr`` (and optionally
-    ``n_intervals``). λ and stderr are multiplied by `time_per_iterate` (the forcing period
-    T for an exponent in 1/s and a stroboscopic section).
+    A float (stderr NaN), ``(λ, stderr)``, ``(λ, stderr, n_intervals)`` or an object with
+    ``exponent``, ``stderr`` (and ``n_intervals``); λ and stderr times `time_per_iterate`.
     """
     check_settings("as_exponent", time_per_iterate=(time_per_iterate, "real>0"))
     n = None
@@ -122,17 +115,18 @@ def exponent_evidence(
 ) -> Evidence:
     """Vote of a largest Lyapunov exponent judged by its confidence interval.
 
-    With z = `Thresholds.exponent_z`, ε = `Thresholds.exponent_zero` and σ the standard
-    error (e.g. from batch means of the per-iterate log growths), ``[λ - z σ, λ + z σ]``
-    votes "chaotic" when ``λ - z σ > ε``, "not_chaotic" when ``λ + z σ < ε`` (zero within ε:
-    a torus; negative: a stable periodic orbit) and always for λ = -inf (the tangent vector
-    collapsed: a zero Floquet multiplier, as after sticking); otherwise it abstains and says
-    how much longer to run, σ taken to shrink as 1/sqrt(run length).
+    With z = `Thresholds.exponent_z`, ε = `Thresholds.exponent_zero`, σ the standard error,
+    ``[λ - z σ, λ + z σ]`` votes "chaotic" when above ε, "not_chaotic" when below (a torus or
+    a stable periodic orbit) or λ = -inf (a zero Floquet multiplier); otherwise it abstains
+    and says how much longer to run (σ ∝ 1/sqrt(run length)).
+
+    Limits: σ is statistical only, not the bias of a short transient; chaos with λ₁ < ε per
+    iterate reads as not chaotic.
 
     Parameters
     ----------
     exponent : float
-        λ₁, in the units named by `unit` (the thresholds are per iterate of the section map).
+        λ₁, in `unit` (the thresholds are per iterate of the section map).
     stderr : float, optional
         Standard error of λ₁ in the same units; None or NaN abstains (unless λ₁ = -inf).
     n_intervals : int, optional
@@ -146,11 +140,6 @@ def exponent_evidence(
     -------
     Evidence
         Value λ₁; detail with the interval and why it votes (or what to run).
-
-    Notes
-    -----
-    Limits: σ is statistical only; the bias of a too-short transient is not in it. A
-    weakly chaotic orbit with λ₁ below ε per iterate is read as not chaotic.
     """
     thr = thresholds or Thresholds()
     lam = float(exponent)
@@ -206,8 +195,7 @@ def lyapunov_evidence(lyap: float, tol: float | None, unit: str) -> Evidence:
 
 
 def exponent_votes(thr, exponent, exponent_time, lyapunov, tol, unit):
-    """A classifier's ``exponent`` and ``lyapunov`` evidence, and the exponent per iterate
-    as ``dict(exponent, stderr, n_intervals)`` (None without one)."""
+    """A classifier's exponent and lyapunov evidence, and the exponent record (or None)."""
     ev, record = [], None
     if exponent is not None:
         lam, se, n_int = as_exponent(exponent, exponent_time)
@@ -324,8 +312,7 @@ def section_evidence(
 
 
 def _vote(name, value, txt, few, passed, vote, yes, no) -> Evidence:
-    """``vote`` (detail ``txt + yes``) when the measure `passed` its threshold, else an
-    abstention (``txt + no``); an abstention (``txt + few``) on too few points."""
+    """``vote`` when `passed`, else an abstention (``few``: too few points)."""
     if few:
         return Evidence(name, value, None, txt + few)
     if passed:
@@ -343,8 +330,7 @@ def _rotation_evidence(name: str, z: np.ndarray, thr: Thresholds, few: str) -> E
 
 
 def _expansion_evidence(name: str, z: np.ndarray, atol, thr: Thresholds, few: str) -> Evidence:
-    """Nearest-neighbour expansion beyond the noise floor (`neighbour_expansion`): chaotic
-    above ``expansion_chaotic``."""
+    """`neighbour_expansion` beyond the noise floor: chaotic above ``expansion_chaotic``."""
     g = neighbour_expansion(z, atol=_floor(z, atol, thr.noise_floor))
     if not math.isfinite(g):
         return Evidence(name, None, None, "too few distinct neighbours above the noise floor")
@@ -355,8 +341,7 @@ def _expansion_evidence(name: str, z: np.ndarray, atol, thr: Thresholds, few: st
 
 
 def _dimension_evidence(name: str, z: np.ndarray, thr: Thresholds) -> Evidence:
-    """Correlation dimension (`correlation_dimension`): chaotic (not a curve) from
-    ``dimension_chaotic``."""
+    """`correlation_dimension`: chaotic (not a curve) from ``dimension_chaotic``."""
     d2, c = correlation_dimension(z), thr.dimension_chaotic
     txt = f"correlation dimension D2 = {d2:.2f}"
     yes, no = f" >= {c}: not a curve", f" < {c}: a curve or unresolved"

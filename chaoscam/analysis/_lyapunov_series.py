@@ -49,14 +49,16 @@ def lyapunov_from_series(
 ) -> SeriesLyapunovResult:
     """Largest Lyapunov exponent of a scalar series by delay embedding (nolds).
 
-    ``method="rosenstein"`` follows the mean logarithmic divergence of nearest neighbours
-    in a delay embedding, ``<ln d_j(i)> ≈ λ₁ i Δt + const`` (Rosenstein, Collins & De Luca
-    1993, Physica D 65, 117), with ``nolds.lyap_r``; ``method="eckmann"`` fits local
-    linear maps to the neighbourhoods and takes QR products of them (Eckmann, Kamphorst,
-    Ruelle & Ciliberto 1986, Phys. Rev. A 34, 4971), with ``nolds.lyap_e`` (Schölzel 2019,
-    https://doi.org/10.5281/zenodo.3814723). The series is first subsampled by ``stride =
-    ceil(N / max_points)`` (both methods cost O(N²)) and nolds is given the interval
-    ``dt * stride``, so the exponent is per unit time.
+    "rosenstein" fits the mean log divergence of nearest neighbours, ``<ln d_j(i)> ≈ λ₁ i Δt
+    + const`` (``nolds.lyap_r``; Rosenstein, Collins & De Luca 1993, Physica D 65, 117);
+    "eckmann" takes QR products of local linear maps (``nolds.lyap_e``; Eckmann, Kamphorst,
+    Ruelle & Ciliberto 1986, Phys. Rev. A 34, 4971); nolds: Schölzel 2019,
+    https://doi.org/10.5281/zenodo.3814723. The series is first subsampled by ``stride =
+    ceil(N / max_points)`` (both cost O(N²)) and nolds given ``dt * stride``: λ₁ per unit time.
+
+    Limits: biased low for weak chaos and rough on short or noisy data (Rosenstein reads
+    7-27 % low on 20 000 samples of Lorenz, Rössler, Ueda); Eckmann gives spurious positive
+    exponents on periodic signals. Prefer `spectrum_from_jacobians` where Jacobians are known.
 
     Parameters
     ----------
@@ -65,42 +67,23 @@ def lyapunov_from_series(
     dt : float
         Sampling interval of `x` (the exponent is per this unit of time).
     method : {"rosenstein", "eckmann"}
-    max_points : int
-        Most samples kept after subsampling.
+    max_points, min_points : int
+        Most samples kept after subsampling; fewer than `min_points` make it doubtful.
     emb_dim : int
-        Embedding dimension (nolds' default 10). For "eckmann" it must satisfy
-        ``(emb_dim - 1) % (matrix_dim - 1) == 0``.
-    lag : int, optional
-        Embedding lag in subsampled steps (None: nolds' autocorrelation rule).
-    min_tsep : int, optional
-        Temporal separation of neighbours (None: nolds uses the mean period).
-    trajectory_len : int
-        Rosenstein: number of steps the divergence is followed and fitted.
-    matrix_dim : int
-        Eckmann: size of the local Jacobians (number of exponents).
-    min_points : int
-        Fewer samples after subsampling make the estimate doubtful.
+        Embedding dimension; "eckmann" needs ``(emb_dim - 1) % (matrix_dim - 1) == 0``.
+    lag, min_tsep : int, optional
+        Embedding lag and neighbours' temporal separation in subsampled steps (None: nolds').
+    trajectory_len, matrix_dim : int
+        Rosenstein: steps the divergence is fitted over; Eckmann: size of the local Jacobians.
     warn : bool
         Emit a `DoubtfulEstimateWarning` when the estimate is doubtful.
 
     Returns
     -------
     SeriesLyapunovResult
-
-    Notes
-    -----
-    Doubtful when: fewer than `min_points` samples; a constant or near-constant series;
-    (Rosenstein) the divergence curve is not a straight line (R² < 0.95) or it saturates
-    (its slope over the last third is below 30 % of that over the first third: shorten
-    `trajectory_len` or subsample less); (Eckmann) the exponents sum to a positive number
-    (impossible for a dissipative system) or, for a flow, no exponent lies near zero
-    (within 10 % of the largest magnitude), which a flow must have; nolds warned.
-
-    Limits: series estimates are biased low for weakly chaotic systems and rough on short
-    or noisy data (on 20 000 samples of the Lorenz, Rössler and Ueda signals Rosenstein
-    reads 7-27 % low); Eckmann's method gives spurious positive exponents on periodic
-    signals at these settings. Where the map's Jacobians are known, prefer
-    `spectrum_from_jacobians`.
+        ``doubtful`` on too few samples, a near-constant series, nolds' warnings; Rosenstein:
+        a non-linear (R² < 0.95) or saturating divergence (last third's slope < 30 % of the
+        first's); Eckmann: a positive exponent sum, or no exponent near zero (for a flow).
     """
     x = as_series(x)
     if method not in ("rosenstein", "eckmann"):
@@ -144,8 +127,7 @@ def lyapunov_from_series(
 
 
 def _nolds(y, method, s, reasons) -> tuple[float, list, float]:
-    """(λ₁, the exponents, R²) by nolds with the settings ``s``; appends to ``reasons`` what
-    makes the estimate doubtful."""
+    """(λ₁, the exponents, R²) by nolds; appends to ``reasons`` what makes it doubtful."""
     import nolds
 
     with recorded() as caught:  # nolds's warnings, kept as reasons (thread-safe)

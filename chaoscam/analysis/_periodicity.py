@@ -1,5 +1,4 @@
-"""Evidence from Poincaré-section points: period and rotation order (the set's expansion,
-dimension and stationarity are in :mod:`._set_measures`)."""
+"""Period and rotation order of Poincaré-section points (other set measures: `_set_measures`)."""
 
 from __future__ import annotations
 
@@ -19,9 +18,8 @@ __all__ = ["PeriodResult", "RotationResult", "embed_angles", "rotation_order", "
 def embed_angles(points, angle_periods: Sequence[float | None] | None = None) -> np.ndarray:
     """Replace angular coordinates by (cos, sin) pairs so that distances ignore the wrap.
 
-    Coordinate j with period P_j (e.g. 2π for a phase, 1 for a circle-map angle in turns)
-    becomes ``(P_j / 2π) (cos 2π x_j / P_j, sin 2π x_j / P_j)``: the chord, which matches the
-    angular distance for small differences, in the coordinate's own units.
+    Coordinate j of period P_j (2π for a phase, 1 for turns) becomes ``(P_j / 2π) (cos 2π
+    x_j / P_j, sin 2π x_j / P_j)``: the chord, in the coordinate's own units.
 
     Parameters
     ----------
@@ -31,7 +29,7 @@ def embed_angles(points, angle_periods: Sequence[float | None] | None = None) ->
 
     Returns
     -------
-    ndarray, shape (N, d'), d' = d + the number of angular coordinates
+    ndarray, shape (N, d + number of angular coordinates)
     """
     x = as_points(points)
     if angle_periods is None:
@@ -93,8 +91,7 @@ class PeriodResult:
     settings: dict = field(default_factory=dict)
     jitter: np.ndarray = field(default_factory=lambda: np.array([]))  # widest band; NaN: none
     extent: np.ndarray = field(default_factory=lambda: np.array([]))  # range of the points kept
-    # least Chebyshev distance of two band centres in units of max(band_separation · jitter_j,
-    # round-off_j) (> 1: distinct bands); inf for period 1 or none
+    # least band-centre distance / max(band_separation · jitter, round-off); > 1: distinct
     separation: float = math.inf
 
     def __post_init__(self) -> None:
@@ -102,8 +99,7 @@ class PeriodResult:
 
 
 def _separation(y: np.ndarray, p: int, scale: np.ndarray) -> float:
-    """Smallest Chebyshev distance between the p band centres, in units of ``scale`` (per
-    coordinate)."""
+    """Smallest Chebyshev distance between the p band centres, in units of ``scale``."""
     if p == 1:
         return math.inf
     c = np.array([np.median(y[r::p], axis=0) for r in range(p)]) / scale
@@ -127,63 +123,45 @@ def section_period(
 ) -> PeriodResult:
     """Period of section points by fixed-lag bands: the smallest n whose n bands are narrow.
 
-    The orbit is period n when the points split, by their index modulo n, into n bands
-    ``B_r = {x_{r + kn}}`` each narrower than the tolerance in every coordinate j,
+    Period n: every band ``B_r = {x_{r + kn}}`` is narrow in every coordinate j,
 
         max_k x_{r+kn, j} - min_k x_{r+kn, j} <= tol_j = max(atol_j, rtol · extent_j),
 
-    extent_j the range of coordinate j (the orbit's size). A band's width is the jitter the
-    orbit carries (integration error, a slow transient, noise). Bands of a lag, unlike
-    clusters, also check the order of the visits, and a slow drift along a curve (a torus
-    near a resonance p/n) widens them.
+    extent_j the range of coordinate j. Bands of a lag, unlike clusters, also check the
+    order of the visits; a slow drift along a curve (a torus near p/n) widens them.
+
+    Limits: periods above N / `min_repeats` are not seen; jitter above `rtol` × extent hides
+    any; a torus with rotation number within ~rtol / (π N) of p/n reads as period n; points
+    closer than the tolerance are one (period n for 2n just after a period doubling).
 
     Parameters
     ----------
     points : array_like, shape (N,) or (N, d)
-        Section points in time order, after the transient; angular coordinates through
-        `embed_angles` first.
+        Section points in time order, after the transient; angles through `embed_angles`.
     rtol : float, optional
         Band width allowed relative to the extent; default `Thresholds.period_rtol`.
     atol : float or array_like, optional
-        Absolute floor per coordinate, in the units of the points; default
-        ``noise_floor · max_j max_k |x_kj|``, which makes period 1 detectable (a fixed
-        point's extent is only round-off). Pass the integrator's accuracy when the
-        coordinates have very different scales.
+        Absolute floor per coordinate, in the units of the points (pass the integrator's
+        accuracy when scales differ); default per `Thresholds.noise_floor`.
     max_period : int, optional
         Largest lag tested; default ``N // min_repeats``.
-    min_repeats : int
-        The pattern must be seen at least this many times (N - transient >= min_repeats n).
+    min_repeats, min_points : int
+        Fewest repeats of the pattern (N - transient >= min_repeats n); fewest points to test.
     allow_transient : bool
-        Also try leaving out the first 10 %, 20 %, ..., 50 % of the points (a slowly
-        converging transient); the tolerance is then computed on the points kept.
-    min_points : int
-        Fewer points than this: no test (period None, `message` says why).
+        Also try leaving out the first 10 %, 20 %, ..., 50 % of the points.
     noise_floor : float, optional
-        Fraction of the largest coordinate magnitude used as `atol` when none is given;
-        default `Thresholds.noise_floor`.
+        `atol` as a fraction of ``max_j max_k |x_kj|``; default `Thresholds.noise_floor`.
     distinct : bool
-        Refuse a lag two of whose bands overlap: centres within `band_separation` widths of
-        the widest band (or within 64 ulps of the coordinate's magnitude) in every
-        coordinate; `rtol` and `atol` bound a band's jitter, not the distance between
-        distinct points. False returns the smallest lag whose bands are all narrow: whether
-        the points keep to bands visited in order (banded chaos), not whether they repeat.
+        Refuse a lag two of whose band centres lie within `band_separation` widths (or 64
+        ulps) in every coordinate. False: whether the points keep to bands visited in order
+        (banded chaos), not whether they repeat.
     band_separation : float, optional
         See `distinct`; default `Thresholds.band_separation`.
 
     Returns
     -------
     PeriodResult
-
-    Notes
-    -----
-    A constant set of points (all within `atol`) is period 1: a fixed point of the section
-    map, for a stroboscopic section a response with the forcing's period.
-
-    Limits: periods above N / `min_repeats` cannot be seen; jitter wider than `rtol` ×
-    extent hides any period (raise `rtol` or `atol` for noisy data); a quasiperiodic orbit
-    whose rotation number lies within ~rtol / (π N) of p/n is read as period n; two
-    distinct points closer than the tolerance are read as one (right after a period
-    doubling, period n for 2n).
+        Period 1 for points all within `atol` (a fixed point of the section map).
     """
     check_settings(
         "section_period",
@@ -268,14 +246,15 @@ def _curve_angles(z: np.ndarray) -> np.ndarray:
 def rotation_order(z) -> RotationResult:
     """Rank-shift consistency: does the orbit advance along a closed curve like a rotation?
 
-    The points are ordered around the curve — by value for d = 1 (the interval read as a
-    circle), else by the angle about the centroid after whitening by the principal axes
-    (the two leading ones when d > 2). With r_k the rank of point k, the shift
-    ``s_k = (r_{k+1} - r_k) mod N`` of a rotation by an irrational ρ (or of any circle
-    homeomorphism conjugate to one) stays within O(log N) of ρN (three-gap theorem and the
-    discrepancy of irrational rotations; Weyl 1916), so the resultant length
-    ``R = |<exp(2πi s_k / N)>|`` is close to 1; a chaotic map scrambles the order and gives
-    R ~ 1/sqrt(N).
+    The points are ordered around the curve (by value for d = 1, else by the angle about the
+    centroid after whitening by the two leading principal axes). With r_k the rank of point
+    k, the shift ``s_k = (r_{k+1} - r_k) mod N`` of an irrational rotation by ρ stays within
+    O(log N) of ρN (three-gap theorem; Weyl 1916), so ``R = |<exp(2πi s_k / N)>|`` is near
+    1; chaos scrambles the order, R ~ 1/sqrt(N).
+
+    Limits: a curve not star-shaped about its centroid lowers R; phase-coherent chaos on a
+    thin band (a breaking torus) can keep R high, so R supports quasiperiodicity only with a
+    non-positive exponent or a low 0–1 K. A periodic orbit is trivially consistent.
 
     Parameters
     ----------
@@ -285,15 +264,6 @@ def rotation_order(z) -> RotationResult:
     Returns
     -------
     RotationResult
-
-    Notes
-    -----
-    Limits: the angle about the centroid orders a curve correctly only when it is
-    star-shaped about its centroid; a folded or self-intersecting closed curve lowers R.
-    Phase-coherent chaos on a thin band around a curve (a torus breaking down) can keep
-    R high: R is evidence for quasiperiodicity only together with a non-positive Lyapunov
-    exponent or a low 0–1 statistic. A periodic orbit gives a trivially consistent shift;
-    test the period first.
     """
     x = as_points(z)
     n = x.shape[0]

@@ -1,6 +1,4 @@
-"""The saltation matrix of a state jump at an event surface (generic, numpy): the reference
-the kernel's own formula for its restitution law (``chaoscam.kernel._tangent.saltation``) is
-tested against."""
+"""Generic saltation matrix of a state jump: the reference the kernel's formula is tested on."""
 
 from __future__ import annotations
 
@@ -21,25 +19,17 @@ def saltation_matrix(g_x, g_t, f_minus, f_plus, h_x, h_t: float) -> np.ndarray:
 
     Parameters
     ----------
-    g_x : array_like, shape (n, n)
-        Jacobian of the jump map with respect to the state.
-    g_t : array_like, shape (n,)
-        Its derivative with respect to time.
+    g_x, g_t : array_like, shapes (n, n) and (n,)
+        Jacobian of the jump map with respect to the state, and its time derivative.
     f_minus, f_plus : array_like, shape (n,)
         The vector field before and after the jump, at the event.
-    h_x : array_like, shape (n,)
-        Gradient of the event function with respect to the state.
-    h_t : float
-        Its derivative with respect to time.
+    h_x, h_t : array_like, shape (n,), and float
+        Gradient of the event function with respect to the state, and its time derivative.
 
     Returns
     -------
     ndarray, shape (n, n)
-
-    Raises
-    ------
-    ValueError
-        For a grazing event (``h_t + h_x · f- = 0``): no saltation matrix exists there.
+        S; raises ValueError for a grazing event (``h_t + h_x · f- = 0``), where none exists.
     """
     g_x, h_x = np.asarray(g_x, dtype=float), np.asarray(h_x, dtype=float)
     rate = float(h_t) + float(h_x @ np.asarray(f_minus, dtype=float))

@@ -12,10 +12,10 @@ __all__ = ["crossing_section", "local_maxima"]
 def local_maxima(x, dt: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     """Local maxima of a sampled signal, refined by a parabola through three samples.
 
-    A strict interior maximum x_{i-1} < x_i >= x_{i+1} is moved to the vertex of the
-    parabola through the three samples: ``δ = (x_{i-1} - x_{i+1}) / (2 (x_{i-1} - 2 x_i +
-    x_{i+1}))``, value ``x_i - (x_{i-1} - x_{i+1}) δ / 4``. The successive maxima form a
-    one-dimensional map of the flow (the Lorenz map; Lorenz 1963, J. Atmos. Sci. 20, 130).
+    A strict interior maximum x_{i-1} < x_i >= x_{i+1} moves to the parabola's vertex,
+    ``δ = (x_{i-1} - x_{i+1}) / (2 (x_{i-1} - 2 x_i + x_{i+1}))``, value ``x_i - (x_{i-1} -
+    x_{i+1}) δ / 4``. Successive maxima form the flow's Lorenz map (Lorenz 1963, J. Atmos.
+    Sci. 20, 130).
 
     Parameters
     ----------
@@ -27,8 +27,7 @@ def local_maxima(x, dt: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
     Returns
     -------
     times, values : ndarray
-        Refined times and values of the maxima. For a smooth signal the value error is
-        O(dt³) per maximum (O(dt²) in time); at a kink (an impact) it is O(dt).
+        Refined maxima: value error O(dt³) (time O(dt²)) when smooth, O(dt) at a kink (an impact).
     """
     x = as_series(x)
     check_settings("local_maxima", dt=(dt, "real>0"))
@@ -58,16 +57,16 @@ def crossing_section(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Poincaré section of a sampled trajectory at ``states[:, index] = level``.
 
-    Crossings in the given direction (+1 upwards, -1 downwards, 0 both) are located by
-    the cubic through the four samples around each sign change (Lagrange interpolation,
-    error O(dt⁴) for smooth trajectories) and every state component is interpolated there.
+    Each crossing is located on the cubic through the four samples around the sign change
+    (Lagrange interpolation, error O(dt⁴) when smooth), and every component interpolated.
+
+    Limits: crossings in the first and last sample intervals are skipped; two within one step
+    are missed. For a stroboscopic section, prefer the integrator's states at the instants.
 
     Parameters
     ----------
-    t : array_like, shape (N,)
-        Sample times.
-    states : array_like, shape (N, d)
-        Sampled states.
+    t, states : array_like, shapes (N,) and (N, d)
+        Sample times and sampled states.
     index, level : int, float
         The section is ``states[:, index] = level``.
     direction : int
@@ -78,13 +77,6 @@ def crossing_section(
     times : ndarray, shape (M,)
     points : ndarray, shape (M, d)
         States on the section (the `index` component equals `level` up to round-off).
-
-    Notes
-    -----
-    Crossings in the first and last sample intervals are skipped (four samples are
-    needed). Sampling must resolve each crossing: two crossings within one sample step
-    are missed. For a stroboscopic section of a simulation, prefer the states the
-    integrator produces at the exact instants.
     """
     t = as_series(t, "t")
     y = as_points(states, "states")

@@ -1,5 +1,4 @@
-"""Measures of a set of section points: nearest-neighbour expansion, correlation dimension,
-stationarity (supporting evidence for :func:`chaoscam.analysis.classify_section`)."""
+"""Nearest-neighbour expansion, correlation dimension, stationarity of a set of section points."""
 
 from __future__ import annotations
 
@@ -27,10 +26,12 @@ def neighbour_expansion(
 ) -> float:
     """Mean one-step log growth of nearest-neighbour distances on the section.
 
-    For each point x_k its nearest neighbour x_k' in the set (coordinates scaled by their
-    extent) gives ``g_k = ln(|x_{k+1} - x_{k'+1}| / |x_k - x_k'|)``; the mean of g_k is a
-    one-step, finite-resolution estimate of the largest Lyapunov exponent per iterate
-    (the first point of Rosenstein et al.'s divergence curve, Physica D 65 (1993) 117).
+    With x_k' the nearest neighbour of x_k (coordinates scaled by their extent), the mean of
+    ``g_k = ln(|x_{k+1} - x_{k'+1}| / |x_k - x_k'|)`` is a one-step estimate of λ₁ per
+    iterate (the first point of Rosenstein et al.'s divergence curve, Physica D 65 (1993) 117).
+
+    Limits: neighbours ~1/N apart bias it towards 0 for small N or strong chaos; noise
+    inflates it; on a set periodic to `section_period`'s tolerance it measures only jitter.
 
     Parameters
     ----------
@@ -41,24 +42,14 @@ def neighbour_expansion(
     min_distance : float
         Pairs closer than this (in extent-scaled coordinates) are left out (recurrences).
     atol : float or array_like, optional
-        Absolute noise floor per coordinate, in the units of the points: pairs closer
-        than it are left out, and each point's nearest neighbour is sought beyond it.
-        Without it, the jitter of a periodic orbit (neighbours a jitter apart, mapped onto
-        points an independent jitter apart) reads as growth.
+        Noise floor per coordinate, in the units of the points: neighbours are sought beyond
+        it (else a periodic orbit's jitter reads as growth).
 
     Returns
     -------
     float
-        Mean g_k: clearly positive for chaos (neighbours separate), near zero for a
-        rotation on a curve, negative for convergence to a periodic orbit; NaN with fewer
-        than 10 usable pairs.
-
-    Notes
-    -----
-    Limits: with N points on a 1-D set the neighbours are ~1/N apart, not infinitesimal,
-    so the value is biased towards 0 (saturation) for small N or strong chaos; noise
-    inflates it. Do not use it on a set that is periodic to the tolerance of
-    `section_period`: there only the jitter is left to measure.
+        Mean g_k: > 0 for chaos, ~0 for a rotation on a curve, < 0 for convergence to a
+        periodic orbit; NaN with fewer than 10 usable pairs.
     """
     check_settings(
         "neighbour_expansion",
@@ -94,9 +85,11 @@ def correlation_dimension(
     """Grassberger–Procaccia correlation dimension of a set of section points.
 
     ``C(r) = 2 / (N (N - 1)) #{i < j : |x_i - x_j| < r}`` and ``D₂ = d ln C / d ln r``
-    (Grassberger & Procaccia 1983, Physica D 9, 189), fitted by least squares over 12
-    radii between the `quantiles` of the pair distances (coordinates scaled by their
-    extent).
+    (Grassberger & Procaccia 1983, Physica D 9, 189), fitted over 12 radii between the
+    `quantiles` of the pair distances (coordinates scaled by their extent).
+
+    Limits: needs ~10^{D₂} points per scaling decade; the fixed window biases D₂ where the
+    scaling region lies elsewhere (Hénon: 1.17–1.19 against 1.21). Supporting evidence only.
 
     Parameters
     ----------
@@ -105,24 +98,14 @@ def correlation_dimension(
     max_points : int
         Only the first `max_points` points are used (the cost is O(N²)).
     quantiles : (float, float)
-        Fractions of the pair distances bounding the fit window, 0 < low < high <= 1.
+        Pair-distance fractions bounding the fit, 0 < low < high <= 1 (skip the smallest:
+        a torus's evenly spread points bias them upwards).
 
     Returns
     -------
     float
-        D₂ (≈ 0 for a periodic orbit, ≈ 1 for a closed curve, non-integer and > 1 for
-        most strange attractors' sections); NaN for fewer than 200 points.
-
-    Notes
-    -----
-    The default window (1 % to 10 % of the pairs) skips the smallest distances, where the
-    evenly spread points of a quasiperiodic orbit (no pair closer than ~ length / N) bias
-    the slope upwards; with 500–2000 points it gives 1.02–1.09 on closed curves and
-    1.17–1.19 on the Hénon attractor (literature 1.21).
-
-    Limits: needs several hundred points (about 10^{D₂} per decade of scaling); the fixed
-    window stands in for a scaling region chosen by eye and biases D₂ for sets whose
-    scaling region lies elsewhere. Use it as supporting evidence only.
+        D₂ (≈ 0 periodic, ≈ 1 a closed curve, > 1 most strange attractors' sections); NaN
+        for fewer than 200 points.
     """
     from scipy.spatial.distance import pdist
 
@@ -149,11 +132,10 @@ def correlation_dimension(
 
 
 def stationarity_ratio(z) -> float:
-    """Stationarity ratio: spread of the second half of the points over that of the first.
+    """Spread (RMS distance to the centroid, extent-scaled) of the second half over the first.
 
-    Spread is the RMS distance to each half's centroid (coordinates scaled by their
-    extent). A stationary set gives about 1, a transient converging to an orbit a small
-    value, one escaping a large value; NaN for fewer than 8 points.
+    About 1 for a stationary set, small for a transient converging, large for one escaping;
+    NaN for fewer than 8 points.
     """
     x = _scaled(as_points(z))
     h = x.shape[0] // 2

@@ -28,10 +28,8 @@ def power_spectrum(x, dt: float) -> tuple[np.ndarray, np.ndarray]:
 
     Returns
     -------
-    freqs : ndarray
-        Frequencies (Hz), 0 .. Nyquist.
-    power : ndarray
-        Periodogram.
+    freqs, power : ndarray
+        Frequencies (Hz), 0 .. Nyquist, and the periodogram.
     """
     x = as_series(x)
     check_settings("power_spectrum", dt=(dt, "real>0"))
@@ -48,13 +46,10 @@ def power_spectrum(x, dt: float) -> tuple[np.ndarray, np.ndarray]:
 class SpectrumResult:
     """Result of `spectrum_analysis`; frequencies in Hz.
 
-    ``model`` is "periodic" (a harmonic comb explains the power), "quasiperiodic"
-    (combinations of two incommensurate bases explain it), "broadband" (a large part of the
-    power lies outside both), "aperiodic" (neither explains it, but the broadband part is
-    small) or "undetermined" (input too short or constant; see ``message``). ``period``,
-    for a forced signal with a periodic model, is the smallest n such that the harmonics of
-    f_forcing / n hold the power: weak subharmonics below `line_tol` are missed, so it can
-    under-count a period seen on a section (it divides it).
+    ``model`` is "periodic", "quasiperiodic", "broadband", "aperiodic" (no line model, small
+    broadband part) or "undetermined" (see ``message``). ``period``, for a forced periodic
+    model, is the smallest n whose comb f_forcing / n holds the power; it can divide the
+    period a section sees (subharmonics below `line_tol` are missed).
     """
 
     model: str
@@ -87,8 +82,7 @@ def _windows(centres: np.ndarray, n_bins: int, h: int) -> np.ndarray:
 
 
 def _local_maxima(power: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Bins of the local maxima and their positions in bins, refined by the parabola through
-    the log power (for a Hann-windowed line its bias is below 0.02 bin)."""
+    """Peak bins and their parabola-refined positions on the log power (bias < 0.02 bin)."""
     p = power
     k = peak_indices(p)
     k = k[p[k] > 1e-14 * p.max()]
@@ -124,9 +118,7 @@ def _on_torus_lines(fk, f1, f2, max_order, ftol) -> np.ndarray:
 
 
 def _comb_candidates(fk, pk, forcing_frequency, df, max_period, min_cycles, ftol):
-    """(max_period, [(n, f0 in bins)]): the periodic model's fundamentals that the record
-    holds `min_cycles` cycles of, ``f_F / n`` when forced, else the strongest peak over n
-    refined on its harmonics."""
+    """(max_period, [(n, f0 in bins)]): the comb fundamentals with `min_cycles` in the record."""
     if max_period is None:
         if forcing_frequency is not None:
             max_period = int(min(64, max(1, forcing_frequency / df // min_cycles)))
@@ -152,12 +144,11 @@ SPECTRUM_RULES = {
     "min_cycles": "real>0",
     "peak_tol": "real>0",
 }
-"""The settings of :func:`spectrum_analysis` and their ranges (see ``check_settings``)."""
+"""The settings of `spectrum_analysis` and their ranges (see ``check_settings``)."""
 
 
 def check_spectrum_options(fn: str, options: dict) -> None:
-    """Refuse a setting :func:`spectrum_analysis` does not take (TypeError) or one out of
-    its range (ValueError), naming ``fn``."""
+    """TypeError for a setting `spectrum_analysis` does not take, ValueError for a bad one."""
     unknown = sorted(set(options) - set(SPECTRUM_RULES))
     if unknown:
         raise TypeError(
@@ -183,25 +174,27 @@ def spectrum_analysis(
 ) -> SpectrumResult:
     """Line-spectrum analysis of a sampled signal: harmonic comb, two-frequency torus or broadband.
 
-    The Hann-windowed, linearly detrended periodogram (`power_spectrum`) is read as lines
-    plus a continuous part. Each local maximum is located to a fraction of a bin
-    (parabolic interpolation of the log power) and belongs to a line model when it lies
-    within `peak_tol` bins of one of the model's lines; the model then explains the power
-    within ± `half_width` bins of the peaks it owns (and of DC). Two models are tried:
+    Each local maximum of the periodogram (`power_spectrum`) is located to a fraction of a
+    bin and belongs to a line model when within `peak_tol` bins of one of its lines; a model
+    explains the power within ± `half_width` bins of its peaks (and of DC). The models:
 
-    * periodic: lines at ``m f0`` (m = 0, 1, ...). With a forcing frequency f_F the
-      candidates are ``f0 = f_F / n``, n = 1 .. `max_period`, and the smallest n that
-      explains ``>= 1 - line_tol`` of the power is the period in forcing periods
-      (harmonics: period 1; subharmonics f_F / n: period n). Without forcing, f0 is the
-      strongest peak divided by k = 1 .. `max_period`, refined by least squares on the
-      harmonics it owns;
-    * quasiperiodic: lines at ``|a f1 + b f2|``, |a|, |b| <= `max_order`, with f1 the forcing
-      (or strongest) frequency and f2 the strongest peak off the f1 comb.
+    * periodic: lines at ``m f0``; forced, ``f0 = f_F / n``, n = 1 .. `max_period`, the
+      smallest n explaining ``>= 1 - line_tol`` of the power being the period in forcing
+      periods; unforced, f0 is the strongest peak over k = 1 .. `max_period`, refined by
+      least squares on its harmonics;
+    * quasiperiodic: lines at ``|a f1 + b f2|``, |a|, |b| <= `max_order`, f1 the forcing (or
+      strongest) frequency, f2 the strongest peak off the f1 comb.
 
-    What neither explains, ``1 - line_fraction``, is the broadband measure: a chaotic
-    signal has a continuous spectrum, so a residual >= `broadband_tol` reads as broadband.
-    Spectral entropy ``-Σ p_k ln p_k / ln K`` and flatness are reported but not used: they
-    depend on how far the sampling rate exceeds the signal's bandwidth.
+    The residual ``1 - line_fraction`` is the broadband measure (chaos has a continuous
+    spectrum). Spectral entropy ``-Σ p_k ln p_k / ln K`` and flatness are reported, not used:
+    they depend on how far the sampling rate exceeds the bandwidth.
+
+    References: Harris (1978), Proc. IEEE 66, 51 (windows); Bergé, Pomeau & Vidal (1984),
+    "Order within Chaos", ch. 2–3; Powell & Percival (1979), J. Phys. A 12, 2053 (entropy).
+
+    Limits: a transient, noise or drift add broadband power. Lines closer than ~`peak_tol`
+    bins are one (a torus whose second base is that close to a low subharmonic reads as
+    periodic). A forced period above `max_period` reads as quasiperiodic.
 
     Parameters
     ----------
@@ -212,41 +205,20 @@ def spectrum_analysis(
     forcing_frequency : float, optional
         Forcing frequency (Hz) of a forced system.
     max_period : int, optional
-        Largest subharmonic order n (forced) or harmonic rank k of the strongest peak
-        (unforced). Default: forced, every n whose comb the record resolves, ``n <= f_F N
-        dt / min_cycles`` (9 for 20 s of the cam at 28.7 rad/s), at most 64; unforced, 8.
-    half_width : int
-        Half width of a line, in bins.
-    line_tol : float
-        A model holding at least ``1 - line_tol`` of the power explains the signal.
-    broadband_tol : float
-        Residual fraction from which the spectrum counts as broadband.
-    max_order : int
-        Largest |a|, |b| of the two-frequency combinations.
-    n_peaks : int
-        Number of peaks reported.
+        Largest subharmonic order n (forced) or harmonic rank k (unforced); default, forced,
+        every n with ``n <= f_F N dt / min_cycles`` up to 64 (9 for 20 s of the cam), else 8.
+    half_width, peak_tol : int, float
+        Half width of a line, and the distance of a refined peak on a model line [bins].
+    line_tol, broadband_tol : float
+        Power fraction a line model may leave unexplained; residual from which it is broadband.
+    max_order, n_peaks : int
+        Largest |a|, |b| of the two-frequency combinations; number of peaks reported.
     min_cycles : float
-        The record must hold at least this many periods of the fundamental tried (else a
-        line cannot be told from its neighbours and the candidate is skipped).
-    peak_tol : float
-        A peak lies on a model line when its refined frequency is within this many bins.
+        Fewest periods of a candidate fundamental in the record (else it is skipped).
 
     Returns
     -------
     SpectrumResult
-
-    Notes
-    -----
-    References: Harris (1978), Proc. IEEE 66, 51 (windows and leakage); Bergé, Pomeau &
-    Vidal (1984), "Order within Chaos", ch. 2–3 (spectra of periodic, quasiperiodic and
-    chaotic motion); Powell & Percival (1979), J. Phys. A 12, 2053 (spectral entropy).
-
-    Limits: a transient, noise or slow drifts add broadband power. Two lines closer than
-    about `peak_tol` bins (of 1/(N dt)) are one, so a quasiperiodic signal whose second
-    base lies that close to a low-order subharmonic of the first reads as periodic.
-    Subharmonics holding less than `line_tol` of the power are missed (a smaller period is
-    reported). A forced periodic response whose period exceeds `max_period` has lines two
-    bases also explain: it reads as quasiperiodic, against a section that sees the period.
     """
     x = as_series(x)
     n = x.size

@@ -1,5 +1,4 @@
-"""Lyapunov exponents from a sequence of map Jacobians by repeated QR (for the model: the
-stroboscopic map's Jacobians through the impacts, which the kernel's tangent integrates)."""
+"""Lyapunov exponents by repeated QR of map Jacobians (the model's: from the kernel's tangent)."""
 
 from __future__ import annotations
 
@@ -19,11 +18,8 @@ __all__ = ["TangentSpectrum", "spectrum_from_jacobians"]
 class TangentSpectrum:
     """Lyapunov exponents of a sequence of map Jacobians (`spectrum_from_jacobians`).
 
-    ``exponents`` are λ₁ ≥ λ₂ per unit time of `period` [1/s for the model]; λ₂ = -inf when
-    a Jacobian is singular (for the model, a plastic closure ending a complete chattering:
-    a Floquet multiplier 0). ``stderr`` are their standard errors from batch means of the
-    per-iterate log growths (NaN with fewer than `n_batches` iterates, or for an infinite
-    exponent).
+    ``exponents`` λ₁ ≥ λ₂ per unit time of `period` (λ₂ = -inf: a Floquet multiplier 0, as at a
+    complete chattering); ``stderr`` by batch means (NaN: < `n_batches` iterates, infinite λ).
     """
 
     exponents: np.ndarray  # shape (2,)
@@ -52,17 +48,21 @@ def spectrum_from_jacobians(
 ) -> TangentSpectrum:
     """Lyapunov exponents of a sequence of 2×2 map Jacobians by repeated QR.
 
-    With ``Q_0 = I`` and ``J_k Q_{k-1} = Q_k R_k`` (Gram–Schmidt, positive diagonal),
+    With ``Q_0 = I`` and ``J_k Q_{k-1} = Q_k R_k`` (positive diagonal),
 
         λ_i = 1 / (n T) Σ_{k=1}^{n} ln R_k[i, i]
 
     (Benettin, Galgani, Giorgilli & Strelcyn 1980, Meccanica 15, 9; Eckmann & Ruelle 1985,
     Rev. Mod. Phys. 57, 617, sec. IV.C); λ₁ + λ₂ is the mean of ln |det J_k| / T.
 
+    Limits: the standard error shrinks as 1/sqrt(n) and omits the bias of a too-short
+    transient. A singular J_k gives λ₂ = -inf; λ₁ goes on.
+
     Parameters
     ----------
     jacobians : ndarray, shape (n, 2, 2)
-        J_k = DP at x_{k-1}, in order along the orbit.
+        J_k = DP at x_{k-1}, in order along the orbit (across an impact, with its
+        `saltation_matrix`).
     period : float
         Time T per map iterate (1: exponents per iterate; the cam period [s]: per second).
     n_batches : int
@@ -71,13 +71,6 @@ def spectrum_from_jacobians(
     Returns
     -------
     TangentSpectrum
-
-    Notes
-    -----
-    Limits: a finite-time average, whose standard error shrinks as 1/sqrt(n) and says
-    nothing about the bias of a too-short transient. The Jacobians must be those of the map
-    along the orbit, across a discontinuity (an impact) including its saltation matrix
-    (`saltation_matrix`). A singular J_k (a zero multiplier) gives λ₂ = -inf; λ₁ goes on.
     """
     check_settings(
         "spectrum_from_jacobians", period=(period, "real>0"), n_batches=(n_batches, "int>=2")
@@ -92,8 +85,7 @@ def spectrum_from_jacobians(
     with np.errstate(divide="ignore"):
         for i, m in enumerate(jac):
             a = m @ q
-            # Gram–Schmidt on two columns; a zero second column (singular J) keeps q's
-            # orthogonal complement so that λ₁ goes on.
+            # Gram–Schmidt; a singular J keeps q's orthogonal complement, so λ₁ goes on
             r11 = math.hypot(a[0, 0], a[1, 0])
             q1 = a[:, 0] / r11 if r11 > 0 else q[:, 0]
             r12 = q1 @ a[:, 1]

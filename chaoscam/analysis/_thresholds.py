@@ -15,81 +15,61 @@ class Thresholds:
 
     Pass one to either classifier (``thresholds=Thresholds(period_rtol=1e-2)``); the verdict
     records it in ``settings["thresholds"]``. Exponents are per iterate of the section map
-    (λ T for a stroboscopic section of a flow forced with period T); lengths are relative
-    to the orbit's extent unless said.
+    (λ T for a stroboscopic section, T the forcing period); lengths are relative to the
+    orbit's extent unless said.
 
     Attributes
     ----------
     period_rtol : float
-        A period n is accepted when each of its n bands (the points k ≡ r mod n) is
-        narrower than ``max(atol_j, period_rtol · extent_j)`` in every coordinate j: 3e-3
-        is three times the ~0.1 % jitter integration error and a slow transient leave on a
-        cam section, and refuses noise of 1 % of the extent.
+        Period n accepted when each band (k ≡ r mod n) is narrower than ``max(atol_j,
+        period_rtol · extent_j)``: 3x the ~0.1 % jitter of a cam section, refuses 1 % noise.
     noise_floor : float
-        Absolute floor of the period tolerance and of the expansion test's distances, as a
-        fraction of ``max_j max_k |x_kj|``: 1e-6, far above round-off and below any dynamics
-        worth resolving; it makes a fixed point (no extent) detectable.
+        Absolute floor of the period and expansion tests, times ``max_j max_k |x_kj|``: above
+        round-off, below any dynamics; it makes a fixed point (no extent) detectable.
     band_separation : float
-        Two bands of a period are distinct when their centres lie more than this many
-        widths of the widest band apart in some coordinate (4: a gap of at least 3 widths);
-        a period-12 cam orbit repeats to 1e-9 rad while two of its points lie 9e-6 rad apart.
+        Bands are distinct when their centres lie > this many widest-band widths apart: a
+        period-12 cam orbit repeats to 1e-9 rad with two points 9e-6 rad apart.
     stationary_low, stationary_high : float
-        Spread of the second half of the points over that of the first: outside [0.5, 2]
-        the points are still converging or escaping and the section abstains.
+        Second-half over first-half spread outside [0.5, 2]: still converging or escaping.
     min_points_aperiodic : int
-        Fewest section points for the rotation-order and expansion votes (a period up to
-        N / 2 shows on fewer; a quasiperiodic/chaotic call from fewer than 100 is weak).
+        Fewest points for the rotation and expansion votes (fewer make a weak call).
     rotation_quasi : float
-        Rank-shift consistency R (`rotation_order`) from which the points advance along a
-        closed curve like a rotation (R ~ 1 / sqrt(N) for chaos).
+        `rotation_order` R from which the points rotate on a closed curve (chaos: 1/sqrt N).
     expansion_chaotic : float
-        Mean one-step log growth of nearest-neighbour distances (`neighbour_expansion`)
-        above which neighbours separate: 0.1 per iterate, a tenth of an e-fold.
+        `neighbour_expansion` above which neighbours separate: 0.1, a tenth of an e-fold.
     dimension_chaotic, dimension_min_points : float, int
-        Correlation dimension from which the set is not a curve (closed curves give
-        1.02-1.09, the Hénon attractor 1.17-1.19, Ueda's section 1.53-1.60), and the fewest
-        points for it to vote (10^{D₂} per scaling decade).
+        Correlation dimension above closed curves' 1.02-1.09 (Hénon 1.17-1.19, Ueda 1.53-1.60),
+        and the fewest points for it to vote (10^{D₂} per scaling decade).
     zero_one_chaotic, zero_one_regular : float
         0-1 test: K >= 0.8 votes chaotic, K <= 0.2 not chaotic (Gottwald & Melbourne 2009).
     zero_one_min_points : int
-        Fewest samples for the 0-1 test to vote: 200, so that its first half still has the
-        100 samples `zero_one_test` needs.
+        Fewest samples for the 0-1 test: 200, so its first half has the 100 it needs.
     zero_one_max_change : float
-        Largest |K(first half) - K(whole)| for which K is taken as converged in N, else the
-        test abstains (on a cam attractor K can fall from 0.94 at 229 points to 0.16 at 914).
+        Largest |K(first half) - K(whole)| taken as converged (a cam attractor's K fell from
+        0.94 at 229 points to 0.16 at 914).
     birkhoff_quasi_digits, birkhoff_min_points : float, int
-        Converged digits of the weighted Birkhoff averages (`weighted_birkhoff`) from which
-        an orbit with no period is quasiperiodic (on 200-4000 points tori give 6-15 digits,
-        chaotic orbits (logistic r = 4, Hénon) below 2.5, noise of 1e-4 about 5), and the
-        fewest points for it to vote (two halves of 100).
+        Converged Birkhoff digits for a torus vote (tori 6-15, chaos < 2.5, 1e-4 noise ~5 on
+        200-4000 points), and the fewest points (two halves of 100).
     birkhoff_rational_tol : float
-        A converged rotation number within this of a rational p/q, q <= N/2, is not a torus
-        vote: an unresolved period-q orbit has one too (the cam at ξ = 0.30, period 30:
-        3/5 + 4e-10); 1e-8 mistakes a torus for one with probability ~1e-8 (N/2)².
+        A rotation number this close to p/q, q <= N/2, is no torus vote (cam at ξ = 0.30,
+        period 30: 3/5 + 4e-10); a torus is refused with probability ~1e-8 (N/2)².
     exponent_zero : float
-        A largest exponent whose confidence interval lies above this is positive (chaotic),
-        below it not positive: 0.01, an e-fold in 100 iterates, below what a run resolves.
+        Exponent interval above this: positive; below: not (0.01, an e-fold in 100 iterates).
     exponent_z : float
         Half-width of the exponent's confidence interval in standard errors (3: ~99.7 %).
     min_chaotic_votes : int
-        Without a decisive exponent, a section is chaotic only when at least this many
-        independent methods vote chaotic (one alone is fooled by noise or a long transient).
+        Chaotic votes needed without a decisive exponent (one is fooled by noise, transients).
     signal_repeat : float
-        `classify_signal`: a sequence whose spread is below this fraction of the signal's
-        (all maxima equal, or a signal that repeats every forcing period) is K = 0.
+        `classify_signal`: K = 0 when the 0-1 sequence's spread is below this of the signal's.
     zero_one_line_periods : float
-        `classify_signal`: a chaotic K is not used when the lags up to N / 10 cover fewer
-        than this many periods of the spectrum's slowest line (a long period mimics
-        diffusion).
+        `classify_signal`: a chaotic K is dropped when lags up to N / 10 cover fewer periods of
+        the slowest spectral line (a long period mimics diffusion).
     signal_lyapunov_tol : float
-        `classify_signal`: |λ₁ T| below this counts as zero when no `lyapunov_tol` is given
-        (T the forcing period or the spectrum's fundamental period).
+        `classify_signal`: default `lyapunov_tol` is this / T (T the forcing or fundamental period).
     series_chaotic, series_regular : float
-        `classify_signal`: Rosenstein's λ₁ T above 0.05 votes chaotic, |λ₁ T| below 0.01
-        not chaotic, in between abstains.
+        `classify_signal`: Rosenstein's λ₁ T > 0.05 votes chaotic, < 0.01 not, else abstains.
     constant_signal : float
-        `classify_signal`: a signal whose range is below this fraction of its magnitude is
-        constant (an equilibrium).
+        `classify_signal`: range below this fraction of the magnitude is constant (equilibrium).
     """
 
     period_rtol: float = 3e-3
@@ -142,9 +122,7 @@ class Thresholds:
 def resolve(
     thresholds: Thresholds | None, rtol: float | None, min_points_aperiodic: int | None
 ) -> Thresholds:
-    """The table a classifier uses: `thresholds` (or the defaults) with the two entries
-    that the classifiers also take as keywords (`rtol`, `min_points_aperiodic`) replaced
-    when given."""
+    """`thresholds` (or the defaults) with the keywords `rtol`, `min_points_aperiodic` applied."""
     thr = thresholds or Thresholds()
     if rtol is not None:
         try:  # the keyword's own name in the message, not the table's entry

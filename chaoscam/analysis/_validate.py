@@ -25,8 +25,7 @@ def _checked(arr: np.ndarray, name: str, min_size: int, what: str) -> np.ndarray
 
 
 def as_series(x, name: str = "x", min_size: int = 1) -> np.ndarray:
-    """`x` as a 1-D float array; NaN or infinite values, or fewer than `min_size` samples,
-    raise ValueError."""
+    """`x` as a 1-D float array; ValueError on NaN, inf or fewer than `min_size` samples."""
     arr = np.asarray(x, dtype=float)
     if arr.ndim != 1:
         arr = np.squeeze(arr)
@@ -36,8 +35,7 @@ def as_series(x, name: str = "x", min_size: int = 1) -> np.ndarray:
 
 
 def as_points(points, name: str = "points", min_size: int = 1) -> np.ndarray:
-    """Section points as an (N, d) float array (1-D input becomes (N, 1)); NaN or infinite
-    values, or fewer than `min_size` points, raise ValueError."""
+    """Points as an (N, d) float array ((N,) -> (N, 1)); ValueError as for `as_series`."""
     arr = np.asarray(points, dtype=float)
     if arr.ndim == 1:
         arr = arr[:, None]
@@ -47,11 +45,8 @@ def as_points(points, name: str = "points", min_size: int = 1) -> np.ndarray:
 
 
 def check_settings(fn: str, **settings: tuple[Any, str]) -> None:
-    """Refuse a setting outside its range: ValueError naming ``fn``, the setting and the
-    range. Each setting is ``(value, rule)``, the rule one of ``"number"`` (any real, NaN
-    and ±inf included: an estimate's value), ``"real"`` (finite), ``"real>0"``,
-    ``"real>=0"``, ``"int>=N"`` (an integer, not a bool or a float, as for the package's
-    other counts); a trailing ``?`` lets None pass (the setting's "not given")."""
+    """ValueError naming ``fn`` for a ``name=(value, rule)`` outside its rule: ``"number"`` (NaN,
+    ±inf too), ``"real"`` (finite), ``"real>0"``, ``"real>=0"``, ``"int>=N"``; ``?`` lets None."""
     for name, (value, rule) in settings.items():
         if value is None and rule.endswith("?"):
             continue
@@ -78,9 +73,7 @@ def check_settings(fn: str, **settings: tuple[Any, str]) -> None:
 
 
 def check_atol(fn: str, atol: Any, d: int) -> None:
-    """Refuse an ``atol`` that is not None, one finite number >= 0, or ``d`` of them (one
-    per coordinate): a string would fail deep inside numpy, NaN would find no period and
-    inf would make any set of points period 1."""
+    """ValueError unless ``atol`` is None, one finite number >= 0, or ``d`` of them."""
     if atol is None:
         return
     items = atol if isinstance(atol, list | tuple | np.ndarray) else [atol]

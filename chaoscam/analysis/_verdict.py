@@ -41,9 +41,8 @@ def _json_value(v):
 
 @dataclass(frozen=True)
 class Evidence:
-    """One method's finding: its ``name`` ("section_period", "spectrum", "zero_one", ...), its
-    headline ``value`` (the period, K, λ₁, ...), its ``vote`` (a key of `VOTES`; None
-    abstains) and a ``detail`` saying what was measured and why it votes as it does."""
+    """One method's finding: ``name``, headline ``value`` (period, K, λ₁, ...), ``vote`` (a key
+    of `VOTES`; None abstains) and a ``detail`` saying what was measured and why it votes."""
 
     name: str
     value: float | int | None
@@ -70,15 +69,13 @@ class Verdict:
     label : str
         One of `LABELS`.
     period : int or None
-        For "periodic": the period in iterates of the section map (in forcing periods for a
-        stroboscopic section); None otherwise.
+        For "periodic": in iterates of the section map (forcing periods if stroboscopic).
     evidence : tuple of Evidence
         Every method's finding, including those that abstained.
     reasons : tuple of str
         Why the label is "undetermined" (disagreement, too little data), or what limits it.
     settings : dict
-        The settings used by each method, ``settings["thresholds"]`` the `Thresholds` table
-        (as a dict); read-only at its top level (a ``FrozenDict``).
+        Each method's settings and ``"thresholds"`` (`Thresholds` as a dict); a ``FrozenDict``.
     """
 
     label: str
@@ -115,14 +112,11 @@ def combine(
 ) -> Verdict:
     """Combine votes into a verdict: the one label every vote admits, with direct support.
 
-    Rules: (1) each vote admits a set of labels (`VOTES`); the verdict's label must lie in
-    the intersection of the sets of all votes cast; (2) it must be named by at least one
-    vote (an exclusion such as "not_chaotic" and "not_periodic" alone does not make a
-    "quasiperiodic"); (3) otherwise — no vote, disagreement, or more than one label left —
-    the label is "undetermined" and `reasons` says why. For "periodic", the periods the
-    methods report (`periods`, by evidence name) must agree: a section's period is taken
-    as exact and a spectral period must divide it (weak subharmonics may be missed by the
-    spectrum); any other disagreement makes the verdict undetermined.
+    The label must lie in every cast vote's set of `VOTES` and be named by at least one vote
+    (exclusions alone do not make a label); else, or with no vote or several labels left,
+    it is "undetermined" and `reasons` says why. A "periodic" verdict takes the section's
+    period (`periods`, by evidence name); a spectral period must divide it (the spectrum may
+    miss weak subharmonics); any other disagreement is undetermined.
     """
     evidence = tuple(evidence)
     label, period, why = _label(evidence, periods or {})

@@ -15,9 +15,8 @@ __all__ = ["ZeroOneResult", "zero_one_test"]
 
 @dataclass(frozen=True)
 class ZeroOneResult:
-    """Result of `zero_one_test`. ``oversampled`` is Matthews' z1test heuristic: the series
-    moves little per sample, or K_c differs strongly between small and large c (subsample
-    and run again)."""
+    """Result of `zero_one_test`. ``oversampled``: Matthews' z1test heuristic (little motion per
+    sample, or K_c far apart for small and large c): subsample and run again."""
 
     k: float  # median of K_c: near 1 chaotic, near 0 regular; NaN when not run (`message`)
     k_c: np.ndarray  # K_c for each c
@@ -70,8 +69,7 @@ def zero_one_test(
     seed : int
         Seed of the c draws (results are reproducible).
     min_length : int
-        Below this many samples (at least 4) the test is not run (K is NaN and `message`
-        says why).
+        Fewest samples (at least 4) for the test to run (else K is NaN, `message` says why).
 
     Returns
     -------
@@ -82,13 +80,10 @@ def zero_one_test(
     Reference: G. A. Gottwald and I. Melbourne, "On the implementation of the 0–1 test for
     chaos", SIAM J. Appl. Dyn. Syst. 8 (2009) 129–145.
 
-    Limits: the test needs N of the order of 1000 to separate 0 from 1 cleanly (a few
-    hundred give K values that scatter by ±0.1–0.2); quasiperiodic signals give K -> 0
-    only slowly with N. For a flow sampled finely (oversampled) the successive φ_j are
-    strongly correlated and a chaotic flow can look regular: subsample first, to a few
-    samples per mean period (for a forced system, a few per forcing period), and check
-    `oversampled`. All M_c(n) are obtained at once through FFT correlations, so the cost
-    is O(n_c N log N).
+    Limits: N ~ 1000 separates 0 from 1 cleanly (a few hundred scatter K by ±0.1–0.2);
+    quasiperiodic signals give K -> 0 only slowly with N. An oversampled flow can look
+    regular: subsample to a few samples per mean (or forcing) period and check
+    `oversampled`. FFT correlations give all M_c(n) at once: cost O(n_c N log N).
     """
     phi = as_series(x)
     check_settings(

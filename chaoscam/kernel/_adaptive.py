@@ -1,26 +1,21 @@
 """Adaptive, event-driven Dormand–Prince 8(5,3) with located impacts: the fast path.
 
-The model and call signature of :func:`._rk4.run_chunk`; what differs is how time is cut:
+The model and call of :func:`._rk4.run_chunk`, time cut differently:
 
 - **Steps**: DOP853 (Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I*, 2nd
-  ed., sec. II.10; :mod:`._dop853`) with the usual error control. Eighth order because the
-  barely damped contact oscillation (period ~1e-4 s) must be followed to ~1e-11 relative.
-- **In flight** (gap > 0) a step integrates the free pendulum ``J theta'' = -(m g l/2) cos
-  theta``, so its interpolant is exact up to the crossing; steps longer than the gap provably
-  stays open (:func:`._physics.safe_horizon`) are cut to ``dt``. **In contact**, (1)–(3)
-  resolved only as finely as the tolerance asks.
-- **Events**: a sign change of the gap over a step is located by Illinois regula falsi on the
-  step's Hermite interpolant to ``event_tol``; the state there is a DOP853 step of that length
-  and the impact law (4)–(5) applies as in the reference. Where the gap rate turns without a
-  sign change (a graze or chattering micro-flight) the turning point is searched first; two
-  turns in one step are not looked for.
+  ed., sec. II.10; :mod:`._dop853`), eighth order for the barely damped contact oscillation
+  (period ~1e-4 s) to ~1e-11 relative. **In flight** the free pendulum ``J theta'' = -(m g l/2)
+  cos theta`` (its interpolant exact up to the crossing; steps beyond
+  :func:`._physics.safe_horizon` cut to ``dt``); **in contact** (1)–(3).
+- **Events**: a gap sign change located by Illinois regula falsi on the step's Hermite
+  interpolant to ``event_tol``, the state there a DOP853 step of that length, the impact law
+  (4)–(5) as in the reference; a turn of the gap rate (graze, micro-flight) searched first, two
+  turns in one step not looked for.
 - **Tangent**: RK4 substeps of ``V' = A V`` along each accepted step (:func:`advance_tangent`),
-  split at events, where the saltation matrix applies. Clock and schedule as in the reference;
-  series samples come from the interpolant, so a series never changes the trajectory.
+  split at events (saltation). Series samples come from the interpolant: no change of the run.
 
-Chattering guard: at most ``max_events_per_step`` events in one grid interval ``[n dt, (n + 1)
-dt)``, later sign changes there stepped over (``I_CHATTER``). The contact fraction is integrated
-in time (``Y_RECORDED``, ``Y_CONTACT``).
+Chattering guard: at most ``max_events_per_step`` events in one grid interval, later sign
+changes there stepped over (``I_CHATTER``). The contact fraction is integrated in time.
 
 Accuracy (``benchmarks/bench_work_precision.py``): 20 s sections of periodic responses are within
 1e-6 rad of converged RK4 from rtol 1e-8 (omega = 45 rad/s) or 1e-5 (xi = 0.2). Limit: with v_min
@@ -60,11 +55,10 @@ MAX_EVENT_GROWTH = 60  # doublings of an event step's overshoot (2^60 event tole
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def locate_on_interpolant(h, th, tr, co, s_lo, g_lo, s_hi, g_hi, c):
-    """The fraction s in (s_lo, s_hi] of the step where the gap changes sign on the interpolant
-    ``co`` (g_lo, g_hi: the gap at the bracket's ends; s_lo > 0 for a micro-flight from the
-    surface, bracketed from its top): Illinois regula falsi on ``s -> delta(t + s h,
-    theta(s))``, bisecting when a pass fails to halve the bracket, to ``event_tol / h``. ``tr``:
-    the step's trigonometric base (``trig_at``). Returns the bracket's end past the crossing."""
+    """The fraction s in (s_lo, s_hi] of the step where the gap (g_lo, g_hi at the ends) changes
+    sign on the interpolant ``co``: Illinois regula falsi on ``s -> delta(t + s h, theta(s))``,
+    bisecting when a pass fails to halve the bracket, to ``event_tol / h``; ``tr``: ``trig_at``'s
+    base. Returns the bracket's end past the crossing."""
     sgn = 1.0 if g_lo > 0.0 else -1.0  # work on sgn * delta, positive at the start
     a, fa, b, fb = s_lo, sgn * g_lo, s_hi, sgn * g_hi
     tol = c[k.C_EVENT_TOL] / h
@@ -103,12 +97,10 @@ def turning_point(h, th, tr, co, rate0, rate1, c):
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side):
-    """With the tangent on, carry it over the accepted step [t, t + s_end h_step] from (th, om)
-    to (th1, om1), inner points from the interpolant ``co``: RK4 substeps of V' = A V
-    (:func:`._tangent.rk4_tangent_along`) with ``h_sub |A| <= TANGENT_STEP_RATE``, |A| the
-    largest at the step's start, middle and end (one substep per DOP853 step would bias lambda_1
-    of the default model to about -22 1/s). The first substep's Jacobian is taken on
-    ``side_first`` (a step from the surface), the others on ``side``."""
+    """Carry the tangent (when on) over the accepted step from (th, om) to (th1, om1), inner
+    points from the interpolant ``co``: RK4 substeps of V' = A V with ``h_sub |A| <=
+    TANGENT_STEP_RATE`` at start, middle and end (one per DOP853 step would bias the default
+    model's lambda_1 to about -22 1/s), the first's Jacobian on ``side_first``, others ``side``."""
     if not steps.tangent_on(t, c):  # off, or in the transient
         return
     _, p0, q0 = ph.acceleration_jacobian(t, th, om, K, c, side_first)
@@ -137,8 +129,7 @@ def advance_tangent(y, c, t, h, th, om, co, s_end, th1, om1, K, side_first, side
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def leave(y, cnt, th, om, t, h, events, window, surface, code, c):
-    """Store all the loop carries (state, time, next step size, event count, surface flags) and
-    return ``code``: a resumed run recomputes the rest the same way, bit-identical."""
+    """Store all the loop carries and return ``code``: a resumed run is bit-identical."""
     y[k.Y_THETA] = th
     y[k.Y_OMEGA] = om
     y[k.Y_TIME] = t
@@ -152,11 +143,8 @@ def leave(y, cnt, th, om, t, h, events, window, surface, code, c):
 
 @njit(cache=True, _nrt=False, error_model="numpy")
 def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
-    """Advance one trajectory from ``y[k.Y_TIME]`` to ``n_stop * dt`` with adaptive steps.
-
-    Arguments, buffers and status codes as :func:`._rk4.run_chunk`; ``cnt[k.I_STEP]`` is the last
-    grid step passed and ``y[k.Y_STEP]`` carries the step size across calls (resumed runs are
-    bit-identical)."""
+    """Advance one trajectory from ``y[Y_TIME]`` to ``n_stop * dt`` with adaptive steps; as
+    :func:`._rk4.run_chunk`, ``cnt[I_STEP]`` the last grid step passed, ``y[Y_STEP]`` the next h."""
     dt = c[k.C_DT]
     t_stop = n_stop * dt
     stride = np.int64(c[k.C_STRIDE])
@@ -195,7 +183,6 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         t_next, is_section, is_resample = steps.next_scheduled(t_stop, cnt, c)
         hs = min(h, c[k.C_H_MAX])
         if flight and hs > dt:
-            # near the cam a long step could hold several crossings: cut to dt
             safe = ph.safe_horizon(max(g, 0.0), l1, cdn, om, c)
             if hs > safe:
                 hs = max(dt, safe)
@@ -256,8 +243,8 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             cnt[k.I_CHATTER] += 1
             crossing = False
         if flight and not crossing and g1 <= 0.0:
-            # A flight step ending in the cam without a located closing (a rebound too weak to
-            # show, or the guard spent) is redone in contact mode, with no hand-back between.
+            # In the cam without a located closing (a weak rebound, the guard spent): redo it in
+            # contact mode, with no hand-back between.
             flight = False
             redo = True
             a1 = accel_trig(tr, om, K, c, flight)
@@ -266,7 +253,6 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
         if crossing:
             s_end = locate_on_interpolant(hs, th, tr, co, s_lo, g_lo, s_hi, g_hi, c)
 
-        # Series samples in (t, t + s_end hs], from the interpolant.
         t_end = t + s_end * hs if crossing else t1
         if stride > 0:
             j = cnt[k.I_SERIES_J]
@@ -291,8 +277,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             side_first = JAC_FLIGHT if flight else JAC_CONTACT
 
         if crossing:
-            # The state at the event: a step of the located length, grown by 2, 4, 8, ...
-            # event tolerances while not yet past the crossing (the interpolant approximates).
+            # The state at the event: the located step, grown 2, 4, 8, ... tolerances until past.
             reach = c[k.C_EVENT_TOL] / hs
             for _ in range(MAX_EVENT_GROWTH):
                 h_event = ph.on_clock(t, s_end * hs)
@@ -324,8 +309,7 @@ def run_chunk_adaptive(y, cnt, c, n_stop, lam, series, section, impacts):
             h = min(h_next, hs)  # the event cut the step: do not grow past it
             continue
 
-        # Accepted whole. theta'' at its end came from direct trigonometry, as a resumed run
-        # computes it; in a changed mode it is evaluated again.
+        # Accepted whole; theta'' at its end (direct trigonometry) is reused if the mode holds.
         step_mode = flight
         advance_tangent(y, c, t, t_end - t, th, om, co, 1.0, th1, om1, K, side_first, side)
         th = th1

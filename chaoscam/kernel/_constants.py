@@ -1,6 +1,5 @@
-"""The kernel's constants vector from a model (:class:`~chaoscam.model.Params`) and its
-numerics (:class:`~chaoscam.numerics.Numerics`): the only bridge from the documented settings to
-the compiled kernels."""
+"""The kernel's constants vector from a model and its numerics: the only bridge from the
+documented settings to the compiled kernels."""
 
 from __future__ import annotations
 
@@ -30,10 +29,8 @@ def kernel_constants(
 
     Parameters
     ----------
-    p : Params
-        The model.
-    num : Numerics
-        The integrator and its settings.
+    p, num : Params, Numerics
+        The model; the integrator and its settings.
     t_record : float
         Outputs (series, section, impacts, contact fraction) are kept from this time [s].
     stride : int
@@ -94,9 +91,8 @@ def initial_state(p: Params) -> np.ndarray:
 
 
 def initial_counters() -> np.ndarray:
-    """The counters (``layout.I_*``) at t = 0: section index 0 (sections are scheduled through
-    the transient, so a realization's steps do not depend on it); series sample and resampling
-    index 1 (index 0 is the initial state)."""
+    """The counters (``layout.I_*``) at t = 0: section index 0 (scheduled through the transient,
+    so the steps do not depend on it); series sample and resampling index 1."""
     cnt = np.zeros(k.N_COUNTERS, dtype=np.int64)
     cnt[k.I_RESAMPLE_J] = 1
     cnt[k.I_SERIES_J] = 1

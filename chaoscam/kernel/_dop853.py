@@ -1,11 +1,10 @@
 """One step of Dormand and Prince's explicit Runge–Kutta 8(5,3) (DOP853), and its interpolant.
 
 Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I* (2nd ed., Springer 1993),
-sec. II.10: 12 stages, order 8, an error estimate combining embedded 5th- and 3rd-order
-solutions. Coefficients as in ``scipy/integrate/_ivp/dop853_coefficients.py``, the stages written
-out without the tableau's zeros (the GPU cannot allocate small arrays); for theta'' = a(t, theta,
-theta') the stage derivatives are (w_i, a_i). Between a step's ends the solution is
-Hermite-interpolated (:func:`theta_at`, :func:`omega_at`) for event location and series samples.
+sec. II.10: 12 stages, order 8, error from embedded 5th- and 3rd-order solutions. Coefficients of
+``scipy/integrate/_ivp/dop853_coefficients.py``, the stages written out without the zeros (the
+GPU cannot allocate small arrays); for theta'' = a(t, theta, theta') the stage derivatives are
+(w_i, a_i). Between a step's ends, Hermite interpolants (:func:`theta_at`, :func:`omega_at`).
 """
 
 from __future__ import annotations

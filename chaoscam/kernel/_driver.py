@@ -29,8 +29,7 @@ def advance(y, cnt, c, n_stop, lam, series, section, impacts):
 
 @njit(parallel=True, cache=True)
 def run_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
-    """:func:`advance` for each member ``i`` of stacked arrays, in parallel (bit-identical on
-    any thread count)."""
+    """:func:`advance` over stacked members in parallel (bit-identical on any thread count)."""
     for i in prange(y.shape[0]):
         status[i] = advance(y[i], cnt[i], c[i], n_stop, lam[i], series[i], section[i], impacts[i])
 
@@ -65,10 +64,9 @@ def alone_kernel(c: np.ndarray):
 
 
 def fork_safe_threads() -> None:
-    """Choose numba's fork-safe "workqueue" threading layer unless the user chose one
-    (``NUMBA_THREADING_LAYER``, or ``numba.config.THREADING_LAYER`` before the first run): the
-    GNU OpenMP layer aborts a process that forks after using it. The layer is fixed by the first
-    parallel call and by ``numba.get_num_threads``, so those come here first."""
+    """Choose numba's fork-safe "workqueue" threading layer unless the user chose one: the GNU
+    OpenMP layer aborts a process that forks after using it. Call before the first parallel call
+    or ``numba.get_num_threads`` (they fix the layer)."""
     import numba
 
     if "NUMBA_THREADING_LAYER" not in os.environ and numba.config.THREADING_LAYER == "default":
@@ -109,10 +107,9 @@ class StopRequested(Exception):
 
 @contextlib.contextmanager
 def members_on_this_thread(stop: threading.Event | None = None):
-    """Within this context the calling thread runs its members one after another through the
-    nogil call (:func:`alone_kernel`), not on numba's threads, with the same bits: for the
-    sweeps' thread backend (one batch per core; no core waits for another batch's slowest
-    member). ``stop``: once set, the next call raises :class:`StopRequested`."""
+    """Within this context the calling thread runs its members one by one through the nogil call
+    (:func:`alone_kernel`), not numba's threads, with the same bits (the sweeps' thread backend);
+    ``stop``: once set, the next call raises :class:`StopRequested`."""
     before = getattr(_here, "active", False)
     _here.active = True
     try:
@@ -181,9 +178,8 @@ def drive_members(
 
 @contextlib.contextmanager
 def _interrupts_held():
-    """Hold a Ctrl-C (or a SIGTERM handled in Python) that arrives during a launch until it
-    returns, then hand it to the handler in place: inside numba's C callbacks (compiling) a
-    KeyboardInterrupt would be lost ("Exception ignored"). Main thread only."""
+    """Hold a Ctrl-C (or SIGTERM) during a launch for its handler after it (inside numba's C
+    callbacks a KeyboardInterrupt would be lost: "Exception ignored"); main thread only."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return

@@ -27,8 +27,7 @@ MAX_GRAZE_STEPS = 200  # passes of the search for the gap rate's turn at most
 @njit(cache=True, _nrt=False)
 def gap_after(t, th, om, tau, K, c, trig):
     """``(delta, l_1, dC/dt.n, theta_f')`` after one RK4 substep of length tau from (t, th, om)
-    (:func:`._physics.rk4` then :func:`._physics.geometry`, the same bits); ``trig``: ``(cc, sc,
-    ct, st)`` at the start (:func:`._physics.geometry_at`)."""
+    (:func:`._physics.rk4`'s bits); ``trig``: ``(cc, sc, ct, st)`` at the start."""
     cc, sc, ct, st = trig
     th1, om1, c4, s4 = rk4_trig(t, th, om, tau, K, c, cc, sc, ct, st)
     delta, l1, cdn = geometry_trig(c4, s4, math.cos(th1), math.sin(th1), c)
@@ -66,23 +65,15 @@ def illinois_update(a, fa, b, fb, m, fm, side):
 @njit(cache=True, _nrt=False)
 def locate_crossing(t, th, om, a, g_start, h, g_end, K, c, flight, trig):
     """The substep length tau in (a, h] at which the gap delta changes sign: a bracketed search
-    on ``tau -> delta(RK4 substep of length tau)`` (a > 0 for a micro-flight from the surface,
-    bracketed from its top) to the event tolerance ``tol``:
-
-    - the first trial is regula falsi's point (:func:`illinois_point`);
-    - each later one is the root nearest the last trial x of the parabola through the last two
-      trials with the gap rate at x (:func:`model_root`), moved ``PROBE_STEP tol`` towards the
-      bracket's farther end, so that the next trial closes the bracket (3.8 substeps a crossing
-      in chattering, against 17.1 for Illinois regula falsi);
-    - an estimate outside the bracket falls back to regula falsi, and three trials that do not
-      halve the bracket are followed by a bisection;
-    - a trial where delta is 0.0 to its last bit is the crossing.
-
-    With ``flight`` (a closing from free flight) the substeps are the free pendulum's: a full
-    substep's last stage in the cam would feel the Hertz force of an overshoot ``v event_tol``,
-    differently wherever the bracket ends. Lengths rounded by :func:`._physics.on_clock`;
-    ``trig`` as in :func:`gap_after`. Returns the bracket's right end past the crossing (delta
-    <= 0 there for a closing, >= 0 for an opening), or the trial where delta is 0.0."""
+    on ``tau -> delta(RK4 substep of length tau)`` (a > 0: a micro-flight from the surface) to
+    the event tolerance ``tol``. The first trial is regula falsi's; each later one the root
+    nearest the last trial x of the parabola through the last two with the gap rate at x
+    (:func:`model_root`), moved ``PROBE_STEP tol`` towards the bracket's farther end so that the
+    next closes it (3.8 substeps a crossing in chattering, against 17.1 for Illinois regula
+    falsi); regula falsi for an estimate outside, a bisection after three trials that do not
+    halve the bracket. With ``flight`` (a closing from free flight) the substeps are the free
+    pendulum's (no Hertz force on an overshoot ``v event_tol``). Returns the bracket's end past
+    the crossing (delta <= 0 for a closing, >= 0 for an opening), or a trial where delta is 0.0."""
     tol = c[C_EVENT_TOL]
     s = 1.0 if g_start > 0.0 else -1.0  # work on s * delta, positive at the start
     fa, b, fb = s * g_start, h, s * g_end
@@ -135,8 +126,7 @@ def model_root(x, fx, dx, xp, fp):
 
 @njit(cache=True, _nrt=False)
 def _gap_at(t, th, om, m, K, c, flight, trig, s):
-    """``s`` times the gap and its rate ``l_1 theta' - dC/dt.n`` after a substep of length m
-    from (t, th, om): the free pendulum's, or the full equations' (:func:`gap_after`)."""
+    """``s`` times the gap and its rate ``l_1 theta' - dC/dt.n`` after a substep of length m."""
     if flight:
         th1, om1 = rk4_flight(th, om, m, c)
         delta, l1, cdn = geometry(t + m, th1, c)
@@ -151,10 +141,9 @@ ON_SURFACE = 1e-300
 
 @njit(cache=True, _nrt=False)
 def graze_point(t, th, om, h, rate0, rate1, K, c, trig):
-    """The substep length tau in (0, h) at which the gap rate l_1 theta' - dC/dt.n turns:
-    Illinois regula falsi on ``tau -> rate(RK4 substep of length tau)`` to ``GRAZE_TOL`` of the
-    step, where the gap's extremum shows whether it crossed zero and came back (a micro-flight
-    or graze shorter than the step). Lengths rounded by :func:`._physics.on_clock`."""
+    """The substep length tau in (0, h) at which the gap rate l_1 theta' - dC/dt.n turns (where
+    the gap's extremum shows a micro-flight or graze): Illinois regula falsi on ``tau ->
+    rate(RK4 substep of length tau)`` to ``GRAZE_TOL`` of the step."""
     s = 1.0 if rate0 > 0.0 else -1.0  # work on s * rate, positive at 0, negative at h
     a, fa, b, fb = 0.0, s * rate0, h, s * rate1
     side = 0

@@ -1,17 +1,12 @@
-"""Ensembles on an NVIDIA GPU with numba-cuda: one CUDA thread per trajectory.
-
-The kernel is the CPU kernel: numba-cuda compiles an ``@numba.njit`` function for the CUDA target
-when a ``@cuda.jit`` kernel calls it, so :func:`._driver.advance` and either integrator run on
-the GPU from one source. Members run until they end or return ``NEED_BUFFER``, are refilled on
-the host as on the CPU path and relaunched alone; a resumed run is bit-identical.
+"""Ensembles on an NVIDIA GPU with numba-cuda: one CUDA thread per trajectory, running the CPU's
+``@numba.njit`` kernel (:func:`._driver.advance`) from one source, refilled on the host as on
+the CPU path; a resumed run is bit-identical.
 
 Limits: not bit-identical to the CPU (NVVM fuses ``a * b + c``; libdevice's sin/cos/tanh may
-differ in the last bit), and chaotic runs part to O(0.1) over 20 s; sections of the first cam
-period and of periodic runs after a transient agree within ``GPU_TOLERANCE``, and ensemble
-statistics are what a GPU run is for (under ``NUMBA_ENABLE_CUDASIM=1`` bit-identical). One
-thread is slow (a warp's members branch apart), so the device needs thousands of members in
-flight: 33,792 members of 5 s run 11.3x as fast as 2 CPU threads on an H200. numba-cuda is
-imported lazily.
+differ in the last bit; the CUDA simulator is), chaotic runs part to O(0.1) over 20 s; sections
+of the first cam period and of periodic runs after a transient agree within ``GPU_TOLERANCE``;
+ensemble statistics are what it is for. One thread is slow (a warp's members branch apart), so
+thousands must be in flight: 33,792 members of 5 s run 11.3x as fast as 2 CPU threads on an H200.
 """
 
 from __future__ import annotations
@@ -35,17 +30,15 @@ GPU_BATCH = 65_536  # members per device batch: ~19 kB each for 20 s runs, 42 kB
 GPU_TOLERANCE = 1e-6  # rad and rad/s: GPU against CPU sections, first period or periodic
 _BLOCK = 64  # threads per block: 202 registers a thread on an H200 (196 from ptxas 12.9)
 _SMALL_GRID = r".*Grid size \d+ will likely result in GPU under-utilization"
-"""numba-cuda's NumbaPerformanceWarning for a launch of few blocks (with its ANSI codes): a
-small batch is expected, and a sweep would record the warning against every run of it."""
+"""numba-cuda's warning for a launch of few blocks (ANSI codes too): expected of a small batch."""
 _NUMPY_TRAP = (2, 5)  # numba-cuda <= 0.30.4 compiles no kernel under numpy >= 2.5
 DEVICE_LOCK = threading.Lock()
 """Held by each :func:`run_on_gpu` call: a GPU sweep launches its next batch from the driver's
 thread while its labelling thread may extend members on the device; they take turns."""
 
 AUTO_GPU_MIN = 4_096
-"""Fewest members (an ensemble's, or a sweep's runs) that ``"auto"`` runs on a GPU: from 4,096
-0.25-s members an H200 outruns a 16-core CPU; below, ``"auto"`` runs on the CPU (``"gpu"`` runs
-any size)."""
+"""Fewest members (or a sweep's runs) that ``"auto"`` runs on a GPU: from 4,096 0.25-s members
+an H200 outruns a 16-core CPU (``"gpu"`` runs any size)."""
 
 
 class GPUFallbackWarning(RuntimeWarning):
@@ -70,8 +63,7 @@ def by_size(backend: str, members: int) -> str:
 
 
 def runs_on_gpu(backend: str) -> bool:
-    """Whether ``backend`` ("cpu", "gpu" or "auto") runs on a GPU here: "gpu" and "auto" do
-    where :func:`gpu_status` says one can run; otherwise the CPU runs them."""
+    """Whether ``backend`` ("cpu", "gpu", "auto") runs on a GPU here (:func:`gpu_status`)."""
     return backend in ("gpu", "auto") and gpu_status()[0]
 
 
@@ -119,8 +111,7 @@ def _advance_members(y, cnt, c, n_stop, lam, series, section, impacts, status):
 
 
 def _members(cuda, step):
-    """:func:`_advance_members` with ``cuda`` and ``step`` bound as globals (not a closure: the
-    CUDA simulator swaps in its fake ``cuda`` module)."""
+    """``_advance_members`` with ``cuda``, ``step`` as globals (the simulator swaps ``cuda``)."""
     namespace = {"__name__": __name__, "cuda": cuda, "step": step, "k": k}
     code = _advance_members.__code__
     return types.FunctionType(code, namespace, "advance_members")
@@ -194,8 +185,7 @@ def kernel_info(method: int | None = k.METHOD_RK4) -> dict:
 
 
 def _configured(kern, blocks: int):
-    """``kern[blocks, _BLOCK]`` without the low-occupancy warning (:data:`_SMALL_GRID`); any
-    other warning is raised again."""
+    """``kern[blocks, _BLOCK]`` without the low-occupancy warning (:data:`_SMALL_GRID`)."""
     with recorded() as said:
         configured = kern[blocks, _BLOCK]
     for w in said:
@@ -205,12 +195,10 @@ def _configured(kern, blocks: int):
 
 
 def run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts=False):
-    """Run stacked members (arrays as in :func:`chaoscam.simulation.run_batch`) to ``n_stop``
-    on the GPU, one call at a time (:data:`DEVICE_LOCK`). Members whose ``status`` is
-    ``NEED_BUFFER`` run; the others keep their code and rows. Updates ``y``, ``cnt``, ``lam``,
-    ``section``, ``status`` in place, ``impacts`` only with ``keep_impacts`` (else counted).
-    ``hand_back(j, lam_j, n)`` empties member ``j``'s impact rows and returns its draws, the
-    used ones dropped and ``n`` new ones appended."""
+    """Run the stacked members whose ``status`` is ``NEED_BUFFER`` (arrays as in
+    :func:`chaoscam.simulation.run_batch`) to ``n_stop`` on the GPU, one call at a time
+    (:data:`DEVICE_LOCK`), in place (``impacts`` only with ``keep_impacts``, else counted);
+    ``hand_back(j, lam_j, n)`` empties member ``j``'s rows and returns its draws renewed."""
     with DEVICE_LOCK:
         _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, keep_impacts)
 
@@ -235,7 +223,6 @@ def _run_on_gpu(y, cnt, c, n_stop, lam, section, impacts, status, hand_back, kee
     configured = _configured(kern, blocks)
 
     def launch(need: np.ndarray) -> np.ndarray:
-        """Every thread starts; those whose member is done return at once."""
         configured(d_y, d_cnt, d_c, n_stop, d_lam, d_series, d_section, d_impacts, d_status)
         d_status.copy_to_host(status)
         return status[need]

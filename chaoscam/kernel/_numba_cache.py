@@ -1,10 +1,6 @@
-"""numba's on-disk cache, emptied when any source file of a package changes.
-
-numba keys a cached function on its own file's modification time and size only, so a cached
-caller keeps its compiled copy of a callee in another file after that file changes. A package
-whose compiled functions call across files calls :func:`guard` on import, before any is
-compiled or loaded: when a fingerprint of its ``.py`` files, kept beside numba's cache files
-(:func:`cache_folder`), differs, they are removed.
+"""numba's on-disk cache, emptied when any source file of a package changes: numba keys a cached
+function on its own file's time and size only, so a caller would keep a changed callee's old
+copy. :func:`guard`, called on import, removes the cache when the sources' fingerprint differs.
 """
 
 from __future__ import annotations
@@ -14,7 +10,7 @@ import os
 from pathlib import Path
 
 STAMP = "chaoscam-sources.sha256"
-"""The fingerprint's file, in the folder numba caches the package in (:func:`cache_folder`)."""
+"""The fingerprint's file, in :func:`cache_folder`."""
 
 
 def fingerprint(folder: Path) -> str:

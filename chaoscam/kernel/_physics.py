@@ -120,8 +120,7 @@ def geometry(t, th, c):
 
 @njit(cache=True, _nrt=False)
 def geometry_at(t, th, c):
-    """:func:`geometry` and its trigonometry, ``(delta, l_1, dC/dt.n, cc, sc, ct, st)``
-    ((cc, sc) of the cam angle, (ct, st) of theta_f)."""
+    """:func:`geometry` and its trigonometry: ``(delta, l_1, dC/dt.n, cc, sc, ct, st)``."""
     cc, sc = cam_trig(t, c)
     ct, st = math.cos(th), math.sin(th)
     delta, l1, cdn = geometry_trig(cc, sc, ct, st, c)
@@ -237,8 +236,7 @@ def acceleration_jacobian_trig(cc, sc, ct, st, om, K, c, side):
 
 @njit(cache=True, _nrt=False)
 def acceleration_jacobian(t, th, om, K, c, side=JAC_NATURAL):
-    """(theta_f'', d theta_f''/d theta_f, d theta_f''/d theta_f') at (t, th, om) [1/s^2, 1/s],
-    the Jacobian taken on ``side`` of the contact surface (see :func:`_equations`)."""
+    """(theta_f'', d theta_f''/d theta_f, d theta_f''/d theta_f') [1/s^2, 1/s] on ``side``."""
     thc = cam_angle(t, c)
     return acceleration_jacobian_trig(
         math.cos(thc), math.sin(thc), math.cos(th), math.sin(th), om, K, c, side

@@ -1,11 +1,10 @@
 """The RK4 kernel's first compilation on two cores: a second process compiles some callees.
 
-numba compiles :func:`._rk4.run_chunk` once per install (``cache=True``) in one process on one
-core. The first RK4 run of a process whose cache lacks them (:func:`start_once`) starts ``python
--m chaoscam.kernel._precompile``, which compiles the callees the kernel's typing reaches last
-(:func:`_callees`) into numba's cache, where this process's compilation finds them: the same
-machine code, so the same bits. A fresh install's first ``simulate`` on 2 cores takes 14.8 s
-instead of 25.6 s; drifted signatures break nothing (a slow test checks each is a cache hit).
+numba compiles :func:`._rk4.run_chunk` once per install, on one core. The first RK4 run of a
+process whose cache lacks them (:func:`start_once`) starts ``python -m
+chaoscam.kernel._precompile`` to compile the callees typed last (:func:`_callees`) into the cache
+(the same machine code): a fresh install's first ``simulate`` on 2 cores takes 14.8 s, not 25.6
+s. Drifted signatures break nothing (a slow test checks each is a cache hit).
 """
 
 from __future__ import annotations
@@ -37,8 +36,7 @@ def _callees():
 
 
 def _cached(dispatcher) -> bool:
-    """Whether numba's cache holds an index for ``dispatcher`` (numba internals; False where
-    they change)."""
+    """Whether numba's cache holds an index for ``dispatcher`` (internals; False if changed)."""
     try:
         return os.path.exists(dispatcher._cache._cache_file._index_path)
     except AttributeError:

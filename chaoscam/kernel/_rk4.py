@@ -1,24 +1,17 @@
 """Fixed-step RK4 with located impacts: the reference integrator (paper sec. 3).
 
-One call of :func:`run_chunk` advances one trajectory on the grid ``t_n = n dt`` to the end step
-or until an output buffer needs emptying. A grid step is cut into *segments* at the scheduled
-times inside it (sections ``k T``, line-length draws ``j dt_l``) and at located impacts, each
-one RK4 substep, so section points are RK4 states and the grid never shifts.
+On the grid ``t_n = n dt`` a step is cut into *segments*, each one RK4 substep, at the scheduled
+times inside it (sections ``k T``, line-length draws ``j dt_l``) and at located impacts, so
+section points are RK4 states and the grid never shifts. Impacts (paper (4)–(5), MODEL.md): a
+sign change of the gap ``delta`` over a segment is located on ``tau -> delta(RK4 substep of
+length tau)`` to ``event_tol`` (:func:`._events.locate_crossing`), the state taken where
+``delta <= 0``, the impact law applied (:func:`._steps.impact`); a micro-flight or graze
+shorter than a step is found where the gap rate turns (:func:`._events.graze_point`). The gap
+is resolved to ~1e-16 m at any time (:func:`._physics.cam_angle`, :func:`._physics.on_clock`).
 
-Impacts (paper (4)–(5), MODEL.md): where the gap ``delta`` goes from > 0 to <= 0 over a segment,
-the crossing is located on ``tau -> delta(RK4 substep of length tau)`` to ``event_tol``
-(:func:`._events.locate_crossing`), the state taken at the bracket end where ``delta <= 0``, and
-the impact law applied (:func:`._steps.impact`). Two crossings in one segment (a micro-flight
-or graze shorter than a step) are found where the gap rate turns (:func:`._events.graze_point`).
-The gap is resolved to ~1e-16 m at any time: the cam angle is reduced exactly
-(:func:`._physics.cam_angle`) and every substep ends on the double it is stamped with
-(:func:`._physics.on_clock`).
-
-With ``c[C_TANGENT]`` set the tangent is integrated with the state (:mod:`._tangent`), carried
-through each impact by the saltation matrix, written beside each section point as the map's
-Jacobian over the last period and restarted from the identity; the state is the same without.
-Compiled without numba's reference counting (``_nrt=False``; nothing allocates): its atomic
-increments cost 8 % of a regime map's samples (``tests/kernel/test_no_refcount.py`` checks).
+The tangent (:mod:`._tangent`, with ``c[C_TANGENT]``) never changes the state. Compiled without
+numba's reference counting (``_nrt=False``): its atomic increments cost 8 % of a regime map's
+samples (``tests/kernel/test_no_refcount.py`` checks).
 """
 
 from __future__ import annotations
@@ -58,10 +51,9 @@ from ._tangent import rk4_flight_tangent, rk4_tangent_trig
 
 @njit(cache=True, inline="always")
 def step_rk4(t, th, om, h, K, c, y, commit, first, rest, trig):
-    """One RK4 substep of the state and, with the tangent on, of the tangent (Jacobian sides
-    ``first``, ``rest``: :func:`._tangent.rk4_tangent_trig`) from ``trig`` = (cc, sc, ct, st):
-    ``(th, om, v11, v21, v12, v22, div)`` (the tangent stored with ``commit``) and the cam
-    angle's (cos, sin) at ``t + h``."""
+    """One RK4 substep of the state and (tangent on; sides ``first``, ``rest``) the tangent from
+    ``trig`` = (cc, sc, ct, st): ``(th, om, v11, v21, v12, v22, div)``, stored with ``commit``,
+    and the cam angle's (cos, sin) at ``t + h``."""
     cc, sc, ct, st = trig
     if tangent_on(t, c):
         v11, v21, v12, v22 = y[k.Y_J11], y[k.Y_J21], y[k.Y_J12], y[k.Y_J22]
@@ -100,10 +92,9 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     """Advance one trajectory from step ``cnt[I_STEP]`` towards grid step ``n_stop``; returns a
     status code, ``NEED_BUFFER`` asking the driver to empty buffers or add draws.
 
-    ``y`` (``Y_*``, at ``t = cnt[I_STEP] dt``) and ``cnt`` (``I_*``) are updated in place; ``c``:
-    the constants (``C_*``); ``lam``: line-length draws, ``lam[cnt[I_LAM_POS]]`` in use;
-    ``series``, ``section``, ``impacts``: output buffers filled from the row counts in ``cnt``
-    (an ``impacts`` of no rows only counts them)."""
+    ``y`` (``Y_*``) and ``cnt`` (``I_*``) are updated in place; ``c``: the constants (``C_*``);
+    ``lam``: line-length draws, ``lam[cnt[I_LAM_POS]]`` in use; ``series``, ``section``,
+    ``impacts``: buffers filled from ``cnt``'s row counts (``impacts`` of no rows: counted)."""
     h = c[k.C_DT]
     stride = np.int64(c[k.C_STRIDE])
     merge = np.int64(c[k.C_FLIGHT_MERGE])
@@ -118,7 +109,6 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     if not resample_on_impact:
         draws_per_step += np.int64(h / c[k.C_RESAMPLE_DT]) + 2
 
-    # gap, lever arm, dC/dt.n here and their trigonometry (a step's first stage: rk4_trig)
     g, l1, cdn, cc0, sc0, ct0, st0 = geometry_at(cnt[k.I_STEP] * h, th, c)
     # Until grid step safe_n the gap certainly stays open. It and the surface flags are kept in
     # the counters, so a resumed run is bit-identical; whoever changes y must reset it to 0.
@@ -128,7 +118,6 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
     budget = np.int64(c[k.C_CALL_STEPS])  # steps before a hand-back (Ctrl-C is seen between)
     taken = np.int64(0)
     while cnt[k.I_STEP] < n_stop:
-        # Room for one more step's worth of outputs and draws, else hand back to Python.
         taken += 1
         if (
             (budget > 0 and taken > budget)
@@ -142,8 +131,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
 
         n = cnt[k.I_STEP]
         t = n * h
-        # Proven flight over several grid steps: one RK4 step of the free pendulum across
-        # them, ending on the grid and before any scheduled time or series sample.
+        # Proven flight: one free-pendulum RK4 step over grid steps, before anything scheduled.
         m = min(safe_n - n, merge, n_stop - n)
         if m >= 2:
             m = min(m, np.int64((cnt[k.I_SECTION_K] * c[k.C_PERIOD] - t) / h))
@@ -153,7 +141,6 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
         if m >= 2:
             th0 = th
             om0 = om
-            # the block's length as the difference of its stamped ends (see on_clock)
             th, om, _, _, _, _, _ = step_flight(t, th0, om0, (n + m) * h - t, c, y, True)
             stale = True
             cnt[k.I_STEP] = n + m
@@ -178,7 +165,6 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
         t_end = (n + 1) * h
         events = 0
         while t < t_end:
-            # The segment ends at the step's end or at the next scheduled time inside it.
             seg_end, is_section, is_resample = next_scheduled(t_end, cnt, c)
             hs = seg_end - t
             if hs > 0.0 and seg_end <= safe_n * h:
@@ -227,9 +213,8 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                         crossing = g_lo > 0.0
                         closing = crossing
                 elif not crossing and events < max_events and trial_full:
-                    # No sign change, but the gap rate turns: the gap may have crossed zero and
-                    # come back. A chattering micro-flight lasts ~2 xi v / |delta''| (0.1 us at
-                    # v = 1e-6 m/s); unlocated, its jump and saltation (~|delta''| / v) are lost.
+                    # The gap rate turns: a micro-flight of ~2 xi v / |delta''| (0.1 us at v =
+                    # 1e-6 m/s) may lie inside; unlocated, its jump and saltation would be lost.
                     if (rate0 < 0.0 < rate1) if gs > 0.0 else (rate1 < 0.0 < rate0):
                         tau_hi = graze_point(t, th, om, hs, rate0, rate1, K, c, trig0)
                         g_hi, _, _, _ = gap_after(t, th, om, tau_hi, K, c, trig0)
@@ -240,10 +225,9 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                 if crossing and events >= max_events:
                     cnt[k.I_CHATTER] += 1  # chattering: the rest of the step is left as it is
                 elif crossing:
-                    # Go to the crossing (no RK4 step straddles the force's kink). A closing's
-                    # substep is the free pendulum's (no Hertz force from a last stage overshooting
-                    # by v event_tol) where free flight crosses in the bracket too; a micro-flight
-                    # from the surface keeps the full equations (overshoot < 1e-15 m).
+                    # To the crossing: a closing by the free pendulum where it crosses too (no
+                    # Hertz force from a last stage overshooting by v event_tol); a micro-flight
+                    # from the surface by the full equations (overshoot < 1e-15 m).
                     free = False
                     if closing and not on_surface:
                         th_f, _ = rk4_flight(th, om, tau_hi, c)
@@ -280,7 +264,7 @@ def run_chunk(y, cnt, c, n_stop, lam, series, section, impacts):
                     safe_n = np.int64(math.floor((t + safe_horizon(g, l1, cdn, om, c)) / h))
             K = at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c)
 
-        # End of the grid step: checks and outputs. Here g and l1 belong to (t_end, th).
+        # End of the grid step: g and l1 belong to (t_end, th).
         cnt[k.I_STEP] = n + 1
         if not (math.isfinite(th) and math.isfinite(om)):
             return leave(y, cnt, th, om, cnt[k.I_STEP] * h, safe_n, k.NON_FINITE)

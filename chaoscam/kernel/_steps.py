@@ -20,9 +20,8 @@ keeps that section's predecessor inside the span whatever the rounding of ``t_re
 @njit(cache=True, inline="always")
 def tangent_on(t, c):
     """Whether the tangent is carried over a segment (or impact) starting at ``t``: with
-    ``c[C_TANGENT]`` set, from ``TANGENT_LEAD`` periods before the recording. Jacobians are
-    written at recorded sections only, each over the period since the last restart, so skipping
-    the transient changes no recorded bit. The state never depends on the tangent."""
+    ``c[C_TANGENT]``, from ``TANGENT_LEAD`` periods before the recording (Jacobians span one
+    period, so skipping the transient changes no recorded bit)."""
     return c[k.C_TANGENT] > 0.0 and t >= c[k.C_T_RECORD] - TANGENT_LEAD * c[k.C_PERIOD]
 
 
@@ -30,10 +29,9 @@ def tangent_on(t, c):
 def surface_mode(g, rate, surf):
     """(flight, on_surface): the side of a step from gap ``g`` with gap rate ``rate``.
 
-    On the surface (a located crossing, delta = 0 to rounding) the side is the motion's:
-    contact after a plastic closure (``SURFACE_SETTLED`` in ``surf``), else flight when moving
-    out (after a rebound, ``SURFACE_JUMPED``, or a located opening); the rounding's sign would
-    make a zero-length event after each rebound, filling the chattering guard."""
+    On the surface (a located crossing) the side is the motion's: contact after a plastic
+    closure (``SURFACE_SETTLED``), else flight when moving out (``SURFACE_JUMPED``, an opening);
+    the rounding's sign would make a zero-length event after each rebound."""
     jumped = (surf & k.SURFACE_JUMPED) != 0
     settled = (surf & k.SURFACE_SETTLED) != 0
     if g == 0.0 or (jumped and g <= 0.0):
@@ -65,9 +63,8 @@ def next_scheduled(t_limit, cnt, c):
 
 @njit(cache=True, inline="always")
 def at_scheduled(t, th, om, is_section, is_resample, K, lam, cnt, section, y, c):
-    """Record the section point and/or draw the next line length at a scheduled time t; at a
-    section the tangent (the map's Jacobian over the period ending here) is written beside the
-    point and restarted from the identity. Returns the stiffness in use afterwards."""
+    """Record the section point (the tangent beside it, then restarted) and/or draw the next line
+    length at a scheduled time t; returns the stiffness in use afterwards."""
     if is_section:
         if t >= c[k.C_T_RECORD]:
             i = cnt[k.I_N_SECTION]
@@ -115,16 +112,13 @@ def impact(t, th, om, l1, cdn, K, lam, cnt, impacts, y, c):
     """The impact law (4)–(5) at a located closing at (t, th) with lever arm l1 and dC/dt.n.
 
     With approach speed ``v = -(l1 theta' - dC/dt.n)`` > ``v_min`` the angular velocity jumps,
-    ``theta'+ = -xi theta'- + (1 + xi) (dC/dt.n) / l1``. Slower than ``v_chatter`` the closing
-    ends a complete chattering sequence (bounces whose speeds fall by ``xi`` each; Nordmark &
-    Piiroinen 2009, Nonlinear Dyn. 58) and is replaced by its accumulation point, the plastic
-    closure ``theta'+ = (dC/dt.n) / l1``. With the tangent on, a jump multiplies it by its
-    saltation matrix. Each jump after the transient is a row of ``impacts`` (kind macro, micro
-    below ``v_micro``, chatter end), or only counted for a buffer of no rows; a macro impact
-    draws a new line length under ``resample="contact"``, every jump under ``"impact"``.
-    Closings slower than ``v_min`` are counted and left to the compliant force. Returns
-    (theta' after, stiffness in use, the surface flags: ``SURFACE_SETTLED`` after a plastic
-    closure, ``SURFACE_JUMPED`` after a rebound moving out, else 0)."""
+    ``theta'+ = -xi theta'- + (1 + xi) (dC/dt.n) / l1``; below ``v_chatter`` the closing ends a
+    complete chattering sequence (speeds falling by ``xi`` a bounce; Nordmark & Piiroinen 2009,
+    Nonlinear Dyn. 58), replaced by its accumulation point ``theta'+ = (dC/dt.n) / l1``. A jump
+    multiplies the tangent by its saltation matrix, is a row of ``impacts`` after the transient
+    (macro, micro below ``v_micro``, chatter end) and draws a line length (macro under
+    ``resample="contact"``, any under ``"impact"``); slower than ``v_min``: counted, left to
+    the compliant force. Returns (theta' after, stiffness, the surface flags)."""
     rate = l1 * om - cdn
     if not (-rate > c[k.C_VMIN]):
         cnt[k.I_SLOW_CLOSINGS] += 1

@@ -1,12 +1,11 @@
 """Tangent (variational) dynamics of the cam-follower through its impacts.
 
-``V' = A(t) V``, ``A = [[0, 1], [d theta''/d theta, d theta''/d theta']]``, is integrated by the
-*same* RK4 stages as the state (:func:`rk4_tangent_trig`), the state bit-identical to
-:func:`._physics.rk4`'s. Through a located impact V is multiplied by the saltation matrix
-(:func:`saltation`; Müller 1995, Chaos Solitons Fractals 5(9); Leine & Nijmeijer 2004,
-*Dynamics and Bifurcations of Non-smooth Mechanical Systems*, sec. 3.5); contact onset and
-separation need none (the field is continuous there). The same quadrature integrates ``tr A``,
-for Liouville's ``ln |det V| = int tr A dt + sum ln |det S|``.
+``V' = A(t) V``, ``A = [[0, 1], [d theta''/d theta, d theta''/d theta']]``, by the *same* RK4
+stages as the state (bit-identical to :func:`._physics.rk4`'s); through a located impact V is
+multiplied by the saltation matrix (:func:`saltation`; Müller 1995, Chaos Solitons Fractals
+5(9); Leine & Nijmeijer 2004, *Dynamics and Bifurcations of Non-smooth Mechanical Systems*, sec.
+3.5), onset and separation need none (a continuous field). The quadrature integrates ``tr A``
+too, for Liouville's ``ln |det V| = int tr A dt + sum ln |det S|``.
 
 Limits: the flow's tangent, not the derivative of the RK4 grid map. Where chattering ends in
 sticking a stage after a located event dips ~1e-12 m into the cam: the tangent then overstates
@@ -39,10 +38,9 @@ def _column(x, y, h, p1, q1, p2, q2, p3, q3, p4, q4):
 
 @njit(cache=True, _nrt=False)
 def rk4_tangent_trig(t, th, om, h, K, c, v11, v21, v12, v22, first, rest, cc, sc, ct, st):
-    """One RK4 step of the state (exactly :func:`._physics.rk4`'s) and of its tangent matrix V
-    (columns (v11, v21), (v12, v22)): returns ``(th, om, v11, v21, v12, v22, div, cc4, sc4)``,
-    ``div`` the step's quadrature of the divergence. The first stage's Jacobian is taken on
-    side ``first`` of the surface, the others' on ``rest`` (:func:`._physics.rk4_stages`)."""
+    """One RK4 step of the state and its tangent V (columns (v11, v21), (v12, v22)), Jacobian
+    sides ``first``, ``rest`` (:func:`._physics.rk4_stages`): ``(th, om, v11, v21, v12, v22,
+    div, cc4, sc4)``, ``div`` the step's quadrature of the divergence."""
     th1, om1, c4, s4, pq = rk4_stages(t, th, om, h, K, c, cc, sc, ct, st, True, first, rest)
     p1, q1, p2, q2, p3, q3, p4, q4 = pq
     n11, n21 = _column(v11, v21, h, p1, q1, p2, q2, p3, q3, p4, q4)

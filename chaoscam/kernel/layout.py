@@ -98,9 +98,8 @@ IMPACT_CHATTER_END = 2  # closing slower than v_chatter: the chattering's accumu
 IMPACT_KINDS = ("macro", "micro", "chatter_end")  # the names of the codes above, in order
 
 SECTION_NAMES = ("k", "t", "theta_f", "omega_f", "l_lambda")
-# The section buffer's further columns: the Jacobian of the stroboscopic map over the period
-# that ends at this section, d(theta, theta')(t_k) / d(theta, theta')(t_k - T), and the
-# integral of the divergence over that period (NaN when the tangent is not integrated).
+# Further section columns: the stroboscopic map's Jacobian d(theta, theta')(t_k) / d(theta,
+# theta')(t_k - T) and the divergence integrated over that period (NaN without the tangent).
 SECTION_TANGENT_NAMES = ("j11", "j21", "j12", "j22", "div")
 IMPACT_NAMES = ("t", "theta_f", "omega_before", "omega_after", "gap_rate_before", "lever_arm",
                 "l_lambda", "kind")  # fmt: skip
@@ -118,7 +117,6 @@ INV_TWO_PI = 0.15915494309189535
 DEKKER_SPLIT = 134217729.0  # 2^27 + 1: splits a double into two halves of 26 bits (Dekker)
 
 # --- the adaptive path's tangent -----------------------------------------------------------
-# Largest h |A| of an RK4 substep of the tangent along an accepted DOP853 step, |A| the largest
-# of sqrt|d theta''/d theta| and |d theta''/d theta'| at its start, middle and end: 0.02 gives
-# the sticking period-1 multiplier at e = 0.02 m converged to ~2e-4 relative.
+# Largest h |A| of a tangent RK4 substep, |A| = max(sqrt|d theta''/d theta|, |d theta''/d theta'|):
+# 0.02 converges the sticking period-1 multiplier at e = 0.02 m to ~2e-4 relative.
 TANGENT_STEP_RATE = 0.02

@@ -1,12 +1,10 @@
 """One batch of members through the compiled kernel: set up at t = 0 or from a kept copy, run on
-the CPU's threads or a GPU, collected as arrays. A batch's members share ``dt`` and ``omega``;
-each is a pure function of its model, numerics and ``(seed, index)``, whatever the batch.
+the CPU's threads or a GPU, collected as arrays. Members share ``dt`` and ``omega``; each is a
+pure function of its model, numerics and ``(seed, index)``, whatever the batch.
 
-**Continuing bit for bit.** RK4 resumes bit-identically at any hand-back, but its end step cuts
-short a block of proven flight that a longer run takes whole. No block crosses a section, so a
-resumable run stops once more at its last section before the end (:func:`snapshot_step`), keeps
-a copy (:class:`Resume`) and goes on. RK4 only: the adaptive kernel shortens its last step onto
-the end time.
+RK4 resumes bit-identically at any hand-back, but its end step cuts short a block of proven
+flight that a longer run takes whole; no block crosses a section, so a resumable run keeps its
+copy at its last section before the end. Not adaptive: it shortens its last step onto the end.
 """
 
 from __future__ import annotations
@@ -62,8 +60,7 @@ def snapshot_step(num: Numerics, p: Params, n_stop: int) -> int | None:
 
 @dataclass(frozen=True)
 class Resume:
-    """Each member's state at grid step ``step`` (one for all members), from which
-    :func:`chaoscam.extend` continues it; one entry per member, in the solution's order.
+    """Each member's state at grid step ``step``, from which :func:`chaoscam.extend` goes on.
 
     Attributes
     ----------
@@ -72,8 +69,7 @@ class Resume:
     y, cnt, c : ndarray
         State, counters (the buffers' row counts and the draw position zeroed) and constants.
     draws, streams : tuple
-        Each member's line-length draws not yet used and its LineLengthStream after them
-        (copied before use).
+        Each member's unused line-length draws and its LineLengthStream (copied before use).
     kept : dict
         For each output of :data:`OUTPUTS`, each member's rows recorded before ``step``.
     n_impacts, status : ndarray of int
@@ -135,9 +131,8 @@ class Start:
 
 @dataclass
 class Batch:
-    """A finished batch: each member's rows (``kept[name][j]``, the kernel's columns; impacts
-    and series only when kept), final arrays, status, impact count and copy (None unless
-    resumable)."""
+    """A finished batch: each member's rows (``kept[name][j]``, the kernel's columns), final
+    arrays, status, impact count and copy (None unless resumable)."""
 
     first: int
     indices: list[int]
@@ -170,8 +165,7 @@ def _margin(num: Numerics) -> int:
 
 
 def _n_draws(plist, num: Numerics, duration: float, room: int) -> int:
-    """Draws every member of the batch starts with: the most any of its models needs (one
-    per resampling interval of the run, or under impact resampling ``room``)."""
+    """Draws each member starts with: the most any model needs (one per interval, or ``room``)."""
 
     def draws(p: Params) -> int:
         return int(duration / p.resample_dt) + 64 if p.resample == "interval" else room
@@ -213,7 +207,6 @@ def resumed(res: Resume, plist, num, duration: float, room, *, series: bool) -> 
     kept = {name: [[r] if len(r) else [] for r in res.kept[name]] for name in OUTPUTS}
     if not series:
         kept["series"] = [[] for _ in range(len(res))]
-    # A member that had ended keeps its code, and is not run.
     status = np.where(res.status == k.OK, k.NEED_BUFFER, res.status)
     return Start(
         res.step, res.y.copy(), res.cnt.copy(), c, lam, streams, kept, res.n_impacts.copy(),
@@ -312,9 +305,8 @@ def _copy(step, y, cnt, c, lam, streams, kept, n_impacts, status) -> Resume:
 
 
 def run_on_cpu(y, cnt, c, n_stop, lam, series, section, impacts, status, hand_back) -> None:
-    """The members whose ``status`` is ``NEED_BUFFER`` through the driver's loop
-    (:func:`chaoscam.kernel.drive_members`), refilled as they ask: on the calling thread for one
-    member or inside :func:`chaoscam.kernel.members_on_this_thread`, else on numba's threads."""
+    """The members whose ``status`` is ``NEED_BUFFER`` through ``kernel.drive_members``:
+    on this thread for one member or in ``members_on_this_thread``, else on numba's threads."""
     if on_this_thread() or y.shape[0] == 1:
         launch = _one_by_one(y, cnt, c, n_stop, lam, series, section, impacts, status)
     else:

@@ -1,11 +1,8 @@
 """Memory and time of a job, estimated before it starts: refuse what cannot fit, warn about hours.
 
-Coarse upper-side guesses that catch absurd requests (a duration of 1e9 s, a series sampled every
-microsecond for minutes, adaptive steps shrunk to picoseconds by a tiny inertia), not
-predictions: memory at 8 bytes per number kept, time per step and series row over the workers,
-adaptive at least :func:`adaptive_seconds`. A job past the memory available is refused (a
-:class:`~chaoscam.model.ParameterError` naming the setting to reduce), one past
-:data:`WARN_SECONDS` warned about; one run is judged by :func:`check_run`.
+Coarse upper-side guesses that catch absurd requests (a duration of 1e9 s, a series every
+microsecond for minutes, picosecond adaptive steps from a tiny inertia), not predictions: 8 bytes
+per number kept, time per step and series row over the workers, adaptive :func:`adaptive_seconds`.
 """
 
 from __future__ import annotations
@@ -72,9 +69,8 @@ def estimate(
 
 
 def persistent_contact(params) -> bool:
-    """Whether gravity holds the follower on the cam: m g l / (2 J) >= e omega^2 / l_1, the
-    rod's angular acceleration from gravity against the largest the cam asks of it (at the
-    initial contact's lever arm)."""
+    """Whether gravity holds the follower on the cam: m g l / (2 J) >= e omega^2 / l_1 (gravity's
+    angular acceleration against the cam's largest, at the initial contact's lever arm)."""
     from ..model import contact_angle, lever_arm
 
     l1 = float(lever_arm(params, 0.0, contact_angle(params, 0.0)))
@@ -112,9 +108,8 @@ def run_seconds(params, num, duration: float, series_rows: float = 0.0) -> float
 
 
 def _costs(params, num, duration: float, series_rows: float = 0.0):
-    """One run's times [s], (steps and series rows, adaptive steps following the contact), and
-    (the least number of steps it takes, why, what shortens it): steps of dt, adaptive steps of
-    at most h_max, a step cut at every interval resampling."""
+    """One run's times [s] (grid steps and series rows; adaptive steps in contact) and (the least
+    number of steps it takes, why, what shortens it)."""
     duration = float(duration)
     found = [(duration / num.dt, f"steps of dt = {num.dt:g} s", "raise dt")]
     adaptive = num.integrator == "adaptive"
@@ -182,8 +177,8 @@ def human_seconds(s: float) -> str:
 
 
 def check_budget(job: JobEstimate, *, what: str, reduce: str, run: tuple | None = None) -> None:
-    """Refuse a job that cannot fit in memory, judge one run of it (:func:`check_run`), warn
-    about a job that will take hours (unless its run was warned about already).
+    """Refuse (ParameterError) a job that cannot fit in memory, judge one run of it
+    (:func:`check_run`), warn about one past :data:`WARN_SECONDS` (unless its run was warned).
 
     Parameters
     ----------

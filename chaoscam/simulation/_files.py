@@ -59,8 +59,7 @@ def read_trajectory(path: str | Path, *, need_data: bool = True):
 
 
 def _check_finite(path: Path, status: Status, tables) -> None:
-    """Refuse NaN or infinite times and states of a run that ended normally (chaoscam writes
-    none)."""
+    """Refuse NaN or infinite times or states of a normally ended run (chaoscam writes none)."""
     if status is not Status.OK:
         return  # a run that diverged may end on a non-finite state
     for name, table in tables:

@@ -1,11 +1,9 @@
 """An independent reference path on ``scipy.integrate.solve_ivp`` with events, for the tests'
-cross-checks of the compiled kernel: slow (numpy right-hand side, DOP853 at tight tolerances)
-and sharing no code with it; :mod:`chaoscam.model`'s functions and the kernel's impact rule.
+cross-checks of the compiled kernel: slow (numpy right-hand side, DOP853 at tight tolerances),
+sharing no code with it but :mod:`chaoscam.model`'s functions and the kernel's impact rule.
 
-Piecewise, restarted at every closing and opening so that no solver step straddles an impact:
-in flight a terminal event watches the gap close, in contact one watches it open while the gap's
-maxima are recorded, so a micro-flight inside one solver step is found from its maximum above 0
-and the piece cut back there. A piece from the surface (|gap| < 1e-14 m) takes its start's side.
+Piecewise, restarted at every closing and opening so that no solver step straddles an impact;
+a piece from the surface (|gap| < 1e-14 m) takes its start's side.
 """
 
 from __future__ import annotations
@@ -45,10 +43,9 @@ FLIGHT, CONTACT = "flight", "contact"
 to the next opening, or back to the first gap maximum above 0 (a micro-flight inside a step)."""
 
 NEAR_STEP = 1.0 / 8.0
-"""The solver's longest step near the cam, as a fraction of the contact oscillation's period:
-the error control alone can step over a contact (a flight's 8.5 ms first step misses a 37 µs
-micro-flight). In contact no step is longer, so a gap maximum shows between two step ends; in
-flight a piece provably cannot close (:func:`_open_for`) or is one such step."""
+"""The solver's longest step near the cam [contact periods]: the error control alone steps over
+a contact (a flight's 8.5 ms first step misses a 37 µs micro-flight). In contact a gap maximum
+thus shows between step ends; in flight a piece cannot close (:func:`_open_for`) or is one step."""
 
 _ON_SURFACE = {"gap": 1e-14, "rate": 1e-12}
 """|value| [m, m/s] below which a piece starts on the event's surface, where the event takes the
@@ -76,8 +73,7 @@ def _events(p: Params, phase: str, t_start: float) -> list:
 
     if phase == FLIGHT:
         return [armed("closing", gap_at, -1.0, 1.0)]
-    # In contact maxima are only recorded (a restart at each would start the solver thousands
-    # of times from its interpolant); the piece is cut back to the first above 0 afterwards.
+    # maxima only recorded: a restart at each would restart the solver thousands of times
     return [armed("opening", gap_at, 1.0, -1.0),
             armed("maximum", rate_at, -1.0, -1.0, terminal=False)]  # fmt: skip
 

@@ -1,6 +1,5 @@
-"""The result of :func:`chaoscam.solve`: the members' sections, impacts, series and statuses
-with the settings that made them, one type for one run and an ensemble (tidy tables with a
-``member`` column; the one-member conveniences read a solution of one member)."""
+"""The result of :func:`chaoscam.solve`, one type for one run and an ensemble: the members'
+sections, impacts, series and statuses (tidy, with a ``member`` column) and their settings."""
 
 from __future__ import annotations
 
@@ -87,7 +86,6 @@ class Solution:
     def __getitem__(self, member: int) -> Solution:
         return self.select([member])
 
-    # --- the model(s) ---------------------------------------------------------------------
     @property
     def params(self) -> Params:
         """The model of every member (a ValueError when members have different models)."""
@@ -96,7 +94,6 @@ class Solution:
             raise ValueError("the members have different models: see Solution.models")
         return first
 
-    # --- one member's view ----------------------------------------------------------------
     def _only(self, what: str) -> int:
         if len(self) != 1:
             raise ValueError(
@@ -185,7 +182,6 @@ class Solution:
             f"section points: {len(self.sections)}"
         )
 
-    # --- selection and files --------------------------------------------------------------
     def select(self, picks) -> Solution:
         """Members ``picks`` (their ``member`` numbers), renumbered 0, 1, ... in that order."""
         import pandas as pd

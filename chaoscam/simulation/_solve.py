@@ -35,9 +35,8 @@ CPU_BATCH = 1024
 
 
 def check_window(duration, transient, *, dt: float | None = None) -> tuple[float, float]:
-    """The run's time window [s] as floats, checked for every entry point (solve, the
-    exponents, the sweeps): ``duration`` > 0 (at least one step ``dt``), ``transient`` in [0,
-    duration)."""
+    """The run's time window [s] as floats, checked for every entry point: ``duration`` > 0 (at
+    least one step ``dt``), ``transient`` in [0, duration)."""
     if isinstance(duration, bool) or not (
         isinstance(duration, numbers.Real) and math.isfinite(duration) and duration > 0
     ):
@@ -66,9 +65,8 @@ def numerics_arg(numerics: Any) -> Numerics:
 
 
 def split_overrides(p: Params, num: Numerics, overrides: dict, caller) -> tuple[Params, Numerics]:
-    """``overrides`` (an API function's keywords) applied to the model or the numerics by field
-    name; any other keyword is refused with what it was probably meant to be (``duraton`` ->
-    ``duration``, from ``caller``'s keyword-only settings and the fields)."""
+    """``overrides`` (keywords) applied to the model or the numerics by field name; another is
+    refused with what it was probably meant to be (``duraton`` -> ``duration``)."""
     import inspect
 
     from .._util import close_names
@@ -108,8 +106,7 @@ def models_digest(plist: Sequence[Params], num: Numerics) -> str:
 
 
 def _pick_backend(backend: str, members: int) -> tuple[bool, str]:
-    """(use the GPU?, the device in words) for ``backend`` and ``members`` (``"auto"``: the GPU
-    from :data:`AUTO_GPU_MIN` members); warns if "gpu" cannot run."""
+    """(use the GPU?, the device in words) for ``backend`` and ``members``; warns if "gpu" can't."""
     if backend not in BACKENDS:
         raise ValueError(
             f"backend must be one of {', '.join(map(repr, BACKENDS))}, got {backend!r}"
@@ -126,8 +123,7 @@ def _pick_backend(backend: str, members: int) -> tuple[bool, str]:
 
 
 def _check_request(p, num, duration, transient, series, output_dt, members) -> None:
-    """Refuse a request that cannot fit in memory; judge one run by its time too (refused past
-    hours, warned about past a minute)."""
+    """Refuse a request that cannot fit in memory; judge one run by its time (:func:`check_run`)."""
     one = estimate(p, num, duration=duration, transient=transient, series=series,
                    output_dt=output_dt)  # fmt: skip
     if members > 1:
@@ -245,10 +241,9 @@ def _models(params, numerics, indices) -> tuple[Params, list[Params], Numerics]:
 
 
 def _run(plist, num, indices, start, settings: dict, progress, resumable) -> Solution:
-    """The members run in batches of ``settings["batch"]`` on its backend, each from
-    ``start(chunk, room)`` through :func:`run_batch` (``progress`` told after each), as one
-    Solution. ``threads``: numba's thread count, 1 for one member (which ran on the calling
-    thread: asking numba would fix its threading layer for every single run)."""
+    """The members in batches of ``settings["batch"]``, each from ``start(chunk, room)`` through
+    :func:`run_batch`, as one Solution; ``threads`` 1 for one member (asking numba would fix its
+    threading layer)."""
     t0, parts = time.perf_counter(), []
     gpu, batch, duration = settings["backend"] == "gpu", settings["batch"], settings["duration"]
     room = ROOM["gpu" if gpu else "cpu"]
@@ -268,10 +263,9 @@ def extend(
     solution: Solution, duration: float, *, members=None, series: bool | None = None,
     resumable: bool = False, backend: str | None = None, progress=None,
 ) -> Solution:  # fmt: skip
-    """Members of ``solution`` made ``duration`` seconds long, bit-identical to runs made that
-    long from t = 0: each goes on from the copy ``solution.resume`` keeps (``resumable=True``,
-    RK4) at its last section time before the end; without a copy (the adaptive integrator, a
-    run not kept resumable, one read from a file) the members run again from t = 0.
+    """Members of ``solution`` made ``duration`` seconds long, bit-identical to runs that long
+    from t = 0: continued from ``solution.resume``'s copy (``resumable=True``, RK4), else (the
+    adaptive integrator, a run not resumable or read from a file) run again from t = 0.
 
     Parameters
     ----------
@@ -280,8 +274,7 @@ def extend(
     duration : float
         The new end time [s], at least that of ``solution``.
     members : sequence of int, optional
-        Which members (``member`` numbers), renumbered 0, 1, ... in this order (``index`` keeps
-        their realization); default all.
+        Which members (default all), renumbered 0, 1, ... in this order (``index`` kept).
     series : bool, optional
         Keep the time series (default: as the solution did; one that kept none cannot gain one).
     resumable : bool

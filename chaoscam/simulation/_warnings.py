@@ -1,6 +1,5 @@
-"""The warnings a run gets before it starts (settings that run but do not do what they say):
-:func:`chaoscam.solve` raises them as ``RuntimeWarning``, the sweeps keep them in each
-realization's ``warnings`` column."""
+"""The warnings a run gets before it starts: :func:`chaoscam.solve` raises them as
+``RuntimeWarning``, the sweeps keep them in each realization's ``warnings`` column."""
 
 from __future__ import annotations
 
@@ -30,10 +29,8 @@ def resolution_warning(p: Params, num: Numerics) -> str | None:
 
 
 def ignored_sigma_warning(p: Params) -> str | None:
-    """The warning for a line-length spread that cannot act, or None: the fractal joint's
-    K_n (MODEL.md (15)/(17)) does not depend on the line length, so with
-    ``stiffness="fractal"`` a positive ``l_lambda_sigma`` is drawn and recorded but changes
-    nothing in the motion."""
+    """The warning for a line-length spread that cannot act, or None: the fractal joint's K_n
+    (MODEL.md (15)/(17)) does not depend on the line length, so its ``l_lambda_sigma`` is idle."""
     if p.stiffness != "fractal" or p.l_lambda_sigma == 0.0:
         return None
     return (
@@ -44,6 +41,5 @@ def ignored_sigma_warning(p: Params) -> str | None:
 
 
 def run_warnings(p: Params, num: Numerics) -> list[str]:
-    """Every warning a run of ``p`` gets before it starts (:func:`resolution_warning`,
-    :func:`ignored_sigma_warning`)."""
+    """The warnings of :func:`resolution_warning` and :func:`ignored_sigma_warning` for ``p``."""
     return [w for w in (resolution_warning(p, num), ignored_sigma_warning(p)) if w]

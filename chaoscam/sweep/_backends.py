@@ -25,8 +25,7 @@ class BackendLost(RuntimeError):
 
 
 WORKERS_PER_CORE = 4
-"""Most local workers per core a sweep accepts: more only compete for the cores, and each
-holds a run in memory."""
+"""Most local workers per core: more only compete for the cores, each holding a run in memory."""
 
 
 def local_workers(workers: int | None) -> int:
@@ -80,10 +79,9 @@ class SerialBackend:
 
 
 class ThreadBackend:
-    """Tasks on ``workers`` threads, each running its members one after another through the
-    compiled call without the GIL (:func:`chaoscam.kernel.members_on_this_thread`): a slow
-    member delays only its own thread, as a ``prange`` launch over a batch would not.
-    ``cancel`` stops the running tasks between two compiled calls."""
+    """Tasks on ``workers`` threads, each running its members one by one without the GIL
+    (:func:`chaoscam.kernel.members_on_this_thread`): a slow member delays only its own
+    thread. ``cancel`` stops the running tasks between two compiled calls."""
 
     def __init__(self, workers: int, prefix: str = "chaoscam-batch") -> None:
         self.workers = int(workers)
@@ -116,10 +114,9 @@ class ThreadBackend:
 
 
 class DaskBackend:
-    """Tasks on Dask: ``scheduler`` ``"tcp://HOST:PORT"``, a connected ``Client`` (left open),
-    or None / ``"local"`` for a ``LocalCluster`` of ``workers`` single-thread processes on
-    127.0.0.1. Dask reschedules a lost worker's tasks; a lost scheduler, or no worker for
-    :data:`DASK_NO_WORKER_S`, is a :class:`BackendLost`."""
+    """Tasks on Dask: ``scheduler`` ``"tcp://HOST:PORT"``, a ``Client`` (left open), or None /
+    ``"local"`` for a ``LocalCluster`` of ``workers`` one-thread processes on 127.0.0.1; Dask
+    reschedules a lost worker's tasks, a lost scheduler is a :class:`BackendLost`."""
 
     _noticed = False
 
@@ -161,9 +158,8 @@ class DaskBackend:
             raise
 
     def wait_any(self, futures: Iterable[Any], timeout: float | None = None) -> set:
-        """The finished futures (none after ``timeout`` s); with no worker connected, a
-        notice after ``_DASK_NOTICE_S`` and :class:`BackendLost` after
-        :data:`DASK_NO_WORKER_S`; a lost scheduler at once."""
+        """The finished futures (none after ``timeout`` s); :class:`BackendLost` for a lost
+        scheduler, or no worker for :data:`DASK_NO_WORKER_S` (after a notice)."""
         futures = list(futures)
         poll = _DASK_POLL_S if timeout is None else min(_DASK_POLL_S, timeout)
         started = time.monotonic()
@@ -238,9 +234,7 @@ class DaskBackend:
 
 
 def _drop_lost_connection(record) -> bool:
-    """A logging filter dropping what distributed logs when the connection to the scheduler
-    closes ("Failed to reconnect", a closed comm's or a cancelled reconnection's traceback):
-    :meth:`DaskBackend._lost` says it in one line."""
+    """Logging filter: drop distributed's lost-connection noise (``DaskBackend._lost`` says it)."""
     import asyncio
 
     from distributed.comm.core import CommClosedError
@@ -253,8 +247,7 @@ def _drop_lost_connection(record) -> bool:
 
 _CLIENT_CONNECTION_LOGGERS = ("distributed.client", "distributed.batched", "distributed.core",
                               "distributed.comm.tcp", "distributed.utils")  # fmt: skip
-"""The loggers that report a client's connection closing (a filter covers its own logger's
-records only, not its children's)."""
+"""The loggers that report a client's connection closing (a filter misses child loggers)."""
 
 
 def _quiet_lost_connection_log() -> None:
@@ -263,12 +256,10 @@ def _quiet_lost_connection_log() -> None:
 
 
 class PipelineBackend(ThreadBackend):
-    """A local GPU's batches: launched at submission in the driver's thread (numba-cuda's
-    only thread), labelled on one thread with ``threads`` numba threads, so the next launch
-    runs while the last is labelled; the records are the serial backend's, bit for bit."""
+    """A local GPU's batches: launched in the driver's thread (numba-cuda's only one), labelled
+    on one thread with ``threads`` numba threads meanwhile; the serial backend's records."""
 
     def __init__(self, threads: int | None = None) -> None:
-        # the engine keeps 2 x workers tasks in flight: one labelled, one launched
         super().__init__(1, prefix="chaoscam-labels")
         self.threads = threads
 

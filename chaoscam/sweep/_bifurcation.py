@@ -1,9 +1,6 @@
-"""Bifurcation diagrams: stroboscopic section points and the verdict over one parameter.
-
-Paper Figs. 4 and 6 (l_lambda over [0.001, 0.018] m; D over [1.36, 1.56] with the fractal
-stiffness): the follower's angle at the cam period after the transient. Several initial
-conditions per value show coexisting attractors; continuation follows one branch.
-"""
+"""Bifurcation diagrams (paper Figs. 4, 6: l_lambda over [0.001, 0.018] m; D over [1.36, 1.56],
+fractal stiffness): section points after the transient and verdicts over one parameter; several
+initial conditions show coexisting attractors, continuation follows one branch."""
 
 from __future__ import annotations
 
@@ -67,10 +64,9 @@ def read_bifurcation(path: str | Path) -> Bifurcation:
 
 
 def initial_offsets(n: int) -> list[tuple[float, float]]:
-    """Offsets (d theta [rad], omega_f0 [rad/s]) of initial conditions 1 .. n-1: the
-    unscrambled 2-D Halton sequence (bases 2, 3; the bits of ``scipy.stats.qmc.Halton``
-    without importing scipy.stats, about a second) without its origin, mapped onto `IC_BOX`.
-    """
+    """Offsets (d theta [rad], omega_f0 [rad/s]) of initial conditions 1 .. n-1: the unscrambled
+    2-D Halton sequence (bases 2, 3; ``scipy.stats.qmc.Halton``'s bits, without a second of
+    importing scipy.stats) without its origin, mapped onto `IC_BOX`."""
     if whole("n", n, low=0) <= 1:
         return []
     d_theta, omega = IC_BOX
@@ -125,8 +121,7 @@ class _BranchPlan(Plan):
 
 
 def next_state(record: dict[str, Any]) -> list[float] | None:
-    """The state a continued chain's next value starts from: the run's last section point
-    (at cam phase theta_c0), or None for a failed run (the condition's own state is taken)."""
+    """A continued chain's next start: the run's last section point; None for a failed run."""
     sec = record.get("section") or {}
     if record["status"] != "OK" or not sec.get("theta_f"):
         return None
@@ -178,24 +173,21 @@ def bifurcation(
     Parameters
     ----------
     param : str or Axis
-        The swept Params or Numerics field (``l_lambda``, ``D``, ``omega``, ``dt``, ...), or
-        an Axis holding the values too.
+        The swept Params or Numerics field (``l_lambda``, ``D``, ``dt``, ...), or an Axis.
     values : sequence of float or str
         The values, or ``"START:STOP:NUM"`` (ends included); Fig. 4:
         ``bifurcation("l_lambda", "0.001:0.018:69")``.
     base, numerics : Params, Numerics, optional
-        Everything not swept; for Fig. 6 ``Params(stiffness="fractal", G=1e-9)`` (a warning
-        says when ``dt`` is too coarse for it).
+        Not swept; Fig. 6: ``Params(stiffness="fractal", G=1e-9)`` (warned if ``dt`` is coarse).
     seed : int
         Seed of the line-length process; value ``v``, condition ``j`` is solve index
         ``realization_index(v, j)``.
     initial_conditions : int or sequence of (theta_f0, omega_f0)
-        An int n: condition 0 is the base's initial state, 1 .. n-1 spread over `IC_BOX`
-        (:func:`initial_offsets`); or explicit states [rad, rad/s]. A diagram over
-        ``theta_f0`` or ``omega_f0`` takes 1 condition and no continuation.
+        An int n: condition 0 is the base's state, 1 .. n-1 :func:`initial_offsets`; or explicit
+        states [rad, rad/s]. Over ``theta_f0`` or ``omega_f0``: 1 condition, no continuation.
     continuation : bool
-        Start value v+1 of each condition from the last section point of value v (a failed
-        run hands over the condition's own state); only the conditions run in parallel.
+        Start value v+1 of each condition from value v's last section point (after a failed
+        run: the condition's own state); only the conditions run in parallel.
     duration, transient, classify, lyapunov, check_step, extend_to, workers, scheduler, out,
     resume, progress, flush_interval, force, device, fate
         As for :func:`regime_map`; the verdicts go to ``FILE.verdicts.parquet``, and a

@@ -40,8 +40,7 @@ def settings(base, numerics, duration, transient, seed, fate, resume, force, nam
 
 
 def make_judge(classify, lyapunov, check_step, extend_to, labels=True) -> Judge:
-    """The sweep's :class:`~._runs.Judge`: the package's verdict (``classify`` None) or a
-    classifier of one's own."""
+    """The sweep's :class:`~._runs.Judge`, checked: the package's verdict or one's own."""
     lyapunov, check_step = flag("lyapunov", lyapunov), flag("check_step", check_step)
     if classify is not None and not callable(classify):
         raise SweepError(f"classify = {classify!r} must be callable (or None: the default)")
@@ -147,9 +146,8 @@ def _column(records: list[dict], key: str):
 
 
 def record_table(records: list[dict], columns, *, fate: bool = True) -> pd.DataFrame:
-    """One row per record: ``columns`` (a record key, or ``(name, values)``), the fate
-    columns (with ``fate``; None / NaN for a run not continued) and one ``ev_<name>`` column
-    per evidence value (float, NaN when absent, names sorted)."""
+    """One row per record: ``columns`` (keys, or ``(name, values)``), the fate columns (with
+    ``fate``) and an ``ev_<name>`` float column per evidence value (NaN when absent, sorted)."""
     cols = dict(c if isinstance(c, tuple) else (c, _column(records, c)) for c in columns)
     if fate:
         cols["fate"] = [r.get("fate") for r in records]

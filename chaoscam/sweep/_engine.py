@@ -1,8 +1,5 @@
-"""The one engine of every sweep: submit batches, collect records, checkpoint, follow up.
-
-A :class:`Plan` decides from finished records only which tasks follow, so the records are
-the same for any backend, batch size and worker count.
-"""
+"""The one engine of every sweep: submit batches, collect records, checkpoint, follow up; a
+:class:`Plan` decides from finished records only, so they do not depend on backend or batch."""
 
 from __future__ import annotations
 
@@ -29,8 +26,7 @@ from ._runs import Batch, Judge
 from ._store import open_store
 
 STOP_POLL_S = 0.1
-"""How often [s] a sweep on a thread that can be asked to stop (:func:`chaoscam.kernel.stop_on`;
-only the main thread gets Ctrl-C) looks whether it was, while it waits."""
+"""How often [s] a waiting sweep thread looks whether it was asked to stop (``kernel.stop_on``)."""
 
 
 class TaskFailed(RuntimeError):
@@ -47,8 +43,7 @@ class SweepInterrupted(KeyboardInterrupt):
         super().__init__(self.message)
 
     def describe(self, word: str = "interrupted") -> str:
-        """The message, opening with ``word`` (the command line says "terminated" after a
-        SIGTERM) unless a cause stopped the run."""
+        """The message, opening with ``word`` ("terminated" after a SIGTERM) unless a cause."""
         why = word if self.cause is None else f"stopped: {self.cause};"
         if self.checkpoint is None:
             return (
@@ -62,9 +57,8 @@ class SweepInterrupted(KeyboardInterrupt):
 
 
 class Plan:
-    """A sweep's tasks: :meth:`start` yields the first (subclasses define it, ``total``,
-    ``make_task`` and ``keys``), :meth:`on_record` the follow-ups of a finished record. Each
-    key (the record's ``keys`` fields) counts once."""
+    """A sweep's tasks: :meth:`start` yields the first, :meth:`on_record` a finished record's
+    follow-ups (subclasses define ``start``, ``total``, ``keys``); each key counts once."""
 
     keys: tuple[str, ...]
 
@@ -115,8 +109,7 @@ def _next_task(queue: deque, source: Iterator[Any], pack, size: int):
 
 
 def _share(plan: Plan, saved: int, inflight: dict, size: int, spread: int) -> int:
-    """Tasks in the next pack: at most ``size`` and, when ``spread`` packs run at once, the
-    tasks left over twice ``spread`` (guided scheduling: a small sweep keeps every thread busy)."""
+    """Tasks in the next pack: at most ``size``, fewer as they run out (guided scheduling)."""
     if spread <= 1:
         return size
     left = plan.total - saved - sum(len(batch.tasks) for batch in inflight.values())
@@ -135,9 +128,8 @@ def _finished(backend, futures: list) -> set:
 
 
 def execute(plan: Plan, backend, store, eng: Engine, *, progress=False, desc="", spread=1) -> None:
-    """Run ``plan`` on ``backend`` in batches of up to ``eng.size`` tasks (fewer as they run
-    out with ``spread`` > 1 threads), storing every record in ``store``; the records already
-    there are given to the plan first. :class:`SweepInterrupted` on Ctrl-C, after saving."""
+    """Run ``plan`` on ``backend`` in batches, every record into ``store`` (its restored ones
+    given to the plan first); :class:`SweepInterrupted` on Ctrl-C, after saving."""
     store.open()
     for record in store.restored():
         try:
@@ -222,8 +214,7 @@ def run_batch(batch: Batch) -> list[dict[str, Any]]:
 
 
 BATCH_SECONDS = 2.0
-"""Target wall time of one CPU batch [s]: a prompt Ctrl-C and frequent checkpoints, yet
-several members per thread to balance."""
+"""Target wall time of one CPU batch [s]: a prompt Ctrl-C and checkpoints, yet balanced threads."""
 
 MAX_BATCH = 256
 """Members per CPU batch at most (bounds the memory of one compiled call)."""
@@ -297,11 +288,9 @@ RECORD_BYTES = 4096
 
 def plan_engine(judge, device, runs, base, num, duration, transient, workers, scheduler, *,
                 what, reduce, sections, fate=None) -> Engine:  # fmt: skip
-    """The engine of a sweep of ``runs`` runs like ``base`` (``device`` "auto" settled by
-    their number) after the budget check: refused when it cannot fit in memory (a batch per
-    worker, the records, with ``sections`` their points), warned about when it takes hours
-    (the step check doubles, a ``fate`` horizon at most ``fate / duration``) or when the
-    extensions of undetermined runs, which the estimate leaves out, could take far longer."""
+    """The engine of a sweep of ``runs`` runs like ``base``, after the budget check: refused past
+    memory (a batch per worker, the records), warned past hours or where the (unestimated)
+    extensions of undetermined runs could take far longer."""
     from ..simulation import WARN_SECONDS, JobEstimate, check_budget, estimate, human_seconds
     from ._backends import default_workers
 
@@ -378,10 +367,8 @@ def run_plan(plan, eng: Engine, store, *, workers, scheduler, progress: bool, de
 
 def run_sweep(plan: Plan, eng: Engine, cls, config: dict[str, Any], build: Callable, *, out,
               resume, force, flush_interval, workers, scheduler, progress, desc: str):  # fmt: skip
-    """Around a plan: lock the output ``out`` and its companion (None: in memory), open its
-    checkpoint (or read back a finished ``cls`` of the same ``config`` under ``resume``),
-    run the plan, ``build`` the result from the sorted records and write it to ``out``, the
-    checkpoint removed. ``progress`` None: a bar when stderr is a terminal."""
+    """Lock ``out`` and its companion (None: in memory), open the checkpoint (or read back a
+    finished ``cls`` of this ``config`` under ``resume``), run the plan, ``build`` and write."""
     out = None if out is None else Path(out)
     outputs = None if out is None else [out, companion(out, cls._tables[1])]
     if progress is None:
@@ -401,8 +388,7 @@ def run_sweep(plan: Plan, eng: Engine, cls, config: dict[str, Any], build: Calla
                 print(f"already finished: {out} (same configuration); read, nothing run",
                       file=sys.stderr)  # fmt: skip
             return result
-        # Outputs there now are this configuration's (a resumed run's) or --force's; any
-        # other that appears while the plan runs is not replaced at the end.
+        # Outputs there now are this configuration's or --force's; one appearing later is kept.
         replace = force or (out is not None and any(p.exists() for p in outputs))
         try:
             run_plan(plan, eng, store, workers=workers, scheduler=scheduler,
@@ -419,8 +405,7 @@ def run_sweep(plan: Plan, eng: Engine, cls, config: dict[str, Any], build: Calla
                 "cause (free space) and run the same command with --resume",
             ) from None
         except Exception:
-            # A run that finished nothing keeps no checkpoint: it would only block the
-            # corrected command ("holds the checkpoint of an interrupted run").
+            # A run that finished nothing keeps no checkpoint (it would block the fixed command).
             if next(iter(store.records()), None) is None:
                 store.remove()
             raise
@@ -449,8 +434,7 @@ def _finish(plan: Plan, store, out: Path | None, build: Callable, replace: bool)
 
 
 def _unique_sorted(records, keys: tuple[str, ...]) -> list[dict]:
-    """Records sorted by their key, one per key (a duplicate must equal the first, NaN
-    included: compared as JSON)."""
+    """Records sorted by key, one per key (a duplicate must equal the first, as JSON)."""
     seen: dict[tuple, dict] = {}
     for r in records:
         k = tuple(r[f] for f in keys)

@@ -1,7 +1,5 @@
-"""Ensembles: many realizations of one model, each with its section, status and verdict.
-
-Member ``i`` is ``solve(params, numerics, seed=seed, indices=[first + i])`` bit for bit.
-"""
+"""Ensembles: realizations of one model with their sections, statuses and verdicts; member
+``i`` is ``solve(params, numerics, seed=seed, indices=[first + i])`` bit for bit."""
 
 from __future__ import annotations
 

@@ -150,10 +150,9 @@ class Axis:
 
 
 def realization_index(cell: int, index: int) -> int:
-    """The :func:`chaoscam.simulate` index of realization ``index`` of grid cell ``cell``:
-    the Cantor pairing ``(c + i)(c + i + 1)/2 + i``, a bijection onto the non-negative
-    integers, so each (cell, realization) has its own stream whatever the workers, the grid
-    size or how many realizations a cell ends with."""
+    """The :func:`chaoscam.simulate` index of realization ``index`` of grid cell ``cell``: the
+    Cantor pairing ``(c + i)(c + i + 1)/2 + i``, a bijection onto the non-negative integers, so
+    each (cell, realization) has its own stream whatever the workers, grid or cell sizes."""
     try:
         c, i = whole("cell", cell, low=0), whole("index", index, low=0)
     except ParameterError as err:

@@ -1,9 +1,6 @@
-"""Monte Carlo regime maps: a grid of two parameters, N classified realizations per cell.
-
-Paper section 2.5 and Figs. 7-10: over the line length's mean mu (``l_lambda``) and spread
-sigma (``l_lambda_sigma``), each label's fraction per cell with its Wilson interval; any two
-numeric fields can be swept (``omega`` x ``xi``, deterministic: one realization per cell).
-"""
+"""Monte Carlo regime maps (paper sec. 2.5, Figs. 7-10): N classified realizations per cell of a
+grid of two numeric fields (the line length's mean mu ``l_lambda`` and spread sigma
+``l_lambda_sigma``, or ``omega`` x ``xi``), each label's fraction with its Wilson interval."""
 
 from __future__ import annotations
 
@@ -75,9 +72,8 @@ def read_regime_map(path: str | Path) -> RegimeMap:
 
 
 class _RegimePlan(Plan):
-    """Each cell's realizations: ``batch`` first; each time its first n are finished,
-    ``batch`` more while the widest Wilson half-width exceeds ``target`` and n < ``cap`` (a
-    rule on the finished indices only); cells in ``once`` run one."""
+    """Each cell's realizations: ``batch``, then ``batch`` more once its first n finished while
+    its widest Wilson half-width exceeds ``target`` and n < ``cap``; cells in ``once`` run one."""
 
     keys = ("cell", "index")
 
@@ -100,8 +96,7 @@ class _RegimePlan(Plan):
         self.counts[record["cell"]][record["label"]] += 1
 
     def _grow(self, c: int) -> int:
-        """Grow cell ``c``'s target while its finished runs ask for more (finished beyond
-        it: a resumed run had decided so); the target before."""
+        """Grow cell ``c``'s target while its finished runs ask for more; the target before."""
         old = self.n_target[c]
         while self.n_target[c] < self.caps[c] and self.n_done[c] >= self.n_target[c]:
             n = self.n_target[c]
@@ -156,8 +151,8 @@ def regime_map(
     base, numerics : Params, Numerics, optional
         Everything not swept.
     realizations : int, optional
-        N per cell (the first batch under adaptive sampling); default 20 if some cell has a
-        random line length, else 1. A deterministic cell runs once.
+        N per cell (adaptive: the first batch); default 20 where some cell has a random line
+        length, else 1; a deterministic cell runs once.
     seed : int
         Realization ``i`` of cell ``c`` is ``solve(params_c, seed=seed,
         indices=[realization_index(c, i)])``, whatever the backend or interruptions.
@@ -171,10 +166,9 @@ def regime_map(
     lyapunov : bool
         Record each run's tangent spectrum (evidence ``lyapunov_1``, ``lyapunov_1_stderr``,
         ``lyapunov_2`` [1/s]).
-    check_step : bool
-        Judge each run at half the step too (the package's verdict only; twice the cost).
-    extend_to : float or None
-        Longest recorded time [s] an undetermined verdict is extended to.
+    check_step, extend_to : bool, float or None
+        Judge each run at half the step too (the package's verdict; twice the cost); the
+        longest recorded time [s] an undetermined verdict is extended to.
     target_halfwidth, max_realizations : float, int, optional
         Adaptive sampling: ``realizations`` more per cell while its widest Wilson half-width
         exceeds ``target_halfwidth``, up to ``max_realizations`` (default 1000).
@@ -188,19 +182,16 @@ def regime_map(
     resume, force : bool
         Continue an interrupted run of the same configuration (or reuse a finished one);
         start over, replacing the outputs. Otherwise an existing output is an error.
-    progress : bool, optional
-        A progress bar on stderr; default: when stderr is a terminal.
-    flush_interval : float
-        Seconds between checkpoint parts [s].
+    progress, flush_interval : bool or None, float
+        A progress bar on stderr (None: when it is a terminal); the time between checkpoints [s].
     device : {"cpu", "gpu", "auto"}
         ``"cpu"`` is bit-identical everywhere; ``"gpu"`` agrees within ``GPU_TOLERANCE``;
         ``"auto"``: the GPU where one runs, for ``AUTO_GPU_MIN`` runs or more.
     fate : float, optional
-        Horizon [s] > duration to which runs labelled chaotic, quasiperiodic or undetermined
-        are continued, for transient chaos the window cannot see (at (omega, xi) = (42.5
-        rad/s, 0.40): chaotic for 174 s, then out of reach): columns ``fate`` (the status
-        there), ``left_at``, ``fate_label``, ``fate_period`` (the verdict on its last half);
-        per cell ``n_transient``, ``n_settled``, ``settled_period``. Labels are unchanged.
+        Horizon [s] > duration to which chaotic, quasiperiodic or undetermined runs go on, for
+        transient chaos (at (omega, xi) = (42.5 rad/s, 0.40): chaotic for 174 s, then out of
+        reach): columns ``fate`` (status), ``left_at``, ``fate_label``, ``fate_period`` (on its
+        last half); per cell ``n_transient``, ``n_settled``, ``settled_period``; labels kept.
 
     Returns
     -------

@@ -35,8 +35,7 @@ def _field(row: Any, name: str) -> Any:
 
 
 def _sweep_row(sweep: Any, row: Any) -> tuple[dict[str, Any], Any]:
-    """The sweep's ``config`` with its ``kind`` (told by its axes in older files), and
-    ``row`` (a whole number: the table's row at that position)."""
+    """The sweep's ``config`` with its ``kind``, and ``row`` (a number: the table's row)."""
     cfg = getattr(sweep, "config", None)
     kind = None
     if isinstance(cfg, dict):

@@ -1,10 +1,6 @@
-"""The work of a sweep: realizations (:class:`Realization`) solved in batches, judged, kept.
-
-A :class:`Batch` solves its tasks (:meth:`~Batch.launch`), then judges them, continues those
-a ``fate`` horizon asks for and builds the records (:meth:`~Batch.label`); apart, a GPU sweep
-launches its next batch while the host labels the last. A record is a JSON-safe dict, a pure
-function of its task whatever the batch, threads, backend or interruption.
-"""
+"""The work of a sweep: :class:`Realization` tasks solved in batches (:meth:`Batch.launch`),
+judged, continued to a ``fate`` horizon and recorded (:meth:`Batch.label`; a GPU sweep launches
+the next meanwhile). A record is a JSON-safe dict, a pure function of its task."""
 
 from __future__ import annotations
 
@@ -109,10 +105,9 @@ def _spectrum_evidence(v, sol: Solution, i: int) -> dict[str, float]:
 
 
 def classifier_identity(classify: Callable) -> str:
-    """A stable text naming a classifier and its settings: ``module.qualname`` (plus a digest
-    of code, defaults and closure for a lambda or local function, positions left out); a
-    bound method's instance; a ``functools.partial``'s function and arguments; an instance's
-    class and ``repr``."""
+    """A stable text naming a classifier: ``module.qualname`` (a lambda's or local function's
+    with a digest of code, defaults and closure), a bound method's instance, a partial's
+    function and arguments, or an instance's class and ``repr``."""
     if isinstance(classify, type) or not callable(classify):
         raise TypeError(f"classify must be a function or an instance, got {classify!r}")
     if isinstance(classify, functools.partial):  # its own name is functools.partial's
@@ -287,8 +282,7 @@ class Batch:
         return self.label(self.launch())
 
     def launch(self) -> list[tuple[list[int], Solution, list[str]]]:
-        """The first phase: per group, (positions in the batch, solution, warnings); resumable
-        (RK4) where a member may be extended or continued to its fate."""
+        """The first phase: per group, (positions in the batch, solution, warnings)."""
         groups: dict[tuple, list[int]] = {}
         for i, t in enumerate(self.tasks):
             groups.setdefault(t.group(), []).append(i)
@@ -330,8 +324,7 @@ class Batch:
 
 
 def _fates(sol: Solution, later: Sequence[int], fate: float) -> list[dict[str, Any]]:
-    """The fate fields of members ``later`` run on to ``fate`` [s] with the tangent (extended
-    where the judged last half starts after the transient, else solved from t = 0)."""
+    """The fate fields of members ``later`` run on to ``fate`` [s] (extended, or from t = 0)."""
     s = sol.settings
     period = max(p.cam_period for p in sol.models)
     continues = sol.resume is not None and (1.0 - FATE_LATE) * (fate - period) > (
@@ -352,8 +345,7 @@ def _fates(sol: Solution, later: Sequence[int], fate: float) -> list[dict[str, A
 
 
 def _fate_fields(long: Solution, i: int) -> dict[str, Any]:
-    """Member ``i``'s fate: its status, ``left_at`` (NaN if it stayed) and the verdict on the
-    run's last :data:`FATE_LATE` when it stayed."""
+    """Member ``i``'s fate: status, ``left_at`` (NaN if it stayed), verdict on :data:`FATE_LATE`."""
     status = str(long.members["status"].iat[i])
     rows = long.sections["member"].to_numpy() == i
     t = long.sections["t"].to_numpy()[rows]

@@ -167,8 +167,7 @@ def fate_split(rows: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
 
 
 def continued_labels(checked: pd.DataFrame) -> str:
-    """How the continued rows were labelled, for a sentence ("labelled chaotic or
-    undetermined")."""
+    """How the continued rows were labelled, for a sentence ("labelled chaotic or ...")."""
     labels = [x for x in ("chaotic", "quasiperiodic", "undetermined") if x in set(checked["label"])]
     if not labels:
         return "continued"

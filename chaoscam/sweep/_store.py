@@ -94,8 +94,7 @@ def decode_part(data: bytes) -> list[dict[str, Any]]:
 
 
 def remove_leftovers(path: Path) -> None:
-    """Remove the ``.tmp-PID-...`` files and folders beside ``path`` of processes that no
-    longer run (a checkpoint or output being made or removed when killed)."""
+    """Remove the ``.tmp-PID-...`` files and folders beside ``path`` of processes now gone."""
     for left in path.parent.glob(f".tmp-*-{path.name}"):
         pid = left.name.split("-", 2)[1]
         if pid.isdigit() and not _running(int(pid)):
@@ -130,13 +129,10 @@ def discard_checkpoint(path: Path) -> None:
 
 
 class CheckpointStore:
-    """A run's records: part files every ``flush_interval`` seconds (0: one per record) under
-    ``directory`` with a manifest of ``config``, or (``directory`` None) in memory only.
-
-    An existing folder is refused without ``resume``, and of another configuration always.
-    ``replaces``: the outputs this run was asked to replace (``--force``), recorded as they
-    are now (:func:`file_identity`) so that a resume replaces them and no file made since.
-    """
+    """A run's records: part files every ``flush_interval`` s (0: one per record) under
+    ``directory`` with a manifest of ``config``, or in memory (None); an existing folder is
+    refused without ``resume``, of another configuration always. ``replaces``: the outputs
+    ``--force`` replaces, recorded (:func:`file_identity`) so a resume replaces no later file."""
 
     def __init__(self, directory: Path | None, config: dict[str, Any], *, resume: bool,
                  flush_interval: float = 1.0, replaces: tuple[Path, ...] = ()) -> None:  # fmt: skip
@@ -276,9 +272,8 @@ def read_sweep_metadata(path: Path) -> dict[str, Any] | None:
 
 def guard_outputs(outputs: list[Path], config: dict[str, Any], resume: bool) -> bool:
     """Check the outputs before any work; True when a finished run can be reused. Without
-    ``resume`` an existing output is refused; with it, one of the same configuration is
-    reused, one of another refused unless the checkpoint beside it is this configuration's
-    (an interrupted ``--force`` run, whose resume replaces the file it found, no other)."""
+    ``resume`` an existing output is refused; with it, this configuration's is reused, another's
+    refused unless the checkpoint beside is this configuration's (an interrupted ``--force``)."""
     existing = [p for p in outputs if p.exists()]
     if not existing:
         return False
@@ -336,8 +331,7 @@ def _read_manifest(directory: Path) -> dict[str, Any]:
 
 
 def _check_replaced(manifest: dict, existing: list[Path], config: dict[str, Any]) -> None:
-    """Refuse an output the resume would overwrite: neither this configuration's table nor
-    the file the interrupted ``--force`` run recorded."""
+    """Refuse an output neither this configuration's nor recorded by the interrupted --force."""
     replaces = manifest.get("replaces") or {}
     for path in existing:
         meta = read_sweep_metadata(path)
