@@ -14,6 +14,9 @@ class Status(enum.IntEnum):
     NON_FINITE = 3
     PENETRATION = 4
 
+    def __str__(self) -> str:  # print(run.status) names it, as a user reads it
+        return self.name
+
     @property
     def message(self) -> str:
         return _MESSAGES[self]

@@ -222,3 +222,11 @@ def test_the_transient_changes_what_is_kept_not_the_motion(integrator, transient
         a, b = getattr(whole, name), getattr(part, name)
         kept = a[a["t"] >= transient].reset_index(drop=True)
         assert len(b) > 5 and kept.equals(b.reset_index(drop=True)), name
+
+
+def test_a_status_prints_as_its_name():
+    """print(run.status) says OK or LEFT_REACH, not the integer the kernel returned."""
+    from chaoscam.kernel import Status
+
+    assert str(Status.OK) == "OK" and f"{Status.LEFT_REACH}" == "LEFT_REACH"
+    assert int(Status.LEFT_REACH) == 2
