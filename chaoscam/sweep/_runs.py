@@ -360,5 +360,6 @@ def _fate_fields(long: Solution, i: int) -> dict[str, Any]:
         return out
     xy = long.sections[["theta_f", "omega_f"]].to_numpy(dtype=float)[rows][late]
     with quiet():  # a short late window warns like the first run did (on batch threads too)
-        v = judge_points(xy, long.jacobians[rows][late], long.models[i], long.numerics, {})
+        noise = {"seed": int(long.settings["seed"]), "index": int(long.members["index"].iat[i])}
+        v = judge_points(xy, long.jacobians[rows][late], long.models[i], long.numerics, {}, **noise)
     return {**out, "fate_label": v.label, "fate_period": v.period}

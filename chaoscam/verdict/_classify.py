@@ -155,8 +155,9 @@ def _judge_all(sol: Solution, discard: float, options: dict) -> list[Verdict]:
         check_stop()  # before each member: a prompt Ctrl-C
         pick = rows_of.get(m, empty)
         status = Status[sol.members["status"].iat[m]]
+        noise = {"seed": int(sol.settings["seed"]), "index": int(sol.members["index"].iat[m])}
         return judge_member(status, t[pick], kk[pick], xy[pick], sol.jacobians[pick],
-                            sol.models[m], sol.numerics, transient, options)  # fmt: skip
+                            sol.models[m], sol.numerics, transient, options, **noise)  # fmt: skip
 
     order = list(range(len(sol)))
     shoot = [realizations_identical(sol.models[m]) for m in order]
@@ -167,9 +168,11 @@ def _judge_all(sol: Solution, discard: float, options: dict) -> list[Verdict]:
     return [next(done_a) if s else next(done_b) for s in shoot]
 
 
-def judge_member(status, t, kk, xy, jac, p, num, transient: float, options: dict) -> Verdict:
+def judge_member(status, t, kk, xy, jac, p, num, transient: float, options: dict, *,
+                 seed: int = 0, index: int = 0) -> Verdict:  # fmt: skip
     """One member's verdict from its status, section rows (times ``t``, indices ``kk``,
-    points ``xy``) and their Jacobians, recording from ``transient`` [s]."""
+    points ``xy``) and their Jacobians, recording from ``transient`` [s]; realization
+    (``seed``, ``index``) for the common-noise twins."""
     if status is not Status.OK:
         return _status_verdict(status, float(t[-1]) if len(t) else float("nan"))
     period = p.cam_period
@@ -178,13 +181,14 @@ def judge_member(status, t, kk, xy, jac, p, num, transient: float, options: dict
         why = (f"{int(keep.sum())} section point(s) after the transient: too few to judge; "
                "run longer than the transient by several cam periods")  # fmt: skip
         return Verdict("undetermined", None, (), (why,))
-    return judge_points(xy[keep], jac[keep], p, num, options)
+    return judge_points(xy[keep], jac[keep], p, num, options, seed=seed, index=index)
 
 
-def judge_points(points, jacobians, p, num, options: dict) -> Verdict:
+def judge_points(points, jacobians, p, num, options: dict, *, seed: int = 0,
+                 index: int = 0) -> Verdict:  # fmt: skip
     """The verdict on section ``points`` (theta_f, theta_f') and the Jacobians of the periods
-    ending at them (one per point) of a run of model ``p``: the section with the tangent
-    exponent, then the model-level rules."""
+    ending at them (one per point) of realization (``seed``, ``index``) of model ``p``: the
+    section with the tangent exponent, then the model-level rules."""
     period = p.cam_period
     opts = section_options(options)
     opts.setdefault("atol", (MODEL_ATOL, MODEL_ATOL / period))
@@ -200,7 +204,8 @@ def judge_points(points, jacobians, p, num, options: dict) -> Verdict:
                "stderr": [float(x) for x in spec.stderr], "n_periods": spec.n_periods,
                "method": method}  # fmt: skip
     extra = {"tangent": tangent}
-    v = apply_rules(v, Context(p, num.replace(integrator="rk4"), points, extra))
+    ctx = Context(p, num.replace(integrator="rk4"), points, extra, seed, index)
+    v = apply_rules(v, ctx)
     return dataclasses.replace(v, settings={**v.settings, **extra})
 
 

@@ -286,14 +286,14 @@ def test_kicks_certify_a_period_2_the_refined_step_leaves_open():
 
 def test_banded_chaos_names_the_votes_it_outweighs():
     """Fig. 8's run (mu = 8 mm, sigma = 4 mm, seed 7, the paper's 20 s): the section period
-    votes 8 on 8 narrow bands, the exponent chaotic; the evidence of the chaotic verdict says
-    why the periodic votes lose (a reader saw them stand next to it unexplained)."""
+    votes 8 on 8 narrow bands, the common-noise twins separate; the evidence of the chaotic
+    verdict says why the periodic votes lose (a reader saw them stand next to it unexplained)."""
     traj = simulate(
         Params(l_lambda=0.008, l_lambda_sigma=0.004), duration=20.0, transient=10.0, seed=7
     )
     (v,) = classify(traj)
     votes = {e.name: e.vote for e in v.evidence}
-    assert v.label == "chaotic" and votes["exponent"] == "chaotic"
+    assert v.label == "chaotic" and votes["twins"] == "chaotic"
     band = next(e for e in v.evidence if e.name == "banded_chaos")
     named = [n for n, vote in votes.items() if vote in ("periodic", "quasiperiodic")]
     assert named and f"outweighs the {', '.join(named)} vote(s)" in band.detail

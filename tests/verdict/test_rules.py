@@ -19,8 +19,9 @@ from chaoscam.verdict import RULES, _rules, judge_points
 
 def _without(monkeypatch, name):
     """RULES with the rule ``name`` taken out, for the rest of the test."""
-    assert name in [r.name for r in RULES]
-    monkeypatch.setattr(_rules, "RULES", tuple(r for r in RULES if r.name != name))
+    rules = _rules.RULES
+    assert name in [r.name for r in rules]
+    monkeypatch.setattr(_rules, "RULES", tuple(r for r in rules if r.name != name))
 
 
 def _verdict(changes, *, seed=0, index=0, extend_to=None):
@@ -42,12 +43,39 @@ def test_the_rules_apply_in_this_order():
     """Each rule of RULES has its test below, in the order the rules apply, and says what it
     checks."""
     assert [r.name for r in RULES] == [
+        "common_noise_twins",
         "torus_needs_zero_exponent",
         "random_period_needs_contraction",
         "banded_chaos",
         "periodic_orbit",
     ]
     assert all(r.checks and callable(r.apply) for r in RULES)
+
+
+# --- common_noise_twins ----------------------------------------------------------------------
+
+
+def test_common_noise_twins_decide_a_random_line_length(monkeypatch):
+    """xi = 0.525, sigma = 2 mm: 8 narrow bands, the tangent exponent positive or undecided,
+    but twins sharing the draws contract: periodic 8 with its noise width (the random set's
+    truth). sigma = 1.5 mm at l_lambda = 8 mm (seed 1, realization 1; chaotic on a 4x longer
+    run): twins separate, chaotic on the short run. The deterministic model runs no twins.
+    Without the rule: the first is not periodic, the second undetermined."""
+    sticking, bands = (
+        dict(xi=0.525, l_lambda_sigma=0.002),
+        dict(l_lambda=0.008, l_lambda_sigma=0.0015),
+    )
+    v = _verdict(sticking)
+    assert (v.label, v.period, _votes(v)["twins"]) == ("periodic", 8, "not_chaotic")
+    assert (
+        v.settings["noisy"]["band_width"] > 0 and v.settings["twins"]["outcome"] == "synchronised"
+    )
+    chaos = _verdict(bands, seed=1, index=1)
+    assert (chaos.label, _votes(chaos)["twins"]) == ("chaotic", "chaotic")
+    assert "twins" not in _votes(_verdict(dict(xi=0.525)))
+    _without(monkeypatch, "common_noise_twins")
+    assert _verdict(sticking).label != "periodic"
+    assert _verdict(bands, seed=1, index=1).label == "undetermined"
 
 
 # --- torus_needs_zero_exponent ---------------------------------------------------------------
@@ -90,7 +118,9 @@ def test_a_random_line_length_needs_a_contracting_exponent_for_a_period(monkeypa
     tolerance but lambda_1 < 0 not confirmed, and no orbit to certify (the line length is
     random): undetermined, run longer (a longer run is chaotic). xi = 0.2, sigma = 2 mm (the
     labelled set's periodic 1) has lambda_1 < 0 beyond its interval: periodic. Without the
-    rule the 8 bands would be called periodic 8."""
+    rule the 8 bands would be called periodic 8. (The rule is the fallback when the twins are
+    inconclusive: they are taken out here, as they would settle the bands.)"""
+    _without(monkeypatch, "common_noise_twins")
     bands = dict(l_lambda=0.008, l_lambda_sigma=0.0015)
     v = _verdict(bands, seed=1, index=1)
     assert v.label == "undetermined" and _votes(v)["section_period"] == "periodic"
@@ -116,15 +146,18 @@ def test_narrow_bands_with_a_positive_exponent_are_banded_chaos(monkeypatch, cha
     """Fig. 8's run (random line length: no orbit to look for; extended to 40 s recorded) and
     the labelled set's l_lambda = 15 mm (chaotic; no attracting period-n orbit in its bands):
     a positive exponent beyond its interval on narrow bands is n-band chaos, with the
-    banded_chaos evidence. Without the rule: undetermined on the same windows (Fig. 8's
-    section tests decide it only on a longer one)."""
+    banded_chaos evidence. Without the rule (and the twins, which reach Fig. 8's n-band chaos
+    by themselves): undetermined on the same windows (Fig. 8's section tests decide it only on
+    a longer one)."""
     v = _verdict(changes, seed=seed, extend_to=40.0)
-    assert v.label == "chaotic" and _votes(v)["exponent"] == "chaotic"
+    # the stretching: the tangent's (extended run), or the twins' (Fig. 8, on the short run)
+    assert v.label == "chaotic" and "chaotic" in (_votes(v)["exponent"], _votes(v).get("twins"))
     band = next(e for e in v.evidence if e.name == "banded_chaos")
     assert band.vote == "chaotic" and band.value >= 2
     orbit = next(e for e in v.evidence if e.name == "periodic_orbit")
     assert orbit.vote != "periodic"
     _without(monkeypatch, "banded_chaos")
+    _without(monkeypatch, "common_noise_twins")
     assert _verdict(changes, seed=seed, extend_to=40.0).label == "undetermined"
 
 
