@@ -99,6 +99,9 @@ def classify_section(
     * ``section_zero_one``: `zero_one_evidence` on the first coordinate.
     * ``exponent`` (`exponent_evidence`), and ``lyapunov``: > `lyapunov_tol` chaotic, else not.
 
+    A scalar (shape (N,)) has its period and expansion judged on its 3-delay vectors, its
+    rotation by value or by delay pairs (`delays`): a torus seen through cos θ stays a curve.
+
     The votes are combined by `combine`; then a chaotic label needs a chaotic exponent or
     `Thresholds.min_chaotic_votes`, and a quasiperiodic one with a negative exponent (a
     period not found) is undetermined. An "undetermined" verdict says in `reasons` what to run.
