@@ -101,6 +101,33 @@ def test_series_with_section_points(tmp_path, capsys):
     assert out["reasons"] == []  # exact points: nothing to add
 
 
+@pytest.mark.parametrize(
+    ("column", "label", "period"),
+    [
+        ("cos", "quasiperiodic", None),
+        ("angle", "quasiperiodic", None),
+        ("period3", "periodic", 3),
+        ("logistic", "chaotic", None),
+        ("henon_x", "chaotic", None),
+    ],
+)
+def test_series_section_of_one_scalar(tmp_path, capsys, column, label, period):
+    """--section on one column: a golden rotation seen through cos of its angle and through
+    the angle (turns) is quasiperiodic, cos(2πk/3) periodic 3, the logistic map (r = 4) and
+    the Hénon map's x chaotic."""
+    from chaoscam.testsystems import GOLDEN, henon_orbit, logistic_orbit
+
+    k = np.arange(2000)
+    angle = np.mod(GOLDEN * k, 1.0)
+    data = {"cos": np.cos(2 * math.pi * angle), "angle": angle,
+            "period3": np.cos(2 * math.pi * k / 3), "logistic": logistic_orbit(4.0, k.size),
+            "henon_x": henon_orbit(k.size)[:, 0]}  # fmt: skip
+    pd.DataFrame({column: data[column]}).to_csv(tmp_path / "x.csv", index=False)
+    assert main(["classify-series", str(tmp_path / "x.csv"), "--column", column, "--section"]) == 0
+    out = _json(capsys)
+    assert (out["label"], out["period"]) == (label, period), out["reasons"]
+
+
 def test_series_section_with_wide_bands_says_it_is_not_certified(tmp_path, capsys):
     """The default model's section (8 bands up to 8e-4 of the extent, chaotic by its
     tangent exponent) is periodic 8 to the tolerance on points alone: the verdict says it
