@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from fractions import Fraction
 
 import numpy as np
@@ -289,6 +290,8 @@ def section_evidence(
     if pr.message:
         return [Evidence(name, None, None, pr.message)], {}, [f"section: {pr.message}"]
     if pr.period is not None:
+        if states is not z:  # each delay coordinate holds the scalar's bands: report one
+            pr = replace(pr, tolerance=pr.tolerance[:1], jitter=pr.jitter[:1], extent=pr.extent[:1])
         return _periodic_evidence(prefix, pr, rtol, zero_one), {name: pr.period}, []
     ratio = stationarity_ratio(z)
     if math.isfinite(ratio) and not thr.stationary_low <= ratio <= thr.stationary_high:
