@@ -112,7 +112,7 @@ def classify_section(
     points : array_like, shape (N,) or (N, d)
         Section points in time order, after the transient. N >= 8, else "undetermined".
     lyapunov, lyapunov_tol : float
-        A largest exponent per iterate without error bar (optional), and |λ₁| counted as zero.
+        A largest exponent per iterate without error bar (optional), and ``|λ₁|`` counted as zero.
     exponent : float, (float, float), (float, float, int) or object, optional
         Largest exponent with its standard error (forms of `as_exponent`), e.g. the tangent's.
     exponent_time : float
