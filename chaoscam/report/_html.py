@@ -243,7 +243,7 @@ def add_bifurcation(
     already rendered, else drawn here)."""
     import pandas as pd
 
-    from ._sweep_figures import sweep_diagram
+    from ..plot import sweep_diagram
 
     name, cfg, v = Path(path).name, bif.config or {}, bif.verdicts
     param = cfg.get("axis", {}).get("name", "value")
@@ -278,7 +278,7 @@ def add_regime_map(
 ) -> None:
     """A regime map's figure, its cell table and its provenance (``png``: its figure already
     rendered, else drawn here)."""
-    from ._sweep_figures import all_deterministic, percent, regime_map_figure
+    from ..plot import all_deterministic, percent, regime_map_figure
 
     name, cfg, c = Path(path).name, rm.config or {}, rm.cells
     x, y = cfg.get("x", {}).get("name", "x"), cfg.get("y", {}).get("name", "y")
@@ -313,7 +313,7 @@ def add_ensemble(parts: ReportParts, path: str, ens, *, png: bytes | None = None
     from . import _ensemble as e
 
     name, n, members = Path(path).name, len(ens.members), ens.members
-    shares, fixed = e.label_shares(members), e.deterministic(ens.config)
+    shares, fixed = e.label_shares(members), ens.identical
     what = "verdicts" if e.classified(members) else "run statuses (not classified)"
     alone = "; every member is the same deterministic run (l_lambda_sigma = 0 or the fractal "
     alone += "stiffness)."

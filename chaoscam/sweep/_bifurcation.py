@@ -57,6 +57,18 @@ class Bifurcation(TwoTables):
     def param(self) -> str:
         return self.config["axis"]["name"]
 
+    def plot(self, ax=None, *, coordinate: str = "theta_f", color_by: str | None = "label"):
+        """The diagram on ``ax`` (None: a new pyplot figure's); returns the Axes.
+
+        The section's ``coordinate`` ("theta_f" [rad] or "omega_f" [rad/s]) over the swept
+        value, coloured by ``color_by`` ("label", "ic" or None); a run without a section
+        point after the transient (out of the cam's reach, diverged) is an x on the top edge.
+        """
+        from ..plot import axes, plot_diagram
+
+        return plot_diagram(self.points, axes(ax), verdicts=self.verdicts,
+                            coordinate=coordinate, color_by=color_by)  # fmt: skip
+
 
 def read_bifurcation(path: str | Path) -> Bifurcation:
     """Read a diagram written by :func:`bifurcation`."""

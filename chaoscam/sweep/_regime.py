@@ -65,6 +65,25 @@ class RegimeMap(TwoTables):
     def y(self) -> str:
         return self.config["y"]["name"]
 
+    def plot(self, ax=None, *, kind: str = "dominant", label: str = "chaotic"):
+        """The map on ``ax`` (None: a new pyplot figure's) as a heatmap over its x and y
+        fields; returns the Axes.
+
+        ``kind`` = "dominant": each cell's dominant label (periodic cells marked Pn);
+        "probability": P(``label``) per cell, with its Wilson interval at the map's
+        confidence written in on grids of at most 64 cells; "width": that interval's width.
+        """
+        from .. import plot
+
+        draw = {"dominant": plot.plot_dominant, "probability": plot.plot_probability,
+                "width": plot.plot_interval_width}  # fmt: skip
+        if kind not in draw:
+            raise ValueError(f"kind = {kind!r}: one of {', '.join(map(repr, draw))}")
+        kw = {"label": label, "confidence": self.config.get("confidence", 0.95)}
+        ax = plot.axes(ax)
+        draw[kind](self.cells, self.x, self.y, ax, **({} if kind == "dominant" else kw))
+        return ax
+
 
 def read_regime_map(path: str | Path) -> RegimeMap:
     """Read a map written by :func:`regime_map` (``FILE.parquet`` and ``FILE.cells.parquet``)."""
