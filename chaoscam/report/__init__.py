@@ -1,8 +1,9 @@
 """Reports: figures (seaborn/matplotlib) and HTML of runs, regime maps, bifurcation diagrams
 and ensembles; ``chaoscam report`` and :mod:`chaoscam.paper` render through it. In Python::
 
-    from chaoscam.report import build_report, load_inputs, write_report
-    write_report(build_report(load_inputs(["run.parquet"])), "run.html", title="run")
+    from chaoscam.report import build_report, write_report
+    parts = build_report(["run.parquet", regime_map])  # files, results in memory, or both
+    write_report(parts, "run.html", title="run")
 
 matplotlib and jinja2 are imported only when a figure is drawn or a page rendered.
 """
@@ -24,6 +25,7 @@ _LAZY = {
     "add_ensemble": ("._html", "add_ensemble"),
     "add_regime_map": ("._html", "add_regime_map"),
     "add_trajectory": ("._html", "add_trajectory"),
+    "as_inputs": ("._inputs", "as_inputs"),
     "bifurcation_figure": ("._figures", "bifurcation_figure"),
     "build_report": ("._html", "build_report"),
     "ensemble_figure": ("._ensemble", "ensemble_figure"),

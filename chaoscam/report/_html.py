@@ -19,7 +19,7 @@ from typing import Any
 from ..io import code_rows
 from ..sweep import fate_clause
 from ._figures import png_bytes, png_uri, response_figure
-from ._inputs import Inputs
+from ._inputs import as_inputs
 
 __all__ = ["Comparison", "FigureItem", "ReportParts", "add_bifurcation", "add_ensemble"]
 __all__ += ["add_regime_map", "add_trajectory", "build_report", "git_commit", "render"]
@@ -433,14 +433,11 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
     )
 
 
-def build_report(inputs: Inputs, parts: ReportParts | None = None) -> ReportParts:
-    """Add every input (what :func:`load_inputs` returns) to the report parts; a kind of
-    input that is not there is named in the "What is missing" section."""
-    if not isinstance(inputs, Inputs):
-        raise TypeError(
-            f"build_report takes what load_inputs returns, not a {type(inputs).__name__}: "
-            "build_report(load_inputs(paths))"
-        )
+def build_report(inputs, parts: ReportParts | None = None) -> ReportParts:
+    """Add every input to the report parts: what :func:`load_inputs` returns, or paths and
+    results in memory (:func:`~chaoscam.report.as_inputs`); a kind of input that is not there
+    is named in the "What is missing" section."""
+    inputs = as_inputs(inputs)
     parts = parts or ReportParts()
     for add, items, kind, what in (
         (add_regime_map, inputs.regime_maps, "regime map", "regime-map"),
