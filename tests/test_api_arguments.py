@@ -97,12 +97,14 @@ def test_load_inputs_takes_one_path(tmp_path):
 
 
 def test_build_report_names_what_it_takes():
-    """A list of paths given to build_report is refused by name (it failed with an
-    AttributeError on 'regime_maps')."""
-    from chaoscam.report import build_report
+    """build_report reads the paths it is given (a missing one named) and refuses anything
+    that is neither a path nor a result, naming what it takes."""
+    from chaoscam.report import InputError, build_report
 
-    with pytest.raises(TypeError, match=r"not a list: build_report\(load_inputs\(paths\)\)"):
+    with pytest.raises(InputError, match="run.parquet: no such file"):
         build_report(["run.parquet"])
+    with pytest.raises(TypeError, match="takes paths, results .* not a dict"):
+        build_report([{}])
 
 
 def test_an_exponent_without_a_standard_error_is_warned():

@@ -21,6 +21,7 @@ LAYERS = (
     "chaoscam.numerics",
     "chaoscam.kernel",
     "chaoscam.io",
+    "chaoscam.plot",
     "chaoscam.simulation",
     "chaoscam.testsystems",
     "chaoscam.analysis",

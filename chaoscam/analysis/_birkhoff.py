@@ -70,7 +70,7 @@ def weighted_birkhoff(points) -> BirkhoffResult:
     chaotic orbit (Das, Saiki, Sander & Yorke, Nonlinearity 30 (2017) 4111; Das & Yorke,
     Nonlinearity 31 (2018) 491). The digits compare the first h iterates with the next h,
 
-        dig = -log10 |WB_h(f)(x_0) - WB_h(f)(x_h)|,
+        ``dig = -log10 |WB_h(f)(x_0) - WB_h(f)(x_h)|``,
 
     f scaled by its range, the minimum over the coordinates, cos and sin of the angle φ
     about the centroid, and the lifted increment Δφ_k, whose average in turns is ρ.

@@ -169,7 +169,7 @@ def classify_signal(
     lyapunov : float, optional
         Largest Lyapunov exponent [1/s] computed elsewhere.
     lyapunov_tol : float, optional
-        |λ₁| [1/s] counted as zero; default `Thresholds.signal_lyapunov_tol` / T (T the
+        ``|λ₁|`` [1/s] counted as zero; default `Thresholds.signal_lyapunov_tol` / T (T the
         forcing period, else the spectrum's fundamental period).
     angle_periods, rtol, atol, max_period, min_points_aperiodic, thresholds, seed
         As for `classify_section`.

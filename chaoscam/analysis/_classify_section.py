@@ -99,6 +99,9 @@ def classify_section(
     * ``section_zero_one``: `zero_one_evidence` on the first coordinate.
     * ``exponent`` (`exponent_evidence`), and ``lyapunov``: > `lyapunov_tol` chaotic, else not.
 
+    A scalar (shape (N,)) has its period and expansion judged on its 3-delay vectors, its
+    rotation by value or by delay pairs (`delays`): a torus seen through cos θ stays a curve.
+
     The votes are combined by `combine`; then a chaotic label needs a chaotic exponent or
     `Thresholds.min_chaotic_votes`, and a quasiperiodic one with a negative exponent (a
     period not found) is undetermined. An "undetermined" verdict says in `reasons` what to run.
@@ -112,7 +115,7 @@ def classify_section(
     points : array_like, shape (N,) or (N, d)
         Section points in time order, after the transient. N >= 8, else "undetermined".
     lyapunov, lyapunov_tol : float
-        A largest exponent per iterate without error bar (optional), and |λ₁| counted as zero.
+        A largest exponent per iterate without error bar (optional), and ``|λ₁|`` counted as zero.
     exponent : float, (float, float), (float, float, int) or object, optional
         Largest exponent with its standard error (forms of `as_exponent`), e.g. the tangent's.
     exponent_time : float

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from fractions import Fraction
 
 import numpy as np
 
 from ._birkhoff import weighted_birkhoff
-from ._periodicity import _floor, embed_angles, rotation_order, section_period
+from ._periodicity import _floor, delays, embed_angles, rotation_order, section_period
 from ._set_measures import correlation_dimension, neighbour_expansion, stationarity_ratio
 from ._thresholds import Thresholds
 from ._validate import as_points, check_settings
@@ -269,19 +270,28 @@ def section_evidence(
     points, thr: Thresholds, *, angle_periods=None, atol=None, max_period=None, zero_one=True,
     seed=0, prefix="section_",
 ):  # fmt: skip
-    """Evidence from section points; returns (evidence list, periods dict, reasons)."""
+    """Evidence from section points; returns (evidence list, periods dict, reasons).
+
+    A scalar's period and expansion are judged on its 3-delay vectors (`delays`: its states,
+    of which a value seen through a fold, cos θ, is not), its rotation by `rotation_order`.
+    """
     rtol, min_points_aperiodic = thr.period_rtol, thr.min_points_aperiodic
     x = as_points(points)
     n = x.shape[0]
     z = embed_angles(x, angle_periods)
+    states = z
+    if z.shape[1] == 1 and n > 3:
+        states, atol = delays(z[:, 0], 3), None if atol is None else float(np.max(atol))
     name = f"{prefix}period"
-    pr, failed = safe(name, section_period, z, rtol=rtol, atol=atol, max_period=max_period,
+    pr, failed = safe(name, section_period, states, rtol=rtol, atol=atol, max_period=max_period,
                       noise_floor=thr.noise_floor, band_separation=thr.band_separation)  # fmt: skip
     if failed:
         return [failed], {}, []
     if pr.message:
         return [Evidence(name, None, None, pr.message)], {}, [f"section: {pr.message}"]
     if pr.period is not None:
+        if states is not z:  # each delay coordinate holds the scalar's bands: report one
+            pr = replace(pr, tolerance=pr.tolerance[:1], jitter=pr.jitter[:1], extent=pr.extent[:1])
         return _periodic_evidence(prefix, pr, rtol, zero_one), {name: pr.period}, []
     ratio = stationarity_ratio(z)
     if math.isfinite(ratio) and not thr.stationary_low <= ratio <= thr.stationary_high:
@@ -301,7 +311,7 @@ def section_evidence(
         Evidence(name, None, "not_periodic", why),
         _rotation_evidence(f"{prefix}rotation", z, thr, few),
         birkhoff_evidence(f"{prefix}birkhoff", z, thr),
-        _expansion_evidence(f"{prefix}expansion", z, atol, thr, few),
+        _expansion_evidence(f"{prefix}expansion", states, atol, thr, few),
     ]
     if z.shape[1] >= 2 and n >= thr.dimension_min_points:
         ev.append(_dimension_evidence(f"{prefix}dimension", z, thr))

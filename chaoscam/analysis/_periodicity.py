@@ -49,6 +49,19 @@ def embed_angles(points, angle_periods: Sequence[float | None] | None = None) ->
     return np.column_stack(cols)
 
 
+def delays(x: np.ndarray, dim: int) -> np.ndarray:
+    """Delay vectors ``(x_k, x_{k+1}, ..., x_{k+dim-1})`` of a series x, shape (N - dim + 1, dim).
+
+    The delay vectors of a generic smooth scalar observable of a map on a set of box
+    dimension D embed that set for ``dim > 2 D`` (Takens 1981, Lecture Notes in Math. 898,
+    366; Sauer, Yorke & Casdagli 1991, J. Stat. Phys. 65, 579): 3 for a closed curve; with
+    2 a curve may cross itself. Lag 1 (one iterate). Limit: for a rotation number near 0 or
+    1/2 the delays of cos θ are nearly ±cos θ, a thin curve.
+    """
+    n = x.shape[0] - dim + 1
+    return np.column_stack([x[j : j + n] for j in range(dim)])
+
+
 def _floor(x: np.ndarray, atol, noise_floor: float) -> np.ndarray:
     """Per-coordinate absolute floor: `atol` if given, else ``noise_floor · max_j max_k |x_kj|``."""
     d = x.shape[1]
@@ -233,9 +246,7 @@ class RotationResult:
 
 
 def _curve_angles(z: np.ndarray) -> np.ndarray:
-    """Angle of each point about the centroid after whitening (1-D: the value itself)."""
-    if z.shape[1] == 1:
-        return z[:, 0]
+    """Angle of each point about the centroid after whitening by the two leading axes."""
     c = z - z.mean(axis=0)
     _, s, vt = np.linalg.svd(c, full_matrices=False)
     s = np.where(s > 0, s, 1.0)
@@ -246,11 +257,13 @@ def _curve_angles(z: np.ndarray) -> np.ndarray:
 def rotation_order(z) -> RotationResult:
     """Rank-shift consistency: does the orbit advance along a closed curve like a rotation?
 
-    The points are ordered around the curve (by value for d = 1, else by the angle about the
-    centroid after whitening by the two leading principal axes). With r_k the rank of point
-    k, the shift ``s_k = (r_{k+1} - r_k) mod N`` of an irrational rotation by ρ stays within
-    O(log N) of ρN (three-gap theorem; Weyl 1916), so ``R = |<exp(2πi s_k / N)>|`` is near
-    1; chaos scrambles the order, R ~ 1/sqrt(N).
+    The points are ordered around the curve by the angle about the centroid after whitening
+    by the two leading principal axes; a scalar (d = 1) both by value (a monotone observable
+    of the angle, e.g. the angle itself) and by the angle of its delay pairs ``(x_k,
+    x_{k+1})`` (a folding one, e.g. cos θ; `delays`), keeping the more consistent order. With
+    r_k the rank of point k, the shift ``s_k = (r_{k+1} - r_k) mod N`` of an irrational
+    rotation by ρ stays within O(log N) of ρN (three-gap theorem; Weyl 1916), so ``R =
+    |<exp(2πi s_k / N)>|`` is near 1; chaos scrambles the order (both orders), R ~ 1/sqrt(N).
 
     Limits: a curve not star-shaped about its centroid lowers R; phase-coherent chaos on a
     thin band (a breaking torus) can keep R high, so R supports quasiperiodicity only with a
@@ -266,8 +279,15 @@ def rotation_order(z) -> RotationResult:
     RotationResult
     """
     x = as_points(z)
-    n = x.shape[0]
-    angles = _curve_angles(x)
+    if x.shape[1] > 1:
+        return _rank_shifts(_curve_angles(x))
+    orders = [x[:, 0]] + ([_curve_angles(delays(x[:, 0], 2))] if x.shape[0] > 2 else [])
+    return max(map(_rank_shifts, orders), key=lambda r: r.consistency)
+
+
+def _rank_shifts(angles: np.ndarray) -> RotationResult:
+    """`rotation_order`'s R and ρ from the points' positions ``angles`` around the curve."""
+    n = angles.shape[0]
     ranks = np.empty(n, dtype=np.int64)
     ranks[np.argsort(angles, kind="stable")] = np.arange(n)
     s = np.mod(np.diff(ranks), n)

@@ -182,7 +182,7 @@ def spectrum_analysis(
       smallest n explaining ``>= 1 - line_tol`` of the power being the period in forcing
       periods; unforced, f0 is the strongest peak over k = 1 .. `max_period`, refined by
       least squares on its harmonics;
-    * quasiperiodic: lines at ``|a f1 + b f2|``, |a|, |b| <= `max_order`, f1 the forcing (or
+    * quasiperiodic: lines at ``|a f1 + b f2|``, ``|a|, |b|`` <= `max_order`, f1 the forcing (or
       strongest) frequency, f2 the strongest peak off the f1 comb.
 
     The residual ``1 - line_fraction`` is the broadband measure (chaos has a continuous
@@ -212,7 +212,7 @@ def spectrum_analysis(
     line_tol, broadband_tol : float
         Power fraction a line model may leave unexplained; residual from which it is broadband.
     max_order, n_peaks : int
-        Largest |a|, |b| of the two-frequency combinations; number of peaks reported.
+        Largest ``|a|``, ``|b|`` of the two-frequency combinations; number of peaks reported.
     min_cycles : float
         Fewest periods of a candidate fundamental in the record (else it is skipped).
 

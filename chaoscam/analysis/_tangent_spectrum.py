@@ -53,7 +53,7 @@ def spectrum_from_jacobians(
         λ_i = 1 / (n T) Σ_{k=1}^{n} ln R_k[i, i]
 
     (Benettin, Galgani, Giorgilli & Strelcyn 1980, Meccanica 15, 9; Eckmann & Ruelle 1985,
-    Rev. Mod. Phys. 57, 617, sec. IV.C); λ₁ + λ₂ is the mean of ln |det J_k| / T.
+    Rev. Mod. Phys. 57, 617, sec. IV.C); λ₁ + λ₂ is the mean of ``ln |det J_k|`` / T.
 
     Limits: the standard error shrinks as 1/sqrt(n) and omits the bias of a too-short
     transient. A singular J_k gives λ₂ = -inf; λ₁ goes on.

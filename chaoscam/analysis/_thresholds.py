@@ -45,7 +45,7 @@ class Thresholds:
     zero_one_min_points : int
         Fewest samples for the 0-1 test: 200, so its first half has the 100 it needs.
     zero_one_max_change : float
-        Largest |K(first half) - K(whole)| taken as converged (a cam attractor's K fell from
+        Largest ``|K(first half) - K(whole)|`` taken as converged (a cam attractor's K fell from
         0.94 at 229 points to 0.16 at 914).
     birkhoff_quasi_digits, birkhoff_min_points : float, int
         Converged Birkhoff digits for a torus vote (tori 6-15, chaos < 2.5, 1e-4 noise ~5 on

@@ -181,7 +181,8 @@ def _uncertified(verdict, points):
 
     if verdict.label != "periodic":
         return verdict
-    pr = section_period(points, rtol=verdict.settings.get("rtol"))
+    # a scalar's period is found on its delays, whose centres differ where its values repeat
+    pr = section_period(points, rtol=verdict.settings.get("rtol"), distinct=np.ndim(points) > 1)
     extent = np.where(pr.extent > 0, pr.extent, np.inf)
     widest = float(np.max(pr.jitter / extent)) if pr.period else 0.0
     if not widest > 1e-6:

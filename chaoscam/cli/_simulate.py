@@ -22,6 +22,8 @@ def register(sub) -> None:
     p.add_argument("--out", type=path_arg, help="time series to FILE.parquet or FILE.csv")
     p.add_argument("--section", type=path_arg, help="stroboscopic section to FILE.csv")
     p.add_argument("--impacts", type=path_arg, help="impact list to FILE.csv")
+    p.add_argument("--plot", type=path_arg, help="the run's figure to FILE.png: θ_f and θ_fc "
+                   "over the last 2 s, phase portrait, section, spectrum")  # fmt: skip
     p.add_argument("--force", action="store_true", help="replace existing output files")
     p.set_defaults(func=run)
 
@@ -32,12 +34,13 @@ def run(args: argparse.Namespace) -> int:
     out = check_output(args.out, force=args.force, suffixes=(".parquet", ".csv"))
     section = check_output(args.section, flag="--section", force=args.force, suffixes=(".csv",))
     impacts = check_output(args.impacts, flag="--impacts", force=args.force, suffixes=(".csv",))
-    _distinct(("--out", out), ("--section", section), ("--impacts", impacts))
+    plot = check_output(args.plot, flag="--plot", force=args.force, suffixes=(".png",))
+    _distinct(("--out", out), ("--section", section), ("--impacts", impacts), ("--plot", plot))
     written: list = []
-    asked = [p for p in (out, section, impacts) if p is not None]
+    asked = [p for p in (out, section, impacts, plot) if p is not None]
     with lock_all(asked):  # as a sweep's outputs: a second run writing one is refused
         try:
-            return _run(args, out, section, impacts, written)
+            return _run(args, (out, section, impacts, plot), written)
         except KeyboardInterrupt:  # one message, saying what is on disk
             if not asked:
                 raise  # nothing to write: the plain "interrupted"
@@ -52,13 +55,14 @@ def run(args: argparse.Namespace) -> int:
             return 130
 
 
-def _run(args: argparse.Namespace, out, section, impacts, written: list) -> int:
+def _run(args: argparse.Namespace, paths, written: list) -> int:
     """Simulate, write the files asked for; 0 when the run simulated what was asked, else 1
     with the cause on stderr (the first warning first: then the likely one)."""
     from ..io import atomic_path, write_table
     from ..simulation import simulate
     from . import parse_assignments, show_warning
 
+    out, section, impacts, plot = paths
     params, numerics = parse_assignments(args.set)
     notes: list[str] = []
 
@@ -71,7 +75,7 @@ def _run(args: argparse.Namespace, out, section, impacts, written: list) -> int:
         warnings.showwarning = note
         traj = simulate(
             params, numerics, duration=args.duration, transient=args.transient, seed=args.seed,
-            index=args.index, series=out is not None, output_dt=args.output_dt,
+            index=args.index, series=out is not None or plot is not None, output_dt=args.output_dt,
         )  # fmt: skip
     print(traj.summary())
     impact_rows = traj.impacts.drop(columns="member")
@@ -82,10 +86,18 @@ def _run(args: argparse.Namespace, out, section, impacts, written: list) -> int:
         else:
             traj.series.drop(columns="member").to_csv(tmp, index=False)
 
+    def figure(tmp) -> None:
+        from ..report import png_bytes, response_figure
+
+        tmp.write_bytes(
+            png_bytes(response_figure(traj, title=f"{plot.name}: status {traj.status}"))
+        )
+
     for path, label, write in (
         (out, "series", series),
         (section, "section", lambda tmp: traj.section.to_csv(tmp, index=False)),
         (impacts, "impacts", lambda tmp: impact_rows.to_csv(tmp, index=False)),
+        (plot, "figure", figure),
     ):
         if path is not None:
             try:

@@ -32,7 +32,7 @@ class Params:
     Every field is overridable by keyword (``Params(omega=30.0)``), by :meth:`replace`, or on
     the command line as ``--set NAME=VALUE``; the field names are the CLI names. Defaults are
     Table 1 of the paper; fields marked *decision* are ours where the paper is silent or
-    inconsistent (shared/MODEL.md), each with its reason in ``FIELD_DOCS``.
+    inconsistent (docs/model.md), each with its reason in ``FIELD_DOCS``.
 
     Derived quantities (``J``, ``y_O``, the composite modulus, the stiffness) are computed by
     properties so that a value left as ``None`` always means "the documented default rule".

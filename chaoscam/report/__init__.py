@@ -1,8 +1,9 @@
 """Reports: figures (seaborn/matplotlib) and HTML of runs, regime maps, bifurcation diagrams
 and ensembles; ``chaoscam report`` and :mod:`chaoscam.paper` render through it. In Python::
 
-    from chaoscam.report import build_report, load_inputs, write_report
-    write_report(build_report(load_inputs(["run.parquet"])), "run.html", title="run")
+    from chaoscam.report import build_report, write_report
+    parts = build_report(["run.parquet", regime_map])  # files, results in memory, or both
+    write_report(parts, "run.html", title="run")
 
 matplotlib and jinja2 are imported only when a figure is drawn or a page rendered.
 """
@@ -12,9 +13,9 @@ from __future__ import annotations
 from .._util import lazy_face
 
 _LAZY = {
-    "LABEL_COLORS": ("._sweep_figures", "LABEL_COLORS"),
-    "SETTLED_MARK": ("._sweep_figures", "SETTLED_MARK"),
-    "TRANSIENT_MARK": ("._sweep_figures", "TRANSIENT_MARK"),
+    "LABEL_COLORS": ("._figures", "LABEL_COLORS"),
+    "SETTLED_MARK": ("._figures", "SETTLED_MARK"),
+    "TRANSIENT_MARK": ("._figures", "TRANSIENT_MARK"),
     "Comparison": ("._html", "Comparison"),
     "FigureItem": ("._html", "FigureItem"),
     "InputError": ("._inputs", "InputError"),
@@ -24,16 +25,17 @@ _LAZY = {
     "add_ensemble": ("._html", "add_ensemble"),
     "add_regime_map": ("._html", "add_regime_map"),
     "add_trajectory": ("._html", "add_trajectory"),
-    "bifurcation_figure": ("._sweep_figures", "bifurcation_figure"),
+    "as_inputs": ("._inputs", "as_inputs"),
+    "bifurcation_figure": ("._figures", "bifurcation_figure"),
     "build_report": ("._html", "build_report"),
     "ensemble_figure": ("._ensemble", "ensemble_figure"),
     "load_inputs": ("._inputs", "load_inputs"),
-    "mark_without_points": ("._sweep_figures", "mark_without_points"),
+    "mark_without_points": ("._figures", "mark_without_points"),
     "png_bytes": ("._figures", "png_bytes"),
     "png_uri": ("._figures", "png_uri"),
-    "regime_map_figure": ("._sweep_figures", "regime_map_figure"),
+    "regime_map_figure": ("._figures", "regime_map_figure"),
     "response_figure": ("._figures", "response_figure"),
-    "sweep_diagram": ("._sweep_figures", "sweep_diagram"),
+    "sweep_diagram": ("._figures", "sweep_diagram"),
     "write_report": ("._html", "write_report"),
 }
 

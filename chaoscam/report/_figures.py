@@ -11,7 +11,19 @@ import io
 
 import numpy as np
 
-__all__ = ["png_bytes", "png_uri", "response_figure"]
+from ..plot import (  # the report's face names the sweeps' figures, drawn in chaoscam.plot
+    LABEL_COLORS,
+    SETTLED_MARK,
+    TRANSIENT_MARK,
+    bifurcation_figure,
+    mark_without_points,
+    regime_map_figure,
+    sweep_diagram,
+)
+
+__all__ = ["LABEL_COLORS", "SETTLED_MARK", "TRANSIENT_MARK", "bifurcation_figure"]
+__all__ += ["mark_without_points", "png_bytes", "png_uri", "regime_map_figure"]
+__all__ += ["response_figure", "sweep_diagram"]
 
 
 def png_bytes(fig, dpi: int = 96) -> bytes:
@@ -38,17 +50,14 @@ def response_figure(run, title: str = ""):
     from matplotlib.figure import Figure
 
     from ..analysis import power_spectrum
+    from ..plot import axis_label, plot_section, plot_series
 
     fig = Figure(figsize=(11, 7.5), layout="constrained")
     (a, b), (c, d) = fig.subplots(2, 2)
     s, sec = run.series, run.section
     f_cam = run.params.omega / (2 * np.pi)
     if s is not None and len(s) > 2:
-        last = s[s["t"] >= s["t"].iloc[-1] - 2.0]
-        a.plot(last["t"], last["theta_f"], lw=0.8, color="#0072B2", label="θ_f (follower)")
-        a.plot(last["t"], last["theta_fc"], lw=0.8, ls="--", color="#D55E00",
-               label="θ_fc (persistent contact)")  # fmt: skip
-        a.legend(frameon=False, fontsize="small", loc="upper right")
+        plot_series(s, a, last=2.0)
         b.plot(s["theta_f"], s["omega_f"], lw=0.3, color="#555555", rasterized=True)
         f, pw = power_spectrum(s["theta_f"].to_numpy(), float(s["t"].diff().median()))
         keep = (f > 0) & (f <= 10 * f_cam)
@@ -60,11 +69,8 @@ def response_figure(run, title: str = ""):
             ax.text(
                 0.5, 0.5, "no time series kept", ha="center", va="center", transform=ax.transAxes
             )
-    c.scatter(sec["theta_f"], sec["omega_f"], s=6, color="#000000", linewidths=0, rasterized=True)
-    a.set(xlabel="time t [s]", ylabel="angle [rad]", title="θ_f and θ_fc, last 2 s")
-    b.set(xlabel="θ_f [rad]", ylabel="θ̇_f [rad/s]", title="phase portrait")
-    c.set(xlabel="θ_f [rad]", ylabel="θ̇_f [rad/s]",
-          title=f"Poincaré section at t = k·2π/ω ({len(sec)} points)")  # fmt: skip
+    plot_section(sec, c)
+    b.set(xlabel=axis_label("theta_f"), ylabel=axis_label("omega_f"), title="phase portrait")
     d.set(xlabel="frequency [Hz]", ylabel="power of θ_f [rad²·s, arbitrary scale]",
           title="spectrum of θ_f")  # fmt: skip
     if title:

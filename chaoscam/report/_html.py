@@ -19,7 +19,7 @@ from typing import Any
 from ..io import code_rows
 from ..sweep import fate_clause
 from ._figures import png_bytes, png_uri, response_figure
-from ._inputs import Inputs
+from ._inputs import as_inputs
 
 __all__ = ["Comparison", "FigureItem", "ReportParts", "add_bifurcation", "add_ensemble"]
 __all__ += ["add_regime_map", "add_trajectory", "build_report", "git_commit", "render"]
@@ -243,7 +243,7 @@ def add_bifurcation(
     already rendered, else drawn here)."""
     import pandas as pd
 
-    from ._sweep_figures import sweep_diagram
+    from ..plot import sweep_diagram
 
     name, cfg, v = Path(path).name, bif.config or {}, bif.verdicts
     param = cfg.get("axis", {}).get("name", "value")
@@ -278,7 +278,7 @@ def add_regime_map(
 ) -> None:
     """A regime map's figure, its cell table and its provenance (``png``: its figure already
     rendered, else drawn here)."""
-    from ._sweep_figures import all_deterministic, percent, regime_map_figure
+    from ..plot import all_deterministic, percent, regime_map_figure
 
     name, cfg, c = Path(path).name, rm.config or {}, rm.cells
     x, y = cfg.get("x", {}).get("name", "x"), cfg.get("y", {}).get("name", "y")
@@ -313,7 +313,7 @@ def add_ensemble(parts: ReportParts, path: str, ens, *, png: bytes | None = None
     from . import _ensemble as e
 
     name, n, members = Path(path).name, len(ens.members), ens.members
-    shares, fixed = e.label_shares(members), e.deterministic(ens.config)
+    shares, fixed = e.label_shares(members), ens.identical
     what = "verdicts" if e.classified(members) else "run statuses (not classified)"
     alone = "; every member is the same deterministic run (l_lambda_sigma = 0 or the fractal "
     alone += "stiffness)."
@@ -433,14 +433,11 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
     )
 
 
-def build_report(inputs: Inputs, parts: ReportParts | None = None) -> ReportParts:
-    """Add every input (what :func:`load_inputs` returns) to the report parts; a kind of
-    input that is not there is named in the "What is missing" section."""
-    if not isinstance(inputs, Inputs):
-        raise TypeError(
-            f"build_report takes what load_inputs returns, not a {type(inputs).__name__}: "
-            "build_report(load_inputs(paths))"
-        )
+def build_report(inputs, parts: ReportParts | None = None) -> ReportParts:
+    """Add every input to the report parts: what :func:`load_inputs` returns, or paths and
+    results in memory (:func:`~chaoscam.report.as_inputs`); a kind of input that is not there
+    is named in the "What is missing" section."""
+    inputs = as_inputs(inputs)
     parts = parts or ReportParts()
     for add, items, kind, what in (
         (add_regime_map, inputs.regime_maps, "regime map", "regime-map"),

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["InputError", "Inputs", "load_inputs"]
+__all__ = ["InputError", "Inputs", "as_inputs", "load_inputs"]
 
 _TRAJ_KEY = b"chaoscam.trajectory"
 _SWEEP_KEY = b"chaoscam.sweep"
@@ -100,4 +100,35 @@ def load_inputs(paths: list[str | Path] | str | Path) -> Inputs:
         if str(main) not in seen:
             seen.add(str(main))
             getattr(out, _KINDS[kind]).append((str(main), _read_sweep(main, kind)))
+    return out
+
+
+def as_inputs(items) -> Inputs:
+    """:class:`Inputs` from what :func:`load_inputs` returns, or from one or a list of paths
+    and results in memory (one-member :class:`chaoscam.Solution`, :class:`~chaoscam.sweep.
+    Bifurcation`, :class:`~chaoscam.sweep.RegimeMap`, :class:`~chaoscam.sweep.Ensemble`), a
+    result in memory named by its kind and place ("regime map 2"); a TypeError otherwise."""
+    from ..simulation import Solution
+    from ..sweep import Bifurcation, Ensemble, RegimeMap
+
+    if isinstance(items, Inputs):
+        return items
+    kinds = {
+        Solution: ("trajectories", "run"),
+        Bifurcation: ("bifurcations", "bifurcation"),
+        RegimeMap: ("regime_maps", "regime map"),
+        Ensemble: ("ensembles", "ensemble"),
+    }
+    items = list(items) if isinstance(items, list | tuple) else [items]
+    out = load_inputs([item for item in items if isinstance(item, str | Path)])
+    for i, item in enumerate(items):
+        if isinstance(item, str | Path):
+            continue
+        if type(item) not in kinds:
+            raise TypeError(
+                f"build_report takes paths, results (Solution, Bifurcation, RegimeMap, "
+                f"Ensemble) or what load_inputs returns, not a {type(item).__name__}"
+            )
+        where, what = kinds[type(item)]
+        getattr(out, where).append((f"{what} {i + 1}", item))
     return out

@@ -182,6 +182,24 @@ class Solution:
             f"section points: {len(self.sections)}"
         )
 
+    def plot(self, ax=None, *, kind: str = "section", last: float | None = None):
+        """The only member on ``ax`` (None: a new pyplot figure's); returns the Axes.
+
+        ``kind`` = "section": the stroboscopic section (θ_f [rad], θ̇_f [rad/s]) at
+        t = k 2π/ω after the transient; "series": θ_f and the persistent-contact angle θ_fc
+        [rad] over t [s] (a run with ``series=True``), its last ``last`` seconds if given.
+        """
+        from ..plot import axes, plot_section, plot_series
+
+        self._only("plot")
+        if kind == "section":
+            return plot_section(self.section, axes(ax))
+        if kind != "series":
+            raise ValueError(f"kind = {kind!r}: 'section' or 'series'")
+        if self.series is None or not len(self.series):
+            raise ValueError("no series kept: simulate with series=True")
+        return plot_series(self.series, axes(ax), last=last)
+
     def select(self, picks) -> Solution:
         """Members ``picks`` (their ``member`` numbers), renumbered 0, 1, ... in that order."""
         import pandas as pd

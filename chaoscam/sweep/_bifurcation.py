@@ -19,7 +19,7 @@ from ..io import code_identity
 from ..model import Params, contact_angle
 from ..numerics import Numerics
 from ..verdict import EXTEND_TO
-from ._common import TwoTables, make_judge, record_table, section_table, settings
+from ._common import TwoTables, dataset, make_judge, record_table, section_table, settings
 from ._engine import Plan, plan_engine, run_sweep
 from ._grid import Axis, SweepError, cell_params, realization_index, validate_grid
 from ._runs import Realization
@@ -56,6 +56,40 @@ class Bifurcation(TwoTables):
     @property
     def param(self) -> str:
         return self.config["axis"]["name"]
+
+    def plot(self, ax=None, *, coordinate: str = "theta_f", color_by: str | None = "label"):
+        """The diagram on ``ax`` (None: a new pyplot figure's); returns the Axes.
+
+        The section's ``coordinate`` ("theta_f" [rad] or "omega_f" [rad/s]) over the swept
+        value, coloured by ``color_by`` ("label", "ic" or None); a run without a section
+        point after the transient (out of the cam's reach, diverged) is an x on the top edge.
+        """
+        from ..plot import axes, plot_diagram
+
+        return plot_diagram(self.points, axes(ax), verdicts=self.verdicts,
+                            coordinate=coordinate, color_by=color_by)  # fmt: skip
+
+    def to_xarray(self):
+        """The diagram as an ``xarray.Dataset`` over (the swept parameter, ``ic``, ``point``)
+        (optional extra ``chaoscam[xarray]``).
+
+        ``k``, ``t`` [s], ``theta_f`` [rad], ``omega_f`` [rad/s] and ``l_lambda_used`` [m] (the
+        line length in force) of each section point are variables over all three dims
+        (``point`` numbers a run's points from 0; NaN past its last); each column of
+        :attr:`verdicts` (``label``, ``period``, ``status``, evidence, ...) is one over
+        (parameter, ``ic``). ``attrs``: ``kind`` and ``config`` (the record, JSON).
+        Round-trips through ``to_netcdf``.
+        """
+        from ..plot import axis_label
+
+        name, pts = self.param, self.points.drop(columns=["param", "status", "label", "period"])
+        pts = pts.rename(columns={"l_lambda": "l_lambda_used"})  # the swept field may be l_lambda
+        pts = pts.assign(point=pts.groupby(["value", "ic"]).cumcount())
+        points = dataset(pts, ["value", "ic", "point"], self.config, value=name)
+        runs = dataset(self.verdicts.drop(columns="param"), ["value", "ic"], {}, value=name)
+        ds = points.drop_vars("value_index").merge(runs)
+        ds[name].attrs["long_name"] = axis_label(name)
+        return ds
 
 
 def read_bifurcation(path: str | Path) -> Bifurcation:

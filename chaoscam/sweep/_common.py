@@ -128,6 +128,26 @@ class TwoTables:
             write_parquet(getattr(self, name), file, self.config, replace=replace)
 
 
+def dataset(frame: pd.DataFrame, dims: list[str], config: dict, **renamed: str):
+    """``frame`` as an ``xarray.Dataset`` over its columns ``dims`` (rows missing from their
+    grid NaN, text there ""), the columns ``renamed``, the record as JSON in ``attrs``."""
+    import json
+
+    try:
+        import xarray as xr
+    except ImportError:
+        raise ImportError(
+            "to_xarray needs xarray, an optional extra: pip install 'chaoscam[xarray]' "
+            "(xarray with netCDF4 for to_netcdf)"
+        ) from None
+    ds = xr.Dataset.from_dataframe(frame.set_index(dims)).rename(renamed)
+    for name, v in ds.data_vars.items():
+        if v.dtype == object:  # text: "" where the grid has no row (NaN, None in the table)
+            ds[name] = v.where(v.notnull(), "").astype(str)
+    ds.attrs = {"kind": config.get("kind", ""), "config": json.dumps(config)}
+    return ds
+
+
 RUN_COLUMNS = ("status", "label", "period", "n_section", "recorded_s", "n_impacts",
                "contact_fraction", "truncated_mass", "reasons", "warnings")  # fmt: skip
 _TEXT = frozenset({"status", "label", "reasons", "warnings"})

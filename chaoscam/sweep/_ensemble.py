@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import re
+from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -13,12 +15,13 @@ import pandas as pd
 
 from .._util import COUNT_MAX, whole
 from ..io import code_identity
-from ..model import Params
+from ..model import Params, realizations_identical
 from ..numerics import Numerics
 from ..verdict import EXTEND_TO
 from ._common import RUN_COLUMNS, TwoTables, make_judge, record_table, section_table, settings
 from ._engine import Plan, plan_engine, run_sweep
 from ._runs import Realization
+from ._stats import LABEL_ORDER, wilson_interval
 
 
 @dataclass(frozen=True)
@@ -42,10 +45,76 @@ class Ensemble(TwoTables):
     sections: pd.DataFrame
     config: dict[str, Any] = field(default_factory=dict)
 
+    @property
+    def identical(self) -> bool:
+        """Whether every member is the same run (``l_lambda_sigma = 0`` or the fractal
+        stiffness: :func:`chaoscam.model.realizations_identical`); False for a record this
+        version cannot read."""
+        try:
+            return realizations_identical(Params(**self.config["params"]))
+        except (KeyError, TypeError, ValueError):
+            return False
+
+    def plot(self, ax=None, *, kind: str = "shares"):
+        """The ensemble on ``ax`` (None: a new pyplot figure's); returns the Axes.
+
+        ``kind`` = "shares": each label's share of the members with its 95 % Wilson interval
+        (none when :attr:`identical`); "section": every member's stroboscopic section
+        (θ_f [rad], θ̇_f [rad/s]) coloured by its label (its verdict, or its run status).
+        """
+        from ..plot import axes, plot_section, plot_shares
+
+        shares = label_shares(self.members)
+        if kind == "shares":
+            return plot_shares(shares, axes(ax), interval=not self.identical)
+        if kind != "section":
+            raise ValueError(f"kind = {kind!r}: 'shares' or 'section'")
+        labels = dict(zip(self.members["member"], member_labels(self.members), strict=True))
+        ax = plot_section(self.sections, axes(ax), labels=self.sections["member"].map(labels),
+                          order=[r["label"] for r in shares])  # fmt: skip
+        ax.set_title(f"stroboscopic section of {self.members['member'].nunique()} members")
+        return ax
+
 
 def read_ensemble(path: str | Path) -> Ensemble:
     """Read an ensemble written by :func:`ensemble` (FILE.parquet, FILE.sections.parquet)."""
     return Ensemble.read(path)
+
+
+def classified(members: pd.DataFrame) -> bool:
+    """Whether an ensemble's members carry verdicts (it was run with ``classify``)."""
+    return "label" in members and bool(members["label"].notna().any())
+
+
+def member_labels(members: pd.DataFrame) -> list[str]:
+    """Each member's label: its verdict ("periodic (period 2)" with its period), or its run
+    status when the ensemble was not classified."""
+    if not classified(members):
+        return [str(s) for s in members["status"]]
+    return [
+        f"periodic (period {int(p)})" if lab == "periodic" and not pd.isna(p) else str(lab)
+        for lab, p in zip(members["label"], members["period"], strict=True)
+    ]
+
+
+def _order(label: str) -> tuple[int, int, str]:
+    head = label.partition(" ")[0]
+    rank = LABEL_ORDER.index(head) if head in LABEL_ORDER else len(LABEL_ORDER)
+    period = re.search(r"period (\d+)", label)
+    return rank, int(period.group(1)) if period else 0, label
+
+
+def label_shares(members: pd.DataFrame, *, confidence: float = 0.95) -> list[dict[str, Any]]:
+    """One row per label of :func:`member_labels`, in display order: label, count, share,
+    and the share's Wilson interval (``lo``, ``hi``) over the members."""
+    counts = Counter(member_labels(members))
+    n = sum(counts.values())
+    rows = []
+    for label in sorted(counts, key=_order):
+        k = counts[label]
+        lo, hi = wilson_interval(k, n, confidence)
+        rows.append({"label": label, "count": k, "share": k / n, "lo": float(lo), "hi": float(hi)})
+    return rows
 
 
 class _Members(Plan):

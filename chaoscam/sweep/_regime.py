@@ -19,7 +19,15 @@ from ..io import code_identity
 from ..model import Params, realizations_identical
 from ..numerics import Numerics
 from ..verdict import EXTEND_TO
-from ._common import RUN_COLUMNS, TwoTables, as_axis, make_judge, record_table, settings
+from ._common import (
+    RUN_COLUMNS,
+    TwoTables,
+    as_axis,
+    dataset,
+    make_judge,
+    record_table,
+    settings,
+)
 from ._engine import Plan, plan_engine, run_sweep
 from ._grid import Axis, SweepError, cell_params, realization_index, validate_grid
 from ._runs import Realization
@@ -64,6 +72,48 @@ class RegimeMap(TwoTables):
     @property
     def y(self) -> str:
         return self.config["y"]["name"]
+
+    def plot(self, ax=None, *, kind: str = "dominant", label: str = "chaotic"):
+        """The map on ``ax`` (None: a new pyplot figure's) as a heatmap over its x and y
+        fields; returns the Axes.
+
+        ``kind`` = "dominant": each cell's dominant label (periodic cells marked Pn);
+        "probability": P(``label``) per cell, with its Wilson interval at the map's
+        confidence written in on grids of at most 64 cells; "width": that interval's width.
+        """
+        from .. import plot
+
+        draw = {"dominant": plot.plot_dominant, "probability": plot.plot_probability,
+                "width": plot.plot_interval_width}  # fmt: skip
+        if kind not in draw:
+            raise ValueError(f"kind = {kind!r}: one of {', '.join(map(repr, draw))}")
+        kw = {"label": label, "confidence": self.config.get("confidence", 0.95)}
+        ax = plot.axes(ax)
+        draw[kind](self.cells, self.x, self.y, ax, **({} if kind == "dominant" else kw))
+        return ax
+
+    def to_xarray(self):
+        """The map as an ``xarray.Dataset`` over its axes (dims named by their fields, the
+        swept values as coordinates; optional extra ``chaoscam[xarray]``).
+
+        Each column of :attr:`cells` is a variable over (x, y): ``dominant`` (the dominant
+        label, text), ``n`` (realizations in the cell), ``n_L``/``p_L`` with ``p_L_lo``,
+        ``p_L_hi`` (count and share of each label L, Wilson interval), period, exponents and
+        the fate counts; each realization's ``label``, ``status`` and ``ev_*`` evidence is a
+        variable over (x, y, ``realization``), "" or NaN past a cell's last one. ``attrs``:
+        ``kind`` and ``config`` (the record, JSON). Round-trips through ``to_netcdf``.
+        """
+        from ..plot import axis_label
+
+        x, y = self.x, self.y
+        runs = [c for c in self.realizations if c in ("label", "status") or c[:3] == "ev_"]
+        cells = dataset(self.cells.drop(columns=["cell", "ix", "iy"]), [x, y], self.config)
+        real = dataset(self.realizations[[x, y, "index", *runs]], [x, y, "index"], {},
+                       index="realization")  # fmt: skip
+        ds = cells.merge(real)
+        for name in (x, y):
+            ds[name].attrs["long_name"] = axis_label(name)
+        return ds
 
 
 def read_regime_map(path: str | Path) -> RegimeMap:

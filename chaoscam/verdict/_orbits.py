@@ -197,7 +197,7 @@ def kick_test(params: Params, x, n: int = 1, *, numerics: Numerics | None = None
     cam periods (:func:`iterate_map`) and compare with the unkicked run; a :class:`KickTest`.
 
     Where chattering ends in sticking the grid map is not differentiable at the scale of its
-    event jitter (at ξ = 0.525 the tangent's |μ|max is 5.9 while kicks of 1e-9 to 1e-6 return
+    event jitter (at ξ = 0.525 the tangent's ``|μ|max`` is 5.9 while kicks of 1e-9 to 1e-6 return
     to a 1e-8 floor): kicks measure at finite sizes (docs/findings.md checks ``returns`` on the
     labelled sets). On chaotic bands many kicks return (sticking merges nearby motions), so
     four directions at two sizes decide together. With ``until_refused`` the kicks stop at the
@@ -236,7 +236,7 @@ class PeriodicOrbit:
     multipliers : ndarray, shape (2,)
         Floquet multipliers: the eigenvalues of DP^n at x_0 (complex in general).
     residual : float
-        |P^n(x_0) - x_0| in the scaled norm (θ in rad, θ̇ times T) at the last iterate.
+        ``|P^n(x_0) - x_0|`` in the scaled norm (θ in rad, θ̇ times T) at the last iterate.
     converged : bool
         Newton's residual fell below `tol`.
     iterations, wall_time : int, float
@@ -292,9 +292,9 @@ def periodic_orbit(params: Params, x0, period: int, *, numerics: Numerics | None
     ``tol`` [rad]: P is smooth only to the event tolerance (a located time jitters by
     ~``event_tol``) and to the chattering threshold ``v_chatter``, so residuals stall at ~1e-9
     to 1e-8 rad on orbits with chattering; 1e-7 rad is far below any band the classifier
-    resolves. With |μ|max < 1 and a residual r, a fixed point of the smooth branch lies within
-    ~r / (1 - |μ|max) of the returned one. The least period is the smallest divisor d of n
-    with |P^d(x_0) - x_0| within ``max(10 residual, tol / 100)``: just past a flip the
+    resolves. With ``|μ|max < 1`` and a residual r, a fixed point of the smooth branch lies within
+    ``~r / (1 - |μ|max)`` of the returned one. The least period is the smallest divisor d of n
+    with ``|P^d(x_0) - x_0|`` within ``max(10 residual, tol / 100)``: just past a flip the
     period-2d orbit's halves lie close (1.2e-7 rad on a period-16 orbit of the fractal
     stiffness whose residual is 5.7e-9 rad), so the bound follows the residual.
 

@@ -60,14 +60,45 @@ def test_circle_map_is_quasiperiodic_by_birkhoff():
 
 
 @pytest.mark.parametrize(
-    "orbit", [logistic_orbit(4.0, 1000), henon_orbit(1000)], ids=["logistic", "henon"]
+    "orbit",
+    [logistic_orbit(4.0, 1000), henon_orbit(1000), henon_orbit(1000)[:, 0]],
+    ids=["logistic", "henon", "henon_x"],
 )
 def test_chaos_is_chaotic_with_two_votes_and_birkhoff_abstains(orbit):
-    """Logistic r = 4 and Hénon: chaotic from >= 2 votes; the Birkhoff averages do not vote."""
+    """Logistic r = 4, Hénon and its x alone: chaotic from >= 2 votes; Birkhoff does not vote."""
     v = classify_section(orbit)
     assert v.label == "chaotic", v.reasons
     assert sum(e.vote == "chaotic" for e in v.evidence) >= 2
     assert by_name(v)["section_birkhoff"].vote is None
+
+
+@pytest.mark.parametrize(
+    "observe",
+    [
+        np.cos,
+        lambda a: a / (2 * math.pi),
+        lambda a: np.cos(a) + np.cos(2 * a + 1) + np.cos(3 * a + 2),
+    ],
+    ids=["cos", "angle", "three_harmonics"],
+)
+def test_torus_seen_through_a_scalar_is_quasiperiodic(observe):
+    """A golden rotation seen through cos θ, θ itself, or three harmonics (their delay pairs
+    cross themselves, 3 delays do not): quasiperiodic, no expansion (|g| < 0.05)."""
+    v = classify_section(observe(np.mod(2 * math.pi * GOLDEN * np.arange(2000), 2 * math.pi)))
+    assert v.label == "quasiperiodic", v.reasons
+    assert abs(by_name(v)["section_expansion"].value) < 0.05
+
+
+@pytest.mark.parametrize(
+    ("x", "period"),
+    [(np.cos(2 * math.pi * np.arange(600) / 3), 3), (np.cos(math.pi * np.arange(600) / 2), 4)],
+    ids=["cos_3", "cos_4"],
+)
+def test_periodic_scalar_with_equal_values_is_periodic(x, period):
+    """cos(2πk/3) and cos(2πk/4) repeat a value within each period (their states do not):
+    periodic 3 and 4, not a torus."""
+    v = classify_section(x)
+    assert (v.label, v.period) == ("periodic", period), v.reasons
 
 
 def test_a_single_chaotic_vote_is_not_enough_and_says_what_to_run():

@@ -71,6 +71,16 @@ def test_rotation_order_of_a_rotation_and_of_chaos():
     assert rotation_order(logistic_orbit(3.9, 500)).consistency < 0.7
 
 
+@pytest.mark.parametrize("observe", [np.cos, lambda a: a], ids=["cos", "angle"])
+def test_rotation_order_of_a_scalar_by_value_or_by_delay_pairs(observe):
+    """A golden rotation seen through cos θ (ordered by its delay pairs) and through θ in
+    [0, 2π) (by value) rotates: R > 0.99 and ρ the golden mean (or 1 - ρ)."""
+    golden = (math.sqrt(5) - 1) / 2
+    rot = rotation_order(observe(np.mod(2 * math.pi * golden * np.arange(1000), 2 * math.pi)))
+    assert rot.consistency > 0.99
+    assert math.isclose(min(rot.rotation_number, 1 - rot.rotation_number), 1 - golden, abs_tol=0.01)
+
+
 def test_embedding_removes_the_wrap_of_angles():
     """One angle written as 0.25, 1.25 and -0.75 turns is one point after embedding."""
     pts = np.array([0.25, 1.25, -0.75] * 10)

@@ -101,6 +101,45 @@ def test_series_with_section_points(tmp_path, capsys):
     assert out["reasons"] == []  # exact points: nothing to add
 
 
+@pytest.mark.parametrize(
+    ("column", "label", "period"),
+    [
+        ("cos", "quasiperiodic", None),
+        ("angle", "quasiperiodic", None),
+        ("period3", "periodic", 3),
+        ("logistic", "chaotic", None),
+        ("henon_x", "chaotic", None),
+    ],
+)
+def test_series_section_of_one_scalar(tmp_path, capsys, column, label, period):
+    """--section on one column: a golden rotation seen through cos of its angle and through
+    the angle (turns) is quasiperiodic, cos(2πk/3) periodic 3, the logistic map (r = 4) and
+    the Hénon map's x chaotic."""
+    from chaoscam.testsystems import GOLDEN, henon_orbit, logistic_orbit
+
+    k = np.arange(2000)
+    angle = np.mod(GOLDEN * k, 1.0)
+    data = {"cos": np.cos(2 * math.pi * angle), "angle": angle,
+            "period3": np.cos(2 * math.pi * k / 3), "logistic": logistic_orbit(4.0, k.size),
+            "henon_x": henon_orbit(k.size)[:, 0]}  # fmt: skip
+    pd.DataFrame({column: data[column]}).to_csv(tmp_path / "x.csv", index=False)
+    assert main(["classify-series", str(tmp_path / "x.csv"), "--column", column, "--section"]) == 0
+    out = _json(capsys)
+    assert (out["label"], out["period"]) == (label, period), out["reasons"]
+
+
+def test_series_section_of_a_scalar_repeating_a_value_says_it_is_not_certified(tmp_path, capsys):
+    """cos(πk/2) (1, 0, -1, 0) with 1e-5 noise is periodic 4 from its delays, and its bands
+    (~3e-5 of the extent) are reported not certified, as for points of several columns."""
+    k = np.arange(1000)
+    x = np.cos(math.pi * k / 2) + 1e-5 * np.random.default_rng(0).standard_normal(k.size)
+    pd.DataFrame({"x": x}).to_csv(tmp_path / "x.csv", index=False)
+    assert main(["classify-series", str(tmp_path / "x.csv"), "--column", "x", "--section"]) == 0
+    out = _json(capsys)
+    assert (out["label"], out["period"]) == ("periodic", 4)
+    assert out["reasons"][-1].startswith("periodic to the tolerance, not certified: its 4 band")
+
+
 def test_series_section_with_wide_bands_says_it_is_not_certified(tmp_path, capsys):
     """The default model's section (8 bands up to 8e-4 of the extent, chaotic by its
     tangent exponent) is periodic 8 to the tolerance on points alone: the verdict says it

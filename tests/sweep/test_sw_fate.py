@@ -81,7 +81,7 @@ def test_chaos_that_settles_later_gets_the_verdict_at_the_horizon(settling):
     from matplotlib.figure import Figure
 
     from chaoscam.paper._sensitivity import transient_finding
-    from chaoscam.report._sweep_figures import SETTLED_MARK, plot_dominant
+    from chaoscam.plot import SETTLED_MARK, plot_dominant
 
     row = settling.realizations.iloc[0]
     assert row["label"] == "chaotic" and row["fate"] == "OK"
@@ -142,7 +142,7 @@ def test_resuming_with_another_horizon_is_refused(tmp_path):
 def test_the_map_figure_marks_transient_cells(rmap):
     from matplotlib.figure import Figure
 
-    from chaoscam.report._sweep_figures import TRANSIENT_MARK, plot_dominant
+    from chaoscam.plot import TRANSIENT_MARK, plot_dominant
 
     ax = Figure().subplots()
     plot_dominant(rmap.cells, "omega", "xi", ax)

@@ -4,7 +4,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from chaoscam.report._sweep_figures import (
+from chaoscam.plot import (
     axis_label,
     bifurcation_figure,
     regime_map_figure,
@@ -64,8 +64,8 @@ def test_deterministic_cells_show_one_run_not_an_interval():
     row in the report's table say so, with no [lo, hi] interval; the other cells keep theirs."""
     from matplotlib.figure import Figure
 
+    from chaoscam.plot import plot_probability
     from chaoscam.report._html import _p_chaotic_text
-    from chaoscam.report._sweep_figures import plot_probability
 
     cells = _cells().assign(deterministic=lambda c: c["l_lambda_sigma"] == 0.0)
     ax = Figure().subplots()
@@ -85,7 +85,7 @@ def test_deterministic_cells_have_no_interval_width():
     as the narrowest width); the other cells keep their widths."""
     from matplotlib.figure import Figure
 
-    from chaoscam.report._sweep_figures import plot_interval_width
+    from chaoscam.plot import plot_interval_width
 
     cells = _cells().assign(deterministic=lambda c: c["l_lambda_sigma"] == 0.0)
     ax = Figure().subplots()

@@ -1,8 +1,8 @@
-"""Figures of sweeps: regime-map heatmaps (seaborn) and bifurcation diagrams.
+"""Drawings of sweeps: regime-map heatmaps (seaborn) and bifurcation diagrams.
 
-Every function takes the tidy tables of :mod:`chaoscam.sweep` and returns a matplotlib
-``Figure`` built without pyplot (nothing opens a window); seaborn and matplotlib are imported
-inside the functions.
+Every function takes the tidy tables of :mod:`chaoscam.sweep` and draws on an Axes, or
+returns a matplotlib ``Figure`` built without pyplot (nothing opens a window); seaborn and
+matplotlib are imported inside the functions.
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ import pandas as pd
 
 __all__ = ["LABEL_COLORS", "SETTLED_MARK", "TRANSIENT_MARK", "all_deterministic", "axis_label"]
 __all__ += ["bifurcation_figure", "mark_without_points", "percent", "plot_bifurcation"]
+__all__ += ["plot_diagram"]
 __all__ += ["plot_dominant", "plot_interval_width", "plot_probability", "regime_map_figure"]
 __all__ += ["sweep_diagram"]
 
@@ -311,6 +312,17 @@ def mark_without_points(ax, points: pd.DataFrame, verdicts: pd.DataFrame, x="val
     return bool(len(gone))
 
 
+def plot_diagram(points, ax, *, verdicts=None, **kw):
+    """:func:`plot_bifurcation` (``kw``: its options), and with the sweep's ``verdicts`` an x
+    on the top edge at each run without a section point, named in the legend; returns ax."""
+    plot_bifurcation(points, ax, **kw)
+    if verdicts is not None and mark_without_points(ax, points, verdicts):
+        scale = ax.get_legend().markerscale if ax.get_legend() else 1.0  # the diagram's dots
+        title = kw.get("color_by", "label")
+        ax.legend(markerscale=scale, frameon=False, fontsize="small", title=title)
+    return ax
+
+
 def bifurcation_figure(
     points: pd.DataFrame, *, coordinate: str = "theta_f", color_by: str = "label",
     note: str = "", verdicts: pd.DataFrame | None = None,
@@ -324,11 +336,8 @@ def bifurcation_figure(
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(9, 5), layout="constrained")
-    ax = fig.subplots()
-    plot_bifurcation(points, ax, coordinate=coordinate, color_by=color_by)
-    if verdicts is not None and mark_without_points(ax, points, verdicts):
-        scale = ax.get_legend().markerscale if ax.get_legend() else 1.0  # the diagram's dots
-        ax.legend(markerscale=scale, frameon=False, fontsize="small", title=color_by)
+    ax = plot_diagram(points, fig.subplots(), coordinate=coordinate, color_by=color_by,
+                      verdicts=verdicts)  # fmt: skip
     what = str(points["param"].iloc[0]) if len(points) else ""
     what += f" ({note})" if note else ""
     ax.set_title(f"bifurcation diagram over {what}: stroboscopic section after the transient")
