@@ -27,7 +27,7 @@ Hertz oscillation, about -(h Omega)^6 / 72 a step (Omega = sqrt(K l_1^2 / J)). T
 damping (``damping="paper_literal"``), outside the hypothesis, is shown for contrast and
 never counted. Exit status 1 when a bound is violated.
 
-Usage: python analyses/monodromy_det.py   (about two minutes of one core)
+Usage: python analyses/monodromy_det.py   (about two minutes of CPU)
 """
 
 from __future__ import annotations
