@@ -14,6 +14,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, is_dataclass
 from typing import Any
 
+import numpy as np
+
 from .._util import quiet, recorded
 from ..analysis import LABELS, spectrum_from_jacobians
 from ..kernel import Status
@@ -21,6 +23,7 @@ from ..model import Params, truncated_mass
 from ..numerics import Numerics
 from ..simulation import Solution, extend, run_warnings, solve
 from ..verdict import EXTEND_TO, classify, judge_points
+from ._stats import SECTION_QUANTILES
 
 FATE_LABELS = frozenset({"chaotic", "quasiperiodic", "undetermined"})
 """Labels whose runs a ``fate`` horizon continues: not a certified attracting orbit, so the
@@ -77,8 +80,11 @@ class Judge:
         for i, v in enumerate(verdicts):
             status = Status[sol.members["status"].iat[i]]
             f = status_fields(status) if status is not Status.OK else verdict_fields(v)
-            if self.lyapunov:
+            if self.lyapunov or (self.custom is None and v is not None):
                 f["evidence"].update(_spectrum_evidence(v, sol, i))
+            twins = (getattr(v, "settings", None) or {}).get("twins") if v is not None else None
+            if twins is not None:
+                f["evidence"]["synchronised"] = float(twins["outcome"] == "synchronised")
             out.append(f)
         return out
 
@@ -256,6 +262,11 @@ class Realization:
             "reasons": fields["reasons"], "warnings": fields["warnings"],
             "evidence": fields["evidence"], **{name: fields.get(name) for name in FATE_FIELDS},
         }  # fmt: skip
+        late = rows & (sol.sections["t"].to_numpy() >= self.transient)
+        if late.any():  # the recorded section's theta_f distribution, as quantiles
+            q = np.quantile(sol.sections["theta_f"].to_numpy()[late], SECTION_QUANTILES)
+            quantiles = {f"section_q{k}": float(v) for k, v in enumerate(q)}
+            rec["evidence"] = {**rec["evidence"], **quantiles}
         if self.sections:
             sec = sol.sections[rows]
             rec["section"] = {c: sec[c].tolist() for c in SECTION_KEYS}

@@ -93,7 +93,9 @@ def summarize_cells(rows: pd.DataFrame, cells: pd.DataFrame, *, confidence=0.95)
         two) and ``lyapunov_n`` over the finite exponents; ``period`` (the modal period of
         the periodic runs, smallest on a tie); ``truncated_mass`` (of Normal(mu, sigma^2)
         below ``l_min``); ``n_transient`` (runs a ``fate`` horizon found to stop later),
-        ``n_settled`` and ``settled_period`` (found periodic there, :func:`fate_settled`).
+        ``n_settled`` and ``settled_period`` (found periodic there, :func:`fate_settled`);
+        the random response of :func:`_random_response` (``lyapunov_lo``, ``lyapunov_hi``,
+        ``n_twins``, ``p_synchronised``, ``section_q0`` .. ``section_q10``).
     """
     labels = [*LABEL_ORDER, *sorted(set(rows["label"]) - set(LABEL_ORDER))]
     out = cells.sort_values("cell").reset_index(drop=True).copy()
@@ -130,6 +132,7 @@ def summarize_cells(rows: pd.DataFrame, cells: pd.DataFrame, *, confidence=0.95)
     out["lyapunov_mean"] = out["cell"].map(g.mean()).astype(float)
     out["lyapunov_std"] = out["cell"].map(g.std(ddof=1)).astype(float)
     out["lyapunov_n"] = out["cell"].map(g.size()).fillna(0).astype(np.int64)
+    out = _random_response(out, rows, lam, col, confidence)
     per = rows[rows["label"] == "periodic"] if "period" in rows else rows.iloc[:0]
     per = per[per["period"].notna()] if len(per) else per
     out["period"] = _modal_period(out["cell"], per, "period")
@@ -140,6 +143,41 @@ def summarize_cells(rows: pd.DataFrame, cells: pd.DataFrame, *, confidence=0.95)
     settled = fate_settled(rows)
     out["n_settled"] = out["cell"].map(settled["cell"].value_counts()).fillna(0).astype(np.int64)
     out["settled_period"] = _modal_period(out["cell"], settled, "fate_period")
+    return out
+
+
+SECTION_QUANTILES = tuple(np.linspace(0.0, 1.0, 11))
+"""The levels of the section's theta_f quantiles a realization records (``ev_section_q0`` ..
+``ev_section_q10``: minimum, deciles, maximum of its recorded section)."""
+
+
+def _random_response(out: pd.DataFrame, rows: pd.DataFrame, lam: pd.DataFrame, col: str,
+                     confidence: float) -> pd.DataFrame:  # fmt: skip
+    """The random system's per-cell response: ``lyapunov_lo``, ``lyapunov_hi`` (Student's
+    interval of the mean exponent over the realizations, each a finite-time estimate of the one
+    top exponent of the cocycle; a single run's own ``stderr`` interval), ``n_twins`` and
+    ``p_synchronised`` (realizations whose common-noise twins ran, and the share of them that
+    synchronised) and ``section_q0`` .. ``section_q10`` (the cell's stationary section
+    distribution of theta_f [rad] as the mean of the realizations' quantile functions)."""
+    from scipy import stats
+
+    n, mean, sd = (out[f"lyapunov_{c}"].to_numpy(dtype=float) for c in ("n", "mean", "std"))
+    t = stats.t.ppf(0.5 + confidence / 2.0, np.maximum(n - 1, 1))
+    half = np.where(n >= 2, t * sd / np.sqrt(np.maximum(n, 1)), np.nan)
+    se = f"{col}_stderr"
+    if se in rows:  # one run: its own interval
+        one = rows.groupby("cell")[se].first()
+        z = ndtri(0.5 + confidence / 2.0)
+        half = np.where(n == 1, z * out["cell"].map(one).to_numpy(dtype=float), half)
+    out["lyapunov_lo"], out["lyapunov_hi"] = mean - half, mean + half
+    sync = rows[["cell", "ev_synchronised"]].dropna() if "ev_synchronised" in rows else None
+    g = sync.groupby("cell")["ev_synchronised"] if sync is not None else None
+    out["n_twins"] = out["cell"].map(g.size()).fillna(0).astype(np.int64) if g is not None else 0
+    out["p_synchronised"] = out["cell"].map(g.mean()).astype(float) if g is not None else np.nan
+    for k in range(len(SECTION_QUANTILES)):
+        name = f"ev_section_q{k}"
+        q = rows.groupby("cell")[name].mean() if name in rows else pd.Series(dtype=float)
+        out[f"section_q{k}"] = out["cell"].map(q).astype(float)
     return out
 
 

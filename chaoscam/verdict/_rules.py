@@ -14,7 +14,7 @@ from ..analysis import Evidence, Verdict, section_period
 from ..model import Params, realizations_identical
 from ..numerics import Numerics
 from ._certificate import MODEL_ATOL, ORBIT_REFINE, certify
-from ._twins import TwinTest, twin_test
+from ._twins import TWIN_DURATION, TwinTest, twin_test
 
 __all__ = ["RULES", "Context", "Rule", "apply_rules", "extensible", "extension_stopped",
            "overflow_evidence"]  # fmt: skip
@@ -24,6 +24,11 @@ BAND_RTOL = 0.05
 n-band chaos rule: the 0-1 test sees a chaotic component of relative size w on a periodic
 sequence only on N >~ 1/w^2 samples (at (omega, xi) = (42.5, 0.15) 4 bands of 1.4e-2 of the
 extent have lambda_1 = 0.317 +- 0.014 per iterate and are 8-band chaos on 600 s runs)."""
+
+MIN_TWIN_POINTS = 20
+"""Fewest recorded section points for the common-noise twins to be run: their starts are the
+record's middle and last points, which a shorter record leaves in the transient, and its clusters
+need a few visits each."""
 
 CLUSTER_RTOL, MAX_CLUSTERS = 0.2, 16
 """A synchronised random response is periodic n when its section visits n clusters in turn,
@@ -50,10 +55,13 @@ class Context:
         return realizations_identical(self.p)
 
     def twins(self) -> TwinTest:
-        """The common-noise twin test from the middle and the last section point (recorded in
-        ``extra["twins"]``)."""
+        """The common-noise twin test from the middle and the last section point, run for the
+        recorded time within [TWIN_DURATION / 3, TWIN_DURATION] (recorded in ``extra["twins"]``)."""
         starts = self.points[[len(self.points) // 2, -1]]
-        tw = twin_test(self.p, self.num, starts, seed=self.seed, index=self.index)
+        recorded = len(self.points) * self.p.cam_period
+        duration = min(TWIN_DURATION, max(recorded, TWIN_DURATION / 3))
+        tw = twin_test(self.p, self.num, starts, seed=self.seed, index=self.index,
+                       duration=duration)  # fmt: skip
         self.extra["twins"] = tw.to_dict()
         return tw
 
@@ -87,7 +95,7 @@ def _torus_needs_zero_exponent(v: Verdict, ctx: Context):
 def _common_noise_twins(v: Verdict, ctx: Context):
     votes = _votes(v)
     broad_chaos = v.label == "chaotic" and votes.get("section_period") != "periodic"
-    if ctx.deterministic or broad_chaos or len(ctx.points) < 2:
+    if ctx.deterministic or broad_chaos or len(ctx.points) < MIN_TWIN_POINTS:
         return None
     tw = ctx.twins()
     vote = {"synchronised": "not_chaotic", "separated": "chaotic"}.get(tw.outcome)
@@ -109,9 +117,10 @@ def _common_noise_twins(v: Verdict, ctx: Context):
 
 def _noisy_periodic(v: Verdict, ctx: Context, twins: Evidence) -> Verdict:
     """The verdict of a response the noise synchronises: periodic n, n the least number of
-    clusters the section visits in turn, each narrower than ``CLUSTER_RTOL`` of its extent (1
-    when none: one noise-blurred cluster), with the widest cluster's width (``noise_width``)."""
-    z = ctx.points * np.array([1.0, ctx.p.cam_period])
+    clusters the last half of the section visits in turn, each narrower than ``CLUSTER_RTOL`` of
+    its extent (1 when none: one noise-blurred cluster), with the widest cluster's width
+    (``noise_width``)."""
+    z = ctx.points[len(ctx.points) // 2 :] * np.array([1.0, ctx.p.cam_period])  # past a transient
     extent = float(np.ptp(z, axis=0).max())
     n, width = 1, extent
     for m in range(1, min(MAX_CLUSTERS, len(z) // 4) + 1):

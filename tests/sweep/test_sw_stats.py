@@ -67,3 +67,31 @@ def test_summary_fractions_sum_to_one_and_keep_non_regular_labels():
     )
     assert s.loc[1, "lyapunov_n"] == 1 and np.isnan(s.loc[1, "lyapunov_std"])
     assert list(s["truncated_mass"]) == [0.1, 0.0]
+
+
+def test_summary_gives_the_random_response_of_each_cell():
+    """The random response: the exponent's Student interval over the realizations (a single
+    run's own stderr interval), the synchronised share among the twins run, and the section's
+    quantile function averaged over the realizations (Vincent average)."""
+    from scipy import stats
+
+    lam = np.array([1.0, 1.4, 0.9, 1.3])
+    rows = pd.DataFrame({
+        "cell": [0, 0, 0, 0, 1], "label": ["chaotic"] * 4 + ["periodic"],
+        "truncated_mass": 0.0, "ev_lyapunov_1": [*lam, -0.5],
+        "ev_lyapunov_1_stderr": [0.1, 0.1, 0.1, 0.1, 0.05],
+        "ev_synchronised": [0.0, 1.0, np.nan, 0.0, np.nan],
+        **{f"ev_section_q{k}": [k, k + 1, k + 2, k + 3, 10 * k] for k in range(11)},
+    })  # fmt: skip
+    cells = pd.DataFrame({"cell": [0, 1], "ix": [0, 1], "iy": [0, 0],
+                          "deterministic": [False, True]})  # fmt: skip
+    out = summarize_cells(rows, cells).set_index("cell")
+    half = stats.t.ppf(0.975, 3) * lam.std(ddof=1) / 2.0
+    assert out.loc[0, "lyapunov_lo"] == pytest.approx(lam.mean() - half)
+    assert out.loc[0, "lyapunov_hi"] == pytest.approx(lam.mean() + half)
+    assert out.loc[1, "lyapunov_hi"] - out.loc[1, "lyapunov_lo"] == pytest.approx(
+        2 * 1.959964 * 0.05
+    )
+    assert (out.loc[0, "n_twins"], out.loc[0, "p_synchronised"]) == (3, pytest.approx(1 / 3))
+    assert out.loc[1, "n_twins"] == 0 and np.isnan(out.loc[1, "p_synchronised"])
+    assert [out.loc[0, f"section_q{k}"] for k in range(11)] == [k + 1.5 for k in range(11)]
