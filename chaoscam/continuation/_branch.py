@@ -49,8 +49,8 @@ class Branch:
         branch), ``j`` (section point j = 0..n-1 of the orbit), ``period`` n [cam periods],
         ``param``, ``value`` (the parameter), ``s`` (scaled arclength), ``theta_f`` [rad],
         ``omega_f`` [rad/s], the multipliers of DP^n at the orbit's x_0 (``mu1_re``,
-        ``mu1_im``, ``mu2_re``, ``mu2_im``, ``|mu1| >= |mu2|``), ``abs_mu`` (|mu1|),
-        ``stable`` (|mu1| < 1), ``n_macro_impacts``, ``n_micro_impacts``, ``n_chatter_ends``
+        ``mu1_im``, ``mu2_re``, ``mu2_im``, ``|mu1| >= |mu2|``), ``abs_mu`` (``|mu1|``),
+        ``stable`` (``|mu1| < 1``), ``n_macro_impacts``, ``n_micro_impacts``, ``n_chatter_ends``
         (counted over the orbit's n cam periods), ``contact_fraction``, ``sticks``
         (persistent contact: a complete chattering or grid steps in contact), ``residual``
         (scaled, rad) and ``iterations`` (the corrector's).
@@ -168,11 +168,11 @@ def continuation(params: Params | None = None, x0=None, *, param: str = "omega",
     The branch ``P^n(x; λ) = x`` (x = (θ_f, θ̇_f) at the section t = 0, cam phase 0; P the
     map over n cam periods 2π/ω, whose length follows ω when ω is the parameter) is followed
     from ``params`` (λ = ``params.<param>``) towards ``to`` in the scaled coordinates
-    z = (θ_f, T θ̇_f, (λ - λ0) / |to - λ0|) [rad, rad, -]: a predictor along the tangent, a
+    ``z = (θ_f, T θ̇_f, λ / |to - λ0|)`` [rad, rad, -]: a predictor along the tangent, a
     Newton corrector on the extended system with the arclength condition (Keller; Kuznetsov
     2004, *Elements of Applied Bifurcation Theory*, sec. 10.2), DP^n from the tangent
     dynamics with saltation through the impacts (di Bernardo et al. 2008, *Piecewise-smooth
-    Dynamical Systems*, ch. 2), ∂P/∂λ by a central difference (step 1e-5 max(|λ|, 1): see
+    Dynamical Systems*, ch. 2), ∂P/∂λ by a central difference (step ``1e-5 max(|λ|, 1)``: see
     :class:`chaoscam.continuation.Settings`). Steps: ``ds`` first, halved on a failed
     corrector down to ``ds_min`` (then the branch ends), 1.5 times longer after one that
     converged in at most 3 iterations, up to ``ds_max`` (scaled arclength; the whole λ
@@ -183,7 +183,7 @@ def continuation(params: Params | None = None, x0=None, *, param: str = "omega",
     followed round it onto the unstable side), ``period_doubling`` (det(DP + I) changes
     sign: a multiplier through -1; with ``switch`` the period-2n branch is followed from
     there, its first step along the eigenvector of -1), ``neimark_sacker`` (a complex pair
-    through |μ1 μ2| = 1: under the default Hunt–Crossley damping |μ1 μ2| ≤ ξ² < 1 after a
+    through ``|μ1 μ2| = 1``: under the default Hunt–Crossley damping ``|μ1 μ2| ≤ ξ² < 1`` after a
     jump and < 1 in persistent contact, which forbids it: docs/continuation.md), and changes
     of the orbit's pattern, bisected: ``impact_change`` (the number of macro impacts over the
     n periods changes: a grazing impact, for which the kernel has no cheaper test function)

@@ -5,7 +5,7 @@ the bouncing ball's impact map go through the same code.
 Unknowns u = (x, λ), scaled to z = w u (``weights``); the branch is ``G(u) = P(x; λ) - x = 0``,
 a curve in R³ whose tangent is the null vector of ``G_u = [DP - I | ∂P/∂λ]`` (the cross
 product of its two scaled rows). A step: the predictor ``z_p = z + h t``, then Newton on the
-extended system ``(G(z), t·(z - z) - h) = 0`` (Keller's pseudo-arclength condition;
+extended system ``(G(z), t·(z - z_k) - h) = 0`` (Keller's pseudo-arclength condition;
 Kuznetsov 2004, *Elements of Applied Bifurcation Theory*, sec. 10.2; Dankowicz & Schilder
 2013, *Recipes for Continuation*, ch. 3).
 """
@@ -25,7 +25,7 @@ CONTINUOUS = ("fold", "period_doubling", "neimark_sacker")
 """Test functions located by the Illinois secant on arclength: ``fold`` the λ component of
 the oriented tangent (∝ det(DP - I), a multiplier through +1), ``period_doubling``
 det(DP + I) (a multiplier through -1), ``neimark_sacker`` det DP - 1 while the multipliers are
-a complex pair (|μ1 μ2| = 1)."""
+a complex pair (``|μ1 μ2| = 1``)."""
 
 
 class MapFailed(Exception):
@@ -48,7 +48,7 @@ class Settings:
         Newton iterations of one corrector.
     fd_step : float
         Relative step of the central difference ∂P/∂λ ≈ (P(λ + δ) - P(λ - δ)) / 2δ,
-        δ = fd_step max(|λ|, 1): truncation ~δ² P''' and round-off ~ε_P / δ balance near
+        ``δ = fd_step max(|λ|, 1)``: truncation ~δ² P''' and round-off ~ε_P / δ balance near
         δ ~ ε_P^(1/3), ε_P the map's own noise (1e-10 rad on the model's located events).
         ∂P/∂λ enters only the Newton matrix and the tangent, never the residual, so its
         error slows the corrector but does not move the branch.
@@ -127,7 +127,7 @@ class _Branch:
             raise MapFailed("the map returned NaN")
         return g, self.w[:2, None] * jac / self.w[None, :], dp
 
-    def correct(self, z0: np.ndarray, t0: np.ndarray, h: float, dp0=None) -> MapPoint | None:
+    def correct(self, z0: np.ndarray, t0: np.ndarray, h: float) -> MapPoint | None:
         """Newton on ``(G(z), t0·(z - z0) - h) = 0`` from the predictor ``z0 + h t0``: the
         point (its tangent oriented along t0), or None when it does not converge."""
         z = z0 + h * t0
