@@ -4,7 +4,8 @@ The public face; every name is defined in a subpackage and resolved on first use
 ``import chaoscam`` stays cheap. The pipeline, down the folders: ``model`` (the physics) and
 ``numerics`` (the integrator) -> ``kernel`` (compiled) -> ``solve`` (a batch of runs, one
 :class:`Solution`) -> ``analysis`` (arrays in, evidence out) -> ``verdict`` (the model's
-verdict) -> ``sweep`` (maps, diagrams, ensembles) -> ``report`` / ``paper`` -> ``cli``.
+verdict) -> ``continuation`` (branches of periodic orbits) -> ``sweep`` (maps, diagrams,
+ensembles) -> ``report`` / ``paper`` -> ``cli``.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ _LAZY = {
     "bifurcation": (".sweep", "bifurcation"),
     "classify": (".verdict", "classify"),
     "contact_period": (".model", "contact_period"),
+    "continuation": (".continuation", "continuation"),
     "ensemble": (".sweep", "ensemble"),
     "extend": (".simulation", "extend"),
     "kick_test": (".verdict", "kick_test"),

@@ -26,6 +26,7 @@ LAYERS = (
     "chaoscam.testsystems",
     "chaoscam.analysis",
     "chaoscam.verdict",
+    "chaoscam.continuation",
     "chaoscam.sweep",
     "chaoscam.report",
     "chaoscam.paper",

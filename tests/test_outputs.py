@@ -80,6 +80,7 @@ COMMANDS = {
     "bifurcation --plot": lambda p: _bif(p.with_name("b.parquet"), "--plot", str(p)),
     "regime-map --out": lambda p: _map(p),
     "ensemble --out": lambda p: _ens(p),
+    "continue --out": lambda p: ["continue", "--from", "31", "--to", "32", "--out", str(p)],
 }
 SUFFIX = {
     "simulate --out": ".csv",

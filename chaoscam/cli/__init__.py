@@ -51,7 +51,7 @@ def _build_parser() -> tuple:
     import argparse
 
     from .._version import __version__
-    from . import _classify, _ensemble, _params, _report, _simulate, _sweep
+    from . import _classify, _continue, _ensemble, _params, _report, _simulate, _sweep
 
     parser = argparse.ArgumentParser(
         prog="chaoscam",
@@ -59,7 +59,15 @@ def _build_parser() -> tuple:
     )
     parser.add_argument("--version", action="version", version=f"chaoscam {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for module in (_simulate, _ensemble, _classify, _sweep, _report, _params):  # --help's order
+    for module in (
+        _simulate,
+        _ensemble,
+        _classify,
+        _sweep,
+        _continue,
+        _report,
+        _params,
+    ):  # --help's order
         module.register(sub)
     return parser, sub
 
@@ -179,7 +187,7 @@ def check_numba_environment() -> None:
         )
 
 
-GRID_FLAGS = ("--values", "--mu", "--sigma")
+GRID_FLAGS = ("--values", "--mu", "--sigma", "--from", "--to", "--x0")
 """Options whose value may start with a minus sign (``--values -0.5,-0.4``)."""
 
 

@@ -11,6 +11,7 @@ from ._orbits import (
     iterate_map,
     kick_test,
     lyapunov_spectrum,
+    map_runner,
     periodic_orbit,
     stroboscopic_map,
 )
@@ -18,5 +19,5 @@ from ._rules import RULES, Rule, apply_rules, extensible, extension_stopped
 
 __all__ = ["EXTEND_TO", "MODEL_ATOL", "RULES", "Certificate", "KickTest", "PeriodicOrbit", "Rule",
            "apply_rules", "certify", "classify", "extensible", "extension_stopped", "iterate_map",
-           "judge_member", "judge_points", "kick_test", "lyapunov_spectrum", "on_orbit",
-           "periodic_orbit", "stroboscopic_map"]  # fmt: skip
+           "judge_member", "judge_points", "kick_test", "lyapunov_spectrum", "map_runner",
+           "on_orbit", "periodic_orbit", "stroboscopic_map"]  # fmt: skip

@@ -24,7 +24,7 @@ from ..numerics import Numerics
 from ..simulation import ROOM, Solution, check_run, fresh, numerics_arg, run_batch, solve
 
 __all__ = ["KickTest", "PeriodicOrbit", "iterate_map", "kick_test", "lyapunov_spectrum",
-           "periodic_orbit", "stroboscopic_map"]  # fmt: skip
+           "map_runner", "periodic_orbit", "stroboscopic_map"]  # fmt: skip
 
 
 def lyapunov_spectrum(params: Params | Solution | None = None, numerics: Numerics | None = None,
@@ -98,8 +98,9 @@ class _MapRunner:
                            room=ROOM["cpu"])  # fmt: skip
         self.calls = 0
 
-    def _rows(self, x: np.ndarray) -> tuple[np.ndarray, int]:
-        """The section rows of n cam periods from x (row 0: x itself), and the status."""
+    def _rows(self, x: np.ndarray, impacts: bool = False):
+        """The section rows of n cam periods from x (row 0: x itself), and the status (with
+        ``impacts`` also the impact rows and the counters)."""
         s = self.start
         y = s.y.copy()
         y[0, k.Y_THETA], y[0, k.Y_OMEGA] = x
@@ -107,7 +108,10 @@ class _MapRunner:
         start = dataclasses.replace(s, y=y, cnt=s.cnt.copy(), lam=s.lam.copy(), kept=kept,
                                     status=s.status.copy())  # fmt: skip
         self.calls += 1
-        out = run_batch([self.p], self.num, [0], start, 0, self.duration, room=ROOM["cpu"])
+        out = run_batch([self.p], self.num, [0], start, 0, self.duration, room=ROOM["cpu"],
+                        keep_impacts=impacts)  # fmt: skip
+        if impacts:
+            return out.kept["section"][0], int(out.status[0]), out.kept["impacts"][0], out.cnt[0]
         return out.kept["section"][0], int(out.status[0])
 
     def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
@@ -120,6 +124,27 @@ class _MapRunner:
             m = jac @ m
         return rows[self.n, 2:4].copy(), m, code
 
+    def counts(self, x: np.ndarray) -> dict[str, Any]:
+        """The orbit through x over its n periods: its section points x, P(x), ..., P^(n-1)(x)
+        (``points``), the impacts of each kind (``n_macro_impacts``, ``n_micro_impacts``,
+        ``n_chatter_ends``: chattering sequences that end in persistent contact), the
+        ``contact_fraction`` of the grid steps, ``slow_closings``, the ``status`` and the macro
+        impacts' times ``macro_times`` [s]."""
+        rows, code, imp, cnt = self._rows(x, impacts=True)
+        kept = imp[imp[:, 0] < self.n * self.p.cam_period]
+        inside = kept[:, -1].astype(int)
+        kinds = np.bincount(inside, minlength=3)
+        pts = np.full((self.n, 2), np.nan)
+        m = min(len(rows), self.n)
+        pts[:m] = rows[:m, 2:4]
+        steps = max(int(cnt[k.I_COUNTED_STEPS]), 1)
+        return {"points": pts, "n_macro_impacts": int(kinds[k.IMPACT_MACRO]),
+                "n_micro_impacts": int(kinds[k.IMPACT_MICRO]),
+                "n_chatter_ends": int(kinds[k.IMPACT_CHATTER_END]),
+                "contact_fraction": int(cnt[k.I_CONTACT_STEPS]) / steps,
+                "slow_closings": int(cnt[k.I_SLOW_CLOSINGS]), "status": Status(code),
+                "macro_times": kept[inside == k.IMPACT_MACRO, 0].copy()}  # fmt: skip
+
     def points(self, x: np.ndarray) -> np.ndarray:
         """x, P(x), ..., P^n(x), shape (n + 1, 2); NaN rows after a run that stopped."""
         rows, _ = self._rows(x)
@@ -127,6 +152,16 @@ class _MapRunner:
         m = min(len(rows), self.n + 1)
         out[:m] = rows[:m, 2:4]
         return out
+
+
+def map_runner(params: Params, n: int = 1, numerics: Numerics | None = None):
+    """The n-th iterate of the stroboscopic map of the deterministic model as a reusable
+    callable: ``run(x) -> (P^n(x), DP^n(x), status code)`` (NaN where the run stopped: 0 is
+    ``OK``), ``run.counts(x)`` (the orbit's section points, impacts by kind, contact
+    fraction), ``run.points(x)`` and ``run.p`` (the model it runs). x = (θ_f [rad], θ̇_f
+    [rad/s]) at t = 0, cam phase 0; DP^n through the impacts' saltation matrices. One call
+    costs one run of n cam periods (about 1 ms a period on the default grid)."""
+    return _MapRunner(params_arg(params), numerics_arg(numerics), whole("n", n, low=1))
 
 
 def iterate_map(params: Params, x, n: int, numerics: Numerics | None = None) -> np.ndarray:

@@ -1,0 +1,40 @@
+"""A continuation branch drawn on a matplotlib Axes: the parameter against the section's θ_f."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._run import axes
+from ._sweep import axis_label
+
+__all__ = ["plot_branch"]
+
+EVENT_MARKS = {"fold": ("o", "#D55E00"), "period_doubling": ("s", "#0072B2"),
+               "neimark_sacker": ("D", "#009E73"), "impact_change": ("^", "#CC79A7"),
+               "sticking": ("v", "#E69F00"), "grazing": ("x", "#000000")}  # fmt: skip
+
+
+def plot_branch(points, events=None, ax=None):
+    """The branch diagram of ``Branch.points`` (one row per section point of each orbit):
+    ``value`` against ``theta_f``, each section point j of each branch a line, solid where
+    the orbit is stable and dashed where not; the ``events`` (``Branch.events``, ``end``
+    left out) marked with their kind in the legend. Returns the Axes."""
+    ax = axes(ax)
+    for (b, _), g in points.groupby(["branch", "j"], sort=True):
+        g = g.sort_values("point")
+        x, y = g["value"].to_numpy(), g["theta_f"].to_numpy()
+        stable = g["stable"].to_numpy(dtype=bool)
+        color = "#000000" if b == 0 else f"C{int(b) % 10}"
+        for mask, ls in ((stable, "-"), (~stable, "--")):
+            keep = mask | np.r_[mask[1:], False] | np.r_[False, mask[:-1]]  # join the pieces
+            ax.plot(x, np.where(keep, y, np.nan), ls=ls, lw=1.0, color=color)
+    if events is not None and len(events):
+        for kind, g in events[events["kind"] != "end"].groupby("kind"):
+            marker, color = EVENT_MARKS.get(kind, ("*", "#000000"))
+            ax.scatter(g["value"], g["theta_f"], marker=marker, color=color, zorder=3,
+                       label=kind.replace("_", " "))  # fmt: skip
+        ax.legend(frameon=False, fontsize="small")
+    name = str(points["param"].iloc[0]) if len(points) else "value"
+    ax.set(xlabel=axis_label(name), ylabel=axis_label("theta_f"),
+           title="continuation: stable solid, unstable dashed")  # fmt: skip
+    return ax

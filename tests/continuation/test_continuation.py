@@ -1,0 +1,142 @@
+"""Pseudo-arclength continuation (chaoscam.continuation): analytic thresholds of the bouncing
+ball through the generic core, the model's period doubling and fold at xi = 0.1, the
+multipliers against Newton shooting, step-halving invariance, the branch switch, the CLI."""
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import chaoscam
+from chaoscam.cli import main
+from chaoscam.continuation import MapFailed, Settings, continuation, follow
+from chaoscam.testsystems import ball_impact_map, ball_period_one_theory
+
+XI = 0.1
+
+
+def _ball(e, n=1, d=1e-6):
+    """The ball's impact map less the table's n periods, DP by central differences."""
+    shift = np.array([2.0 * math.pi * n, 0.0])
+
+    def fun(x, gamma):
+        if x[1] - gamma * math.cos(x[0]) <= 0.0:
+            raise MapFailed("the ball would leave downwards")
+
+        def p(y):
+            return ball_impact_map(y, gamma, e) - shift
+
+        cols = [(p(x + d * v) - p(x - d * v)) / (2.0 * d) for v in np.eye(2)]
+        return p(x), np.column_stack(cols)
+
+    return fun
+
+
+@pytest.mark.parametrize("e", [0.5, 0.3])
+def test_ball_fold_and_period_doubling_match_the_closed_form(e):
+    """The core follows the ball's period-one orbit down through its saddle-node and up
+    through its flip; both located within 1e-6 relative of the closed-form thresholds."""
+    fold, flip = ball_period_one_theory(e)
+    g0 = 0.5 * (fold + flip)
+    u0 = (math.acos(fold / g0), math.pi, g0)
+    st = Settings(weights=(1.0, 1.0, 1.0), lo=0.9 * fold, hi=1.05 * flip, h0=0.01,
+                  h_min=1e-8, h_max=0.05, tol=1e-11, event_tol=1e-9)  # fmt: skip
+    found = {}
+    for direction in (1.0, -1.0):
+        _, events = follow(_ball(e), u0, st, direction=direction)
+        found.update({kind: p for kind, p, _ in events if kind != "end"})
+    assert abs(found["fold"].u[2] - fold) <= 1e-6 * fold
+    assert abs(found["period_doubling"].u[2] - flip) <= 1e-6 * flip
+    assert np.isclose(found["period_doubling"].multipliers[0], -1.0, atol=1e-6)
+
+
+@pytest.fixture(scope="module")
+def up():
+    """The period-1 branch at xi = 0.1 from omega = 30 to 33, switched at its doubling."""
+    return continuation(chaoscam.Params(xi=XI, omega=30.0), param="omega", to=33.0, switch=True)
+
+
+def test_period_doubling_between_32_and_32_1(up):
+    """One period doubling on the period-1 branch, in (32.0, 32.1) rad/s, multiplier -1."""
+    pd_ = up.events[(up.events.kind == "period_doubling") & (up.events.branch == 0)]
+    assert len(pd_) == 1
+    assert 32.0 < pd_.value.iloc[0] < 32.1
+    assert abs(pd_.mu1_re.iloc[0] + 1.0) < 1e-4
+    main = up.points[up.points.branch == 0]
+    assert (main.stable == (main.value < pd_.value.iloc[0])).all()
+    assert (main.n_macro_impacts == 1).all() and not main.sticks.any()
+
+
+def test_doubled_branch_is_stable_period_two(up):
+    """The switched branch is period 2, born on the side where period 1 is unstable, and
+    attracting past its first points (a supercritical flip)."""
+    two = up.points[up.points.branch == 1]
+    value = up.events[up.events.kind == "period_doubling"].value.iloc[0]
+    assert (two.period == 2).all() and (two.value >= value - 1e-6).all()
+    assert two[two.value > value + 0.01].stable.all()
+    assert (two.n_macro_impacts == 2).all()
+
+
+def test_multipliers_agree_with_newton_shooting(up):
+    """A point's multipliers are those periodic_orbit finds there from its section point."""
+    row = up.points[up.points.branch == 0].iloc[10]
+    p = chaoscam.Params(xi=XI, omega=float(row.value))
+    orbit = chaoscam.periodic_orbit(p, (row.theta_f, row.omega_f), 1)
+    mu = sorted(orbit.multipliers, key=lambda m: -abs(m))
+    assert np.allclose([row.mu1_re + 1j * row.mu1_im, row.mu2_re + 1j * row.mu2_im], mu,
+                       atol=1e-5)  # fmt: skip
+
+
+def test_no_neimark_sacker_under_hunt_crossley(up):
+    """|mu1 mu2| <= xi^2 on every orbit with a jump: no complex pair reaches the unit circle."""
+    mu1 = up.points.mu1_re + 1j * up.points.mu1_im
+    mu2 = up.points.mu2_re + 1j * up.points.mu2_im
+    assert (np.abs(mu1 * mu2) <= XI**2**up.points.period + 1e-6).all()
+    assert "neimark_sacker" not in set(up.events.kind)
+
+
+def test_fold_between_29_and_29_1_followed_onto_the_unstable_side():
+    """Down from 31 rad/s the branch turns at a fold in (29.0, 29.1), where a multiplier is
+    +1, and goes on with omega increasing, unstable (|mu1| > 1)."""
+    b = continuation(chaoscam.Params(xi=XI, omega=31.0), param="omega", to=28.0)
+    fold = b.events[b.events.kind == "fold"]
+    assert len(fold) == 1 and 29.0 < fold.value.iloc[0] < 29.1
+    assert abs(fold.mu1_re.iloc[0] - 1.0) < 1e-4
+    after = b.points[b.points.s > fold.s.iloc[0]]
+    assert len(after) >= 2 and not after.stable.any() and (after.value > fold.value.iloc[0]).all()
+
+
+def test_event_location_unchanged_when_the_step_is_halved():
+    """The period doubling's location moves by less than 1e-5 rad/s with half the steps."""
+    p = chaoscam.Params(xi=XI, omega=31.5)
+    values = []
+    for f in (1.0, 0.5):
+        b = continuation(p, param="omega", to=32.5, ds=0.005 * f, ds_max=0.02 * f)
+        values.append(b.events[b.events.kind == "period_doubling"].value.iloc[0])
+    assert abs(values[0] - values[1]) < 1e-5
+
+
+def test_cli_writes_points_and_events_and_refuses_overwrite(tmp_path, capsys):
+    """continue writes FILE.parquet and FILE.events.parquet, reports the period doubling,
+    and refuses to overwrite without --force (exit 2)."""
+    out = tmp_path / "branch.parquet"
+    args = ["continue", "--param", "omega", "--from", "31.8", "--to", "32.3", "--set",
+            "xi=0.1", "--period", "1", "--out", str(out)]  # fmt: skip
+    assert main(args) == 0
+    assert "period_doubling at omega = 32.0" in capsys.readouterr().out
+    events = pd.read_parquet(tmp_path / "branch.events.parquet")
+    assert set(events.kind) == {"period_doubling", "end"}
+    assert len(pd.read_parquet(out)) > 5
+    assert main(args) == 2
+    assert "exists" in capsys.readouterr().err
+    assert main([*args, "--force"]) == 0
+
+
+def test_cli_start_without_orbit_is_exit_2(tmp_path, capsys):
+    """A start from which Newton finds no orbit is a one-line error, exit 2, no file."""
+    out = tmp_path / "b.parquet"
+    code = main(["continue", "--from", "31", "--to", "32", "--set", "xi=0.1", "--x0", "0.5",
+                 "30", "--out", str(out)])  # fmt: skip
+    assert code == 2 and "no period-1 orbit" in capsys.readouterr().err
+    assert not out.exists()
