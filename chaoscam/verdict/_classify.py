@@ -27,7 +27,14 @@ from ..model import realizations_identical
 from ..numerics import Numerics
 from ..simulation import Solution, extend, solve
 from ._certificate import MODEL_ATOL
-from ._rules import Context, apply_rules, extensible, extension_stopped, overflow_evidence
+from ._rules import (
+    STEP_MARGINAL,
+    Context,
+    apply_rules,
+    extensible,
+    extension_stopped,
+    overflow_evidence,
+)
 
 __all__ = ["EXTEND_TO", "classify", "judge_member", "judge_points"]
 
@@ -64,7 +71,9 @@ def classify(solution: Solution, *, extend_to: float | None = EXTEND_TO, check_s
     check_step : bool
         Judge the same realizations at half the step (:meth:`Numerics.refined`), with the
         same extension; a verdict that changes becomes "undetermined" with the reason
-        (evidence ``step_check``: 1 unchanged, 0 changed; not a vote).
+        (evidence ``step_check``: 1 unchanged, 0 changed; not a vote). Without it, the members
+        whose verdict the step may decide (evidence ``step_marginal``: n-band chaos on an orbit
+        unstable only at the run's step) are checked so all the same.
     discard : float
         Extra time after the transient left out of the classification [s].
     progress : callable, optional
@@ -102,8 +111,10 @@ def classify(solution: Solution, *, extend_to: float | None = EXTEND_TO, check_s
     how = {"check_step": check_step, "discard": discard, "extend_to": extend_to, **options}
     run = _tangent_solution(solution)
     verdicts = _settled(run, extend_to, discard, options, progress)
-    if check_step:
-        verdicts = _step_checked(run, verdicts, extend_to, discard, options)
+    marginal = {j for j, v in enumerate(verdicts) if STEP_MARGINAL in {e.name for e in v.evidence}}
+    if check_step or marginal:
+        only = None if check_step else marginal
+        verdicts = _step_checked(run, verdicts, extend_to, discard, options, only)
     return [_with_run(v, solution, j, how) for j, v in enumerate(verdicts)]
 
 
@@ -258,13 +269,15 @@ def _after_extension(before: Verdict, after: Verdict, longer: Solution, i, note,
     return extension_stopped(before, status, float(t.max()) if len(t) else np.nan, recorded)
 
 
-def _step_checked(sol, verdicts, extend_to, discard, options) -> list[Verdict]:
-    """The verdicts checked against the same realizations at :meth:`Numerics.refined` (dt / 2;
-    the adaptive tolerances / 32), judged the same way (extension included). An undetermined
-    verdict is not re-run: no half-step verdict can change it."""
+def _step_checked(sol, verdicts, extend_to, discard, options, only=None) -> list[Verdict]:
+    """The verdicts (of the members in ``only``; None: all) checked against the same
+    realizations at :meth:`Numerics.refined` (dt / 2; the adaptive tolerances / 32), judged the
+    same way (extension included). An undetermined verdict is not re-run: no half-step verdict
+    can change it."""
     fine = sol.numerics.refined()
-    asked = [j for j, v in enumerate(verdicts) if v.label != "undetermined"]
-    out = [_skipped(v, fine) if v.label == "undetermined" else v for v in verdicts]
+    asked = [j for j, v in enumerate(verdicts)
+             if v.label != "undetermined" and (only is None or j in only)]  # fmt: skip
+    out = [_skipped(v, fine) if v.label == "undetermined" and only is None else v for v in verdicts]
     if not asked:
         return out
     fine_verdicts = _settled(_solved_again(sol, asked, fine), extend_to, discard, options, None)
@@ -306,7 +319,8 @@ def _compared(v: Verdict, half: Verdict, coarse: Numerics, fine: Numerics, secon
     checked = _step_record(v, Evidence("step_check", int(same), None, changed), record)
     if same:
         return checked
-    why = f"halving the step changes the verdict ({what})"
+    why = (f"halving the step changes the verdict ({what}): rerun at "
+           f"{fine.refined().describe_step()} to see which holds")  # fmt: skip
     return Verdict("undetermined", None, checked.evidence, (*v.reasons, why), checked.settings)
 
 

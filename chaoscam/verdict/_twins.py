@@ -126,7 +126,7 @@ def _outcome(pairs, duration: float, delta: float) -> TwinTest:
         outcome, why = "inconclusive", "no pair grew with shared draws and not every one shrank"
     shown = ", ".join(f"{r:.2g}" for r in ratios)
     splits = sum(s is not None for s in split)
-    detail = (f"{len(pairs)} twin pairs {delta:g} rad apart sharing the draws, {duration:g} "
+    detail = (f"{len(pairs)} twin pairs {delta:g} rad apart sharing the draws, {duration:.3g} "
               f"s: distance over the last quarter {shown} x the start ({why}); finite-time rate "
               f"{exponent:+.3g} 1/s")  # fmt: skip
     if splits:

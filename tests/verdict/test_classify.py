@@ -261,12 +261,14 @@ def test_a_resumable_run_is_extended_by_continuing_it(monkeypatch, series):
     run = dict(indices=[0, 1], seed=1, duration=20.0, transient=10.0)
     made = _spy_extend(monkeypatch)
     again = classify(solve(p, tangent=True, **run))
-    assert made and all(m.settings["continued_from"] is None for m in made)
+    # the extensions at the run's step (its 7 bands are also checked at dt/2: step_marginal)
+    at_dt = lambda: [m for m in made if m.numerics == Numerics()]  # noqa: E731
+    assert at_dt() and all(m.settings["continued_from"] is None for m in at_dt())
     kept = solve(p, series=series, tangent=not series, resumable=not series, **run)
     made.clear()
     calls = _spy_solve(monkeypatch)
     continued = classify(kept)
-    assert len(calls) == (1 if series else 0)  # only the tangent run, once
+    assert len([c for c in calls if c[1] == Numerics()]) == (1 if series else 0)  # the tangent's
     assert made and all(m.settings["continued_from"] is not None for m in made)
     assert any("extended" in v.settings for v in again)
     for a, b in zip(again, continued, strict=True):
@@ -427,3 +429,19 @@ def test_one_verdict_per_member_in_the_members_order():
         assert v.settings["trajectory"]["settings"]["index"] == i
     with pytest.raises(TypeError, match="Solution"):
         chaoscam.classify(sol.sections)
+
+
+def test_a_verdict_the_step_decides_is_checked_at_half_the_step_unasked():
+    """(omega, xi) = (25, 0.5), the issue's case: at the default dt the run lies on a period-7
+    orbit in 7 bands of 1-6e-5 rad that the grid's multipliers call unstable (7-band chaos);
+    at dt/2 kicks return to it (periodic 7) and at dt/4 it is certified. classify checks such
+    a verdict at dt/2 by itself and answers undetermined, saying why, not chaotic."""
+    run = simulate(Params(xi=0.5, omega=25.0), duration=120.0, transient=60.0, series=False)
+    (v,) = classify(run)
+    assert v.label == "undetermined"
+    assert any("halving the step changes the verdict" in r for r in v.reasons)
+    assert v.settings["step_check"]["grid_label"] == "chaotic"
+    assert (v.settings["step_check"]["label"], v.settings["step_check"]["period"]) == (
+        "periodic",
+        7,
+    )
