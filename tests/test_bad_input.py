@@ -571,8 +571,8 @@ def test_lyapunov_tol_is_refused_by_the_tangent_verdict(run1):
 
 def test_review_tracebacks_are_named():
     """lyapunov_spectrum("run.parquet") was an AttributeError, run_paper(figures=3) a
-    TypeError from list(3), and a contact period that rounds to zero steps a
-    ZeroDivisionError in the step warning."""
+    TypeError from list(3); a contact too stiff for any allowed dt is said so (it advised
+    "use dt <= 0 s")."""
     from chaoscam.paper import run_paper
     from chaoscam.simulation import resolution_warning
 
@@ -581,7 +581,8 @@ def test_review_tracebacks_are_named():
     for figures in (99, np.array([99]), (f for f in [99])):  # one figure, or any iterable
         with pytest.raises(ValueError, match=r"figures = \[.*99\)?\]: choose from"):
             run_paper(quick=True, out="unused.html", figures=figures)
-    assert "a step longer than the period" in resolution_warning(Params(l_lambda=1e300), Numerics())
+    stiffest = Params(l_lambda=10.0, Y_f=1e13, Y_c=1e13, J=1e-15)  # the ranges' extremes
+    assert "no allowed dt (>= 1e-12 s)" in resolution_warning(stiffest, Numerics())
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,61 @@
+"""Input holes of a review, each refused with a message naming the field (or file, or
+address) and its range, exit 2, never a traceback or a run that should not start."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from chaoscam import Numerics, ParameterError, Params
+from chaoscam.cli import main
+
+NUMERIC = [
+    (cls, f.name)
+    for cls in (Params, Numerics)
+    for f in dataclasses.fields(cls)
+    if f.metadata["choices"] is None
+]
+BIF = ["bifurcation", "--param", "l_lambda", "--values", "0.006:0.008:2", "--duration", "0.3"]
+BIF += ["--workers", "1", "--quiet"]
+
+
+def _refused(capsys, argv, *named):
+    """``argv`` exits 2 with one message naming each of ``named``, no traceback."""
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "chaoscam: error:" in err and "Traceback" not in err, err
+    for text in named:
+        assert text in err, err
+    return err
+
+
+@pytest.mark.parametrize("cls, name", NUMERIC, ids=[n for _, n in NUMERIC])
+def test_every_numeric_field_has_a_finite_range_that_refuses_absurd_values(cls, name):
+    """(0, inf) let Y_f = 1e-300, J = 1e300 or v_eps = 1e300 through, and R = 1e300 or mu_f =
+    1e300 ended in NON_FINITE advising "lower dt": every field's range is finite, holds its
+    default, and refuses 1e300 and -1e300 naming the field and the range."""
+    f = next(g for g in dataclasses.fields(cls) if g.name == name)
+    lo, hi = f.metadata["range"][:2]
+    assert np.isfinite([lo, hi]).all() and (f.default is None or lo <= f.default <= hi)
+    huge = 10**300 if f.type == "int" else 1e300
+    for value in (huge, -huge):
+        with pytest.raises(ParameterError, match=rf"^{name} = .* outside the allowed range"):
+            cls(**{name: value})
+
+
+@pytest.mark.parametrize("value", ["1e300", "1e200"])
+def test_an_overflowing_radius_is_refused_naming_its_range(capsys, value):
+    """--set r=1e300 (or 1e200) was an OverflowError traceback (r**2 in the inertia)."""
+    argv = ["simulate", "--duration", "0.05", "--set", f"r={value}"]
+    _refused(capsys, argv, "r = 1e+", "outside the allowed range [1e-06, 10.0]")
+
+
+def test_a_huge_integer_is_refused_with_the_range_not_its_400_digits():
+    with pytest.raises(ParameterError, match=r"^l = 100000\.\.\. \(401 digits\) \[m\] is outside"):
+        Params(l=10**400)
+
+
+def test_a_bifurcation_over_absurd_values_is_refused(tmp_path, capsys):
+    """l_lambda 1e300:1e301 ran, exit 0, advising "use dt <= 0 s"."""
+    argv = [*BIF[:4], "1e300:1e301:2", *BIF[5:], "--out", str(tmp_path / "b.parquet")]
+    _refused(capsys, argv, "l_lambda = 1e+300 [m] is outside the allowed range")
