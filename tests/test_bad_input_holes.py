@@ -59,3 +59,17 @@ def test_a_bifurcation_over_absurd_values_is_refused(tmp_path, capsys):
     """l_lambda 1e300:1e301 ran, exit 0, advising "use dt <= 0 s"."""
     argv = [*BIF[:4], "1e300:1e301:2", *BIF[5:], "--out", str(tmp_path / "b.parquet")]
     _refused(capsys, argv, "l_lambda = 1e+300 [m] is outside the allowed range")
+
+
+@pytest.mark.parametrize("command", ["regime-map", "ensemble", "bifurcation"])
+def test_every_command_refuses_a_duration_shorter_than_one_step(tmp_path, capsys, command):
+    """--duration 1e-300, refused by simulate, was a task failure (exit 1) in the sweeps: one
+    rule for every command, before any run."""
+    args = {
+        "regime-map": ["regime-map", "--mu", "0.006:0.008:2", "--sigma", "0:0.001:2"],
+        "ensemble": ["ensemble", "--members", "2"],
+        "bifurcation": BIF[:5],
+    }[command]
+    argv = [*args, "--duration", "1e-300", "--quiet", "--out", str(tmp_path / "o.parquet")]
+    _refused(capsys, argv, "duration = 1e-300 s is shorter than one step dt = 2e-06 s")
+    assert list(tmp_path.iterdir()) == []
