@@ -73,3 +73,24 @@ def test_every_command_refuses_a_duration_shorter_than_one_step(tmp_path, capsys
     argv = [*args, "--duration", "1e-300", "--quiet", "--out", str(tmp_path / "o.parquet")]
     _refused(capsys, argv, "duration = 1e-300 s is shorter than one step dt = 2e-06 s")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "extra, named",
+    [
+        (["--dt", "1e-300"], "--dt 1e-300: the sampling interval must be in [1e-12, 1e+06] s"),
+        (["--dt", "0.01", "--forcing-period", "1e-300"], "--forcing-period 1e-300: must be"),
+    ],
+    ids=["dt", "forcing-period"],
+)
+def test_classify_series_refuses_absurd_sampling(tmp_path, capsys, extra, named):
+    """--dt 1e-300 or --forcing-period 1e-300 gave verdicts; the API refuses them too."""
+    from chaoscam.analysis import classify_signal
+
+    path = tmp_path / "s.csv"
+    path.write_text("x\n" + "\n".join(f"{np.sin(0.05 * i):.6f}" for i in range(2000)) + "\n")
+    _refused(capsys, ["classify-series", str(path), "--column", "x", *extra], named)
+    x = np.sin(0.05 * np.arange(2000))
+    for dt, period in ((1e-300, None), (0.01, 1e-300), (0.01, 1e3)):
+        with pytest.raises(ValueError, match="dt" if period is None else "forcing_period"):
+            classify_signal(x, dt, period)

@@ -87,7 +87,7 @@ def run_classify(args: argparse.Namespace) -> int:
 
 
 def run_classify_series(args: argparse.Namespace) -> int:
-    from ..analysis import classify_section, classify_signal
+    from ..analysis import SAMPLING_DT, classify_section, classify_signal
     from . import UsageError
 
     if args.dt is None and not args.section:
@@ -95,16 +95,17 @@ def run_classify_series(args: argparse.Namespace) -> int:
             "say what the rows are: --dt SECONDS (a uniformly sampled signal) or --section "
             "(section points / map iterates)"
         )
-    if args.dt is not None and not (math.isfinite(args.dt) and args.dt > 0):
-        raise UsageError(f"--dt {args.dt}: the sampling interval must be a finite number > 0")
+    lo, hi = SAMPLING_DT
+    if args.dt is not None and not lo <= args.dt <= hi:
+        raise UsageError(f"--dt {args.dt}: the sampling interval must be in [{lo:g}, {hi:g}] s")
     if args.forcing_period is not None:
         if args.section:
             raise UsageError(
                 "--forcing-period applies to a sampled signal (--dt); section points are "
                 "already one per forcing period"
             )
-        if not (math.isfinite(args.forcing_period) and args.forcing_period > 0):
-            raise UsageError(f"--forcing-period {args.forcing_period}: must be a finite number > 0")
+        if not (math.isfinite(args.forcing_period) and args.forcing_period >= 2 * args.dt):
+            raise UsageError(f"--forcing-period {args.forcing_period}: must be >= 2 x --dt")
     if args.dt is not None and len(args.column) != 1:
         raise UsageError("--dt takes one --column (a scalar signal)")
     twice = sorted({c for c in args.column if args.column.count(c) > 1})
