@@ -2,6 +2,8 @@
 address) and its range, exit 2, never a traceback or a run that should not start."""
 
 import dataclasses
+import errno
+import pathlib
 
 import numpy as np
 import pytest
@@ -94,3 +96,44 @@ def test_classify_series_refuses_absurd_sampling(tmp_path, capsys, extra, named)
     for dt, period in ((1e-300, None), (0.01, 1e-300), (0.01, 1e3)):
         with pytest.raises(ValueError, match="dt" if period is None else "forcing_period"):
             classify_signal(x, dt, period)
+
+
+def _disk_full(*args, **kwargs):
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+
+def test_a_full_disk_names_the_report_it_could_not_write(tmp_path, capsys, monkeypatch):
+    """report printed a bare "[Errno 28] No space left on device"."""
+    run = tmp_path / "r.parquet"
+    assert main(["simulate", "--duration", "0.3", "--out", str(run)]) == 0
+    capsys.readouterr()
+    monkeypatch.setattr(pathlib.Path, "write_bytes", _disk_full)
+    out = tmp_path / "r.html"
+    _refused(capsys, ["report", str(run), "--out", str(out)], f"cannot write {out}: No space")
+    assert not out.exists()
+
+
+def test_a_full_disk_in_an_ensemble_names_the_file_and_what_is_kept(tmp_path, capsys, monkeypatch):
+    """The final table: the file that failed, the checkpoint kept and --resume; the
+    checkpoint itself: nothing was saved (it said "kept in" a folder that was never made),
+    and no half-made folder is left behind."""
+    import pyarrow.parquet as pq
+
+    out = tmp_path / "e.parquet"
+    argv = ["ensemble", "--members", "2", "--duration", "0.3", "--quiet", "--out", str(out)]
+    with monkeypatch.context() as m:
+        m.setattr(pq, "write_table", _disk_full)
+        err = _refused(capsys, argv, f"cannot write {out}: No space", "--resume")
+        assert f"kept in {out}.ckpt" in err and (tmp_path / "e.parquet.ckpt").is_dir()
+    other = tmp_path / "f.parquet"
+    monkeypatch.setattr(pathlib.Path, "write_bytes", _disk_full)
+    _refused(capsys, [*argv[:-1], str(other)], "manifest.json: No space", "nothing was saved")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["e.parquet.ckpt"]
+
+
+def test_a_full_disk_in_the_paper_names_the_file_and_the_resume(tmp_path, capsys, monkeypatch):
+    """paper printed a bare "[Errno 28]" without the file or how to go on."""
+    monkeypatch.setattr(pathlib.Path, "write_bytes", _disk_full)
+    out = tmp_path / "p.html"
+    argv = ["paper", "--quick", "--figures", "3", "--out", str(out)]
+    _refused(capsys, argv, f"cannot write {out}: No space", "--resume")

@@ -397,12 +397,17 @@ def run_sweep(plan: Plan, eng: Engine, cls, config: dict[str, Any], build: Calla
         except OSError as err:  # a full disk: say what is kept, and where
             if out is None or err.errno not in SAVE_ERRNOS:
                 raise  # not a failure to save (a lost connection, a file that appeared)
+            kept = (
+                f"the runs finished and saved so far are kept in {store.path}: fix the cause "
+                "(free space) and run the same command with --resume"
+                if store.path.is_dir() else "nothing was saved: fix the cause (free space) "
+                "and run the command again"
+            )  # fmt: skip
             raise type(err)(
                 err.errno,
                 f"{err.strerror or err} while saving the results of {out}"
                 + (f" ({err.filename})" if err.filename else "")
-                + f"; the runs finished and saved so far are kept in {store.path}: fix the "
-                "cause (free space) and run the same command with --resume",
+                + f"; {kept}",
             ) from None
         except Exception:
             # A run that finished nothing keeps no checkpoint (it would block the fixed command).
