@@ -4,6 +4,8 @@ address) and its range, exit 2, never a traceback or a run that should not start
 import dataclasses
 import errno
 import pathlib
+import socket
+import threading
 
 import numpy as np
 import pytest
@@ -137,3 +139,37 @@ def test_a_full_disk_in_the_paper_names_the_file_and_the_resume(tmp_path, capsys
     out = tmp_path / "p.html"
     argv = ["paper", "--quick", "--figures", "3", "--out", str(out)]
     _refused(capsys, argv, f"cannot write {out}: No space", "--resume")
+
+
+@pytest.fixture
+def not_dask():
+    """A TCP peer that answers in another protocol (an SSH banner), and its port."""
+    server = socket.create_server(("127.0.0.1", 0))
+    server.settimeout(30)
+
+    def answer():
+        try:
+            while True:
+                peer, _ = server.accept()
+                peer.sendall(b"SSH-2.0-OpenSSH_9.6 not dask\r\n" * 8)
+        except OSError:
+            return
+
+    threading.Thread(target=answer, daemon=True).start()
+    yield server.getsockname()[1]
+    server.close()
+
+
+def test_a_peer_that_is_not_dask_is_named_so(tmp_path, capsys, not_dask):
+    """It was reported as "out of memory" (Dask read a garbage frame length)."""
+    pytest.importorskip("distributed")
+    address = f"tcp://127.0.0.1:{not_dask}"
+    argv = [*BIF[:7], "--quiet", "--scheduler", address, "--out", str(tmp_path / "b.parquet")]
+    _refused(capsys, argv, f"'{address}' answered, but not as a Dask scheduler")
+
+
+def test_an_invalid_port_is_refused_at_once(tmp_path, capsys):
+    """tcp://127.0.0.1:99999 waited Dask's 30 s before "cannot reach"; checked before any run."""
+    argv = [*BIF[:7], "--quiet", "--scheduler", "tcp://127.0.0.1:99999"]
+    argv += ["--out", str(tmp_path / "b.parquet")]
+    _refused(capsys, argv, "port must be a whole number in 1..65535")
