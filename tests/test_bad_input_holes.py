@@ -173,3 +173,23 @@ def test_an_invalid_port_is_refused_at_once(tmp_path, capsys):
     argv = [*BIF[:7], "--quiet", "--scheduler", "tcp://127.0.0.1:99999"]
     argv += ["--out", str(tmp_path / "b.parquet")]
     _refused(capsys, argv, "port must be a whole number in 1..65535")
+
+
+def test_a_refused_million_cell_map_builds_no_cell_first(monkeypatch):
+    """A 10^6-cell map beyond memory built and checked every cell's model (65 s of silence)
+    before the budget check refused it: now the budget comes first."""
+    from chaoscam.simulation import _budget
+    from chaoscam.sweep import _grid, _regime, regime_map
+
+    def built(*args, **kwargs):
+        raise AssertionError("a cell's model was built before the budget check")
+
+    monkeypatch.setattr(_budget, "available_memory", lambda: 2.0**30)
+    for module in (_grid, _regime):
+        monkeypatch.setattr(module, "cell_params", built)
+    x, y = (
+        ("l_lambda", np.linspace(0.006, 0.008, 1000)),
+        ("l_lambda_sigma", np.linspace(0, 1e-3, 1000)),
+    )
+    with pytest.raises(ParameterError, match="needs about .* of memory"):
+        regime_map(x, y)
