@@ -402,7 +402,7 @@ def test_classify_a_run_shorter_than_a_cam_period(tmp_path, capsys):
     out = tmp_path / "s.parquet"
     assert main(["simulate", "--duration", "0.2", "--out", str(out)]) == 0
     capsys.readouterr()
-    assert main(["classify", "--no-extend", str(out)]) == 0
+    assert main(["classify", "--no-extend", "--json", str(out)]) == 0
     captured = capsys.readouterr()
     verdict = json.loads(captured.out)
     assert "Traceback" not in captured.err and verdict["label"] == "undetermined"
@@ -469,7 +469,9 @@ def test_classify_discard_on_the_command_line(tmp_path, capsys):
     path = tmp_path / "r.parquet"
     run.to_parquet(path)
     for discard in (0.0, 1.0):
-        assert main(["classify", str(path), "--discard", str(discard), "--no-extend"]) == 0
+        assert (
+            main(["classify", str(path), "--discard", str(discard), "--no-extend", "--json"]) == 0
+        )
         out = json.loads(capsys.readouterr().out)
         (api,) = chaoscam.classify(run, discard=discard, extend_to=None)
         assert out == json.loads(json.dumps(api.to_dict()))
