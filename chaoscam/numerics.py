@@ -17,6 +17,7 @@ from ._util import check_fields, meta, parse_field, strict_init
 __all__ = ["INTEGRATORS", "Numerics"]
 
 INTEGRATORS = ("rk4", "adaptive")
+_ROUNDING = "at least 1e-12 s: a shorter step is lost in the rounding of t ~ 1e3 s"
 
 
 @strict_init
@@ -40,11 +41,11 @@ class Numerics:
         "(benchmarks/bench_work_precision.py)", "-", None, INTEGRATORS))  # fmt: skip
     dt: float = field(default=2e-6, metadata=meta(
         "RK4 step; resolves the Hertz contact oscillation (period ~9e-5 s) with ~45 steps; "
-        "on the adaptive path, the step cap near the cam", "s",
-        (0.0, 1.0, False, True)))  # fmt: skip
+        "on the adaptive path, the step cap near the cam", "s", (1e-12, 1.0, True, True),
+        why=_ROUNDING))  # fmt: skip
     event_tol: float = field(default=1e-12, metadata=meta(
-        "located impact time's tolerance, at most 1e-9 s", "s",
-        (0.0, 1e-9, False, True)))  # fmt: skip
+        "located impact time's tolerance, at most 1e-9 s", "s", (1e-15, 1e-9, True, True),
+        why="a bisection resolves no finer than a time's rounding"))  # fmt: skip
     max_events_per_step: int = field(default=8, metadata=meta(
         "chattering guard: impacts handled inside one step before the rest of the step is "
         "left to the compliant contact (at most 1024: buffers are sized by it)", "-",
@@ -57,13 +58,15 @@ class Numerics:
     rtol: float = field(default=1e-12, metadata=meta(
         "adaptive integrator: relative tolerance of the local error of (theta_f, theta_f'); "
         "1e-12: periodic sections within 1e-6 rad of converged RK4 (tests)", "-",
-        (0.0, 1e-2, False, True)))  # fmt: skip
+        (1e-15, 1e-2, True, True),
+        why="no step meets a tolerance below double precision"))  # fmt: skip
     atol: float = field(default=1e-13, metadata=meta(
         "adaptive integrator: absolute tolerance of the local error, for theta_f [rad] and "
-        "theta_f' [rad/s]", "rad, rad/s", (0.0, 1.0, False, True)))  # fmt: skip
+        "theta_f' [rad/s]", "rad, rad/s", (1e-18, 1.0, True, True),
+        why="down to double precision's spacing near 0.01 rad"))  # fmt: skip
     h_max: float = field(default=0.005, metadata=meta(
         "adaptive integrator: largest step (flight), at most 1 s", "s",
-        (0.0, 1.0, False, True)))  # fmt: skip
+        (1e-12, 1.0, True, True), why=_ROUNDING))  # fmt: skip
 
     def __post_init__(self) -> None:
         check_fields(self)

@@ -402,7 +402,7 @@ def test_classify_a_run_shorter_than_a_cam_period(tmp_path, capsys):
     out = tmp_path / "s.parquet"
     assert main(["simulate", "--duration", "0.2", "--out", str(out)]) == 0
     capsys.readouterr()
-    assert main(["classify", "--no-extend", str(out)]) == 0
+    assert main(["classify", "--no-extend", "--json", str(out)]) == 0
     captured = capsys.readouterr()
     verdict = json.loads(captured.out)
     assert "Traceback" not in captured.err and verdict["label"] == "undetermined"
@@ -469,7 +469,9 @@ def test_classify_discard_on_the_command_line(tmp_path, capsys):
     path = tmp_path / "r.parquet"
     run.to_parquet(path)
     for discard in (0.0, 1.0):
-        assert main(["classify", str(path), "--discard", str(discard), "--no-extend"]) == 0
+        assert (
+            main(["classify", str(path), "--discard", str(discard), "--no-extend", "--json"]) == 0
+        )
         out = json.loads(capsys.readouterr().out)
         (api,) = chaoscam.classify(run, discard=discard, extend_to=None)
         assert out == json.loads(json.dumps(api.to_dict()))
@@ -571,8 +573,8 @@ def test_lyapunov_tol_is_refused_by_the_tangent_verdict(run1):
 
 def test_review_tracebacks_are_named():
     """lyapunov_spectrum("run.parquet") was an AttributeError, run_paper(figures=3) a
-    TypeError from list(3), and a contact period that rounds to zero steps a
-    ZeroDivisionError in the step warning."""
+    TypeError from list(3); a contact too stiff for any allowed dt is said so (it advised
+    "use dt <= 0 s")."""
     from chaoscam.paper import run_paper
     from chaoscam.simulation import resolution_warning
 
@@ -581,7 +583,8 @@ def test_review_tracebacks_are_named():
     for figures in (99, np.array([99]), (f for f in [99])):  # one figure, or any iterable
         with pytest.raises(ValueError, match=r"figures = \[.*99\)?\]: choose from"):
             run_paper(quick=True, out="unused.html", figures=figures)
-    assert "a step longer than the period" in resolution_warning(Params(l_lambda=1e300), Numerics())
+    stiffest = Params(l_lambda=10.0, Y_f=1e13, Y_c=1e13, J=1e-15)  # the ranges' extremes
+    assert "no allowed dt (>= 1e-12 s)" in resolution_warning(stiffest, Numerics())
 
 
 @pytest.mark.parametrize(

@@ -54,7 +54,7 @@ def test_classifier_agrees_with_the_settled_label(name, row, tmp_path, capsys):
     argv = ["simulate", "--duration", "120", "--transient", "60", *sets, "--out", str(run)]
     assert main(argv) == 0
     capsys.readouterr()
-    assert main(["classify", str(run)]) == 0
+    assert main(["classify", str(run), "--json"]) == 0
     verdict = json.loads(capsys.readouterr().out)
     assert (verdict["label"], verdict["period"]) == (row["label"], row["period"]), (
         f"{name}: settled {row['label']} {row['period']} ({row['why']}); "

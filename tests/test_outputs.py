@@ -415,7 +415,7 @@ def test_a_full_disk_names_the_simulation_output(tmp_path, monkeypatch, capsys):
     out = tmp_path / "s.parquet"
     assert main(["simulate", "--duration", "0.2", "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    assert f"No space left on device while writing {out}; nothing was written" in err
+    assert f"cannot write {out}: No space left on device; nothing was written" in err
     assert not out.exists()
 
 

@@ -9,7 +9,7 @@ _LAZY = {
     "real": ("._checks", "real"), "whole": ("._checks", "whole"),
     "check_fields": ("._fields", "check_fields"), "close_names": ("._fields", "close_names"),
     "field_table": ("._fields", "field_table"), "meta": ("._fields", "meta"),
-    "NON_NEGATIVE": ("._fields", "NON_NEGATIVE"), "ParameterError": ("._fields", "ParameterError"),
+    "ParameterError": ("._fields", "ParameterError"),
     "parse_field": ("._fields", "parse_field"), "strict_init": ("._fields", "strict_init"),
     "unknown_message": ("._fields", "unknown_message"),
     "freeze_fields": ("._frozen", "freeze_fields"), "FrozenDict": ("._frozen", "FrozenDict"),

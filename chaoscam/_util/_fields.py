@@ -11,8 +11,8 @@ import math
 from typing import Any
 
 __all__ = [
-    "POSITIVE", "NON_NEGATIVE", "ParameterError", "check_fields", "close_names", "describe_range",
-    "field_table", "meta", "parse_field", "strict_init", "unknown_message",
+    "ParameterError", "check_fields", "close_names", "describe_range", "field_table", "meta",
+    "parse_field", "strict_init", "unknown_message",
 ]  # fmt: skip
 
 
@@ -21,22 +21,18 @@ class ParameterError(ValueError):
     message names the field and the allowed range)."""
 
 
-# (lower, upper, lower_inclusive, upper_inclusive); None = unbounded.
-POSITIVE = (0.0, None, False, None)
-NON_NEGATIVE = (0.0, None, True, None)
-
-
-def meta(doc: str, unit: str, rng: tuple | None = POSITIVE, choices: tuple | None = None) -> dict:
-    """A field's metadata: its meaning, unit, allowed range (or ``choices`` for a text)."""
-    return {"doc": doc, "unit": unit, "range": rng, "choices": choices}
+def meta(doc: str, unit: str, rng: tuple | None = None, choices: tuple | None = None,
+         why: str = "") -> dict:  # fmt: skip
+    """A field's metadata: its meaning, unit, allowed range ``(lower, upper, lower_inclusive,
+    upper_inclusive)``, finite for a number, and ``why`` that range (or ``choices``, a text's)."""
+    return {"doc": doc, "unit": unit, "range": rng, "choices": choices, "why": why}
 
 
 def describe_range(rng: tuple) -> str:
     """``(lo, hi]``-style text of a range tuple."""
     lo, hi, lo_inc, hi_inc = rng
-    left = "(-inf" if lo is None else ("[" if lo_inc else "(") + repr(lo)
-    right = "inf)" if hi is None else repr(hi) + ("]" if hi_inc else ")")
-    return f"{left}, {right}"
+    lo, hi = (repr(x) if len(repr(x)) <= 10 else f"{x:.7g}" for x in (lo, hi))  # 1e+13
+    return f"{'[' if lo_inc else '('}{lo}, {hi}{']' if hi_inc else ')'}"
 
 
 def _validate(f: dataclasses.Field, value: Any) -> None:
@@ -53,21 +49,19 @@ def _validate(f: dataclasses.Field, value: Any) -> None:
         return
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ParameterError(f"{name} = {value!r} must be a number [{meta_['unit']}]")
-    if f.type == "int" and not float(value).is_integer():
-        raise ParameterError(f"{name} = {value!r} must be an integer")
+    lo, hi, lo_inc, hi_inc = meta_["range"]  # compared exactly: 10**400 is no overflow
+    if value < lo or value > hi or (value == lo and not lo_inc) or (value == hi and not hi_inc):
+        shown = repr(value)
+        shown = shown if len(shown) <= 24 else f"{shown[:6]}... ({len(shown)} digits)"
+        why = f" ({meta_['why']})" if meta_["why"] else ""
+        raise ParameterError(
+            f"{name} = {shown} [{meta_['unit']}] is outside the allowed range "
+            f"{describe_range(meta_['range'])}{why}: {meta_['doc']}"
+        )
     if not math.isfinite(value):
         raise ParameterError(f"{name} = {value!r} must be finite [{meta_['unit']}]")
-    rng = meta_["range"]
-    if rng is None:
-        return
-    lo, hi, lo_inc, hi_inc = rng
-    bad_lo = lo is not None and (value < lo or (value == lo and not lo_inc))
-    bad_hi = hi is not None and (value > hi or (value == hi and not hi_inc))
-    if bad_lo or bad_hi:
-        raise ParameterError(
-            f"{name} = {value!r} [{meta_['unit']}] is outside the allowed range "
-            f"{describe_range(rng)}: {meta_['doc']}"
-        )
+    if f.type == "int" and not float(value).is_integer():
+        raise ParameterError(f"{name} = {value!r} must be an integer")
 
 
 def check_fields(obj: Any) -> None:
@@ -78,12 +72,9 @@ def check_fields(obj: Any) -> None:
         if type(value).__module__ == "numpy" and getattr(value, "size", 0) == 1:
             value = value.item()
         kind = {"int": int, "float": float, "float | None": float}.get(f.type)
-        try:
-            _validate(f, value)
-            if kind and value is not None and type(value) is not kind:
-                value = kind(value)
-        except OverflowError:  # int(10**400) compared with, or made, a float
-            raise ParameterError(f"{f.name} = {value!r} is too large") from None
+        _validate(f, value)
+        if kind and value is not None and type(value) is not kind:
+            value = kind(value)
         object.__setattr__(obj, f.name, value)
 
 
@@ -146,9 +137,10 @@ def field_table(cls: type) -> list[dict[str, Any]]:
     rows = []
     for f in dataclasses.fields(cls):
         m = f.metadata
-        allowed = describe_range(m["range"]) if m["range"] is not None else "any"
         if m["choices"] is not None:
             allowed = ", ".join(map(repr, m["choices"]))
+        else:
+            allowed = describe_range(m["range"]) + (f" ({m['why']})" if m["why"] else "")
         rows.append({"name": f.name, "unit": m["unit"], "default": f.default, "range": allowed,
                      "doc": m["doc"]})  # fmt: skip
     return rows

@@ -4,7 +4,7 @@ Everything here takes numpy arrays; nothing imports the model, the kernels or th
 """
 
 from ._birkhoff import BirkhoffResult, birkhoff_weights, weighted_birkhoff
-from ._classify import classify_signal
+from ._classify import SAMPLING_DT, classify_signal
 from ._classify_section import SECTION_OPTIONS, check_options, classify_section, section_options
 from ._evidence import as_exponent, exponent_evidence, zero_one_evidence
 from ._lyapunov_series import DoubtfulEstimateWarning, SeriesLyapunovResult, lyapunov_from_series
@@ -20,6 +20,7 @@ from ._zero_one import ZeroOneResult, zero_one_test
 
 __all__ = [
     "LABELS",
+    "SAMPLING_DT",
     "SECTION_OPTIONS",
     "VOTES",
     "BirkhoffResult",

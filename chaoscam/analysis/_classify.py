@@ -15,7 +15,11 @@ from ._thresholds import Thresholds, resolve
 from ._validate import MIN_SERIES, as_points, as_series, check_atol, check_settings
 from ._verdict import Evidence, Verdict, combine
 
-__all__ = ["classify_signal"]
+__all__ = ["SAMPLING_DT", "classify_signal"]
+
+SAMPLING_DT = (1e-12, 1e6)
+"""The sampling intervals [s] `classify_signal` takes: a terahertz sampler to 11.6 days a
+sample (outside, 1 / dt and the spectrum's frequencies leave any physical scale)."""
 
 _SPECTRUM_VOTES = {"periodic": "periodic", "quasiperiodic": "quasiperiodic",
                    "broadband": "chaotic", "aperiodic": "not_periodic"}  # fmt: skip
@@ -68,7 +72,13 @@ def _check_signal_settings(given: dict) -> int:
                  zero_one_per_period="int>=1?", seed="int>=0", exponent_time="real>0")  # fmt: skip
     check_settings("classify_signal", **{k: (given[k], rule) for k, rule in rules.items()})
     per_period, forcing_period = given["zero_one_per_period"], given["forcing_period"]
-    most = 4 if forcing_period is None else max(1, round(forcing_period / given["dt"]))
+    (lo, hi), dt, n = SAMPLING_DT, given["dt"], given["x"].size
+    if not lo <= dt <= hi:
+        raise ValueError(f"classify_signal: dt = {dt!r} s must be in [{lo:g}, {hi:g}] s")
+    if forcing_period is not None and not 2 * dt <= forcing_period <= n * dt:
+        raise ValueError(f"classify_signal: forcing_period = {forcing_period!r} s must be in "
+                         f"[2 dt, N dt] = [{2 * dt:g}, {n * dt:g}] s")  # fmt: skip
+    most = 4 if forcing_period is None else max(1, round(forcing_period / dt))
     if per_period is not None and forcing_period is not None and per_period > most:
         raise ValueError(
             f"classify_signal: zero_one_per_period = {per_period} must be <= {most}, "
@@ -153,7 +163,8 @@ def classify_signal(
     The votes are combined by `combine`. The period comes from the section, else from the
     spectrum of a forced signal, else 1 (the signal's own fundamental, noted in `reasons`).
 
-    Raises ValueError on NaN or infinite samples, a non-positive `dt` or `forcing_period`.
+    Raises ValueError on NaN or infinite samples, `dt` outside `SAMPLING_DT`, or a
+    `forcing_period` outside [2 dt, N dt].
     Limits: ~20 s of a cam signal (~90 forcing periods) gives the 0–1 test ~360 samples and
     the spectrum subharmonics up to order 9: a periodic call is solid, quasiperiodic versus
     chaotic rests on the spectrum and the 0–1 test agreeing.

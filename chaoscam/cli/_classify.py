@@ -1,4 +1,5 @@
-"""``chaoscam classify`` and ``chaoscam classify-series``: a verdict as JSON on stdout."""
+"""``chaoscam classify`` (a one-line verdict; ``--json``: with its evidence) and
+``chaoscam classify-series`` (a verdict as JSON on stdout)."""
 
 from __future__ import annotations
 
@@ -15,10 +16,12 @@ def register(sub) -> None:
         help="classify a simulated trajectory (Parquet) as periodic/quasiperiodic/chaotic",
         description="Classify a trajectory written by `chaoscam simulate --out FILE.parquet` "
         "from its stroboscopic section and the tangent exponent through the impacts (with the "
-        "periodic-orbit certificate for the deterministic model), printed as JSON (label, "
-        "period, evidence, reasons; extended: the recorded time, when a longer run settled it).",
+        "periodic-orbit certificate for the deterministic model): one line, e.g. 'chaotic "
+        "(lambda_1 = +1.4 +- 0.1 /s)' or 'undetermined: REASON'; --json: as JSON (label, period, "
+        "evidence, reasons; extended: the recorded time, when a longer run settled it).",
     )
     p.add_argument("trajectory", type=path_arg, metavar="TRAJ.parquet")
+    p.add_argument("--json", action="store_true", help="print the verdict and its evidence as JSON")
     p.add_argument(
         "--no-extend",
         action="store_true",
@@ -75,9 +78,11 @@ def run_classify(args: argparse.Namespace) -> int:
 
     traj = read_trajectory(args.trajectory)
     extend_to = None if args.no_extend else EXTEND_TO
-    (verdict,) = classify(
-        traj, extend_to=extend_to, check_step=args.check_step, discard=args.discard
-    )
+    verdicts = classify(traj, extend_to=extend_to, check_step=args.check_step, discard=args.discard)
+    if not args.json:  # one line a member
+        print("\n".join(map(verdict_line, verdicts)), flush=True)
+        return 0
+    (verdict,) = verdicts  # a trajectory file holds one run
     out = verdict.to_dict()
     extended = verdict.settings.get("extended")
     if extended:  # the evidence is that of the longer run: say how long (not the wall time)
@@ -86,8 +91,23 @@ def run_classify(args: argparse.Namespace) -> int:
     return 0
 
 
+def verdict_line(v) -> str:
+    """A verdict in one line: the label and period, a certified orbit, the tangent lambda_1 and
+    its standard error [1/s]; an undetermined one with its first reason."""
+    if v.label == "undetermined":
+        return "undetermined" + (f": {v.reasons[0]}" if v.reasons else "")
+    certified = any(e.name == "periodic_orbit" and e.vote == "periodic" for e in v.evidence)
+    notes = ["certified orbit"] if certified else []
+    tangent = v.settings.get("tangent") or {}
+    lam, err = (tangent.get("exponents") or [math.nan])[0], (tangent.get("stderr") or [0.0])[0]
+    if math.isfinite(lam):
+        notes.append(f"lambda_1 = {lam:+.2g} +- {err:.1g} /s")
+    period = f", period {v.period}" if v.period else ""
+    return v.label + period + (f" ({', '.join(notes)})" if notes else "")
+
+
 def run_classify_series(args: argparse.Namespace) -> int:
-    from ..analysis import classify_section, classify_signal
+    from ..analysis import SAMPLING_DT, classify_section, classify_signal
     from . import UsageError
 
     if args.dt is None and not args.section:
@@ -95,16 +115,17 @@ def run_classify_series(args: argparse.Namespace) -> int:
             "say what the rows are: --dt SECONDS (a uniformly sampled signal) or --section "
             "(section points / map iterates)"
         )
-    if args.dt is not None and not (math.isfinite(args.dt) and args.dt > 0):
-        raise UsageError(f"--dt {args.dt}: the sampling interval must be a finite number > 0")
+    lo, hi = SAMPLING_DT
+    if args.dt is not None and not lo <= args.dt <= hi:
+        raise UsageError(f"--dt {args.dt}: the sampling interval must be in [{lo:g}, {hi:g}] s")
     if args.forcing_period is not None:
         if args.section:
             raise UsageError(
                 "--forcing-period applies to a sampled signal (--dt); section points are "
                 "already one per forcing period"
             )
-        if not (math.isfinite(args.forcing_period) and args.forcing_period > 0):
-            raise UsageError(f"--forcing-period {args.forcing_period}: must be a finite number > 0")
+        if not (math.isfinite(args.forcing_period) and args.forcing_period >= 2 * args.dt):
+            raise UsageError(f"--forcing-period {args.forcing_period}: must be >= 2 x --dt")
     if args.dt is not None and len(args.column) != 1:
         raise UsageError("--dt takes one --column (a scalar signal)")
     twice = sorted({c for c in args.column if args.column.count(c) > 1})

@@ -79,7 +79,7 @@ def run_report(args: argparse.Namespace) -> int:
 
 
 def run_paper(args: argparse.Namespace) -> int:
-    from ..paper import FIGURES
+    from ..paper import FIGURES, RESUME_HINT
     from ..paper import run_paper as _run
     from ..sweep import local_workers
     from . import UsageError
@@ -117,11 +117,13 @@ def run_paper(args: argparse.Namespace) -> int:
             command=command, echo=True, force=args.force, resume=args.resume,
         )  # fmt: skip
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM: say what is kept and how to go on, once
-        from ..paper import RESUME_HINT
         from . import stop_word
 
         print(f"chaoscam: {stop_word()}; {RESUME_HINT}", file=sys.stderr)
         return 130
+    except OSError as err:  # a full disk: the file (named by the write), and what is kept
+        print(f"chaoscam: error: {err}; {RESUME_HINT}", file=sys.stderr)
+        return 2
     print(f"report: {run.path}")
     if run.failed:
         print(

@@ -103,12 +103,12 @@ def _run(args: argparse.Namespace, paths, written: list) -> int:
             try:
                 with atomic_path(path, replace=args.force) as tmp:
                     write(tmp)
-            except OSError as err:  # a full disk: name the file, say nothing half-written
+            except OSError as err:  # a full disk (the write names the file): nothing half-written
                 if isinstance(err, FileExistsError):
                     raise
                 raise type(err)(
-                    err.errno, f"{err.strerror or err} while writing {path}; nothing was "
-                    "written there (atomic write): fix the cause and run again"
+                    err.errno, f"{err.strerror or err}; nothing was written there (atomic "
+                    "write): fix the cause and run again"
                 ) from None  # fmt: skip
             written.append(path)
             print(f"{label}: {path}")

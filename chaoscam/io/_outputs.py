@@ -1,7 +1,8 @@
 """One rule for every file chaoscam writes: checked first (:func:`check_output`, before any
 work), never overwritten silently, written whole (:func:`atomic_path`: a temporary name beside
 it, flushed, then renamed into place), locked against a second process (:class:`OutputLock`).
-Every failure is an :class:`OutputError` (a ``ValueError``) naming the path and what to do."""
+Every failure is an :class:`OutputError` (a ``ValueError``) naming the path and what to do (or,
+for a write, an OSError naming the file)."""
 
 from __future__ import annotations
 
@@ -119,9 +120,10 @@ def _probe(folder: Path, what: str) -> None:
 def atomic_path(path: str | Path, *, replace: bool = True) -> Iterator[Path]:
     """A temporary path to write ``path`` to, flushed and moved into place when the block
     succeeds (the file is whole or absent whenever the process is killed), removed on an
-    exception. ``replace=False`` places it only if ``path`` still does not exist, atomically (a
-    hard link refuses an existing name): a file another process wrote meanwhile is kept, this
-    one's result beside it (:func:`conflict_name`), and an :class:`OutputError` names both."""
+    exception (an OSError then names ``path``). ``replace=False`` places it only if ``path``
+    still does not exist, atomically (a hard link refuses an existing name): a file another
+    process wrote meanwhile is kept, this one's result beside it (:func:`conflict_name`), and
+    an :class:`OutputError` names both."""
     path = Path(path)
     tmp = tmp_name(path)
     try:
@@ -141,6 +143,9 @@ def atomic_path(path: str | Path, *, replace: bool = True) -> Iterator[Path]:
                     "with replace=False) it was there before; it was not overwritten, and this "
                     f"run's result is in {kept}"
                 ) from None
+    except OSError as err:  # a full or failing disk: the file named, not a bare "[Errno 28]"
+        why = f"cannot write {path}: {err.strerror or err}"
+        raise (OSError(why) if err.errno is None else OSError(err.errno, why)) from None
     finally:
         with contextlib.suppress(OSError):
             tmp.unlink()

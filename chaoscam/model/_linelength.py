@@ -15,12 +15,14 @@ from ._params import Params
 __all__ = ["realization_rng", "realizations_identical", "truncated_mass", "LineLengthStream"]
 
 
-def realizations_identical(p: Params) -> bool:
+def realizations_identical(p: Params, sigma=None):
     """True when every realization of ``p`` is the same run (a deterministic model):
     ``l_lambda_sigma = 0``, or ``stiffness = "fractal"``, whose K_n (15)/(17), the only place the
     line length enters the motion, does not depend on it. A sweep runs such a model once, and
-    its periodic orbits can be certified by shooting."""
-    return p.l_lambda_sigma == 0.0 or p.stiffness == "fractal"
+    its periodic orbits can be certified by shooting. ``sigma``: an array of l_lambda_sigma
+    values in place of p's (a regime map's cells): an array of answers."""
+    sigma = p.l_lambda_sigma if sigma is None else np.asarray(sigma)
+    return (sigma == 0.0) | (p.stiffness == "fractal")
 
 
 def realization_rng(seed: int, index: int) -> np.random.Generator:

@@ -12,7 +12,6 @@ import math
 from dataclasses import dataclass, field, fields
 from typing import Any
 
-from .._util import NON_NEGATIVE as _NONNEG
 from .._util import check_fields, parse_field, strict_init
 from .._util import meta as _meta
 from ._stiffness import composite_modulus, fractal_stiffness, hertz_line_stiffness
@@ -22,6 +21,20 @@ __all__ = ["FIELD_DOCS", "Params", "field_names", "params_arg", "parse_value"]
 STIFFNESS_MODELS = ("hertz", "fractal")
 DAMPING_FORMS = ("hunt_crossley", "paper_literal")
 RESAMPLE_MODES = ("contact", "impact", "interval")
+_MODULUS = "Pa", 1e2, 1e13, "a soft gel (1e2 Pa) to above diamond (1.2e12 Pa)"
+
+
+def _in(doc: str, unit: str, low: float, high: float, why: str) -> dict:
+    """The metadata of a field in [low, high], with ``why`` that range."""
+    return _meta(doc, unit, (low, high, True, True), why=why)
+
+
+def _length(doc: str, low: float = 1e-6) -> dict:
+    return _in(doc, "m", low, 10.0, f"a machine part: {'1 um' if low else '0'} to 10 m")
+
+
+def _speed(doc: str) -> dict:
+    return _in(doc, "m/s", 0.0, 10.0, "above a cam follower's every speed (~0.01-5 m/s)")
 
 
 @strict_init
@@ -42,42 +55,47 @@ class Params:
     _WHAT = "parameter"
 
     # --- Table 1 -------------------------------------------------------------------------
-    l: float = field(
-        default=0.6, metadata=_meta("follower (rod) length", "m", (0.0, 100.0, False, True))
-    )
-    r: float = field(default=0.005, metadata=_meta("follower radius", "m"))
-    m: float = field(default=0.3676, metadata=_meta("follower mass", "kg"))
-    R: float = field(default=0.09, metadata=_meta("cam radius", "m"))
-    e: float = field(default=0.04, metadata=_meta("cam eccentricity", "m", _NONNEG))
+    l: float = field(default=0.6, metadata=_length("follower (rod) length"))
+    r: float = field(default=0.005, metadata=_length("follower radius"))
+    m: float = field(default=0.3676, metadata=_in("follower mass", "kg", 1e-6, 1e3, "1 mg to 1 t"))
+    R: float = field(default=0.09, metadata=_length("cam radius"))
+    e: float = field(default=0.04, metadata=_length("cam eccentricity", 0.0))
     nu_f: float = field(
         default=0.3, metadata=_meta("Poisson's ratio of the follower", "-", (0.0, 0.5, True, False))
     )
     nu_c: float = field(
         default=0.3, metadata=_meta("Poisson's ratio of the cam", "-", (0.0, 0.5, True, False))
     )
-    Y_f: float = field(default=2.07e11, metadata=_meta("Young's modulus of the follower", "Pa"))
-    Y_c: float = field(default=2.07e11, metadata=_meta("Young's modulus of the cam", "Pa"))
-    g: float = field(default=9.81, metadata=_meta("gravity", "m/s^2", _NONNEG))
-    mu_f: float = field(default=0.3, metadata=_meta("friction coefficient", "-", _NONNEG))
-    beta: float = field(default=3.25, metadata=_meta("impact damping factor", "s/m", _NONNEG))
+    Y_f: float = field(default=2.07e11, metadata=_in("Young's modulus of the follower", *_MODULUS))
+    Y_c: float = field(default=2.07e11, metadata=_in("Young's modulus of the cam", *_MODULUS))
+    g: float = field(default=9.81, metadata=_in("gravity", "m/s^2", 0.0, 100.0, "none to ~10 g"))
+    mu_f: float = field(default=0.3, metadata=_in(
+        "friction coefficient", "-", 0.0, 10.0, "dry contacts stay below ~1.5"))  # fmt: skip
+    beta: float = field(default=3.25, metadata=_in("impact damping factor", "s/m", 0.0, 1e4,
+        "Hunt-Crossley's 3 (1 - e) / (2 v) for impact speeds down to 1e-4 m/s"))  # fmt: skip
     xi: float = field(default=0.42, metadata=_meta(
         "coefficient of restitution, eq. (4)", "-", (0.0, 1.0, True, True)))  # fmt: skip
     omega: float = field(default=28.7, metadata=_meta(
         "cam speed (practical bound: 1e4 rad/s, ~95,000 rpm)", "rad/s",
         (0.0, 1e4, False, True)))  # fmt: skip
-    l_lambda: float = field(default=0.008, metadata=_meta(
-        "contact line length l_lambda, the mean mu when random, eq. (18)", "m"))  # fmt: skip
+    l_lambda: float = field(default=0.008, metadata=_length(
+        "contact line length l_lambda, the mean mu when random, eq. (18)"))  # fmt: skip
     D: float = field(default=1.45, metadata=_meta(
         "fractal dimension, eq. (15)", "-", (1.0, 2.0, False, False)))  # fmt: skip
-    G: float = field(default=1e-10, metadata=_meta("fractal roughness, eq. (15)", "m"))
-    k: float = field(default=2.8, metadata=_meta("hardness/yield-strength ratio", "-"))
-    phi: float = field(default=0.01, metadata=_meta("yield-strength/modulus ratio", "-"))
-    A_r: float = field(default=1e-5, metadata=_meta("real contact area", "m^2"))
+    G: float = field(default=1e-10, metadata=_in(
+        "fractal roughness, eq. (15)", "m", 1e-15, 1e-3, "below an atom to 1 mm"))  # fmt: skip
+    k: float = field(default=2.8, metadata=_in("hardness/yield-strength ratio", "-", 0.1, 10.0,
+        "Tabor's ~2.8 for metals, a decade either side"))  # fmt: skip
+    phi: float = field(default=0.01, metadata=_in("yield-strength/modulus ratio", "-", 1e-5, 1.0,
+        "a yield strength below the modulus"))  # fmt: skip
+    A_r: float = field(default=1e-5, metadata=_in(
+        "real contact area", "m^2", 1e-12, 1.0, "1 um^2 to 1 m^2"))  # fmt: skip
 
     # --- Decisions: geometry and inertia -------------------------------------------------
     J: float | None = field(default=None, metadata=_meta(
         "follower moment of inertia about the pivot; None = m (l^2/3 + r^2/4), a solid rod "
-        "about a transverse axis through its end (decision)", "kg m^2"))  # fmt: skip
+        "about a transverse axis through its end (decision)", "kg m^2", (1e-15, 1e5, True, True),
+        why="a 1-mg, 0.1-mm part to a 1-t, 10-m rod"))  # fmt: skip
     x_O: float = field(default=-0.5, metadata=_meta(
         "pivot x, cam rotation centre at the origin (decision; practical bound 100 m)", "m",
         (-100.0, 100.0, True, True)))  # fmt: skip
@@ -105,44 +123,44 @@ class Params:
         "'paper_literal' F = -K d - beta K d dd/dt, whose damping feeds energy in on "
         "restitution; kept for reproduction only (decision). Both are clamped at F >= 0: a "
         "contact pushes, never pulls", "-", None, DAMPING_FORMS))  # fmt: skip
-    friction_arm: float | None = field(default=None, metadata=_meta(
+    friction_arm: float | None = field(default=None, metadata=_length(
         "arm of the friction force about the pivot; None = r, the rod radius (decision: (1) "
-        "writes a force where a torque belongs)", "m", _NONNEG))  # fmt: skip
-    v_eps: float = field(default=1e-4, metadata=_meta(
+        "writes a force where a torque belongs)", 0.0))  # fmt: skip
+    v_eps: float = field(default=1e-4, metadata=_speed(
         "slip-speed scale of the regularised sign, sgn(v) ~ tanh(v / v_eps); 0 = exact sign. "
         "Decision: keeps the right-hand side smooth for RK4; slips are 1.4-3.8 m/s in contact "
-        "at the defaults, far from 0", "m/s", _NONNEG))  # fmt: skip
-    v_min: float = field(default=0.0, metadata=_meta(
+        "at the defaults, far from 0"))  # fmt: skip
+    v_min: float = field(default=0.0, metadata=_speed(
         "least approach speed -d(delta)/dt for which the restitution jump (4) is applied; "
         "slower closings are left to the compliant force. Default 0: the law applies at every "
         "closing (MODEL.md: a positive v_min lets slow closings rebound almost elastically, the "
         "sticking phase rattles and the flight amplifies it into bands that grow with v_min; "
-        "the model is the limit v_min -> 0)", "m/s", _NONNEG))  # fmt: skip
-    v_chatter: float = field(default=1e-6, metadata=_meta(
+        "the model is the limit v_min -> 0)"))  # fmt: skip
+    v_chatter: float = field(default=1e-6, metadata=_speed(
         "approach speed below which a closing is taken as the end of a complete chattering "
         "sequence and replaced by its accumulation point, a plastic closure (gap rate 0; "
         "Nordmark & Piiroinen 2009). Bounces slower than this last < 2 xi v / ((1 - xi) "
         "|delta''|) ~ 1e-7 s in all; 0 = simulate every bounce (Zeno: the count then depends "
-        "on dt). Measured convergence: docs/verdicts.md", "m/s", _NONNEG))  # fmt: skip
-    v_micro: float = field(default=1e-2, metadata=_meta(
+        "on dt). Measured convergence: docs/verdicts.md"))  # fmt: skip
+    v_micro: float = field(default=1e-2, metadata=_speed(
         "approach speed below which an applied impact is micro (in a chattering sequence), "
         "not macro (the fast impacts after a flight, ~0.05-1 m/s): a label, and under "
-        "resample = 'contact' the start of a new contact's line", "m/s", _NONNEG))  # fmt: skip
+        "resample = 'contact' the start of a new contact's line"))  # fmt: skip
 
     # --- Decisions: random contact-line length (section 2.5) -----------------------------
-    l_lambda_sigma: float = field(default=0.0, metadata=_meta(
-        "standard deviation sigma of the contact-line length; 0 = deterministic", "m",
-        _NONNEG))  # fmt: skip
-    l_min: float = field(default=1e-4, metadata=_meta(
-        "lower truncation of the line-length normal, which must stay positive (decision)",
-        "m"))  # fmt: skip
+    l_lambda_sigma: float = field(default=0.0, metadata=_length(
+        "standard deviation sigma of the contact-line length; 0 = deterministic", 0.0))  # fmt: skip
+    l_min: float = field(default=1e-4, metadata=_length(
+        "lower truncation of the line-length normal, which must stay positive "
+        "(decision)"))  # fmt: skip
     resample: str = field(default="contact", metadata=_meta(
         "when a new line length is drawn: at each macro impact ('contact', default: each "
         "contact has its own line), at every applied jump ('impact': micro-impacts too, whose "
         "count changes with dt, and the draws with it; docs/model.md), or every resample_dt "
         "('interval', the paper's Fig. 3)", "-", None, RESAMPLE_MODES))  # fmt: skip
     resample_dt: float = field(default=0.01, metadata=_meta(
-        "interval between draws when resample = 'interval'", "s"))  # fmt: skip
+        "interval between draws when resample = 'interval'", "s", (1e-12, 1e4, True, True),
+        why="from a time's rounding at 1000 s to 1e4 s"))  # fmt: skip
 
     # ------------------------------------------------------------------------------------
     def __post_init__(self) -> None:

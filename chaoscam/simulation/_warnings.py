@@ -14,12 +14,14 @@ def resolution_warning(p: Params, num: Numerics) -> str | None:
     steps = period / num.dt
     if steps >= 20 or num.integrator != "rk4":
         return None
-    if steps >= 1:
-        few = f"only {steps:.1f} steps"
-    elif steps > 0:
-        few = f"a step {1 / steps:.3g}x the period"
-    else:  # a period that rounds to zero
-        few = "a step longer than the period"
+    few = f"only {steps:.1f} steps" if steps >= 1 else f"a step {1 / steps:.3g}x the period"
+    finest = Numerics.field_docs()["dt"]["range"][0]
+    if period / 40 < finest:
+        return (
+            f"dt = {num.dt:g} s resolves the contact oscillation (period {period:.3g} s) with "
+            f"{few}, and no allowed dt (>= {finest:g} s) resolves it in 40 steps: soften the "
+            "contact (Y_f, Y_c, l_lambda) or make the follower heavier (m, J)"
+        )
     return (
         f"dt = {num.dt:g} s resolves the contact oscillation (period {period:.3g} s) with "
         f"{few}; use dt <= {period / 40:.2g} s (40 steps), and check the verdict "

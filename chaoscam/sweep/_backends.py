@@ -147,6 +147,11 @@ class DaskBackend:
                     "(dask scheduler) and its workers (dask worker ADDRESS), or use "
                     "--scheduler local"
                 ) from None
+            except MemoryError:  # a frame length read from a peer that does not speak Dask
+                raise ConnectionError(
+                    f"{scheduler!r} answered, but not as a Dask scheduler (its reply is not "
+                    "Dask's protocol): give the address of a running `dask scheduler`"
+                ) from None
         self.workers = max(1, sum(self.client.nthreads().values()))
 
     def submit(self, fn: Callable, arg: Any):

@@ -236,7 +236,7 @@ def bifurcation(
         base, numerics, duration, transient, seed, fate, resume, force
     )
     continuation = flag("continuation", continuation)
-    validate_grid(base, num, [axis])
+    validate_grid(base, num, [axis], points=False)  # its points after the budget check
     counted = isinstance(initial_conditions, numbers.Integral) and not isinstance(
         initial_conditions, bool
     )
@@ -246,6 +246,7 @@ def bifurcation(
     eng = plan_engine(judge, device, len(axis) * n_specs, base, num, duration, transient,
                       workers, scheduler, what="this bifurcation diagram", sections=True, fate=fate,
                       reduce="the values, the initial conditions or the duration")  # fmt: skip
+    validate_grid(base, num, [axis])
     if counted:  # built after the budget check: a huge count is refused first
         specs = [("base", base.theta_f0, base.omega_f0)] + [
             ("offset", a, b) for a, b in initial_offsets(initial_conditions)

@@ -25,7 +25,7 @@ def settings(base, numerics, duration, transient, seed, fate, resume, force, nam
     base, num = params_arg(base, name), numerics_arg(numerics)
     if transient is None and isinstance(duration, numbers.Real) and not isinstance(duration, bool):
         transient = 0.5 * float(duration)  # checked with the duration just below
-    duration, transient = (float(v) for v in check_window(duration, transient))
+    duration, transient = check_window(duration, transient, dt=num.dt)  # simulate's rule
     whole("seed", seed)
     if fate is not None:
         if isinstance(fate, bool) or not (

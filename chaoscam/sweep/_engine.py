@@ -262,6 +262,7 @@ def resolve_engine(judge: Judge, device: str, base, num, run, workers, scheduler
 
     if device not in ("cpu", "gpu", "auto"):
         raise SweepError(f"device = {device!r} must be one of cpu, gpu, auto")
+    check_scheduler(scheduler)
     threads = None
     if scheduler is None:
         try:
@@ -338,14 +339,27 @@ def _numba_threads(n: int | None):
         numba.set_num_threads(before)
 
 
+def check_scheduler(scheduler: Any) -> None:
+    """Refuse, before any work, what cannot be a Dask scheduler: neither None, 'local', an
+    address nor a client, or an address whose port is not 1..65535 (Dask would try it for 30 s)."""
+    from urllib.parse import urlsplit
+
+    if scheduler is None or scheduler == "local" or hasattr(scheduler, "submit"):
+        return
+    if not isinstance(scheduler, str):
+        raise SweepError(
+            f"scheduler = {scheduler!r} is not a Dask scheduler: give 'local', the "
+            "address of a running one ('tcp://HOST:PORT') or a distributed.Client"
+        )
+    with contextlib.suppress(ValueError):  # a port out of range, or not a number
+        if urlsplit(scheduler if "://" in scheduler else f"tcp://{scheduler}").port != 0:
+            return  # a valid port, or none (Dask says so)
+    raise SweepError(f"scheduler {scheduler!r}: the port must be a whole number in 1..65535")
+
+
 def run_plan(plan, eng: Engine, store, *, workers, scheduler, progress: bool, desc: str) -> None:
     """Execute a sweep's plan on its engine's backend."""
     if scheduler is not None:
-        if not isinstance(scheduler, str) and not hasattr(scheduler, "submit"):
-            raise SweepError(
-                f"scheduler = {scheduler!r} is not a Dask scheduler: give 'local', the "
-                "address of a running one ('tcp://HOST:PORT') or a distributed.Client"
-            )
         try:
             backend = DaskBackend(scheduler, workers)
         except (ValueError, ConnectionError) as err:
@@ -397,12 +411,17 @@ def run_sweep(plan: Plan, eng: Engine, cls, config: dict[str, Any], build: Calla
         except OSError as err:  # a full disk: say what is kept, and where
             if out is None or err.errno not in SAVE_ERRNOS:
                 raise  # not a failure to save (a lost connection, a file that appeared)
+            kept = (
+                f"the runs finished and saved so far are kept in {store.path}: fix the cause "
+                "(free space) and run the same command with --resume"
+                if store.path.is_dir() else "nothing was saved: fix the cause (free space) "
+                "and run the command again"
+            )  # fmt: skip
             raise type(err)(
                 err.errno,
                 f"{err.strerror or err} while saving the results of {out}"
                 + (f" ({err.filename})" if err.filename else "")
-                + f"; the runs finished and saved so far are kept in {store.path}: fix the "
-                "cause (free space) and run the same command with --resume",
+                + f"; {kept}",
             ) from None
         except Exception:
             # A run that finished nothing keeps no checkpoint (it would block the fixed command).

@@ -170,8 +170,9 @@ def cell_params(base: Params, num: Numerics, changes: dict[str, float]) -> tuple
     return p, (num.replace(**steps) if steps else num)
 
 
-def validate_grid(base: Params, num: Numerics, axes: Sequence[Axis]) -> None:
-    """Raise before any work if a grid point gives invalid parameters (names the point)."""
+def validate_grid(base: Params, num: Numerics, axes: Sequence[Axis], *, points=True) -> None:
+    """Raise before any work if the axes repeat a parameter, the grid is too large or (with
+    ``points``, a second pass after the budget check) a point gives invalid parameters."""
     names = [a.name for a in axes]
     if len(set(names)) != len(names):
         raise SweepError(f"the axes repeat a parameter: {names}")
@@ -180,6 +181,8 @@ def validate_grid(base: Params, num: Numerics, axes: Sequence[Axis]) -> None:
         raise SweepError(
             f"the grid has {size} points, more than {MAX_GRID_POINTS}; sweep a coarser grid"
         )
+    if not points:
+        return
     grids = np.meshgrid(*[np.asarray(a.values) for a in axes], indexing="ij")
     for point in zip(*[g.ravel().tolist() for g in grids], strict=True):
         changes = dict(zip(names, point, strict=True))

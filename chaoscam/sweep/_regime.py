@@ -263,14 +263,15 @@ def regime_map(
     base, num, duration, transient, fate, resume, force = settings(
         base, numerics, duration, transient, seed, fate, resume, force
     )
-    validate_grid(base, num, [x, y])
+    validate_grid(base, num, [x, y], points=False)  # its points after the budget check
     cells = _cells_frame(x, y)
     xs, ys = cells[x.name].to_numpy(), cells[y.name].to_numpy()
 
     def cell(c: int) -> tuple[Params, Numerics]:
         return cell_params(base, num, {x.name: float(xs[c]), y.name: float(ys[c])})
 
-    once = frozenset(c for c in range(len(cells)) if realizations_identical(cell(c)[0]))
+    sigma = cells.get("l_lambda_sigma", np.full(len(cells), base.l_lambda_sigma))
+    once = frozenset(np.flatnonzero(realizations_identical(base, sigma)).tolist())
     if realizations is None:
         realizations = RANDOM_REALIZATIONS if len(once) < len(cells) else 1
     realizations = whole("realizations", realizations, low=1)
@@ -284,6 +285,7 @@ def regime_map(
     eng = plan_engine(judge, device, len(cells) * cap, base, num, duration, transient, workers,
                       scheduler, what="this regime map", sections=False, fate=fate,
                       reduce="the grid, the realizations or the duration")  # fmt: skip
+    validate_grid(base, num, [x, y])
     config = eng.config(
         "regime_map", code_identity(), base=base.to_dict(), numerics=num.to_dict(),
         x=x.to_dict(), y=y.to_dict(), realizations=realizations, seed=int(seed),

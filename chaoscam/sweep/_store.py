@@ -172,8 +172,12 @@ class CheckpointStore:
         shutil.rmtree(tmp, ignore_errors=True)
         tmp.mkdir(parents=True)
         manifest = {"hash": self.hash, "config": self._config, "replaces": self._replaces}
-        atomic_write_bytes(tmp / "manifest.json", json.dumps(manifest, indent=1).encode())
-        os.replace(tmp, self.path)
+        try:
+            atomic_write_bytes(tmp / "manifest.json", json.dumps(manifest, indent=1).encode())
+            os.replace(tmp, self.path)
+        except OSError:  # a full disk: no half-made folder left behind
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
 
     def _check_manifest(self) -> None:
         try:

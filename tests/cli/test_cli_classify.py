@@ -30,22 +30,22 @@ def test_classify_says_when_the_verdict_needed_a_longer_run(tmp_path, capsys):
     realization longer; the JSON says how long, and why."""
     path = tmp_path / "short.parquet"
     chaoscam.simulate(duration=20.0, transient=10.0, l_lambda=0.001).to_parquet(path)
-    assert main(["classify", str(path)]) == 0
+    assert main(["classify", str(path), "--json"]) == 0
     out = _json(capsys, extended=True)
     assert out["label"] == "chaotic"
     assert out["extended"] == {
         "recorded_s": 40.0,
         "why": "the verdict on the run as given was undetermined",
     }
-    assert main(["classify", str(path), "--no-extend"]) == 0
+    assert main(["classify", str(path), "--no-extend", "--json"]) == 0
     assert _json(capsys)["label"] == "undetermined"
 
 
 def test_classify_prints_the_verdict_as_json(traj_file, capsys):
-    """classify TRAJ.parquet: JSON verdict on stdout, exit 0 (--no-extend: the 3 s run's
+    """classify TRAJ.parquet --json: JSON verdict on stdout, exit 0 (--no-extend: the 3 s run's
     own evidence, from its section and the tangent exponent; 8 periods are too few to
     decide, so by default the run is extended)."""
-    assert main(["classify", str(traj_file), "--no-extend"]) == 0
+    assert main(["classify", str(traj_file), "--no-extend", "--json"]) == 0
     out = _json(capsys)
     assert out["label"] in ("periodic", "quasiperiodic", "chaotic", "undetermined")
     assert {e["name"] for e in out["evidence"]} >= {"section_period", "exponent"}
@@ -194,7 +194,7 @@ def test_series_bad_input_exits_2(tmp_path, capsys, extra, content, message):
 def test_classify_uses_the_tangent_exponent(traj_file, capsys):
     """The verdict, extended by default, carries the tangent exponent through the impacts
     (a trajectory file keeps no Jacobians: the realization is solved again with them)."""
-    assert main(["classify", str(traj_file)]) == 0
+    assert main(["classify", str(traj_file), "--json"]) == 0
     out = _json(capsys, extended=True)
     exponent = [e for e in out["evidence"] if e["name"] == "exponent"]
     assert len(exponent) == 1 and math.isfinite(exponent[0]["value"])
@@ -222,3 +222,34 @@ def test_a_closed_pipe_ends_quietly(traj_file):
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=120) == 141, err
     assert "Broken pipe" not in err and "Traceback" not in err
+
+
+def test_classify_prints_one_line_by_default(traj_file, capsys):
+    """classify TRAJ.parquet without --json: one line, the API verdict's (it printed ~50
+    lines of JSON)."""
+    from chaoscam.cli._classify import verdict_line
+
+    assert main(["classify", str(traj_file), "--no-extend"]) == 0
+    out = capsys.readouterr().out
+    (api,) = chaoscam.classify(chaoscam.load_trajectory(traj_file), extend_to=None)
+    assert out == verdict_line(api) + "\n" and out.startswith(api.label)
+
+
+def test_the_verdict_line_says_label_period_certificate_and_exponent():
+    """The line names the label, the period, a certified orbit and lambda_1 +- its standard
+    error [1/s]; an undetermined verdict its first reason."""
+    from chaoscam.analysis import Evidence, Verdict
+    from chaoscam.cli._classify import verdict_line
+
+    def tangent(lam, err):
+        return {"tangent": {"exponents": [lam, -5.0], "stderr": [err, 0.1]}}
+
+    cert = Evidence("periodic_orbit", 4, "periodic", "certified: ...")
+    periodic = Verdict("periodic", 4, (cert,), (), tangent(-0.8, 0.02))
+    assert (
+        verdict_line(periodic) == "periodic, period 4 (certified orbit, lambda_1 = -0.8 +- 0.02 /s)"
+    )
+    chaotic = Verdict("chaotic", None, (), (), tangent(1.4, 0.1))
+    assert verdict_line(chaotic) == "chaotic (lambda_1 = +1.4 +- 0.1 /s)"
+    undetermined = Verdict("undetermined", None, (), ("too few points", "another"), {})
+    assert verdict_line(undetermined) == "undetermined: too few points"
