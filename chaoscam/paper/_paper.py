@@ -398,6 +398,14 @@ def _response(case: tuple[float, float]):
 
 
 _QUASI2 = "the random deviation suppresses chaos into quasiperiod 2"
+QUASI2_NOTE = (
+    "; a quasiperiod 2 (a 2-torus) cannot occur here: the stroboscopic map contracts area (the "
+    "flow's divergence is <= 0 and each impact multiplies area by ξ², so every periodic orbit "
+    "has |μ₁μ₂| <= ξ² and no Neimark–Sacker bifurcation exists; none of 12,406 periods checked "
+    "by analyses/monodromy_det.py exceeds it), so what looks like quasiperiod 2 is banded chaos "
+    "(Table 1: 8 bands of ~3e-4 rad, λ₁ ≈ +1.5 1/s) or, with a random line length, a noisy period"
+)
+"""Why the paper's "quasiperiod 2" pictures are not a torus in this model (docs/model.md)."""
 _FIG7_10_CLAIMS = {
     0.008: ("Figs. 7–8", "μ = 0.008 m: quasiperiodic at σ = 0, chaotic as σ grows to 0.004 m",
             "quasiperiodic", "chaotic"),
@@ -439,7 +447,7 @@ def _fig7_10_comparisons(cells: pd.DataFrame, smax: float, n: int, quick: bool):
                 f"{got0} → {got1} (P(chaotic) {r0['p_chaotic']:.2f} → {r1['p_chaotic']:.2f})"
             )
         if want1 == "quasiperiodic":
-            why += "; our labels do not separate quasiperiod 2 from other quasiperiodic motion"
+            why += QUASI2_NOTE
         why += FIGS7_10_NOTE
         if quick:
             why += f"; quick run: {n} realizations per cell, wide intervals"

@@ -172,8 +172,9 @@ RULES: tuple[Rule, ...] = (
          "with a random line length, twin runs sharing the draws decide the sign of the top "
          "exponent unless the section is broad chaos: synchronised, periodic n (noise-blurred "
          "clusters, noise_width); separated, chaotic (at xi = 0.525, sigma = 2 mm the tangent "
-         "reads +0.26 1/s over 8 bands where twins 1e-6 apart contract to 2e-10 in 40 s, at dt "
-         "and dt/2)", _common_noise_twins),
+         "reads +1.17 1/s at dt and +0.19 at dt/2 over 8 bands, while twins 1e-6 rad apart end "
+         "at 8e-5 to 0.29 of their start at dt and 4e-5 to 4e-4 at dt/2: analyses/random_set.py)",
+         _common_noise_twins),
     Rule("torus_needs_zero_exponent",
          "a quasiperiodic verdict needs lambda_1 = 0 within the tangent exponent's interval "
          "(a torus has a zero top exponent); else undetermined", _torus_needs_zero_exponent),

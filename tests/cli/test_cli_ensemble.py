@@ -245,7 +245,7 @@ def test_progress_ends_full_after_the_extensions(tmp_path, capsys):
     after 100 %), and no member is left undetermined."""
     out = tmp_path / "x.parquet"
     args = ["ensemble", "--members", "2", "--duration", "20", "--transient", "10"]
-    sets = ["--set", "omega=26", "--set", "xi=0.3", "--seed", "1", "--classify"]
+    sets = ["--set", "omega=27", "--set", "xi=0.5", "--seed", "1", "--classify"]
     assert main([*args, *sets, "--out", str(out)]) == 0
     err = capsys.readouterr().err
     assert "2/2" in err, err

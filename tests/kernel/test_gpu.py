@@ -310,7 +310,7 @@ def test_a_gpu_solutions_extensions_run_on_the_cpu(fake_gpu):
     run's (the fake GPU runs the CPU's kernel)."""
     from chaoscam import classify
 
-    p = Params(omega=26.0, xi=0.3)  # undetermined after 20 s, chaotic when extended
+    p = Params(omega=27.0, xi=0.5)  # undetermined after 20 s, chaotic when extended
     run = dict(seed=1, duration=20.0, transient=10.0, tangent=True, resumable=True)
     ens = solve(p, indices=[0], backend="gpu", **run)
     launched = len(fake_gpu)

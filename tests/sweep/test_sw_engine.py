@@ -328,7 +328,7 @@ def test_dask_workers_asked_for_their_gpus_get_batches_a_gpu_can_fill(device, la
     from chaoscam.sweep._runs import Judge
 
     eng = _engine.resolve_engine(Judge(), device, Params(), Numerics(), (20.0, 0.0), None,
-                                 object())  # fmt: skip
+                                 "tcp://127.0.0.1:8786")  # fmt: skip
     assert (eng.size == _engine.GPU_BATCH) is large
     assert not eng.pipeline  # the workers run whole batches
 

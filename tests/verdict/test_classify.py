@@ -220,7 +220,7 @@ UNSETTLED_BANDS = {
 )
 def test_bands_that_only_look_periodic_are_not_called_periodic(changes, index, words):
     """Periodic only with a certificate or a contracting exponent; else undetermined, and
-    the extended run settles it (chaotic)."""
+    the extended run is not periodic either."""
     traj = simulate(
         Params(**changes),
         duration=20.0,
@@ -234,7 +234,12 @@ def test_bands_that_only_look_periodic_are_not_called_periodic(changes, index, w
     assert short.label == "undetermined" and any(words in r for r in short.reasons)
     assert "run longer" in short.reasons[-1]  # the reason says what to run
     (settled,) = classify(traj)
-    assert settled.label == "chaotic" and settled.settings["extended"]["recorded_s"] > 10.0
+    # chaotic on the extended run at dt; its 7 bands lie on an orbit unstable only at that
+    # step, and at dt/2 the verdict differs: undetermined, saying so (the holdout set leaves
+    # (26, 0.3) unsettled: lambda_1 = +1.77 at dt, -0.46 at dt/2)
+    assert settled.label == "undetermined" and settled.settings["extended"]["recorded_s"] > 10.0
+    assert settled.settings["step_check"]["grid_label"] == "chaotic"
+    assert any("halving the step changes the verdict" in r for r in settled.reasons)
 
 
 def _spy_extend(monkeypatch):
