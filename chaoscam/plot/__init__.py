@@ -11,7 +11,7 @@ _LAZY = {
     "LABEL_COLORS": ("._sweep", "LABEL_COLORS"), "SETTLED_MARK": ("._sweep", "SETTLED_MARK"),
     "TRANSIENT_MARK": ("._sweep", "TRANSIENT_MARK"),
     "all_deterministic": ("._sweep", "all_deterministic"), "axis_label": ("._sweep", "axis_label"),
-    "bifurcation_figure": ("._sweep", "bifurcation_figure"),
+    "band_zoom": ("._sweep", "band_zoom"), "bifurcation_figure": ("._sweep", "bifurcation_figure"),
     "mark_without_points": ("._sweep", "mark_without_points"), "percent": ("._sweep", "percent"),
     "plot_bifurcation": ("._sweep", "plot_bifurcation"),
     "plot_diagram": ("._sweep", "plot_diagram"), "plot_dominant": ("._sweep", "plot_dominant"),
