@@ -3,6 +3,7 @@ headline computed from them (which regimes occur where), and long texts folded."
 
 from __future__ import annotations
 
+import re
 from collections import Counter
 
 import pandas as pd
@@ -12,6 +13,8 @@ __all__ += ["mostly", "verdict_tag"]
 
 WORDS = {"left_reach": "out of the cam's reach", "diverged": "diverged (the state left the model)"}
 """Labels that a sentence says in other words."""
+
+_SENTENCE = r"(?<!\bFig)(?<!\bFigs)(?<!\bEq)(?<!\be\.g)(?<!\bi\.e)\. "  # not "Figs. 7"
 
 FOLD_AT = 240
 """A text longer than this many characters is shown by its head, the rest folded."""
@@ -77,10 +80,10 @@ def fold(text: str, limit: int = FOLD_AT) -> tuple[str, str]:
     or word within ``limit`` characters (the report shows the head, the rest folded)."""
     if len(text) <= limit:
         return text, ""
-    for mark in (". ", "; ", ": ", " "):
-        at = text.rfind(mark, 12, limit)
-        if at > 0:
-            return text[: at + len(mark)].rstrip(), text[at + len(mark) :]
+    for mark in (_SENTENCE, "; ", ": ", " "):
+        ends = [m.end() for m in re.finditer(mark, text[:limit]) if m.start() >= 12]
+        if ends:
+            return text[: ends[-1]].rstrip(), text[ends[-1] :]
     return text[:limit], text[limit:]
 
 
