@@ -89,13 +89,14 @@ def fold(text: str, limit: int = FOLD_AT) -> tuple[str, str]:
 
 def headline(found: list[dict]) -> list[str]:
     """The answer of a report of one's own results (``found``: per input its ``name``,
-    ``what`` and verdict ``tags``, and ``unit``): the regimes overall, then where each
-    input's commonest regime lies."""
+    ``what``, the ``tags`` of its verdicts (a map's: its cells') and their ``unit``, and a
+    map's ``runs``: its realizations' tags): the regimes of all runs, then where each input's
+    commonest regime lies."""
     if not found:
         return []
-    tags = [t for f in found for t in f["tags"]]
-    units = {f["unit"] for f in found}
-    unit = units.pop() if len(units) == 1 else "runs and cells"
+    tags = [t for f in found for t in f.get("runs", f["tags"])]
+    units = {"run" if f["unit"] == "run" else f["unit"] for f in found if "runs" not in f}
+    unit = "members" if units == {"members"} else "runs"
     where = [f"{f['name']} ({f['what']}): {mostly(f['tags'], f['unit'])}" for f in found[:4]]
     more = f"; {len(found) - 4} more below" if len(found) > 4 else ""
     first = in_words(tags, f"{unit} given") + "."

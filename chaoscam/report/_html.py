@@ -350,7 +350,8 @@ def add_regime_map(
     level = percent(confidence)
     tags = [verdict_tag(d, per) for d, per in zip(c["dominant"], c["period"], strict=True)]
     what = f"{x} × {y}"
-    parts.found.append({"name": name, "what": what, "tags": tags, "unit": "cells"})
+    runs = frame_tags(rm.realizations)
+    parts.found.append({"name": name, "what": what, "tags": tags, "unit": "cells", "runs": runs})
     parts.regime_maps.append({"figure": figure, "x": x, "y": y, "level": level, "rows": rows})
     dom = _counts(c["dominant"].value_counts().to_dict() if len(c) else {})
     fate = fate_clause(rm.realizations, cfg.get("fate"), "realizations")
