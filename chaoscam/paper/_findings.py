@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from ..model import Params
-from ..report import SETTLED_MARK, TRANSIENT_MARK
+from ..report import SETTLED_MARK, TRANSIENT_MARK, band_counts, band_number, frame_tags, verdict_tag
 
 PAPER_K_N = (8.9e7, 1.6e9)
 """The paper's Hertz line stiffness range [N/m] (its l_λ range with Table 1's materials)."""
@@ -18,33 +18,6 @@ PAPER_L_LAMBDA = (0.001, 0.018)  # the paper's l_λ range [m] (Fig. 4), which sp
 
 XI_WINDOW = 0.05
 """Half-width of the neighbourhood of Table 1's ξ that the restitution finding looks at."""
-
-
-def band_number(label, period, bands=None) -> int | None:
-    """n of a motion on n narrow bands (a period, or ``ev_banded_chaos``); None for others."""
-    if label == "periodic" and period is not None and pd.notna(period):
-        return int(period)
-    if label == "chaotic" and bands is not None and pd.notna(bands) and bands > 1:
-        return int(bands)
-    return None
-
-
-def verdict_tag(label, period, bands=None) -> str:
-    """A verdict in a finding's words: "period 8", "8-band chaos", else the label."""
-    n = band_number(label, period, bands)
-    if n is None:
-        return str(label)
-    return f"period {n}" if label == "periodic" else f"{n}-band chaos"
-
-
-def band_counts(v: pd.DataFrame):
-    """The band counts of a verdict table (None where it has no ``ev_banded_chaos``)."""
-    return v["ev_banded_chaos"] if "ev_banded_chaos" in v else [None] * len(v)
-
-
-def frame_tags(v: pd.DataFrame) -> list[str]:
-    """:func:`verdict_tag` of every row of a verdict table (label, period, bands)."""
-    return [verdict_tag(*t) for t in zip(v["label"], v["period"], band_counts(v), strict=True)]
 
 
 def along(v: pd.DataFrame, key: str = "value") -> str:
@@ -118,7 +91,8 @@ def choices_finding(inertia, pivot, arm, damping, hertz_tags: list[str]) -> str:
         + paper_regimes(found, "among them")
         + (
             f" Not swept: the chattering limit (v_min = {p.v_min:g}, v_chatter = "
-            f"{p.v_chatter:g} m/s; numerical, its convergence measured in docs/verdicts.md) and, "
+            f"{p.v_chatter:g} m/s; numerical, its convergence measured on the documentation's "
+            f"verdicts page) and, "
             f"for a random line length (σ > 0, not Table 1's), when a length is drawn "
             f"(resample = {p.resample})."
         )

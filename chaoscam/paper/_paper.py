@@ -72,7 +72,7 @@ FIG6_STEPS = {True: 40, False: FULL_STEPS}  # Fig. 6's steps at D = 1.56 (quick,
 FIGS7_10_NOTE = (
     "; at σ = 0 the realizations are identical (the deterministic system); the model's default "
     "dt, whose labels hold when it is refined (measured: 100 of 100 runs at dt/2, 39 of 39 at "
-    "dt/4: docs/findings.md), though its exponent is about 2.5x dt/4's"
+    "dt/4: the documentation's findings page), though its exponent is about 2.5x dt/4's"
 )
 
 _COARSE = "a step at which labels are not converged"
@@ -93,7 +93,8 @@ def fig4_step_note(stiffest: Params, dt: float) -> str:
     here += f"{stiffest.l_lambda:g} m"
     measured = (
         "measured at the default 2e-6 s (30 steps), the period-8 windows at 8.75, 13.5 and "
-        "15.25 mm read chaotic and the exponent is about twice dt/8's (docs/findings.md)"
+        "15.25 mm read chaotic and the exponent is about twice dt/8's (the documentation's "
+        "findings page)"
     )
     if steps < FULL_STEPS * 0.9:
         return f"{here}, {_COARSE}: {measured}; the full report takes {FULL_STEPS})"
@@ -105,7 +106,7 @@ def fig6_step_note(stiffest: Params, quick: bool) -> str:
     here = f"; {FIG6_STEPS[quick]} RK4 steps per contact period at D = {stiffest.D:g}"
     measured = (
         "measured: at 40 the exponent is overstated up to 5x and 20 of 42 labels differ from "
-        "dt/8's, at 160 9 of 42 (docs/findings.md)"
+        "dt/8's, at 160 9 of 42 (the documentation's findings page)"
     )
     if quick:
         return f"{here}, {_COARSE} ({measured}; the full report takes {FIG6_STEPS[False]})"
@@ -295,8 +296,9 @@ def fig6(quick: bool, outdir: Path, workers=None) -> FigureResult:
     res.comparisons.append(Comparison(
         "Fig. 6", "bifurcation diagrams over D ∈ [1.36, 1.56] for G = 1e-9 and 1e-10 m",
         "; ".join(found), "not comparable",
-        "the paper's statement for Fig. 6 that we hold (MODEL.md) names the sweep, not a "
-        "sequence of regimes, so there is no claim to test; the diagrams are shown for reading"
+        "the paper's statement for Fig. 6 that we hold (the documentation's model page) names "
+        "the sweep, not a sequence of regimes, so there is no claim to test; the diagrams are "
+        "shown for reading"
         + fig6_step_note(stiffest, quick)
         + (f"; quick run: {duration:g} s runs ({transient:g} s transient), 6 values of D, no "
            "extension of undetermined runs" if quick

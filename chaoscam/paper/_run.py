@@ -17,7 +17,16 @@ from pathlib import Path
 import pandas as pd
 
 from ..io import OutputError, OutputLock, check_output
-from ..report import ReportParts, add_bifurcation, add_regime_map, add_trajectory, write_report
+from ..report import (
+    ReportParts,
+    add_bifurcation,
+    add_regime_map,
+    add_trajectory,
+    frame_tags,
+    in_words,
+    mostly,
+    write_report,
+)
 from ._paper import FIG6_STEPS, FIGURES, FULL_STEPS, SENSITIVITY, data_files, sensitivity_stage
 from ._stage import FATE_S, FULL_EXTEND_TO, QUICK_EXTEND_TO, drawing, settle, store_mode
 from ._step_audit import PER_SWEEP, audit_sentence, step_audit, sweep_names
@@ -158,7 +167,7 @@ def _run_each(stages: dict, quick, outdir, workers, say, fail) -> tuple[list, se
 def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> PaperRun:
     """The body of :func:`run_paper`, holding the report folder's lock."""
     say = functools.partial(print, file=sys.stderr, flush=True) if echo else lambda text: None
-    stages, parts, failed = {}, ReportParts(), []  # stages: function -> first figure number
+    stages, parts, failed = {}, ReportParts(paper=True), []  # stages: function -> first number
     for number in sorted(set(figures or FIGURES)):
         stages.setdefault(FIGURES[number], min(n for n in FIGURES if FIGURES[n] is FIGURES[number]))
     if figures is None:  # the whole report: the sweeps that explain the differences too
@@ -183,6 +192,7 @@ def _run_stages(quick, out, outdir, figures, workers, command, echo, force) -> P
         summary += f" {len(failed)} of {len(stages)} stages failed (see What is missing)."
     parts.summary.append(summary)
     _add_results(parts, results)
+    parts.headline = paper_headline(results, parts.comparison, lead=parts.lead is not None)
     head = _findings(parts, results, audit)
     if echo:
         print("\n".join([parts.summary[0], *head]), flush=True)
@@ -205,6 +215,8 @@ def _add_results(parts, results) -> None:
         parts.paper_figures.extend(r.figures)
         for path, rm, png in r.regime_maps:
             add_regime_map(parts, path, rm, png=png)
+            if Path(path).name == OMEGA_XI:  # the figure the answer leads with
+                parts.lead = parts.regime_maps[-1]["figure"]
         for path, bif, png in r.bifurcations:
             add_bifurcation(parts, path, bif, png=png)
         for path, run, png, verdict in r.trajectories:
@@ -254,6 +266,53 @@ def _audit_stage(results, quick, workers, say, parts):
     seconds = time.perf_counter() - t0
     say(f"step audit: {seconds:.0f} s")
     return rows, seconds
+
+
+OMEGA_XI = "sensitivity-omega-xi.parquet"
+"""The (ω, ξ) map: the figure the paper report's answer leads with, when it was made."""
+
+
+def _and(items: list[str]) -> str:
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def paper_headline(results, comparisons, *, lead: bool = False) -> list[str]:
+    """The paper report's answer, computed from its verdicts: the regimes of each figure's
+    runs (where the paper looks), which figures agree and differ, and (``lead``: the
+    (ω, ξ) map is the figure shown with it) the regimes away from Table 1."""
+    found, every = [], []
+    for r in (r for r in results if r.number != SENSITIVITY):
+        tags = [t for _, b, _ in r.bifurcations for t in frame_tags(b.verdicts)]
+        tags += [t for _, m, _ in r.regime_maps for t in frame_tags(m.realizations)]
+        if tags:
+            what = STAGE_TITLES.get(r.number, r.name).split(": ", 1)[-1]
+            found.append(f"{r.name} ({what}): {mostly(tags)}")
+            every += tags
+    lines = []
+    if found:
+        top = pd.Series(every).value_counts().index[0]
+        text = f"Where the paper looks, the motion is mostly {top}: " + "; ".join(found) + "."
+        if top.endswith("-band chaos"):
+            n = top.split("-")[0]
+            text += f" That is chaos on {n} narrow bands: at full scale it looks like period {n}"
+            text += " (the bifurcation diagrams zoom on a band)."
+        lines.append(text)
+    verbs = {"agrees": ("agrees", "agree"), "differs": ("differs", "differ"),
+             "not comparable": ("is not comparable", "are not comparable")}  # fmt: skip
+    by = {v: [c.figure for c in comparisons if c.verdict == v] for v in verbs}
+    said = [f"{_and(f)} {verbs[v][len(f) > 1]}" for v, f in by.items() if f]
+    if said:
+        lines.append("Against the paper's claims: " + "; ".join(said) + ".")
+    maps = [m for r in results for p, m, _ in r.regime_maps if Path(p).name == OMEGA_XI]
+    if maps and lead:
+        cells = maps[0].cells
+        periodic = cells.loc[cells["dominant"] == "periodic", "period"].dropna()
+        periods = sorted({int(p) for p in periodic})
+        notes = {"periodic": f" (periods {', '.join(map(str, periods))})"} if periods else {}
+        text = in_words(cells["dominant"], "cells of the (ω, ξ) map shown here", notes=notes)
+        lines.append("Away from Table 1 the regime moves with what the paper leaves open: "
+                     + text[0].lower() + text[1:] + ".")  # fmt: skip
+    return lines
 
 
 _LABELS = ("periodic", "chaotic", "quasiperiodic", "undetermined")

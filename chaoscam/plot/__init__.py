@@ -11,6 +11,7 @@ _LAZY = {
     "LABEL_COLORS": ("._sweep", "LABEL_COLORS"), "SETTLED_MARK": ("._sweep", "SETTLED_MARK"),
     "TRANSIENT_MARK": ("._sweep", "TRANSIENT_MARK"),
     "all_deterministic": ("._sweep", "all_deterministic"), "axis_label": ("._sweep", "axis_label"),
+    "BAND_ZOOM": ("._sweep", "BAND_ZOOM"), "band_zoom": ("._sweep", "band_zoom"),
     "bifurcation_figure": ("._sweep", "bifurcation_figure"),
     "mark_without_points": ("._sweep", "mark_without_points"), "percent": ("._sweep", "percent"),
     "plot_bifurcation": ("._sweep", "plot_bifurcation"),

@@ -11,7 +11,8 @@ import numpy as np
 import pandas as pd
 
 __all__ = ["LABEL_COLORS", "SETTLED_MARK", "TRANSIENT_MARK", "all_deterministic", "axis_label"]
-__all__ += ["bifurcation_figure", "mark_without_points", "percent", "plot_bifurcation"]
+__all__ += ["band_zoom", "bifurcation_figure", "mark_without_points", "percent"]
+__all__ += ["plot_bifurcation"]
 __all__ += ["plot_diagram"]
 __all__ += ["plot_dominant", "plot_interval_width", "plot_probability", "regime_map_figure"]
 __all__ += ["sweep_diagram"]
@@ -45,6 +46,9 @@ reach later (transient chaos; see :func:`chaoscam.sweep.regime_map`)."""
 SETTLED_MARK = "→"
 """Before Pn in a cell where a fate horizon found runs periodic (n) on the continued run's
 last half, after the recorded window its label describes."""
+
+BAND_ZOOM = 0.02
+"""A diagram zooms on a band of n-band chaos narrower than this share of its full scale."""
 
 _SYMBOLS = {"l_lambda": "l_λ", "omega": "ω", "xi": "ξ", "beta": "β", "mu_f": "μ_f",
             "theta_f": "θ_f", "omega_f": "θ̇_f"}  # fmt: skip
@@ -323,11 +327,59 @@ def plot_diagram(points, ax, *, verdicts=None, **kw):
     return ax
 
 
+def band_zoom(points: pd.DataFrame, verdicts: pd.DataFrame | None, coordinate: str = "theta_f"):
+    """The band a diagram zooms on: ``(value, ic, n, lo, hi)`` of the widest of the n bands
+    of the n-band chaos run (``ev_banded_chaos`` of ``verdicts``) at the median such value,
+    its points split into n bands at their n - 1 widest gaps; None when no run is n-band
+    chaos or its bands are wider than :data:`BAND_ZOOM` of the diagram's range."""
+    if verdicts is None or "ev_banded_chaos" not in verdicts or not len(points):
+        return None
+    banded = verdicts[(verdicts["label"] == "chaotic") & (verdicts["ev_banded_chaos"] > 1)]
+    if not len(banded):
+        return None
+    row = banded.sort_values("value").iloc[len(banded) // 2]
+    n = int(row["ev_banded_chaos"])
+    mine = points[(points["value"] == row["value"]) & (points["ic"] == row["ic"])]
+    y = np.sort(mine[coordinate].to_numpy(dtype=float))
+    if len(y) < 2 * n:
+        return None
+    cuts = np.sort(np.argsort(np.diff(y))[len(y) - n :] + 1)  # the n - 1 widest gaps
+    bands = [b for b in np.split(y, cuts) if len(b)]
+    widest = max(bands, key=lambda b: b[-1] - b[0])
+    lo, hi = float(widest[0]), float(widest[-1])
+    full = float(points[coordinate].max() - points[coordinate].min())
+    if not (0 < hi - lo < BAND_ZOOM * full):
+        return None
+    return float(row["value"]), int(row["ic"]), n, lo, hi
+
+
+def _draw_zoom(ax, zax, points, zoom, coordinate: str, color_by: str) -> None:
+    """One band of ``zoom`` (:func:`band_zoom`) drawn on ``zax`` over the nearest values,
+    its place marked on the diagram ``ax``."""
+    value, _, n, lo, hi = zoom
+    values = np.unique(points["value"].to_numpy(dtype=float))
+    at = int(np.searchsorted(values, value))
+    near = values[max(0, at - 3) : at + 4]
+    pad = hi - lo
+    window = points[points["value"].isin(near)]
+    window = window[window[coordinate].between(lo - pad, hi + pad)]
+    plot_bifurcation(window, zax, coordinate=coordinate, color_by=color_by, size=14.0)
+    if zax.get_legend():
+        zax.get_legend().remove()
+    zax.set_ylim(lo - pad, hi + pad)
+    zax.ticklabel_format(axis="y", useOffset=False)
+    zax.set_title(f"one of the {n} bands, zoomed:\n{hi - lo:.2g} rad wide at {value:.4g}")
+    zax.set_ylabel(f"{axis_label(coordinate)}, zoomed")
+    ax.indicate_inset_zoom(zax, edgecolor="#000000", alpha=0.8)
+
+
 def bifurcation_figure(
     points: pd.DataFrame, *, coordinate: str = "theta_f", color_by: str = "label",
     note: str = "", verdicts: pd.DataFrame | None = None,
 ):  # fmt: skip
-    """One panel: the bifurcation diagram of ``coordinate`` over the swept parameter.
+    """The bifurcation diagram of ``coordinate`` over the swept parameter, with a panel
+    zoomed on one band where n-band chaos lies on bands too narrow to see at full scale
+    (:func:`band_zoom`).
 
     ``note`` (e.g. "G = 1e-10 m") goes into the title, to tell panels of one figure apart.
     With the sweep's ``verdicts``, a run that left no section point after the transient (out
@@ -335,9 +387,12 @@ def bifurcation_figure(
     """
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(9, 5), layout="constrained")
-    ax = plot_diagram(points, fig.subplots(), coordinate=coordinate, color_by=color_by,
-                      verdicts=verdicts)  # fmt: skip
+    zoom = band_zoom(points, verdicts, coordinate)
+    fig = Figure(figsize=(12, 5) if zoom else (9, 5), layout="constrained")
+    ax, zax = fig.subplots(1, 2, width_ratios=(3, 1)) if zoom else (fig.subplots(), None)
+    plot_diagram(points, ax, coordinate=coordinate, color_by=color_by, verdicts=verdicts)
+    if zoom:
+        _draw_zoom(ax, zax, points, zoom, coordinate, color_by)
     what = str(points["param"].iloc[0]) if len(points) else ""
     what += f" ({note})" if note else ""
     ax.set_title(f"bifurcation diagram over {what}: stroboscopic section after the transient")

@@ -25,6 +25,14 @@ _LAZY = {
     "add_ensemble": ("._html", "add_ensemble"),
     "add_regime_map": ("._html", "add_regime_map"),
     "add_trajectory": ("._html", "add_trajectory"),
+    "band_counts": ("._headline", "band_counts"),
+    "band_number": ("._headline", "band_number"),
+    "fold": ("._headline", "fold"),
+    "frame_tags": ("._headline", "frame_tags"),
+    "headline": ("._headline", "headline"),
+    "in_words": ("._headline", "in_words"),
+    "lead_figure": ("._html", "lead_figure"),
+    "mostly": ("._headline", "mostly"),
     "as_inputs": ("._inputs", "as_inputs"),
     "bifurcation_figure": ("._figures", "bifurcation_figure"),
     "build_report": ("._html", "build_report"),
@@ -36,6 +44,7 @@ _LAZY = {
     "regime_map_figure": ("._figures", "regime_map_figure"),
     "response_figure": ("._figures", "response_figure"),
     "sweep_diagram": ("._figures", "sweep_diagram"),
+    "verdict_tag": ("._headline", "verdict_tag"),
     "write_report": ("._html", "write_report"),
 }
 

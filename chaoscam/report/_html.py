@@ -2,7 +2,9 @@
 
 Figures are inline PNG data URIs and the template holds its own CSS: nothing in the file
 refers to the network, so it opens from disk anywhere. A report built from a partial set of
-inputs says what is missing instead of failing.
+inputs says what is missing instead of failing. It leads with its answer (:mod:`._headline`);
+the paper's sections (figures reproduced, the comparison, why it differs) appear only in the
+report of :mod:`chaoscam.paper` (``ReportParts(paper=True)``).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from typing import Any
 from ..io import code_rows
 from ..sweep import fate_clause
 from ._figures import png_bytes, png_uri, response_figure
+from ._headline import fold, frame_tags, headline, verdict_tag
 from ._inputs import as_inputs
 
 __all__ = ["Comparison", "FigureItem", "ReportParts", "add_bifurcation", "add_ensemble"]
@@ -28,7 +31,14 @@ __all__ += ["uncommitted_sources", "write_report"]
 CLASSIFIER = "chaoscam.classify() (tangent exponent, orbit certificate)"
 """The classifier the report's runs are labelled with, in words."""
 
+SOURCE_PAPER = (
+    "Effect of Surface Morphology on Dynamic Characteristics of Cam-Follower Oblique Impact System"
+)
+"""The title of the paper whose model chaoscam implements (authors, venue, year and DOI are
+not recorded)."""
+
 SECTIONS = (
+    ("answer", "The answer"),
     ("summary", "Summary of findings"),
     ("provenance", "Parameters and provenance"),
     ("paper-figures", "Paper figures reproduced"),
@@ -40,6 +50,9 @@ SECTIONS = (
     ("why", "Why the paper differs"),
     ("missing", "What is missing"),
 )
+
+PAPER_SECTIONS = ("paper-figures", "comparison", "why")
+"""The sections only :mod:`chaoscam.paper`'s report has."""
 
 ENSEMBLES = ("ensembles", "Ensembles")
 """A section shown after the bifurcation diagrams only when the report has an ensemble."""
@@ -85,15 +98,26 @@ class Comparison:
 
 @dataclass
 class ReportParts:
-    """Everything the template shows, gathered before rendering."""
+    """Everything the template shows, gathered before rendering.
 
+    ``paper``: the report of :mod:`chaoscam.paper` (with its sections). ``headline``: the
+    answer's sentences and ``lead`` its figure (else computed from ``found``: per input its
+    name, what it sweeps and its verdicts' tags). ``listing``: one line per input (folded).
+    ``responses``: one figure per distinct verdict, with the runs it stands for.
+    """
+
+    paper: bool = False
+    headline: list[str] = field(default_factory=list)
+    lead: FigureItem | None = None
+    found: list[dict[str, Any]] = field(default_factory=list)
+    listing: list[str] = field(default_factory=list)
     summary: list[str] = field(default_factory=list)
     provenance: list[dict[str, Any]] = field(default_factory=list)
     paper_figures: list[FigureItem] = field(default_factory=list)
     regime_maps: list[dict[str, Any]] = field(default_factory=list)
     bifurcations: list[dict[str, Any]] = field(default_factory=list)
     ensembles: list[dict[str, Any]] = field(default_factory=list)
-    responses: list[FigureItem] = field(default_factory=list)
+    responses: list[dict[str, Any]] = field(default_factory=list)
     evidence: list[dict[str, Any]] = field(default_factory=list)
     comparison: list[Comparison] = field(default_factory=list)
     why: list[str] = field(default_factory=list)
@@ -163,10 +187,23 @@ def _uri(png: bytes | None, draw) -> str:
 
 
 def _record(parts: ReportParts, path: str, kind: str, settings: dict, summary: str) -> None:
-    """An input's settings in the provenance section and its line in the summary."""
+    """An input's settings in the provenance section and its line in the listing."""
     rows = [(k, _fmt(v)) for k, v in settings.items()]
     parts.provenance.append({"source": path, "kind": kind, "rows": rows})
-    parts.summary.append(summary)
+    parts.listing.append(summary)
+
+
+def _evidence_rows(evidence) -> list[tuple[str, str, str, str]]:
+    """(method, value, vote, detail) of a verdict's evidence; methods that abstain with the
+    same detail share one row."""
+    rows: list[list[str]] = []
+    for e in evidence:
+        row = [e.name, _fmt(e.value), e.vote or "abstains", e.detail]
+        if rows and row[1:] == rows[-1][1:] and not row[1]:
+            rows[-1][0] += f", {e.name}"
+        else:
+            rows.append(row)
+    return [tuple(r) for r in rows]
 
 
 def classifier_fingerprint() -> str:
@@ -200,19 +237,27 @@ def add_trajectory(
     if verdict is None:
         (verdict,) = classify(run)
     label = verdict.label + (f" (period {verdict.period})" if verdict.period else "")
-    figure = FigureItem(
-        f"resp-{len(parts.responses) + 1}",
-        f"Response of {name}",
-        _uri(png, lambda: response_figure(run, title=f"{name}: {label}")),
-        f"Four panels for {name}: follower angle and persistent-contact angle over the last "
-        f"2 s, phase portrait, stroboscopic Poincaré section and spectrum of theta_f; "
-        f"classified {label}.",
-        caption
-        or f"μ = l_lambda = {p.l_lambda:g} m, σ = {p.l_lambda_sigma:g} m, "
-        f"stiffness {p.stiffness}; classified {label}.",
-    )
-    parts.responses.append(figure)
-    rows = [(e.name, _fmt(e.value), e.vote or "abstains", e.detail) for e in verdict.evidence]
+    bands = next((e.value for e in verdict.evidence if e.name == "banded_chaos"), None)
+    tag = verdict_tag(verdict.label, verdict.period, bands)
+    parts.found.append({"name": name, "what": "a run", "tags": [tag], "unit": "run"})
+    where = f"μ = l_lambda = {p.l_lambda:g} m, σ = {p.l_lambda_sigma:g} m, stiffness {p.stiffness}"
+    key = (tag, run.status.name)
+    same = next((r for r in parts.responses if r["key"] == key), None)
+    if same is not None:  # drawn once per distinct verdict: this run joins its panel
+        same["runs"].append(f"{name} ({where})")
+    else:
+        figure = FigureItem(
+            f"resp-{len(parts.responses) + 1}",
+            f"Response of {name}",
+            _uri(png, lambda: response_figure(run, title=f"{name}: {label}")),
+            f"Four panels for {name}: follower angle and persistent-contact angle over the "
+            f"last 2 s, phase portrait, stroboscopic Poincaré section and spectrum of "
+            f"theta_f; classified {label}.",
+            caption or f"{where}; classified {label}.",
+        )
+        parts.responses.append({"figure": figure, "key": key, "tag": tag,
+                                "runs": [f"{name} ({where})"]})  # fmt: skip
+    rows = _evidence_rows(verdict.evidence)
     parts.evidence.append({
         "run": name, "label": verdict.label, "period": verdict.period,
         "reasons": list(verdict.reasons), "classifier": CLASSIFIER, "rows": rows,
@@ -265,6 +310,9 @@ def add_bifurcation(
         f"label; label counts {counts}.",
         caption or f"{len(v)} runs, {len(bif.points)} section points; labels {counts}.",
     )
+    vals = v["value"] if len(v) else pd.Series([0.0])
+    what = f"{param} from {vals.min():g} to {vals.max():g}"
+    parts.found.append({"name": name, "what": what, "tags": frame_tags(v), "unit": "runs"})
     header = [param, "initial condition", "label", "period", "status"]
     header += [c[3:] for c in ev_cols] + [named[c] for c in later]
     parts.bifurcations.append({"figure": figure, "header": header, "rows": rows[:300]})
@@ -300,6 +348,10 @@ def add_regime_map(
         caption or f"{len(rm.realizations)} realizations in {len(c)} cells.",
     )
     level = percent(confidence)
+    tags = [verdict_tag(d, per) for d, per in zip(c["dominant"], c["period"], strict=True)]
+    what = f"{x} × {y}"
+    runs = frame_tags(rm.realizations)
+    parts.found.append({"name": name, "what": what, "tags": tags, "unit": "cells", "runs": runs})
     parts.regime_maps.append({"figure": figure, "x": x, "y": y, "level": level, "rows": rows})
     dom = _counts(c["dominant"].value_counts().to_dict() if len(c) else {})
     fate = fate_clause(rm.realizations, cfg.get("fate"), "realizations")
@@ -332,6 +384,8 @@ def add_ensemble(parts: ReportParts, path: str, ens, *, png: bytes | None = None
         for r in shares
     ]  # fmt: skip
     parts.ensembles.append({"figure": figure, "rows": rows, "reasons": e.top_reasons(members)})
+    tags = [r["label"] for r in shares for _ in range(int(r["count"]))]
+    parts.found.append({"name": name, "what": "an ensemble", "tags": tags, "unit": "members"})
     counts = "; ".join(f"{r['label']}: {r['count']}" for r in shares)
     summary = f"{name}: ensemble of {n} members, {what}: {counts}"
     summary += " (σ = 0: one deterministic run)." if fixed else "."
@@ -395,12 +449,28 @@ def model_rows() -> list[tuple[str, Any, str, str]]:
 
 
 def _sections(parts: ReportParts) -> tuple[tuple[str, str], ...]:
-    """The table of contents: :data:`SECTIONS`, with :data:`ENSEMBLES` after the
-    bifurcation diagrams when there is an ensemble."""
+    """The table of contents: :data:`SECTIONS` (without :data:`PAPER_SECTIONS` outside the
+    paper's report), with :data:`ENSEMBLES` after the bifurcation diagrams when there is an
+    ensemble."""
+    shown = tuple(s for s in SECTIONS if parts.paper or s[0] not in PAPER_SECTIONS)
     if not parts.ensembles:
-        return SECTIONS
-    at = [sid for sid, _ in SECTIONS].index("bifurcations") + 1
-    return (*SECTIONS[:at], ENSEMBLES, *SECTIONS[at:])
+        return shown
+    at = [sid for sid, _ in shown].index("bifurcations") + 1
+    return (*shown[:at], ENSEMBLES, *shown[at:])
+
+
+def lead_figure(parts: ReportParts) -> FigureItem | None:
+    """The figure the headline leads with: :attr:`ReportParts.lead`, else the first regime
+    map, bifurcation diagram, ensemble, response or paper figure."""
+    for item in (
+        parts.lead,
+        *(m["figure"] for m in parts.regime_maps + parts.bifurcations + parts.ensembles),
+        *(r["figure"] for r in parts.responses),
+        *parts.paper_figures,
+    ):
+        if item is not None:
+            return item
+    return None
 
 
 def render(parts: ReportParts, *, title: str, command: str | None = None) -> str:
@@ -423,6 +493,10 @@ def render(parts: ReportParts, *, title: str, command: str | None = None) -> str
         title=title,
         sections=_sections(parts),
         parts=parts,
+        answer=parts.headline or headline(parts.found),
+        lead=lead_figure(parts),
+        fold=fold,
+        source=SOURCE_PAPER,
         version=__version__,
         commit=commit or "not available (not run from a git checkout)",
         date=_dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M:%S UTC"),

@@ -11,7 +11,7 @@ import pytest
 
 import chaoscam
 from chaoscam.cli import main
-from chaoscam.report._html import SECTIONS
+from chaoscam.report._html import PAPER_SECTIONS, SECTIONS
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -85,7 +85,7 @@ def test_full_report_has_every_section_and_valid_images(outputs, tmp_path, capsy
     )
     assert code == 0, err
     doc = _parse(text)
-    assert {sid for sid, _ in SECTIONS} <= doc.ids
+    assert {sid for sid, _ in SECTIONS if sid not in PAPER_SECTIONS} <= doc.ids
     assert len(doc.imgs) >= 3 and doc.tables >= 4
     for img in doc.imgs:
         assert img.get("alt"), "every figure has alt text"
@@ -105,6 +105,60 @@ def test_full_report_has_every_section_and_valid_images(outputs, tmp_path, capsy
     assert "<td>omega</td><td>28.7</td><td>rad/s</td>" in text
     assert "<td>xi</td><td>0.42</td>" in text
     assert "<td>base dt [s]</td>" in text and "<td>base xi" not in text
+
+
+def test_a_report_of_ones_own_runs_has_no_paper_sections(outputs, tmp_path, capsys):
+    """`chaoscam report` of non-paper inputs: no paper figures, no comparison with the paper,
+    no "why the paper differs", neither in the page nor in its contents (they stood there,
+    empty); the source paper is cited by title."""
+    code, text, err = _report([outputs / "traj.parquet", outputs / "map.parquet"], tmp_path, capsys)
+    assert code == 0, err
+    doc = _parse(text)
+    assert not doc.ids & set(PAPER_SECTIONS)
+    for absent in ("Paper figures reproduced", "The paper against this run", "Why the paper"):
+        assert absent not in text
+    assert "<cite>Effect of Surface Morphology on Dynamic Characteristics of Cam-Follower" in text
+    assert "docs/" not in text and ".md" not in text  # the docs are not shipped: named only
+
+
+def test_the_headline_is_computed_from_the_verdicts(outputs):
+    """The answer names the commonest regime of the inputs' verdicts and where it lies;
+    other verdicts give another answer, and the lead figure is the first sweep's."""
+    from chaoscam.report import build_report
+    from chaoscam.report._html import lead_figure
+    from chaoscam.sweep import read_bifurcation
+
+    bif = read_bifurcation(outputs / "bif.parquet")
+    parts = build_report([bif])
+    from chaoscam.report._headline import headline
+
+    before = headline(parts.found)
+    assert len(before) == 2 and before[0].startswith(f"Of the {len(bif.verdicts)} runs given, ")
+    assert lead_figure(parts).id == "bif-1"
+    bif.verdicts["label"], bif.verdicts["period"] = "periodic", 3
+    after = headline(build_report([bif]).found)
+    assert after != before
+    n = len(bif.verdicts)
+    assert after[0] == f"Of the {n} runs given, {n} are period 3."
+    assert "period 3 in 2 of 2 runs" in after[1]
+
+
+def test_long_texts_fold_and_abstaining_methods_share_a_row():
+    """fold keeps short texts whole and cuts long ones after a sentence within the limit;
+    methods abstaining with one detail share one evidence row."""
+    from types import SimpleNamespace as E
+
+    from chaoscam.report._headline import fold
+    from chaoscam.report._html import _evidence_rows
+
+    assert fold("short.") == ("short.", "")
+    head, rest = fold("A first sentence. " + "word " * 80)
+    assert head == "A first sentence." and rest.startswith("word")
+    same = "periodic to the tolerance"
+    ev = [E(name=n, value=None, vote=None, detail=same) for n in ("a", "b", "c")]
+    ev.append(E(name="exponent", value=0.5, vote="chaotic", detail="positive"))
+    rows = _evidence_rows(ev)
+    assert rows == [("a, b, c", "", "abstains", same), ("exponent", "0.5", "chaotic", "positive")]
 
 
 def test_a_sweep_lists_every_base_field_it_changes():

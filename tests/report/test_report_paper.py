@@ -88,7 +88,8 @@ def test_a_failing_figure_is_reported_as_missing(tmp_path, monkeypatch, capsys):
     text = run.path.read_text()
     assert fail in text
     assert "Fig. 5 — fractal stiffness against D" in text
-    assert "Fig. 5 in " in text and "Figs. 3" not in text and "1 of 2 stages failed" in text
+    claims = text.replace("and Figs. 3–10); the authors", "")  # the source paper's citation
+    assert "Fig. 5 in " in text and "Figs. 3" not in claims and "1 of 2 stages failed" in text
     assert "(incomplete: 1 of 2 stages failed)" in text
     err = capsys.readouterr().err  # the stages by their titles, not function names
     assert f"[1/2] Fig. 3: line-length draws ...\n[1/2] {fail}\n" in err
@@ -357,10 +358,13 @@ def test_each_figure_is_rendered_once_and_the_report_embeds_its_file(tmp_path, m
     assert len(files) == 11  # figs 3, 4, 5, the map, its random response and six responses
     assert sorted(rendered) == sorted(files.values())  # once each, nothing else drawn
     text = out.read_text()
-    embedded = {
-        base64.b64decode(u) for u in re.findall(r'src="data:image/png;base64,([^"]+)"', text)
-    }
-    assert embedded == set(files.values())
+    found = re.findall(r'src="data:image/png;base64,([^"]+)"', text)
+    embedded = {base64.b64decode(u) for u in found}
+    assert len(found) == len(embedded)  # the answer's figure is not shown twice
+    # every figure but the responses that share a verdict, which one panel stands for
+    panels = text.count('<figure id="resp-')
+    assert 1 <= panels <= 6 and embedded <= set(files.values())
+    assert len(set(files.values()) - embedded) == 6 - panels
 
 
 def test_the_summary_opens_with_the_labels_counted_from_the_tables():
@@ -454,3 +458,44 @@ def test_write_report_keeps_an_existing_file_and_needs_its_folder(tmp_path):
     with pytest.raises(OutputError, match="does not exist"):
         write_report(ReportParts(), tmp_path / "no" / "r.html", title="t")
     assert not (tmp_path / "no").exists()
+
+
+def test_the_paper_headline_is_computed_from_the_verdicts():
+    """The answer: each figure's commonest regime (n-band chaos said to look like period n),
+    the figures that agree and differ, and the (omega, xi) map's regimes; other verdicts
+    give another answer."""
+    from types import SimpleNamespace as NS
+
+    from chaoscam.paper._run import paper_headline
+    from chaoscam.report import Comparison
+
+    nan = float("nan")
+
+    def fig4(labels, periods, bands):
+        table = pd.DataFrame({"label": labels, "period": periods, "ev_banded_chaos": bands})
+        return NS(number=4, name="Fig. 4", bifurcations=[("b", NS(verdicts=table), b"")],
+                  regime_maps=[])  # fmt: skip
+
+    comparisons = [Comparison("Fig. 4", "p", "f", "differs", "r")]
+    comparisons.append(Comparison("Fig. 5", "p", "f", "agrees", "r"))
+    banded = fig4(["chaotic"] * 3, [nan] * 3, [8.0, 8.0, nan])
+    assert paper_headline([banded], comparisons) == [
+        "Where the paper looks, the motion is mostly 8-band chaos: Fig. 4 (bifurcation over "
+        "l_λ): 8-band chaos in 2 of 3 runs, chaotic in 1. That is chaos on 8 narrow bands: at "
+        "full scale it looks like period 8 (the bifurcation diagrams zoom on a band).",
+        "Against the paper's claims: Fig. 5 agrees; Fig. 4 differs.",
+    ]
+    cells = pd.DataFrame({"dominant": ["periodic", "periodic", "chaotic", "left_reach"],
+                          "period": [1, 3, nan, nan]})  # fmt: skip
+    sens = NS(number=0, name="s", bifurcations=[],
+              regime_maps=[("d/sensitivity-omega-xi.parquet", NS(cells=cells), b"")])  # fmt: skip
+    periodic = fig4(["periodic"] * 3, [2, 2, 2], [nan] * 3)
+    lines = paper_headline([periodic, sens], comparisons[1:], lead=True)
+    assert lines == [
+        "Where the paper looks, the motion is mostly period 2: Fig. 4 (bifurcation over l_λ): "
+        "period 2 in 3 of 3 runs.",
+        "Against the paper's claims: Fig. 5 agrees.",
+        "Away from Table 1 the regime moves with what the paper leaves open: of the 4 cells of "
+        "the (ω, ξ) map shown here, 2 are periodic (periods 1, 3), 1 is chaotic and 1 is out of "
+        "the cam's reach.",
+    ]

@@ -122,11 +122,13 @@ def test_build_report_takes_results_in_memory(results, tmp_path):
     r = results
     parts = build_report([r["map"], r["bif"], r["ens"], r["run"], tmp_path / "run.parquet"])
     assert (len(parts.regime_maps), len(parts.bifurcations), len(parts.ensembles)) == (1, 1, 1)
-    assert len(parts.responses) == 2 and not parts.missing
-    assert parts.summary[0].startswith("regime map 1:")
+    # one run given twice: one panel, standing for both runs
+    assert len(parts.responses) == 1 and len(parts.responses[0]["runs"]) == 2
+    assert len(parts.evidence) == 2 and not parts.missing
+    assert parts.listing[0].startswith("regime map 1:")
     assert {p["source"] for p in parts.provenance} >= {"run 4", str(tmp_path / "run.parquet")}
     out = write_report(parts, tmp_path / "r.html", title="in memory")
-    assert out.read_text().count("data:image/png;base64,") >= 5
+    assert out.read_text().count("data:image/png;base64,") >= 4
 
 
 def test_simulate_plot_writes_a_png(tmp_path, capsys):

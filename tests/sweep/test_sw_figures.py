@@ -112,3 +112,36 @@ def test_runs_without_section_points_are_marked():
     assert xs[0].get_offsets()[:, 0].tolist() == [0.7]
     ax = bifurcation_figure(pts, verdicts=verdicts.iloc[:2]).axes[0]
     assert not any("no section" in t.get_text() for t in ax.get_legend().get_texts())
+
+
+def _banded(width: float):
+    """A diagram over l_lambda of 8-band chaos: 8 bands of ``width`` rad on [0, 0.3] rad."""
+    rng = np.random.default_rng(np.random.SeedSequence(5))
+    values = np.linspace(0.001, 0.018, 7)
+    centres = np.linspace(0.0, 0.3, 8)
+    pts = pd.DataFrame(
+        [(v, 0, c + width * rng.random(), "chaotic") for v in values for c in centres
+         for _ in range(6)],
+        columns=["value", "ic", "theta_f", "label"],
+    ).assign(param="l_lambda")  # fmt: skip
+    verdicts = pd.DataFrame({"value": values, "ic": 0, "label": "chaotic", "ev_banded_chaos": 8.0})
+    return pts, verdicts
+
+
+def test_bands_too_narrow_to_see_get_a_zoomed_panel():
+    """8-band chaos on bands of 3e-4 rad (1e-3 of the scale, invisible): a second panel zooms
+    on one band, its limits around that band's width; bands of 0.02 rad (visible) or a
+    diagram without band counts get none."""
+    from chaoscam.plot import band_zoom
+
+    pts, verdicts = _banded(3e-4)
+    value, ic, n, lo, hi = band_zoom(pts, verdicts)
+    assert n == 8 and 0 < hi - lo <= 3e-4 and value in set(verdicts["value"])
+    fig = bifurcation_figure(pts, verdicts=verdicts)
+    zoom = [a for a in fig.axes if "zoomed" in a.get_title()]
+    assert len(zoom) == 1 and "8 bands" in zoom[0].get_title()
+    assert np.diff(zoom[0].get_ylim())[0] < 4 * 3e-4
+    wide_pts, wide = _banded(0.02)
+    assert band_zoom(wide_pts, wide) is None
+    assert len(bifurcation_figure(wide_pts, verdicts=wide).axes) == 1
+    assert band_zoom(pts, verdicts.drop(columns="ev_banded_chaos")) is None
