@@ -19,7 +19,7 @@ from ..model import Params, field_names, params_arg
 from ..numerics import Numerics
 from ..simulation import numerics_arg, simulate
 from ..verdict import map_runner, periodic_orbit
-from ._core import MapFailed, MapPoint, Settings, follow
+from ._core import MapFailed, Settings, follow
 
 __all__ = ["Branch", "NoOrbitError", "continuation", "events_path"]
 
@@ -284,8 +284,9 @@ def _switched(params, param, n, num, st, events) -> list:
     return out
 
 
-def _mu_columns(p: MapPoint) -> dict[str, float]:
-    mu = p.multipliers
+def _mu_columns(dp: np.ndarray) -> dict[str, float]:
+    mu = np.linalg.eigvals(dp).astype(complex)
+    mu = mu[np.argsort(-np.abs(mu), kind="stable")]
     return {"mu1_re": mu[0].real, "mu1_im": mu[0].imag, "mu2_re": mu[1].real,
             "mu2_im": mu[1].imag}  # fmt: skip
 
@@ -297,7 +298,7 @@ def _points_frame(found, param: str) -> pd.DataFrame:
     rows = []
     for b, n, points, _ in found:
         for i, p in enumerate(points):
-            mu = _mu_columns(p)
+            mu = _mu_columns(p.dp)
             common = {"branch": b, "point": i, "period": n, "param": param,
                       "value": float(p.u[2]), "s": p.s}  # fmt: skip
             info = {key: p.info.get(key) for key in _INFO}
@@ -313,7 +314,7 @@ def _points_frame(found, param: str) -> pd.DataFrame:
 
 def _events_frame(found, param: str) -> pd.DataFrame:
     rows = [{"branch": b, "kind": kind, "param": param, "value": float(p.u[2]), "s": p.s,
-             "theta_f": float(p.u[0]), "omega_f": float(p.u[1]), **_mu_columns(p),
+             "theta_f": float(p.u[0]), "omega_f": float(p.u[1]), **_mu_columns(p.dp),
              "detail": detail}
             for b, _, _, events in found for kind, p, detail in events]  # fmt: skip
     return pd.DataFrame(rows)

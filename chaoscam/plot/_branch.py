@@ -1,4 +1,5 @@
-"""A continuation branch drawn on a matplotlib Axes: the parameter against the section's θ_f."""
+"""Continuation drawn on a matplotlib Axes: a branch (the parameter against the section's θ_f)
+and bifurcation curves in two parameters."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 from ._run import axes
 from ._sweep import axis_label
 
-__all__ = ["plot_branch"]
+__all__ = ["plot_branch", "plot_curves"]
 
 EVENT_MARKS = {"fold": ("o", "#D55E00"), "period_doubling": ("s", "#0072B2"),
                "neimark_sacker": ("D", "#009E73"), "impact_change": ("^", "#CC79A7"),
@@ -37,4 +38,27 @@ def plot_branch(points, events=None, ax=None):
     name = str(points["param"].iloc[0]) if len(points) else "value"
     ax.set(xlabel=axis_label(name), ylabel=axis_label("theta_f"),
            title="continuation: stable solid, unstable dashed")  # fmt: skip
+    return ax
+
+
+CURVE_STYLES = {"fold": ("-", "#D55E00"), "period_doubling": ("--", "#0072B2")}
+
+
+def plot_curves(points, ax=None, *, swap: bool = False):
+    """Bifurcation curves (``Curve.points``) on ``ax``: ``value`` (λ1) on x and ``value2``
+    (λ2) on y (``swap``: the other way round), one line per ``curve``, styled by ``kind``
+    (fold solid vermilion, period doubling dashed blue). Returns the Axes."""
+    ax = axes(ax)
+    seen = set()
+    for (_, kind), g in points.groupby(["curve", "kind"], sort=True):
+        g = g.sort_values("point")
+        ls, color = CURVE_STYLES.get(kind, ("-.", "#000000"))
+        xy = (g["value2"], g["value"]) if swap else (g["value"], g["value2"])
+        ax.plot(*xy, ls=ls, lw=2.0, color=color,
+                label=None if kind in seen else kind.replace("_", " "))  # fmt: skip
+        seen.add(kind)
+    if len(points):
+        names = [axis_label(str(points[c].iloc[0])) for c in ("param", "param2")]
+        ax.set(xlabel=names[swap], ylabel=names[not swap])
+        ax.legend(frameon=False, fontsize="small")
     return ax
