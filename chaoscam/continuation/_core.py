@@ -228,7 +228,8 @@ def _crossings(br: _Branch, a: MapPoint, b: MapPoint, kinds) -> list[tuple[str, 
 
 def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
            observe: Callable | None = None, kinds=CONTINUOUS,
-           on_point: Callable | None = None) -> tuple[list[MapPoint], list[tuple]]:  # fmt: skip
+           on_point: Callable | None = None,
+           resume=None) -> tuple[list[MapPoint], list[tuple]]:  # fmt: skip
     """Follow the branch of fixed points of ``fun`` from u0 = (x, λ), a fixed point.
 
     Parameters
@@ -251,6 +252,8 @@ def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
         The test functions (:data:`CONTINUOUS`) located along the branch.
     on_point : callable, optional
         ``on_point(points, events)`` after each new point (a checkpoint).
+    resume : (points, events), optional
+        An interrupted branch: followed on from its last point and tangent (u0 unused).
 
     Returns
     -------
@@ -259,7 +262,10 @@ def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
     """
     br = _Branch(fun, st, observe)
     z0 = np.asarray(u0, dtype=float) * br.w
-    if t0 is None:
+    if resume is not None:
+        points, events, h = list(resume[0]), list(resume[1]), st.h0
+        a = points[-1]
+    elif t0 is None:
         a = br.correct(z0, np.eye(len(z0))[-1], 0.0)  # λ fixed: plain Newton on x
         if a is None:
             raise MapFailed("no fixed point near the start: the corrector did not converge")
@@ -268,8 +274,9 @@ def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
         g, _, dp = br.evaluate(z0)
         t0 = np.asarray(t0, dtype=float)
         a = MapPoint(z0 / br.w, t0 / np.linalg.norm(t0), dp, float(np.linalg.norm(g)), 0)
-    a.info = observe(a.u[:-1], float(a.u[-1])) if observe else {}
-    points, events, h = [a], [], st.h0
+    if resume is None:
+        a.info = observe(a.u[:-1], float(a.u[-1])) if observe else {}
+        points, events, h = [a], [], st.h0
     reason = f"max_points = {st.max_points} reached"
     while len(points) < st.max_points:
         b = br.at(a, h)

@@ -97,3 +97,18 @@ def test_fold_curve_from_the_branch_fold():
     c = curve(p, row, second="xi", to=0.15)
     assert abs(c.points.value.iloc[0] - 29.0894) < 1e-4
     assert np.allclose(c.points.mu1_re, 1.0, atol=1e-5) and c.points.value2.max() >= 0.15
+
+
+def test_cli_curve_writes_the_curves(tmp_path, capsys):
+    """continue --curve xi --curve-to 0.2 writes FILE.curves.parquet (a multiplier -1 along
+    the curve from the branch's doubling) and FILE.curves.events.parquet."""
+    out = tmp_path / "b.parquet"
+    args = ["continue", "--from", "31.9", "--to", "32.2", "--set", "xi=0.1", "--curve", "xi",
+            "--curve-to", "0.2", "--out", str(out)]  # fmt: skip
+    assert main(args) == 0
+    assert "curves:" in capsys.readouterr().out
+    pts = pd.read_parquet(tmp_path / "b.curves.parquet")
+    assert set(pts.kind) == {"period_doubling"} and pts.value2.max() >= 0.2
+    assert np.allclose(pts.mu1_re, -1.0, atol=1e-6)
+    assert pd.read_parquet(tmp_path / "b.curves.events.parquet").kind.iloc[-1] == "end"
+    assert main(args[:-4] + ["--out", str(out)]) == 2  # --curve without --curve-to
