@@ -1,13 +1,13 @@
-"""Pseudo-arclength continuation of fixed points of a map ``P(x; λ)``, x in R², with its test
-functions located along the branch, generic over the map: the model's stroboscopic map and
-the bouncing ball's impact map go through the same code.
+"""Pseudo-arclength continuation of fixed points of a map ``P(x; λ)``, x in R^m, with its test
+functions located along the branch, generic over the map: the model's stroboscopic map, the
+bouncing ball's impact map and a bifurcation curve's extended system go through the same code.
 
 Unknowns u = (x, λ), scaled to z = w u (``weights``); the branch is ``G(u) = P(x; λ) - x = 0``,
-a curve in R³ whose tangent is the null vector of ``G_u = [DP - I | ∂P/∂λ]`` (the cross
-product of its two scaled rows). A step: the predictor ``z_p = z + h t``, then Newton on the
-extended system ``(G(z), t·(z - z_k) - h) = 0`` (Keller's pseudo-arclength condition;
-Kuznetsov 2004, *Elements of Applied Bifurcation Theory*, sec. 10.2; Dankowicz & Schilder
-2013, *Recipes for Continuation*, ch. 3).
+a curve in R^(m+1) whose tangent is the null vector of ``G_u = [DP - I | ∂P/∂λ]`` (its
+signed minors: the cross product of its two scaled rows when m = 2). A step: the predictor
+``z_p = z + h t``, then Newton on the extended system ``(G(z), t·(z - z_k) - h) = 0``
+(Keller's pseudo-arclength condition; Kuznetsov 2004, *Elements of Applied Bifurcation
+Theory*, sec. 10.2; Dankowicz & Schilder 2013, *Recipes for Continuation*, ch. 3).
 """
 
 from __future__ import annotations

@@ -127,7 +127,7 @@ def curve(params: Params | None, start, *, second: str, to: float, param: str | 
     ``Q(x, λ1; λ2) = (P^n, λ1 + g / w1)``, scaled to ``z = (θ_f, T θ̇_f, λ1 / span,
     λ2 / |to - λ2_0|)``. DP^n from the tangent dynamics with saltation (di Bernardo et al.
     2008, ch. 2); ∂g/∂x by central differences of DP^n with steps 1e-5 rad in θ_f and
-    1e-5 / T rad/s in θ̇_f, ∂/∂λ1 and ∂/∂λ2 with steps 1e-5 max(|λ|, 1). Changes of the
+    1e-5 / T rad/s in θ̇_f, ∂/∂λ1 and ∂/∂λ2 with steps ``1e-5 max(|λ|, 1)``. Changes of the
     impact count or of sticking along the curve are bisected into its events.
 
     Parameters
