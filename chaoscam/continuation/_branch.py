@@ -161,7 +161,8 @@ def continuation(params: Params | None = None, x0=None, *, param: str = "omega",
                  period: int = 1, numerics: Numerics | None = None, ds: float = 0.005,
                  ds_min: float = 1e-6, ds_max: float = 0.02, tol: float = 1e-7,
                  event_tol: float = 1e-6, max_points: int = 500, switch: bool = False,
-                 transient: float = 20.0) -> Branch:  # fmt: skip
+                 transient: float = 20.0,
+                 checkpoint: str | Path | None = None) -> Branch:  # fmt: skip
     """Pseudo-arclength continuation of a period-n orbit of the stroboscopic map in one
     parameter, with its Floquet multipliers, impacts, sticking and bifurcations.
 
@@ -205,6 +206,10 @@ def continuation(params: Params | None = None, x0=None, *, param: str = "omega",
         1e-9 to 1e-8 rad on orbits with chattering: see :func:`chaoscam.periodic_orbit`).
     max_points : int
         Most points of each branch.
+    checkpoint : path, optional
+        A JSON file that keeps the followed branch's points and events so far (written whole
+        at most once every :data:`CHECKPOINT_S`): one left by an interrupted call with the same
+        settings is followed on from its last point and tangent; removed once done.
 
     Raises
     ------
@@ -223,7 +228,6 @@ def continuation(params: Params | None = None, x0=None, *, param: str = "omega",
     to = real("to", to)
     if to == lam0:
         raise ParameterError(f"to = {to}: equal to the start {param} = {lam0}; give another")
-    orbit = find_start(params, x0, n, num, transient=transient)
     model = _ModelMap(params, param, n, num)
     span = abs(to - lam0)
     st = Settings(weights=(1.0, params.cam_period, 1.0 / span), lo=min(lam0, to),
@@ -233,20 +237,95 @@ def continuation(params: Params | None = None, x0=None, *, param: str = "omega",
                   tol=real("tol", tol, low=0.0, strict=True),
                   event_tol=real("event_tol", event_tol, low=0.0, strict=True),
                   max_points=whole("max_points", max_points, low=2))  # fmt: skip
-    u0 = np.array([*orbit.points[0], lam0])
+    config = {"params": dataclasses.asdict(params), "numerics": dataclasses.asdict(num),
+              "param": param, "from": lam0, "to": to, "period": n,
+              "x0": None if x0 is None else [float(v) for v in x0], "transient": transient,
+              **{f.name: getattr(st, f.name) for f in dataclasses.fields(st)}}  # fmt: skip
+    ckpt = _Checkpoint(checkpoint, config)
+    resume = ckpt.restore()
+    if resume is None:
+        u0 = np.array([*find_start(params, x0, n, num, transient=transient).points[0], lam0])
+    else:
+        u0 = resume[0][-1].u
     try:
-        found = [(0, n, *follow(model, u0, st, direction=math.copysign(1.0, to - lam0),
-                                observe=model.observe))]  # fmt: skip
+        done = resume is not None and any(e[0] == "end" for e in resume[1])
+        found = [(0, n, *(resume if done else follow(
+            model, u0, st, direction=math.copysign(1.0, to - lam0),
+            observe=model.observe, on_point=ckpt.save, resume=resume)))]  # fmt: skip
     except MapFailed as err:
         raise NoOrbitError(f"the start orbit could not be continued: {err}") from None
+    ckpt.save(found[0][2], found[0][3], now=True)
     _section_hint(found[0][3], n)
     if switch:
         found += _switched(params, param, n, num, st, found[0][3])
-    settings = {"params": dataclasses.asdict(params), "numerics": dataclasses.asdict(num),
-                "param": param, "from": lam0, "to": to, "period": n,
-                **{f.name: getattr(st, f.name) for f in dataclasses.fields(st)},
-                "switch": switch, "wall_time": time.perf_counter() - t_start}  # fmt: skip
-    return Branch(_points_frame(found, param), _events_frame(found, param), settings)
+    settings = {**config, "switch": switch, "resumed": resume is not None,
+                "wall_time": time.perf_counter() - t_start}  # fmt: skip
+    branch = Branch(_points_frame(found, param), _events_frame(found, param), settings)
+    ckpt.remove()
+    return branch
+
+
+CHECKPOINT_S = 1.0
+"""Least time [s] between two writes of a branch's checkpoint."""
+
+
+class _Checkpoint:
+    """A branch's points and events so far in one JSON file (the settings, then each
+    MapPoint's fields), written whole; None: no file."""
+
+    def __init__(self, path, config: dict) -> None:
+        self.path, self.config, self.last = (Path(path) if path else None), config, 0.0
+
+    def restore(self):
+        """(points, events) from the file, or None when there is none."""
+        if self.path is None or not self.path.exists():
+            return None
+        try:
+            saved = json.loads(self.path.read_text())
+            saved["config"], saved["points"], saved["events"]  # noqa: B018
+        except (ValueError, TypeError, KeyError):
+            raise ParameterError(f"the checkpoint {self.path} is damaged: remove it") from None
+        same = (
+            json.dumps(c, sort_keys=True, default=_plain) for c in (saved["config"], self.config)
+        )
+        if len(set(same)) > 1:
+            keys = sorted(k for k in self.config if saved["config"].get(k) != self.config[k])
+            raise ParameterError(f"the checkpoint {self.path} was made with other settings "
+                                 f"({', '.join(keys) or 'its format'}): remove it, or resume "
+                                 "with the same settings")  # fmt: skip
+        pts = [_point(d) for d in saved["points"]]
+        return pts, [(k, pts[i] if i >= 0 else _point(d), detail)
+                     for k, i, d, detail in saved["events"]]  # fmt: skip
+
+    def save(self, points, events, now: bool = False) -> None:
+        if self.path is None or not now and time.monotonic() - self.last < CHECKPOINT_S:
+            return
+        from ..io import atomic_write_bytes
+
+        index = {id(p): i for i, p in enumerate(points)}
+        data = {"config": self.config, "points": [_fields(p) for p in points],
+                "events": [(k, index.get(id(p), -1), None if id(p) in index else _fields(p),
+                            detail) for k, p, detail in events]}  # fmt: skip
+        atomic_write_bytes(self.path, json.dumps(data, default=_plain).encode())
+        self.last = time.monotonic()
+
+    def remove(self) -> None:
+        if self.path is not None:
+            self.path.unlink(missing_ok=True)
+
+
+def _plain(value):
+    return value.tolist() if isinstance(value, np.ndarray | np.generic) else str(value)
+
+
+def _fields(p: MapPoint) -> dict:
+    return {f.name: getattr(p, f.name) for f in dataclasses.fields(p)}
+
+
+def _point(d: dict) -> MapPoint:
+    info = {k: np.asarray(v) if isinstance(v, list) else v for k, v in d["info"].items()}
+    arrays = {k: np.asarray(d[k], dtype=float) for k in ("u", "t", "dp")}
+    return MapPoint(**{**d, **arrays, "info": info})
 
 
 SECTION_NEAR = 0.01
@@ -284,8 +363,9 @@ def _switched(params, param, n, num, st, events) -> list:
     return out
 
 
-def _mu_columns(p: MapPoint) -> dict[str, float]:
-    mu = p.multipliers
+def _mu_columns(dp: np.ndarray) -> dict[str, float]:
+    mu = np.linalg.eigvals(dp).astype(complex)
+    mu = mu[np.argsort(-np.abs(mu), kind="stable")]
     return {"mu1_re": mu[0].real, "mu1_im": mu[0].imag, "mu2_re": mu[1].real,
             "mu2_im": mu[1].imag}  # fmt: skip
 
@@ -297,7 +377,7 @@ def _points_frame(found, param: str) -> pd.DataFrame:
     rows = []
     for b, n, points, _ in found:
         for i, p in enumerate(points):
-            mu = _mu_columns(p)
+            mu = _mu_columns(p.dp)
             common = {"branch": b, "point": i, "period": n, "param": param,
                       "value": float(p.u[2]), "s": p.s}  # fmt: skip
             info = {key: p.info.get(key) for key in _INFO}
@@ -313,7 +393,7 @@ def _points_frame(found, param: str) -> pd.DataFrame:
 
 def _events_frame(found, param: str) -> pd.DataFrame:
     rows = [{"branch": b, "kind": kind, "param": param, "value": float(p.u[2]), "s": p.s,
-             "theta_f": float(p.u[0]), "omega_f": float(p.u[1]), **_mu_columns(p),
+             "theta_f": float(p.u[0]), "omega_f": float(p.u[1]), **_mu_columns(p.dp),
              "detail": detail}
             for b, _, _, events in found for kind, p, detail in events]  # fmt: skip
     return pd.DataFrame(rows)

@@ -1,13 +1,13 @@
-"""Pseudo-arclength continuation of fixed points of a map ``P(x; λ)``, x in R², with its test
-functions located along the branch, generic over the map: the model's stroboscopic map and
-the bouncing ball's impact map go through the same code.
+"""Pseudo-arclength continuation of fixed points of a map ``P(x; λ)``, x in R^m, with its test
+functions located along the branch, generic over the map: the model's stroboscopic map, the
+bouncing ball's impact map and a bifurcation curve's extended system go through the same code.
 
 Unknowns u = (x, λ), scaled to z = w u (``weights``); the branch is ``G(u) = P(x; λ) - x = 0``,
-a curve in R³ whose tangent is the null vector of ``G_u = [DP - I | ∂P/∂λ]`` (the cross
-product of its two scaled rows). A step: the predictor ``z_p = z + h t``, then Newton on the
-extended system ``(G(z), t·(z - z_k) - h) = 0`` (Keller's pseudo-arclength condition;
-Kuznetsov 2004, *Elements of Applied Bifurcation Theory*, sec. 10.2; Dankowicz & Schilder
-2013, *Recipes for Continuation*, ch. 3).
+a curve in R^(m+1) whose tangent is the null vector of ``G_u = [DP - I | ∂P/∂λ]`` (its
+signed minors: the cross product of its two scaled rows when m = 2). A step: the predictor
+``z_p = z + h t``, then Newton on the extended system ``(G(z), t·(z - z_k) - h) = 0``
+(Keller's pseudo-arclength condition; Kuznetsov 2004, *Elements of Applied Bifurcation
+Theory*, sec. 10.2; Dankowicz & Schilder 2013, *Recipes for Continuation*, ch. 3).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MapPoint", "Settings", "follow"]
+__all__ = ["MapPoint", "Settings", "follow", "null_vector"]
 
 CONTINUOUS = ("fold", "period_doubling", "neimark_sacker")
 """Test functions located by the Illinois secant on arclength: ``fold`` the λ component of
@@ -100,9 +100,9 @@ class MapPoint:
     def test(self, kind: str) -> float:
         """The value of test function ``kind`` (:data:`CONTINUOUS`) here."""
         if kind == "fold":
-            return float(self.t[2])
+            return float(self.t[-1])
         if kind == "period_doubling":
-            return float(np.linalg.det(self.dp + np.eye(2)))
+            return float(np.linalg.det(self.dp + np.eye(len(self.dp))))
         tr, det = np.trace(self.dp), np.linalg.det(self.dp)
         return float(det - 1.0) if tr * tr < 4.0 * det else math.nan
 
@@ -112,20 +112,21 @@ class _Branch:
 
     def __init__(self, fun: Callable, st: Settings, observe: Callable | None) -> None:
         self.fun, self.st, self.observe = fun, st, observe
+        self.value = getattr(fun, "value", lambda x, lam: fun(x, lam)[0])
         self.w = np.asarray(st.weights, dtype=float)
 
     def evaluate(self, z: np.ndarray):
-        """(scaled residual G, scaled G_z (2 x 3), DP) at scaled z; MapFailed if it fails."""
+        """(scaled residual G, scaled G_z (m x m+1), DP) at scaled z; MapFailed if it fails."""
         u = z / self.w
-        x, lam = u[:2], float(u[2])
+        x, lam = u[:-1], float(u[-1])
         px, dp = self.fun(x, lam)
         d = self.st.fd_step * max(abs(lam), 1.0)
-        dlam = (self.fun(x, lam + d)[0] - self.fun(x, lam - d)[0]) / (2.0 * d)
-        jac = np.column_stack([dp - np.eye(2), dlam])
-        g = (px - x) * self.w[:2]
+        dlam = (self.value(x, lam + d) - self.value(x, lam - d)) / (2.0 * d)
+        jac = np.column_stack([dp - np.eye(len(x)), dlam])
+        g = (px - x) * self.w[:-1]
         if not (np.isfinite(g).all() and np.isfinite(jac).all()):
             raise MapFailed("the map returned NaN")
-        return g, self.w[:2, None] * jac / self.w[None, :], dp
+        return g, self.w[:-1, None] * jac / self.w[None, :], dp
 
     def correct(self, z0: np.ndarray, t0: np.ndarray, h: float) -> MapPoint | None:
         """Newton on ``(G(z), t0·(z - z0) - h) = 0`` from the predictor ``z0 + h t0``: the
@@ -138,7 +139,7 @@ class _Branch:
                 return None
             res = float(np.linalg.norm(g))
             if res <= self.st.tol and it > 0 or res <= 0.01 * self.st.tol:
-                t = np.cross(jz[0], jz[1])
+                t = null_vector(jz)
                 norm = float(np.linalg.norm(t))
                 if not norm > 0.0:
                     return None
@@ -159,13 +160,13 @@ class _Branch:
         b = self.correct(a.u * self.w, a.t, s)
         if b is not None:
             b.s = a.s + s
-            b.info = self.observe(b.u[:2], float(b.u[2])) if self.observe else {}
+            b.info = self.observe(b.u[:-1], float(b.u[-1])) if self.observe else {}
         return b
 
     def locate(self, a: MapPoint, b: MapPoint, kind: str) -> MapPoint:
         """Where test function ``kind`` changes sign between a and b: the Illinois secant on
         the arclength from a, to a bracket of ``event_tol * w_λ``."""
-        s_tol = self.st.event_tol * self.w[2]
+        s_tol = self.st.event_tol * self.w[-1]
         lo, hi = 0.0, b.s - a.s
         f_lo, f_hi = a.test(kind), b.test(kind)
         best, side = b, 0
@@ -190,7 +191,7 @@ class _Branch:
     def bisect(self, a: MapPoint, b: MapPoint, same: Callable) -> MapPoint:
         """The first point past a where ``same(a, p)`` fails, bisected on the arclength to a
         bracket of ``event_tol * w_λ`` (a change of the impact or sticking pattern)."""
-        s_tol = self.st.event_tol * self.w[2]
+        s_tol = self.st.event_tol * self.w[-1]
         lo, hi, best = 0.0, b.s - a.s, b
         while hi - lo > s_tol:
             mid = 0.5 * (lo + hi)
@@ -204,10 +205,17 @@ class _Branch:
         return best
 
 
-def _crossings(br: _Branch, a: MapPoint, b: MapPoint) -> list[tuple[str, MapPoint, str]]:
+def null_vector(jac: np.ndarray) -> np.ndarray:
+    """The null vector of an m x (m + 1) matrix: t_i = (-1)^i det(jac without column i), the
+    cross product of its rows when m = 2; its last component is det of the first m columns."""
+    cols = range(jac.shape[1])
+    return np.array([(-1) ** i * np.linalg.det(np.delete(jac, i, axis=1)) for i in cols])
+
+
+def _crossings(br: _Branch, a: MapPoint, b: MapPoint, kinds) -> list[tuple[str, MapPoint, str]]:
     """The events between consecutive points a and b: (kind, located point, detail)."""
     found = []
-    for kind in CONTINUOUS:
+    for kind in kinds:
         fa, fb = a.test(kind), b.test(kind)
         if fa * fb < 0.0:  # NaN (no complex pair) and an exact zero (a switch's start) pass
             found.append((kind, br.locate(a, b, kind), ""))
@@ -219,14 +227,18 @@ def _crossings(br: _Branch, a: MapPoint, b: MapPoint) -> list[tuple[str, MapPoin
 
 
 def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
-           observe: Callable | None = None) -> tuple[list[MapPoint], list[tuple]]:  # fmt: skip
-    """Follow the branch of fixed points of ``fun`` from u0 = (x1, x2, λ), a fixed point.
+           observe: Callable | None = None, kinds=CONTINUOUS,
+           on_point: Callable | None = None,
+           resume=None) -> tuple[list[MapPoint], list[tuple]]:  # fmt: skip
+    """Follow the branch of fixed points of ``fun`` from u0 = (x, λ), a fixed point.
 
     Parameters
     ----------
     fun : callable
-        ``fun(x, lam) -> (P(x; lam), DP(x; lam))``, raising :class:`MapFailed` where it cannot.
-    u0 : array of 3
+        ``fun(x, lam) -> (P(x; lam), DP(x; lam))``, x in R^m (m = 2 for an orbit, 3 for a
+        bifurcation curve's extended system), raising :class:`MapFailed` where it cannot;
+        ``fun.value(x, lam) -> P(x; lam)``, when it has one, serves the λ difference.
+    u0 : array of m + 1
         A fixed point (corrected first, at λ fixed) and its parameter.
     st : Settings
         Steps, tolerances, the λ interval.
@@ -236,6 +248,12 @@ def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
     observe : callable, optional
         ``observe(x, lam) -> dict`` of the orbit's discrete features (``n_macro_impacts``,
         ``sticks``): a change between points is an event, bisected.
+    kinds : tuple of str
+        The test functions (:data:`CONTINUOUS`) located along the branch.
+    on_point : callable, optional
+        ``on_point(points, events)`` after each new point (a checkpoint).
+    resume : (points, events), optional
+        An interrupted branch: followed on from its last point and tangent (u0 unused).
 
     Returns
     -------
@@ -244,17 +262,21 @@ def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
     """
     br = _Branch(fun, st, observe)
     z0 = np.asarray(u0, dtype=float) * br.w
-    if t0 is None:
-        a = br.correct(z0, np.array([0.0, 0.0, 1.0]), 0.0)  # λ fixed: plain Newton on x
+    if resume is not None:
+        points, events, h = list(resume[0]), list(resume[1]), st.h0
+        a = points[-1]
+    elif t0 is None:
+        a = br.correct(z0, np.eye(len(z0))[-1], 0.0)  # λ fixed: plain Newton on x
         if a is None:
             raise MapFailed("no fixed point near the start: the corrector did not converge")
-        a.t = a.t if a.t[2] * direction >= 0 else -a.t
+        a.t = a.t if a.t[-1] * direction >= 0 else -a.t
     else:  # a branch point (its Jacobian singular): taken as it is, left along t0
         g, _, dp = br.evaluate(z0)
         t0 = np.asarray(t0, dtype=float)
         a = MapPoint(z0 / br.w, t0 / np.linalg.norm(t0), dp, float(np.linalg.norm(g)), 0)
-    a.info = observe(a.u[:2], float(a.u[2])) if observe else {}
-    points, events, h = [a], [], st.h0
+    if resume is None:
+        a.info = observe(a.u[:-1], float(a.u[-1])) if observe else {}
+        points, events, h = [a], [], st.h0
     reason = f"max_points = {st.max_points} reached"
     while len(points) < st.max_points:
         b = br.at(a, h)
@@ -267,10 +289,12 @@ def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
                 break  # fmt: skip
             h = max(0.5 * h, st.h_min)
             continue
-        events.extend(_crossings(br, a, b))
+        events.extend(_crossings(br, a, b, kinds))
         points.append(b)
         a = b
-        if not st.lo <= float(b.u[2]) <= st.hi:
+        if on_point is not None:
+            on_point(points, events)
+        if not st.lo <= float(b.u[-1]) <= st.hi:
             reason = f"left the interval [{st.lo:g}, {st.hi:g}]"
             break
         if b.iterations <= st.easy:

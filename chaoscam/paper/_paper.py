@@ -17,6 +17,7 @@ from ..model import ParameterError, Params, contact_period, fractal_stiffness
 from ..numerics import Numerics
 from ..report import Comparison, FigureItem, response_figure
 from . import _sensitivity
+from ._continued import CONTINUED_FILES
 from ._findings import first_ic
 from ._side_by_side import beside, side_by_side
 from ._stage import FULL_EXTEND_TO, RUN, SWEEP_FATE_S, FigureResult, draw, judging, swept, uri_of
@@ -53,7 +54,7 @@ def data_files(number: int) -> list[str]:
         names = ("stiffness", "hertz", "xi", "J", "pivot", "arm")  # and the Y_f sweep's diagram
         sweeps = [f"sensitivity-{n}{ext}" for n in names for ext in bif] + ["sensitivity-yf.png"]
         sweeps += ["sensitivity-damping.parquet", "sensitivity-damping.verdicts.parquet"]
-        return sweeps + [f"sensitivity-omega-xi{e}" for e in table]
+        return sweeps + [f"sensitivity-omega-xi{e}" for e in table] + CONTINUED_FILES
     names = [f"fig7-10{ext}" for ext in table] + ["fig7-10-random-response.png"]
     for mu in MU_PAPER:
         for sigma in (0.0, SIGMA_MAX):

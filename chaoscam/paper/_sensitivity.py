@@ -13,6 +13,7 @@ import pandas as pd
 
 from ..model import Params
 from ..report import LABEL_COLORS, FigureItem, mark_without_points
+from ._continued import continued_part
 from ._findings import (
     PAPER_K_N,
     PAPER_L_LAMBDA,
@@ -96,6 +97,7 @@ def sensitivity(quick: bool, outdir: Path, workers=None, judge: dict | None = No
         choices = open_choices(sweep, quick, hertz_tags)
         rm = omega_xi.result()
     res.why += [omega_xi_finding(rm, FATE_S[quick]), choices]
+    continued_part(res, sweep, quick, outdir, rm)
     return res
 
 

@@ -7,7 +7,7 @@ from .._util import lazy_face
 _LAZY = {
     "axes": ("._run", "axes"), "plot_section": ("._run", "plot_section"),
     "plot_series": ("._run", "plot_series"), "plot_shares": ("._run", "plot_shares"),
-    "plot_branch": ("._branch", "plot_branch"),
+    "plot_branch": ("._branch", "plot_branch"), "plot_curves": ("._branch", "plot_curves"),
     "LABEL_COLORS": ("._sweep", "LABEL_COLORS"), "SETTLED_MARK": ("._sweep", "SETTLED_MARK"),
     "TRANSIENT_MARK": ("._sweep", "TRANSIENT_MARK"),
     "all_deterministic": ("._sweep", "all_deterministic"), "axis_label": ("._sweep", "axis_label"),

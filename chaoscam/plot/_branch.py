@@ -1,4 +1,5 @@
-"""A continuation branch drawn on a matplotlib Axes: the parameter against the section's θ_f."""
+"""Continuation drawn on a matplotlib Axes: a branch (the parameter against the section's θ_f)
+and bifurcation curves in two parameters."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 from ._run import axes
 from ._sweep import axis_label
 
-__all__ = ["plot_branch"]
+__all__ = ["plot_branch", "plot_curves"]
 
 EVENT_MARKS = {"fold": ("o", "#D55E00"), "period_doubling": ("s", "#0072B2"),
                "neimark_sacker": ("D", "#009E73"), "impact_change": ("^", "#CC79A7"),
@@ -37,4 +38,48 @@ def plot_branch(points, events=None, ax=None):
     name = str(points["param"].iloc[0]) if len(points) else "value"
     ax.set(xlabel=axis_label(name), ylabel=axis_label("theta_f"),
            title="continuation: stable solid, unstable dashed")  # fmt: skip
+    return ax
+
+
+CURVE_STYLES = {"fold": ("-", "#D55E00"), "period_doubling": ("--", "#0072B2")}
+
+
+def _cell_coordinate(v, values, flip: bool):
+    """Heatmap coordinates of data values v over a grid's ``values`` (cell i centred at
+    i + 0.5, rows from the largest down when ``flip``): piecewise linear, NaN outside."""
+    values = np.sort(np.unique(values))
+    i = np.interp(v, values, np.arange(len(values)), left=np.nan, right=np.nan)
+    return (len(values) - 1 - i if flip else i) + 0.5
+
+
+def plot_curves(points, ax=None, *, swap: bool = False, grid=None):
+    """Bifurcation curves (``Curve.points``) on ``ax``: ``value`` (λ1) on x and ``value2``
+    (λ2) on y (``swap``: the other way round), one line per ``curve``, styled by ``kind``
+    (fold solid vermilion, period doubling dashed blue). ``grid`` = (x values, y values)
+    of a heatmap drawn on ``ax`` (:func:`plot_dominant`): the curves in its cell
+    coordinates, cut at its outer cells' centres. Returns the Axes."""
+    from matplotlib.patheffects import withStroke
+
+    ax, seen, stroke = axes(ax), set(), withStroke(linewidth=4.5, foreground="white")
+    for (_, kind), g in points.groupby(["curve", "kind"], sort=True):
+        g = g.sort_values("point")
+        ls, color = CURVE_STYLES.get(kind, ("-.", "#000000"))
+        xy = (g["value2"], g["value"]) if swap else (g["value"], g["value2"])
+        if grid is not None:
+            xy = (_cell_coordinate(xy[0], grid[0], False), _cell_coordinate(xy[1], grid[1], True))
+        ax.plot(*xy, ls=ls, lw=2.5, color=color, path_effects=[stroke],
+                label=None if kind in seen else kind.replace("_", " "))  # fmt: skip
+        seen.add(kind)
+    if len(points) and grid is None:
+        names = [axis_label(str(points[c].iloc[0])) for c in ("param", "param2")]
+        ax.set(xlabel=names[swap], ylabel=names[not swap])
+    if len(points):
+        old, lines = ax.get_legend(), ax.get_legend_handles_labels()
+        if old is not None:  # a heatmap's legend of labels: the curves join it
+            handles = [*old.legend_handles, *lines[0]]
+            labels = [*(t.get_text() for t in old.get_texts()), *lines[1]]
+            ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.01, 1.0),
+                      frameon=False, fontsize="small")  # fmt: skip
+        else:
+            ax.legend(frameon=False, fontsize="small")
     return ax

@@ -140,3 +140,43 @@ def test_cli_start_without_orbit_is_exit_2(tmp_path, capsys):
                  "30", "--out", str(out)])  # fmt: skip
     assert code == 2 and "no period-1 orbit" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_interrupted_branch_resumes_from_its_checkpoint(tmp_path, monkeypatch):
+    """A branch interrupted after 12 points resumes from its checkpoint: its first points
+    are the interrupted run's, its doubling where an uninterrupted run puts it (1e-6 rad/s),
+    and the checkpoint is removed once done; other settings are refused."""
+    from chaoscam.continuation import _branch
+
+    p, ckpt = chaoscam.Params(xi=XI, omega=31.9), tmp_path / "b.parquet.ckpt"
+    whole = continuation(p, param="omega", to=32.2)
+    monkeypatch.setattr(_branch, "CHECKPOINT_S", 0.0)
+    save = _branch._Checkpoint.save
+
+    def stop(self, points, events, now=False):
+        save(self, points, events, now)
+        if len(points) == 12:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(_branch._Checkpoint, "save", stop)
+    with pytest.raises(KeyboardInterrupt):
+        continuation(p, param="omega", to=32.2, checkpoint=ckpt)
+    monkeypatch.setattr(_branch._Checkpoint, "save", save)
+    with pytest.raises(ValueError, match="other settings"):
+        continuation(p, param="omega", to=32.25, checkpoint=ckpt)
+    b = continuation(p, param="omega", to=32.2, checkpoint=ckpt)
+    assert b.settings["resumed"] and not ckpt.exists()
+    first = b.points[b.points.point < 12]
+    assert np.array_equal(first.value, whole.points[whole.points.point < 12].value)
+    pd_ = [x.events[x.events.kind == "period_doubling"].value.iloc[0] for x in (b, whole)]
+    assert abs(pd_[0] - pd_[1]) < 1e-6
+
+
+def test_cli_refuses_a_checkpoint_without_resume(tmp_path, capsys):
+    """An interrupted branch's checkpoint beside the output: exit 2 saying --resume, unless
+    --force (which starts over)."""
+    out = tmp_path / "b.parquet"
+    (tmp_path / "b.parquet.ckpt").write_text("{}")
+    args = ["continue", "--from", "31.9", "--to", "32.0", "--set", "xi=0.1", "--out", str(out)]
+    assert main(args) == 2 and "--resume" in capsys.readouterr().err
+    assert main([*args, "--force"]) == 0 and not (tmp_path / "b.parquet.ckpt").exists()

@@ -320,7 +320,7 @@ def test_ctrl_c_in_the_sensitivity_stage_stops_the_map_beside_it_and_resume_fini
         resumed = _paper.sensitivity_stage(True, tmp_path, workers=1)
     (tmp_path / "fresh").mkdir()
     fresh = _paper.sensitivity_stage(True, tmp_path / "fresh", workers=1)
-    assert resumed.why == fresh.why and len(fresh.why) == 4
+    assert resumed.why == fresh.why and len(fresh.why) == 5
 
 
 def test_paper_unwritable_places_are_refused(tmp_path, capsys):
