@@ -35,7 +35,7 @@ LAYERS = (
 CORE = ("chaoscam.model", "chaoscam.kernel", "chaoscam.simulation", "chaoscam.verdict",
         "chaoscam.sweep")  # fmt: skip
 MAX_TOP_LEVEL_MODULES = 6
-MAX_PACKAGE_LINES = 20_000
+MAX_PACKAGE_LINES = 21_000
 MAX_FUNCTION_LINES = 80
 MAX_LONG_FUNCTIONS = 5
 """At most this many functions of the core run past MAX_FUNCTION_LINES lines of code (their
@@ -180,7 +180,8 @@ def test_a_handful_of_modules_at_the_top_level():
 
 def test_the_package_keeps_its_line_budget():
     """The package (docstrings counted) stays within MAX_PACKAGE_LINES lines (the redesign's
-    18,000, with room for the plotting, the random-system verdicts and continuation)."""
+    18,000, and the plotting, the report's headline, the random-system verdicts and continuation
+    in one and two parameters since)."""
     total = sum(len(p.read_text().splitlines()) for p in MODULES.values())
     assert total <= MAX_PACKAGE_LINES, f"{total} lines"
 
