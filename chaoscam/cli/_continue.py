@@ -38,8 +38,8 @@ def register(sub) -> None:
         "--transient run from the model's initial state",
     )
     p.add_argument("--transient", type=float, default=20.0, help="start run [s] (default 20)")
-    p.add_argument("--switch", action="store_true", help="follow the period-2n branch "
-                   "from each period doubling too")  # fmt: skip
+    p.add_argument("--no-switch", dest="switch", action="store_false",
+                   help="do not follow the period-2n branch from each period doubling")  # fmt: skip
     p.add_argument("--max-points", type=int, default=500, help="most points (default 500)")
     p.add_argument("--curve", metavar="NAME", help="continue each fold and period doubling of "
                    "the branch in (--param, NAME) too, into FILE.curves.parquet")  # fmt: skip
