@@ -55,7 +55,7 @@ class RegimeMap(TwoTables):
         ``ev_exponent`` is λ₁·T per section iterate, ``ev_lyapunov_1`` λ₁ [1/s] and
         ``ev_lyapunov_1_stderr`` its standard error, ``ev_twins`` the common-noise twins'
         finite-time rate [1/s] and ``ev_synchronised`` 1 or 0 where they ran,
-        ``ev_section_q0`` .. ``ev_section_q10`` the recorded section's theta_f quantiles
+        ``ev_section_q0`` .. ``ev_section_q20`` the recorded section's theta_f quantiles
         [rad]).
     cells : DataFrame
         The per-cell summary of :func:`summarize_cells`.

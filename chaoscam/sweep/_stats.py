@@ -95,7 +95,7 @@ def summarize_cells(rows: pd.DataFrame, cells: pd.DataFrame, *, confidence=0.95)
         below ``l_min``); ``n_transient`` (runs a ``fate`` horizon found to stop later),
         ``n_settled`` and ``settled_period`` (found periodic there, :func:`fate_settled`);
         the random response of :func:`_random_response` (``lyapunov_lo``, ``lyapunov_hi``,
-        ``n_twins``, ``p_synchronised``, ``section_q0`` .. ``section_q10``).
+        ``n_twins``, ``p_synchronised``, ``section_q0`` .. ``section_q20``).
     """
     labels = [*LABEL_ORDER, *sorted(set(rows["label"]) - set(LABEL_ORDER))]
     out = cells.sort_values("cell").reset_index(drop=True).copy()
@@ -146,9 +146,9 @@ def summarize_cells(rows: pd.DataFrame, cells: pd.DataFrame, *, confidence=0.95)
     return out
 
 
-SECTION_QUANTILES = tuple(np.linspace(0.0, 1.0, 11))
+SECTION_QUANTILES = tuple(np.linspace(0.0, 1.0, 21))
 """The levels of the section's theta_f quantiles a realization records (``ev_section_q0`` ..
-``ev_section_q10``: minimum, deciles, maximum of its recorded section)."""
+``ev_section_q20``: minimum, every 5 %, maximum of its recorded section)."""
 
 
 def _random_response(out: pd.DataFrame, rows: pd.DataFrame, lam: pd.DataFrame, col: str,
@@ -157,7 +157,7 @@ def _random_response(out: pd.DataFrame, rows: pd.DataFrame, lam: pd.DataFrame, c
     interval of the mean exponent over the realizations, each a finite-time estimate of the one
     top exponent of the cocycle; a single run's own ``stderr`` interval), ``n_twins`` and
     ``p_synchronised`` (realizations whose common-noise twins ran, and the share of them that
-    synchronised) and ``section_q0`` .. ``section_q10`` (the cell's stationary section
+    synchronised) and ``section_q0`` .. ``section_q20`` (the cell's stationary section
     distribution of theta_f [rad] as the mean of the realizations' quantile functions)."""
     from scipy import stats
 

@@ -81,7 +81,7 @@ def test_summary_gives_the_random_response_of_each_cell():
         "truncated_mass": 0.0, "ev_lyapunov_1": [*lam, -0.5],
         "ev_lyapunov_1_stderr": [0.1, 0.1, 0.1, 0.1, 0.05],
         "ev_synchronised": [0.0, 1.0, np.nan, 0.0, np.nan],
-        **{f"ev_section_q{k}": [k, k + 1, k + 2, k + 3, 10 * k] for k in range(11)},
+        **{f"ev_section_q{k}": [k, k + 1, k + 2, k + 3, 10 * k] for k in range(21)},
     })  # fmt: skip
     cells = pd.DataFrame({"cell": [0, 1], "ix": [0, 1], "iy": [0, 0],
                           "deterministic": [False, True]})  # fmt: skip
@@ -94,4 +94,4 @@ def test_summary_gives_the_random_response_of_each_cell():
     )
     assert (out.loc[0, "n_twins"], out.loc[0, "p_synchronised"]) == (3, pytest.approx(1 / 3))
     assert out.loc[1, "n_twins"] == 0 and np.isnan(out.loc[1, "p_synchronised"])
-    assert [out.loc[0, f"section_q{k}"] for k in range(11)] == [k + 1.5 for k in range(11)]
+    assert [out.loc[0, f"section_q{k}"] for k in range(21)] == [k + 1.5 for k in range(21)]
