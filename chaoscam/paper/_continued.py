@@ -23,6 +23,10 @@ OMEGA_RANGE = (28.9, 33.0)
 BRUTE_OMEGAS = {True: 11, False: 41}
 """How many ω of the brute-force diagram over :data:`OMEGA_RANGE` (quick, full)."""
 
+COEXISTING = (29.0, 29.25)
+"""ω [rad/s] the brute-force diagram always samples: near the fold, where the run from the
+model's initial state finds another attractor than the period-1 orbit (P4 at 29.25)."""
+
 CONTINUED_FILES = [*(f"continuation-{n}{e}" for n in ("p1", "curves")
                      for e in (".parquet", ".events.parquet")),
                    "continuation-omega.parquet", "continuation-omega.verdicts.parquet",
@@ -131,7 +135,8 @@ def continued_part(res, sweep, quick: bool, outdir: Path, rm) -> None:
     branch, curves = follow_window(float(rm.cells["xi"].max()))
     branch.to_parquet(outdir / "continuation-p1.parquet", replace=True)
     curves.to_parquet(outdir / "continuation-curves.parquet", replace=True)
-    omegas = np.linspace(*OMEGA_RANGE, BRUTE_OMEGAS[quick]).round(6).tolist()
+    grid = np.linspace(*OMEGA_RANGE, BRUTE_OMEGAS[quick]).round(6).tolist()
+    omegas = sorted({*grid, *COEXISTING})
     bif = sweep("continuation-omega", "omega", omegas, base=Params(xi=XI_BRANCH), png=None)
     cross = crossings(curves.points, rm.cells)
     png = draw(outdir / "continuation.png", _figure, rm, branch, curves, bif)
