@@ -92,12 +92,19 @@ def run_classify(args: argparse.Namespace) -> int:
 
 
 def verdict_line(v) -> str:
-    """A verdict in one line: the label and period, a certified orbit, the tangent lambda_1 and
-    its standard error [1/s]; an undetermined one with its first reason."""
+    """A verdict in one line: the label and period, a certified orbit or the common-noise twins'
+    outcome and noise width, the tangent lambda_1 and its standard error [1/s]; an undetermined
+    one with its first reason."""
     if v.label == "undetermined":
         return "undetermined" + (f": {v.reasons[0]}" if v.reasons else "")
     certified = any(e.name == "periodic_orbit" and e.vote == "periodic" for e in v.evidence)
     notes = ["certified orbit"] if certified else []
+    twins = (v.settings.get("twins") or {}).get("outcome")
+    if twins in ("synchronised", "separated"):
+        notes.append(f"twins sharing the draws {twins}")
+    noisy = v.settings.get("noisy")
+    if v.label == "periodic" and noisy:
+        notes.append(f"noise width {noisy['band_width']:.2g} rad")
     tangent = v.settings.get("tangent") or {}
     lam, err = (tangent.get("exponents") or [math.nan])[0], (tangent.get("stderr") or [0.0])[0]
     if math.isfinite(lam):

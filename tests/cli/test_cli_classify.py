@@ -253,3 +253,17 @@ def test_the_verdict_line_says_label_period_certificate_and_exponent():
     assert verdict_line(chaotic) == "chaotic (lambda_1 = +1.4 +- 0.1 /s)"
     undetermined = Verdict("undetermined", None, (), ("too few points", "another"), {})
     assert verdict_line(undetermined) == "undetermined: too few points"
+
+
+def test_the_one_line_verdict_names_the_twins_and_the_noise_width():
+    """A noisy period of the random model says what decided it and how wide its clusters are."""
+    from chaoscam.analysis import Evidence, Verdict
+    from chaoscam.cli._classify import verdict_line
+
+    v = Verdict("periodic", 8, (Evidence("twins", -0.3, "not_chaotic", "synchronised"),), (),
+                {"twins": {"outcome": "synchronised"}, "noisy": {"band_width": 1.2e-4},
+                 "tangent": {"exponents": [1.17, -3.0], "stderr": [0.11, 0.1]}})  # fmt: skip
+    assert verdict_line(v) == (
+        "periodic, period 8 (twins sharing the draws synchronised, noise width 0.00012 rad, "
+        "lambda_1 = +1.2 +- 0.1 /s)"
+    )
