@@ -3,7 +3,7 @@ random system's top exponent is negative and separate where it is positive; a pa
 contacts part stops sharing the draws, which the test reports."""
 
 import chaoscam
-from chaoscam.verdict._twins import twin_test
+from chaoscam.verdict import twin_test
 
 
 def _twins(delta, **changes):
