@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from chaoscam.cli import main
+from ._settled import classified_through_the_cli
 
 DATA = Path(__file__).parent / "data"
 TABLE = json.loads((DATA / "labelled_set.json").read_text())
@@ -49,13 +49,7 @@ def test_the_set_is_large_and_varied():
 @pytest.mark.parametrize(("name", "row"), list(_cases()))
 def test_classifier_agrees_with_the_settled_label(name, row, tmp_path, capsys):
     """120 s run through `chaoscam simulate` and `chaoscam classify`: the settled label."""
-    run = tmp_path / "run.parquet"
-    sets = [f"--set={k}={v}" for k, v in row["params"].items()]
-    argv = ["simulate", "--duration", "120", "--transient", "60", *sets, "--out", str(run)]
-    assert main(argv) == 0
-    capsys.readouterr()
-    assert main(["classify", str(run), "--json"]) == 0
-    verdict = json.loads(capsys.readouterr().out)
+    verdict = classified_through_the_cli(row["params"], tmp_path, capsys)
     assert (verdict["label"], verdict["period"]) == (row["label"], row["period"]), (
         f"{name}: settled {row['label']} {row['period']} ({row['why']}); "
         f"classifier {verdict['label']} {verdict['period']}: {verdict['reasons']}"

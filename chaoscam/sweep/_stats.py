@@ -11,7 +11,7 @@ from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd
-from scipy.special import ndtri
+from scipy.special import ndtri, stdtrit
 
 LABEL_ORDER = ("periodic", "quasiperiodic", "chaotic", "undetermined", "left_reach", "diverged")
 """Labels of a map in display order: the verdicts, then the statuses of runs that left the
@@ -159,10 +159,8 @@ def _random_response(out: pd.DataFrame, rows: pd.DataFrame, lam: pd.DataFrame, c
     ``p_synchronised`` (realizations whose common-noise twins ran, and the share of them that
     synchronised) and ``section_q0`` .. ``section_q20`` (the cell's stationary section
     distribution of theta_f [rad] as the mean of the realizations' quantile functions)."""
-    from scipy import stats
-
     n, mean, sd = (out[f"lyapunov_{c}"].to_numpy(dtype=float) for c in ("n", "mean", "std"))
-    t = stats.t.ppf(0.5 + confidence / 2.0, np.maximum(n - 1, 1))
+    t = stdtrit(np.maximum(n - 1, 1), 0.5 + confidence / 2.0)  # Student's quantile
     half = np.where(n >= 2, t * sd / np.sqrt(np.maximum(n, 1)), np.nan)
     se = f"{col}_stderr"
     if se in rows:  # one run: its own interval
