@@ -25,7 +25,12 @@ CONTINUOUS = ("fold", "period_doubling", "neimark_sacker")
 """Test functions located by the Illinois secant on arclength: ``fold`` the λ component of
 the oriented tangent (∝ det(DP - I), a multiplier through +1), ``period_doubling``
 det(DP + I) (a multiplier through -1), ``neimark_sacker`` det DP - 1 while the multipliers are
-a complex pair (``|μ1 μ2| = 1``)."""
+a complex pair (``|μ1 μ2| = 1``). Any other kind is read from the point's observation
+(``info[kind]``, e.g. ``grazing``: the flights' margin ψ); a sign change of one where it does
+not go to zero (``|f| > JUMP max(|f_a|, |f_b|)`` at the located point) is a jump, not an
+event."""
+JUMP = 0.1
+"""See :data:`CONTINUOUS`."""
 
 
 class MapFailed(Exception):
@@ -103,8 +108,10 @@ class MapPoint:
             return float(self.t[-1])
         if kind == "period_doubling":
             return float(np.linalg.det(self.dp + np.eye(len(self.dp))))
-        tr, det = np.trace(self.dp), np.linalg.det(self.dp)
-        return float(det - 1.0) if tr * tr < 4.0 * det else math.nan
+        if kind == "neimark_sacker":
+            tr, det = np.trace(self.dp), np.linalg.det(self.dp)
+            return float(det - 1.0) if tr * tr < 4.0 * det else math.nan
+        return float(self.info.get(kind, math.nan))
 
 
 class _Branch:
@@ -218,7 +225,9 @@ def _crossings(br: _Branch, a: MapPoint, b: MapPoint, kinds) -> list[tuple[str, 
     for kind in kinds:
         fa, fb = a.test(kind), b.test(kind)
         if fa * fb < 0.0:  # NaN (no complex pair) and an exact zero (a switch's start) pass
-            found.append((kind, br.locate(a, b, kind), ""))
+            p = br.locate(a, b, kind)
+            if kind in CONTINUOUS or abs(p.test(kind)) <= JUMP * max(abs(fa), abs(fb)):
+                found.append((kind, p, ""))
     for kind, key in (("impact_change", "n_macro_impacts"), ("sticking", "sticks")):
         if key in a.info and a.info[key] != b.info.get(key):
             p = br.bisect(a, b, lambda a_, p_, key=key: p_.info.get(key) == a_.info[key])
@@ -226,10 +235,10 @@ def _crossings(br: _Branch, a: MapPoint, b: MapPoint, kinds) -> list[tuple[str, 
     return sorted(found, key=lambda e: e[1].s)
 
 
-def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
+def follow(fun: Callable, u0, st: Settings, *, t0=None, direction=1.0,
            observe: Callable | None = None, kinds=CONTINUOUS,
-           on_point: Callable | None = None,
-           resume=None) -> tuple[list[MapPoint], list[tuple]]:  # fmt: skip
+           on_point: Callable | None = None, resume=None,
+           prior=None) -> tuple[list[MapPoint], list[tuple]]:  # fmt: skip
     """Follow the branch of fixed points of ``fun`` from u0 = (x, λ), a fixed point.
 
     Parameters
@@ -242,9 +251,10 @@ def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
         A fixed point (corrected first, at λ fixed) and its parameter.
     st : Settings
         Steps, tolerances, the λ interval.
-    t0 : array of 3, optional
+    t0 : array of m + 1, optional
         The first tangent (scaled); by default the branch's, oriented so that λ moves with
-        the sign of ``direction``. A branch switch gives the new branch's direction here.
+        the sign of ``direction`` (a float), or along ``direction`` (an array of m + 1,
+        scaled). A branch switch gives the new branch's direction here.
     observe : callable, optional
         ``observe(x, lam) -> dict`` of the orbit's discrete features (``n_macro_impacts``,
         ``sticks``): a change between points is an event, bisected.
@@ -254,6 +264,9 @@ def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
         ``on_point(points, events)`` after each new point (a checkpoint).
     resume : (points, events), optional
         An interrupted branch: followed on from its last point and tangent (u0 unused).
+    prior : (points, events), optional
+        The branch so far in other coordinates (another Poincaré section): the new points
+        follow them in the lists returned, the arclength going on from their last.
 
     Returns
     -------
@@ -265,18 +278,24 @@ def follow(fun: Callable, u0, st: Settings, *, t0=None, direction: float = 1.0,
     if resume is not None:
         points, events, h = list(resume[0]), list(resume[1]), st.h0
         a = points[-1]
+        if len(points) > 1 and a.s > points[-2].s:  # the step that follows a's, as it was
+            h = min((a.s - points[-2].s) * (st.grow if a.iterations <= st.easy else 1.0),
+                    st.h_max)  # fmt: skip
     elif t0 is None:
         a = br.correct(z0, np.eye(len(z0))[-1], 0.0)  # λ fixed: plain Newton on x
         if a is None:
             raise MapFailed("no fixed point near the start: the corrector did not converge")
-        a.t = a.t if a.t[-1] * direction >= 0 else -a.t
+        along = a.t @ direction if np.ndim(direction) else a.t[-1] * direction
+        a.t = a.t if along >= 0 else -a.t
     else:  # a branch point (its Jacobian singular): taken as it is, left along t0
         g, _, dp = br.evaluate(z0)
         t0 = np.asarray(t0, dtype=float)
         a = MapPoint(z0 / br.w, t0 / np.linalg.norm(t0), dp, float(np.linalg.norm(g)), 0)
     if resume is None:
         a.info = observe(a.u[:-1], float(a.u[-1])) if observe else {}
-        points, events, h = [a], [], st.h0
+        points, events = (list(prior[0]), list(prior[1])) if prior else ([], [])
+        a.s = points[-1].s if points else 0.0
+        points, h = [*points, a], st.h0
     reason = f"max_points = {st.max_points} reached"
     while len(points) < st.max_points:
         b = br.at(a, h)

@@ -14,13 +14,28 @@ from .._util import ParameterError, real, whole
 from ..model import Params, params_arg
 from ..numerics import Numerics
 from ..simulation import numerics_arg
-from ._branch import Branch, _check_param, _ModelMap, _mu_columns
+from ._branch import (
+    Branch,
+    _advance,
+    _check_param,
+    _fixed_point,
+    _locate_grazing,
+    _ModelMap,
+    _mu_columns,
+)
 from ._core import MapFailed, Settings, follow
 
 __all__ = ["CURVE_KINDS", "Curve", "CurveMap", "curve"]
 
-CURVE_KINDS = {"fold": 1.0, "period_doubling": -1.0}
-"""The events a curve continues and σ of their test function det(DP^n - σ I)."""
+_SIGMA = {"fold": 1.0, "period_doubling": -1.0}
+"""σ of the test function det(DP^n - σ I) of the events the augmented system continues."""
+CURVE_KINDS = (*_SIGMA, "grazing")
+"""The events a curve continues."""
+GRAZE_TOL = 1e-6
+"""The λ1 tolerance each point of a grazing curve is located to (λ1's units)."""
+GRAZE_MARGIN = 1e-4
+"""First distance [× max(|λ1|, 1)] from a grazing, on the flight side, at which a grazing
+curve's next orbit is looked for (4 times more at each of up to 6 tries)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -30,9 +45,10 @@ class Curve(Branch):
 
     ``points``: one row per point: ``curve``, ``point``, ``kind`` (:data:`CURVE_KINDS`),
     ``period``, ``param``, ``value`` (λ1), ``param2``, ``value2`` (λ2), ``s`` (scaled
-    arclength), ``theta_f`` [rad], ``omega_f`` [rad/s] (the orbit's x_0), its multipliers
-    (``mu1_re`` ... ``mu2_im``, ``abs_mu``), ``test`` (det(DP^n - σ I) there, ~0),
-    ``n_macro_impacts``, ``sticks``, ``residual``, ``iterations``."""
+    arclength; a grazing's: the λ2 fraction), ``theta_f`` [rad], ``omega_f`` [rad/s] (the
+    orbit's x_0 at phase 0), its multipliers (``mu1_re`` ... ``mu2_im``, ``abs_mu``),
+    ``test`` (det(DP^n - σ I) there, ~0; a grazing's margin ψ [m]), ``n_macro_impacts``,
+    ``sticks``, ``residual``, ``iterations``."""
 
     def plot(self, ax=None):
         """λ1 against λ2 on ``ax`` (a new figure's when None), one line per curve; the Axes."""
@@ -115,9 +131,10 @@ def curve(params: Params | None, start, *, second: str, to: float, param: str | 
           kind: str | None = None, period: int = 1, numerics: Numerics | None = None,
           span: float | None = None, ds: float = 0.005, ds_min: float = 1e-6,
           ds_max: float = 0.02, tol: float = 1e-7, max_points: int = 300) -> Curve:  # fmt: skip
-    """Pseudo-arclength continuation of a fold or period doubling of a period-n orbit in two
+    """Continuation of a fold, period doubling or grazing of a period-n orbit in two
     parameters: the curve of (λ1, λ2) = (``param``, ``second``) on which P^n has a
-    multiplier σ = +1 (fold) or -1 (period doubling).
+    multiplier σ = +1 (fold) or -1 (period doubling), by pseudo-arclength, or on which a
+    flight of the orbit touches the cam (grazing), by natural steps in λ2 (below).
 
     The unknowns u = (θ_f, θ̇_f, λ1, λ2) solve the minimally augmented system
     ``P^n(x; λ1, λ2) - x = 0``, ``g = det(DP^n - σ I) = 0`` (Kuznetsov 2004, *Elements of
@@ -144,6 +161,13 @@ def curve(params: Params | None, start, *, second: str, to: float, param: str | 
     span : float, optional
         λ1's unit of scaled arclength, by default ``0.1 max(|λ1|, 1)``.
 
+    A grazing (its row's ``section_phase`` kept) is traced in steps of ``ds_max`` × |to - λ2|
+    in λ2: at each the orbit on the flight side of the last grazing (:data:`GRAZE_MARGIN`)
+    by Newton at fixed λ1, and the grazing located from it in λ1 to :data:`GRAZE_TOL`, as
+    :func:`chaoscam.continuation.continuation` locates one where a branch ends (the map is
+    not smooth across a grazing, so the augmented system does not apply); ``test`` is the
+    margin ψ there [m]. It cannot turn round a fold of the curve.
+
     Limits: where the impact pattern changes the map is only piecewise smooth and the curve
     may end there (``end``); a codimension-two point (a cusp, a fold-flip) is not detected.
     """
@@ -162,11 +186,16 @@ def curve(params: Params | None, start, *, second: str, to: float, param: str | 
     lam1 = float(start["value"])
     span = real("span", span, low=0.0, strict=True) if span else 0.1 * max(abs(lam1), 1.0)
     p0 = params.replace(**{param: lam1})
+    if kind == "grazing":
+        points, ends = _grazing_curve(p0, start, (param, second), to, n, num, ds_max,
+                                      max_points)  # fmt: skip
+        return _curve_frames(points, ends, kind, n, (param, second), p0, num, t_start,
+                             {"from": lam2, "to": to, "h_max": ds_max})  # fmt: skip
     w = (1.0, p0.cam_period, 1.0 / span, 1.0 / abs(to - lam2))
     st = Settings(weights=w, lo=min(lam2, to), hi=max(lam2, to), h0=ds, h_min=ds_min,
                   h_max=ds_max, tol=tol,
                   max_points=whole("max_points", max_points, low=2))  # fmt: skip
-    qmap = CurveMap(_ModelPair(p0, (param, second), n, num), CURVE_KINDS[kind], w, st.fd_step)
+    qmap = CurveMap(_ModelPair(p0, (param, second), n, num), _SIGMA[kind], w, st.fd_step)
     u0 = (float(start["theta_f"]), float(start["omega_f"]), lam1, lam2)
     try:
         points, events = follow(qmap, u0, st, direction=math.copysign(1.0, to - lam2),
@@ -174,18 +203,93 @@ def curve(params: Params | None, start, *, second: str, to: float, param: str | 
     except MapFailed as err:
         msg = f"the {kind} at {param} = {lam1:g} could not be continued: {err}"
         raise ParameterError(msg) from None
-    common = {"curve": 0, "kind": kind, "period": n, "param": param, "param2": second}
-    rows = [{**common, "point": i, "value": float(p.u[2]), "value2": float(p.u[3]), "s": p.s,
-             "theta_f": float(p.u[0]), "omega_f": float(p.u[1]), **_mu_columns(p.info["dp"]),
-             "test": p.info["test"], "n_macro_impacts": p.info["n_macro_impacts"],
-             "sticks": p.info["sticks"], "residual": p.residual, "iterations": p.iterations}
-            for i, p in enumerate(points)]  # fmt: skip
+    return _curve_frames([(p.u, p.s, p.info, p.residual, p.iterations) for p in points],
+                         [(k, p.u, p.s, d) for k, p, d in events], kind, n, (param, second), p0,
+                         num, t_start, {"from": lam2, "to": to,
+                                        **{f.name: getattr(st, f.name)
+                                           for f in dataclasses.fields(st)}})  # fmt: skip
+
+
+def _curve_frames(points, events, kind, n, names, p0, num, t_start, more) -> Curve:
+    """The Curve of ``points`` (u = (θ_f, θ̇_f, λ1, λ2), s, info, residual, iterations) and
+    ``events`` (kind, u, s, detail)."""
+    common = {"curve": 0, "kind": kind, "period": n, "param": names[0], "param2": names[1]}
+    rows = [{**common, "point": i, "value": float(u[2]), "value2": float(u[3]), "s": s,
+             "theta_f": float(u[0]), "omega_f": float(u[1]), **_mu_columns(info["dp"]),
+             "test": info["test"], "n_macro_impacts": info["n_macro_impacts"],
+             "sticks": info["sticks"], "residual": res, "iterations": it}
+            for i, (u, s, info, res, it) in enumerate(points)]  # fmt: skip
     for r in rows:
         r["abs_mu"] = math.hypot(r["mu1_re"], r["mu1_im"])
-    ev = pd.DataFrame([{**common, "kind": k, "value": float(p.u[2]), "value2": float(p.u[3]),
-                        "s": p.s, "detail": detail} for k, p, detail in events])  # fmt: skip
+    ev = pd.DataFrame([{**common, "kind": k, "value": float(u[2]), "value2": float(u[3]),
+                        "s": s, "detail": detail} for k, u, s, detail in events])  # fmt: skip
     settings = {"params": dataclasses.asdict(p0), "numerics": dataclasses.asdict(num),
-                "kind": kind, "param": param, "second": second, "from": lam2, "to": to,
-                "period": n, **{f.name: getattr(st, f.name) for f in dataclasses.fields(st)},
+                "kind": kind, "param": names[0], "second": names[1], "period": n, **more,
                 "wall_time": time.perf_counter() - t_start}  # fmt: skip
     return Curve(pd.DataFrame(rows), ev, settings)
+
+
+def _grazing_curve(p0: Params, start, names, to: float, n: int, num: Numerics, step: float,
+                   max_points: int) -> tuple[list, list]:  # fmt: skip
+    """A grazing continued in λ2 by natural steps of ``step`` times |to - λ2|: at each λ2 the
+    orbit on the flight side near the last grazing (Newton at fixed λ1) and the grazing
+    located from it in λ1 (:func:`~chaoscam.continuation._branch._locate_grazing`), since
+    the map is not smooth across a grazing; (points, events) as :func:`_curve_frames`
+    takes them."""
+    param, second = names
+    lam1, lam2 = float(start["value"]), float(getattr(p0, second))
+    phase = float(start.get("section_phase", 0.0) or 0.0)
+    x = np.array([float(start["theta_f"]), float(start["omega_f"])])
+    if phase:
+        x = _advance(p0, num, x, phase / p0.omega)
+    d2, points, side, track = step * (to - lam2), [], None, [lam1]
+    reason = f"max_points = {max_points} reached"
+    for k in range(max_points):
+        v2 = lam2 + k * d2
+        if (v2 - to) * math.copysign(1.0, d2) > 1e-12 * max(abs(to), 1.0):
+            reason = f"reached {second} = {to:g}"
+            break
+        model = _ModelMap(p0.replace(**{second: v2}), param, n, num, phase)
+        guess = 2 * track[-1] - track[-2] if len(track) > 1 else track[-1]
+        found = _flight_side(model, x, guess, side)
+        located = (
+            None
+            if found is None
+            else _locate_grazing(
+                model, found[1], found[0], found[2], found[3], GRAZE_TOL, (-math.inf, math.inf)
+            )
+        )
+        if located is None:
+            reason = f"no grazing located at {second} = {v2:.6g}"
+            break
+        x, lam, info = located
+        side = math.copysign(1.0, found[0] - lam)
+        track.append(lam)
+        _, dp = model(x, lam)
+        u = (*_phase0_of(info, x), lam, v2)
+        points.append((u, abs(v2 - lam2) / abs(to - lam2), {**info, "dp": dp,
+                       "test": info["grazing"]}, math.nan, 0))  # fmt: skip
+    end = points[-1][0] if points else (*x, lam1, lam2)
+    return points, [("end", end, points[-1][1] if points else 0.0, reason)]
+
+
+def _phase0_of(info: dict, x) -> tuple[float, float]:
+    pts = info.get("points")
+    y = pts[0] if info.get("section_phase") and pts is not None else x
+    return float(y[0]), float(y[1])
+
+
+def _flight_side(model: _ModelMap, x, guess: float, side: float | None):
+    """An orbit near x on the flight side (ψ > 0) of a grazing near λ1 = ``guess``:
+    (λ1, x, info, dψ/dλ1 estimate), or None."""
+    margin = GRAZE_MARGIN * max(abs(guess), 1.0)
+    for _ in range(6):
+        for sgn in (side,) if side else (-1.0, 1.0):
+            lam = guess + sgn * margin
+            y = _fixed_point(model, x, lam)
+            info = model.observe(y, lam) if y is not None else {}
+            psi = info.get("grazing", math.nan)
+            if psi > 0.0:
+                return lam, y, info, -psi / (guess - lam)
+        margin *= 4.0
+    return None

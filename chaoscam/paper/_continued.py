@@ -102,7 +102,7 @@ def _figure(rm, branch, curves, bif):
 
 def _sentence(branch: Branch, curves: Curve, cross: pd.DataFrame, bif) -> str:
     """What ends the period-1 window at ξ = 0.1 and where its curves go."""
-    ev = branch.events.set_index("kind")["value"]
+    ev = branch.events.groupby("kind")["value"].first()
     fold, flip = float(ev["fold"]), float(ev["period_doubling"])
     at = curves.points.groupby("kind").apply(
         lambda g: g.loc[g.value2.idxmax()], include_groups=False
@@ -115,6 +115,10 @@ def _sentence(branch: Branch, curves: Curve, cross: pd.DataFrame, bif) -> str:
             f"the period-1 window ends below at a fold (a saddle-node, multiplier +1) at "
             f"ω = {fold:.4f} rad/s and above at a period doubling (multiplier −1) at "
             f"ω = {flip:.4f} rad/s, where the period-2 orbit takes over")  # fmt: skip
+    if "grazing" in ev:
+        text += (f"; the unstable period-1 orbit born at the fold ends at a grazing (a flight "
+                 f"touching the cam, no period-1 orbit past it) at ω = "
+                 f"{float(ev['grazing']):.4f} rad/s")  # fmt: skip
     if len(tags):
         counts = ", ".join(f"{n} {tag}" for tag, n in tags.value_counts().sort_index().items())
         text += (f"; the {len(tags)} brute-force runs (from the model's initial state) inside "

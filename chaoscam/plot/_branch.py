@@ -19,7 +19,7 @@ def plot_branch(points, events=None, ax=None):
     """The branch diagram of ``Branch.points`` (one row per section point of each orbit):
     ``value`` against ``theta_f``, each section point j of each branch a line, solid where
     the orbit is stable and dashed where not; the ``events`` (``Branch.events``, ``end``
-    left out) marked with their kind in the legend. Returns the Axes."""
+    and ``section`` left out) marked with their kind in the legend. Returns the Axes."""
     ax = axes(ax)
     for (b, _), g in points.groupby(["branch", "j"], sort=True):
         g = g.sort_values("point")
@@ -30,7 +30,7 @@ def plot_branch(points, events=None, ax=None):
             keep = mask | np.r_[mask[1:], False] | np.r_[False, mask[:-1]]  # join the pieces
             ax.plot(x, np.where(keep, y, np.nan), ls=ls, lw=1.0, color=color)
     if events is not None and len(events):
-        for kind, g in events[events["kind"] != "end"].groupby("kind"):
+        for kind, g in events[~events["kind"].isin(["end", "section"])].groupby("kind"):
             marker, color = EVENT_MARKS.get(kind, ("*", "#000000"))
             ax.scatter(g["value"], g["theta_f"], marker=marker, color=color, zorder=3,
                        label=kind.replace("_", " "))  # fmt: skip
@@ -41,7 +41,8 @@ def plot_branch(points, events=None, ax=None):
     return ax
 
 
-CURVE_STYLES = {"fold": ("-", "#D55E00"), "period_doubling": ("--", "#0072B2")}
+CURVE_STYLES = {"fold": ("-", "#D55E00"), "period_doubling": ("--", "#0072B2"),
+                "grazing": (":", "#000000")}  # fmt: skip
 
 
 def _cell_coordinate(v, values, flip: bool):

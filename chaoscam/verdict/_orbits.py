@@ -96,12 +96,12 @@ class _MapRunner:
         self.duration = (int(math.floor(n * p.cam_period / num.dt)) + 2) * num.dt
         self.start = fresh([self.p], num, [0], 0, self.duration, 0.0, tangent=tangent, stride=0,
                            room=ROOM["cpu"])  # fmt: skip
-        self.calls = 0
+        self.calls, self.watchers = 0, {}
 
-    def _rows(self, x: np.ndarray, impacts: bool = False):
+    def _rows(self, x: np.ndarray, impacts: bool = False, s=None):
         """The section rows of n cam periods from x (row 0: x itself), and the status (with
-        ``impacts`` also the impact rows and the counters)."""
-        s = self.start
+        ``impacts`` also the impact rows and the counters; ``s``: another start)."""
+        s = self.start if s is None else s
         y = s.y.copy()
         y[0, k.Y_THETA], y[0, k.Y_OMEGA] = x
         kept = {"section": [[]], "impacts": [[]], "series": [[]]}
@@ -113,6 +113,37 @@ class _MapRunner:
         if impacts:
             return out.kept["section"][0], int(out.status[0]), out.kept["impacts"][0], out.cnt[0]
         return out.kept["section"][0], int(out.status[0])
+
+    def watch(self, x: np.ndarray, every: int) -> tuple[np.ndarray, np.ndarray, int]:
+        """The run of n cam periods from x sampled every ``every`` grid steps: its series
+        rows (t, θ_f, θ̇_f, l_λ), its impact rows (``IMPACT_NAMES``) and its status."""
+        if every not in self.watchers:
+            self.watchers[every] = fresh(
+                [self.p],
+                self.num,
+                [0],
+                0,
+                self.duration,
+                0.0,
+                tangent=False,
+                stride=every,
+                room=ROOM["cpu"],
+            )
+        s = self.watchers[every]
+        s = dataclasses.replace(
+            s,
+            kept={
+                "section": [[]],
+                "impacts": [[]],
+                "series": [[np.array([[0.0, *x, s.lam[0, 0]]])]],
+            },
+        )
+        y = s.y.copy()
+        y[0, k.Y_THETA], y[0, k.Y_OMEGA] = x
+        s = dataclasses.replace(s, y=y, cnt=s.cnt.copy(), lam=s.lam.copy(), status=s.status.copy())
+        out = run_batch([self.p], self.num, [0], s, 0, self.duration, room=ROOM["cpu"],
+                        keep_impacts=True)  # fmt: skip
+        return out.kept["series"][0], out.kept["impacts"][0], int(out.status[0])
 
     def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
         """(P^n(x), DP^n(x), status)."""
@@ -128,8 +159,8 @@ class _MapRunner:
         """The orbit through x over its n periods: its section points x, P(x), ..., P^(n-1)(x)
         (``points``), the impacts of each kind (``n_macro_impacts``, ``n_micro_impacts``,
         ``n_chatter_ends``: chattering sequences that end in persistent contact), the
-        ``contact_fraction`` of the grid steps, ``slow_closings``, the ``status`` and the macro
-        impacts' times ``macro_times`` [s]."""
+        ``contact_fraction`` of the grid steps, ``slow_closings``, the ``status`` and the
+        times [s] of the impacts, ``impact_times`` (all kinds) and ``macro_times``."""
         rows, code, imp, cnt = self._rows(x, impacts=True)
         kept = imp[imp[:, 0] < self.n * self.p.cam_period]
         inside = kept[:, -1].astype(int)
@@ -143,6 +174,7 @@ class _MapRunner:
                 "n_chatter_ends": int(kinds[k.IMPACT_CHATTER_END]),
                 "contact_fraction": int(cnt[k.I_CONTACT_STEPS]) / steps,
                 "slow_closings": int(cnt[k.I_SLOW_CLOSINGS]), "status": Status(code),
+                "impact_times": kept[:, 0].copy(),
                 "macro_times": kept[inside == k.IMPACT_MACRO, 0].copy()}  # fmt: skip
 
     def points(self, x: np.ndarray) -> np.ndarray:

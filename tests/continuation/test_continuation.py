@@ -96,15 +96,57 @@ def test_no_neimark_sacker_under_hunt_crossley(up):
     assert "neimark_sacker" not in set(up.events.kind)
 
 
-def test_fold_between_29_and_29_1_followed_onto_the_unstable_side():
+@pytest.fixture(scope="module")
+def down():
+    return continuation(chaoscam.Params(xi=XI, omega=31.0), param="omega", to=28.0)
+
+
+def test_fold_between_29_and_29_1_followed_onto_the_unstable_side(down):
     """Down from 31 rad/s the branch turns at a fold in (29.0, 29.1), where a multiplier is
-    +1, and goes on with omega increasing, unstable (|mu1| > 1)."""
-    b = continuation(chaoscam.Params(xi=XI, omega=31.0), param="omega", to=28.0)
-    fold = b.events[b.events.kind == "fold"]
+    +1, and goes on with omega increasing, unstable (|mu1| > 1), past the impact that
+    crosses the section (the section moves) for more than 0.5 rad/s."""
+    fold = down.events[down.events.kind == "fold"]
     assert len(fold) == 1 and 29.0 < fold.value.iloc[0] < 29.1
     assert abs(fold.mu1_re.iloc[0] - 1.0) < 1e-4
-    after = b.points[b.points.s > fold.s.iloc[0]]
-    assert len(after) >= 2 and not after.stable.any() and (after.value > fold.value.iloc[0]).all()
+    after = down.points[down.points.s > fold.s.iloc[0]]
+    assert len(after) >= 10 and not after.stable.any() and (after.value > fold.value.iloc[0]).all()
+    assert "section" in set(down.events.kind) and (after.section_phase > 0).any()
+    assert after.value.max() > fold.value.iloc[0] + 0.5
+
+
+def test_moved_section_keeps_the_orbit_and_its_multipliers(down):
+    """On the moved section the branch is the same orbit: Newton shooting on the model's own
+    section from the table's phase-0 state converges there with the same multipliers."""
+    moved = down.points[(down.points.section_phase > 0)].iloc[[5, -5]]
+    for row in moved.itertuples():
+        p = chaoscam.Params(xi=XI, omega=row.value)
+        orbit = chaoscam.periodic_orbit(p, (row.theta_f, row.omega_f), 1)
+        assert orbit.converged and np.allclose(orbit.points[0], (row.theta_f, row.omega_f),
+                                               atol=1e-6)  # fmt: skip
+        assert abs(np.max(np.abs(orbit.multipliers)) - row.abs_mu) < 1e-4 * row.abs_mu
+
+
+def test_unstable_side_ends_at_a_located_grazing(down):
+    """The unstable side ends where a flight touches the cam: ψ falls linearly to 0, a run
+    from the orbit at the grazing has a flight minimum of the gap below 1e-8 m, and just past
+    it (1e-4 rad/s) Newton finds no period-1 orbit."""
+    ev = down.events
+    graze = ev[ev.kind == "grazing"]
+    assert len(graze) == 1 and ev.kind.iloc[-1] == "end"
+    lam = graze.value.iloc[0]
+    side = down.points[down.points.section_phase > 0]
+    psi = side.flight_margin.to_numpy()[-6:]
+    assert (np.diff(psi) < 0).all() and psi[-1] < 1e-5
+    p = chaoscam.Params(xi=XI, omega=lam)
+    run = chaoscam.simulate(p.replace(theta_f0=graze.theta_f.iloc[0],
+                                      omega_f0=graze.omega_f.iloc[0]),
+                            duration=p.cam_period, output_dt=2e-6)  # fmt: skip
+    g = run.series.gap.to_numpy()
+    inner = (g[1:-1] < g[:-2]) & (g[1:-1] < g[2:]) & (g[1:-1] > 0)
+    assert 0 < g[1:-1][inner].min() < 1e-8
+    past = chaoscam.periodic_orbit(p.replace(omega=lam + 1e-4), (graze.theta_f.iloc[0],
+                                   graze.omega_f.iloc[0]), 1)  # fmt: skip
+    assert not past.converged
 
 
 def test_event_location_unchanged_when_the_step_is_halved():
@@ -115,6 +157,23 @@ def test_event_location_unchanged_when_the_step_is_halved():
         b = continuation(p, param="omega", to=32.5, ds=0.005 * f, ds_max=0.02 * f)
         values.append(b.events[b.events.kind == "period_doubling"].value.iloc[0])
     assert abs(values[0] - values[1]) < 1e-5
+
+
+def test_fold_and_grazing_unchanged_when_the_step_and_dt_are_halved(down):
+    """The fold and the grazing move by less than event_tol = 1e-6 rad/s with half the
+    continuation steps and with half the RK4 step dt (the fold at tol = 1e-9: its λ is as good
+    as the corrector's residual over |∂P/∂λ|, 1e-6 rad/s at the default tol = 1e-7)."""
+    p = chaoscam.Params(xi=XI, omega=31.0)
+    runs = {
+        "base": continuation(p, param="omega", to=28.0, tol=1e-9),
+        "ds/2": continuation(p, param="omega", to=28.0, tol=1e-9, ds=0.0025, ds_max=0.01),
+        "dt/2": continuation(p, param="omega", to=28.0, numerics=chaoscam.Numerics(dt=1e-6)),
+    }
+    at = {k: b.events.groupby("kind").value.first() for k, b in runs.items()}
+    at["default"] = down.events.groupby("kind").value.first()
+    for kind in ("fold", "grazing"):
+        assert abs(at["ds/2"][kind] - at["base"][kind]) < 1e-6
+        assert abs(at["dt/2"][kind] - at["default"][kind]) < 1e-6
 
 
 def test_cli_writes_points_and_events_and_refuses_overwrite(tmp_path, capsys):
@@ -143,31 +202,39 @@ def test_cli_start_without_orbit_is_exit_2(tmp_path, capsys):
 
 
 def test_interrupted_branch_resumes_from_its_checkpoint(tmp_path, monkeypatch):
-    """A branch interrupted after 12 points resumes from its checkpoint: its first points
-    are the interrupted run's, its doubling where an uninterrupted run puts it (1e-6 rad/s),
-    and the checkpoint is removed once done; other settings are refused."""
+    """A run interrupted on its doubled branch resumes from its checkpoint: branch 0 as it
+    finished (no new start), branch 1 followed on from its 6th point, both where an
+    uninterrupted run puts them, and the checkpoint is removed once done; other settings
+    are refused."""
     from chaoscam.continuation import _branch
 
     p, ckpt = chaoscam.Params(xi=XI, omega=31.9), tmp_path / "b.parquet.ckpt"
-    whole = continuation(p, param="omega", to=32.2)
+    whole = continuation(p, param="omega", to=32.2, switch=True)
     monkeypatch.setattr(_branch, "CHECKPOINT_S", 0.0)
     save = _branch._Checkpoint.save
 
-    def stop(self, points, events, now=False):
-        save(self, points, events, now)
-        if len(points) == 12:
+    def stop(self, b, n, points, events, now=False):
+        save(self, b, n, points, events, now)
+        if b == 1 and len(points) == 6:
             raise KeyboardInterrupt
 
     monkeypatch.setattr(_branch._Checkpoint, "save", stop)
     with pytest.raises(KeyboardInterrupt):
-        continuation(p, param="omega", to=32.2, checkpoint=ckpt)
+        continuation(p, param="omega", to=32.2, switch=True, checkpoint=ckpt)
     monkeypatch.setattr(_branch._Checkpoint, "save", save)
     with pytest.raises(ValueError, match="other settings"):
-        continuation(p, param="omega", to=32.25, checkpoint=ckpt)
-    b = continuation(p, param="omega", to=32.2, checkpoint=ckpt)
+        continuation(p, param="omega", to=32.25, switch=True, checkpoint=ckpt)
+    resumed = []
+    follow = _branch.follow
+    monkeypatch.setattr(_branch, "find_start", lambda *a, **k: pytest.fail("a new start"))
+    monkeypatch.setattr(_branch, "follow", lambda *a, **k: resumed.append(k["resume"])
+                        or follow(*a, **k))  # fmt: skip
+    b = continuation(p, param="omega", to=32.2, switch=True, checkpoint=ckpt)
     assert b.settings["resumed"] and not ckpt.exists()
-    first = b.points[b.points.point < 12]
-    assert np.array_equal(first.value, whole.points[whole.points.point < 12].value)
+    assert [len(r[0]) for r in resumed] == [6]
+    for k in (0, 1):
+        got, want = (x.points[x.points.branch == k] for x in (b, whole))
+        assert len(got) == len(want) and np.allclose(got.value, want.value, atol=1e-6, rtol=0)
     pd_ = [x.events[x.events.kind == "period_doubling"].value.iloc[0] for x in (b, whole)]
     assert abs(pd_[0] - pd_[1]) < 1e-6
 

@@ -112,3 +112,24 @@ def test_cli_curve_writes_the_curves(tmp_path, capsys):
     assert np.allclose(pts.mu1_re, -1.0, atol=1e-6)
     assert pd.read_parquet(tmp_path / "b.curves.events.parquet").kind.iloc[-1] == "end"
     assert main(args[:-4] + ["--out", str(out)]) == 2  # --curve without --curve-to
+
+
+def test_grazing_curve_from_the_unstable_side_grazing():
+    """The grazing that ends the fold's unstable side (29.9713 rad/s at xi = 0.1) continues
+    in xi: it starts where the branch located it, its margin psi stays below 1e-8 m, and at a
+    point of it an orbit exists 1e-3 rad/s to the flight side (psi > 0) and none 1e-3 past."""
+    p = chaoscam.Params(xi=XI, omega=31.0)
+    b = continuation(p, param="omega", to=28.0)
+    row = b.events[b.events.kind == "grazing"].iloc[0]
+    c = curve(p, row, second="xi", to=0.15, ds_max=0.1)
+    pts = c.points
+    assert set(pts.kind) == {"grazing"} and pts.value2.max() >= 0.15 - 1e-12
+    assert abs(pts.value.iloc[0] - row.value) < 1e-5 and (pts.test.abs() < 1e-8).all()
+    assert (np.diff(pts.value) < 0).all()  # the grazing moves to lower omega with more damping
+    mid = pts.iloc[len(pts) // 2]
+    q = p.replace(xi=mid.value2)
+    inside = chaoscam.periodic_orbit(q.replace(omega=mid.value - 1e-3), (mid.theta_f,
+                                     mid.omega_f), 1)  # fmt: skip
+    past = chaoscam.periodic_orbit(q.replace(omega=mid.value + 1e-3), (mid.theta_f,
+                                   mid.omega_f), 1)  # fmt: skip
+    assert inside.converged and inside.period == 1 and not past.converged
