@@ -150,13 +150,14 @@ def test_unstable_side_ends_at_a_located_grazing(down):
 
 
 def test_event_location_unchanged_when_the_step_is_halved():
-    """The period doubling's location moves by less than 1e-5 rad/s with half the steps."""
+    """The period doubling's location moves by less than 1e-5 rad/s with half the
+    continuation steps, and by less than 1e-6 rad/s with half the RK4 step dt."""
     p = chaoscam.Params(xi=XI, omega=31.5)
     values = []
-    for f in (1.0, 0.5):
-        b = continuation(p, param="omega", to=32.5, ds=0.005 * f, ds_max=0.02 * f)
+    for f, num in ((1.0, None), (0.5, None), (1.0, chaoscam.Numerics(dt=1e-6))):
+        b = continuation(p, param="omega", to=32.5, ds=0.005 * f, ds_max=0.02 * f, numerics=num)
         values.append(b.events[b.events.kind == "period_doubling"].value.iloc[0])
-    assert abs(values[0] - values[1]) < 1e-5
+    assert abs(values[0] - values[1]) < 1e-5 and abs(values[0] - values[2]) < 1e-6
 
 
 def test_fold_and_grazing_unchanged_when_the_step_and_dt_are_halved(down):
