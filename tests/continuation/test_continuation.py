@@ -68,6 +68,23 @@ def test_period_doubling_between_32_and_32_1(up):
     assert (main.n_macro_impacts == 1).all() and not main.sticks.any()
 
 
+def test_doublings_lie_where_brute_force_turns_period_n_into_2n(up):
+    """Each doubling of the period-1 and period-2 orbits lies between the last omega where
+    runs from the model's initial state are P(n) and the first where they are P(2n)."""
+    two = continuation(chaoscam.Params(xi=XI, omega=32.5), param="omega", to=33.5, period=2)
+    found = [(1, up.events[(up.events.kind == "period_doubling") & (up.events.branch == 0)]),
+             (2, two.events[two.events.kind == "period_doubling"])]  # fmt: skip
+    brute = chaoscam.bifurcation(
+        "omega", [31.75, 32.25, 33.0, 33.25], base=chaoscam.Params(xi=XI), progress=False
+    ).verdicts
+    periods = dict(zip(brute.value, brute.period, strict=True))
+    for n, ev in found:
+        assert len(ev) == 1
+        below = max(v for v, k in periods.items() if k == n and v < ev.value.iloc[0])
+        above = min(v for v, k in periods.items() if k == 2 * n and v > ev.value.iloc[0])
+        assert not any(below < v < above for v in periods)
+
+
 def test_doubled_branch_is_stable_period_two(up):
     """The switched branch is period 2, born on the side where period 1 is unstable, and
     attracting past its first points (a supercritical flip)."""
