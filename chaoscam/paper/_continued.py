@@ -1,6 +1,7 @@
-"""The period-1 window at ξ = 0.1 by continuation: the branch over a brute-force diagram in ω,
-its fold and period doubling continued over the (ω, ξ) map, and the sentence that names the
-bifurcations ending the window (:mod:`chaoscam.continuation`; docs/continuation.md)."""
+"""Continuation in the paper report (:mod:`chaoscam.continuation`; docs/continuation.md): the
+period-1 window at ξ = 0.1, its branch over a brute-force diagram in ω, its fold and period
+doubling continued over the (ω, ξ) map, and the sentence that names the bifurcations ending
+the window; and Table 1's periodic orbits continued over Fig. 4's l_λ diagram."""
 
 from __future__ import annotations
 
@@ -9,8 +10,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..continuation import Branch, Curve, continuation, curve
+from ..continuation import Branch, Curve, NoOrbitError, continuation, curve, find_start
 from ..model import Params
+from ..numerics import Numerics
 from ..report import FigureItem
 from ._stage import draw, uri_of
 
@@ -152,3 +154,104 @@ def continued_part(res, sweep, quick: bool, outdir: Path, rm) -> None:
         "Pseudo-arclength continuation of the period-1 orbit (stable solid, unstable dashed) "
         "and of its fold and period doubling in (ω, ξ) (docs/continuation.md). Data: "
         + ", ".join(CONTINUED_FILES[:6]) + "."))  # fmt: skip
+
+
+LAMBDA_PERIODS = (1, 2, 4, 8)
+"""Periods of the orbits looked for at Table 1 (Newton from a 20-s run's last section point)
+and continued over Fig. 4's l_λ range; one with no impact (the follower off the cam) is
+left out."""
+
+LAMBDA_FILES = [f"fig4-continued{e}" for e in (".parquet", ".events.parquet", ".png")]
+"""The files :func:`lambda_part` writes into the data folder."""
+
+
+def follow_lambda(num: Numerics, lo: float, hi: float) -> Branch:
+    """Each orbit of :data:`LAMBDA_PERIODS` found at Table 1 followed in l_λ from Table 1's
+    value both ways over [lo, hi] (one Branch, an orbit a ``branch``, the lower half's points
+    numbered negative)."""
+    p, points, events, found = Params(), [], [], []
+    for n in LAMBDA_PERIODS:
+        try:
+            x0 = find_start(p, None, n, num).points[0]
+        except NoOrbitError:
+            continue
+        halves = [continuation(p, x0, param="l_lambda", to=to, period=n, numerics=num,
+                               ds_max=0.05) for to in (lo, hi)]  # fmt: skip
+        if (halves[0].points.n_macro_impacts == 0).all():
+            continue
+        b, (down, up) = len(found), halves
+        points += [down.points.assign(branch=b, point=-down.points.point),
+                   up.points.assign(branch=b)]  # fmt: skip
+        events += [h.events.assign(branch=b) for h in halves]
+        found.append(n)
+    if not found:
+        return Branch(pd.DataFrame(), pd.DataFrame(), {"periods": []})
+    return Branch(pd.concat(points, ignore_index=True), pd.concat(events, ignore_index=True),
+                  {"periods": found})  # fmt: skip
+
+
+def _lambda_sentence(branch: Branch) -> str:
+    """What the orbits continued over l_λ show."""
+    if not len(branch.points):
+        return ("Continued over Fig. 4's l_λ range: Newton finds no periodic orbit with an "
+                "impact at Table 1 from the start run (periods "
+                f"{', '.join(map(str, LAMBDA_PERIODS))}), so none is drawn.")  # fmt: skip
+    parts = []
+    for _, g in branch.points.groupby("branch"):
+        n, lo, hi = int(g.period.iloc[0]), g.value.min(), g.value.max()
+        mu, spread = g.abs_mu, float(g.groupby("j").theta_f.agg(np.ptp).max())
+        how = "sticking" if g.sticks.any() else "no contact phase"
+        stable = g[g.stable].value
+        text = (f"the period-{n} orbit ({int(g.n_macro_impacts.max())} impacts over its {n} "
+                f"cam period{'s' if n > 1 else ''}, {how}) has "
+                + (f"|μ1| = {mu.min():.4g}" if mu.max() - mu.min() < 1e-6 * mu.max()
+                   else f"|μ1| from {mu.min():.3g} to {mu.max():.3g}")
+                + f" over l_λ ∈ [{lo:.4g}, {hi:.4g}] m: "
+                + (f"stable for l_λ in [{stable.min():.4g}, {stable.max():.4g}] m" if len(stable)
+                   else "unstable throughout"))  # fmt: skip
+        if spread < 1e-9 and not g.sticks.any() and (g.contact_fraction == 0).all():
+            text += (", and its θ_f does not move (by less than 1e-9 rad): with no contact "
+                     "phase, where alone the line length acts, it is the same orbit at every "
+                     "l_λ")  # fmt: skip
+        parts.append(text)
+    text = ("Continued over Fig. 4's l_λ range from Table 1 (chaoscam continue --param "
+            "l_lambda), " + "; ".join(parts))  # fmt: skip
+    if not branch.points.stable.any():
+        one = branch.points.branch.nunique() == 1
+        who = ("It is not", "it") if one else ("None of them is", "them")
+        text += (f". {who[0]} stable anywhere on the range, so no periodic window over l_λ "
+                 f"comes from {who[1]}")  # fmt: skip
+        if 2 in branch.settings["periods"]:
+            text += ": the paper's period-2 window is not this period-2 orbit"
+    return text + "."
+
+
+def _lambda_figure(bif, branch):
+    """Fig. 4's brute-force diagram with the continued orbits."""
+    from matplotlib.figure import Figure
+
+    from ..plot import plot_bifurcation, plot_branch
+
+    fig = Figure(figsize=(9, 5.5), layout="constrained")
+    ax = fig.subplots()
+    plot_bifurcation(bif.points, ax)
+    if len(branch.points):
+        plot_branch(branch.points, branch.events, ax=ax)
+    ax.set_title("Fig. 4: brute force (dots) and the continued periodic orbits (dashed: unstable)")
+    return fig
+
+
+def lambda_part(res, outdir: Path, bif, num: Numerics, lo: float, hi: float) -> None:
+    """Table 1's orbits continued over Fig. 4's l_λ range into ``res``: the files, the figure
+    over the brute-force diagram ``bif`` and the sentence."""
+    branch = follow_lambda(num, lo, hi)
+    if len(branch.points):
+        branch.to_parquet(outdir / LAMBDA_FILES[0], replace=True)
+    png = draw(outdir / LAMBDA_FILES[2], _lambda_figure, bif, branch)
+    res.why.append(_lambda_sentence(branch))
+    res.why_figures.append(FigureItem(
+        "fig4-continued", "Fig. 4's periodic orbits by continuation", uri_of(png),
+        "Fig. 4's bifurcation diagram over l_λ with Table 1's periodic orbits continued over it.",
+        "Pseudo-arclength continuation in l_λ (stable solid, unstable dashed) of the periodic "
+        "orbits Newton finds at Table 1 (docs/continuation.md). Data: "
+        + ", ".join(LAMBDA_FILES[:2]) + "."))  # fmt: skip

@@ -17,7 +17,7 @@ from ..model import ParameterError, Params, contact_period, fractal_stiffness
 from ..numerics import Numerics
 from ..report import Comparison, FigureItem, response_figure
 from . import _sensitivity
-from ._continued import CONTINUED_FILES
+from ._continued import CONTINUED_FILES, LAMBDA_FILES, lambda_part
 from ._findings import first_ic
 from ._side_by_side import beside, side_by_side
 from ._stage import FULL_EXTEND_TO, RUN, SWEEP_FATE_S, FigureResult, draw, judging, swept, uri_of
@@ -47,7 +47,7 @@ def data_files(number: int) -> list[str]:
     if number in (3, 5):
         return [f"fig{number}.csv", f"fig{number}.png"]
     if number == 4:
-        return [f"fig4{ext}" for ext in bif]
+        return [f"fig4{ext}" for ext in bif] + LAMBDA_FILES
     if number == 6:
         return [f"{fig6_tag(g)}{ext}" for g in G_FIG6 for ext in bif]
     if number == SENSITIVITY:
@@ -195,6 +195,10 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
     return res
 
 
+PAPER_RANGE = (0.001, 0.018)
+"""Fig. 4's l_λ range [m]."""
+
+
 def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 4: bifurcation of θ_f over l_λ ∈ [0.001, 0.018] m (Hertz line stiffness)."""
     from ..sweep import parse_range
@@ -237,6 +241,7 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     res.comparisons.append(
         Comparison("Fig. 4", paper, found, verdict, why + fig4_step_note(stiffest, dt))
     )
+    lambda_part(res, outdir, bif, Numerics(dt=dt), *PAPER_RANGE)
     return res
 
 
