@@ -355,7 +355,8 @@ def test_each_figure_is_rendered_once_and_the_report_embeds_its_file(tmp_path, m
         monkeypatch.setattr(module, "png_bytes", stub)
     out = run_paper(quick=True, out=tmp_path / "p.html", figures=[3, 4, 5, 7]).path
     files = {p.name: p.read_bytes() for p in (tmp_path / "paper-data").glob("*.png")}
-    assert len(files) == 11  # figs 3, 4, 5, the map, its random response and six responses
+    assert len(files) == 12  # figs 3, 4 (and its continued orbits), 5, the map, its random
+    # response and six responses
     assert sorted(rendered) == sorted(files.values())  # once each, nothing else drawn
     text = out.read_text()
     found = re.findall(r'src="data:image/png;base64,([^"]+)"', text)
