@@ -65,6 +65,11 @@ class Settings:
     min_cos : float
         A step whose new tangent makes with the last one an angle whose cosine is below this
         is refused and retried shorter (a guard against jumping between branches).
+    max_jump : float
+        A step whose corrected point lies farther than ``max_jump`` times the step from its
+        predictor is refused and retried shorter: the corrector went to another branch (on
+        the model, from an impacting orbit to the follower hanging off the cam, whose tangent
+        points the same way).
     """
 
     weights: tuple
@@ -81,6 +86,7 @@ class Settings:
     event_tol: float = 1e-6
     max_points: int = 500
     min_cos: float = 0.8
+    max_jump: float = 1.0
 
 
 @dataclass
@@ -212,6 +218,11 @@ class _Branch:
         return best
 
 
+def _jumped(br: _Branch, a: MapPoint, b: MapPoint, h: float) -> bool:
+    """Whether b lies farther than ``max_jump * h`` from a's predictor (scaled)."""
+    return float(np.linalg.norm(b.u * br.w - (a.u * br.w + h * a.t))) > br.st.max_jump * h
+
+
 def null_vector(jac: np.ndarray) -> np.ndarray:
     """The null vector of an m x (m + 1) matrix: t_i = (-1)^i det(jac without column i), the
     cross product of its rows when m = 2; its last component is det of the first m columns."""
@@ -299,7 +310,7 @@ def follow(fun: Callable, u0, st: Settings, *, t0=None, direction=1.0,
     reason = f"max_points = {st.max_points} reached"
     while len(points) < st.max_points:
         b = br.at(a, h)
-        if b is None or b.t @ a.t < st.min_cos:
+        if b is None or b.t @ a.t < st.min_cos or _jumped(br, a, b, h):
             if h <= st.h_min:
                 reason = (
                     f"the corrector failed at the least step (h_min = {st.h_min:g}): the "

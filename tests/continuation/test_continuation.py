@@ -177,6 +177,16 @@ def test_event_location_unchanged_when_the_step_is_halved():
     assert abs(values[0] - values[1]) < 1e-5 and abs(values[0] - values[2]) < 1e-6
 
 
+def test_corrector_does_not_jump_to_the_follower_off_the_cam():
+    """At xi = 0.3 from omega = 25 a corrector of 7 iterations lands on the follower hanging
+    off the cam (theta_f = pi/2, no impact), whose tangent points the same way: the step is
+    refused, and the impacting branch goes on to its grazing at 25.53 rad/s."""
+    b = continuation(chaoscam.Params(xi=0.3, omega=25.0), param="omega", to=35.0)
+    assert (b.points.n_macro_impacts == 2).all() and (b.points.theta_f.abs() < 0.1).all()
+    ev = b.events.set_index("kind").value
+    assert "impact_change" not in ev and 25.5 < ev["grazing"] < 25.6
+
+
 def test_fold_and_grazing_unchanged_when_the_step_and_dt_are_halved(down):
     """The fold and the grazing move by less than event_tol = 1e-6 rad/s with half the
     continuation steps and with half the RK4 step dt (the fold at tol = 1e-9: its λ is as good
