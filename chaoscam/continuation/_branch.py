@@ -58,7 +58,9 @@ class Branch:
         ``theta_c0``, of the section the branch was solved on there: 0 unless an impact
         crossing the section moved it), the multipliers of DP^n at the orbit's x_0 (``mu1_re``,
         ``mu1_im``, ``mu2_re``, ``mu2_im``, ``|mu1| >= |mu2|``), ``abs_mu`` (``|mu1|``),
-        ``stable`` (``|mu1| < 1``), ``n_macro_impacts``, ``n_micro_impacts``, ``n_chatter_ends``
+        ``stable`` (``|mu1| < 1``: the tangent's verdict, which does not decide where
+        chattering ends in sticking; :func:`chaoscam.kick_test` does there),
+        ``n_macro_impacts``, ``n_micro_impacts``, ``n_chatter_ends``
         (counted over the orbit's n cam periods), ``contact_fraction``, ``sticks``
         (persistent contact: a complete chattering or grid steps in contact),
         ``flight_margin`` ψ [m] (the grazing test function: the least gap of the flight

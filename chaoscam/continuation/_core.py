@@ -26,9 +26,11 @@ CONTINUOUS = ("fold", "period_doubling", "neimark_sacker")
 the oriented tangent (∝ det(DP - I), a multiplier through +1), ``period_doubling``
 det(DP + I) (a multiplier through -1), ``neimark_sacker`` det DP - 1 while the multipliers are
 a complex pair (``|μ1 μ2| = 1``). Any other kind is read from the point's observation
-(``info[kind]``, e.g. ``grazing``: the flights' margin ψ); a sign change of one where it does
-not go to zero (``|f| > JUMP max(|f_a|, |f_b|)`` at the located point) is a jump, not an
-event."""
+(``info[kind]``, e.g. ``grazing``: the flights' margin ψ). A sign change where the function
+does not go to zero (``|f| > JUMP max(|f_a|, |f_b|)`` at the located point) is a jump, not a
+zero: no event, except for the kinds above where the stability (``|μ|max < 1``) differs on
+the two sides, an event whose detail says it was not located (on a sticking orbit the
+multipliers of the grid map jump, e.g. from +27 to -15, without a bifurcation)."""
 JUMP = 0.1
 """See :data:`CONTINUOUS`."""
 
@@ -218,6 +220,10 @@ class _Branch:
         return best
 
 
+def _stable(p: MapPoint) -> bool:
+    return bool(np.max(np.abs(p.multipliers)) < 1.0)
+
+
 def _jumped(br: _Branch, a: MapPoint, b: MapPoint, h: float) -> bool:
     """Whether b lies farther than ``max_jump * h`` from a's predictor (scaled)."""
     return float(np.linalg.norm(b.u * br.w - (a.u * br.w + h * a.t))) > br.st.max_jump * h
@@ -237,8 +243,12 @@ def _crossings(br: _Branch, a: MapPoint, b: MapPoint, kinds) -> list[tuple[str, 
         fa, fb = a.test(kind), b.test(kind)
         if fa * fb < 0.0:  # NaN (no complex pair) and an exact zero (a switch's start) pass
             p = br.locate(a, b, kind)
-            if kind in CONTINUOUS or abs(p.test(kind)) <= JUMP * max(abs(fa), abs(fb)):
+            if abs(p.test(kind)) <= JUMP * max(abs(fa), abs(fb)):
                 found.append((kind, p, ""))
+            elif kind in CONTINUOUS and _stable(a) != _stable(b):
+                found.append((kind, p, f"the test function jumps across 0 between "
+                              f"{float(a.u[-1]):.8g} and {float(b.u[-1]):.8g} (the map is not "
+                              "smooth there): not located"))  # fmt: skip
     for kind, key in (("impact_change", "n_macro_impacts"), ("sticking", "sticks")):
         if key in a.info and a.info[key] != b.info.get(key):
             p = br.bisect(a, b, lambda a_, p_, key=key: p_.info.get(key) == a_.info[key])

@@ -14,6 +14,7 @@ from ..continuation import Branch, Curve, NoOrbitError, continuation, curve, fin
 from ..model import Params
 from ..numerics import Numerics
 from ..report import FigureItem
+from ..verdict import kick_test
 from ._stage import draw, uri_of
 
 XI_BRANCH, OMEGA_START = 0.1, 30.0
@@ -186,8 +187,26 @@ def follow_lambda(num: Numerics, lo: float, hi: float) -> Branch:
         found.append(n)
     if not found:
         return Branch(pd.DataFrame(), pd.DataFrame(), {"periods": []})
-    return Branch(pd.concat(points, ignore_index=True), pd.concat(events, ignore_index=True),
-                  {"periods": found})  # fmt: skip
+    points = pd.concat(points, ignore_index=True)
+    kicks = {b: _kicks(g, num) for b, g in points.groupby("branch") if g.sticks.any()}
+    return Branch(points, pd.concat(events, ignore_index=True),
+                  {"periods": found, "kicks": kicks})  # fmt: skip
+
+
+def _kicks(g: pd.DataFrame, num: Numerics) -> list[tuple[float, bool]]:
+    """(l_λ, whether kicks return) at a sticking branch's ends and nearest Table 1: where
+    chattering ends in sticking the tangent's multipliers do not decide stability, and
+    kicks do (docs/verdicts.md)."""
+    first = g[g.j == 0]
+    rows = {first.value.idxmin(), first.value.idxmax(),
+            (first.value - Params().l_lambda).abs().idxmin()}  # fmt: skip
+    out = []
+    for i in sorted(rows, key=lambda i: first.value[i]):
+        r = first.loc[i]
+        test = kick_test(Params(l_lambda=float(r.value)), (r.theta_f, r.omega_f), int(r.period),
+                         numerics=num)  # fmt: skip
+        out.append((float(r.value), bool(test.returns)))
+    return out
 
 
 def _lambda_sentence(branch: Branch) -> str:
@@ -209,6 +228,13 @@ def _lambda_sentence(branch: Branch) -> str:
                 + f" over l_λ ∈ [{lo:.4g}, {hi:.4g}] m: "
                 + (f"stable for l_λ in [{stable.min():.4g}, {stable.max():.4g}] m" if len(stable)
                    else "unstable throughout"))  # fmt: skip
+        kicks = branch.settings.get("kicks", {}).get(g.branch.iloc[0])
+        if kicks:
+            back = [f"{v:.4g} m" for v, r in kicks if r]
+            text += (" by its tangent multipliers, which do not decide stability where it sticks; "
+                     f"kicks of 1e-7 to 1e-6 rad return at {len(back)} of {len(kicks)} of its "
+                     f"points checked (l_λ = {', '.join(f'{v:.4g}' for v, _ in kicks)} m)"
+                     + (f": it attracts at {', '.join(back)}" if back else ""))  # fmt: skip
         if spread < 1e-9 and not g.sticks.any() and (g.contact_fraction == 0).all():
             text += (", and its θ_f does not move (by less than 1e-9 rad): with no contact "
                      "phase, where alone the line length acts, it is the same orbit at every "
@@ -216,7 +242,9 @@ def _lambda_sentence(branch: Branch) -> str:
         parts.append(text)
     text = ("Continued over Fig. 4's l_λ range from Table 1 (chaoscam continue --param "
             "l_lambda), " + "; ".join(parts))  # fmt: skip
-    if not branch.points.stable.any():
+    if not branch.points.stable.any() and not any(
+        r for ks in branch.settings.get("kicks", {}).values() for _, r in ks
+    ):
         one = branch.points.branch.nunique() == 1
         who = ("It is not", "it") if one else ("None of them is", "them")
         text += (f". {who[0]} stable anywhere on the range, so no periodic window over l_λ "

@@ -33,6 +33,34 @@ def _ball(e, n=1, d=1e-6):
     return fun
 
 
+def _diagonal(mu):
+    """The map x -> diag(mu(λ), 0.1) x: its fixed point 0 at every λ, multipliers mu(λ), 0.1."""
+
+    def fun(x, lam):
+        dp = np.diag([mu(lam), 0.1])
+        return dp @ x, dp
+
+    return fun
+
+
+@pytest.mark.parametrize(
+    "mu, kinds",
+    [(lambda lam: -0.5 - lam, [("period_doubling", 0.5, "")]),  # smooth: located at 0.5
+     (lambda lam: 20.0 if lam < 0.5 else -15.0, []),  # jumps across -1, unstable both sides
+     (lambda lam: -0.5 if lam < 0.5 else -1.5, [("period_doubling", 0.5, "not located")])],
+)  # fmt: skip
+def test_a_test_function_that_jumps_is_no_located_event(mu, kinds):
+    """A multiplier through -1 is located; one that jumps across it without a change of
+    stability is no event; one that jumps and changes stability is an event not located."""
+    st = Settings(weights=(1.0, 1.0, 1.0), lo=0.0, hi=1.0, h0=0.05, h_min=1e-6, h_max=0.05,
+                  event_tol=1e-8)  # fmt: skip
+    _, events = follow(_diagonal(mu), (0.0, 0.0, 0.11), st)
+    got = [(k, p.u[-1], d) for k, p, d in events if k != "end"]
+    assert len(got) == len(kinds)
+    for (k, lam, detail), (kind, where, note) in zip(got, kinds, strict=True):
+        assert k == kind and abs(lam - where) < 1e-6 and note in detail
+
+
 @pytest.mark.parametrize("e", [0.5, 0.3])
 def test_ball_fold_and_period_doubling_match_the_closed_form(e):
     """The core follows the ball's period-one orbit down through its saddle-node and up
