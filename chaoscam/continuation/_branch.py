@@ -19,7 +19,7 @@ from ..model import Params, field_names, params_arg
 from ..numerics import Numerics
 from ..simulation import numerics_arg, simulate
 from ..verdict import map_runner, periodic_orbit
-from ._core import CONTINUOUS, JUMP, MapFailed, MapPoint, Settings, follow
+from ._core import CONTINUOUS, CORRECTOR_FAILED, JUMP, MapFailed, MapPoint, Settings, follow
 from ._grazing import GRAZE_SAMPLES, flight_margin
 
 __all__ = ["Branch", "NoOrbitError", "continuation", "events_path"]
@@ -440,7 +440,7 @@ def _sectioned(model: _ModelMap, u0, st: Settings, *, t0=None, direction=1.0, re
                             kinds=KINDS, on_point=on_point, resume=resume)  # fmt: skip
     for _ in range(SECTION_MOVES):
         end = events[-1]
-        if "corrector failed" not in end[2] or not _near_section(end[1], model.n):
+        if not end[2].startswith(CORRECTOR_FAILED) or not _near_section(end[1], model.n):
             break
         if model.name == "theta_c0" or len(points) < 3:
             break
@@ -459,7 +459,7 @@ def _sectioned(model: _ModelMap, u0, st: Settings, *, t0=None, direction=1.0, re
         events.insert(len(prior[1]), ("section", first, f"an impact crossed the section: moved "
                                       f"to phase {model.phase:.6g} rad"))  # fmt: skip
     kind, p, detail = events[-1]
-    if "corrector failed" not in detail:
+    if not detail.startswith(CORRECTOR_FAILED):
         return points, events
     if _near_section(p, model.n):
         events[-1] = (kind, p, detail + "; an impact lies at the section time, where P^n "
@@ -615,14 +615,15 @@ def _points_frame(found, param: str) -> pd.DataFrame:
 
 def _events_frame(found, param: str) -> pd.DataFrame:
     rows = [{"branch": b, "kind": kind, "param": param, "value": float(p.u[2]), "s": p.s,
-             **dict(zip(("theta_f", "omega_f"), _phase0(p), strict=True)),
+             **dict(zip(("theta_f", "omega_f"), _phase0(p.info, p.u[:2]), strict=True)),
              "section_phase": p.info.get("section_phase", 0.0), **_mu_columns(p.dp),
              "detail": detail}
             for b, _, _, events in found for kind, p, detail in events]  # fmt: skip
     return pd.DataFrame(rows)
 
 
-def _phase0(p: MapPoint) -> tuple[float, float]:
-    """The orbit's state at the model's own section (phase 0)."""
-    x = p.info.get("points", p.u[None, :2])[0] if p.info.get("section_phase") else p.u[:2]
-    return float(x[0]), float(x[1])
+def _phase0(info: dict, x) -> tuple[float, float]:
+    """The orbit's state at the model's own section (phase 0), from its observation ``info``
+    and its point x on the section it was solved on."""
+    y = info["points"][0] if info.get("section_phase") and "points" in info else x
+    return float(y[0]), float(y[1])

@@ -33,6 +33,8 @@ the two sides, an event whose detail says it was not located (on a sticking orbi
 multipliers of the grid map jump, e.g. from +27 to -15, without a bifurcation)."""
 JUMP = 0.1
 """See :data:`CONTINUOUS`."""
+CORRECTOR_FAILED = "the corrector failed at the least step"
+"""How the ``end`` event's reason begins where the step fell below ``h_min``."""
 
 
 class MapFailed(Exception):
@@ -323,7 +325,7 @@ def follow(fun: Callable, u0, st: Settings, *, t0=None, direction=1.0,
         if b is None or b.t @ a.t < st.min_cos or _jumped(br, a, b, h):
             if h <= st.h_min:
                 reason = (
-                    f"the corrector failed at the least step (h_min = {st.h_min:g}): the "
+                    f"{CORRECTOR_FAILED} (h_min = {st.h_min:g}): the "
                     "branch ends, or the map is not smooth here (grazing, chattering)"
                 )
                 break  # fmt: skip

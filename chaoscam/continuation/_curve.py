@@ -22,6 +22,7 @@ from ._branch import (
     _locate_grazing,
     _ModelMap,
     _mu_columns,
+    _phase0,
 )
 from ._core import MapFailed, Settings, follow
 
@@ -266,17 +267,11 @@ def _grazing_curve(p0: Params, start, names, to: float, n: int, num: Numerics, s
         side = math.copysign(1.0, found[0] - lam)
         track.append(lam)
         _, dp = model(x, lam)
-        u = (*_phase0_of(info, x), lam, v2)
+        u = (*_phase0(info, x), lam, v2)
         points.append((u, abs(v2 - lam2) / abs(to - lam2), {**info, "dp": dp,
                        "test": info["grazing"]}, math.nan, 0))  # fmt: skip
     end = points[-1][0] if points else (*x, lam1, lam2)
     return points, [("end", end, points[-1][1] if points else 0.0, reason)]
-
-
-def _phase0_of(info: dict, x) -> tuple[float, float]:
-    pts = info.get("points")
-    y = pts[0] if info.get("section_phase") and pts is not None else x
-    return float(y[0]), float(y[1])
 
 
 def _flight_side(model: _ModelMap, x, guess: float, side: float | None):

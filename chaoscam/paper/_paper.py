@@ -18,7 +18,7 @@ from ..numerics import Numerics
 from ..report import Comparison, FigureItem, response_figure
 from . import _sensitivity
 from ._continued import CONTINUED_FILES, LAMBDA_FILES, lambda_part
-from ._findings import first_ic
+from ._findings import PAPER_L_LAMBDA, first_ic
 from ._side_by_side import beside, side_by_side
 from ._stage import FULL_EXTEND_TO, RUN, SWEEP_FATE_S, FigureResult, draw, judging, swept, uri_of
 
@@ -195,10 +195,6 @@ def fig3(quick: bool, outdir: Path, workers=None) -> FigureResult:
     return res
 
 
-PAPER_RANGE = (0.001, 0.018)
-"""Fig. 4's l_λ range [m]."""
-
-
 def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     """Fig. 4: bifurcation of θ_f over l_λ ∈ [0.001, 0.018] m (Hertz line stiffness)."""
     from ..sweep import parse_range
@@ -241,7 +237,7 @@ def fig4(quick: bool, outdir: Path, workers=None) -> FigureResult:
     res.comparisons.append(
         Comparison("Fig. 4", paper, found, verdict, why + fig4_step_note(stiffest, dt))
     )
-    lambda_part(res, outdir, bif, Numerics(dt=dt), *PAPER_RANGE)
+    lambda_part(res, outdir, bif, Numerics(dt=dt), *PAPER_L_LAMBDA)
     return res
 
 

@@ -98,18 +98,20 @@ class _MapRunner:
                            room=ROOM["cpu"])  # fmt: skip
         self.calls, self.watchers = 0, {}
 
-    def _rows(self, x: np.ndarray, impacts: bool = False, s=None):
-        """The section rows of n cam periods from x (row 0: x itself), and the status (with
-        ``impacts`` also the impact rows and the counters; ``s``: another start)."""
-        s = self.start if s is None else s
+    def _from(self, x: np.ndarray, s, series: list) -> Any:
+        """A copy of the start ``s`` from the state x, its kept series begun with ``series``."""
         y = s.y.copy()
         y[0, k.Y_THETA], y[0, k.Y_OMEGA] = x
-        kept = {"section": [[]], "impacts": [[]], "series": [[]]}
-        start = dataclasses.replace(s, y=y, cnt=s.cnt.copy(), lam=s.lam.copy(), kept=kept,
-                                    status=s.status.copy())  # fmt: skip
+        kept = {"section": [[]], "impacts": [[]], "series": [series]}
+        return dataclasses.replace(s, y=y, cnt=s.cnt.copy(), lam=s.lam.copy(), kept=kept,
+                                   status=s.status.copy())  # fmt: skip
+
+    def _rows(self, x: np.ndarray, impacts: bool = False):
+        """The section rows of n cam periods from x (row 0: x itself), and the status (with
+        ``impacts`` also the impact rows and the counters)."""
         self.calls += 1
-        out = run_batch([self.p], self.num, [0], start, 0, self.duration, room=ROOM["cpu"],
-                        keep_impacts=impacts)  # fmt: skip
+        out = run_batch([self.p], self.num, [0], self._from(x, self.start, []), 0,
+                        self.duration, room=ROOM["cpu"], keep_impacts=impacts)  # fmt: skip
         if impacts:
             return out.kept["section"][0], int(out.status[0]), out.kept["impacts"][0], out.cnt[0]
         return out.kept["section"][0], int(out.status[0])
@@ -118,30 +120,11 @@ class _MapRunner:
         """The run of n cam periods from x sampled every ``every`` grid steps: its series
         rows (t, θ_f, θ̇_f, l_λ), its impact rows (``IMPACT_NAMES``) and its status."""
         if every not in self.watchers:
-            self.watchers[every] = fresh(
-                [self.p],
-                self.num,
-                [0],
-                0,
-                self.duration,
-                0.0,
-                tangent=False,
-                stride=every,
-                room=ROOM["cpu"],
-            )
+            self.watchers[every] = fresh([self.p], self.num, [0], 0, self.duration, 0.0,
+                                         tangent=False, stride=every, room=ROOM["cpu"])  # fmt: skip
         s = self.watchers[every]
-        s = dataclasses.replace(
-            s,
-            kept={
-                "section": [[]],
-                "impacts": [[]],
-                "series": [[np.array([[0.0, *x, s.lam[0, 0]]])]],
-            },
-        )
-        y = s.y.copy()
-        y[0, k.Y_THETA], y[0, k.Y_OMEGA] = x
-        s = dataclasses.replace(s, y=y, cnt=s.cnt.copy(), lam=s.lam.copy(), status=s.status.copy())
-        out = run_batch([self.p], self.num, [0], s, 0, self.duration, room=ROOM["cpu"],
+        start = self._from(x, s, [np.array([[0.0, *x, s.lam[0, 0]]])])
+        out = run_batch([self.p], self.num, [0], start, 0, self.duration, room=ROOM["cpu"],
                         keep_impacts=True)  # fmt: skip
         return out.kept["series"][0], out.kept["impacts"][0], int(out.status[0])
 
